@@ -1,0 +1,58 @@
+# petsc_ssi: everything a fresh Debian 12 machine needs, then demo and tests.
+#   make demo   install what is missing, run the Pekeris demo (HDF5, XDMF, PNG)
+#   make test   install what is missing, run the test suite
+SHELL := /bin/bash
+VENV ?= .venv
+PY := $(VENV)/bin/python
+PETSC_DIR ?= /usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real
+SLEPC_DIR ?= /usr/lib/slepcdir/slepc3.18/x86_64-linux-gnu-real
+export PETSC_DIR SLEPC_DIR
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+export OPENBLAS_NUM_THREADS ?= 1
+export OMP_NUM_THREADS ?= 1
+export NUMBA_CACHE_DIR ?= $(CURDIR)/.numba_cache
+APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
+            python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
+            openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
+PIP_PKGS := numba gmsh matplotlib pytest pytest-timeout
+
+.PHONY: all deps demo test test-fast bench clean help-options
+
+all: test
+
+# System packages (PETSc 3.18 with MUMPS/hypre/HDF5 from Debian), then the venv.
+.deps/apt.stamp:
+	@mkdir -p .deps
+	@if ! /usr/bin/python3 -c "import petsc4py, mpi4py, h5py, scipy, slepc4py" 2>/dev/null; then \
+	  echo "[deps] installing Debian packages: $(APT_PKGS)"; \
+	  SUDO=$$( [ $$(id -u) -eq 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $(APT_PKGS) >/dev/null; \
+	fi
+	@touch $@
+
+$(VENV)/.stamp: .deps/apt.stamp setup.py
+	@[ -x $(PY) ] || /usr/bin/python3 -m venv --system-site-packages $(VENV)
+	@echo "[deps] installing into $(VENV): $(PIP_PKGS) (numpy kept at Debian's 1.x)"
+	@NPV=$$(/usr/bin/python3 -c "import numpy; print(numpy.__version__)"); \
+	  $(PY) -m pip install -q --disable-pip-version-check "numpy==$$NPV" $(PIP_PKGS)
+	@$(PY) -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+	@$(PY) -c "import petsc4py, mpi4py, numba, gmsh, matplotlib; print('[deps] ok: petsc4py', petsc4py.__version__, 'numba', numba.__version__, 'gmsh', gmsh.__version__)"
+	@touch $@
+
+deps: $(VENV)/.stamp
+
+demo: deps
+	$(PY) -m petsc_ssi.demo
+
+test: deps
+	$(PY) -m pytest -q tests
+
+bench: deps
+	bash jobscripts/pekeris_bench.sh
+
+help-options: deps
+	$(PY) -m petsc_ssi -help
+
+clean:
+	rm -rf .venv .deps .numba_cache build *.egg-info out

@@ -1,0 +1,1 @@
+"""Time-domain BEM for the elastic half-space (paper Section 2)."""

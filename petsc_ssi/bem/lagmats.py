@@ -1,0 +1,86 @@
+"""Lag matrices as PETSc Mats: MATMPIDENSE for dense lags, MATMPIBAIJ (3x3
+node blocks) for shell-sparse ones, chosen per lag by global block fill
+(``-ssi_lag_storage auto|dense|sparse``, threshold ``-ssi_lag_fill``).
+
+Triplets (row node, lag, column node, 3x3 block) come from ``assemble``;
+rows are the locally owned nodes, columns global node (or traction) ids.
+"""
+import numpy as np
+
+from ..petsc import init
+
+
+def _by_lag(trip, L):
+    row, lag, col, val = trip
+    order = np.lexsort((col, row, lag))
+    row, lag, col, val = row[order], lag[order], col[order], val[order]
+    bounds = np.searchsorted(lag, np.arange(1, L + 2))
+    return row, col, val, bounds
+
+
+def _csr(rows_local, cols, vals, nloc):
+    counts = np.bincount(rows_local, minlength=nloc)
+    indptr = np.zeros(nloc + 1, np.int32)
+    np.cumsum(counts, out=indptr[1:])
+    return indptr, cols.astype(np.int32), vals
+
+
+def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
+    """MPIBAIJ (bs 3) from sorted node-block triplets of local rows."""
+    PETSc = init()
+    ip, ix, v = _csr(rows - r0, cols, vals, nrow_loc)
+    A = PETSc.Mat().createBAIJ(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
+                               bsize=3, csr=(ip, ix, np.ascontiguousarray(v).reshape(-1)), comm=comm)
+    A.assemble()
+    return A
+
+
+def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
+    """MPIDENSE from node-block triplets of local rows."""
+    PETSc = init()
+    A = PETSc.Mat().createDense(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
+                                comm=comm)
+    A.setUp()
+    arr = A.getDenseArray()
+    arr[...] = 0.0
+    rl = rows - r0
+    for p in range(3):
+        for q in range(3):
+            arr[3 * rl + p, 3 * cols + q] = vals[:, p, q]
+    A.restoreDenseArray() if hasattr(A, "restoreDenseArray") else None
+    A.assemble()
+    return A
+
+
+def build(comm, trip, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
+    """Collective: one Mat per lag 1..L (None where the lag is empty
+    everywhere). Returns (mats, info) with info rows (lag, type, blocks)."""
+    row, col, val, bounds = _by_lag(trip, L)
+    r0, r1 = node_range
+    nloc = r1 - r0
+    mpi = comm.tompi4py()
+    counts = np.diff(bounds)[:L]
+    gcounts = np.zeros_like(counts)
+    mpi.Allreduce(counts, gcounts)
+    mats, info = [], []
+    for li in range(L):
+        s, e = bounds[li], bounds[li + 1]
+        nb = int(gcounts[li])
+        if nb == 0:
+            mats.append(None)
+            info.append((li + 1, "empty", 0))
+            continue
+        f = nb / float(n_rows_glob * n_cols_glob)
+        use_dense = storage == "dense" or (storage == "auto" and f > fill)
+        mk = dense if use_dense else baij
+        mats.append(mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row[s:e], col[s:e], val[s:e]))
+        info.append((li + 1, "dense" if use_dense else "baij", nb))
+    return mats, info
+
+
+def mat_bytes(A):
+    """Bytes a Mat stores (values and indices), from MatGetInfo."""
+    if A is None:
+        return 0
+    inf = A.getInfo()
+    return int(inf.get("memory", 0)) or int(inf.get("nz_allocated", 0) * 8)

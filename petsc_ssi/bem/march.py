@@ -1,0 +1,225 @@
+r"""Time marching of the BEM (paper eqs. 6-7; method notes section 2).
+
+Step equations E_n: sum_{m<=n} H_{n-m+1} u^m = sum_{m<=n} G_{n-m+1} p^m.
+
+plain (eq. 6):       H_1 u^n - G_1 p^n = sum_{j>=2} [G_j x_j(p) - H_j x_j(u)],
+                     x_j(v) = v^{n-j+1}
+stabilized (eq. 7):  E_{n+1} + 2 E_n + E_{n-1}, with u^{n+1} = 2u^n - u^{n-1}
+                     and p^{n+1} = 2p^n - p^{n-1} (extrapolated; for KNOWN
+                     values too, so the scheme is one linear combination of
+                     step equations for every boundary condition):
+   (4H_1 + H_2) u^n - (4G_1 + G_2) p^n = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)],
+   q_j(v) = v^{n-j+2} + 2 v^{n-j+1} + v^{n-j}, terms with index in 1..n-1.
+The terms H_1 u^{n-1} - G_1 p^{n-1} of eq. 7 cancel the j = 1 history term
+exactly, so the sum starts at j = 2 (paper eq. 8 prints u^{n-m-2} for
+u^{n-m+2}: a typo, the G-term shows the right index).
+
+Unknowns: u at free nodes, p at nodes of prescribed-displacement regions.
+The step matrix A (u columns of H_s, p columns of -G_s) is local and sparse:
+AIJ, factorised once (KSP prefix ``ssi_bem_``: preonly + LU with MUMPS by
+default, any KSP/PC from the options database). The history sum runs over the
+stored lags with past states in a ring buffer of fixed length.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from ..petsc import init, set_default_options, direct_solver_defaults, printf
+from ..monitor import event
+
+
+def _expand(trip, r0, coef, colmap=None):
+    """Scalar COO entries of node-block triplets (local rows)."""
+    row, _, col, val = trip
+    if colmap is not None:
+        col = colmap[col]
+    p, q = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    R = (3 * (row - r0))[:, None, None] + p
+    C = (3 * col)[:, None, None] + q
+    return R.ravel(), C.ravel(), (coef * val).ravel()
+
+
+def step_matrix(comm, lagset, scheme, pres_node_mask):
+    """Collective: AIJ step matrix from the lag-1 and lag-2 triplets."""
+    PETSc = init()
+    r0, r1 = lagset.node_range
+    nloc = r1 - r0
+    N = lagset.mesh.n_nodes
+    coefs = {1: 4.0, 2: 1.0} if scheme == "stabilized" else {1: 1.0}
+    Rs, Cs, Vs = [], [], []
+    H = lagset.H
+    G = lagset.G
+    reg = lagset.regions
+    for lag, c in coefs.items():
+        m = (H[1] == lag) & ~pres_node_mask[H[2]]
+        r, cc, v = _expand(tuple(a[m] for a in H), r0, c)
+        Rs.append(r); Cs.append(cc); Vs.append(v)
+        if reg.n_disp:
+            m = (G[1] == lag) & (G[2] >= reg.n_load)
+            r, cc, v = _expand(tuple(a[m] for a in G), r0, -c, colmap=reg.tnode)
+            Rs.append(r); Cs.append(cc); Vs.append(v)
+    R = np.concatenate(Rs); C = np.concatenate(Cs); V = np.concatenate(Vs)
+    A = sp.csr_matrix((V, (R, C)), shape=(3 * nloc, 3 * N))
+    A.sum_duplicates()
+    A.sort_indices()
+    M = PETSc.Mat().createAIJ(size=((3 * nloc, 3 * N), (3 * nloc, 3 * N)), bsize=3,
+                              csr=(A.indptr.astype(np.int32), A.indices.astype(np.int32), A.data),
+                              comm=comm)
+    M.assemble()
+    return M
+
+
+class Marcher:
+    """Collective: steps the BEM in time. ``H``, ``G``: lists of Mats (lag 1..L)."""
+
+    def __init__(self, comm, lagset, H, G, scheme, known_u, known_p, log=printf):
+        PETSc = init()
+        self.PETSc = PETSc
+        self.comm = comm
+        self.H, self.G = H, G
+        self.L = len(H)
+        self.scheme = "stabilized" if scheme.startswith("stabili") else "plain"
+        reg = lagset.regions
+        self.reg = reg
+        N = lagset.mesh.n_nodes
+        self.N = N
+        pres = np.zeros(N, bool)
+        pres[reg.disp_nodes] = True
+        self.pres = pres
+        ev = event("SSI_BEM_Factor")
+        ev.begin()
+        self.A = step_matrix(comm, lagset, self.scheme, pres)
+        self.ksp = PETSc.KSP().create(comm=comm)
+        self.ksp.setOptionsPrefix("ssi_bem_")
+        set_default_options("ssi_bem_", direct_solver_defaults(comm), log)
+        self.ksp.setOperators(self.A)
+        self.ksp.setFromOptions()
+        self.ksp.setUp()
+        ev.end()
+        self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
+        self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)
+        self.u_tmpl = self.A.createVecRight()
+        self.p_tmpl = self._p_vec()
+        self.depth = self.L + 2
+        self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
+        self.pbuf = [self.p_tmpl.duplicate() for _ in range(self.depth)]
+        self.n = 0
+        self._setup_index_maps()
+        self.rhs = self.u_tmpl.duplicate()
+        self.x = self.u_tmpl.duplicate()
+        self.wu = self.u_tmpl.duplicate()
+        self.wp = self.p_tmpl.duplicate()
+
+    def _p_vec(self):
+        PETSc = self.PETSc
+        nt = max(self.reg.n_t, 0)
+        for M in self.G:
+            if M is not None:
+                return M.createVecRight()
+        return PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=self.comm)
+
+    def _setup_index_maps(self):
+        """Scatters between the unknown vector and the u / p vectors."""
+        PETSc = self.PETSc
+        reg = self.reg
+        dn = reg.disp_nodes
+        dofs = (3 * dn[:, None] + np.arange(3)).ravel().astype(np.int32)
+        tdofs = (3 * (reg.n_load + np.arange(reg.n_disp))[:, None] + np.arange(3)).ravel().astype(np.int32)
+        ldofs = (3 * np.arange(reg.n_load)[:, None] + np.arange(3)).ravel().astype(np.int32)
+        rank = self.comm.getRank()
+        # every rank sets what it owns; index sets built from rank 0's share to avoid duplicates
+        take = lambda a: a if rank == 0 else a[:0]
+        self.is_pres_u = PETSc.IS().createGeneral(take(dofs), comm=self.comm)
+        self.is_pres_p = PETSc.IS().createGeneral(take(tdofs), comm=self.comm)
+        self.is_load_p = PETSc.IS().createGeneral(take(ldofs), comm=self.comm)
+        self.sc_x2p = PETSc.Scatter().create(self.u_tmpl, self.is_pres_u, self.p_tmpl, self.is_pres_p)
+        self.kv_u = self.u_tmpl.duplicate()   # known u at prescribed DOFs (zero elsewhere)
+        self.kv_p = self.p_tmpl.duplicate()   # known p at load DOFs (zero elsewhere)
+        self.dofs_pres = dofs
+        self.dofs_load = ldofs
+
+    def _set_known(self, n):
+        """Known values of step n into kv_u / kv_p (set by rank 0, assembled)."""
+        self.kv_u.set(0.0)
+        self.kv_p.set(0.0)
+        if self.comm.getRank() == 0:
+            if self.reg.n_disp:
+                self.kv_u.setValues(self.dofs_pres, self.known_u(n))
+            if self.reg.n_load:
+                self.kv_p.setValues(self.dofs_load, self.known_p(n))
+        for v in (self.kv_u, self.kv_p):
+            v.assemblyBegin(); v.assemblyEnd()
+
+    def _slot(self, m):
+        return m % self.depth
+
+    def history(self, n, out_u):
+        """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n."""
+        out_u.set(0.0)
+        jmax = min(self.L, n + 1)
+        for j in range(2, jmax + 1):
+            if self.scheme == "stabilized":
+                terms = [(n - j + 2, 1.0), (n - j + 1, 2.0), (n - j, 1.0)]
+            else:
+                terms = [(n - j + 1, 1.0)]
+            terms = [(m, c) for m, c in terms if 1 <= m <= n - 1]
+            if not terms:
+                continue
+            Hj = self.H[j - 1]
+            Gj = self.G[j - 1] if j - 1 < len(self.G) else None
+            if Hj is not None:
+                self._combine(self.wu, self.ubuf, terms)
+                Hj.mult(self.wu, self.rhs)
+                out_u.axpy(-1.0, self.rhs)
+            if Gj is not None:
+                self._combine(self.wp, self.pbuf, terms)
+                Gj.multAdd(self.wp, out_u, out_u)
+
+    def _combine(self, w, buf, terms):
+        w.set(0.0)
+        w.maxpy([c for _, c in terms], [buf[self._slot(m)] for m, _ in terms])
+
+    def step(self):
+        """Advance one step; returns (u^n, p^n) Vecs (views into the buffer)."""
+        self.n += 1
+        n = self.n
+        b = self.u_tmpl.duplicate() if not hasattr(self, "_b") else self._b
+        self._b = b
+        ev = event("SSI_BEM_History")
+        ev.begin()
+        self.history(n, b)
+        ev.end()
+        self._set_known(n)
+        coef = (4.0, 1.0) if self.scheme == "stabilized" else (1.0, 0.0)
+        for lag, c in ((1, coef[0]), (2, coef[1])):
+            if c == 0.0 or lag > self.L:
+                continue
+            if self.reg.n_load and self.G[lag - 1] is not None:
+                self.G[lag - 1].mult(self.kv_p, self.rhs)
+                b.axpy(c, self.rhs)
+            if self.reg.n_disp and self.H[lag - 1] is not None:
+                self.H[lag - 1].mult(self.kv_u, self.rhs)
+                b.axpy(-c, self.rhs)
+        ev = event("SSI_BEM_Solve")
+        ev.begin()
+        self.ksp.solve(b, self.x)
+        ev.end()
+        u = self.ubuf[self._slot(n)]
+        p = self.pbuf[self._slot(n)]
+        # u: solution at free DOFs, known values at prescribed DOFs
+        self.x.copy(u)
+        p.set(0.0)
+        if self.reg.n_disp:
+            self.sc_x2p.scatter(self.x, p, addv=self.PETSc.InsertMode.INSERT_VALUES)
+            uk = u.getArray()
+            r0 = u.getOwnershipRange()[0]
+            loc = self.dofs_pres_local(r0, len(uk))
+            if loc.size:
+                uk[loc] = self.kv_u.getArray()[loc]
+        p.axpy(1.0, self.kv_p)
+        return u, p
+
+    def dofs_pres_local(self, r0, nloc):
+        if not hasattr(self, "_pres_local"):
+            d = np.where(np.repeat(self.pres, 3))[0]
+            self._pres_local = (d[(d >= r0) & (d < r0 + nloc)] - r0).astype(np.int64)
+        return self._pres_local

@@ -1,0 +1,148 @@
+"""BEM model set-up: regions, lags, memory estimate, assembly into PETSc Mats.
+
+Collective functions say so. Rows (collocation DOFs, 3 per node) are split by
+the ownership ranges of a PETSc Vec of size 3N with block size 3; each rank
+computes only the rows it owns, with no gather of matrices.
+"""
+import math
+import os
+import time
+
+import numpy as np
+
+from ..petsc import init, SSIError, collective_error, printf, warn
+from ..monitor import Progress, event
+from . import symmetry
+from .assemble import assemble_rows
+
+
+class Material:
+    def __init__(self, cp, cs, rho):
+        self.cp, self.cs, self.rho = float(cp), float(cs), float(rho)
+        self.mu = rho * cs ** 2
+        self.lam = rho * cp ** 2 - 2 * self.mu
+        k2 = (cp / cs) ** 2
+        self.nu = (k2 - 2.0) / (2.0 * (k2 - 1.0))
+
+
+class Regions:
+    """Traction columns: nodes of the loaded and of the prescribed-displacement
+    element sets. Tractions are continuous inside a region and discontinuous
+    across its boundary (a traction-free neighbour has zero traction at a
+    shared node), so each region numbers its own nodes."""
+
+    def __init__(self, mesh, load_elems=(), disp_elems=()):
+        load_elems = np.unique(np.asarray(load_elems, np.int64))
+        disp_elems = np.unique(np.asarray(disp_elems, np.int64))
+        both = np.intersect1d(load_elems, disp_elems)
+        if both.size:
+            raise SSIError(f"{both.size} elements are both loaded and have a prescribed displacement")
+        self.load_nodes = np.unique(mesh.cells[load_elems]) if load_elems.size else np.zeros(0, np.int64)
+        self.disp_nodes = np.unique(mesh.cells[disp_elems]) if disp_elems.size else np.zeros(0, np.int64)
+        self.n_load = len(self.load_nodes)
+        self.n_disp = len(self.disp_nodes)
+        self.n_t = self.n_load + self.n_disp
+        tcols = -np.ones(mesh.cells.shape, np.int64)
+        for elems, nodes, off in ((load_elems, self.load_nodes, 0),
+                                  (disp_elems, self.disp_nodes, self.n_load)):
+            if elems.size:
+                lut = -np.ones(mesh.n_nodes, np.int64)
+                lut[nodes] = off + np.arange(len(nodes))
+                tcols[elems] = lut[mesh.cells[elems]]
+        self.tcols = tcols
+        self.tnode = np.concatenate([self.load_nodes, self.disp_nodes])  # node of each traction column
+
+
+def causal_lags(r_max, mat, dt):
+    """Lags that can be non-zero: the P kernel vanishes once (l-2) dt > r/c_s."""
+    return int(math.floor(r_max / (mat.cs * dt))) + 2
+
+
+def bounding_spheres(VX):
+    c = VX[:, 8, :].copy()
+    R = 1.1 * np.linalg.norm(VX - c[:, None, :], axis=2).max(axis=1) + 1e-12
+    h = np.maximum(np.linalg.norm(VX[:, 4] - VX[:, 0], axis=1), np.linalg.norm(VX[:, 7] - VX[:, 0], axis=1)) * 2
+    return c, R, h
+
+
+def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, chunk=256):
+    """Estimated number of non-zero 3x3 blocks of all H lags in ``rows``:
+    for each (row, virtual element) the lags its shell touches, times four
+    nodes per element (a node is shared by about four elements)."""
+    total = 0.0
+    for s in range(0, len(rows), chunk):
+        xc = xnodes[rows[s:s + chunk]]
+        d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
+        lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
+        hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
+        total += np.clip(hi - lo + 1, 0, None).sum() * 4.0
+    return total
+
+
+def machine_memory():
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemTotal"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return float("inf")
+
+
+class LagSet:
+    """The assembled H_l, G_l (l = 1..L) of one rank as triplets, then Mats."""
+
+    def __init__(self, comm, mesh, mat, dt, L, regions, planes, opts):
+        self.comm = comm
+        self.mesh, self.mat, self.dt, self.L = mesh, mat, dt, L
+        self.regions, self.planes, self.opts = regions, planes, opts
+        PETSc = init()
+        N = mesh.n_nodes
+        v = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * N), bsize=3, comm=comm)
+        r0, r1 = v.getOwnershipRange()
+        v.destroy()
+        self.node_range = (r0 // 3, r1 // 3)
+        self.rows = np.arange(r0 // 3, r1 // 3, dtype=np.int64)
+        VX, VN, VS, VT = symmetry.virtual_elements(mesh.cell_coords(), mesh.cells, regions.tcols, planes)
+        self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
+        self.Vc, self.VR, self.Vh = bounding_spheres(VX)
+
+    def estimate_memory(self):
+        """Collective: (bytes of H lags in sparse storage, dense bytes per lag)."""
+        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt)
+        nb = self.comm.tompi4py().allreduce(nb)
+        N = self.mesh.n_nodes
+        g_bytes = 9.0 * N * max(self.regions.n_t, 0) * 8 * self.L
+        return nb * (72 + 4) + g_bytes, 9.0 * N * N * 8
+
+    def assemble(self, monitor=False, chunk=None):
+        """Collective in effect (each rank its rows): the triplets."""
+        o = self.opts
+        gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
+        gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
+        rows = self.rows
+        chunk = chunk or max(1, min(64, len(rows) // 20 + 1))
+        prog = Progress("BEM assembly", max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
+        parts = []
+        nev = 0
+        ev = event("SSI_BEM_Assembly")
+        ev.begin()
+        for s in range(0, len(rows), chunk):
+            res = assemble_rows(rows[s:s + chunk], self.mesh.nodes, self.VX, self.VN, self.VS, self.VT,
+                                self.Vc, self.VR, self.Vh, self.L, self.dt, self.mat.cp, self.mat.cs,
+                                self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
+                                o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
+                                self.regions.n_t, 0.5, 1e-8)
+            parts.append(res[:8])
+            nev += res[8]
+            prog.update(min(s + chunk, len(rows)))
+        ev.end()
+        if not parts:
+            parts.append((np.zeros(0, np.int64),) * 3 + (np.zeros((0, 3, 3)),) + (np.zeros(0, np.int64),) * 3
+                         + (np.zeros((0, 3, 3)),))
+        cat = lambda k: np.concatenate([p[k] for p in parts])
+        self.H = tuple(cat(k) for k in range(4))
+        self.G = tuple(cat(k) for k in range(4, 8))
+        self.kernel_evaluations = self.comm.tompi4py().allreduce(nev)
+        return self

@@ -1,0 +1,73 @@
+"""Receivers on the surface mesh: locate, interpolate with the element shape
+functions (a sparse PETSc matrix R, y = R u per step: no gather of fields)."""
+import numpy as np
+
+from ..petsc import init, SSIError
+from ..mesh import quad9
+from . import symmetry
+
+
+def parse(spec):
+    pts = []
+    spec = (spec or "").strip()
+    if not spec:
+        return np.zeros((0, 3))
+    for part in spec.split(";"):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            v = [float(s) for s in part.split(",")]
+        except ValueError:
+            raise SSIError(f"-ssi_receivers '{spec}': expected 'x,y,z;x,y,z'") from None
+        if len(v) != 3:
+            raise SSIError(f"-ssi_receivers '{spec}': each point needs x,y,z")
+        pts.append(v)
+    return np.array(pts)
+
+
+def locate(mesh, p, tol=1e-8):
+    """(element, xi, eta) of the surface point nearest to p in plan (x, y).
+    Raises SSIError if p lies off the mesh."""
+    X = mesh.cell_coords()
+    lo = X[:, :, :2].min(1) - 1e-9
+    hi = X[:, :, :2].max(1) + 1e-9
+    cand = np.where(np.all((p[:2] >= lo) & (p[:2] <= hi), axis=1))[0]
+    for e in cand:
+        xi = np.zeros(2)
+        for _ in range(30):
+            N = quad9.shape(xi[0], xi[1])
+            d1, d2 = quad9.shape_grad(xi[0], xi[1])
+            x = N @ X[e]
+            J = np.array([d1 @ X[e][:, :2], d2 @ X[e][:, :2]]).T
+            dx = np.linalg.solve(J, p[:2] - x[:2])
+            xi += dx
+            if np.abs(dx).max() < 1e-13:
+                break
+        if np.all(np.abs(xi) <= 1 + tol):
+            return int(e), float(xi[0]), float(xi[1])
+    raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) lies off the surface mesh")
+
+
+def operator(comm, mesh, points, planes, ncol_loc):
+    """Collective: AIJ matrix (3R x 3N) mapping nodal u to receiver values."""
+    PETSc = init()
+    R = len(points)
+    N = mesh.n_nodes
+    rows, cols, vals, where = [], [], [], []
+    for k, p in enumerate(points):
+        q, s = symmetry.map_point(p, planes)
+        e, xi, eta = locate(mesh, q)
+        N9 = quad9.shape(xi, eta)
+        where.append((e, xi, eta))
+        for a in range(9):
+            for c in range(3):
+                rows.append(3 * k + c); cols.append(3 * mesh.cells[e, a] + c); vals.append(N9[a] * s[c])
+    M = PETSc.Mat().createAIJ(size=((PETSc.DECIDE, 3 * R), (ncol_loc, 3 * N)), nnz=(27, 27), comm=comm)
+    M.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    r0, r1 = M.getOwnershipRange()
+    for r, c, v in zip(rows, cols, vals):
+        if r0 <= r < r1:
+            M.setValue(r, c, v, addv=True)
+    M.assemble()
+    return M, where

@@ -1,0 +1,320 @@
+"""``-ssi_problem bem``: the half-space BEM run, from options to HDF5.
+
+Order of work: every input check (collective, one-line errors) and the memory
+estimate come before any assembly.
+"""
+import math
+import os
+import time
+
+import numpy as np
+
+from ..petsc import init, SSIError, check, collective_error, printf, warn
+from ..monitor import Progress, event, stage, fmt_time
+from ..mesh import surface
+from ..io.output import Output, provenance
+from . import symmetry, receivers as rec, histories, lagmats
+from .model import Material, Regions, LagSet, causal_lags, machine_memory
+from .march import Marcher
+
+
+def _pair(text, name):
+    try:
+        v = [float(s) for s in text.split(",")]
+    except ValueError:
+        raise SSIError(f"-ssi_{name} '{text}': expected 'a,b'") from None
+    if len(v) != 2 or min(v) <= 0:
+        raise SSIError(f"-ssi_{name} '{text}': expected two positive numbers 'a,b'")
+    return v
+
+
+def load_mesh(cfg, planes, comm):
+    """Collective: the surface mesh (grid generator or gmsh; rank 0 reads, broadcast)."""
+    Lx, Ly = _pair(cfg.mesh_size, "mesh_size")
+    patch = _pair(cfg.mesh_patch, "mesh_patch") if cfg.mesh_patch else None
+    xmin = 0.0 if any(a == 0 for a, _ in planes) else None
+    ymin = 0.0 if any(a == 1 for a, _ in planes) else None
+    mpi = comm.tompi4py()
+    err, mesh = None, None
+    if comm.getRank() == 0:
+        try:
+            if cfg.mesh == "grid":
+                mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
+            else:
+                params = {"Lx": Lx, "Ly": Ly, "h": cfg.mesh_h,
+                          "xmin": -Lx / 2 if xmin is None else 0.0,
+                          "ymin": -Ly / 2 if ymin is None else 0.0}
+                if patch:
+                    params.update({"a": patch[0], "b": patch[1]})
+                mesh = surface.read_gmsh(cfg.mesh, params)
+            mesh.check()
+        except SSIError as exc:
+            err = str(exc)
+        except Exception as exc:  # unreadable file, gmsh failure
+            err = f"-ssi_mesh {cfg.mesh}: cannot read the mesh ({type(exc).__name__}: {exc})"
+    collective_error(mpi.bcast(err), comm)
+    return mpi.bcast(mesh)
+
+
+class BEMProblem:
+    """Everything a BEM run needs, checked before heavy work (collective)."""
+
+    def __init__(self, cfg, comm, log=printf):
+        self.cfg, self.comm, self.log = cfg, comm, log
+        self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
+        self.planes = symmetry.parse(cfg.symmetry)
+        self.mesh = load_mesh(cfg, self.planes, comm)
+        h = float(self.mesh.element_sizes().max())
+        symmetry.check_mesh(self.mesh.nodes, self.planes, h)
+        self.dt = cfg.dt
+        self.n_steps = int(round(cfg.t_end / cfg.dt))
+        load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
+        disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
+        if cfg.load_group and cfg.load_p0 == 0.0:
+            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
+        self.regions = Regions(self.mesh, load, disp)
+        self.receivers = rec.parse(cfg.receivers)
+        for p in self.receivers:
+            q, _ = symmetry.map_point(p, self.planes)
+            rec.locate(self.mesh, q)
+            if abs(p[2]) > 1e-6 * max(h, 1.0):
+                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        self._lags()
+        self._warnings(h)
+
+    def _lags(self):
+        VX = self.mesh.cell_coords()
+        ext = np.abs(VX).max(axis=(0, 1))
+        if self.planes:
+            lo = -ext
+        else:
+            lo = VX.min(axis=(0, 1))
+        hi = VX.max(axis=(0, 1))
+        self.r_max = float(np.linalg.norm(hi - lo))
+        self.T_N = self.r_max / self.mat.cs
+        causal = causal_lags(self.r_max, self.mat, self.dt)
+        self.L = max(2, min(causal, self.n_steps + 1))
+
+    def _warnings(self, h):
+        cfg = self.cfg
+        sizes = self.mesh.element_sizes()
+        lmin, lmax = sizes.min(), sizes.max()
+        self.beta = (self.mat.cs * self.dt / lmax, self.mat.cp * self.dt / lmin)
+        if cfg.warn_beta and (self.beta[0] < 0.3 or self.beta[1] > 1.3):
+            warn(f"beta = c dt / l spans [{self.beta[0]:.3f}, {self.beta[1]:.3f}] (c_s with the largest, "
+                 f"c_p with the smallest node spacing), outside [0.3, 1.3]: the time marching may be "
+                 f"inaccurate or unstable")
+        if len(self.receivers) and self.regions.n_load:
+            src = self.mesh.nodes[self.regions.load_nodes]
+            edge = self._edge_points()
+            if len(edge):
+                d_se = np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0)
+                for p in self.receivers:
+                    q, _ = symmetry.map_point(p, self.planes)
+                    t_d = (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp
+                    if t_d < cfg.t_end:
+                        warn(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}): waves diffracted at the mesh edge "
+                             f"arrive at t = {t_d:.4g} s < t_end = {cfg.t_end:g} s")
+
+    def _edge_points(self):
+        """Nodes on the truncation edge (not on a symmetry plane)."""
+        x = self.mesh.nodes
+        out = np.zeros(len(x), bool)
+        for ax in (0, 1):
+            lo, hi = x[:, ax].min(), x[:, ax].max()
+            tol = 1e-9 * max(abs(lo), abs(hi), 1.0)
+            on_plane = any(a == ax for a, _ in self.planes)
+            out |= np.abs(x[:, ax] - hi) < tol
+            if not on_plane:
+                out |= np.abs(x[:, ax] - lo) < tol
+        return x[out]
+
+    def summary(self):
+        mesh = self.mesh
+        nimg = len(symmetry.images(self.planes))
+        return (f"[ssi] BEM: {mesh.n_cells} nine-node elements ({mesh.n_cells * nimg} with symmetry images), "
+                f"{mesh.n_nodes} nodes, {3 * mesh.n_nodes} DOFs; {self.regions.n_t} traction nodes; "
+                f"dt {self.dt:g} s, {self.n_steps} steps, scheme {self.cfg.scheme}; "
+                f"r_max {self.r_max:.4g} m, T_N = r_max/c_s = {self.T_N:.4g} s; lags stored {self.L} "
+                f"(causal limit {causal_lags(self.r_max, self.mat, self.dt)}); "
+                f"beta in [{self.beta[0]:.3f}, {self.beta[1]:.3f}]")
+
+    def quad_options(self):
+        c = self.cfg
+        return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
+                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions}
+
+    def lagset(self):
+        return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,
+                      self.quad_options())
+
+    def check_memory(self, ls):
+        """Collective: refuse runs whose lag matrices would not fit."""
+        sparse_b, dense_per_lag = ls.estimate_memory()
+        limit = self.cfg.memory_limit * 1e9 if self.cfg.memory_limit > 0 else 0.8 * machine_memory()
+        est = min(sparse_b, dense_per_lag * self.L + 9.0 * self.mesh.n_nodes * self.regions.n_t * 8 * self.L)
+        # assembly holds the triplets (96 B per block) and the Mats at once
+        peak = est + sparse_b * 96.0 / 76.0
+        self.mem_estimate = est
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB, assembly peak {peak / 1e9:.3g} GB "
+                 f"(limit {limit / 1e9:.3g} GB)")
+        if peak > limit:
+            raise SSIError(f"the lag matrices need about {peak / 1e9:.3g} GB at assembly, more than the "
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit); use symmetry planes, a "
+                           f"coarser mesh, a shorter -ssi_t_end or more nodes")
+
+    def known_p(self):
+        c = self.cfg
+        f = histories.make(c.load_history, c.load_t0, c.load_table) if self.regions.n_load else None
+        tr = np.array([0.0, 0.0, -c.load_p0])   # p0 > 0 pushes the surface down (-z)
+        nl = self.regions.n_load
+
+        def kp(n):
+            return np.tile(tr * histories.step_mean(f, n, self.dt, c.load_history, c.load_t0), nl)
+        return kp
+
+    def known_u(self):
+        c = self.cfg
+        nd = self.regions.n_disp
+        if not nd:
+            return lambda n: np.zeros(0)
+        try:
+            val = np.array([float(s) for s in c.disp_value.split(",")])
+            assert val.size == 3
+        except (ValueError, AssertionError):
+            raise SSIError(f"-ssi_disp_value '{c.disp_value}': expected 'ux,uy,uz'") from None
+        f = histories.make(c.disp_history, c.disp_t0, c.disp_table)
+        return lambda n: np.tile(val * float(f(n * self.dt)), nd)
+
+
+def run_bem(cfg, comm=None):
+    """Collective: the whole BEM run. Returns a dict of results (rank 0 has receivers)."""
+    PETSc = init()
+    comm = comm or PETSc.COMM_WORLD
+    t_start = time.perf_counter()
+    log = printf if cfg.monitor else (lambda m: None)
+    with_stage = stage("SSI BEM setup")
+    with_stage.push()
+    prob = BEMProblem(cfg, comm, log=printf)
+    printf(prob.summary())
+    ls = prob.lagset()
+    prob.check_memory(ls)
+    with_stage.pop()
+    st = stage("SSI BEM assembly")
+    st.push()
+    t0 = time.perf_counter()
+    ls.assemble(monitor=cfg.monitor)
+    N = prob.mesh.n_nodes
+    r0, r1 = ls.node_range
+    H, hinfo = lagmats.build(comm, ls.H, prob.L, ls.node_range, N, N, r1 - r0, cfg.lag_storage, cfg.lag_fill)
+    nt = prob.regions.n_t
+    if nt:
+        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+        G, ginfo = lagmats.build(comm, ls.G, prob.L, ls.node_range, N, nt, pl.getLocalSize() // 3, "dense")
+        pl.destroy()
+    else:
+        G = [None] * prob.L
+    t_asm = time.perf_counter() - t0
+    st.pop()
+    mem = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
+    ndense = sum(1 for i in hinfo if i[1] == "dense")
+    nbaij = sum(1 for i in hinfo if i[1] == "baij")
+    blocks = sum(i[2] for i in hinfo)
+    fill = blocks / float(prob.L * N * N)
+    printf(f"[ssi] assembly {fmt_time(t_asm)}: {prob.L} lags ({ndense} dense, {nbaij} block-sparse), "
+           f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
+           f"{ls.kernel_evaluations:.3g} kernel evaluations")
+    st = stage("SSI BEM time loop")
+    st.push()
+    march = Marcher(comm, ls, H, G, cfg.scheme, prob.known_u(), prob.known_p(), log=log)
+    ls.H = ls.G = None   # the triplets are in the Mats now
+    out = Output(cfg.output, comm)
+    res = _time_loop(cfg, comm, prob, march, out)
+    st.pop()
+    stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
+             "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
+             "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
+             "kernel_evaluations": ls.kernel_evaluations, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
+    res["stats"] = stats
+    _finish(cfg, comm, prob, out, res)
+    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
+    return res
+
+
+def _time_loop(cfg, comm, prob, march, out):
+    PETSc = init()
+    mesh = prob.mesh
+    cvec = march.u_tmpl.duplicate()
+    r0, r1 = cvec.getOwnershipRange()
+    cvec.setArray(mesh.nodes.reshape(-1)[r0:r1])
+    out.write_mesh(cvec, mesh.cells if comm.getRank() == 0 else None, "quad9")
+    nrec = len(prob.receivers)
+    R = None
+    if nrec:
+        R, where = rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
+        y = R.createVecLeft()
+    tnode = _traction_to_nodes(comm, prob, march)
+    tfield = march.u_tmpl.duplicate()
+    series = []
+    times = []
+    prog = Progress("BEM time loop", prob.n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
+    ev_io = event("SSI_IO")
+    stride = cfg.output_stride
+    unorm = []
+    for n in range(1, prob.n_steps + 1):
+        u, p = march.step()
+        t = n * prob.dt
+        times.append(t)
+        if R is not None:
+            R.mult(u, y)
+            series.append(y.getArray().copy())
+        if stride and n % stride == 0:
+            ev_io.begin()
+            if tnode is not None:
+                tnode.mult(p, tfield)
+            out.write_fields(t, {"displacement": u, "traction": tfield})
+            ev_io.end()
+        nrm = u.norm()
+        unorm.append(nrm)
+        prog.update(n, f"t={t:.4g}s |u|={nrm:.3e}")
+    ser = None
+    if nrec:
+        loc = np.array(series).reshape(len(times), -1)
+        allp = comm.tompi4py().gather(loc, root=0)
+        if comm.getRank() == 0:
+            ser = np.concatenate(allp, axis=1).reshape(len(times), nrec, 3)
+    return {"t": np.array(times), "u": ser, "unorm": np.array(unorm)}
+
+
+def _traction_to_nodes(comm, prob, march):
+    """AIJ mapping traction columns to a nodal traction field (for output)."""
+    PETSc = init()
+    reg = prob.regions
+    if not reg.n_t:
+        return None
+    T = PETSc.Mat().createAIJ(size=((march.u_tmpl.getLocalSize(), 3 * prob.mesh.n_nodes),
+                                    (march.p_tmpl.getLocalSize(), 3 * reg.n_t)), nnz=(3, 3), comm=comm)
+    T.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    r0, r1 = T.getOwnershipRange()
+    for k, node in enumerate(reg.tnode):
+        for c in range(3):
+            if r0 <= 3 * node + c < r1:
+                T.setValue(3 * node + c, 3 * k + c, 1.0)
+    T.assemble()
+    return T
+
+
+def _finish(cfg, comm, prob, out, res):
+    ev = event("SSI_IO")
+    ev.begin()
+    recd = None
+    if res["u"] is not None:
+        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+    attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
+             "scheme": cfg.scheme, "load_p0": cfg.load_p0}
+    rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
+    out.close(receivers=recd, attrs=attrs, record=rec_)
+    ev.end()
+    if cfg.plot and comm.getRank() == 0 and recd is not None:
+        from ..plot import receiver_plot
+        receiver_plot(cfg.output, cfg)

@@ -1,0 +1,83 @@
+"""Symmetry planes x = 0 and/or y = 0 (``-ssi_symmetry x=sym,y=anti``).
+
+Only the part x >= 0 (y >= 0) is meshed; each element is integrated together
+with its mirror images. A field symmetric about x = 0 satisfies
+u(-x, y) = S u(x, y) with S = diag(-1, 1, 1); antisymmetric: S = diag(1, -1, -1).
+Images across both planes use the product. Reflection reverses the orientation
+of an element, so the node order of an image with an odd number of
+reflections is permuted to keep the outward normal.
+"""
+import numpy as np
+
+from ..petsc import SSIError
+
+FLIP = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])   # swaps xi and eta
+
+
+def parse(spec):
+    """'x=sym,y=anti' -> [(axis, +1 sym / -1 anti), ...]"""
+    planes = []
+    spec = (spec or "").strip()
+    if not spec or spec.lower() == "none":
+        return planes
+    for part in spec.split(","):
+        try:
+            ax, kind = (s.strip().lower() for s in part.split("="))
+        except ValueError:
+            raise SSIError(f"-ssi_symmetry '{spec}': expected e.g. 'x=sym,y=anti'") from None
+        if ax not in ("x", "y") or kind not in ("sym", "anti", "symmetric", "antisymmetric"):
+            raise SSIError(f"-ssi_symmetry '{spec}': planes are x or y, types sym or anti")
+        a = 0 if ax == "x" else 1
+        if any(p[0] == a for p in planes):
+            raise SSIError(f"-ssi_symmetry '{spec}': plane {ax}=0 given twice")
+        planes.append((a, 1 if kind.startswith("sym") else -1))
+    return planes
+
+
+def sign_matrix(axis, kind):
+    s = np.ones(3)
+    s[axis] = -1.0
+    return s if kind > 0 else -s
+
+
+def images(planes):
+    """All images: list of (reflect_axes tuple, sign vector (3,))."""
+    out = [((), np.ones(3))]
+    for ax, kind in planes:
+        s = sign_matrix(ax, kind)
+        out += [(axes + (ax,), sgn * s) for axes, sgn in out]
+    return out
+
+
+def check_mesh(nodes, planes, h):
+    for ax, _ in planes:
+        if nodes[:, ax].min() < -1e-9 * max(h, 1.0):
+            name = "xy"[ax]
+            raise SSIError(f"-ssi_symmetry: the mesh crosses the plane {name} = 0; mesh only {name} >= 0")
+
+
+def virtual_elements(X, cells, tcols, planes):
+    """Arrays of virtual elements: coords (V,9,3), node ids, sign (V,3), traction cols."""
+    VX, VN, VS, VT = [], [], [], []
+    for axes, sgn in images(planes):
+        Xi = X.copy()
+        for ax in axes:
+            Xi[:, :, ax] *= -1.0
+        perm = FLIP if len(axes) % 2 else np.arange(9)
+        VX.append(Xi[:, perm])
+        VN.append(cells[:, perm])
+        VS.append(np.tile(sgn, (cells.shape[0], 1)))
+        VT.append(tcols[:, perm])
+    return (np.ascontiguousarray(np.concatenate(VX)), np.ascontiguousarray(np.concatenate(VN)),
+            np.ascontiguousarray(np.concatenate(VS)), np.ascontiguousarray(np.concatenate(VT)))
+
+
+def map_point(p, planes):
+    """Map a point into the meshed part: returns (mapped point, sign vector)."""
+    p = np.array(p, float)
+    s = np.ones(3)
+    for ax, kind in planes:
+        if p[ax] < 0:
+            p[ax] = -p[ax]
+            s *= sign_matrix(ax, kind)
+    return p, s

@@ -1,0 +1,55 @@
+"""Command line: ``petsc-ssi [COMMAND] [PETSc/-ssi_ options]``.
+
+Commands:
+  (none) | run    run the case the options describe (-ssi_problem bem|fem|ssi)
+  post FILE.h5    post-process an output file (--receivers --csv)
+  modes           natural frequencies and mode shapes of a FE structure (SLEPc)
+  help            list every -ssi_ option with default, unit and meaning
+
+Errors in the input end the run with one line, ``petsc-ssi: error: ...``,
+and exit status 2 on every rank.
+"""
+import sys
+
+COMMANDS = ("run", "post", "modes", "help", "estimate")
+
+
+def _split(argv):
+    if len(argv) > 1 and argv[1] in COMMANDS:
+        return argv[1], [argv[0]] + argv[2:]
+    return "run", list(argv)
+
+
+def main(argv=None):
+    argv = list(sys.argv if argv is None else argv)
+    cmd, rest = _split(argv)
+    if cmd == "post":
+        from .post import main as post_main
+        return post_main(rest[1:])
+    from .petsc import init, SSIError
+    PETSc = init(rest)
+    from . import options
+    if cmd == "help" or "-help" in rest or "--help" in rest:
+        PETSc.Sys.Print(options.help_text())
+        if cmd == "help":
+            return 0
+    try:
+        if cmd == "run":
+            from .driver import run
+            run()
+        elif cmd == "modes":
+            from .fem.modes import main as modes_main
+            modes_main()
+        elif cmd == "estimate":
+            from .driver import estimate
+            estimate()
+    except SSIError as exc:
+        PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
+        sys.stdout.flush()
+        PETSc.COMM_WORLD.tompi4py().Barrier()
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,87 @@
+"""Declarations of the common and BEM options; FEM/coupling modules add theirs.
+
+Units are SI. Coordinates: the free surface is z = 0, soil in z < 0, z up.
+"""
+import importlib
+import os
+
+from .options import register, register_check, positive, at_least
+
+# ---------------------------------------------------------------- common
+register("problem", "enum", "bem", "", "what to run: bem (half-space alone), fem (structure alone), ssi (coupled)",
+         "common", choices=("bem", "fem", "ssi"))
+register("dt", "real", 7.5e-4, "s", "time step", "common", validator=positive)
+register("t_end", "real", 0.04, "s", "end time of the run", "common", validator=positive)
+register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it)", "common")
+register("output_stride", "int", 1, "steps", "write the fields every this many steps (0: receivers only)", "common",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE node)", "common")
+register("monitor", "bool", False, "", "print progress: assembly, per-step time, elapsed, ETA (rank 0)", "common")
+register("monitor_every", "int", 0, "steps", "monitor line every this many steps (0: about 20 lines per run)", "common",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
+
+# ---------------------------------------------------------------- BEM soil
+register("cp", "real", 548.0, "m/s", "P-wave speed of the half-space", "bem", validator=positive)
+register("cs", "real", 316.0, "m/s", "S-wave speed of the half-space", "bem", validator=positive)
+register("rho", "real", 2000.0, "kg/m^3", "density of the half-space", "bem", validator=positive)
+register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator) or a gmsh .geo/.msh file of nine-node quads", "bem")
+register("mesh_size", "str", "16,16", "m", "grid/.geo: full extent 'Lx,Ly' of the surface, centred at the origin", "bem")
+register("mesh_h", "real", 1.0, "m", "grid/.geo: element size (node spacing is h/2)", "bem", validator=positive)
+register("mesh_patch", "str", "", "m", "grid/.geo: half-widths 'a,b' of a central patch named 'load' whose edges the mesh follows", "bem")
+register("scheme", "enum", "stabilized", "", "time marching: plain (paper eq. 6) or stabilized (eq. 7)", "bem",
+         choices=("plain", "stabilized", "stabilised"))
+register("subdivisions", "int", 4, "per side", "equal subdivisions of each element side in natural coordinates", "bem",
+         validator=at_least(1))
+register("near_factor", "real", 2.0, "", "subdivide more near the collocation point: at least near_factor*h/d per side (0: off)", "bem",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("max_subdivisions", "int", 32, "per side", "cap on the near-field subdivision", "bem", validator=at_least(1))
+register("gauss", "int", 2, "per direction", "Gauss points per subdivision and direction (paper: 2)", "bem", validator=at_least(1))
+register("singular_order", "int", 12, "", "Gauss order of the polar (radial and angular) singular integration", "bem",
+         validator=at_least(2))
+register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
+register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
+         choices=("auto", "dense", "sparse"))
+register("lag_fill", "real", 0.35, "", "auto storage: lags with block fill above this are dense", "bem",
+         validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
+register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this (0: 80% of this machine's memory)", "bem",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("load_group", "str", "", "", "loaded elements: a physical group name, or 'box:x0,x1,y0,y1' (element centres inside)", "bem")
+register("load_p0", "real", 0.0, "N/m^2", "uniform pressure on the loaded elements (p0 > 0 pushes the surface down)", "bem")
+register("load_history", "enum", "heaviside", "", "time history of the load: heaviside, box (p0 on [0, t0)), table", "bem",
+         choices=("heaviside", "box", "table"))
+register("load_t0", "real", 0.025, "s", "duration of the box pulse", "bem", validator=positive)
+register("load_table", "str", "", "", "file of 't value' rows (value multiplies p0), linearly interpolated", "bem")
+register("disp_group", "str", "", "", "elements with a prescribed displacement (group name or 'box:...')", "bem")
+register("disp_value", "str", "0,0,0", "m", "prescribed displacement 'ux,uy,uz' (times the history)", "bem")
+register("disp_history", "enum", "heaviside", "", "time history of the prescribed displacement: heaviside, box, table", "bem",
+         choices=("heaviside", "box", "table"))
+register("disp_t0", "real", 0.025, "s", "duration of the box history", "bem", validator=positive)
+register("disp_table", "str", "", "", "file of 't value' rows for the prescribed displacement", "bem")
+register("warn_beta", "bool", True, "", "warn when beta = c dt / l leaves [0.3, 1.3]", "bem")
+
+
+def _bem_checks(cfg):
+    if cfg.cs >= cfg.cp:
+        return f"-ssi_cs {cfg.cs} must be smaller than -ssi_cp {cfg.cp}"
+    if cfg.cp < cfg.cs * 2 ** 0.5 * 0.999999:
+        return (f"-ssi_cp/-ssi_cs = {cfg.cp / cfg.cs:.4f} < sqrt(2): Poisson's ratio would be negative "
+                "(not supported)")
+    if cfg.t_end < cfg.dt:
+        return f"-ssi_t_end {cfg.t_end} is shorter than one step -ssi_dt {cfg.dt}"
+    if cfg.mesh != "grid" and not os.path.isfile(cfg.mesh):
+        return f"-ssi_mesh {cfg.mesh}: no such file"
+    if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
+        return f"-ssi_load_table '{cfg.load_table}': no such file"
+    return None
+
+
+register_check(("bem",), _bem_checks)
+
+# Modules that own further options declare them when imported.
+for _mod in ("petsc_ssi.fem.options", "petsc_ssi.coupling.options"):
+    try:
+        importlib.import_module(_mod)
+    except ModuleNotFoundError as _exc:
+        if _exc.name is None or not _mod.startswith(_exc.name):
+            raise

@@ -1,0 +1,165 @@
+"""Output: fields through the PETSc HDF5 viewer, an XDMF file for ParaView,
+and a JSON provenance record beside them.
+
+Layout of ``FILE.h5`` (flat dataset names, so the same file is written by
+petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
+
+  coordinates            (N, 3)  node coordinates           [PETSc Vec, bs 3]
+  <field>_<k:06d>        (N, 3)  nodal field at snapshot k  [PETSc Vec, bs 3]
+  topology               (E, n)  cell connectivity (0-based)        [rank 0]
+  time                   (K,)    time of snapshot k                 [rank 0]
+  receivers/...          receiver series (see ``write_receivers``)  [rank 0]
+  attrs: cell_type, fields, n_snapshots, petsc_ssi_version
+
+Distributed fields are written collectively by the PETSc viewer; the small
+serial data (topology, time, receiver series) by rank 0 with h5py after the
+viewer is closed. ``FILE.xmf`` (XDMF 3, temporal collection) is written on
+rank 0 so ParaView opens the result; ``FILE.json`` holds the resolved options,
+library versions, git revision and number of ranks (PyLith's habit).
+"""
+import json
+import os
+import platform
+import subprocess
+import time as _time
+
+import numpy as np
+
+from ..petsc import init
+
+XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
+             "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
+
+
+class Output:
+    """Collective writer of one run's fields and series."""
+
+    def __init__(self, path, comm):
+        PETSc = init()
+        self.PETSc = PETSc
+        self.path = path
+        self.comm = comm
+        self.rank = comm.getRank()
+        d = os.path.dirname(os.path.abspath(path))
+        if self.rank == 0:
+            os.makedirs(d, exist_ok=True)
+        comm.tompi4py().Barrier()
+        self.viewer = PETSc.Viewer().createHDF5(path, mode="w", comm=comm)
+        self.times = []
+        self.fields = []
+        self.cells = None
+        self.cell_type = None
+        self.n_nodes = 0
+
+    def write_mesh(self, coords_vec, cells, cell_type):
+        """``coords_vec``: PETSc Vec (bs 3) of node coordinates in the field
+        layout; ``cells``: (E, n) int array, needed on rank 0 only."""
+        coords_vec.setName("coordinates")
+        coords_vec.view(self.viewer)
+        self.n_nodes = coords_vec.getSize() // 3
+        self.cells = None if cells is None else np.asarray(cells, dtype=np.int64)
+        self.cell_type = cell_type
+
+    def write_fields(self, t, fields):
+        """Collective: one snapshot of nodal fields ``{name: Vec(bs 3)}``."""
+        k = len(self.times)
+        for name, vec in fields.items():
+            old = vec.getName()
+            vec.setName(f"{name}_{k:06d}")
+            vec.view(self.viewer)
+            vec.setName(old)
+            if name not in self.fields:
+                self.fields.append(name)
+        self.times.append(float(t))
+
+    def close(self, receivers=None, attrs=None, record=None):
+        """Collective: close the viewer, then rank 0 adds the serial data and
+        writes the XDMF and JSON files. ``receivers``: dict with 'points'
+        (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0."""
+        self.viewer.destroy()
+        self.comm.tompi4py().Barrier()
+        if self.rank == 0:
+            import h5py
+            with h5py.File(self.path, "a") as f:
+                if self.cells is not None:
+                    f.create_dataset("topology", data=self.cells)
+                f.create_dataset("time", data=np.asarray(self.times))
+                f.attrs["cell_type"] = self.cell_type or ""
+                f.attrs["fields"] = ",".join(self.fields)
+                f.attrs["n_snapshots"] = len(self.times)
+                from .. import __version__
+                f.attrs["petsc_ssi_version"] = __version__
+                for k, v in (attrs or {}).items():
+                    f.attrs[k] = v
+                if receivers is not None:
+                    g = f.create_group("receivers")
+                    for k, v in receivers.items():
+                        g.create_dataset(k, data=np.asarray(v))
+            self._write_xdmf()
+            if record is not None:
+                with open(os.path.splitext(self.path)[0] + ".json", "w") as fh:
+                    json.dump(record, fh, indent=1, sort_keys=True, default=str)
+        self.comm.tompi4py().Barrier()
+
+    def _write_xdmf(self):
+        if self.cells is None:
+            return
+        base = os.path.basename(self.path)
+        ctype, npc = XDMF_CELL[self.cell_type]
+        ne = self.cells.shape[0]
+        nn = self.n_nodes
+        lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "<Domain>",
+                 '<Grid Name="TimeSeries" GridType="Collection" CollectionType="Temporal">']
+        steps = range(len(self.times)) if self.times else [None]
+        for k in steps:
+            lines.append('<Grid Name="mesh" GridType="Uniform">')
+            if k is not None:
+                lines.append(f'<Time Value="{self.times[k]:.9g}"/>')
+            lines.append(f'<Topology TopologyType="{ctype}" NumberOfElements="{ne}">'
+                         f'<DataItem Dimensions="{ne} {npc}" NumberType="Int" Precision="8" '
+                         f'Format="HDF">{base}:/topology</DataItem></Topology>')
+            lines.append(f'<Geometry GeometryType="XYZ"><DataItem Dimensions="{nn} 3" '
+                         f'Format="HDF">{base}:/coordinates</DataItem></Geometry>')
+            if k is not None:
+                for name in self.fields:
+                    lines.append(f'<Attribute Name="{name}" AttributeType="Vector" Center="Node">'
+                                 f'<DataItem Dimensions="{nn} 3" Format="HDF">'
+                                 f'{base}:/{name}_{k:06d}</DataItem></Attribute>')
+            lines.append("</Grid>")
+        lines += ["</Grid>", "</Domain>", "</Xdmf>"]
+        with open(os.path.splitext(self.path)[0] + ".xmf", "w") as fh:
+            fh.write("\n".join(lines) + "\n")
+
+
+def provenance(cfg, comm, extra=None):
+    """The run record: resolved options, library versions, git revision, ranks."""
+    PETSc = init()
+    import petsc4py
+    import mpi4py
+    from mpi4py import MPI
+    rec = {"options": cfg.as_dict() if cfg is not None else {},
+           "option_sources": cfg.sources() if cfg is not None else {},
+           "petsc": ".".join(map(str, PETSc.Sys.getVersion())),
+           "petsc4py": petsc4py.__version__, "mpi4py": mpi4py.__version__,
+           "mpi": MPI.Get_library_version().splitlines()[0].strip(),
+           "ranks": comm.getSize(), "python": platform.python_version(),
+           "date": _time.strftime("%Y-%m-%dT%H:%M:%S"), "host": platform.node()}
+    try:
+        import h5py
+        rec["hdf5"] = h5py.version.hdf5_version
+    except ImportError:
+        pass
+    try:
+        import gmsh
+        rec["gmsh"] = gmsh.__version__
+    except Exception:  # gmsh is optional for runs on structured meshes
+        pass
+    try:
+        here = os.path.dirname(os.path.abspath(__file__))
+        rec["git"] = subprocess.run(["git", "-C", here, "describe", "--always", "--dirty"],
+                                    capture_output=True, text=True, timeout=5).stdout.strip()
+    except Exception:
+        rec["git"] = ""
+    if extra:
+        rec.update(extra)
+    return rec

@@ -1,0 +1,1 @@
+"""Meshes: nine-node quadrilateral surfaces (BEM) and their readers."""

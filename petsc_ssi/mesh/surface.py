@@ -1,0 +1,182 @@
+"""Surface meshes of nine-node quadrilaterals for the half-space BEM.
+
+``SurfaceMesh``: nodes (N, 3), cells (E, 9) in gmsh order, named element
+groups. ``grid`` builds a structured mesh (tests, quick runs); ``read_gmsh``
+reads a .geo/.msh through the gmsh Python API.
+"""
+import numpy as np
+
+from ..petsc import SSIError
+from . import quad9
+
+
+class SurfaceMesh:
+    def __init__(self, nodes, cells, groups=None, name=""):
+        self.nodes = np.ascontiguousarray(nodes, dtype=float)
+        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
+        self.groups = {k: np.asarray(v, dtype=np.int64) for k, v in (groups or {}).items()}
+        self.name = name
+
+    @property
+    def n_nodes(self):
+        return self.nodes.shape[0]
+
+    @property
+    def n_cells(self):
+        return self.cells.shape[0]
+
+    def cell_coords(self):
+        return self.nodes[self.cells]          # (E, 9, 3)
+
+    def centres(self):
+        return self.nodes[self.cells[:, 8]]
+
+    def select(self, spec):
+        """Element ids of a group name or 'box:x0,x1,y0,y1' (centres inside)."""
+        if spec.startswith("box:"):
+            try:
+                x0, x1, y0, y1 = (float(v) for v in spec[4:].split(","))
+            except ValueError:
+                raise SSIError(f"'{spec}': a box is 'box:x0,x1,y0,y1'") from None
+            c = self.centres()
+            sel = np.where((c[:, 0] >= x0) & (c[:, 0] <= x1) & (c[:, 1] >= y0) & (c[:, 1] <= y1))[0]
+            if sel.size == 0:
+                raise SSIError(f"'{spec}': no element centre lies in the box")
+            return sel
+        if spec not in self.groups:
+            raise SSIError(f"element group '{spec}' is not in the mesh (groups: "
+                           f"{', '.join(sorted(self.groups)) or 'none'})")
+        return self.groups[spec]
+
+    def element_sizes(self):
+        """Distance between neighbouring nodes along each element side (E, 2)."""
+        X = self.cell_coords()
+        s1 = np.linalg.norm(X[:, 4] - X[:, 0], axis=1)
+        s2 = np.linalg.norm(X[:, 7] - X[:, 0], axis=1)
+        return np.stack([s1, s2], 1)
+
+    def check(self):
+        """Validate a nine-node surface: conforming ids, positive orientation."""
+        if self.cells.ndim != 2 or self.cells.shape[1] != 9:
+            raise SSIError("the surface mesh must consist of nine-node quadrilaterals")
+        if self.cells.min() < 0 or self.cells.max() >= self.n_nodes:
+            raise SSIError("the surface mesh refers to nodes that do not exist")
+        X = self.cell_coords()
+        _, jn = quad9.geometry(X, np.array([0.0]), np.array([0.0]))
+        jn = jn[:, 0, :]
+        if np.any(np.linalg.norm(jn, axis=1) <= 0):
+            raise SSIError("the surface mesh has degenerate elements")
+        used = np.zeros(self.n_nodes, bool)
+        used[self.cells.ravel()] = True
+        if not used.all():
+            raise SSIError(f"the surface mesh has {int((~used).sum())} nodes in no element")
+
+
+def _lines(lo, hi, h, cuts):
+    """Grid lines from lo to hi of spacing about h, passing through cuts."""
+    pts = sorted({lo, hi, *[c for c in cuts if lo < c < hi]})
+    out = [pts[0]]
+    for a, b in zip(pts[:-1], pts[1:]):
+        n = max(1, int(round((b - a) / h)))
+        out += list(np.linspace(a, b, n + 1)[1:])
+    return np.array(out)
+
+
+def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
+    """Structured nine-node mesh of [xmin, Lx/2] x [ymin, Ly/2] (z = 0).
+
+    Defaults: centred at the origin. With ``patch=(a, b)`` the grid lines
+    pass through x = +-a, y = +-b and the elements inside form group 'load'.
+    Outward normal +z (soil below).
+    """
+    x0 = -Lx / 2 if xmin is None else xmin
+    y0 = -Ly / 2 if ymin is None else ymin
+    cx = cy = ()
+    if patch is not None:
+        cx, cy = (-patch[0], patch[0]), (-patch[1], patch[1])
+    xs = _lines(x0, Lx / 2, h, cx)
+    ys = _lines(y0, Ly / 2, h, cy)
+    nx, ny = len(xs) - 1, len(ys) - 1
+    # node lines including mid-points
+    xn = np.empty(2 * nx + 1); xn[0::2] = xs; xn[1::2] = 0.5 * (xs[:-1] + xs[1:])
+    yn = np.empty(2 * ny + 1); yn[0::2] = ys; yn[1::2] = 0.5 * (ys[:-1] + ys[1:])
+    X, Y = np.meshgrid(xn, yn, indexing="ij")
+    nodes = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], 1)
+    idx = lambda i, j: i * (2 * ny + 1) + j
+    cells = []
+    for i in range(nx):
+        for j in range(ny):
+            I, J = 2 * i, 2 * j
+            cells.append([idx(I, J), idx(I + 2, J), idx(I + 2, J + 2), idx(I, J + 2),
+                          idx(I + 1, J), idx(I + 2, J + 1), idx(I + 1, J + 2), idx(I, J + 1),
+                          idx(I + 1, J + 1)])
+    cells = np.array(cells, dtype=np.int64)
+    groups = {"surface": np.arange(len(cells))}
+    if patch is not None:
+        c = nodes[cells[:, 8]]
+        groups["load"] = np.where((np.abs(c[:, 0]) < patch[0]) & (np.abs(c[:, 1]) < patch[1]))[0]
+    return SurfaceMesh(nodes, cells, groups, name="grid")
+
+
+def read_gmsh(path, params=None):
+    """Read nine-node quads (gmsh type 10) from a .msh, or mesh a .geo first.
+
+    ``params``: {name: value} set with gmsh.onelab/setNumber before meshing a
+    .geo (DefineConstant parameters). Physical surface groups become element
+    groups. Collective callers should call this on every rank (it is cheap)
+    or broadcast the result.
+    """
+    import gmsh
+    own = not gmsh.isInitialized()
+    if own:
+        gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        if path.endswith(".geo"):
+            for k, v in (params or {}).items():
+                gmsh.onelab.setNumber(f"Parameters/{k}", [float(v)])
+            gmsh.open(path)
+            gmsh.model.mesh.generate(2)
+            gmsh.model.mesh.setOrder(2)
+        else:
+            gmsh.open(path)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        coords = coords.reshape(-1, 3)
+        order = np.argsort(tags)
+        tags = tags[order]; coords = coords[order]
+        tag2idx = {int(t): i for i, t in enumerate(tags)}
+        etypes, etags, enodes = gmsh.model.mesh.getElements(2)
+        if 10 not in list(etypes):
+            names = [gmsh.model.mesh.getElementProperties(t)[0] for t in etypes]
+            raise SSIError(f"{path}: the surface mesh has no nine-node quadrilaterals "
+                           f"(found: {', '.join(names) or 'no 2D elements'})")
+        if len(etypes) > 1:
+            raise SSIError(f"{path}: the surface mesh mixes element types; use nine-node quadrilaterals only")
+        i = list(etypes).index(10)
+        cell_tags = etags[i]
+        conn = np.array([tag2idx[int(t)] for t in enodes[i]], dtype=np.int64).reshape(-1, 9)
+        tag2cell = {int(t): k for k, t in enumerate(cell_tags)}
+        groups = {}
+        for dim, ptag in gmsh.model.getPhysicalGroups(2):
+            name = gmsh.model.getPhysicalName(dim, ptag) or f"group{ptag}"
+            ids = []
+            for ent in gmsh.model.getEntitiesForPhysicalGroup(dim, ptag):
+                _, et, _ = gmsh.model.mesh.getElements(dim, ent)
+                for arr in et:
+                    ids += [tag2cell[int(t)] for t in arr if int(t) in tag2cell]
+            groups[name] = np.array(sorted(ids), dtype=np.int64)
+    finally:
+        if own:
+            gmsh.finalize()
+    used = np.unique(conn)
+    remap = -np.ones(len(coords), np.int64)
+    remap[used] = np.arange(len(used))
+    mesh = SurfaceMesh(coords[used], remap[conn], groups, name=path)
+    # gmsh may orient surfaces with normal -z; the half-space needs +z
+    X = mesh.cell_coords()
+    _, jn = quad9.geometry(X, np.array([0.0]), np.array([0.0]))
+    flip = jn[:, 0, 2] < 0
+    if flip.any():
+        perm = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])
+        mesh.cells[flip] = mesh.cells[flip][:, perm]
+    return mesh

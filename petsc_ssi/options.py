@@ -1,0 +1,222 @@
+"""The one registry of petsc_ssi options (prefix ``-ssi_``).
+
+Every option is declared once, here or in the module that owns it, through
+``register``: name, type, default, unit, help text and an optional validator
+(PyLith's ``meta["tip"]`` + validators). ``resolve`` reads the PETSc options
+database, converts and validates every option of the groups a command uses,
+runs the cross-checks, and raises the same one-line ``SSIError`` on every rank
+before any heavy work. ``-help`` prints the registry (petsc4py has no
+PetscOptionsBegin); ``markdown_table`` generates the README table.
+
+Misspelt ``-ssi_`` options are an error (with a suggestion), so a typo never
+silently runs the default case.
+"""
+import difflib
+from dataclasses import dataclass, field
+
+from .petsc import init, SSIError, collective_error
+
+PREFIX = "ssi_"
+
+_REGISTRY = {}
+_CHECKS = []
+
+
+@dataclass
+class Option:
+    name: str              # without the -ssi_ prefix
+    kind: str              # real | int | bool | str | enum | path
+    default: object
+    unit: str = ""
+    help: str = ""
+    group: str = "run"
+    choices: tuple = ()
+    validator: object = None   # callable(value) -> None or error text
+    aliases: tuple = field(default_factory=tuple)
+
+
+def register(name, kind, default, unit="", help="", group="run", choices=(),
+             validator=None):
+    if name in _REGISTRY:
+        old = _REGISTRY[name]
+        if (old.kind, old.default) != (kind, default):
+            raise ValueError(f"option -ssi_{name} registered twice differently")
+        return old
+    opt = Option(name, kind, default, unit, help, group, tuple(choices), validator)
+    _REGISTRY[name] = opt
+    return opt
+
+
+def register_check(groups, func):
+    """A cross-check ``func(cfg) -> None | str`` run when all ``groups`` resolve."""
+    _CHECKS.append((tuple(groups), func))
+
+
+def positive(v):
+    return None if v > 0 else "must be > 0"
+
+
+def nonnegative(v):
+    return None if v >= 0 else "must be >= 0"
+
+
+def at_least(n):
+    return lambda v: None if v >= n else f"must be >= {n}"
+
+
+def options():
+    return dict(_REGISTRY)
+
+
+class Config:
+    """Resolved option values (attribute access) and where each came from."""
+
+    def __init__(self, values, sources):
+        self._values = values
+        self._sources = sources
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["_values"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def get(self, name, default=None):
+        return self._values.get(name, default)
+
+    def set(self, name, value):
+        self._values[name] = value
+
+    def user_set(self, name):
+        return self._sources.get(name) == "user"
+
+    def as_dict(self):
+        return dict(self._values)
+
+    def sources(self):
+        return dict(self._sources)
+
+
+def _convert(opt, text):
+    if opt.kind == "real":
+        return float(text)
+    if opt.kind == "int":
+        return int(text)
+    if opt.kind == "bool":
+        t = str(text).strip().lower()
+        if t in ("", "1", "true", "yes", "on"):
+            return True
+        if t in ("0", "false", "no", "off"):
+            return False
+        raise ValueError(f"'{text}' is not a boolean")
+    if opt.kind == "enum":
+        t = str(text).strip().lower()
+        if t not in opt.choices:
+            raise ValueError(f"'{text}' is not one of {'|'.join(opt.choices)}")
+        return t
+    return str(text)
+
+
+def _load_modules():
+    # Modules that declare options; imported here so -help sees them all.
+    from . import config_options  # noqa: F401
+
+
+def resolve(groups=None, comm=None):
+    """Collective: read, convert and validate the options of ``groups``.
+
+    Raises ``SSIError`` (same message on every rank) on an unknown ``-ssi_``
+    option, a value that does not convert, a failed validator or cross-check.
+    """
+    PETSc = init()
+    comm = comm or PETSc.COMM_WORLD
+    _load_modules()
+    db = PETSc.Options()
+    allopts = db.getAll()
+    err = None
+    for key in allopts:
+        if key.startswith(PREFIX):
+            name = key[len(PREFIX):]
+            if name in _REGISTRY or _is_petsc_object_option(name):
+                continue
+            near = difflib.get_close_matches(name, list(_REGISTRY), n=1)
+            hint = f" (did you mean -ssi_{near[0]}?)" if near else ""
+            err = f"unknown option -{key}{hint}; -help lists every -ssi_ option"
+            break
+    values, sources = {}, {}
+    if err is None:
+        for name, opt in _REGISTRY.items():
+            if groups is not None and opt.group not in groups and opt.group != "common":
+                continue
+            key = PREFIX + name
+            if db.hasName(key):
+                raw = db.getString(key, "")
+                try:
+                    val = _convert(opt, raw)
+                except ValueError as exc:
+                    err = f"-ssi_{name}: {exc}"
+                    break
+                sources[name] = "user"
+            else:
+                val = opt.default
+                sources[name] = "default"
+            if opt.validator is not None and val is not None:
+                msg = opt.validator(val)
+                if msg:
+                    err = f"-ssi_{name} {val}: {msg}"
+                    break
+            values[name] = val
+    cfg = Config(values, sources)
+    if err is None:
+        for grps, func in _CHECKS:
+            if groups is not None and not set(grps) <= set(groups) | {"common"}:
+                continue
+            msg = func(cfg)
+            if msg:
+                err = msg
+                break
+    collective_error(err, comm)
+    return cfg
+
+
+def _is_petsc_object_option(name):
+    # -ssi_bem_ksp_type, -ssi_fem_pc_type, ...: options of PETSc objects that
+    # carry a petsc_ssi prefix belong to PETSc, not to this registry.
+    for pfx in ("bem_", "fem_", "coupling_", "modes_"):
+        if name.startswith(pfx):
+            rest = name[len(pfx):]
+            if rest.split("_")[0] in ("ksp", "pc", "mat", "eps", "st", "snes", "vec"):
+                return True
+    return False
+
+
+def help_text():
+    _load_modules()
+    lines = ["petsc_ssi options (prefix -ssi_); PETSc's own options follow with -help", ""]
+    bygroup = {}
+    for opt in _REGISTRY.values():
+        bygroup.setdefault(opt.group, []).append(opt)
+    for grp in sorted(bygroup):
+        lines.append(f"  [{grp}]")
+        for opt in sorted(bygroup[grp], key=lambda o: o.name):
+            kind = "|".join(opt.choices) if opt.kind == "enum" else opt.kind
+            unit = f" [{opt.unit}]" if opt.unit else ""
+            lines.append(f"  -ssi_{opt.name} <{opt.default}> ({kind}){unit}: {opt.help}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def markdown_table(groups=None):
+    """The README's option table, generated from the registry."""
+    _load_modules()
+    rows = ["| option | default | unit | meaning |", "|---|---|---|---|"]
+    for opt in sorted(_REGISTRY.values(), key=lambda o: (o.group, o.name)):
+        if groups is not None and opt.group not in groups:
+            continue
+        kind = "|".join(opt.choices) if opt.kind == "enum" else opt.kind
+        rows.append(f"| `-ssi_{opt.name}` ({kind}) | `{opt.default}` | {opt.unit} | {opt.help} |")
+    return "\n".join(rows)
+
+
+__all__ = ["register", "register_check", "resolve", "help_text", "markdown_table",
+           "Config", "SSIError", "positive", "nonnegative", "at_least"]

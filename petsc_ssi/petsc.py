@@ -1,0 +1,115 @@
+"""Start-up of petsc4py and small collective helpers.
+
+``init()`` must be called before ``from petsc4py import PETSc`` anywhere, so
+that command-line options reach the PETSc options database (petsc4py demos,
+PyLith). Nothing here captures MPI state at import time.
+"""
+import sys
+
+_INITIALISED = False
+
+
+def init(argv=None):
+    """Initialise petsc4py with ``argv`` (default ``sys.argv``); idempotent."""
+    global _INITIALISED
+    if not _INITIALISED:
+        import petsc4py
+        petsc4py.init(sys.argv if argv is None else argv)
+        _INITIALISED = True
+    from petsc4py import PETSc
+    return PETSc
+
+
+class SSIError(RuntimeError):
+    """An input or set-up error, raised on every rank with the same message."""
+
+
+def comm_world():
+    PETSc = init()
+    return PETSc.COMM_WORLD
+
+
+def collective_error(message, comm=None):
+    """Collective: raise SSIError on every rank if any rank passes a message.
+
+    Each rank passes ``None`` (all well) or a one-line message. The message of
+    the lowest failing rank is broadcast so that all ranks raise the same
+    error and mpirun never hangs on a rank that stopped alone.
+    """
+    comm = comm or comm_world()
+    mpi = comm.tompi4py()
+    flags = mpi.allgather(message)
+    for m in flags:
+        if m is not None:
+            raise SSIError(m)
+
+
+def check(condition, message, comm=None):
+    """Collective assert: ``condition`` may differ between ranks."""
+    collective_error(None if condition else message, comm)
+
+
+def rank(comm=None):
+    return (comm or comm_world()).getRank()
+
+
+def size(comm=None):
+    return (comm or comm_world()).getSize()
+
+
+def printf(msg, comm=None):
+    """Print from rank 0 only (PETSc.Sys.Print), flushing at once."""
+    PETSc = init()
+    PETSc.Sys.Print(msg, comm=comm or PETSc.COMM_WORLD)
+    sys.stdout.flush()
+
+
+def warn(msg, comm=None):
+    printf("petsc-ssi: warning: " + msg, comm)
+
+
+def set_default_options(prefix, defaults, log=None):
+    """Insert PETSc options ``prefix+key`` only where the user set nothing.
+
+    Returns the list of defaults applied, so the run log can say which were
+    (PyLith ``Options::set``).
+    """
+    PETSc = init()
+    opts = PETSc.Options()
+    applied = []
+    for key, value in defaults.items():
+        name = prefix + key
+        if not opts.hasName(name):
+            opts.setValue(name, value)
+            applied.append(f"-{name} {value}")
+    if log is not None and applied:
+        log(f"  defaults applied: {' '.join(applied)}")
+    return applied
+
+
+def has_package(name):
+    """Whether this PETSc build has an external package (MUMPS, hypre, ...)."""
+    PETSc = init()
+    try:
+        return bool(PETSc.Sys.hasExternalPackage(name))
+    except AttributeError:  # very old petsc4py
+        return True
+
+
+def direct_solver_defaults(comm):
+    """KSP defaults for a factorise-once direct solve.
+
+    MUMPS when PETSc has it; PETSc's own LU only on one rank, with a warning;
+    a clear error in parallel without MUMPS or SuperLU_dist (never a silent
+    fall back to a serial-only factorisation, Firedrake's rule).
+    """
+    for pkg in ("mumps", "superlu_dist"):
+        if has_package(pkg):
+            return {"ksp_type": "preonly", "pc_type": "lu",
+                    "pc_factor_mat_solver_type": pkg}
+    if comm.getSize() == 1:
+        warn("PETSc has neither MUMPS nor SuperLU_dist: using PETSc's serial LU")
+        return {"ksp_type": "preonly", "pc_type": "lu",
+                "pc_factor_mat_solver_type": "petsc"}
+    raise SSIError("this PETSc has no parallel direct solver (MUMPS, SuperLU_dist); "
+                   "run on one rank or choose an iterative solver with -ssi_*_ksp_type/-pc_type")
