@@ -10,4 +10,30 @@ Import order matters: ``petsc_ssi.petsc.init()`` must run (it calls
 every command-line option reaches the options database. The command line
 ``petsc-ssi`` does this; library users call it first.
 """
+import hashlib as _hashlib
+import os as _os
+
 __version__ = "0.1.0"
+
+
+def _numba_cache_dir():
+    """Key numba's on-disk cache on a hash of this package's sources.
+
+    numba's cache of a compiled function does not notice edits to the
+    functions it inlines from other modules, so a stale kernel could run
+    after an upgrade. A per-source-hash directory makes that impossible.
+    """
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    h = _hashlib.sha1(__version__.encode())
+    for root, _, files in sorted(_os.walk(here)):
+        for f in sorted(files):
+            if f.endswith(".py"):
+                with open(_os.path.join(root, f), "rb") as fh:
+                    h.update(fh.read())
+    base = _os.environ.get("NUMBA_CACHE_DIR") or _os.path.join(
+        _os.path.expanduser("~"), ".cache", "petsc_ssi", "numba")
+    return _os.path.join(base, h.hexdigest()[:12])
+
+
+if "numba" not in __import__("sys").modules:
+    _os.environ["NUMBA_CACHE_DIR"] = _numba_cache_dir()

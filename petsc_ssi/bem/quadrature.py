@@ -38,7 +38,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .kernels import f1_tensor, t2_tensor, kelvin_u, kelvin_p
+from .kernels import ab1, ab2_fast, kelvin_u, kelvin_p
 
 # natural coordinates of the nine nodes and 1D Lagrange indices (quad9 module)
 _NXI = np.array([-1., 1., 1., -1., 0., 1., 0., -1., 0.])
@@ -92,6 +92,20 @@ def _sub_sphere(X, cx, cy, hh, N, d1, d2, xc, jn, pt):
     return 1.1 * rad + 1e-12
 
 
+@njit(cache=True, inline="always")
+def _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, out):
+    """Traction tensor of A d_lk + B g_l g_k (kernels.traction_from_ab),
+    regrouped as a1 g_l n_k + a2 (n_l g_k + gn d_lk) + a3 gn g_l g_k."""
+    br = B / r
+    a1 = lam * (dA + dB + 2.0 * br) + 2.0 * mu * br
+    a2 = mu * (dA + br)
+    a3 = gn * mu * (2.0 * dB - 4.0 * br)
+    for l in range(3):
+        for k in range(3):
+            out[l, k] = a1 * g[l] * n[k] + a2 * n[l] * g[k] + a3 * g[l] * g[k]
+        out[l, l] += a2 * gn
+
+
 @njit(cache=True)
 def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                    Ub, Pb, want_u):
@@ -100,20 +114,27 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
     Ub, Pb: (hi-lo+1, 9, 3, 3), accumulated (caller zeroes). ``sing`` >= 0:
     xi is node ``sing`` of the element; the static kernels are subtracted
     from lag 1 (their singular integral is added by ``singular_static``).
-    Returns the number of kernel evaluations (for cost accounting).
+    The traction is linear in (A, B, A', B') at a fixed point, so the second
+    time difference is taken on these four scalars and one tensor is formed
+    per lag. Returns the number of (point, lag) kernel evaluations.
     """
     mu = rho * beta * beta
+    lam = rho * alpha * alpha - 2.0 * mu
+    s4 = 1.0 / (4.0 * math.pi * rho)
     ng = gq.shape[0]
     h = 2.0 / ns
     N = np.zeros(9); d1 = np.zeros(9); d2 = np.zeros(9)
     x = np.zeros(3); jn = np.zeros(3); cen = np.zeros(3); tmp = np.zeros(3)
     g = np.zeros(3); n = np.zeros(3)
     nl = hi - lo + 1
-    F1 = np.zeros((nl + 2, 3, 3))
-    T2 = np.zeros((nl + 3, 3, 3))
+    S2 = np.zeros((nl + 3, 4))
+    S1 = np.zeros((nl + 3, 2))
+    pt = np.zeros((3, 3)); ut = np.zeros((3, 3))
     ku = np.zeros((3, 3)); kp = np.zeros((3, 3))
     cdt_a = alpha * dt
     cdt_b = beta * dt
+    ia = 1.0 / alpha
+    ib = 1.0 / beta
     nev = 0
     for si in range(ns):
         for sj in range(ns):
@@ -143,8 +164,10 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                     r = math.sqrt(r)
                     if r < 1e-14:
                         continue
+                    ir = 1.0 / r
                     for k in range(3):
-                        g[k] /= r
+                        g[k] *= ir
+                    gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2]
                     plo = max(slo, int(math.floor(r / cdt_a)) + 1)
                     phi = min(shi, int(math.floor(r / cdt_b)) + 2)
                     subtract = sing >= 0 and lo == 1
@@ -152,38 +175,58 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                         plo = 1
                     if plo > phi:
                         continue
-                    # kernel values at times j*dt, j = plo-2 .. phi
                     for j in range(plo - 2, phi + 1):
                         jj = j - (plo - 2)
                         t = j * dt
                         if t <= 0.0:
-                            for a in range(3):
-                                for b in range(3):
-                                    F1[jj, a, b] = 0.0
-                                    T2[jj, a, b] = 0.0
+                            S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
+                            S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
                         else:
+                            a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
+                            S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
                             if want_u:
-                                f1_tensor(g, r, t, alpha, beta, rho, F1[jj])
-                            t2_tensor(g, n, r, t, alpha, beta, rho, T2[jj])
-                            nev += 1
+                                a1, b1 = ab1(r, t, alpha, beta)
+                                S1[jj, 0] = a1; S1[jj, 1] = b1
                     if subtract:
                         kelvin_u(g, r, nu, mu, ku)
                         kelvin_p(g, n, r, nu, kp)
+                    fdt = s4 / dt
                     for l in range(plo, phi + 1):
                         jj = l - (plo - 2)
                         li = l - lo
+                        A = (S2[jj, 0] - 2.0 * S2[jj - 1, 0] + S2[jj - 2, 0]) * fdt
+                        B = (S2[jj, 1] - 2.0 * S2[jj - 1, 1] + S2[jj - 2, 1]) * fdt
+                        dA = (S2[jj, 2] - 2.0 * S2[jj - 1, 2] + S2[jj - 2, 2]) * fdt
+                        dB = (S2[jj, 3] - 2.0 * S2[jj - 1, 3] + S2[jj - 2, 3]) * fdt
+                        nev += 1
+                        if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0 and not (subtract and l == 1):
+                            continue
+                        _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, pt)
+                        if subtract and l == 1:
+                            for a in range(3):
+                                for b in range(3):
+                                    pt[a, b] -= kp[a, b]
                         for a in range(3):
                             for b in range(3):
-                                pv = (T2[jj, a, b] - 2.0 * T2[jj - 1, a, b] + T2[jj - 2, a, b]) / dt
-                                uv = F1[jj, a, b] - F1[jj - 1, a, b]
-                                if subtract and l == 1:
-                                    pv -= kp[a, b]
-                                    uv -= ku[a, b]
-                                pw = pv * w
-                                uw = uv * w
-                                for c in range(9):
-                                    Pb[li, c, a, b] += pw * N[c]
-                                    if want_u:
+                                pw = pt[a, b] * w
+                                if pw != 0.0:
+                                    for c in range(9):
+                                        Pb[li, c, a, b] += pw * N[c]
+                        if want_u:
+                            A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
+                            B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
+                            for a in range(3):
+                                for b in range(3):
+                                    ut[a, b] = B1 * g[a] * g[b]
+                                ut[a, a] += A1
+                            if subtract and l == 1:
+                                for a in range(3):
+                                    for b in range(3):
+                                        ut[a, b] -= ku[a, b]
+                            for a in range(3):
+                                for b in range(3):
+                                    uw = ut[a, b] * w
+                                    for c in range(9):
                                         Ub[li, c, a, b] += uw * N[c]
     return nev
 

@@ -311,7 +311,9 @@ def _finish(cfg, comm, prob, out, res):
     if res["u"] is not None:
         recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
     attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
-             "scheme": cfg.scheme, "load_p0": cfg.load_p0}
+             "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
+    if cfg.mesh_patch and cfg.load_group == "load":
+        attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
     rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
     out.close(receivers=recd, attrs=attrs, record=rec_)
     ev.end()
