@@ -29,7 +29,9 @@ def _numba_cache_dir():
         for f in sorted(files):
             if f.endswith(".py"):
                 with open(_os.path.join(root, f), "rb") as fh:
-                    h.update(fh.read())
+                    src = fh.read()
+                if b"njit" in src:     # only modules with compiled code matter
+                    h.update(f.encode() + src)
     base = _os.environ.get("NUMBA_CACHE_DIR") or _os.path.join(
         _os.path.expanduser("~"), ".cache", "petsc_ssi", "numba")
     return _os.path.join(base, h.hexdigest()[:12])

@@ -39,6 +39,7 @@ register("max_subdivisions", "int", 32, "per side", "cap on the near-field subdi
 register("gauss", "int", 2, "per direction", "Gauss points per subdivision and direction (paper: 2)", "bem", validator=at_least(1))
 register("singular_order", "int", 12, "", "Gauss order of the polar (radial and angular) singular integration", "bem",
          validator=at_least(2))
+register("cache", "bool", True, "", "integrate each distinct (collocation point, element) geometry once and reuse it for translated copies (exact)", "bem")
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))

@@ -12,7 +12,8 @@ displacement regions): a traction-free surface multiplies zeros.
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.typed import Dict
 
 from .quadrature import integrate_pair, singular_static
 
@@ -28,13 +29,39 @@ def _grow(a, n):
 
 
 @njit(cache=True)
+def _geom_key(X, xc, qinv, key):
+    """Quantised coordinates of an element relative to the collocation point
+    and their hash: equal keys mean the same pair geometry to within 1/qinv."""
+    hsh = np.int64(1469598103934665603)
+    for a in range(9):
+        for k in range(3):
+            q = np.int64(round((X[a, k] - xc[k]) * qinv))
+            key[3 * a + k] = q
+            hsh = (hsh ^ q) * np.int64(1099511628211)
+    return hsh
+
+
+def new_cache():
+    """An element-integral cache (kept across calls of ``assemble_rows``)."""
+    return (Dict.empty(key_type=types.int64, value_type=types.int64),
+            np.zeros((16, 27), np.int64), np.zeros((16, 4), np.int64),
+            np.zeros(1024), np.zeros(1024))
+
+
+@njit(cache=True)
 def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alpha, beta,
                   rho, nu, ns_base, near_factor, ns_max, gq, gw, gr, gwr, n_nodes, n_tcols,
-                  free_term, tol):
+                  free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv):
     """Collective-free numba kernel: triplets of H and G for ``rows``.
 
-    Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev) with lags
-    1-based and ``nev`` the number of kernel evaluations.
+    Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev, hits, cache
+    arrays) with lags 1-based, ``nev`` the number of (point, lag) kernel
+    evaluations and ``hits`` the pairs taken from the cache. With
+    ``use_cache`` the element integrals of a pair are reused for every later
+    pair with the same relative geometry (quantised to 1/qinv): translated
+    copies of an element on a structured mesh are integrated once. The key
+    includes the node order, so images and singular pairs are keyed correctly;
+    the integrals depend on nothing else (material, dt and lags are fixed).
     """
     mu = rho * beta * beta
     nv = VX.shape[0]
@@ -50,6 +77,14 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
     Pb = np.zeros((L, 9, 3, 3))
     Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
     nev = 0
+    hits = 0
+    ncache = len(cidx)
+    pool_n = 0
+    for k in range(ncache):
+        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
+        if e > pool_n:
+            pool_n = e
+    key = np.zeros(27, np.int64)
     reach = alpha * dt * L
     for ii in range(rows.shape[0]):
         i = rows[ii]
@@ -84,16 +119,50 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                 if Vtcol[v, a] >= 0:
                     want_u = True
             nl = hi - lo + 1
-            Ub[:nl] = 0.0
-            Pb[:nl] = 0.0
-            nev += integrate_pair(xc, VX[v], sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
-                                  Ub, Pb, want_u)
-            if sing >= 0:
-                Us[:] = 0.0
-                Ps[:] = 0.0
-                singular_static(VX[v], sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps)
-                Ub[0] += Us
-                Pb[0] += Ps
+            found = -1
+            if use_cache:
+                hsh = _geom_key(VX[v], xc, qinv, key)
+                if hsh in cidx:
+                    c = cidx[hsh]
+                    same = cmeta[c, 0] == lo and cmeta[c, 1] == hi and (cmeta[c, 3] == 1 or not want_u)
+                    for k in range(27):
+                        if ckeys[c, k] != key[k]:
+                            same = False
+                    if same:
+                        found = c
+            if found >= 0:
+                off = cmeta[found, 2]
+                Pb[:nl] = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
+                if want_u:
+                    Ub[:nl] = cpoolU[off:off + nl * 81].reshape((nl, 9, 3, 3))
+                hits += 1
+            else:
+                Ub[:nl] = 0.0
+                Pb[:nl] = 0.0
+                nev += integrate_pair(xc, VX[v], sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
+                                      Ub, Pb, want_u)
+                if sing >= 0:
+                    Us[:] = 0.0
+                    Ps[:] = 0.0
+                    singular_static(VX[v], sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps)
+                    Ub[0] += Us
+                    Pb[0] += Ps
+                if use_cache and hsh not in cidx:
+                    c = ncache
+                    ckeys = _grow(ckeys, c)
+                    cmeta = _grow(cmeta, c)
+                    while pool_n + nl * 81 > cpoolP.shape[0]:
+                        cpoolP = _grow(cpoolP, cpoolP.shape[0])
+                        cpoolU = _grow(cpoolU, cpoolU.shape[0])
+                    ckeys[c] = key
+                    cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
+                    cmeta[c, 3] = 1 if want_u else 0
+                    cpoolP[pool_n:pool_n + nl * 81] = Pb[:nl].ravel()
+                    if want_u:
+                        cpoolU[pool_n:pool_n + nl * 81] = Ub[:nl].ravel()
+                    pool_n += nl * 81
+                    cidx[hsh] = c
+                    ncache += 1
             for li in range(nl):
                 lag = lo + li
                 for a in range(9):
@@ -146,4 +215,4 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
         for k in range(g0, ng_):
             slotG[glag[k], gcol[k]] = -1
     return (hrow[:nh], hlag[:nh], hcol[:nh], hval[:nh], grw[:ng_], glag[:ng_], gcol[:ng_],
-            gval[:ng_], nev)
+            gval[:ng_], nev, hits, ckeys, cmeta, cpoolP, cpoolU)

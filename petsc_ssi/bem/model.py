@@ -13,7 +13,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import assemble_rows
+from .assemble import assemble_rows, new_cache
 
 
 class Material:
@@ -128,15 +128,24 @@ class LagSet:
         nev = 0
         ev = event("SSI_BEM_Assembly")
         ev.begin()
+        cidx, ckeys, cmeta, cpP, cpU = new_cache()
+        qinv = 1.0 / (1e-9 * float(self.Vh.min()))
+        hits = 0
         for s in range(0, len(rows), chunk):
             res = assemble_rows(rows[s:s + chunk], self.mesh.nodes, self.VX, self.VN, self.VS, self.VT,
                                 self.Vc, self.VR, self.Vh, self.L, self.dt, self.mat.cp, self.mat.cs,
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
-                                self.regions.n_t, 0.5, 1e-8)
+                                self.regions.n_t, 0.5, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
+                                cpP, cpU, qinv)
             parts.append(res[:8])
             nev += res[8]
+            hits += res[9]
+            ckeys, cmeta, cpP, cpU = res[10:14]
             prog.update(min(s + chunk, len(rows)))
+        self.cache_entries = len(cidx)
+        self.cache_hits = self.comm.tompi4py().allreduce(hits)
+        self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)
         ev.end()
         if not parts:
             parts.append((np.zeros(0, np.int64),) * 3 + (np.zeros((0, 3, 3)),) + (np.zeros(0, np.int64),) * 3

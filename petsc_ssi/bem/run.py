@@ -142,7 +142,7 @@ class BEMProblem:
     def quad_options(self):
         c = self.cfg
         return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
-                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions}
+                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions, "cache": c.cache}
 
     def lagset(self):
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,
@@ -223,7 +223,8 @@ def run_bem(cfg, comm=None):
     fill = blocks / float(prob.L * N * N)
     printf(f"[ssi] assembly {fmt_time(t_asm)}: {prob.L} lags ({ndense} dense, {nbaij} block-sparse), "
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
-           f"{ls.kernel_evaluations:.3g} kernel evaluations")
+           f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
+           f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
     st = stage("SSI BEM time loop")
     st.push()
     march = Marcher(comm, ls, H, G, cfg.scheme, prob.known_u(), prob.known_p(), log=log)
@@ -234,7 +235,7 @@ def run_bem(cfg, comm=None):
     stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
              "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
              "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
-             "kernel_evaluations": ls.kernel_evaluations, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
+             "kernel_evaluations": ls.kernel_evaluations, "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
     res["stats"] = stats
     _finish(cfg, comm, prob, out, res)
     printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")

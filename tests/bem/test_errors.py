@@ -1,0 +1,72 @@
+"""Bad input: a clear one-line error before heavy work, on every rank."""
+import shutil
+
+import numpy as np
+import pytest
+
+from helpers import resolve_error, cli, ROOT
+
+SMALL = dict(mesh_size="4,4", mesh_h=1.0, t_end=0.003)
+
+
+@pytest.mark.parametrize("opts,expect", [
+    (dict(dt=0), "-ssi_dt 0.0: must be > 0"),
+    (dict(dt=-1e-3), "must be > 0"),
+    (dict(cs=600, cp=548), "must be smaller than -ssi_cp"),
+    (dict(rho=0), "-ssi_rho 0.0: must be > 0"),
+    (dict(mesh="/nonexistent/surface.msh"), "no such file"),
+    (dict(receivers="30,0,0"), "lies off the surface mesh"),
+    (dict(receivers="1,0,-2"), "not on the surface"),
+    (dict(receivers="1,2"), "each point needs x,y,z"),
+    (dict(load_group="nosuchgroup", load_p0=1), "element group 'nosuchgroup' is not in the mesh"),
+    (dict(symmetry="z=sym"), "planes are x or y"),
+    (dict(memory_limit=1e-6, t_end=0.01), "more than the"),
+    (dict(scheme="explicit"), "is not one of"),
+    (dict(dtt=1e-3), "did you mean -ssi_dt"),
+])
+def test_bad_input_one_line_error(opts, expect):
+    msg = resolve_error(**{**SMALL, **opts})
+    assert msg is not None and expect in msg, msg
+    assert "\n" not in msg
+
+
+def _write_msh(path, order, xmin=-2.0):
+    import gmsh
+    gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
+    try:
+        gmsh.model.add("t")
+        s = gmsh.model.occ.addRectangle(xmin, -2, 0, 4, 4)
+        gmsh.model.occ.synchronize()
+        gmsh.model.addPhysicalGroup(2, [s], name="surface")
+        gmsh.option.setNumber("Mesh.RecombineAll", 1)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
+        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(order)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+
+
+def test_mesh_not_nine_node_quads(tmp_path):
+    p = tmp_path / "quad4.msh"
+    _write_msh(p, 1)
+    msg = resolve_error(**{**SMALL, "mesh": str(p)})
+    assert msg is not None and "nine-node quadrilaterals" in msg, msg
+
+
+def test_symmetry_plane_not_respected(tmp_path):
+    p = tmp_path / "full.msh"
+    _write_msh(p, 2)
+    assert resolve_error(**{**SMALL, "mesh": str(p)}) is None   # the mesh itself is fine
+    msg = resolve_error(**{**SMALL, "mesh": str(p), "symmetry": "x=sym"})
+    assert msg is not None and "crosses the plane x = 0" in msg, msg
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
+def test_error_under_mpirun_does_not_hang():
+    """Two ranks, bad receiver: exit status 2 with the message, within the timeout."""
+    p = cli(["-ssi_mesh_size", "4,4", "-ssi_receivers", "30,0,0", "-ssi_t_end", "0.003"], nranks=2,
+            timeout=120, check=False)
+    assert p.returncode != 0
+    assert "petsc-ssi: error: receiver (30, 0, 0) lies off the surface mesh" in p.stdout

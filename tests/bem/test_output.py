@@ -1,0 +1,53 @@
+"""Output: HDF5 (PETSc viewer) + XDMF + JSON record, and `petsc-ssi post`."""
+import json
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from helpers import cli, read_h5, ROOT
+
+
+def test_hdf5_xdmf_json_and_post_csv(tmp_path):
+    out = tmp_path / "run.h5"
+    cli(["-options_file", "runs/pekeris/small.opts", "-ssi_mesh_size", "6,6", "-ssi_t_end", "0.003",
+         "-ssi_output_stride", "2", "-ssi_output", str(out), "-ssi_plot"])
+    d = read_h5(out)
+    assert {"coordinates", "topology", "time", "displacement_000000", "displacement_000001",
+            "traction_000000", "receivers"} <= set(d["keys"])
+    assert d["u"].shape == (4, 2, 3)
+    np.testing.assert_allclose(d["t"], 7.5e-4 * np.arange(1, 5), rtol=1e-12)
+    import h5py
+    with h5py.File(out) as f:
+        ncoord = f["coordinates"].shape
+        assert f["topology"].shape[1] == 9 and ncoord[1] == 3
+        assert np.all(f["topology"][:] < ncoord[0])
+        np.testing.assert_allclose(f["time"][:], [1.5e-3, 3.0e-3])
+        # the applied traction appears in the traction field: -p0 in z under the load
+        assert np.isclose(f["traction_000000"][:, 2].min(), -1000.0)
+    xmf = ET.parse(str(out).replace(".h5", ".xmf")).getroot()
+    grids = xmf.findall(".//Grid[@GridType='Uniform']")
+    assert len(grids) == 2 and grids[0].find("Topology").get("TopologyType") == "Quadrilateral_9"
+    rec = json.load(open(str(out).replace(".h5", ".json")))
+    for key in ("petsc", "petsc4py", "mpi4py", "mpi", "ranks", "options", "git", "hdf5"):
+        assert key in rec
+    assert rec["options"]["dt"] == 7.5e-4 and rec["option_sources"]["dt"] == "user"
+    assert os.path.getsize(str(out).replace(".h5", ".png")) > 10000
+    p = subprocess.run([sys.executable, "-m", "petsc_ssi", "post", str(out), "--receivers", "--csv"],
+                       capture_output=True, text=True, cwd=ROOT, check=True)
+    lines = p.stdout.strip().splitlines()
+    assert lines[0] == "receiver,x,y,z,t,ux,uy,uz"
+    assert len(lines) == 1 + 2 * 4
+    row = lines[-1].split(",")
+    assert row[0] == "1" and float(row[1]) == 5.0 and np.isclose(float(row[7]), d["u"][-1, 1, 2], rtol=1e-8)
+
+
+def test_help_lists_every_option():
+    p = subprocess.run([sys.executable, "-m", "petsc_ssi", "help"], capture_output=True, text=True,
+                       cwd=ROOT, check=True)
+    from petsc_ssi import options
+    options._load_modules()
+    for name, opt in options.options().items():
+        assert f"-ssi_{name} <{opt.default}>" in p.stdout

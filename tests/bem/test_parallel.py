@@ -1,0 +1,23 @@
+"""mpirun -n 2 reproduces -n 1 (the test launches mpirun)."""
+import shutil
+
+import numpy as np
+import pytest
+
+from helpers import cli, read_h5, relmax
+
+ARGS = ["-ssi_mesh_size", "8,8", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load",
+        "-ssi_load_p0", "1000", "-ssi_symmetry", "x=sym", "-ssi_t_end", "0.0075", "-ssi_dt", "7.5e-4",
+        "-ssi_receivers", "3,0,0;-2,2,0", "-ssi_output_stride", "5"]
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
+@pytest.mark.parametrize("storage", ["auto", "sparse"])
+def test_two_ranks_reproduce_one(tmp_path, storage):
+    a, b = tmp_path / "n1.h5", tmp_path / "n2.h5"
+    cli(ARGS + ["-ssi_lag_storage", storage, "-ssi_output", str(a)], nranks=1)
+    cli(ARGS + ["-ssi_lag_storage", storage, "-ssi_output", str(b)], nranks=2)
+    r1, r2 = read_h5(a), read_h5(b)
+    assert np.abs(r1["u"]).max() > 0
+    assert relmax(r2["u"], r1["u"]) <= 1e-10
+    assert relmax(r2["last"], r1["last"]) <= 1e-10

@@ -1,0 +1,80 @@
+"""Helpers for tests that run petsc_ssi in-process or under mpirun."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PY = sys.executable
+
+
+def petsc():
+    from petsc_ssi.petsc import init
+    return init(["pytest"])
+
+
+def run_bem(**opts):
+    """Run a BEM case in this process with -ssi_<key> <value> options."""
+    PETSc = petsc()
+    from petsc_ssi import options
+    from petsc_ssi.bem.run import run_bem as _run
+    db = PETSc.Options()
+    for k, v in opts.items():
+        db.setValue("ssi_" + k, str(v))
+    try:
+        cfg = options.resolve(("common", "bem"))
+        return _run(cfg)
+    finally:
+        for k in opts:
+            db.delValue("ssi_" + k)
+
+
+def resolve_error(groups=("common", "bem"), **opts):
+    """The SSIError message options.resolve + BEM set-up raise, or None."""
+    PETSc = petsc()
+    from petsc_ssi import options
+    from petsc_ssi.petsc import SSIError
+    from petsc_ssi.bem.run import BEMProblem
+    db = PETSc.Options()
+    for k, v in opts.items():
+        db.setValue("ssi_" + k, str(v))
+    try:
+        cfg = options.resolve(groups)
+        prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
+        prob.check_memory(prob.lagset())
+        return None
+    except SSIError as exc:
+        return str(exc)
+    finally:
+        for k in opts:
+            db.delValue("ssi_" + k)
+
+
+def cli(args, nranks=1, timeout=900, check=True):
+    """Run ``petsc-ssi`` (python -m petsc_ssi) in a subprocess, optionally under mpirun."""
+    cmd = [PY, "-m", "petsc_ssi"] + list(args)
+    if nranks > 1:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
+    env = dict(os.environ)
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout, env=env)
+    if check and p.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
+    return p
+
+
+def read_h5(path):
+    import h5py
+    with h5py.File(path, "r") as f:
+        d = {"t": f["receivers/t"][:], "u": f["receivers/u"][:], "points": f["receivers/points"][:]}
+        snaps = sorted(k for k in f.keys() if k.startswith("displacement_"))
+        if snaps:
+            d["last"] = f[snaps[-1]][:]
+        d["attrs"] = dict(f.attrs)
+        d["keys"] = list(f.keys())
+    return d
+
+
+def relmax(a, b):
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / max(np.abs(np.asarray(b)).max(), 1e-300))
