@@ -1,0 +1,367 @@
+r"""Time integrators of M a + C v + K u = f with C = alpha_m M (lumped M).
+
+GreenIntegrator: implicit Green's functions (Soares & Mansur 2005; paper
+Section 3, eqs. 13-24). NewmarkIntegrator: plain Newmark, for comparison.
+Both factorise D = M/(alpha dt^2) + delta/(alpha dt) C + K (eq. 15) once.
+
+Derivation of the constants (alpha, delta = Newmark's beta, gamma).
+The implicit Green's function G(t) is the displacement response to
+u(0) = 0, v(0) = M^{-1} (a unit impulse), computed by ONE Newmark step; then
+a(0) = -M^{-1} C M^{-1} = -alpha_m M^{-1} and Newmark's step gives
+
+  G(dt)   = b1 D^{-1},        b1 = (delta/alpha - 1) alpha_m
+                                   - (dt/2)(delta/alpha - 2) alpha_m^2 - b0
+  dG(dt)  = b3 D^{-1} + b2 M^{-1},   b3 = delta b1 / (alpha dt),
+                                   b2 = 1 - dt (1 - delta) alpha_m + delta dt b0
+  ddG(dt) = b1/(alpha dt^2) D^{-1} + b0 M^{-1},
+                                   b0 = (1/(2 alpha) - 1) alpha_m - 1/(alpha dt)
+
+(the velocity/acceleration follow Newmark's updates a1 = (u1 - dt v0)/(alpha
+dt^2) - (1/(2 alpha) - 1) a0, v1 = v0 + dt((1 - delta) a0 + delta a1)). The
+free response to (u, v) at t_{n-1} is u(t) = [dG M + G C] u + G M v, so with
+C = alpha_m M
+
+  u^n = D^{-1} M (b4 u^{n-1} + b1 v^{n-1}) + b2 u^{n-1},         b4 = alpha_m b1 + b3   (13)
+  v^n = D^{-1} M (b5 u^{n-1} + b3 v^{n-1}) + b6 u^{n-1} + b2 v^{n-1},
+                                     b5 = alpha_m b3 + b1/(alpha dt^2), b6 = alpha_m b2 + b0
+
+and since b3/b1 = delta/(alpha dt), (b3/b1) b4 = b5 exactly when delta^2 = alpha:
+then the velocity reuses the same solve, v^n = b7 w + b6 u + b2 v with
+w = D^{-1} M (b4 u + b1 v), b7 = b3/b1 (eq. 14). These are the printed
+eqs. 17-24; no typo in them (the text calls delta "beta" once). Only the
+trapezoidal rule alpha = 1/4, delta = 1/2 makes the scheme identical to
+Newmark in free vibration (b2 = -1, b4 = b1 (alpha_m + 2/dt), b1 = 4/dt:
+u^n = 2 D^{-1}M(...) - u, v^n = 2(u^n - u^{n-1})/dt - v^{n-1}); for other
+delta^2 = alpha it is a different (Green-superposed) scheme.
+
+Loads. The load enters as a velocity impulse at t_n (eq. 16):
+v^n <- v^n + M^{-1} f^n dt, so u^n does not depend on f^n (B.1 before B.5).
+The impulse train sum_k M^{-1} f^k dt delta(t - t_k) approximates the Duhamel
+integral by a rectangle rule; comparing with the trapezoidal rule shows
+  (i) an O(dt) displacement error -dt/2 G(t_n) f(0) unless the load at t = 0
+      enters as a HALF impulse M^{-1} f(0+) dt/2 (``start(f0=...)``), and
+ (ii) the state velocity after the impulse exceeds v(t_n) by M^{-1} f^n dt/2:
+      v(t_n) is the mean of the velocities just before and just after the
+      impulse (``velocity()``).
+With both, and with f^n the mean of f over [t_n - dt/2, t_n + dt/2] (equal
+to f(t_n) + O(dt^2) for smooth loads), displacement and velocity converge at
+order 2, like Newmark's; across a jump of the load the displacement stays
+second order, while at the one node next to the jump the velocity has an O(dt)
+local error (a nodal sample cannot tell where in the step the load stops;
+Newmark has the same). So f^n is "the load at t_n", sampled as that cell mean.
+Taking f^n = f(t_n) for a load switched on at t = 0 without the half impulse
+gives order 1 (tests/fem/test_fem_convergence.py shows both). Note for the
+coupling: an interface force that is the mean over (t_{n-1}, t_n]
+(piecewise-constant BE tractions) is half a step late here: order 1.
+
+Relation to Newmark's treatment of loads. Trapezoidal Newmark is the
+trapezoidal (Crank-Nicolson) rule on y' = A y + J f, y = (u, v):
+(I - dt/2 A) y^n = (I + dt/2 A) y^{n-1} + dt/2 J (f^{n-1} + f^n), so its u^n
+depends on f^n. With P = (I - dt/2 A)^{-1} dt/2, the shifted state
+z^n = y^n - P J f^n obeys z^n = R z^{n-1} + dt (I - dt/2 A)^{-2} J f^{n-1}, R the
+free propagator; as (I - dt/2 A)^{-2} = R + O(dt^2), that is the Green
+recurrence (impulse dt J f^{n-1} at t_{n-1}, then one free step) to O(dt^3) per
+step, and y^n = z^n + P J f^n is the Green state before the impulse at t_n plus
+half of it: Newmark's velocity is the mean velocity of ``velocity()``, and
+Newmark's u^n holds an extra O(dt^2) part of f^n (the displacement part of
+P J f^n) that the Green scheme drops, which is what makes u^n independent of
+f^n. Both are second order; they agree exactly only in free vibration.
+
+Newmark with loads (NewmarkIntegrator): the usual form with the same cell-mean
+samples f^n, a^0 = M^{-1}(f^0 - C v^0 - K u^0).
+
+Constraints: fixed dofs have zero rows and columns in D (the mean diagonal on
+the diagonal) and are masked in every impulse and right-hand side, so
+u = v = 0 stays exact there.
+"""
+import numpy as np
+
+from ..petsc import init, SSIError, check, collective_error, set_default_options, \
+    direct_solver_defaults, printf
+from ..monitor import event
+from .assembly import check_mass
+
+
+def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5):
+    """b0..b7 of paper eqs. 17-24 (derived in the module docstring)."""
+    b0 = (1 / (2 * alpha) - 1) * alpha_m - 1 / (alpha * dt)
+    b1 = (delta / alpha - 1) * alpha_m - 0.5 * dt * (delta / alpha - 2) * alpha_m ** 2 - b0
+    b2 = 1 - dt * (1 - delta) * alpha_m + delta * dt * b0
+    b3 = delta * b1 / (alpha * dt)
+    b4 = alpha_m * b1 + b3
+    b5 = alpha_m * b3 + b1 / (alpha * dt ** 2)
+    b6 = alpha_m * b2 + b0
+    b7 = b3 / b1
+    return dict(b0=b0, b1=b1, b2=b2, b3=b3, b4=b4, b5=b5, b6=b6, b7=b7)
+
+
+def d_mass_coefficient(dt, alpha_m, alpha, delta):
+    """c with D = K + c M (eq. 15 with C = alpha_m M)."""
+    return 1.0 / (alpha * dt ** 2) + delta * alpha_m / (alpha * dt)
+
+
+# CG + BoomerAMG with settings for 3D elasticity (hypre's advice: strong threshold
+# 0.5 in 3D, HMIS coarsening, ext+i interpolation, one level of aggressive
+# coarsening): a 2.5x cheaper V-cycle than hypre's defaults on the bricks here.
+# Tight rtol: the Green's-function scheme assumes exact solves of D.
+SOLVER_ITERATIVE = {"ksp_type": "cg", "ksp_rtol": "1e-12", "ksp_atol": "1e-50",
+                    "pc_type": "hypre", "pc_hypre_type": "boomeramg",
+                    "pc_hypre_boomeramg_strong_threshold": "0.5",
+                    "pc_hypre_boomeramg_coarsen_type": "HMIS",
+                    "pc_hypre_boomeramg_interp_type": "ext+i",
+                    "pc_hypre_boomeramg_agg_nl": "1"}
+
+
+def mean_diagonal(A):
+    """Collective: mean of the diagonal of A."""
+    d = A.getDiagonal()
+    mean = d.sum() / d.getSize()
+    d.destroy()
+    return mean
+
+
+def make_solver(A, prefix, solver, comm, coords_vec=None, log=printf):
+    """Collective: KSP on A with prefix; defaults only where the user set none.
+
+    A Krylov method starts from the previous solution (the step-to-step
+    change is small); preonly (LU) ignores it.
+    """
+    PETSc = init()
+    defaults = direct_solver_defaults(comm) if solver == "direct" else dict(SOLVER_ITERATIVE)
+    set_default_options(prefix, defaults, log=log)
+    if coords_vec is not None:
+        A.setNearNullSpace(PETSc.NullSpace().createRigidBody(coords_vec))
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOptionsPrefix(prefix)
+    ksp.setOperators(A)
+    ksp.setFromOptions()
+    if ksp.getType() != "preonly":
+        ksp.setInitialGuessNonzero(True)
+    return ksp
+
+
+def setup_or_fail(ksp, probe, what, comm):
+    """Collective: factorise (KSP setUp) and solve ``probe``; SSIError on failure."""
+    PETSc = init()
+    err = None
+    try:
+        ksp.setUp()
+        x = probe.duplicate()
+        x.zeroEntries()
+        ksp.solve(probe, x)
+        reason = ksp.getConvergedReason()
+        if reason < 0 or not np.isfinite(x.norm()):
+            err = f"the solve with {what} failed (KSP reason {reason}): the matrix is singular or indefinite"
+    except PETSc.Error as exc:
+        err = f"factorising {what} failed ({str(exc).splitlines()[0]}): the matrix is singular"
+    collective_error(err, comm)
+
+
+class _Dynamic:
+    """Shared set-up: D = K + c M, the mask of free dofs, M^{-1} on free dofs."""
+
+    def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5,
+                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf):
+        comm = K.getComm()
+        check(dt > 0, f"time step dt = {dt} must be > 0", comm)
+        self.comm, self.K, self.m, self.dt = comm, K, m, float(dt)
+        self.alpha_m, self.alpha, self.delta = float(alpha_m), float(alpha), float(delta)
+        self._masks(fixed)
+        check_mass(m, self.mask, comm)
+        with event("FEM_assembly"):
+            self.D = self._assemble_D()
+        self.ksp = make_solver(self.D, prefix, solver, comm, coords_vec, log)
+        with event("FEM_factor"):
+            setup_or_fail(self.ksp, self.mask, "D (eq. 15)", comm)
+        self.u, self.v, self.w, self.rhs = (self._zeros() for _ in range(4))
+        self.n = 0
+
+    def _zeros(self):
+        v = self.m.duplicate()
+        v.zeroEntries()
+        return v
+
+    def _masks(self, fixed):
+        """Owned fixed dofs, the 0/1 mask of free dofs and M^{-1} on free dofs."""
+        PETSc = init()
+        r0, r1 = self.K.getOwnershipRange()
+        fixed = np.asarray(fixed, dtype=np.int64)
+        self.fixed_owned = fixed[(fixed >= r0) & (fixed < r1)].astype(PETSc.IntType)
+        self.mask = self.m.duplicate()
+        self.mask.set(1.0)
+        self.mask.getArray()[self.fixed_owned - r0] = 0.0
+        mm = self.m.getArray(readonly=True)
+        self.minv = self.m.duplicate()
+        self.minv.getArray()[:] = self.mask.getArray(readonly=True) / np.where(mm > 0, mm, 1.0)
+
+    def _assemble_D(self):
+        """Collective: D = K + (1/(alpha dt^2) + delta alpha_m/(alpha dt)) M (eq. 15), fixed dofs
+        eliminated (zero rows and columns, the mean diagonal on the diagonal, so AMG sees rows
+        scaled like the rest)."""
+        PETSc = init()
+        D = self.K.copy()
+        cm = self.m.copy()
+        cm.scale(d_mass_coefficient(self.dt, self.alpha_m, self.alpha, self.delta))
+        D.setDiagonal(cm, addv=PETSc.InsertMode.ADD_VALUES)
+        cm.destroy()
+        D.zeroRowsColumns(self.fixed_owned, diag=mean_diagonal(D))
+        return D
+
+    @property
+    def t(self):
+        return self.n * self.dt
+
+    def _set_initial(self, u0, v0):
+        for dst, src in ((self.u, u0), (self.v, v0)):
+            if src is None:
+                dst.zeroEntries()
+            else:
+                src.copy(dst)
+            dst.pointwiseMult(dst, self.mask)
+        self.n = 0
+
+    def _masked_minv(self, out, *forces):
+        """out = M^{-1} (sum of forces) on free dofs, 0 on fixed ones."""
+        out.zeroEntries()
+        for f in forces:
+            if f is not None:
+                out.axpy(1.0, f)
+        out.pointwiseMult(out, self.minv)
+        return out
+
+    def solve(self, b, x):
+        self.ksp.solve(b, x)
+        if self.ksp.getConvergedReason() < 0:
+            raise SSIError(f"solve with D diverged at step {self.n} (KSP reason {self.ksp.getConvergedReason()})")
+
+    def destroy(self):
+        for obj in (self.ksp, self.D, self.u, self.v, self.w, self.rhs, self.mask, self.minv):
+            obj.destroy()
+
+
+class GreenIntegrator(_Dynamic):
+    """Implicit Green's-function integrator, paper eqs. 13-16 (trapezoidal).
+
+    Collective. Per step: ``predict()`` -> u^n (Table 2, B.1, eq. 13, one
+    triangular solve), then ``correct(f, f_interface)`` -> v^n (B.5-B.6,
+    eqs. 14 and 16). ``step(f)`` does both. f is the load sample of step n
+    (mean over [t_n - dt/2, t_n + dt/2], see the module docstring).
+    """
+
+    def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5, **kw):
+        check(abs(delta * delta - alpha) < 1e-12, f"Green's-function integrator needs delta^2 = alpha "
+              f"(paper eq. 24); got alpha {alpha}, delta {delta}", K.getComm())
+        super().__init__(K, m, dt, alpha_m, fixed, alpha, delta, **kw)
+        self.b = green_constants(dt, alpha_m, alpha, delta)
+        self.vhalf = m.duplicate()            # M^{-1} f dt/2 of the last impulse
+        self.vhalf.zeroEntries()
+        self._predicted = False
+
+    def start(self, u0=None, v0=None, f0=None):
+        """Initial state; f0 = mean load over [0, dt/2] enters as a half impulse."""
+        self._set_initial(u0, v0)
+        self._masked_minv(self.vhalf, f0)
+        self.vhalf.scale(0.5 * self.dt)
+        self.v.axpy(1.0, self.vhalf)
+        self._predicted = False
+
+    def predict(self):
+        """u^n from (u^{n-1}, v^{n-1}) (eq. 13); v holds the free velocity after."""
+        b = self.b
+        self.u.copy(self.rhs)
+        self.rhs.scale(b["b4"])
+        self.rhs.axpy(b["b1"], self.v)
+        self.rhs.pointwiseMult(self.rhs, self.m)
+        self.rhs.pointwiseMult(self.rhs, self.mask)
+        self.solve(self.rhs, self.w)                              # w = D^-1 M (b4 u + b1 v)
+        self.v.scale(b["b2"])                                     # eq. 14 without f*
+        self.v.axpy(b["b6"], self.u)
+        self.v.axpy(b["b7"], self.w)
+        self.u.scale(b["b2"])                                     # eq. 13
+        self.u.axpy(1.0, self.w)
+        self.n += 1
+        self._predicted = True
+        return self.u
+
+    def correct(self, f=None, f_interface=None):
+        """Add the impulse M^{-1} (f^n + f_f^n) dt to the velocity (B.5, eq. 16)."""
+        if not self._predicted:
+            raise SSIError("GreenIntegrator.correct() called without predict()")
+        self._masked_minv(self.vhalf, f, f_interface)
+        self.vhalf.scale(0.5 * self.dt)
+        self.v.axpy(2.0, self.vhalf)
+        self._predicted = False
+        return self.v
+
+    def step(self, f=None):
+        self.predict()
+        return self.correct(f)
+
+    def velocity(self, out=None):
+        """v(t_n): mean of the velocities before and after the impulse at t_n
+        (at t = 0 the state before the initial half impulse)."""
+        out = self.v.duplicate() if out is None else out
+        self.v.copy(out)
+        out.axpy(-1.0, self.vhalf)
+        return out
+
+
+class NewmarkIntegrator(_Dynamic):
+    """Plain Newmark (trapezoidal by default) with the same interface: step(f)."""
+
+    def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5, **kw):
+        super().__init__(K, m, dt, alpha_m, fixed, alpha, delta, **kw)
+        self.a = m.duplicate()
+        a, d, am = self.alpha, self.delta, self.alpha_m
+        self.c_u = 1 / (a * dt ** 2) + am * d / (a * dt)
+        self.c_v = 1 / (a * dt) + am * (d / a - 1)
+        self.c_a = (1 / (2 * a) - 1) + am * dt * (d / (2 * a) - 1)
+
+    def start(self, u0=None, v0=None, f0=None):
+        """Initial state; a^0 = M^{-1}(f^0 - C v^0 - K u^0) on free dofs."""
+        self._set_initial(u0, v0)
+        self.K.mult(self.u, self.w)
+        self.w.scale(-1.0)
+        if f0 is not None:
+            self.w.axpy(1.0, f0)
+        self.w.pointwiseMult(self.w, self.minv)
+        self.w.axpy(-self.alpha_m, self.v)
+        self.w.pointwiseMult(self.w, self.mask)
+        self.w.copy(self.a)
+
+    def step(self, f=None):
+        a, d, dt = self.alpha, self.delta, self.dt
+        self.rhs.zeroEntries()
+        self.rhs.axpy(self.c_u, self.u)
+        self.rhs.axpy(self.c_v, self.v)
+        self.rhs.axpy(self.c_a, self.a)
+        self.rhs.pointwiseMult(self.rhs, self.m)
+        if f is not None:
+            self.rhs.axpy(1.0, f)
+        self.rhs.pointwiseMult(self.rhs, self.mask)
+        self.solve(self.rhs, self.w)                              # u^n
+        # a^n = (u^n - u - dt v)/(a dt^2) - (1/(2a) - 1) a^{n-1}
+        self.rhs.waxpy(-1.0, self.u, self.w)
+        self.rhs.axpy(-dt, self.v)
+        self.rhs.scale(1 / (a * dt ** 2))
+        self.rhs.axpy(-(1 / (2 * a) - 1), self.a)
+        self.v.axpy(dt * (1 - d), self.a)
+        self.v.axpy(dt * d, self.rhs)
+        self.rhs.copy(self.a)
+        self.w.copy(self.u)
+        self.n += 1
+        return self.u
+
+    def velocity(self, out=None):
+        out = self.v.duplicate() if out is None else out
+        self.v.copy(out)
+        return out
+
+    def destroy(self):
+        self.a.destroy()
+        super().destroy()
+
+
+def make_integrator(kind, *args, **kw):
+    """'green' or 'newmark'."""
+    return {"green": GreenIntegrator, "newmark": NewmarkIntegrator}[kind](*args, **kw)

@@ -1,0 +1,126 @@
+"""``petsc-ssi modes``: natural frequencies and mode shapes (SLEPc).
+
+Generalised symmetric problem K x = omega^2 M x (lumped M) on the free dofs
+(fixed dofs removed with a sub-matrix; with no -ssi_fem_fixed the structure
+is free and its six rigid-body modes come out at 0 Hz), solved by Krylov-
+Schur with shift-and-invert about a small negative target (so that K - sigma M
+is positive definite even for a free structure; every eigenvalue is >= 0 >
+sigma, so "nearest the target" means "lowest"). The inner solve is a MUMPS
+factorisation. Options prefix ``ssi_modes_`` (``-ssi_modes_eps_nev`` is set
+from ``-ssi_modes_n``; any ``-ssi_modes_eps_*``/``-ssi_modes_st_*`` wins).
+
+Output: a table ``mode,frequency_hz`` on stdout (rank 0), the mode shapes
+(max |u| = 1) as snapshots ``mode_shape_<k>`` of -ssi_output with "time" =
+mode number and attribute ``frequencies_hz``. With -ssi_fem_damping_ratio
+zeta, alpha_m = 2 zeta omega is printed for the first flexible mode.
+"""
+import math
+
+import numpy as np
+
+from ..petsc import init, collective_error, printf, set_default_options, has_package
+from ..monitor import event
+from .. import options as ssi_options
+
+
+def _submatrices(K, m, fixed):
+    """Collective: K and diag(m) restricted to the free dofs, and their IS."""
+    PETSc = init()
+    comm = K.getComm()
+    r0, r1 = K.getOwnershipRange()
+    free = np.setdiff1d(np.arange(r0, r1), np.asarray(fixed, np.int64)).astype(PETSc.IntType)
+    isf = PETSc.IS().createGeneral(free, comm=comm)
+    Kf = K.createSubMatrix(isf, isf)
+    mf = m.getSubVector(isf)
+    Mf = PETSc.Mat().createAIJ(size=Kf.getSizes(), nnz=(1, 0), comm=comm)
+    Mf.setDiagonal(mf)
+    Mf.assemble()
+    m.restoreSubVector(isf, mf)
+    return Kf, Mf, isf, free
+
+
+def default_target(mat, coords):
+    """-1e-3 (c_s / L)^2: a negative shift well below the lowest flexible omega^2."""
+    L = float(np.max(np.ptp(coords, axis=0)))
+    cs2 = mat.E / (2 * (1 + mat.nu)) / mat.rho
+    return -1e-3 * cs2 / L ** 2
+
+
+def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_"):
+    """Collective: (frequencies [Hz] (k,), list of full-size mode Vecs (max |u| = 1))."""
+    PETSc = init()
+    from slepc4py import SLEPc
+    comm = K.getComm()
+    Kf, Mf, isf, free = _submatrices(K, m, fixed)
+    solver = "mumps" if has_package("mumps") else "petsc"
+    set_default_options(prefix, {"st_type": "sinvert", "st_ksp_type": "preonly", "st_pc_type": "lu",
+                                 "st_pc_factor_mat_solver_type": solver}, log=None)
+    eps = SLEPc.EPS().create(comm)
+    eps.setOptionsPrefix(prefix)
+    eps.setOperators(Kf, Mf)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+    eps.setDimensions(nev=n_modes)
+    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+    eps.setTarget(target)
+    eps.setTolerances(tol=1e-10)
+    eps.setFromOptions()
+    with event("FEM_modes"):
+        eps.solve()
+    nconv = eps.getConverged()
+    collective_error(None if nconv >= n_modes else f"SLEPc converged {nconv} of {n_modes} modes", comm)
+    lam = np.array([eps.getEigenvalue(i).real for i in range(n_modes)])
+    order = np.argsort(lam)
+    xr = Kf.createVecRight()
+    freqs, shapes = [], []
+    for i in order:
+        eps.getEigenvector(int(i), xr)
+        full = m.duplicate()
+        full.zeroEntries()
+        full.getArray()[free - K.getOwnershipRange()[0]] = xr.getArray(readonly=True)
+        full.scale(1.0 / max(full.norm(PETSc.NormType.INFINITY), 1e-300))
+        freqs.append(math.sqrt(max(lam[i], 0.0)) / (2 * math.pi))
+        shapes.append(full)
+    for obj in (eps, Kf, Mf, isf, xr):
+        obj.destroy()
+    return np.array(freqs), shapes
+
+
+def main():
+    """Collective: the ``petsc-ssi modes`` command (PETSc already initialised)."""
+    PETSc = init()
+    comm = PETSc.COMM_WORLD
+    cfg = ssi_options.resolve(("common", "fem"))
+    from .model import build_model
+    model = build_model(cfg, comm)
+    target = PETSc.Options().getReal("ssi_modes_eps_target", default_target(model.material, model.mesh.coords))
+    free = "free (6 rigid-body modes at 0 Hz)" if len(model.fixed) == 0 else "fixed: " + cfg.fem_fixed
+    printf(f"[modes] {cfg.modes_n} lowest modes, {free}, shift-and-invert target {target:.4g} rad^2/s^2")
+    freqs, shapes = compute_modes(model.K, model.m, model.fixed, cfg.modes_n, target)
+    printf("mode,frequency_hz")
+    for k, f in enumerate(freqs, 1):
+        printf(f"{k},{f:.8g}")
+    _damping_note(cfg, freqs)
+    if cfg.output:
+        _write(cfg, model, freqs, shapes, comm)
+    return freqs
+
+
+def _damping_note(cfg, freqs):
+    flex = freqs[freqs > 1e-6 * max(freqs.max(), 1e-300)]
+    if cfg.fem_damping_ratio > 0 and flex.size:
+        f1 = flex[0]
+        printf(f"[modes] zeta = {cfg.fem_damping_ratio:g} at the first flexible mode f = {f1:.6g} Hz: "
+               f"alpha_m = 2 zeta omega = {2 * cfg.fem_damping_ratio * 2 * math.pi * f1:.6g} 1/s "
+               f"(with -ssi_fem_damping_freq {cfg.fem_damping_freq:g} Hz: "
+               f"{2 * cfg.fem_damping_ratio * 2 * math.pi * cfg.fem_damping_freq:.6g} 1/s)")
+
+
+def _write(cfg, model, freqs, shapes, comm):
+    from ..io.output import Output, provenance
+    out = Output(cfg.output, comm)
+    out.write_mesh(model.coords_vec(), model.mesh.cells if comm.getRank() == 0 else None, "hex8")
+    for k, s in enumerate(shapes, 1):
+        out.write_fields(float(k), {"mode_shape": s})
+    out.close(attrs={"problem": "modes", "frequencies_hz": np.asarray(freqs), "time_is": "mode number"},
+              record=provenance(cfg, comm, {"modes": {"frequencies_hz": [float(f) for f in freqs]}}))
+    printf(f"[modes] wrote {cfg.output} (+ .xmf, .json)")

@@ -1,0 +1,101 @@
+"""Options of the structural FEM (group "fem"), declared once in the registry.
+
+Units are SI; z is up. ``-ssi_fem_ksp_*`` / ``-ssi_fem_pc_*`` go to the PETSc
+solver of D (paper eq. 15) and ``-ssi_modes_eps_*`` / ``-ssi_modes_st_*`` to
+SLEPc, unchanged (they are PETSc object options, not registry entries).
+"""
+import os
+
+from ..options import register, register_check, positive, nonnegative, at_least
+
+G = "fem"
+
+
+def _nu_range(v):
+    return None if -1.0 < v < 0.5 else "Poisson's ratio must lie in (-1, 0.5)"
+
+
+def _triple(kind):
+    def check(text):
+        try:
+            vals = [kind(s) for s in str(text).split(",")]
+        except ValueError:
+            return "must be three comma-separated numbers"
+        return None if len(vals) == 3 else "must be three comma-separated numbers"
+    return check
+
+
+register("fem_mesh", "str", "box", "",
+         "hex8 mesh of the structure: 'box' (structured generator, see -ssi_fem_box_*) "
+         "or a gmsh .geo/.msh file with hex8 cells (paths relative to the working directory)", G)
+register("fem_box_cells", "str", "10,10,4", "cells", "box: number of bricks 'nx,ny,nz'", G,
+         validator=_triple(int))
+register("fem_box_size", "str", "1,1,0.5", "m", "box: edge lengths 'lx,ly,lz'", G, validator=_triple(float))
+register("fem_box_origin", "str", "-0.5,-0.5,0", "m", "box: lowest corner 'x0,y0,z0' (default: paper block "
+         "centred at x=y=0, base z=0)", G, validator=_triple(float))
+register("fem_renumber", "bool", True, "", "reverse Cuthill-McKee node renumbering (compact rank partitions)", G)
+register("fem_E", "real", 300e6, "N/m^2", "Young's modulus of the structure (paper: concrete 300e6)", G,
+         validator=positive)
+register("fem_nu", "real", 0.2, "", "Poisson's ratio of the structure, in (-1, 0.5)", G, validator=_nu_range)
+register("fem_rho", "real", 2000.0, "kg/m^3", "density of the structure (lumped mass)", G, validator=positive)
+register("fem_alpha_m", "real", 0.0, "1/s", "mass-proportional damping C = alpha_m M", G, validator=nonnegative)
+register("fem_damping_ratio", "real", 0.0, "", "damping ratio zeta at -ssi_fem_damping_freq: alpha_m = 2 zeta "
+         "omega (instead of -ssi_fem_alpha_m)", G, validator=nonnegative)
+register("fem_damping_freq", "real", 0.0, "Hz", "reference frequency of -ssi_fem_damping_ratio", G,
+         validator=nonnegative)
+register("fem_integrator", "enum", "green", "", "time integrator: green (implicit Green's functions, paper "
+         "eqs. 13-24) or newmark (plain Newmark)", G, choices=("green", "newmark"))
+register("fem_newmark_alpha", "real", 0.25, "", "Newmark alpha (beta in most texts); green needs "
+         "delta^2 = alpha", G, validator=positive)
+register("fem_newmark_delta", "real", 0.5, "", "Newmark delta (gamma in most texts)", G, validator=positive)
+register("fem_solver", "enum", "direct", "", "solver of D: direct (factorise once, MUMPS) or iterative "
+         "(CG + hypre BoomerAMG); -ssi_fem_ksp_*/-ssi_fem_pc_* override", G, choices=("direct", "iterative"))
+register("fem_load_group", "str", "", "", "loaded faces: comma-separated face group names (e.g. top)", G)
+register("fem_load_p0", "real", 0.0, "N/m^2", "pressure on the load group; p0 > 0 pushes into the body "
+         "(traction -p0 h(t) n, n the outward normal)", G)
+register("fem_load_history", "enum", "heaviside", "", "load history h(t) of the pressure and point loads: "
+         "heaviside, box (1 on [0, t0)), table", G, choices=("heaviside", "box", "table"))
+register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse", G, validator=positive)
+register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (constant beyond the "
+         "ends)", G)
+register("fem_point_load", "str", "", "m, N", "point loads 'x,y,z,fx,fy,fz;...' at the nearest FE node, "
+         "times h(t)", G)
+register("fem_fixed", "str", "", "", "fixed (zero displacement) node groups 'name[:xyz],...', e.g. 'base' or "
+         "'xmin:x' (only the x component)", G)
+register("modes_n", "int", 6, "", "petsc-ssi modes: number of natural modes", G, validator=at_least(1))
+
+
+def _fem_checks(cfg):
+    if cfg.t_end < cfg.dt:
+        return f"-ssi_t_end {cfg.t_end} is shorter than one step -ssi_dt {cfg.dt}"
+    if cfg.fem_mesh != "box" and not os.path.isfile(cfg.fem_mesh):
+        return f"-ssi_fem_mesh {cfg.fem_mesh}: no such file (relative to {os.getcwd()})"
+    if cfg.user_set("fem_alpha_m") and cfg.fem_damping_ratio > 0:
+        return "give either -ssi_fem_alpha_m or -ssi_fem_damping_ratio, not both"
+    if cfg.fem_damping_ratio > 0 and cfg.fem_damping_freq <= 0:
+        return "-ssi_fem_damping_ratio needs a reference frequency -ssi_fem_damping_freq > 0"
+    if cfg.fem_load_p0 != 0 and not cfg.fem_load_group.strip():
+        return "-ssi_fem_load_p0 is set but -ssi_fem_load_group names no face group"
+    uses_history = cfg.fem_load_p0 != 0 or cfg.fem_point_load.strip()
+    if uses_history and cfg.fem_load_history == "table" and not os.path.isfile(cfg.fem_load_table):
+        return f"-ssi_fem_load_table '{cfg.fem_load_table}': no such file"
+    a, d = cfg.fem_newmark_alpha, cfg.fem_newmark_delta
+    if cfg.fem_integrator == "green" and abs(d * d - a) > 1e-12:
+        return (f"-ssi_fem_integrator green needs delta^2 = alpha (paper eq. 24); got "
+                f"alpha {a}, delta {d}")
+    if d < 0.5 or a < d / 2:
+        return f"Newmark alpha {a}, delta {d} is not unconditionally stable (need delta >= 1/2, alpha >= delta/2)"
+    return None
+
+
+register_check((G,), _fem_checks)
+
+
+def alpha_m(cfg):
+    """Mass-proportional damping alpha_m [1/s] and a one-line note of its origin."""
+    if cfg.fem_damping_ratio > 0:
+        import math
+        am = 2.0 * cfg.fem_damping_ratio * 2.0 * math.pi * cfg.fem_damping_freq
+        return am, (f"alpha_m = 2 zeta omega = 2*{cfg.fem_damping_ratio:g}*2pi*{cfg.fem_damping_freq:g} Hz "
+                    f"= {am:.6g} 1/s")
+    return cfg.fem_alpha_m, f"alpha_m = {cfg.fem_alpha_m:.6g} 1/s"
