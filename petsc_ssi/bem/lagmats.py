@@ -10,14 +10,6 @@ import numpy as np
 from ..petsc import init
 
 
-def _by_lag(trip, L):
-    row, lag, col, val = trip
-    order = np.lexsort((col, row, lag))
-    row, lag, col, val = row[order], lag[order], col[order], val[order]
-    bounds = np.searchsorted(lag, np.arange(1, L + 2))
-    return row, col, val, bounds
-
-
 def _csr(rows_local, cols, vals, nloc):
     counts = np.bincount(rows_local, minlength=nloc)
     indptr = np.zeros(nloc + 1, np.int32)
@@ -52,19 +44,19 @@ def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
     return A
 
 
-def build(comm, trip, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
+def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
     """Collective: one Mat per lag 1..L (None where the lag is empty
-    everywhere). Returns (mats, info) with info rows (lag, type, blocks)."""
-    row, col, val, bounds = _by_lag(trip, L)
+    everywhere), freeing each lag's triplets once its Mat is built.
+    Returns (mats, info) with info rows (lag, type, blocks)."""
     r0, r1 = node_range
     nloc = r1 - r0
     mpi = comm.tompi4py()
-    counts = np.diff(bounds)[:L]
+    counts = np.array([buckets.count(l) for l in range(1, L + 1)], dtype=np.int64)
     gcounts = np.zeros_like(counts)
     mpi.Allreduce(counts, gcounts)
     mats, info = [], []
     for li in range(L):
-        s, e = bounds[li], bounds[li + 1]
+        row, col, val = buckets.take(li + 1)
         nb = int(gcounts[li])
         if nb == 0:
             mats.append(None)
@@ -73,7 +65,7 @@ def build(comm, trip, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage=
         f = nb / float(n_rows_glob * n_cols_glob)
         use_dense = storage == "dense" or (storage == "auto" and f > fill)
         mk = dense if use_dense else baij
-        mats.append(mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row[s:e], col[s:e], val[s:e]))
+        mats.append(mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val))
         info.append((li + 1, "dense" if use_dense else "baij", nb))
     return mats, info
 

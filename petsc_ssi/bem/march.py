@@ -50,12 +50,14 @@ def step_matrix(comm, lagset, scheme, pres_node_mask):
     G = lagset.G
     reg = lagset.regions
     for lag, c in coefs.items():
-        m = (H[1] == lag) & ~pres_node_mask[H[2]]
-        r, cc, v = _expand(tuple(a[m] for a in H), r0, c)
+        hr, hc, hv = H.peek(lag)
+        m = ~pres_node_mask[hc]
+        r, cc, v = _expand((hr[m], None, hc[m], hv[m]), r0, c)
         Rs.append(r); Cs.append(cc); Vs.append(v)
         if reg.n_disp:
-            m = (G[1] == lag) & (G[2] >= reg.n_load)
-            r, cc, v = _expand(tuple(a[m] for a in G), r0, -c, colmap=reg.tnode)
+            gr, gc, gv = G.peek(lag)
+            m = gc >= reg.n_load
+            r, cc, v = _expand((gr[m], None, gc[m], gv[m]), r0, -c, colmap=reg.tnode)
             Rs.append(r); Cs.append(cc); Vs.append(v)
     R = np.concatenate(Rs); C = np.concatenate(Cs); V = np.concatenate(Vs)
     A = sp.csr_matrix((V, (R, C)), shape=(3 * nloc, 3 * N))
@@ -71,23 +73,32 @@ def step_matrix(comm, lagset, scheme, pres_node_mask):
 class Marcher:
     """Collective: steps the BEM in time. ``H``, ``G``: lists of Mats (lag 1..L)."""
 
-    def __init__(self, comm, lagset, H, G, scheme, known_u, known_p, log=printf):
+    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=()):
+        """Collective: step matrix and its factorisation (from the lag-1 and
+        lag-2 triplets of ``lagset``); ``set_lags`` then hands over the Mats."""
         PETSc = init()
         self.PETSc = PETSc
         self.comm = comm
-        self.H, self.G = H, G
-        self.L = len(H)
+        self.L = lagset.L
         self.scheme = "stabilized" if scheme.startswith("stabili") else "plain"
         reg = lagset.regions
         self.reg = reg
         N = lagset.mesh.n_nodes
         self.N = N
+        self.nt = reg.n_t
         pres = np.zeros(N, bool)
         pres[reg.disp_nodes] = True
         self.pres = pres
         ev = event("SSI_BEM_Factor")
         ev.begin()
         self.A = step_matrix(comm, lagset, self.scheme, pres)
+        # DOFs a symmetry plane forces to zero: identity rows, zero columns
+        # (their equations involve only these DOFs; see symmetry.zero_dofs)
+        r0, r1 = self.A.getOwnershipRange()
+        zd = np.asarray(zero_dofs, dtype=np.int64)
+        zd = zd[(zd >= r0) & (zd < r1)]
+        self.A.zeroRowsColumns(zd.astype(PETSc.IntType), diag=1.0)
+        self.zero_local = zd - r0
         self.ksp = PETSc.KSP().create(comm=comm)
         self.ksp.setOptionsPrefix("ssi_bem_")
         set_default_options("ssi_bem_", direct_solver_defaults(comm), log)
@@ -98,11 +109,15 @@ class Marcher:
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)
         self.u_tmpl = self.A.createVecRight()
+        self.n = 0
+
+    def set_lags(self, H, G):
+        """Collective: the lag Mats H_l, G_l (lists, index l-1; None = empty)."""
+        self.H, self.G = H, G
         self.p_tmpl = self._p_vec()
         self.depth = self.L + 2
         self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
         self.pbuf = [self.p_tmpl.duplicate() for _ in range(self.depth)]
-        self.n = 0
         self._setup_index_maps()
         self.rhs = self.u_tmpl.duplicate()
         self.x = self.u_tmpl.duplicate()
@@ -111,11 +126,10 @@ class Marcher:
 
     def _p_vec(self):
         PETSc = self.PETSc
-        nt = max(self.reg.n_t, 0)
         for M in self.G:
             if M is not None:
                 return M.createVecRight()
-        return PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=self.comm)
+        return PETSc.Vec().createMPI((PETSc.DECIDE, 3 * self.nt), bsize=3, comm=self.comm)
 
     def _setup_index_maps(self):
         """Scatters between the unknown vector and the u / p vectors."""
@@ -199,6 +213,8 @@ class Marcher:
             if self.reg.n_disp and self.H[lag - 1] is not None:
                 self.H[lag - 1].mult(self.kv_u, self.rhs)
                 b.axpy(-c, self.rhs)
+        if self.zero_local.size:
+            b.getArray()[self.zero_local] = 0.0
         ev = event("SSI_BEM_Solve")
         ev.begin()
         self.ksp.solve(b, self.x)

@@ -65,17 +65,23 @@ def bounding_spheres(VX):
     return c, R, h
 
 
-def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, chunk=256):
+def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
     """Estimated number of non-zero 3x3 blocks of all H lags in ``rows``:
-    for each (row, virtual element) the lags its shell touches, times four
+    for each (row, element) the lags its wave window touches (union over the
+    element's symmetry images, which fold onto the same columns), times four
     nodes per element (a node is shared by about four elements)."""
     total = 0.0
+    E = len(Vc) // n_images
     for s in range(0, len(rows), chunk):
         xc = xnodes[rows[s:s + chunk]]
         d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
         lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
         hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
-        total += np.clip(hi - lo + 1, 0, None).sum() * 4.0
+        n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
+        lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
+        hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
+        union = np.minimum(n.sum(1), np.clip(hi - lo + 1, 0, None))
+        total += union.sum() * 4.0
     return total
 
 
@@ -88,6 +94,42 @@ def machine_memory():
     except OSError:
         pass
     return float("inf")
+
+
+def _by_lag(trip, L):
+    """Split the triplets of one chunk of rows by lag: [(rows, cols, vals)] * L
+    (sorted by row then column within a lag), so the per-chunk row/lag index
+    arrays are dropped at once and every lag can be freed after use."""
+    row, lag, col, val = trip
+    order = np.lexsort((col, row, lag))
+    row, lag, col, val = row[order], lag[order], col[order], val[order]
+    b = np.searchsorted(lag, np.arange(1, L + 2))
+    return ([(row[b[l]:b[l + 1]], col[b[l]:b[l + 1]].astype(np.int32), val[b[l]:b[l + 1]].copy())
+             for l in range(L)],)
+
+
+class Buckets:
+    """Node-block triplets of the local rows, by lag (1-based): ``take(l)``
+    returns (rows, cols, vals) and frees them; ``peek(l)`` keeps them."""
+
+    def __init__(self, L, chunks):
+        self.L = L
+        self._b = [[c[0][l] for c in chunks] for l in range(L)]
+
+    def peek(self, lag):
+        parts = self._b[lag - 1]
+        if not parts:
+            return np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 3, 3))
+        return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+                np.concatenate([p[2] for p in parts]))
+
+    def take(self, lag):
+        out = self.peek(lag)
+        self._b[lag - 1] = []
+        return out
+
+    def count(self, lag):
+        return sum(len(p[0]) for p in self._b[lag - 1])
 
 
 class LagSet:
@@ -110,7 +152,8 @@ class LagSet:
 
     def estimate_memory(self):
         """Collective: (bytes of H lags in sparse storage, dense bytes per lag)."""
-        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt)
+        nimg = len(self.Vc) // self.mesh.n_cells
+        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt, nimg)
         nb = self.comm.tompi4py().allreduce(nb)
         N = self.mesh.n_nodes
         g_bytes = 9.0 * N * max(self.regions.n_t, 0) * 8 * self.L
@@ -138,7 +181,7 @@ class LagSet:
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
                                 self.regions.n_t, 0.5, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
                                 cpP, cpU, qinv)
-            parts.append(res[:8])
+            parts.append(_by_lag(res[:4], self.L) + _by_lag(res[4:8], self.L))
             nev += res[8]
             hits += res[9]
             ckeys, cmeta, cpP, cpU = res[10:14]
@@ -147,11 +190,8 @@ class LagSet:
         self.cache_hits = self.comm.tompi4py().allreduce(hits)
         self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)
         ev.end()
-        if not parts:
-            parts.append((np.zeros(0, np.int64),) * 3 + (np.zeros((0, 3, 3)),) + (np.zeros(0, np.int64),) * 3
-                         + (np.zeros((0, 3, 3)),))
-        cat = lambda k: np.concatenate([p[k] for p in parts])
-        self.H = tuple(cat(k) for k in range(4))
-        self.G = tuple(cat(k) for k in range(4, 8))
+        self.H = Buckets(self.L, [p[0:1] for p in parts])
+        self.G = Buckets(self.L, [p[1:2] for p in parts])
+        parts = None
         self.kernel_evaluations = self.comm.tompi4py().allreduce(nev)
         return self

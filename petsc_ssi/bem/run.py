@@ -65,6 +65,7 @@ class BEMProblem:
         self.planes = symmetry.parse(cfg.symmetry)
         self.mesh = load_mesh(cfg, self.planes, comm)
         h = float(self.mesh.element_sizes().max())
+        self.h = h
         symmetry.check_mesh(self.mesh.nodes, self.planes, h)
         self.dt = cfg.dt
         self.n_steps = int(round(cfg.t_end / cfg.dt))
@@ -73,6 +74,8 @@ class BEMProblem:
         if cfg.load_group and cfg.load_p0 == 0.0:
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         self.regions = Regions(self.mesh, load, disp)
+        symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None,
+                                  self._disp_value() if len(disp) else None)
         self.receivers = rec.parse(cfg.receivers)
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
@@ -153,8 +156,9 @@ class BEMProblem:
         sparse_b, dense_per_lag = ls.estimate_memory()
         limit = self.cfg.memory_limit * 1e9 if self.cfg.memory_limit > 0 else 0.8 * machine_memory()
         est = min(sparse_b, dense_per_lag * self.L + 9.0 * self.mesh.n_nodes * self.regions.n_t * 8 * self.L)
-        # assembly holds the triplets (96 B per block) and the Mats at once
-        peak = est + sparse_b * 96.0 / 76.0
+        # triplets are freed lag by lag as the Mats are built; the element cache
+        # holds about one lag set of distinct pairs
+        peak = 1.1 * max(est, sparse_b * 84.0 / 76.0)
         self.mem_estimate = est
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB, assembly peak {peak / 1e9:.3g} GB "
                  f"(limit {limit / 1e9:.3g} GB)")
@@ -173,16 +177,20 @@ class BEMProblem:
             return np.tile(tr * histories.step_mean(f, n, self.dt, c.load_history, c.load_t0), nl)
         return kp
 
+    def _disp_value(self):
+        try:
+            val = np.array([float(s) for s in self.cfg.disp_value.split(",")])
+            assert val.size == 3
+        except (ValueError, AssertionError):
+            raise SSIError(f"-ssi_disp_value '{self.cfg.disp_value}': expected 'ux,uy,uz'") from None
+        return val
+
     def known_u(self):
         c = self.cfg
         nd = self.regions.n_disp
         if not nd:
             return lambda n: np.zeros(0)
-        try:
-            val = np.array([float(s) for s in c.disp_value.split(",")])
-            assert val.size == 3
-        except (ValueError, AssertionError):
-            raise SSIError(f"-ssi_disp_value '{c.disp_value}': expected 'ux,uy,uz'") from None
+        val = self._disp_value()
         f = histories.make(c.disp_history, c.disp_t0, c.disp_table)
         return lambda n: np.tile(val * float(f(n * self.dt)), nd)
 
@@ -206,6 +214,8 @@ def run_bem(cfg, comm=None):
     ls.assemble(monitor=cfg.monitor)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
+    march = Marcher(comm, ls, cfg.scheme, prob.known_u(), prob.known_p(), log=log,
+                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
     H, hinfo = lagmats.build(comm, ls.H, prob.L, ls.node_range, N, N, r1 - r0, cfg.lag_storage, cfg.lag_fill)
     nt = prob.regions.n_t
     if nt:
@@ -227,7 +237,7 @@ def run_bem(cfg, comm=None):
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
     st = stage("SSI BEM time loop")
     st.push()
-    march = Marcher(comm, ls, H, G, cfg.scheme, prob.known_u(), prob.known_p(), log=log)
+    march.set_lags(H, G)
     ls.H = ls.G = None   # the triplets are in the Mats now
     out = Output(cfg.output, comm)
     res = _time_loop(cfg, comm, prob, march, out)

@@ -81,3 +81,27 @@ def map_point(p, planes):
             p[ax] = -p[ax]
             s *= sign_matrix(ax, kind)
     return p, s
+
+
+def zero_dofs(nodes, planes, h, tol=1e-9):
+    """DOFs that a symmetry plane forces to zero: the components of a node on
+    the plane that are odd under the plane's reflection (u_x on x = 0 for
+    'sym', u_y and u_z for 'anti'); the same holds for the traction there."""
+    out = []
+    for ax, kind in planes:
+        on = np.where(np.abs(nodes[:, ax]) <= tol * max(h, 1.0))[0]
+        odd = np.where(sign_matrix(ax, kind) < 0)[0]
+        out.append((3 * on[:, None] + odd[None, :]).ravel())
+    return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
+
+
+def check_compatible(planes, traction, disp):
+    """Refuse loads the declared symmetry contradicts (a uniform field on a
+    patch is even: components with S = -1 must vanish)."""
+    for ax, kind in planes:
+        s = sign_matrix(ax, kind)
+        name = f"{'xy'[ax]}={'sym' if kind > 0 else 'anti'}"
+        for what, v in (("the load traction", traction), ("the prescribed displacement", disp)):
+            if v is not None and np.any((s < 0) & (np.abs(v) > 0)):
+                raise SSIError(f"-ssi_symmetry {name}: {what} {tuple(float(x) for x in v)} is not "
+                               f"{'symmetric' if kind > 0 else 'antisymmetric'} about this plane")

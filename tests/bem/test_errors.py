@@ -70,3 +70,12 @@ def test_error_under_mpirun_does_not_hang():
             timeout=120, check=False)
     assert p.returncode != 0
     assert "petsc-ssi: error: receiver (30, 0, 0) lies off the surface mesh" in p.stdout
+
+
+@pytest.mark.parametrize("opts,expect", [
+    (dict(symmetry="x=anti", mesh_patch="1,1", load_group="load", load_p0=1000), "is not antisymmetric"),
+    (dict(symmetry="y=sym", mesh_patch="1,1", disp_group="load", disp_value="0,1e-6,0"), "is not symmetric"),
+])
+def test_load_contradicting_symmetry(opts, expect):
+    msg = resolve_error(**{**SMALL, **opts})
+    assert msg is not None and expect in msg, msg

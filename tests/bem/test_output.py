@@ -13,7 +13,8 @@ from helpers import cli, read_h5, ROOT
 def test_hdf5_xdmf_json_and_post_csv(tmp_path):
     out = tmp_path / "run.h5"
     cli(["-options_file", "runs/pekeris/small.opts", "-ssi_mesh_size", "6,6", "-ssi_t_end", "0.003",
-         "-ssi_output_stride", "2", "-ssi_output", str(out), "-ssi_plot"])
+         "-ssi_output_stride", "2", "-ssi_output", str(out), "-ssi_plot",
+         "-ssi_receivers", "2,0,0;3,1,0"])
     d = read_h5(out)
     assert {"coordinates", "topology", "time", "displacement_000000", "displacement_000001",
             "traction_000000", "receivers"} <= set(d["keys"])
@@ -41,7 +42,7 @@ def test_hdf5_xdmf_json_and_post_csv(tmp_path):
     assert lines[0] == "receiver,x,y,z,t,ux,uy,uz"
     assert len(lines) == 1 + 2 * 4
     row = lines[-1].split(",")
-    assert row[0] == "1" and float(row[1]) == 5.0 and np.isclose(float(row[7]), d["u"][-1, 1, 2], rtol=1e-8)
+    assert row[0] == "1" and float(row[1]) == 3.0 and float(row[2]) == 1.0 and np.isclose(float(row[7]), d["u"][-1, 1, 2], rtol=1e-8)
 
 
 def test_help_lists_every_option():
