@@ -9,10 +9,37 @@ import sys
 _INITIALISED = False
 
 
+def _find_debian_petsc4py():
+    """Debian's petsc4py lives under $PETSC_DIR/lib/python3/dist-packages and
+    its .pth file finds it only when PETSC_DIR is set; without it, look for
+    the installed real-scalar build ourselves (and set PETSC_DIR/SLEPC_DIR)."""
+    import glob
+    import os
+    for d in sorted(glob.glob("/usr/lib/petscdir/petsc*/*-real"), reverse=True):
+        sp = os.path.join(d, "lib", "python3", "dist-packages")
+        if os.path.isdir(os.path.join(sp, "petsc4py")):
+            os.environ.setdefault("PETSC_DIR", d)
+            sys.path.append(sp)
+            for s in sorted(glob.glob("/usr/lib/slepcdir/slepc*/*-real"), reverse=True):
+                os.environ.setdefault("SLEPC_DIR", s)
+                ssp = os.path.join(s, "lib", "python3", "dist-packages")
+                if os.path.isdir(ssp):
+                    sys.path.append(ssp)
+                break
+            return True
+    return False
+
+
 def init(argv=None):
     """Initialise petsc4py with ``argv`` (default ``sys.argv``); idempotent."""
     global _INITIALISED
     if not _INITIALISED:
+        try:
+            import petsc4py  # noqa: F401
+        except ImportError:
+            if not _find_debian_petsc4py():
+                raise SystemExit("petsc-ssi: error: petsc4py is not installed (run 'make deps', "
+                                 "or set PETSC_DIR to a PETSc build with petsc4py)")
         import petsc4py
         petsc4py.init(sys.argv if argv is None else argv)
         _INITIALISED = True
