@@ -59,6 +59,14 @@ register("disp_history", "enum", "heaviside", "", "time history of the prescribe
          choices=("heaviside", "box", "table"))
 register("disp_t0", "real", 0.025, "s", "duration of the box history", "bem", validator=positive)
 register("disp_table", "str", "", "", "file of 't value' rows for the prescribed displacement", "bem")
+register("interp", "enum", "none", "", "lag-matrix interpolation beyond T_L: none, chebyshev (eqs. 9, 11), linear (eqs. 10, 12), auto (paper's rule)", "bem",
+         choices=("none", "chebyshev", "linear", "auto"))
+register("interp_tl", "real", 0.0, "s", "threshold time T_L: lags with (l-1) dt < T_L are exact (auto: chosen)", "bem",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("interp_k", "int", 0, "", "number k of interpolating matrices (auto: one every 5 steps)", "bem",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("interp_grading", "real", 1.0, "", "multi-linear node grading exponent p in T_j = T_L + (T_N-T_L)((j-1)/(k-1))^p", "bem",
+         validator=lambda v: None if v > 0 else "must be > 0")
 register("warn_beta", "bool", True, "", "warn when beta = c dt / l leaves [0.3, 1.3]", "bem")
 
 
@@ -72,6 +80,8 @@ def _bem_checks(cfg):
         return f"-ssi_t_end {cfg.t_end} is shorter than one step -ssi_dt {cfg.dt}"
     if cfg.mesh != "grid" and not os.path.isfile(cfg.mesh):
         return f"-ssi_mesh {cfg.mesh}: no such file"
+    if cfg.interp in ("chebyshev", "linear") and (cfg.interp_k < 1 or cfg.interp_tl <= 0):
+        return f"-ssi_interp {cfg.interp} needs -ssi_interp_tl > 0 and -ssi_interp_k >= 1 (or use -ssi_interp auto)"
     if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
         return f"-ssi_load_table '{cfg.load_table}': no such file"
     return None

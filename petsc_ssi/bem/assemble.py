@@ -51,7 +51,8 @@ def new_cache():
 @njit(cache=True)
 def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alpha, beta,
                   rho, nu, ns_base, near_factor, ns_max, gq, gw, gr, gwr, n_nodes, n_tcols,
-                  free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv):
+                  free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
+                  lag_lo=1, toff=0.0):
     """Collective-free numba kernel: triplets of H and G for ``rows``.
 
     Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev, hits, cache
@@ -62,6 +63,8 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
     copies of an element on a structured mesh are integrated once. The key
     includes the node order, so images and singular pairs are keyed correctly;
     the integrals depend on nothing else (material, dt and lags are fixed).
+    Only lags lag_lo..L are computed, at kernel times l dt + toff (a cache
+    must not be shared between calls with different lag_lo, L or toff).
     """
     mu = rho * beta * beta
     nv = VX.shape[0]
@@ -85,7 +88,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
         if e > pool_n:
             pool_n = e
     key = np.zeros(27, np.int64)
-    reach = alpha * dt * L
+    reach = alpha * (dt * L + toff)
     for ii in range(rows.shape[0]):
         i = rows[ii]
         xc = xnodes[i]
@@ -97,16 +100,19 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
             if dmin >= reach:
                 continue
             dmax = dcen + VR[v]
-            lo = max(1, int(math.floor(dmin / (alpha * dt))) + 1)
-            hi = min(L, int(math.floor(dmax / (beta * dt))) + 2)
+            lo = max(lag_lo, int(math.floor((dmin / alpha - toff) / dt)) + 1)
+            hi = min(L, int(math.floor((dmax / beta - toff) / dt)) + 2)
             sing = -1
             for a in range(9):
                 d = math.sqrt((VX[v, a, 0] - xc[0]) ** 2 + (VX[v, a, 1] - xc[1]) ** 2 + (VX[v, a, 2] - xc[2]) ** 2)
                 if d < tol * Vh[v]:
                     sing = a
             if sing >= 0:
-                lo = 1
                 ns = min(ns_max, 2 * ns_base)
+                if lag_lo == 1:
+                    lo = 1
+                else:
+                    sing = -1   # lags >= 2 vanish near xi: regular
             else:
                 ns = ns_base
                 if near_factor > 0.0:
@@ -140,7 +146,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                 Ub[:nl] = 0.0
                 Pb[:nl] = 0.0
                 nev += integrate_pair(xc, VX[v], sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
-                                      Ub, Pb, want_u)
+                                      Ub, Pb, want_u, toff)
                 if sing >= 0:
                     Us[:] = 0.0
                     Ps[:] = 0.0
@@ -200,16 +206,17 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                             for q in range(3):
                                 gval[s, p, q] += Ub[li, a, p, q] * Vsign[v, q]
         # free term c_lk = delta_lk / 2 (smooth surface point)
-        s = slotH[1, i]
-        if s < 0:
-            hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
-            hval = _grow(hval, nh)
-            s = nh
-            hrow[s] = i; hlag[s] = 1; hcol[s] = i
-            hval[s] = 0.0
-            nh += 1
-        for p in range(3):
-            hval[s, p, p] += free_term
+        if lag_lo == 1:
+            s = slotH[1, i]
+            if s < 0:
+                hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
+                hval = _grow(hval, nh)
+                s = nh
+                hrow[s] = i; hlag[s] = 1; hcol[s] = i
+                hval[s] = 0.0
+                nh += 1
+            for p in range(3):
+                hval[s, p, p] += free_term
         for k in range(h0, nh):
             slotH[hlag[k], hcol[k]] = -1
         for k in range(g0, ng_):

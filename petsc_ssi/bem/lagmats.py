@@ -57,17 +57,28 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     mats, info = [], []
     for li in range(L):
         row, col, val = buckets.take(li + 1)
-        nb = int(gcounts[li])
-        if nb == 0:
-            mats.append(None)
-            info.append((li + 1, "empty", 0))
-            continue
-        f = nb / float(n_rows_glob * n_cols_glob)
-        use_dense = storage == "dense" or (storage == "auto" and f > fill)
-        mk = dense if use_dense else baij
-        mats.append(mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val))
-        info.append((li + 1, "dense" if use_dense else "baij", nb))
+        A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val,
+                        storage, fill)
+        mats.append(A)
+        info.append((li + 1, kind, int(gcounts[li])))
     return mats, info
+
+
+def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val, storage, fill):
+    if nb == 0:
+        return None, "empty"
+    f = nb / float(n_rows_glob * n_cols_glob)
+    use_dense = storage == "dense" or (storage == "auto" and f > fill)
+    mk = dense if use_dense else baij
+    return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val), ("dense" if use_dense else "baij")
+
+
+def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
+    """Collective: the Mat of one lag of ``buckets`` (an interpolating matrix)."""
+    r0, r1 = node_range
+    row, col, val = buckets.take(lag)
+    nb = comm.tompi4py().allreduce(len(row))
+    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val, storage, fill)
 
 
 def mat_bytes(A):

@@ -111,9 +111,13 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
 
-    def set_lags(self, H, G):
-        """Collective: the lag Mats H_l, G_l (lists, index l-1; None = empty)."""
+    def set_lags(self, H, G, plan=None, HI=(), GI=()):
+        """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
+        empty) and, with an active interpolation ``plan``, the interpolating
+        Mats HI[j] = H(T_j), GI[j] = G(T_j) that stand for lags plan.Lx+1..L."""
         self.H, self.G = H, G
+        self.plan = plan if (plan is not None and plan.active) else None
+        self.HI, self.GI = list(HI), list(GI)
         self.p_tmpl = self._p_vec()
         self.depth = self.L + 2
         self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
@@ -166,16 +170,25 @@ class Marcher:
     def _slot(self, m):
         return m % self.depth
 
+    def _terms(self, n, j):
+        """(state index m, coefficient) of q_j at step n, indices in 1..n-1."""
+        if self.scheme == "stabilized":
+            terms = [(n - j + 2, 1.0), (n - j + 1, 2.0), (n - j, 1.0)]
+        else:
+            terms = [(n - j + 1, 1.0)]
+        return [(m, c) for m, c in terms if 1 <= m <= n - 1]
+
     def history(self, n, out_u):
-        """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n."""
+        """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n; lags beyond
+        the plan's exact ones through the interpolating matrices: the weighted
+        history w_i = sum_l I(l, i) q_l is formed first, then one product per
+        interpolating matrix (k products per step, not one per lag)."""
         out_u.set(0.0)
-        jmax = min(self.L, n + 1)
+        jmax = min(len(self.H), n + 1)
+        if self.plan is not None:
+            self._interp_history(n, out_u)
         for j in range(2, jmax + 1):
-            if self.scheme == "stabilized":
-                terms = [(n - j + 2, 1.0), (n - j + 1, 2.0), (n - j, 1.0)]
-            else:
-                terms = [(n - j + 1, 1.0)]
-            terms = [(m, c) for m, c in terms if 1 <= m <= n - 1]
+            terms = self._terms(n, j)
             if not terms:
                 continue
             Hj = self.H[j - 1]
@@ -187,6 +200,30 @@ class Marcher:
             if Gj is not None:
                 self._combine(self.wp, self.pbuf, terms)
                 Gj.multAdd(self.wp, out_u, out_u)
+
+    def _interp_history(self, n, out_u):
+        plan = self.plan
+        lags = np.arange(plan.Lx + 1, min(plan.L, n + 1) + 1)
+        if lags.size == 0:
+            return
+        offs = ((2, 1.0), (1, 2.0), (0, 1.0)) if self.scheme == "stabilized" else ((1, 1.0),)
+        coef = np.zeros((n + 1, plan.k))      # coef[m, i]: weight of state m in w_i
+        for off, c in offs:
+            m = n - lags + off
+            ok = (m >= 1) & (m <= n - 1)
+            np.add.at(coef, m[ok], c * plan.W[lags[ok] - plan.Lx - 1])
+        ms = np.nonzero(np.any(coef != 0.0, axis=1))[0]
+        if ms.size == 0:
+            return
+        for i in range(plan.k):
+            terms = [(int(m), float(coef[m, i])) for m in ms]
+            if self.HI[i] is not None:
+                self._combine(self.wu, self.ubuf, terms)
+                self.HI[i].mult(self.wu, self.rhs)
+                out_u.axpy(-1.0, self.rhs)
+            if self.GI and self.GI[i] is not None:
+                self._combine(self.wp, self.pbuf, terms)
+                self.GI[i].multAdd(self.wp, out_u, out_u)
 
     def _combine(self, w, buf, terms):
         w.set(0.0)

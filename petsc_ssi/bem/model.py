@@ -150,23 +150,33 @@ class LagSet:
         self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
 
-    def estimate_memory(self):
-        """Collective: (bytes of H lags in sparse storage, dense bytes per lag)."""
+    def estimate_memory(self, stored=None):
+        """Collective: (bytes of H lags in sparse storage, dense bytes per lag);
+        ``stored`` = (exact lags, interpolating matrices) when interpolating."""
         nimg = len(self.Vc) // self.mesh.n_cells
-        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt, nimg)
+        L = self.L if stored is None else stored[0]
+        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
+        if stored is not None and stored[1]:
+            # an interpolating matrix is a late lag: about the mean lag fill
+            nb_all = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt,
+                                     nimg)
+            nb += stored[1] * nb_all / self.L
+            L = L + stored[1]
         nb = self.comm.tompi4py().allreduce(nb)
         N = self.mesh.n_nodes
-        g_bytes = 9.0 * N * max(self.regions.n_t, 0) * 8 * self.L
+        g_bytes = 9.0 * N * max(self.regions.n_t, 0) * 8 * L
         return nb * (72 + 4) + g_bytes, 9.0 * N * N * 8
 
-    def assemble(self, monitor=False, chunk=None):
-        """Collective in effect (each rank its rows): the triplets."""
+    def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly"):
+        """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
+        each rank its rows; sets and returns (H, G) Buckets."""
         o = self.opts
+        lag_hi = self.L if lag_hi is None else lag_hi
         gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
         gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
         rows = self.rows
         chunk = chunk or max(1, min(64, len(rows) // 20 + 1))
-        prog = Progress("BEM assembly", max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
+        prog = Progress(what, max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
         parts = []
         nev = 0
         ev = event("SSI_BEM_Assembly")
@@ -176,22 +186,22 @@ class LagSet:
         hits = 0
         for s in range(0, len(rows), chunk):
             res = assemble_rows(rows[s:s + chunk], self.mesh.nodes, self.VX, self.VN, self.VS, self.VT,
-                                self.Vc, self.VR, self.Vh, self.L, self.dt, self.mat.cp, self.mat.cs,
+                                self.Vc, self.VR, self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
                                 self.regions.n_t, 0.5, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
-                                cpP, cpU, qinv)
-            parts.append(_by_lag(res[:4], self.L) + _by_lag(res[4:8], self.L))
+                                cpP, cpU, qinv, lag_lo, toff)
+            parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
             nev += res[8]
             hits += res[9]
             ckeys, cmeta, cpP, cpU = res[10:14]
             prog.update(min(s + chunk, len(rows)))
+        ev.end()
         self.cache_entries = len(cidx)
         self.cache_hits = self.comm.tompi4py().allreduce(hits)
         self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)
-        ev.end()
-        self.H = Buckets(self.L, [p[0:1] for p in parts])
-        self.G = Buckets(self.L, [p[1:2] for p in parts])
+        self.H = Buckets(lag_hi, [p[0:1] for p in parts])
+        self.G = Buckets(lag_hi, [p[1:2] for p in parts])
         parts = None
         self.kernel_evaluations = self.comm.tompi4py().allreduce(nev)
-        return self
+        return self.H, self.G

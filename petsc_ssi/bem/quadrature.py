@@ -108,9 +108,11 @@ def _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, out):
 
 @njit(cache=True)
 def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
-                   Ub, Pb, want_u):
+                   Ub, Pb, want_u, toff=0.0):
     """Regular (subdivided Gauss) integration of lags lo..hi into Ub, Pb.
 
+    Lag l is evaluated at the kernel time T = l dt + toff (toff in [0, dt):
+    a lag matrix at a non-integer lag time, for the interpolation).
     Ub, Pb: (hi-lo+1, 9, 3, 3), accumulated (caller zeroes). ``sing`` >= 0:
     xi is node ``sing`` of the element; the static kernels are subtracted
     from lag 1 (their singular integral is added by ``singular_static``).
@@ -144,8 +146,8 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
             dc = math.sqrt((cen[0] - xc[0]) ** 2 + (cen[1] - xc[1]) ** 2 + (cen[2] - xc[2]) ** 2)
             dmin = max(dc - rad, 0.0)
             dmax = dc + rad
-            slo = max(lo, int(math.floor(dmin / cdt_a)) + 1)
-            shi = min(hi, int(math.floor(dmax / cdt_b)) + 2)
+            slo = max(lo, int(math.floor((dmin * ia - toff) / dt)) + 1)
+            shi = min(hi, int(math.floor((dmax * ib - toff) / dt)) + 2)
             if sing >= 0:
                 slo = lo  # lag 1 carries the static subtraction
             if slo > shi:
@@ -168,8 +170,8 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                     for k in range(3):
                         g[k] *= ir
                     gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2]
-                    plo = max(slo, int(math.floor(r / cdt_a)) + 1)
-                    phi = min(shi, int(math.floor(r / cdt_b)) + 2)
+                    plo = max(slo, int(math.floor((r * ia - toff) / dt)) + 1)
+                    phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
                     subtract = sing >= 0 and lo == 1
                     if subtract:
                         plo = 1
@@ -177,7 +179,7 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                         continue
                     for j in range(plo - 2, phi + 1):
                         jj = j - (plo - 2)
-                        t = j * dt
+                        t = j * dt + toff
                         if t <= 0.0:
                             S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
                             S1[jj, 0] = 0.0; S1[jj, 1] = 0.0

@@ -3,27 +3,14 @@ functions (a sparse PETSc matrix R, y = R u per step: no gather of fields)."""
 import numpy as np
 
 from ..petsc import init, SSIError
+from ..points import parse_points
 from ..mesh import quad9
 from . import symmetry
 
 
 def parse(spec):
-    pts = []
-    spec = (spec or "").strip()
-    if not spec:
-        return np.zeros((0, 3))
-    for part in spec.split(";"):
-        part = part.strip()
-        if not part:
-            continue
-        try:
-            v = [float(s) for s in part.split(",")]
-        except ValueError:
-            raise SSIError(f"-ssi_receivers '{spec}': expected 'x,y,z;x,y,z'") from None
-        if len(v) != 3:
-            raise SSIError(f"-ssi_receivers '{spec}': each point needs x,y,z")
-        pts.append(v)
-    return np.array(pts)
+    """'x,y,z;...' -> (R, 3) receiver points (the shared parser, petsc_ssi.points)."""
+    return parse_points(spec, 3, "-ssi_receivers")
 
 
 def locate(mesh, p, tol=1e-8):

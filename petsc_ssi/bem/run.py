@@ -15,6 +15,7 @@ from ..mesh import surface
 from ..io.output import Output, provenance
 from . import symmetry, receivers as rec, histories, lagmats
 from .model import Material, Regions, LagSet, causal_lags, machine_memory
+from . import interp
 from .march import Marcher
 
 
@@ -142,6 +143,24 @@ class BEMProblem:
                 f"(causal limit {causal_lags(self.r_max, self.mat, self.dt)}); "
                 f"beta in [{self.beta[0]:.3f}, {self.beta[1]:.3f}]")
 
+    def interp_plan(self):
+        """The lag interpolation plan from -ssi_interp* (auto: the paper's rule)."""
+        c = self.cfg
+        method, TL, k = c.interp, c.interp_tl, c.interp_k
+        if method == "auto":
+            src = (self.mesh.nodes[self.regions.load_nodes].mean(0) if self.regions.n_load
+                   else np.zeros(3))
+            for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
+                src[ax] = 0.0
+            TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, self.receivers, src)
+            method = "chebyshev"
+            printf(f"[ssi] -ssi_interp auto: {why}")
+        plan = interp.Plan(method, self.dt, self.L, TL if TL else None, k, c.interp_grading)
+        if c.interp != "none" and not plan.active:
+            printf("[ssi] lag interpolation falls back to exact lags (T_L >= T_N or no lag to replace)")
+        self.plan = plan
+        return plan
+
     def quad_options(self):
         c = self.cfg
         return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
@@ -151,11 +170,13 @@ class BEMProblem:
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,
                       self.quad_options())
 
-    def check_memory(self, ls):
+    def check_memory(self, ls, plan=None):
         """Collective: refuse runs whose lag matrices would not fit."""
-        sparse_b, dense_per_lag = ls.estimate_memory()
+        stored = (plan.Lx, plan.k) if plan is not None and plan.active else None
+        sparse_b, dense_per_lag = ls.estimate_memory(stored)
+        nst = self.L if stored is None else stored[0] + stored[1]
         limit = self.cfg.memory_limit * 1e9 if self.cfg.memory_limit > 0 else 0.8 * machine_memory()
-        est = min(sparse_b, dense_per_lag * self.L + 9.0 * self.mesh.n_nodes * self.regions.n_t * 8 * self.L)
+        est = min(sparse_b, dense_per_lag * nst + 9.0 * self.mesh.n_nodes * self.regions.n_t * 8 * nst)
         # triplets are freed lag by lag as the Mats are built; the element cache
         # holds about one lag set of distinct pairs
         peak = 1.1 * max(est, sparse_b * 84.0 / 76.0)
@@ -205,44 +226,65 @@ def run_bem(cfg, comm=None):
     with_stage.push()
     prob = BEMProblem(cfg, comm, log=printf)
     printf(prob.summary())
+    plan = prob.interp_plan()
+    printf("[ssi] " + plan.describe())
     ls = prob.lagset()
-    prob.check_memory(ls)
+    prob.check_memory(ls, plan)
     with_stage.pop()
     st = stage("SSI BEM assembly")
     st.push()
     t0 = time.perf_counter()
-    ls.assemble(monitor=cfg.monitor)
+    ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
     march = Marcher(comm, ls, cfg.scheme, prob.known_u(), prob.known_p(), log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
-    H, hinfo = lagmats.build(comm, ls.H, prob.L, ls.node_range, N, N, r1 - r0, cfg.lag_storage, cfg.lag_fill)
+    H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage, cfg.lag_fill)
     nt = prob.regions.n_t
     if nt:
         pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-        G, ginfo = lagmats.build(comm, ls.G, prob.L, ls.node_range, N, nt, pl.getLocalSize() // 3, "dense")
+        tcol_loc = pl.getLocalSize() // 3
         pl.destroy()
+        G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
     else:
-        G = [None] * prob.L
+        G = [None] * plan.Lx
+    nev = ls.kernel_evaluations
+    HI, GI = [], []
+    for j in range(plan.k if plan.active else 0):
+        lag, toff = plan.kernel_time(j)
+        hb, gb = ls.assemble(monitor=False, lag_lo=lag, lag_hi=lag, toff=toff)
+        nev += ls.kernel_evaluations
+        HI.append(lagmats.build_one(comm, hb, lag, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
+                                    cfg.lag_fill)[0])
+        GI.append(lagmats.build_one(comm, gb, lag, ls.node_range, N, nt, tcol_loc, "dense")[0] if nt else None)
+    ls.kernel_evaluations = nev
     t_asm = time.perf_counter() - t0
     st.pop()
-    mem = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
+    mem_exact = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
+    mem_interp = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in HI + GI))
+    mem = mem_exact + mem_interp
     ndense = sum(1 for i in hinfo if i[1] == "dense")
     nbaij = sum(1 for i in hinfo if i[1] == "baij")
     blocks = sum(i[2] for i in hinfo)
-    fill = blocks / float(prob.L * N * N)
-    printf(f"[ssi] assembly {fmt_time(t_asm)}: {prob.L} lags ({ndense} dense, {nbaij} block-sparse), "
+    fill = blocks / float(plan.Lx * N * N)
+    if plan.active:
+        printf(f"[ssi] memory: {plan.Lx} exact lags {mem_exact / 1e9:.3g} GB, {plan.k} interpolating "
+               f"matrices {mem_interp / 1e9:.3g} GB (T_N = {plan.TN:.4g} s, T_L = {plan.TL:.4g} s)")
+    printf(f"[ssi] assembly {fmt_time(t_asm)}: {plan.Lx} exact lags ({ndense} dense, {nbaij} block-sparse), "
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
     st = stage("SSI BEM time loop")
     st.push()
-    march.set_lags(H, G)
+    march.set_lags(H, G, plan, HI, GI)
     ls.H = ls.G = None   # the triplets are in the Mats now
     out = Output(cfg.output, comm)
     res = _time_loop(cfg, comm, prob, march, out)
     st.pop()
     stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
+             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
+             "T_L": plan.TL if plan.active else None, "lag_bytes_exact": mem_exact,
+             "lag_bytes_interp": mem_interp,
              "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
              "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
              "kernel_evaluations": ls.kernel_evaluations, "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}

@@ -13,8 +13,14 @@ matrices of every brick that touches one of its nodes, keeps the rows it
 owns, sums them into a local CSR (global columns) that also gives the exact
 preallocation, and adds them with ``setValuesCSR(..., ADD_VALUES)``. No
 matrix is ever assembled serially and scattered. M is stored as a Vec (the
-diagonal) and, for D and SLEPc, as a diagonal AIJ matrix. C = alpha_m M
+diagonal): D = K + c M adds it to K's diagonal, and ``diagonal_mat`` makes
+the diagonal AIJ that SLEPc needs (modes.py, on the free dofs). C = alpha_m M
 (paper, below eq. 15) is never formed.
+
+Fixed dofs (one implementation for the integrators, the static solve and the
+modes): ``owned_dofs`` picks the fixed dofs a rank owns, ``eliminate_dofs``
+zeroes their rows and columns and puts the mean diagonal on the diagonal
+(rows scaled like the rest, for AMG).
 """
 from dataclasses import dataclass
 
@@ -22,6 +28,7 @@ import numpy as np
 
 from ..petsc import init, SSIError, collective_error
 from ..monitor import event
+from .mesh import one_line
 
 XI_NODES = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                      [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
@@ -145,12 +152,6 @@ class Layout:
     def n_local(self):
         return self.r1 - self.r0
 
-    def owned_dofs(self, dofs):
-        """The entries of ``dofs`` (global) this rank owns, as local offsets."""
-        d = np.asarray(dofs, dtype=np.int64)
-        d = d[(d >= self.r0) & (d < self.r1)]
-        return d - self.r0
-
     def nodal_vec(self, values):
         """Vec from a replicated (N, 3) array."""
         v = self.vec()
@@ -201,38 +202,68 @@ def csr_to_petsc(A, layout):
     return M
 
 
-def lumped_mass_vec(mesh, mat, layout):
-    """Collective: Vec of nodal masses (each repeated for the 3 components)."""
+def local_lumped_mass(mesh, mat, layout):
+    """Nodal masses of the nodes this rank owns (numpy, no communication)."""
     cells = mesh.cells[local_cells(mesh, layout)]
     me = hex8_lumped_mass(mesh.coords[cells], mat.rho)
-    m = np.bincount(cells.ravel(), weights=me.ravel(), minlength=mesh.n_nodes)[layout.n0:layout.n1]
+    return np.bincount(cells.ravel(), weights=me.ravel(), minlength=mesh.n_nodes)[layout.n0:layout.n1]
+
+
+def lumped_mass_vec(mesh, mat, layout, local=None):
+    """Collective: Vec of nodal masses (each repeated for the 3 components)."""
+    m = local_lumped_mass(mesh, mat, layout) if local is None else local
     v = layout.vec()
     v.getArray()[:] = np.repeat(m, 3)
     return v
 
 
-def diagonal_mat(d, layout):
-    """Collective: diagonal AIJ (bs 3) from a Vec."""
+def diagonal_mat(d):
+    """Collective: diagonal AIJ matrix with the layout and entries of the Vec ``d``."""
     PETSc = init()
-    n = 3 * layout.n_nodes
-    M = PETSc.Mat().createAIJ(size=((layout.n_local, n), (layout.n_local, n)), bsize=3,
-                              nnz=(1, 0), comm=layout.comm)
+    M = PETSc.Mat().createAIJ(size=(d.getSizes(), d.getSizes()), nnz=(1, 0), comm=d.getComm())
     M.setDiagonal(d)
     M.assemble()
     return M
 
 
+def owned_dofs(dofs, obj):
+    """The global ``dofs`` in the ownership range of ``obj`` (Mat or Vec), as PETSc ints."""
+    PETSc = init()
+    r0, r1 = obj.getOwnershipRange()
+    d = np.asarray(dofs, dtype=np.int64)
+    return d[(d >= r0) & (d < r1)].astype(PETSc.IntType)
+
+
+def mean_diagonal(A):
+    """Collective: mean of the diagonal of A."""
+    d = A.getDiagonal()
+    mean = d.sum() / d.getSize()
+    d.destroy()
+    return mean
+
+
+def eliminate_dofs(A, owned):
+    """Collective: zero the rows and columns ``owned`` (global, owned by this rank) of A
+    in place and put the mean diagonal of A on their diagonal; returns A."""
+    A.zeroRowsColumns(owned, diag=mean_diagonal(A))
+    return A
+
+
 def assemble(mesh, mat, layout):
-    """Collective: (K Mat, lumped mass Vec). Checks the brick Jacobians first."""
+    """Collective: (K Mat, lumped mass Vec). Checks the brick Jacobians first; an error on
+    any rank (SSIError or not) is raised on every rank as a one-line SSIError."""
     with event("FEM_assembly"):
         err = None
-        try:
+        A = m = None
+        try:                                   # local numpy work only: nothing collective in here
             A = local_stiffness_csr(mesh, mat, layout)
-            m = lumped_mass_vec(mesh, mat, layout)
+            m = local_lumped_mass(mesh, mat, layout)
         except SSIError as exc:
             err = str(exc)
+        except Exception as exc:  # noqa: BLE001 -- a failure on one rank must reach the others
+            err = f"assembling K and M failed on rank {layout.comm.getRank()}: {one_line(exc)}"
         collective_error(err, layout.comm)
-        return csr_to_petsc(A, layout), m
+        return csr_to_petsc(A, layout), lumped_mass_vec(mesh, mat, layout, m)
 
 
 def check_mass(m, free_mask, comm):

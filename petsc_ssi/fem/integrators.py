@@ -50,9 +50,22 @@ second order, while at the one node next to the jump the velocity has an O(dt)
 local error (a nodal sample cannot tell where in the step the load stops;
 Newmark has the same). So f^n is "the load at t_n", sampled as that cell mean.
 Taking f^n = f(t_n) for a load switched on at t = 0 without the half impulse
-gives order 1 (tests/fem/test_fem_convergence.py shows both). Note for the
-coupling: an interface force that is the mean over (t_{n-1}, t_n]
-(piecewise-constant BE tractions) is half a step late here: order 1.
+gives order 1 (tests/fem/test_fem_convergence.py shows both).
+
+Interface forces (for the FEM-BEM coupling). ``correct(f, f_interface)``
+takes f_interface^n in the same sense as f^n: THE LOAD AT t_n, i.e. the cell
+mean over [t_n - dt/2, t_n + dt/2]. A BE traction is piecewise constant on
+(t_{n-1}, t_n]: its value p^n is the mean over that interval, centred at
+t_n - dt/2, so handing p^n over as it is puts the impulse half a step late
+and the scheme drops to order 1. Extrapolate it to the cell:
+    f_interface^n = 1.5 p^n - 0.5 p^{n-1}      (p^0 = 0: at rest before t = 0)
+(= (p^n + p^{n+1})/2 with p^{n+1} extrapolated linearly, = f(t_n) + O(dt^2)
+for smooth tractions), which keeps order 2. On an SDOF under a smooth force
+the observed displacement orders are 1.0 (p^n as it is) and 2.0
+(extrapolated): tests/fem/test_fem_convergence.py::test_interface_traction_
+must_be_extrapolated. The velocity at t_n needs the impulse of step n: between
+``predict()`` and ``correct()`` only ``free_velocity()`` (v(t_n-), before the
+impulse) is defined, and ``velocity()`` raises.
 
 Relation to Newmark's treatment of loads. Trapezoidal Newmark is the
 trapezoidal (Crank-Nicolson) rule on y' = A y + J f, y = (u, v):
@@ -71,15 +84,18 @@ Newmark with loads (NewmarkIntegrator): the usual form with the same cell-mean
 samples f^n, a^0 = M^{-1}(f^0 - C v^0 - K u^0).
 
 Constraints: fixed dofs have zero rows and columns in D (the mean diagonal on
-the diagonal) and are masked in every impulse and right-hand side, so
-u = v = 0 stays exact there.
+the diagonal, ``assembly.eliminate_dofs``) and are masked in every impulse
+and right-hand side, so u = v = 0 stays exact there. A load on a fixed dof is
+therefore taken by the support and does nothing: the first time a load (or
+interface force) has a non-zero entry on a fixed dof, rank 0 prints a
+warning, once per integrator.
 """
 import numpy as np
 
 from ..petsc import init, SSIError, check, collective_error, set_default_options, \
-    direct_solver_defaults, printf
+    direct_solver_defaults, printf, warn
 from ..monitor import event
-from .assembly import check_mass
+from .assembly import check_mass, owned_dofs, eliminate_dofs
 
 
 def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5):
@@ -100,9 +116,10 @@ def d_mass_coefficient(dt, alpha_m, alpha, delta):
     return 1.0 / (alpha * dt ** 2) + delta * alpha_m / (alpha * dt)
 
 
-# CG + BoomerAMG with settings for 3D elasticity (hypre's advice: strong threshold
-# 0.5 in 3D, HMIS coarsening, ext+i interpolation, one level of aggressive
-# coarsening): a 2.5x cheaper V-cycle than hypre's defaults on the bricks here.
+# CG + BoomerAMG with the settings hypre's documentation advises for 3D elasticity
+# (strong threshold 0.5 in 3D, HMIS coarsening, ext+i interpolation, one level of
+# aggressive coarsening); not compared with hypre's defaults here. On the meshes of
+# runs/foundation/README.md MUMPS (factorise once) is the faster solver anyway.
 # Tight rtol: the Green's-function scheme assumes exact solves of D.
 SOLVER_ITERATIVE = {"ksp_type": "cg", "ksp_rtol": "1e-12", "ksp_atol": "1e-50",
                     "pc_type": "hypre", "pc_hypre_type": "boomeramg",
@@ -110,14 +127,6 @@ SOLVER_ITERATIVE = {"ksp_type": "cg", "ksp_rtol": "1e-12", "ksp_atol": "1e-50",
                     "pc_hypre_boomeramg_coarsen_type": "HMIS",
                     "pc_hypre_boomeramg_interp_type": "ext+i",
                     "pc_hypre_boomeramg_agg_nl": "1"}
-
-
-def mean_diagonal(A):
-    """Collective: mean of the diagonal of A."""
-    d = A.getDiagonal()
-    mean = d.sum() / d.getSize()
-    d.destroy()
-    return mean
 
 
 def make_solver(A, prefix, solver, comm, coords_vec=None, log=printf):
@@ -157,6 +166,22 @@ def setup_or_fail(ksp, probe, what, comm):
     collective_error(err, comm)
 
 
+def count_on_fixed(forces, owned, comm):
+    """Collective: number of non-zero entries of the Vecs ``forces`` (None skipped) on the
+    fixed dofs ``owned`` (global, owned by this rank), summed over the ranks."""
+    n = 0
+    for f in forces:
+        if f is not None and len(owned):
+            r0 = f.getOwnershipRange()[0]
+            n += int(np.count_nonzero(f.getArray(readonly=True)[owned - r0]))
+    return comm.tompi4py().allreduce(n)
+
+
+def fixed_load_message(count, where):
+    return (f"a load acts on {count} fixed dof(s) {where}: the supports take it and it does not move the "
+            "structure (-ssi_fem_fixed); warned once")
+
+
 class _Dynamic:
     """Shared set-up: D = K + c M, the mask of free dofs, M^{-1} on free dofs."""
 
@@ -175,6 +200,7 @@ class _Dynamic:
             setup_or_fail(self.ksp, self.mask, "D (eq. 15)", comm)
         self.u, self.v, self.w, self.rhs = (self._zeros() for _ in range(4))
         self.n = 0
+        self.fixed_load_warning = None       # the warning, once a load acted on fixed dofs
 
     def _zeros(self):
         v = self.m.duplicate()
@@ -183,10 +209,8 @@ class _Dynamic:
 
     def _masks(self, fixed):
         """Owned fixed dofs, the 0/1 mask of free dofs and M^{-1} on free dofs."""
-        PETSc = init()
-        r0, r1 = self.K.getOwnershipRange()
-        fixed = np.asarray(fixed, dtype=np.int64)
-        self.fixed_owned = fixed[(fixed >= r0) & (fixed < r1)].astype(PETSc.IntType)
+        r0 = self.K.getOwnershipRange()[0]
+        self.fixed_owned = owned_dofs(fixed, self.K)
         self.mask = self.m.duplicate()
         self.mask.set(1.0)
         self.mask.getArray()[self.fixed_owned - r0] = 0.0
@@ -196,16 +220,14 @@ class _Dynamic:
 
     def _assemble_D(self):
         """Collective: D = K + (1/(alpha dt^2) + delta alpha_m/(alpha dt)) M (eq. 15), fixed dofs
-        eliminated (zero rows and columns, the mean diagonal on the diagonal, so AMG sees rows
-        scaled like the rest)."""
+        eliminated (``assembly.eliminate_dofs``)."""
         PETSc = init()
         D = self.K.copy()
         cm = self.m.copy()
         cm.scale(d_mass_coefficient(self.dt, self.alpha_m, self.alpha, self.delta))
         D.setDiagonal(cm, addv=PETSc.InsertMode.ADD_VALUES)
         cm.destroy()
-        D.zeroRowsColumns(self.fixed_owned, diag=mean_diagonal(D))
-        return D
+        return eliminate_dofs(D, self.fixed_owned)
 
     @property
     def t(self):
@@ -220,8 +242,19 @@ class _Dynamic:
             dst.pointwiseMult(dst, self.mask)
         self.n = 0
 
+    def _check_fixed(self, *forces):
+        """Collective: warn (rank 0, once) if a force has a non-zero entry on a fixed dof."""
+        if self.fixed_load_warning is not None:
+            return
+        count = count_on_fixed(forces, self.fixed_owned, self.comm)
+        if count:
+            self.fixed_load_warning = fixed_load_message(count, f"at step {self.n} (t = {self.t:.6g} s)")
+            warn(self.fixed_load_warning, self.comm)
+
     def _masked_minv(self, out, *forces):
-        """out = M^{-1} (sum of forces) on free dofs, 0 on fixed ones."""
+        """Collective: out = M^{-1} (sum of forces) on free dofs, 0 on fixed ones (where a
+        non-zero force is dropped, with a warning the first time)."""
+        self._check_fixed(*forces)
         out.zeroEntries()
         for f in forces:
             if f is not None:
@@ -244,8 +277,11 @@ class GreenIntegrator(_Dynamic):
 
     Collective. Per step: ``predict()`` -> u^n (Table 2, B.1, eq. 13, one
     triangular solve), then ``correct(f, f_interface)`` -> v^n (B.5-B.6,
-    eqs. 14 and 16). ``step(f)`` does both. f is the load sample of step n
-    (mean over [t_n - dt/2, t_n + dt/2], see the module docstring).
+    eqs. 14 and 16). ``step(f)`` does both. f and f_interface are the loads
+    at t_n as cell means over [t_n - dt/2, t_n + dt/2] (module docstring; a
+    BE traction piecewise constant on (t_{n-1}, t_n] must be extrapolated).
+    Between predict() and correct() ``velocity()`` raises (v(t_n) needs the
+    impulse of step n); ``free_velocity()`` is v(t_n-) at any time.
     """
 
     def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5, **kw):
@@ -256,6 +292,7 @@ class GreenIntegrator(_Dynamic):
         self.vhalf = m.duplicate()            # M^{-1} f dt/2 of the last impulse
         self.vhalf.zeroEntries()
         self._predicted = False
+        self._kick = 1.0                      # v = v(t_n-) + kick * vhalf (1 after start, 2 after correct)
 
     def start(self, u0=None, v0=None, f0=None):
         """Initial state; f0 = mean load over [0, dt/2] enters as a half impulse."""
@@ -264,9 +301,12 @@ class GreenIntegrator(_Dynamic):
         self.vhalf.scale(0.5 * self.dt)
         self.v.axpy(1.0, self.vhalf)
         self._predicted = False
+        self._kick = 1.0
 
     def predict(self):
-        """u^n from (u^{n-1}, v^{n-1}) (eq. 13); v holds the free velocity after."""
+        """u^n from (u^{n-1}, v^{n-1}) (eq. 13); v holds the free velocity v(t_n-) after."""
+        if self._predicted:
+            raise SSIError("GreenIntegrator.predict() called twice without correct()")
         b = self.b
         self.u.copy(self.rhs)
         self.rhs.scale(b["b4"])
@@ -291,6 +331,7 @@ class GreenIntegrator(_Dynamic):
         self.vhalf.scale(0.5 * self.dt)
         self.v.axpy(2.0, self.vhalf)
         self._predicted = False
+        self._kick = 2.0
         return self.v
 
     def step(self, f=None):
@@ -299,10 +340,24 @@ class GreenIntegrator(_Dynamic):
 
     def velocity(self, out=None):
         """v(t_n): mean of the velocities before and after the impulse at t_n
-        (at t = 0 the state before the initial half impulse)."""
+        (at t = 0 the state before the initial half impulse). SSIError between
+        predict() and correct(): the impulse of step n is not known yet."""
+        if self._predicted:
+            raise SSIError(f"GreenIntegrator.velocity() called between predict() and correct() of step "
+                           f"{self.n}: v(t_n) needs the load of step n; call correct() first, or use "
+                           "free_velocity() for the velocity before the impulse")
         out = self.v.duplicate() if out is None else out
         self.v.copy(out)
         out.axpy(-1.0, self.vhalf)
+        return out
+
+    def free_velocity(self, out=None):
+        """v(t_n-): the velocity just before the impulse at t_n (the free response of
+        the state at t_{n-1}), defined before and after correct(); v0 at t = 0."""
+        out = self.v.duplicate() if out is None else out
+        self.v.copy(out)
+        if not self._predicted:
+            out.axpy(-self._kick, self.vhalf)
         return out
 
 
@@ -320,6 +375,7 @@ class NewmarkIntegrator(_Dynamic):
     def start(self, u0=None, v0=None, f0=None):
         """Initial state; a^0 = M^{-1}(f^0 - C v^0 - K u^0) on free dofs."""
         self._set_initial(u0, v0)
+        self._check_fixed(f0)
         self.K.mult(self.u, self.w)
         self.w.scale(-1.0)
         if f0 is not None:
@@ -331,6 +387,7 @@ class NewmarkIntegrator(_Dynamic):
 
     def step(self, f=None):
         a, d, dt = self.alpha, self.delta, self.dt
+        self._check_fixed(f)
         self.rhs.zeroEntries()
         self.rhs.axpy(self.c_u, self.u)
         self.rhs.axpy(self.c_v, self.v)

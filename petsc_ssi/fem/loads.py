@@ -6,73 +6,30 @@ nodal forces over the bilinear face quads,
 for flat or warped bilinear quads), with n the outward normal (p0 > 0 pushes
 into the body: the paper's top load p(t) = -p0 (H(t) - H(t - 0.025 s)) is
 p0 = 1000 N/m^2 on "top" with the box history); plus point loads at the
-nearest FE nodes.
+nearest FE nodes (refused farther away than the largest element size).
 
-Time part h(t): heaviside (1 for t >= 0), box (1 on [0, t0)), or a table of
-(t, h) rows linearly interpolated, constant beyond its ends; h = 0 for t < 0.
+Time part h(t): ``petsc_ssi.histories.History``, shared with the BEM:
+heaviside H(t) = 1 for t > 0, box 1 on (0, t0], or a table of (t, h) rows
+linearly interpolated (0 before the first time, the last value after the
+last); h = 0 for t <= 0.
 
 Load samples. The integrators take at step n the mean of the load over the
 cell [t_n - dt/2, t_n + dt/2] (for n = 0 the half cell [0, dt/2]),
     f^n = F * (I(b) - I(a)) / (b - a),   I(t) = int_0^t h,
 computed exactly (``History.cell_mean``). For smooth loads f^n = f(t_n) +
 O(dt^2); at a jump the cell mean is what keeps both integrators second-order
-accurate (see integrators.py for why, and tests/fem/test_convergence.py).
+accurate (see integrators.py for why, and tests/fem/test_fem_convergence.py).
 """
 import numpy as np
 
 from ..petsc import SSIError
-from .mesh import parse_points, snap_points
-
-
-class History:
-    """Scalar load history h(t) with its exact running integral."""
-
-    def __init__(self, kind="heaviside", t0=0.025, table=None):
-        self.kind, self.t0 = kind, float(t0)
-        if kind == "table":
-            tab = np.atleast_2d(np.loadtxt(table)) if isinstance(table, str) else np.asarray(table, float)
-            if tab.ndim != 2 or tab.shape[1] != 2 or tab.shape[0] < 1 or np.any(np.diff(tab[:, 0]) <= 0):
-                raise SSIError(f"load table {table if isinstance(table, str) else ''}: need rows 't h' with "
-                               "increasing t")
-            self.tt, self.hh = tab[:, 0], tab[:, 1]
-        elif kind not in ("heaviside", "box"):
-            raise SSIError(f"unknown load history '{kind}'")
-
-    def __call__(self, t):
-        t = np.asarray(t, float)
-        if self.kind == "heaviside":
-            return np.where(t >= 0, 1.0, 0.0)
-        if self.kind == "box":
-            return np.where((t >= 0) & (t < self.t0), 1.0, 0.0)
-        return np.where(t >= 0, np.interp(t, self.tt, self.hh), 0.0)
-
-    def integral(self, t):
-        """I(t) = int_0^t h(s) ds, exact."""
-        t = np.maximum(np.asarray(t, float), 0.0)
-        if self.kind == "heaviside":
-            return t
-        if self.kind == "box":
-            return np.minimum(t, self.t0)
-        return self._table_integral(t)
-
-    def _table_integral(self, t):
-        # breakpoints: 0, the table times > 0; h piecewise linear between them
-        knots = np.unique(np.concatenate([[0.0], self.tt[self.tt > 0]]))
-        hk = np.interp(knots, self.tt, self.hh)
-        cum = np.concatenate([[0.0], np.cumsum(0.5 * (hk[1:] + hk[:-1]) * np.diff(knots))])
-        k = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 1)
-        s = t - knots[k]
-        h_end = np.interp(t, self.tt, self.hh)
-        return cum[k] + 0.5 * (hk[k] + h_end) * s
-
-    def cell_mean(self, n, dt):
-        """Mean of h over [t_n - dt/2, t_n + dt/2] (n = 0: over [0, dt/2])."""
-        a = max(0.0, (n - 0.5) * dt)
-        b = (n + 0.5) * dt
-        return float((self.integral(b) - self.integral(a)) / (b - a))
+from ..histories import History  # noqa: F401  (the FEM's load histories)
+from ..points import parse_points
+from .mesh import snap_points
 
 
 def history_from(cfg):
+    """The load history of the options (SSIError on a bad table)."""
     return History(cfg.fem_load_history, cfg.fem_load_t0,
                    cfg.fem_load_table if cfg.fem_load_history == "table" else None)
 
@@ -115,8 +72,8 @@ def nodal_load(mesh, cfg):
             F[:, i] += np.bincount(quads.ravel(), weights=fq[:, :, i].ravel(), minlength=mesh.n_nodes)
     dist = np.zeros(0)
     if cfg.fem_point_load.strip():
-        pl = parse_points(cfg.fem_point_load, 6, "-ssi_fem_point_load")
-        nodes, dist = snap_points(mesh, pl[:, :3])
+        pl = parse_points(cfg.fem_point_load, 6, "-ssi_fem_point_load", "x,y,z,fx,fy,fz")
+        nodes, dist = snap_points(mesh, pl[:, :3], "-ssi_fem_point_load")
         np.add.at(F, nodes, pl[:, 3:])
     return F, dist
 

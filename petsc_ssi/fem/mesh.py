@@ -18,10 +18,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..petsc import SSIError, collective_error
+from ..points import parse_triple
 
 # Local faces of a hex8, each ordered so that (x1-x0) x (x3-x0) points outward.
 HEX_FACES = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4],
                       [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]])
+# The 12 edges of a hex8 (local node pairs).
+HEX_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 7], [7, 4],
+                      [0, 4], [1, 5], [2, 6], [3, 7]])
 GMSH_HEX8, GMSH_QUAD4, GMSH_QUAD9 = 5, 3, 10
 
 
@@ -49,6 +53,12 @@ class HexMesh:
         if name in self.nodes:
             return self.nodes[name]
         return np.unique(self.faces[name])
+
+
+def one_line(exc):
+    """'Type: first line of the message' of an unexpected exception."""
+    lines = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {lines[0]}" if lines else type(exc).__name__
 
 
 # ------------------------------------------------------------------ generator
@@ -212,22 +222,20 @@ def renumber_rcm(mesh):
                    {k: old2new[v] for k, v in mesh.nodes.items()}, mesh.source)
 
 
-def _parse_triple(text, kind):
-    return tuple(kind(s) for s in str(text).split(","))
-
-
 def build_mesh(cfg):
     """Serial: the mesh the options describe (no renumbering)."""
     if cfg.fem_mesh == "box":
-        return structured_box(_parse_triple(cfg.fem_box_cells, int), _parse_triple(cfg.fem_box_size, float),
-                              _parse_triple(cfg.fem_box_origin, float))
+        return structured_box(parse_triple(cfg.fem_box_cells, int, "-ssi_fem_box_cells"),
+                              parse_triple(cfg.fem_box_size, float, "-ssi_fem_box_size"),
+                              parse_triple(cfg.fem_box_origin, float, "-ssi_fem_box_origin"))
     return read_gmsh(cfg.fem_mesh)
 
 
 def load_mesh(cfg, comm):
     """Collective: build or read the mesh on rank 0, renumber, broadcast.
 
-    gmsh runs on rank 0 only; an error there is raised on every rank.
+    gmsh runs on rank 0 only; any error there (SSIError or not) is raised on
+    every rank as a one-line SSIError, so the other ranks never wait in bcast.
     """
     mpi = comm.tompi4py()
     mesh, err = None, None
@@ -238,32 +246,39 @@ def load_mesh(cfg, comm):
                 mesh = renumber_rcm(mesh)
         except SSIError as exc:
             err = str(exc)
-    err = mpi.bcast(err, root=0)
+        except Exception as exc:  # noqa: BLE001 -- any failure must reach the other ranks
+            err = f"reading the mesh '{cfg.fem_mesh}' failed: {one_line(exc)}"
     collective_error(err, comm)
     return mpi.bcast(mesh, root=0)
 
 
 # ------------------------------------------------------------------ queries
-def snap_points(mesh, points):
-    """Nearest FE node of each point: (node ids, distances)."""
+def largest_element_size(mesh):
+    """The longest edge of any brick: the mesh's largest element size h_max."""
+    if mesh.n_cells == 0:
+        return 0.0
+    X = mesh.coords[mesh.cells]
+    a, b = HEX_EDGES.T
+    return float(np.linalg.norm(X[:, a] - X[:, b], axis=2).max())
+
+
+def snap_points(mesh, points, what="-ssi_receivers"):
+    """Nearest FE node of each point: (node ids, distances).
+
+    SSIError (one line, naming ``what``) if a point is farther from its
+    nearest node than the largest element size: it lies outside the
+    structure (any point inside a brick is within half the brick's diagonal
+    of a node).
+    """
     from scipy.spatial import cKDTree
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     if pts.size == 0:
         return np.zeros(0, np.int64), np.zeros(0)
     dist, idx = cKDTree(mesh.coords).query(pts)
+    h = largest_element_size(mesh)
+    far = np.nonzero(dist > h)[0]
+    if far.size:
+        p, d = pts[far[0]], dist[far[0]]
+        raise SSIError(f"{what}: point ({p[0]:g}, {p[1]:g}, {p[2]:g}) is {d:.3g} m from the nearest FE node, "
+                       f"more than the largest element size {h:.3g} m: it lies outside the structure")
     return idx.astype(np.int64), dist
-
-
-def parse_points(text, ncols=3, what="-ssi_receivers"):
-    """'x,y,z;x,y,z' -> (R, ncols) array; SSIError on a malformed entry."""
-    rows = [r for r in str(text).replace("\n", ";").split(";") if r.strip()]
-    out = []
-    for r in rows:
-        try:
-            vals = [float(s) for s in r.split(",")]
-        except ValueError:
-            vals = []
-        if len(vals) != ncols:
-            raise SSIError(f"{what}: '{r.strip()}' is not {ncols} comma-separated numbers")
-        out.append(vals)
-    return np.array(out, dtype=float).reshape(-1, ncols)

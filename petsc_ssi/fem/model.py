@@ -3,6 +3,8 @@
 ``build_model`` is collective and checks every input (groups, receivers,
 point loads) on the replicated mesh before the matrices are assembled, so a
 bad input costs no assembly and raises the same SSIError on every rank.
+Receivers and point loads snap to the nearest FE node; one farther away than
+the largest element size is refused (it lies outside the structure).
 """
 from dataclasses import dataclass
 
@@ -11,7 +13,8 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf
 from .assembly import Layout, Material, assemble
 from .loads import fixed_dofs, nodal_load, restrains_rigid_motion
-from .mesh import load_mesh, parse_points, snap_points
+from .mesh import load_mesh, snap_points
+from ..points import parse_points
 
 
 @dataclass
@@ -40,8 +43,8 @@ class Model:
 def _inputs(mesh, cfg):
     fixed = fixed_dofs(mesh, cfg.fem_fixed)
     F, pdist = nodal_load(mesh, cfg)
-    pts = parse_points(cfg.receivers) if cfg.receivers.strip() else np.zeros((0, 3))
-    nodes, dist = snap_points(mesh, pts)
+    pts = parse_points(cfg.receivers, 3, "-ssi_receivers")
+    nodes, dist = snap_points(mesh, pts, "-ssi_receivers")
     return fixed, F, pts, nodes, dist, pdist
 
 

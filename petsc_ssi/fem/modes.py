@@ -5,8 +5,10 @@ Generalised symmetric problem K x = omega^2 M x (lumped M) on the free dofs
 is free and its six rigid-body modes come out at 0 Hz), solved by Krylov-
 Schur with shift-and-invert about a small negative target (so that K - sigma M
 is positive definite even for a free structure; every eigenvalue is >= 0 >
-sigma, so "nearest the target" means "lowest"). The inner solve is a MUMPS
-factorisation. Options prefix ``ssi_modes_`` (``-ssi_modes_eps_nev`` is set
+sigma, so "nearest the target" means "lowest"). The inner solve is a direct
+factorisation chosen by ``petsc.direct_solver_defaults`` (MUMPS, else
+SuperLU_dist; PETSc's serial LU only on one rank, with a warning; an error in
+parallel without either). Options prefix ``ssi_modes_`` (``-ssi_modes_eps_nev`` is set
 from ``-ssi_modes_n``; any ``-ssi_modes_eps_*``/``-ssi_modes_st_*`` wins).
 
 Output: a table ``mode,frequency_hz`` on stdout (rank 0), the mode shapes
@@ -18,9 +20,10 @@ import math
 
 import numpy as np
 
-from ..petsc import init, collective_error, printf, set_default_options, has_package
+from ..petsc import init, collective_error, printf, set_default_options, direct_solver_defaults
 from ..monitor import event
 from .. import options as ssi_options
+from .assembly import diagonal_mat, owned_dofs
 
 
 def _submatrices(K, m, fixed):
@@ -28,13 +31,11 @@ def _submatrices(K, m, fixed):
     PETSc = init()
     comm = K.getComm()
     r0, r1 = K.getOwnershipRange()
-    free = np.setdiff1d(np.arange(r0, r1), np.asarray(fixed, np.int64)).astype(PETSc.IntType)
+    free = np.setdiff1d(np.arange(r0, r1), owned_dofs(fixed, K)).astype(PETSc.IntType)
     isf = PETSc.IS().createGeneral(free, comm=comm)
     Kf = K.createSubMatrix(isf, isf)
     mf = m.getSubVector(isf)
-    Mf = PETSc.Mat().createAIJ(size=Kf.getSizes(), nnz=(1, 0), comm=comm)
-    Mf.setDiagonal(mf)
-    Mf.assemble()
+    Mf = diagonal_mat(mf)
     m.restoreSubVector(isf, mf)
     return Kf, Mf, isf, free
 
@@ -52,9 +53,9 @@ def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_"):
     from slepc4py import SLEPc
     comm = K.getComm()
     Kf, Mf, isf, free = _submatrices(K, m, fixed)
-    solver = "mumps" if has_package("mumps") else "petsc"
-    set_default_options(prefix, {"st_type": "sinvert", "st_ksp_type": "preonly", "st_pc_type": "lu",
-                                 "st_pc_factor_mat_solver_type": solver}, log=None)
+    defaults = {"st_type": "sinvert"}
+    defaults.update({"st_" + k: v for k, v in direct_solver_defaults(comm).items()})
+    set_default_options(prefix, defaults, log=None)
     eps = SLEPc.EPS().create(comm)
     eps.setOptionsPrefix(prefix)
     eps.setOperators(Kf, Mf)

@@ -7,6 +7,8 @@ SLEPc, unchanged (they are PETSc object options, not registry entries).
 import os
 
 from ..options import register, register_check, positive, nonnegative, at_least
+from ..petsc import SSIError
+from ..points import parse_triple
 
 G = "fem"
 
@@ -18,10 +20,10 @@ def _nu_range(v):
 def _triple(kind):
     def check(text):
         try:
-            vals = [kind(s) for s in str(text).split(",")]
-        except ValueError:
+            parse_triple(text, kind)
+        except SSIError:
             return "must be three comma-separated numbers"
-        return None if len(vals) == 3 else "must be three comma-separated numbers"
+        return None
     return check
 
 
@@ -54,10 +56,10 @@ register("fem_load_group", "str", "", "", "loaded faces: comma-separated face gr
 register("fem_load_p0", "real", 0.0, "N/m^2", "pressure on the load group; p0 > 0 pushes into the body "
          "(traction -p0 h(t) n, n the outward normal)", G)
 register("fem_load_history", "enum", "heaviside", "", "load history h(t) of the pressure and point loads: "
-         "heaviside, box (1 on [0, t0)), table", G, choices=("heaviside", "box", "table"))
+         "heaviside (1 for t > 0), box (1 on (0, t0]), table", G, choices=("heaviside", "box", "table"))
 register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse", G, validator=positive)
-register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (constant beyond the "
-         "ends)", G)
+register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (0 before the first "
+         "time, the last value after the last)", G)
 register("fem_point_load", "str", "", "m, N", "point loads 'x,y,z,fx,fy,fz;...' at the nearest FE node, "
          "times h(t)", G)
 register("fem_fixed", "str", "", "", "fixed (zero displacement) node groups 'name[:xyz],...', e.g. 'base' or "
@@ -79,6 +81,12 @@ def _fem_checks(cfg):
     uses_history = cfg.fem_load_p0 != 0 or cfg.fem_point_load.strip()
     if uses_history and cfg.fem_load_history == "table" and not os.path.isfile(cfg.fem_load_table):
         return f"-ssi_fem_load_table '{cfg.fem_load_table}': no such file"
+    if uses_history:
+        from .loads import history_from       # read and check the table now, before any assembly
+        try:
+            history_from(cfg)
+        except SSIError as exc:
+            return f"-ssi_fem_load_history {cfg.fem_load_history}: {exc}"
     a, d = cfg.fem_newmark_alpha, cfg.fem_newmark_delta
     if cfg.fem_integrator == "green" and abs(d * d - a) > 1e-12:
         return (f"-ssi_fem_integrator green needs delta^2 = alpha (paper eq. 24); got "
