@@ -48,6 +48,14 @@ def main(argv=None):
         sys.stdout.flush()
         PETSc.COMM_WORLD.tompi4py().Barrier()
         return 2
+    except Exception:  # a bug or an I/O failure on some ranks only: never hang mpirun
+        import traceback
+        traceback.print_exc()
+        sys.stderr.flush()
+        comm = PETSc.COMM_WORLD.tompi4py()
+        if comm.Get_size() > 1:
+            comm.Abort(1)
+        return 1
     return 0
 
 

@@ -41,6 +41,24 @@ def _geom_key(X, xc, qinv, key):
     return hsh
 
 
+@njit(cache=True)
+def lag_order(lag, L):
+    """Stable counting sort by lag (1..L): the permutation and the bucket
+    bounds. Triplets come out row-major, so within a lag rows stay sorted."""
+    cnt = np.zeros(L + 2, np.int64)
+    for x in lag:
+        cnt[x + 1] += 1
+    for l in range(1, L + 2):
+        cnt[l] += cnt[l - 1]
+    bounds = cnt.copy()
+    order = np.empty(lag.shape[0], np.int64)
+    pos = cnt[:-1].copy()
+    for i in range(lag.shape[0]):
+        order[pos[lag[i]]] = i
+        pos[lag[i]] += 1
+    return order, bounds[1:]
+
+
 def new_cache():
     """An element-integral cache (kept across calls of ``assemble_rows``)."""
     return (Dict.empty(key_type=types.int64, value_type=types.int64),
@@ -52,7 +70,7 @@ def new_cache():
 def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alpha, beta,
                   rho, nu, ns_base, near_factor, ns_max, gq, gw, gr, gwr, n_nodes, n_tcols,
                   free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  lag_lo=1, toff=0.0):
+                  lag_lo=1, toff=0.0, h_ref=1.0):
     """Collective-free numba kernel: triplets of H and G for ``rows``.
 
     Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev, hits, cache
@@ -138,9 +156,8 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                         found = c
             if found >= 0:
                 off = cmeta[found, 2]
-                Pb[:nl] = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
-                if want_u:
-                    Ub[:nl] = cpoolU[off:off + nl * 81].reshape((nl, 9, 3, 3))
+                Psrc = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
+                Usrc = cpoolU[off:off + nl * 81].reshape((nl, 9, 3, 3)) if want_u else Ub[:nl]
                 hits += 1
             else:
                 Ub[:nl] = 0.0
@@ -150,7 +167,8 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                 if sing >= 0:
                     Us[:] = 0.0
                     Ps[:] = 0.0
-                    singular_static(VX[v], sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps)
+                    singular_static(VX[v], sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps,
+                                    h_ref)
                     Ub[0] += Us
                     Pb[0] += Ps
                 if use_cache and hsh not in cidx:
@@ -169,13 +187,15 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                     pool_n += nl * 81
                     cidx[hsh] = c
                     ncache += 1
+                Psrc = Pb[:nl]
+                Usrc = Ub[:nl]
             for li in range(nl):
                 lag = lo + li
                 for a in range(9):
                     nz = False
                     for p in range(3):
                         for q in range(3):
-                            if Pb[li, a, p, q] != 0.0:
+                            if Psrc[li, a, p, q] != 0.0:
                                 nz = True
                     if nz:
                         col = Vnode[v, a]
@@ -190,7 +210,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                             nh += 1
                         for p in range(3):
                             for q in range(3):
-                                hval[s, p, q] += Pb[li, a, p, q] * Vsign[v, q]
+                                hval[s, p, q] += Psrc[li, a, p, q] * Vsign[v, q]
                     tc = Vtcol[v, a]
                     if tc >= 0:
                         s = slotG[lag, tc]
@@ -204,7 +224,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                             ng_ += 1
                         for p in range(3):
                             for q in range(3):
-                                gval[s, p, q] += Ub[li, a, p, q] * Vsign[v, q]
+                                gval[s, p, q] += Usrc[li, a, p, q] * Vsign[v, q]
         # free term c_lk = delta_lk / 2 (smooth surface point)
         if lag_lo == 1:
             s = slotH[1, i]

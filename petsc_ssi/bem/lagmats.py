@@ -20,6 +20,8 @@ def _csr(rows_local, cols, vals, nloc):
 def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
     """MPIBAIJ (bs 3) from sorted node-block triplets of local rows."""
     PETSc = init()
+    o = np.lexsort((cols, rows))               # CSR: columns sorted within a row
+    rows, cols, vals = rows[o], cols[o], vals[o]
     ip, ix, v = _csr(rows - r0, cols, vals, nrow_loc)
     A = PETSc.Mat().createBAIJ(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
                                bsize=3, csr=(ip, ix, np.ascontiguousarray(v).reshape(-1)), comm=comm)
@@ -85,5 +87,6 @@ def mat_bytes(A):
     """Bytes a Mat stores (values and indices), from MatGetInfo."""
     if A is None:
         return 0
-    inf = A.getInfo()
+    PETSc = init()
+    inf = A.getInfo(PETSc.Mat.InfoType.LOCAL)   # the caller sums over ranks
     return int(inf.get("memory", 0)) or int(inf.get("nz_allocated", 0) * 8)

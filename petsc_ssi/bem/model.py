@@ -13,7 +13,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import assemble_rows, new_cache
+from .assemble import assemble_rows, new_cache, lag_order
 
 
 class Material:
@@ -97,15 +97,14 @@ def machine_memory():
 
 
 def _by_lag(trip, L):
-    """Split the triplets of one chunk of rows by lag: [(rows, cols, vals)] * L
-    (sorted by row then column within a lag), so the per-chunk row/lag index
-    arrays are dropped at once and every lag can be freed after use."""
+    """Split the triplets of one chunk of rows by lag: [(rows, cols, vals)] * L,
+    rows ascending within a lag (a stable O(n) counting sort), so the
+    per-chunk row/lag index arrays are dropped at once and every lag can be
+    freed after use. Columns are sorted later, only where BAIJ needs them."""
     row, lag, col, val = trip
-    order = np.lexsort((col, row, lag))
-    row, lag, col, val = row[order], lag[order], col[order], val[order]
-    b = np.searchsorted(lag, np.arange(1, L + 2))
-    return ([(row[b[l]:b[l + 1]], col[b[l]:b[l + 1]].astype(np.int32), val[b[l]:b[l + 1]].copy())
-             for l in range(L)],)
+    order, b = lag_order(lag, L)
+    row, col, val = row[order], col[order].astype(np.int32), val[order]
+    return ([(row[b[l]:b[l + 1]], col[b[l]:b[l + 1]], val[b[l]:b[l + 1]]) for l in range(L)],)
 
 
 class Buckets:
@@ -190,7 +189,7 @@ class LagSet:
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
                                 self.regions.n_t, 0.5, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
-                                cpP, cpU, qinv, lag_lo, toff)
+                                cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()))
             parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
             nev += res[8]
             hits += res[9]

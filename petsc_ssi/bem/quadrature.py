@@ -25,11 +25,16 @@ theta; P_static (strongly singular) as a Cauchy principal value with
 Guiggiani's direct method (Guiggiani & Gigante 1990; Guiggiani 1992):
 
   CPV = int_theta { int_0^rhohat [F(rho,th) - F_{-1}(th)/rho] drho
-                    + F_{-1}(th) ln(rhohat(th) |A(th)|) } dth,
+                    + F_{-1}(th) ln(rhohat(th) |A(th)| / h_ref) } dth,
   F_{-1}(th) = K(A/|A|, n_c) J_c / |A|^2 (only for the node at xi),
 
 with A(th) = dx/dxi cos th + dx/deta sin th at xi and K the r^-2 coefficient
 of Kelvin's traction kernel. Convergence under increasing order is tested.
+h_ref (the smallest element size of the mesh) cancels at interior nodes; at a
+node on the truncation edge of an open surface the CPV does not exist (the
+mesh ends, the half-space does not), and measuring the exclusion radius in
+units of h_ref is our convention there: results no longer depend on the
+length unit.
 The free term c_lk = delta_lk/2 (smooth surface point) is added by the
 assembler.
 """
@@ -234,11 +239,16 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
 
 
 @njit(cache=True)
-def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps):
+def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_ref=1.0):
     """Static Kelvin integrals over an element with xi at its node ``c``.
 
     Polar coordinates around the node in the parameter square, one triangle
     per square side not containing the node. Us, Ps: (9, 3, 3), accumulated.
+    The exclusion radius of the CPV is measured in units of ``h_ref`` (one
+    length for the whole mesh): around an interior node the constant cancels
+    over the full circle; at a node on the truncation edge of an open surface
+    the CPV does not exist and this fixes the result independently of the
+    length unit (the convention of the module docstring).
     """
     xc0 = _NXI[c]
     ec0 = _NET[c]
@@ -306,7 +316,7 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps):
                 for p in range(3):
                     for q in range(3):
                         Ps[c, p, q] -= wth * wr * fm1 * k0[p, q] / rho_
-            lg = math.log(rhat * Aabs)
+            lg = math.log(rhat * Aabs / h_ref)
             for p in range(3):
                 for q in range(3):
                     Ps[c, p, q] += wth * fm1 * k0[p, q] * lg

@@ -57,6 +57,14 @@ def load_mesh(cfg, planes, comm):
     return mpi.bcast(mesh)
 
 
+def _history(cfg, which):
+    """The -ssi_<which>_history as a callable, read and checked now."""
+    try:
+        return histories.make(cfg.get(which + "_history"), cfg.get(which + "_t0"), cfg.get(which + "_table"))
+    except SSIError as exc:
+        raise SSIError(f"-ssi_{which}_history {cfg.get(which + '_history')}: {exc}") from None
+
+
 class BEMProblem:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
@@ -69,11 +77,19 @@ class BEMProblem:
         self.h = h
         symmetry.check_mesh(self.mesh.nodes, self.planes, h)
         self.dt = cfg.dt
-        self.n_steps = int(round(cfg.t_end / cfg.dt))
+        # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
+        self.n_steps = int(math.ceil(cfg.t_end / cfg.dt - 1e-9))
         load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
         if cfg.load_group and cfg.load_p0 == 0.0:
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
+        if cfg.user_set("load_p0") and not cfg.load_group:
+            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
+        if cfg.user_set("disp_value") and not cfg.disp_group:
+            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+        # histories are built (and tables read and checked) before any heavy work
+        self._load_f = _history(cfg, "load") if len(load) else None
+        self._disp_f = _history(cfg, "disp") if len(disp) else None
         self.regions = Regions(self.mesh, load, disp)
         symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None,
                                   self._disp_value() if len(disp) else None)
@@ -190,7 +206,7 @@ class BEMProblem:
 
     def known_p(self):
         c = self.cfg
-        f = histories.make(c.load_history, c.load_t0, c.load_table) if self.regions.n_load else None
+        f = self._load_f
         tr = np.array([0.0, 0.0, -c.load_p0])   # p0 > 0 pushes the surface down (-z)
         nl = self.regions.n_load
 
@@ -212,7 +228,7 @@ class BEMProblem:
         if not nd:
             return lambda n: np.zeros(0)
         val = self._disp_value()
-        f = histories.make(c.disp_history, c.disp_t0, c.disp_table)
+        f = self._disp_f
         return lambda n: np.tile(val * float(f(n * self.dt)), nd)
 
 

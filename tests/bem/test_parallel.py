@@ -12,11 +12,17 @@ ARGS = ["-ssi_mesh_size", "8,8", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1", "
 
 
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
-@pytest.mark.parametrize("storage", ["auto", "sparse"])
-def test_two_ranks_reproduce_one(tmp_path, storage):
+@pytest.mark.parametrize("storage,extra", [
+    ("auto", []), ("sparse", []),
+    # prescribed displacement (the traction-unknown scatters) plus a box load
+    ("auto", ["-ssi_disp_group", "box:2,3,-1,1", "-ssi_disp_value", "0,0,-1e-6",
+              "-ssi_load_history", "box", "-ssi_load_t0", "0.003"]),
+    ("auto", ["-ssi_interp", "chebyshev", "-ssi_interp_tl", "0.003", "-ssi_interp_k", "3"]),
+])
+def test_two_ranks_reproduce_one(tmp_path, storage, extra):
     a, b = tmp_path / "n1.h5", tmp_path / "n2.h5"
-    cli(ARGS + ["-ssi_lag_storage", storage, "-ssi_output", str(a)], nranks=1)
-    cli(ARGS + ["-ssi_lag_storage", storage, "-ssi_output", str(b)], nranks=2)
+    cli(ARGS + extra + ["-ssi_lag_storage", storage, "-ssi_output", str(a)], nranks=1)
+    cli(ARGS + extra + ["-ssi_lag_storage", storage, "-ssi_output", str(b)], nranks=2)
     r1, r2 = read_h5(a), read_h5(b)
     assert np.abs(r1["u"]).max() > 0
     assert relmax(r2["u"], r1["u"]) <= 1e-10

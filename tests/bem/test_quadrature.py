@@ -92,3 +92,51 @@ def test_element_lag_sum_is_static_integral():
         U0 = np.zeros((1, 9, 3, 3)); P0 = np.zeros((1, 9, 3, 3))
         integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, 1, 1e3, cp, cs, rho, nu, U0, P0, True)
         assert np.abs(Ub.sum(0) - U0[0]).max() <= 1e-10 * np.abs(U0).max()
+
+
+def test_traction_lag_sum_is_static_integral():
+    """The same identity for the traction kernel P (1e-10)."""
+    dt, cp, cs, rho = 7.5e-4, 548.0, 316.0, 2000.0
+    nu = (cp ** 2 - 2 * cs ** 2) / (2 * (cp ** 2 - cs ** 2))
+    gq, gw = np.polynomial.legendre.leggauss(2)
+    X = grid(1.0, 1.0, 1.0).cell_coords()[0].copy() + np.array([2.0, 0.3, 0.0])
+    X[:, 2] = 0.05 * X[:, 0] ** 2          # curved: gamma.n != 0, all terms active
+    L = int(3.0 / (cs * dt)) + 4
+    Ub = np.zeros((L, 9, 3, 3)); Pb = np.zeros((L, 9, 3, 3))
+    integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, L, dt, cp, cs, rho, nu, Ub, Pb, False)
+    U0 = np.zeros((1, 9, 3, 3)); P0 = np.zeros((1, 9, 3, 3))
+    integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, 1, 1e3, cp, cs, rho, nu, U0, P0, False)
+    assert np.abs(Pb.sum(0) - P0[0]).max() <= 1e-10 * np.abs(P0).max()
+
+
+def test_static_row_sum_equals_analytic_cpv_on_nonuniform_mesh():
+    """Row sums of the static H (one lag of dt = 1e3 s) at interior nodes of a
+    non-uniform flat mesh equal I/2 + the analytic CPV over the rectangle,
+    K int (x - x_i)/r^3 dA with K = (1-2nu)/(8 pi (1-nu)) (1e-6): checks the
+    log term of the Guiggiani CPV at corner, edge and centre nodes."""
+    from helpers import petsc
+    PETSc = petsc()
+    from petsc_ssi.bem.model import Material, Regions, LagSet
+    mesh = grid(6.0, 5.0, 0.7, patch=(1.1, 0.8))
+    mat = Material(548.0, 316.0, 2000.0)
+    reg = Regions(mesh)
+    opts = {"gauss": 2, "singular_order": 16, "subdivisions": 4, "near_factor": 2.0,
+            "max_subdivisions": 32, "cache": False}
+    x = mesh.nodes
+    interior = np.where((np.abs(x[:, 0]) < 2.5) & (np.abs(x[:, 1]) < 2.0))[0][::7]
+    ls = LagSet(PETSc.COMM_SELF, mesh, mat, 1e3, 1, reg, [], opts)
+    ls.rows = interior
+    ls.assemble()
+    r, c, v = ls.H.peek(1)
+    K = (1 - 2 * mat.nu) / (8 * np.pi * (1 - mat.nu))
+
+    def cpv(xi, yi, x0, x1, y0, y1):
+        f = lambda y, a: np.arcsinh((y - yi) / abs(a - xi))
+        return (f(y1, x0) - f(y0, x0)) - (f(y1, x1) - f(y0, x1))
+    for i in interior:
+        S = v[r == i].sum(0)
+        Ix = K * cpv(x[i, 0], x[i, 1], -3, 3, -2.5, 2.5)
+        Iy = K * cpv(x[i, 1], x[i, 0], -2.5, 2.5, -3, 3)
+        ref = 0.5 * np.eye(3)
+        ref[0, 2], ref[2, 0], ref[1, 2], ref[2, 1] = Ix, -Ix, Iy, -Iy
+        assert np.abs(S - ref).max() <= 1e-6, (i, S, ref)
