@@ -67,6 +67,9 @@ register("interp_k", "int", 0, "", "number k of interpolating matrices (auto: on
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("interp_grading", "real", 1.0, "", "multi-linear node grading exponent p in T_j = T_L + (T_N-T_L)((j-1)/(k-1))^p", "bem",
          validator=lambda v: None if v > 0 else "must be > 0")
+register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause", "bem")
+register("guard_factor", "real", 100.0, "", "guard: stop when |u| exceeds this times the largest |u| of the first half of the run so far", "bem",
+         validator=lambda v: None if v > 1 else "must be > 1")
 register("warn_beta", "bool", True, "", "warn when beta = c dt / l leaves [0.3, 1.3]", "bem")
 
 

@@ -346,6 +346,8 @@ def _time_loop(cfg, comm, prob, march, out):
         nrm = u.norm()
         unorm.append(nrm)
         prog.update(n, f"t={t:.4g}s |u|={nrm:.3e}")
+        if cfg.guard:
+            _guard(cfg, prob, march, unorm, n)
     ser = None
     if nrec:
         loc = np.array(series).reshape(len(times), -1)
@@ -353,6 +355,33 @@ def _time_loop(cfg, comm, prob, march, out):
         if comm.getRank() == 0:
             ser = np.concatenate(allp, axis=1).reshape(len(times), nrec, 3)
     return {"t": np.array(times), "u": ser, "unorm": np.array(unorm)}
+
+
+def _guard(cfg, prob, march, unorm, n):
+    """Stop a clearly diverging run (same decision on every rank: the norm is
+    a global reduction). Diverging: a non-finite norm, or after 20 steps a
+    norm above guard_factor times the largest norm of the first half of the
+    run so far. A loaded, damped (radiating) half-space cannot do that."""
+    nrm = unorm[-1]
+    if np.isfinite(nrm) and (n < 20 or nrm <= cfg.guard_factor * max(max(unorm[:n // 2]), 1e-300)):
+        return
+    ref = max(unorm[:n // 2]) if n >= 2 else 0.0
+    rate = (np.log(nrm / ref) / (n - n // 2)) if (np.isfinite(nrm) and ref > 0) else float("inf")
+    causes = []
+    if march.scheme == "plain":
+        causes.append("the plain scheme (eq. 6) is unstable for small beta: use -ssi_scheme stabilized")
+    if prob.beta[0] < 0.3 or prob.beta[1] > 1.3:
+        causes.append(f"beta = c dt / l spans [{prob.beta[0]:.2f}, {prob.beta[1]:.2f}], outside [0.3, 1.3]: "
+                      "change -ssi_dt or the mesh")
+    plan = getattr(march, "plan", None)
+    if plan is not None:
+        causes.append(f"lag interpolation from T_L = {plan.TL:.4g} s: a threshold below the Rayleigh "
+                      "arrival (tau_L < 1.09) is inaccurate; raise -ssi_interp_tl")
+    if not causes:
+        causes.append("unknown (check the mesh and dt; -ssi_guard 0 disables this check)")
+    raise SSIError(f"the solution is diverging at step {n} (t = {n * prob.dt:.4g} s): |u| = {nrm:.3e}, "
+                   f"{nrm / ref if ref > 0 else float('inf'):.3g} x the largest norm of the first half, growth "
+                   f"rate {rate:.3g} per step; likely cause: {'; '.join(causes)}")
 
 
 def _traction_to_nodes(comm, prob, march):
