@@ -24,6 +24,8 @@ The two samplings the solvers use:
   ``cell_mean(n, dt)``  mean over [t_n - dt/2, t_n + dt/2] (n = 0: [0, dt/2]):
                         the FEM's load sample at t_n (fem/integrators.py).
 """
+import warnings
+
 import numpy as np
 
 from .petsc import SSIError
@@ -35,9 +37,11 @@ def read_table(table):
     """(t, h) arrays of a table file or (K, 2) array; SSIError if malformed."""
     name = f"'{table}'" if isinstance(table, str) else "(array)"
     if table is None or (isinstance(table, str) and not table.strip()):
-        raise SSIError("load history 'table' needs a table file of 't h' rows")
+        raise SSIError("history 'table' needs a table file of 't h' rows")
     try:
-        data = np.loadtxt(table, ndmin=2) if isinstance(table, str) else np.array(table, dtype=float, ndmin=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)          # an empty file: the shape check says so
+            data = np.loadtxt(table, ndmin=2) if isinstance(table, str) else np.array(table, dtype=float, ndmin=2)
     except (OSError, ValueError) as exc:
         msg = str(exc).strip().splitlines()
         raise SSIError(f"history table {name}: {msg[-1] if msg else type(exc).__name__}") from None
@@ -47,7 +51,7 @@ def read_table(table):
         raise SSIError(f"history table {name}: non-finite value (nan or inf)")
     if np.any(np.diff(data[:, 0]) <= 0):
         k = int(np.nonzero(np.diff(data[:, 0]) <= 0)[0][0])
-        raise SSIError(f"history table {name}: t must increase strictly (row {k + 2}: t = {data[k + 1, 0]:g} "
+        raise SSIError(f"history table {name}: t must increase strictly (data row {k + 2}: t = {data[k + 1, 0]:g} "
                        f"after {data[k, 0]:g})")
     return data[:, 0].copy(), data[:, 1].copy()
 

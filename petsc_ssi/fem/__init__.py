@@ -2,7 +2,7 @@
 
   mesh.py         hex8 meshes: gmsh reader, structured generator, named groups
   assembly.py     vectorised hex8 kernels; distributed K (AIJ, bs 3) and lumped M
-  loads.py        pressure/point loads, load histories, fixed dofs
+  loads.py        pressure/point loads, fixed dofs (load histories: petsc_ssi/histories.py)
   integrators.py  implicit Green's-function integrator (eqs. 13-16) and Newmark
   model.py        the structure described by the options (checked before assembly)
   static.py       K u = f (reference)

@@ -28,8 +28,16 @@ from ..points import parse_points
 from .mesh import snap_points
 
 
+def uses_history(cfg):
+    """Whether the options load the structure at all (a pressure or point loads)."""
+    return cfg.fem_load_p0 != 0 or bool(cfg.fem_point_load.strip())
+
+
 def history_from(cfg):
-    """The load history of the options (SSIError on a bad table)."""
+    """The load history of the options (SSIError on a bad table); heaviside when nothing is
+    loaded (F = 0: the history is never used, its options are not checked)."""
+    if not uses_history(cfg):
+        return History("heaviside")
     return History(cfg.fem_load_history, cfg.fem_load_t0,
                    cfg.fem_load_table if cfg.fem_load_history == "table" else None)
 

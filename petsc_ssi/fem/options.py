@@ -78,11 +78,10 @@ def _fem_checks(cfg):
         return "-ssi_fem_damping_ratio needs a reference frequency -ssi_fem_damping_freq > 0"
     if cfg.fem_load_p0 != 0 and not cfg.fem_load_group.strip():
         return "-ssi_fem_load_p0 is set but -ssi_fem_load_group names no face group"
-    uses_history = cfg.fem_load_p0 != 0 or cfg.fem_point_load.strip()
-    if uses_history and cfg.fem_load_history == "table" and not os.path.isfile(cfg.fem_load_table):
+    from .loads import uses_history, history_from
+    if uses_history(cfg) and cfg.fem_load_history == "table" and not os.path.isfile(cfg.fem_load_table):
         return f"-ssi_fem_load_table '{cfg.fem_load_table}': no such file"
-    if uses_history:
-        from .loads import history_from       # read and check the table now, before any assembly
+    if uses_history(cfg):                     # read and check the table now, before any assembly
         try:
             history_from(cfg)
         except SSIError as exc:

@@ -1,6 +1,7 @@
 """``-ssi_problem fem``: the structure alone, time-stepped (paper Section 3).
 
-Collective. Steps: build the model (mesh, checks, K, M), alpha_m, the
+Collective. Steps: the load history (already read and checked with the
+options, before any heavy work), build the model (mesh, checks, K, M), alpha_m, the
 integrator (D factorised once), then for n = 1..N: u^n (eq. 13), the load
 sample f^n (mean of f over [t_n - dt/2, t_n + dt/2]) as a velocity impulse
 (eqs. 14, 16); displacement and velocity every -ssi_output_stride steps, the
@@ -45,11 +46,12 @@ class ReceiverSeries:
 
 
 def _history(cfg, comm):
+    """Collective: the load history (the option checks read it once already)."""
     err, hist = None, None
     try:
         hist = history_from(cfg)
-    except (SSIError, OSError, ValueError) as exc:
-        err = f"-ssi_fem_load_table: {exc}"
+    except SSIError as exc:
+        err = f"-ssi_fem_load_history {cfg.fem_load_history}: {exc}"
     collective_error(err, comm)
     return hist
 
@@ -70,8 +72,8 @@ def run_fem(cfg):
     """Collective: run the case; returns a summary dict (receiver series on rank 0)."""
     PETSc = init()
     comm = PETSc.COMM_WORLD
+    hist = _history(cfg, comm)                     # before assembly and factorisation
     model, integ, am = make_model_integrator(cfg, comm)
-    hist = _history(cfg, comm)
     n_steps = int(round(cfg.t_end / cfg.dt))
     F, fn = model.load_vec(), model.load_vec()
     out = _open_output(cfg, model, comm)

@@ -13,7 +13,9 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
 
 Distributed fields are written collectively by the PETSc viewer; the small
 serial data (topology, time, receiver series) by rank 0 with h5py after the
-viewer is closed. ``FILE.xmf`` (XDMF 3, temporal collection) is written on
+viewer is closed. Rank-0-only file work never leaves the other ranks waiting:
+an error there is caught, passed to every rank (``petsc.collective_error``)
+and raised everywhere as the same one-line SSIError. ``FILE.xmf`` (XDMF 3, temporal collection) is written on
 rank 0 so ParaView opens the result; ``FILE.json`` holds the resolved options,
 library versions, git revision and number of ranks (PyLith's habit).
 """
@@ -25,7 +27,7 @@ import time as _time
 
 import numpy as np
 
-from ..petsc import init
+from ..petsc import init, collective_error
 
 XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
              "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
@@ -41,9 +43,7 @@ class Output:
         self.comm = comm
         self.rank = comm.getRank()
         d = os.path.dirname(os.path.abspath(path))
-        if self.rank == 0:
-            os.makedirs(d, exist_ok=True)
-        comm.tompi4py().Barrier()
+        self._rank0(lambda: os.makedirs(d, exist_ok=True), f"cannot create the output directory {d}")
         self.viewer = PETSc.Viewer().createHDF5(path, mode="w", comm=comm)
         self.times = []
         self.fields = []
@@ -78,28 +78,42 @@ class Output:
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0."""
         self.viewer.destroy()
         self.comm.tompi4py().Barrier()
+        self._rank0(lambda: self._write_serial(receivers, attrs, record), f"writing {self.path}")
+
+    def _rank0(self, work, what):
+        """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
+        one-line SSIError (the allgather of collective_error is also the barrier)."""
+        err = None
         if self.rank == 0:
-            import h5py
-            with h5py.File(self.path, "a") as f:
-                if self.cells is not None:
-                    f.create_dataset("topology", data=self.cells)
-                f.create_dataset("time", data=np.asarray(self.times))
-                f.attrs["cell_type"] = self.cell_type or ""
-                f.attrs["fields"] = ",".join(self.fields)
-                f.attrs["n_snapshots"] = len(self.times)
-                from .. import __version__
-                f.attrs["petsc_ssi_version"] = __version__
-                for k, v in (attrs or {}).items():
-                    f.attrs[k] = v
-                if receivers is not None:
-                    g = f.create_group("receivers")
-                    for k, v in receivers.items():
-                        g.create_dataset(k, data=np.asarray(v))
-            self._write_xdmf()
-            if record is not None:
-                with open(os.path.splitext(self.path)[0] + ".json", "w") as fh:
-                    json.dump(record, fh, indent=1, sort_keys=True, default=str)
-        self.comm.tompi4py().Barrier()
+            try:
+                work()
+            except Exception as exc:  # noqa: BLE001 -- must reach the other ranks
+                lines = str(exc).strip().splitlines()
+                err = f"{what}: {type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+        collective_error(err, self.comm)
+
+    def _write_serial(self, receivers, attrs, record):
+        """Rank 0: topology, time, attributes and receivers into the HDF5 file; XDMF; JSON."""
+        import h5py
+        with h5py.File(self.path, "a") as f:
+            if self.cells is not None:
+                f.create_dataset("topology", data=self.cells)
+            f.create_dataset("time", data=np.asarray(self.times))
+            f.attrs["cell_type"] = self.cell_type or ""
+            f.attrs["fields"] = ",".join(self.fields)
+            f.attrs["n_snapshots"] = len(self.times)
+            from .. import __version__
+            f.attrs["petsc_ssi_version"] = __version__
+            for k, v in (attrs or {}).items():
+                f.attrs[k] = v
+            if receivers is not None:
+                g = f.create_group("receivers")
+                for k, v in receivers.items():
+                    g.create_dataset(k, data=np.asarray(v))
+        self._write_xdmf()
+        if record is not None:
+            with open(os.path.splitext(self.path)[0] + ".json", "w") as fh:
+                json.dump(record, fh, indent=1, sort_keys=True, default=str)
 
     def _write_xdmf(self):
         if self.cells is None:

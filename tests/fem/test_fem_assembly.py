@@ -8,7 +8,7 @@ from fem_helpers import ROOT, small_system, dense
 from petsc_ssi.petsc import SSIError
 from petsc_ssi.fem import assembly as asm
 from petsc_ssi.fem.mesh import structured_box, read_gmsh, renumber_rcm, boundary_faces
-from petsc_ssi.fem.loads import quad_pressure_forces, History, fixed_dofs
+from petsc_ssi.fem.loads import quad_pressure_forces, fixed_dofs
 
 
 def distorted_bricks(n=5, seed=1):
@@ -137,17 +137,6 @@ def test_tet_mesh_is_rejected(tmp_path):
     geo.write_text('SetFactory("OpenCASCADE");\nBox(1) = {0,0,0,1,1,1};\nMesh.MeshSizeMax = 0.5;\n')
     with pytest.raises(SSIError, match="no hex8"):
         read_gmsh(str(geo))
-
-
-def test_history_cell_means():
-    """Exact cell means: box pulse end inside a cell, table = ramp."""
-    h = History("box", 0.02)
-    assert h.cell_mean(0, 0.01) == 1.0 and h.cell_mean(2, 0.01) == pytest.approx(0.5)
-    assert h.cell_mean(3, 0.01) == 0.0
-    ramp = History("table", table=np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 1.0]]))
-    assert ramp.cell_mean(5, 0.1) == pytest.approx(0.5, rel=1e-14)      # linear part: midpoint value
-    assert ramp.cell_mean(10, 0.1) == pytest.approx(0.9875, rel=1e-14)    # straddles the kink
-    assert ramp.cell_mean(0, 0.1) == pytest.approx(0.025, rel=1e-14)
 
 
 def test_fixed_components():

@@ -40,6 +40,12 @@ CASES = [
     (["-ssi_fem_newmark_alpha", "0.3"], "green needs delta^2 = alpha"),
     (["-ssi_fem_E_modulus", "3e8"], "unknown option -ssi_fem_E_modulus"),
     (["-ssi_receivers", "0,0"], "-ssi_receivers: '0,0' is not 3 comma-separated numbers"),
+    (["-ssi_receivers", "0,0,5"], "-ssi_receivers: point (0, 0, 5) is 4.5 m from the nearest FE node, more "
+     "than the largest element size 0.5 m: it lies outside the structure"),
+    (["-ssi_fem_point_load", "3,0,0.5,1,0,0"], "-ssi_fem_point_load: point (3, 0, 0.5) is 2.5 m from the "
+     "nearest FE node, more than the largest element size 0.5 m"),
+    (["-ssi_fem_point_load", "0,0,0.5"], "-ssi_fem_point_load: '0,0,0.5' is not 6 comma-separated numbers "
+     "(each point needs x,y,z,fx,fy,fz)"),
 ]
 
 
@@ -61,3 +67,24 @@ def test_error_on_every_rank(args, message):
     """Under mpirun -n 2: same exit status 2, one line (rank 0 prints), no hang (timeout 60 s)."""
     r = run_cli(FEM + args, n=2, timeout=60)
     assert r.returncode == 2 and message in one_line_error(r)
+
+
+TABLES = {"non-numeric": ("0 0\n0.01 one\n", "history table '{path}': "),
+          "decreasing": ("0 0\n0.02 1\n0.01 1\n", "t must increase strictly (data row 3: t = 0.01 after 0.02)"),
+          "three columns": ("0 0 1\n0.01 1 1\n", "need rows of two numbers 't h'"),
+          "nan": ("0 0\n0.01 nan\n", "non-finite value")}
+
+
+@pytest.mark.parametrize("kind", list(TABLES))
+def test_bad_load_table_fails_before_the_mesh(tmp_path, kind):
+    """A malformed -ssi_fem_load_table ends the run in the option checks: one line, before the mesh
+    is read (no '[fem] mesh' line), let alone assembled and factorised."""
+    text, message = TABLES[kind]
+    path = tmp_path / "h.txt"
+    path.write_text(text)
+    r = run_cli(FEM + ["-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history",
+                       "table", "-ssi_fem_load_table", str(path)])
+    line = one_line_error(r)
+    assert line.startswith("petsc-ssi: error: -ssi_fem_load_history table: history table"), line
+    assert message.format(path=path) in line, line
+    assert "[fem]" not in r.stdout, r.stdout

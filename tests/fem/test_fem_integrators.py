@@ -112,48 +112,130 @@ def test_forced_newmark_matches_textbook(PETSc, alpha, delta):
         assert np.abs(integ.u.getArray()[free] - us[n]).max() <= RTOL * np.abs(us).max()
 
 
-def test_load_is_an_impulse_at_tn(PETSc):
-    """f^k changes v^k by M^{-1} f dt but not u^k; then u^{k+1} = G(dt) f dt = b1 dt D^{-1} f (eq. 13)."""
-    mesh, K, m, fixed, free = block_model()
-    dt, am, k = 1e-3, 5.0, 3
+def free_load(mesh, free, seed, scale=1.0):
     f = np.zeros(3 * mesh.n_nodes)
-    f[free[-3:]] = [1.0, -2.0, 3.0]
-    integ = GreenIntegrator(K, m, dt, am, fixed, prefix="timp_")
-    integ.start()
-    for n in range(1, k):
-        integ.step()
-    integ.predict()
-    assert integ.u.norm() == 0.0                      # u^k does not see f^k
-    integ.correct(vec_from(f, m))
-    mf = m.getArray()
-    jump = np.where(f != 0, f / np.where(mf > 0, mf, 1) * dt, 0)
-    assert np.allclose(integ.v.getArray(), jump, rtol=1e-14, atol=0)
-    assert np.allclose(integ.velocity().getArray(), 0.5 * jump, rtol=1e-14, atol=0)   # v(t_k): the mean
-    integ.step()
-    x = integ.u.duplicate()
-    integ.ksp.solve(vec_from(f, m), x)
-    ref = green_constants(dt, am)["b1"] * dt * x.getArray()
-    assert np.abs(integ.u.getArray() - ref).max() <= 1e-12 * np.abs(ref).max()
+    f[free] = scale * np.random.default_rng(seed).standard_normal(free.size)
+    return f
 
 
-def test_predict_correct_equals_step(PETSc):
-    """predict(); correct(f_a, f_interface) == step(f_a + f_interface) to round-off (B.1, B.5-B.6)."""
+def diff(a, b):
+    return b.getArray() - a.getArray()
+
+
+def test_load_is_an_impulse_at_tn(PETSc):
+    """From a non-zero state under a background load g, two runs that differ only in the load f of
+    step k: u^k is bitwise the same (predict() never sees f^k); v^k differs by M^{-1} f dt, velocity()
+    by half of it (1e-12), and u^{k+1} by G(dt) f dt = b1 dt D^{-1} f (eq. 13; 1e-9 of its size,
+    a difference of two ~1e3 times larger states)."""
     mesh, K, m, fixed, free = block_model()
     u0, v0 = initial_state(mesh, free)
-    rng = np.random.default_rng(7)
-    fa, fb = rng.standard_normal((2, 3 * mesh.n_nodes))
-    a = GreenIntegrator(K, m, 1e-3, 2.0, fixed, prefix="tsplit_")
-    b = GreenIntegrator(K, m, 1e-3, 2.0, fixed, prefix="tsplit_")
+    dt, am, k = 1e-3, 5.0, 3
+    g = vec_from(free_load(mesh, free, 11), m)
+    f = np.zeros(3 * mesh.n_nodes)
+    f[free[-3:]] = [1.0, -2.0, 3.0]
+    a, b = (GreenIntegrator(K, m, dt, am, fixed, prefix="timp_") for _ in range(2))
     for integ in (a, b):
+        integ.start(vec_from(u0, m), vec_from(v0, m), f0=g)
+        for n in range(1, k):
+            integ.step(g)
+        integ.predict()
+    assert a.u.norm() > 0 and np.array_equal(a.u.getArray(), b.u.getArray())
+    a.correct(g)
+    b.correct(vec_from(g.getArray() + f, m))
+    mf = m.getArray()
+    jump = np.where(f != 0, f / np.where(mf > 0, mf, 1) * dt, 0)
+    assert np.abs(diff(a.v, b.v) - jump).max() <= 1e-12 * np.abs(jump).max()
+    assert np.abs(diff(a.velocity(), b.velocity()) - 0.5 * jump).max() <= 1e-12 * np.abs(jump).max()
+    for integ in (a, b):
+        integ.step(g)
+    x = a.u.duplicate()
+    a.ksp.solve(vec_from(f, m), x)
+    ref = green_constants(dt, am)["b1"] * dt * x.getArray()
+    assert np.abs(diff(a.u, b.u) - ref).max() <= 1e-9 * np.abs(ref).max()
+    assert np.abs(ref).max() < 1e-2 * np.abs(a.u.getArray()).max()      # the states are much larger
+
+
+def test_predict_ignores_the_load_of_step_n(PETSc):
+    """Random loads through both arguments of correct(f, f_interface); a second run perturbs only the
+    interface force of step k. Every predict() up to step k gives bitwise the same u^n, the first
+    prediction after it differs; and correct(f, f_interface) == correct(f + f_interface) (1e-13)."""
+    mesh, K, m, fixed, free = block_model()
+    u0, v0 = initial_state(mesh, free)
+    nsteps, k = 8, 5
+    fa = [vec_from(free_load(mesh, free, 20 + n), m) for n in range(nsteps + 1)]
+    fb = [vec_from(free_load(mesh, free, 40 + n, 0.5), m) for n in range(nsteps + 1)]
+    fb_pert = [v.copy() for v in fb]
+    fb_pert[k].axpy(1.0, vec_from(free_load(mesh, free, 99), m))
+    runs = {}
+    for key, fint in (("ref", fb), ("pert", fb_pert)):
+        integ = GreenIntegrator(K, m, 1e-3, 2.0, fixed, prefix="tsplit_")
         integ.start(vec_from(u0, m), vec_from(v0, m))
-    for n in range(5):
-        a.predict()
-        a.correct(vec_from(fa, m), f_interface=vec_from(fb, m))
-        b.step(vec_from(fa + fb, m))
-    assert np.abs(a.u.getArray() - b.u.getArray()).max() <= 1e-13 * np.abs(b.u.getArray()).max()
-    assert np.abs(a.v.getArray() - b.v.getArray()).max() <= 1e-13 * np.abs(b.v.getArray()).max()
+        us = []
+        for n in range(1, nsteps + 1):
+            us.append(integ.predict().getArray().copy())
+            integ.correct(fa[n], f_interface=fint[n])
+        runs[key] = (np.array(us), integ)
+    (ua, a), (ub, b) = runs["ref"], runs["pert"]
+    assert np.array_equal(ua[:k], ub[:k])                                  # u^1 .. u^k
+    assert np.abs(ua[k] - ub[k]).max() > 1e-6 * np.abs(ua[k]).max()        # u^{k+1} sees it
+    summed = GreenIntegrator(K, m, 1e-3, 2.0, fixed, prefix="tsplit_")
+    summed.start(vec_from(u0, m), vec_from(v0, m))
+    for n in range(1, nsteps + 1):
+        summed.step(vec_from(fa[n].getArray() + fb[n].getArray(), m))
+    for x, y in ((a.u, summed.u), (a.v, summed.v)):
+        assert np.abs(x.getArray() - y.getArray()).max() <= 1e-13 * np.abs(y.getArray()).max()
     with pytest.raises(SSIError, match="without predict"):
         a.correct()
+    a.predict()
+    with pytest.raises(SSIError, match="predict\\(\\) called twice"):
+        a.predict()
+
+
+def test_velocity_between_predict_and_correct(PETSc):
+    """velocity() raises while a prediction is pending (it would be off by M^{-1} f dt / 2);
+    free_velocity() is v(t_n-) before and after correct(), and velocity() - free_velocity() is
+    half the impulse after it (1e-14); at t = 0 both are v0 (before the initial half impulse)."""
+    mesh, K, m, fixed, free = block_model()
+    u0, v0 = initial_state(mesh, free)
+    dt = 1e-3
+    g = vec_from(free_load(mesh, free, 5), m)
+    integ = GreenIntegrator(K, m, dt, 3.0, fixed, prefix="tvel_")
+    integ.start(vec_from(u0, m), vec_from(v0, m), f0=g)
+    for get in (integ.velocity, integ.free_velocity):
+        assert np.abs(get().getArray() - v0).max() <= 1e-14 * np.abs(v0).max()
+    integ.step(g)
+    integ.predict()
+    with pytest.raises(SSIError, match="velocity\\(\\) called between predict\\(\\) and correct\\(\\) "
+                       "of step 2.*free_velocity"):
+        integ.velocity()
+    vfree = integ.free_velocity().getArray().copy()
+    assert np.array_equal(vfree, integ.v.getArray())
+    integ.correct(g)
+    half = 0.5 * dt * np.where(np.isin(np.arange(len(v0)), fixed), 0, g.getArray() / m.getArray())
+    assert np.abs(integ.free_velocity().getArray() - vfree).max() <= 1e-14 * np.abs(vfree).max()
+    assert np.abs(integ.velocity().getArray() - vfree - half).max() <= 1e-14 * np.abs(vfree).max()
+
+
+def test_load_on_fixed_dofs_warns_once(PETSc, capfd):
+    """A load with entries on fixed dofs: rank 0 warns once (not every step), u = v = 0 stays exact
+    there; the static solve warns too. Loads on free dofs only: no warning."""
+    mesh, K, m, fixed, free = block_model()
+    f = free_load(mesh, free, 8)
+    f[fixed[:2]] = 5.0
+    integ = GreenIntegrator(K, m, 1e-3, 0.0, fixed, prefix="tfixw_")
+    integ.start()
+    for _ in range(4):
+        integ.step(vec_from(f, m))
+    out = capfd.readouterr().out
+    assert out.count("petsc-ssi: warning: a load acts on 2 fixed dof(s) at step 1") == 1, out
+    assert out.count("a load acts on") == 1, out
+    assert np.all(integ.u.getArray()[fixed] == 0) and np.all(integ.velocity().getArray()[fixed] == 0)
+    static_solve(K, vec_from(f, m), fixed, mesh.coords, prefix="tstat_")
+    assert "a load acts on 2 fixed dof(s) in the static solve" in capfd.readouterr().out
+    quiet = NewmarkIntegrator(K, m, 1e-3, 0.0, fixed, prefix="tfixw_")
+    quiet.start(f0=vec_from(free_load(mesh, free, 8), m))
+    quiet.step(vec_from(free_load(mesh, free, 8), m))
+    assert quiet.fixed_load_warning is None and "warning" not in capfd.readouterr().out
 
 
 @pytest.mark.parametrize("value, word", [(0.0, r"\(0 negative\)"), (-1.0, r"\(3 negative\)")])
