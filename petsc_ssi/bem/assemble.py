@@ -22,7 +22,7 @@ from .quadrature import integrate_pair, singular_static
 def _grow(a, n):
     if n < a.shape[0]:
         return a
-    shape = (max(2 * a.shape[0], 16),) + a.shape[1:]
+    shape = (max(2 * a.shape[0], n + 1, 16),) + a.shape[1:]
     b = np.zeros(shape, a.dtype)
     b[:a.shape[0]] = a
     return b
@@ -189,6 +189,14 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                     ncache += 1
                 Psrc = Pb[:nl]
                 Usrc = Ub[:nl]
+            # capacity for every block this pair can add, checked once per pair
+            # (array views or calls per block cost ~200 ns each in numba)
+            need = nh + nl * 9
+            hrow = _grow(hrow, need); hlag = _grow(hlag, need); hcol = _grow(hcol, need)
+            hval = _grow(hval, need)
+            needg = ng_ + nl * 9
+            grw = _grow(grw, needg); glag = _grow(glag, needg); gcol = _grow(gcol, needg)
+            gval = _grow(gval, needg)
             for li in range(nl):
                 lag = lo + li
                 for a in range(9):
@@ -201,12 +209,12 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                         col = Vnode[v, a]
                         s = slotH[lag, col]
                         if s < 0:
-                            hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
-                            hval = _grow(hval, nh)
                             s = nh
                             slotH[lag, col] = s
                             hrow[s] = i; hlag[s] = lag; hcol[s] = col
-                            hval[s] = 0.0
+                            for p in range(3):
+                                for q in range(3):
+                                    hval[s, p, q] = 0.0
                             nh += 1
                         for p in range(3):
                             for q in range(3):
@@ -215,12 +223,12 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                     if tc >= 0:
                         s = slotG[lag, tc]
                         if s < 0:
-                            grw = _grow(grw, ng_); glag = _grow(glag, ng_); gcol = _grow(gcol, ng_)
-                            gval = _grow(gval, ng_)
                             s = ng_
                             slotG[lag, tc] = s
                             grw[s] = i; glag[s] = lag; gcol[s] = tc
-                            gval[s] = 0.0
+                            for p in range(3):
+                                for q in range(3):
+                                    gval[s, p, q] = 0.0
                             ng_ += 1
                         for p in range(3):
                             for q in range(3):
@@ -233,7 +241,9 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                 hval = _grow(hval, nh)
                 s = nh
                 hrow[s] = i; hlag[s] = 1; hcol[s] = i
-                hval[s] = 0.0
+                for p in range(3):
+                    for q in range(3):
+                        hval[s, p, q] = 0.0
                 nh += 1
             for p in range(3):
                 hval[s, p, p] += free_term
