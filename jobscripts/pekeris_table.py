@@ -23,7 +23,7 @@ BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
 def run_row(log):
     text = open(log).read()
     lv = parse(text)
-    m = re.search(r"pekeris-(\w+)-n(\d+)\.log", log)
+    m = re.search(r"pekeris-([\w-]+?)-n(\d+)\.log", log)
     case, ranks = m.group(1), int(m.group(2))
     row = {"case": case, "ranks": ranks}
     m = re.search(r"BEM: (\d+) nine-node elements \((\d+) with", text)
@@ -55,6 +55,20 @@ def run_row(log):
             row[f"err_rad_r{k + 1}_pct"] = round(100 * eh, 2)
     except Exception as exc:  # a run that did not finish
         row["note"] = f"no result ({type(exc).__name__})"
+    # an interpolated case against the exact run of the same case and ranks
+    if case.endswith("-interp"):
+        ref = h5.replace(f"pekeris-{case}-", f"pekeris-{case[:-len('-interp')]}-")
+        try:
+            import h5py
+            import numpy as np
+            with h5py.File(h5, "r") as a, h5py.File(ref, "r") as b:
+                ua, ub = a["receivers/u"][:], b["receivers/u"][:]
+            for k in range(ua.shape[1]):
+                for c, name in ((2, "vert"), (0, "rad")):
+                    row[f"vs_exact_{name}_r{k + 1}_pct"] = round(
+                        100 * np.linalg.norm(ua[:, k, c] - ub[:, k, c]) / np.linalg.norm(ub[:, k, c]), 3)
+        except OSError:
+            pass
     return row
 
 
@@ -66,13 +80,14 @@ def markdown(rows, cols):
 
 
 def main(outdir, readme, csvpath):
-    order = {"small": 0, "medium": 1, "paper": 2}
+    order = {"small": 0, "medium": 1, "paper": 2, "paper-interp": 3}
     logs = sorted(glob.glob(os.path.join(outdir, "pekeris-*-n*.log")),
-                  key=lambda p: (order.get(re.search(r"pekeris-(\w+)-n", p).group(1), 9), p))
+                  key=lambda p: (order.get(re.search(r"pekeris-([\w-]+?)-n\d", p).group(1), 9), p))
     rows = [run_row(l) for l in logs]
     cols = ["case", "ranks", "elements", "dofs", "steps", "lags", "fill_pct", "lag_GB", "assembly_s",
             "factor_s", "history_s", "solve_s", "time_loop_s", "total_s", "peak_mem_GB",
-            "r1_m", "err_vert_r1_pct", "err_rad_r1_pct", "r2_m", "err_vert_r2_pct", "err_rad_r2_pct"]
+            "r1_m", "err_vert_r1_pct", "err_rad_r1_pct", "r2_m", "err_vert_r2_pct", "err_rad_r2_pct",
+            "vs_exact_vert_r1_pct", "vs_exact_rad_r1_pct", "vs_exact_vert_r2_pct", "vs_exact_rad_r2_pct"]
     with open(csvpath, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=cols + ["note"], extrasaction="ignore")
         w.writeheader()

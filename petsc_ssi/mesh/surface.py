@@ -72,6 +72,34 @@ class SurfaceMesh:
             raise SSIError(f"the surface mesh has {int((~used).sum())} nodes in no element")
 
 
+def kinks(mesh, planes=(), max_angle_deg=1.0):
+    """Nodes where the surface is not smooth: the unit normals of the elements
+    sharing the node differ by more than ``max_angle_deg`` (an edge or a
+    corner), or, on a symmetry plane, the normal is not parallel to the plane
+    (the mirrored surface would fold there). Returns (node ids, angles deg)."""
+    X = mesh.cell_coords()
+    xi = quad9.NODE_XI
+    _, jn = quad9.geometry(X[:, None, :, :], xi[None, :, 0], xi[None, :, 1])
+    n = jn / np.linalg.norm(jn, axis=-1, keepdims=True)          # (E, 9, 3)
+    nodes = mesh.cells.ravel()
+    nn = n.reshape(-1, 3)
+    order = np.argsort(nodes, kind="stable")
+    nodes, nn = nodes[order], nn[order]
+    first = np.r_[0, np.nonzero(np.diff(nodes))[0] + 1]
+    ref = np.repeat(nn[first], np.diff(np.r_[first, len(nodes)]), axis=0)
+    cosang = np.clip(np.einsum("ij,ij->i", nn, ref), -1.0, 1.0)
+    worst = np.minimum.reduceat(cosang, first)
+    ang = np.degrees(np.arccos(worst))
+    x = mesh.nodes[nodes[first]]
+    h = float(mesh.element_sizes().max())
+    for ax, _ in planes:
+        on = np.abs(x[:, ax]) <= 1e-9 * max(h, 1.0)
+        tilt = np.degrees(2 * np.arcsin(np.clip(np.abs(nn[first][:, ax]), 0, 1)))
+        ang = np.where(on, np.maximum(ang, tilt), ang)
+    bad = ang > max_angle_deg
+    return nodes[first][bad], ang[bad]
+
+
 def _lines(lo, hi, h, cuts):
     """Grid lines from lo to hi of spacing about h, passing through cuts."""
     pts = sorted({lo, hi, *[c for c in cuts if lo < c < hi]})
