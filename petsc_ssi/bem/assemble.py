@@ -233,7 +233,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                         for p in range(3):
                             for q in range(3):
                                 gval[s, p, q] += Usrc[li, a, p, q] * Vsign[v, q]
-        # free term c_lk = delta_lk / 2 (smooth surface point)
+        # free term c_lk (I/2 at smooth points; freeterm module at edges/corners)
         if lag_lo == 1:
             s = slotH[1, i]
             if s < 0:
@@ -246,7 +246,8 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                         hval[s, p, q] = 0.0
                 nh += 1
             for p in range(3):
-                hval[s, p, p] += free_term
+                for q in range(3):
+                    hval[s, p, q] += free_term[i, p, q]
         for k in range(h0, nh):
             slotH[hlag[k], hcol[k]] = -1
         for k in range(g0, ng_):

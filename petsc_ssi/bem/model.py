@@ -148,6 +148,10 @@ class LagSet:
         VX, VN, VS, VT = symmetry.virtual_elements(mesh.cell_coords(), mesh.cells, regions.tcols, planes)
         self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
+        from .freeterm import free_terms
+        self.cfree = free_terms(VX, VN, mesh.n_nodes, mat.nu, nodes=self.rows)
+        self.n_nonsmooth = self.comm.tompi4py().allreduce(
+            int(np.sum(np.abs(self.cfree[self.rows] - 0.5 * np.eye(3)).max(axis=(1, 2)) > 1e-14)))
 
     def estimate_memory(self, stored=None):
         """Collective: (bytes of H lags in sparse storage, dense bytes per lag);
@@ -188,7 +192,7 @@ class LagSet:
                                 self.Vc, self.VR, self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
-                                self.regions.n_t, 0.5, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
+                                self.regions.n_t, self.cfree, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
                                 cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()))
             parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
             nev += res[8]

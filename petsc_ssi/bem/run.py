@@ -78,11 +78,8 @@ class BEMProblem:
         symmetry.check_mesh(self.mesh.nodes, self.planes, h)
         bad, ang = surface.kinks(self.mesh, self.planes)
         if len(bad):
-            x = self.mesh.nodes[bad[0]]
-            raise SSIError(f"the surface has {len(bad)} non-smooth nodes (edges or corners, up to "
-                           f"{ang.max():.3g} degrees, e.g. node at ({x[0]:g}, {x[1]:g}, {x[2]:g})): the free "
-                           f"term there needs Hartmann's formula, which petsc_ssi does not implement yet; "
-                           f"only smooth surfaces (c = I/2) are supported")
+            printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
+                   f"free term from the interior solid angle (Hartmann)")
         self.dt = cfg.dt
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
         self.n_steps = int(math.ceil(cfg.t_end / cfg.dt - 1e-9))

@@ -81,12 +81,12 @@ def test_load_contradicting_symmetry(opts, expect):
     assert msg is not None and expect in msg, msg
 
 
-def test_non_smooth_surface_refused():
-    """A folded surface (an edge) would get the smooth free term I/2: refused."""
+def test_non_smooth_surface_detected():
+    """Edges are found (the free term there comes from the interior cone)."""
     from petsc_ssi.mesh.surface import grid, kinks
     m = grid(4.0, 4.0, 1.0)
     assert len(kinks(m)[0]) == 0
-    m.nodes[:, 2] = -0.5 * np.abs(m.nodes[:, 0])          # a V-shaped valley along x = 0
+    m.nodes[:, 2] = -0.5 * np.abs(m.nodes[:, 0])          # a ridge along x = 0
     bad, ang = kinks(m)
     assert len(bad) == 9 and np.allclose(m.nodes[bad, 0], 0.0) and np.allclose(ang, 2 * np.degrees(np.arctan(0.5)))
     # a surface tilted across a symmetry plane folds when mirrored
