@@ -70,7 +70,7 @@ def new_cache():
 def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alpha, beta,
                   rho, nu, ns_base, near_factor, ns_max, gq, gw, gr, gwr, n_nodes, n_tcols,
                   free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  lag_lo=1, toff=0.0, h_ref=1.0):
+                  lag_lo=1, toff=0.0, h_ref=1.0, cache_max=1 << 62):
     """Collective-free numba kernel: triplets of H and G for ``rows``.
 
     Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev, hits, cache
@@ -83,6 +83,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
     the integrals depend on nothing else (material, dt and lags are fixed).
     Only lags lag_lo..L are computed, at kernel times l dt + toff (a cache
     must not be shared between calls with different lag_lo, L or toff).
+    The cache stops growing at ``cache_max`` bytes per pool (reuse goes on).
     """
     mu = rho * beta * beta
     nv = VX.shape[0]
@@ -171,7 +172,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                                     h_ref)
                     Ub[0] += Us
                     Pb[0] += Ps
-                if use_cache and hsh not in cidx:
+                if use_cache and hsh not in cidx and 8 * (pool_n + nl * 81) <= cache_max:
                     c = ncache
                     ckeys = _grow(ckeys, c)
                     cmeta = _grow(cmeta, c)

@@ -66,11 +66,11 @@ def bounding_spheres(VX):
 
 
 def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
-    """Estimated number of non-zero 3x3 blocks of all H lags in ``rows``:
-    for each (row, element) the lags its wave window touches (union over the
-    element's symmetry images, which fold onto the same columns), times four
-    nodes per element (a node is shared by about four elements)."""
-    total = 0.0
+    """Estimated number of non-zero 3x3 blocks of each H lag (array, index
+    l-1) in ``rows``: for each (row, element) the lags its wave window touches
+    (union over the element's symmetry images, which fold onto the same
+    columns), times four nodes per element (a node is shared by about four)."""
+    diff = np.zeros(L + 2)
     E = len(Vc) // n_images
     for s in range(0, len(rows), chunk):
         xc = xnodes[rows[s:s + chunk]]
@@ -80,9 +80,10 @@ def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
         n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
         lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
         hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
-        union = np.minimum(n.sum(1), np.clip(hi - lo + 1, 0, None))
-        total += union.sum() * 4.0
-    return total
+        ok = np.isfinite(lo) & (hi >= lo)
+        np.add.at(diff, lo[ok].astype(np.int64), 4.0)
+        np.add.at(diff, hi[ok].astype(np.int64) + 1, -4.0)
+    return np.cumsum(diff)[1:L + 1]
 
 
 def machine_memory():
@@ -153,22 +154,39 @@ class LagSet:
         self.n_nonsmooth = self.comm.tompi4py().allreduce(
             int(np.sum(np.abs(self.cfree[self.rows] - 0.5 * np.eye(3)).max(axis=(1, 2)) > 1e-14)))
 
-    def estimate_memory(self, stored=None):
-        """Collective: (bytes of H lags in sparse storage, dense bytes per lag);
-        ``stored`` = (exact lags, interpolating matrices) when interpolating."""
+    def estimate_memory(self, lags, storage="auto", fill=0.35, extra_lags=()):
+        """Collective: estimated bytes of the stored Mats and the assembly peak.
+
+        ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
+        for interpolating matrices. Each lag is stored dense (N^2 x 72 B) or
+        block-sparse (76 B per block) by the same rule as the build; triplets
+        (84 B per block) are freed lag by lag as the Mats are built, so the
+        peak is max_k [Mats of lags <= k + triplets of lags > k]."""
         nimg = len(self.Vc) // self.mesh.n_cells
-        L = self.L if stored is None else stored[0]
+        L = max([lags] + list(extra_lags))
         nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
-        if stored is not None and stored[1]:
-            # an interpolating matrix is a late lag: about the mean lag fill
-            nb_all = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, self.L, self.mat, self.dt,
-                                     nimg)
-            nb += stored[1] * nb_all / self.L
-            L = L + stored[1]
         nb = self.comm.tompi4py().allreduce(nb)
+        use = np.r_[nb[:lags], [nb[l - 1] for l in extra_lags]] if len(extra_lags) else nb[:lags]
         N = self.mesh.n_nodes
-        g_bytes = 9.0 * N * max(self.regions.n_t, 0) * 8 * L
-        return nb * (72 + 4) + g_bytes, 9.0 * N * N * 8
+        f = use / float(N * N)
+        dense = (f > fill) if storage == "auto" else np.full(len(use), storage == "dense")
+        mats = np.where(dense, 72.0 * N * N, 76.0 * use)
+        trip = 84.0 * use
+        g = 9.0 * N * max(self.regions.n_t, 1) * 8
+        build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
+        # + element cache (capped), one chunk's raw triplets, process baseline
+        transient = 2 * self.CACHE_MAX + 2 * 256e6 + 0.5e9
+        peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient * self.comm.getSize()
+        return float(mats.sum() + g * len(use)), float(peak), int(dense.sum())
+
+    CACHE_MAX = 512 << 20        # bytes per cache pool (P and U): 1 GiB per rank at most
+
+    def chunk_rows(self, lag_hi):
+        """Rows per numba call: about 256 MB of triplets (96 B per block, up to
+        2x over-allocated) per call, at least one row."""
+        N = self.mesh.n_nodes
+        per_row = 96.0 * 2 * N * max(lag_hi, 1) * 0.6
+        return int(max(1, min(64, 256e6 // per_row, len(self.rows) // 20 + 1)))
 
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly"):
         """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
@@ -178,7 +196,7 @@ class LagSet:
         gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
         gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
         rows = self.rows
-        chunk = chunk or max(1, min(64, len(rows) // 20 + 1))
+        chunk = chunk or self.chunk_rows(lag_hi - lag_lo + 1)
         prog = Progress(what, max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
         parts = []
         nev = 0
@@ -193,7 +211,7 @@ class LagSet:
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
                                 self.regions.n_t, self.cfree, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
-                                cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()))
+                                cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()), self.CACHE_MAX)
             parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
             nev += res[8]
             hits += res[9]

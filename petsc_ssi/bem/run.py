@@ -191,22 +191,29 @@ class BEMProblem:
                       self.quad_options())
 
     def check_memory(self, ls, plan=None):
-        """Collective: refuse runs whose lag matrices would not fit."""
-        stored = (plan.Lx, plan.k) if plan is not None and plan.active else None
-        sparse_b, dense_per_lag = ls.estimate_memory(stored)
-        nst = self.L if stored is None else stored[0] + stored[1]
-        limit = self.cfg.memory_limit * 1e9 if self.cfg.memory_limit > 0 else 0.8 * machine_memory()
-        est = min(sparse_b, dense_per_lag * nst + 9.0 * self.mesh.n_nodes * self.regions.n_t * 8 * nst)
-        # triplets are freed lag by lag as the Mats are built; the element cache
-        # holds about one lag set of distinct pairs
-        peak = 1.1 * max(est, sparse_b * 84.0 / 76.0)
+        """Collective: refuse runs whose lag matrices would not fit; if the
+        dense lags of the automatic storage choice would not fit but block-
+        sparse storage would, store every lag block-sparse (and say so)."""
+        c = self.cfg
+        limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
+        lags = plan.Lx if plan is not None and plan.active else self.L
+        extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
+        self.lag_fill = c.lag_fill
+        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra)
+        if peak > limit and c.lag_storage == "auto":
+            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra)
+            if peak2 <= limit:
+                self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
+                         f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
+                self.lag_fill = 1.01
+                est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
-        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB, assembly peak {peak / 1e9:.3g} GB "
-                 f"(limit {limit / 1e9:.3g} GB)")
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags), assembly "
+                 f"peak {peak / 1e9:.3g} GB (limit {limit / 1e9:.3g} GB)")
         if peak > limit:
             raise SSIError(f"the lag matrices need about {peak / 1e9:.3g} GB at assembly, more than the "
-                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit); use symmetry planes, a "
-                           f"coarser mesh, a shorter -ssi_t_end or more nodes")
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit); use symmetry planes, "
+                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
 
     def known_p(self):
         c = self.cfg
@@ -259,7 +266,7 @@ def run_bem(cfg, comm=None):
     r0, r1 = ls.node_range
     march = Marcher(comm, ls, cfg.scheme, prob.known_u(), prob.known_p(), log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
-    H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage, cfg.lag_fill)
+    H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
     nt = prob.regions.n_t
     if nt:
         pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
@@ -275,7 +282,7 @@ def run_bem(cfg, comm=None):
         hb, gb = ls.assemble(monitor=False, lag_lo=lag, lag_hi=lag, toff=toff)
         nev += ls.kernel_evaluations
         HI.append(lagmats.build_one(comm, hb, lag, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
-                                    cfg.lag_fill)[0])
+                                    prob.lag_fill)[0])
         GI.append(lagmats.build_one(comm, gb, lag, ls.node_range, N, nt, tcol_loc, "dense")[0] if nt else None)
     ls.kernel_evaluations = nev
     t_asm = time.perf_counter() - t0
