@@ -7,7 +7,7 @@ rows are the locally owned nodes, columns global node (or traction) ids.
 """
 import numpy as np
 
-from ..petsc import init
+from ..petsc import init, release_memory
 
 
 def _csr(rows_local, cols, vals, nloc):
@@ -63,6 +63,8 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
                         storage, fill)
         mats.append(A)
         info.append((li + 1, kind, int(gcounts[li])))
+        del row, col, val
+        release_memory()
     return mats, info
 
 

@@ -104,8 +104,10 @@ def _by_lag(trip, L):
     freed after use. Columns are sorted later, only where BAIJ needs them."""
     row, lag, col, val = trip
     order, b = lag_order(lag, L)
-    row, col, val = row[order], col[order].astype(np.int32), val[order]
-    return ([(row[b[l]:b[l + 1]], col[b[l]:b[l + 1]], val[b[l]:b[l + 1]]) for l in range(L)],)
+    # one independent copy per lag (not views of one sorted array), so taking
+    # a lag really frees its memory
+    return ([(row[order[b[l]:b[l + 1]]], col[order[b[l]:b[l + 1]]].astype(np.int32),
+              val[order[b[l]:b[l + 1]]]) for l in range(L)],)
 
 
 class Buckets:
