@@ -18,9 +18,17 @@ def _value(text, name, default=None):
     return m.group(1) if m else default
 
 
+def _read(path):
+    """The file's text with nested -options_file lines expanded (outer lines first)."""
+    text = open(path).read()
+    for m in re.finditer(r"^-options_file\s+(\S+)", text, re.M):
+        text += "\n" + _read(os.path.join(ROOT, m.group(1)))
+    return text
+
+
 @pytest.mark.parametrize("path", OPTS, ids=[os.path.relpath(p, ROOT) for p in OPTS])
 def test_options_file_runs_reduced(path, tmp_path):
-    text = open(path).read()
+    text = _read(path)
     problem = _value(text, "problem", "bem")
     dt = float(_value(text, "dt", "7.5e-4"))
     out = tmp_path / "run.h5"
