@@ -374,9 +374,11 @@ def _guard(cfg, prob, march, unorm, n):
     norm above guard_factor times the largest norm of the first half of the
     run so far. A loaded, damped (radiating) half-space cannot do that."""
     nrm = unorm[-1]
-    if np.isfinite(nrm) and (n < 20 or nrm <= cfg.guard_factor * max(max(unorm[:n // 2]), 1e-300)):
+    pm = march.__dict__.setdefault("_prefix_max", [])      # running max of |u|: O(1) per step
+    pm.append(max(pm[-1], nrm) if pm else nrm)
+    ref = pm[n // 2 - 1] if n >= 2 else 0.0
+    if np.isfinite(nrm) and (n < 20 or nrm <= cfg.guard_factor * max(ref, 1e-300)):
         return
-    ref = max(unorm[:n // 2]) if n >= 2 else 0.0
     rate = (np.log(nrm / ref) / (n - n // 2)) if (np.isfinite(nrm) and ref > 0) else float("inf")
     causes = []
     if march.scheme == "plain":
