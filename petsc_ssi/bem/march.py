@@ -231,15 +231,29 @@ class Marcher:
 
     def step(self):
         """Advance one step; returns (u^n, p^n) Vecs (views into the buffer)."""
-        self.n += 1
-        n = self.n
-        b = self.u_tmpl.duplicate() if not hasattr(self, "_b") else self._b
-        self._b = b
+        n = self.begin_step()
+        self._set_known(n)
+        b = self.add_known(self._b)
+        self.solve(b, self.x)
+        return self.store(n, self.x)
+
+    # The pieces of a step, for callers that set the known values themselves
+    # (the FEM-BEM coupling: u at interface nodes from the structure).
+    def begin_step(self):
+        """Collective: the history part of the right-hand side of step n = self.n + 1
+        into ``self._b`` (it depends only on past states); returns n."""
+        n = self.n + 1
+        if not hasattr(self, "_b"):
+            self._b = self.u_tmpl.duplicate()
         ev = event("SSI_BEM_History")
         ev.begin()
-        self.history(n, b)
+        self.history(n, self._b)
         ev.end()
-        self._set_known(n)
+        return n
+
+    def add_known(self, b):
+        """Collective: b += the terms of the known values in kv_u / kv_p (step matrix
+        coefficients of lags 1 and 2); rows of symmetry-zero DOFs set to 0."""
         coef = (4.0, 1.0) if self.scheme == "stabilized" else (1.0, 0.0)
         for lag, c in ((1, coef[0]), (2, coef[1])):
             if c == 0.0 or lag > self.L:
@@ -252,17 +266,27 @@ class Marcher:
                 b.axpy(-c, self.rhs)
         if self.zero_local.size:
             b.getArray()[self.zero_local] = 0.0
+        return b
+
+    def solve(self, b, x):
+        """Collective: x = A^{-1} b with the factorised step matrix."""
         ev = event("SSI_BEM_Solve")
         ev.begin()
-        self.ksp.solve(b, self.x)
+        self.ksp.solve(b, x)
         ev.end()
+
+    def store(self, n, x):
+        """Collective: u^n, p^n into the history buffers from the unknowns x (u at
+        free DOFs, p at prescribed-displacement DOFs) and the known values kv_u,
+        kv_p; returns (u, p) and makes n the current step."""
+        self.n = n
         u = self.ubuf[self._slot(n)]
         p = self.pbuf[self._slot(n)]
         # u: solution at free DOFs, known values at prescribed DOFs
-        self.x.copy(u)
+        x.copy(u)
         p.set(0.0)
         if self.reg.n_disp:
-            self.sc_x2p.scatter(self.x, p, addv=self.PETSc.InsertMode.INSERT_VALUES)
+            self.sc_x2p.scatter(x, p, addv=self.PETSc.InsertMode.INSERT_VALUES)
             uk = u.getArray()
             r0 = u.getOwnershipRange()[0]
             loc = self.dofs_pres_local(r0, len(uk))

@@ -260,11 +260,37 @@ def run_bem(cfg, comm=None):
     with_stage.pop()
     st = stage("SSI BEM assembly")
     st.push()
+    march, info = build_bem(cfg, comm, prob, plan, ls, prob.known_u(), prob.known_p(), log)
+    t_asm, mem_exact, mem_interp = info["t_asm"], info["mem_exact"], info["mem_interp"]
+    ndense, nbaij, fill, mem = info["ndense"], info["nbaij"], info["fill"], info["mem"]
+    st.pop()
+    st = stage("SSI BEM time loop")
+    st.push()
+    out = Output(cfg.output, comm)
+    res = _time_loop(cfg, comm, prob, march, out)
+    st.pop()
+    stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
+             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
+             "T_L": plan.TL if plan.active else None, "lag_bytes_exact": mem_exact,
+             "lag_bytes_interp": mem_interp,
+             "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
+             "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
+             "kernel_evaluations": ls.kernel_evaluations, "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
+    res["stats"] = stats
+    _finish(cfg, comm, prob, out, res)
+    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
+    return res
+
+
+def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
+    """Collective: assemble the lag matrices (exact and interpolating), factorise
+    the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
+    PETSc = init()
     t0 = time.perf_counter()
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
-    march = Marcher(comm, ls, cfg.scheme, prob.known_u(), prob.known_p(), log=log,
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
     H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
     nt = prob.regions.n_t
@@ -286,7 +312,6 @@ def run_bem(cfg, comm=None):
         GI.append(lagmats.build_one(comm, gb, lag, ls.node_range, N, nt, tcol_loc, "dense")[0] if nt else None)
     ls.kernel_evaluations = nev
     t_asm = time.perf_counter() - t0
-    st.pop()
     mem_exact = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
     mem_interp = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in HI + GI))
     mem = mem_exact + mem_interp
@@ -301,24 +326,10 @@ def run_bem(cfg, comm=None):
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
-    st = stage("SSI BEM time loop")
-    st.push()
     march.set_lags(H, G, plan, HI, GI)
     ls.H = ls.G = None   # the triplets are in the Mats now
-    out = Output(cfg.output, comm)
-    res = _time_loop(cfg, comm, prob, march, out)
-    st.pop()
-    stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
-             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
-             "T_L": plan.TL if plan.active else None, "lag_bytes_exact": mem_exact,
-             "lag_bytes_interp": mem_interp,
-             "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
-             "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
-             "kernel_evaluations": ls.kernel_evaluations, "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
-    res["stats"] = stats
-    _finish(cfg, comm, prob, out, res)
-    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
-    return res
+    return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
+                   "nbaij": nbaij, "fill": fill, "mem": mem}
 
 
 def _time_loop(cfg, comm, prob, march, out):

@@ -5,7 +5,8 @@ nodal forces over the bilinear face quads,
     F_a = -p0 int_face N_a n dA = -p0 int N_a (x_s x x_t) ds dt   (2x2 Gauss, exact
 for flat or warped bilinear quads), with n the outward normal (p0 > 0 pushes
 into the body: the paper's top load p(t) = -p0 (H(t) - H(t - 0.025 s)) is
-p0 = 1000 N/m^2 on "top" with the box history); plus point loads at the
+p0 = 1000 N/m^2 on "top" with the box history; 'name:factor' scales p0 on a
+group, e.g. 'top_left,top_right:-1' for the antisymmetric case); plus point loads at the
 nearest FE nodes (refused farther away than the largest element size).
 
 Time part h(t): ``petsc_ssi.histories.History``, shared with the BEM:
@@ -70,14 +71,29 @@ def group_faces(mesh, names, what):
     return np.concatenate(out) if out else np.zeros((0, 4), np.int64)
 
 
+def load_groups(spec):
+    """[(group, factor)] of 'name[:factor],...': the pressure on a group is factor * p0
+    (e.g. 'top_left,top_right:-1' for the paper's antisymmetric load, Fig. 7c)."""
+    out = []
+    for item in [s.strip() for s in str(spec).split(",") if s.strip()]:
+        name, _, fac = item.partition(":")
+        try:
+            f = float(fac) if fac.strip() else 1.0
+        except ValueError:
+            raise SSIError(f"-ssi_fem_load_group '{item}': the factor after ':' must be a number") from None
+        out.append((name.strip(), f))
+    return out
+
+
 def nodal_load(mesh, cfg):
     """Replicated (N, 3) spatial load F [N] and the point-load snap distances."""
     F = np.zeros((mesh.n_nodes, 3))
     if cfg.fem_load_p0 != 0:
-        quads = group_faces(mesh, cfg.fem_load_group, "-ssi_fem_load_group")
-        fq = quad_pressure_forces(mesh.coords[quads], cfg.fem_load_p0)
-        for i in range(3):
-            F[:, i] += np.bincount(quads.ravel(), weights=fq[:, :, i].ravel(), minlength=mesh.n_nodes)
+        for name, scale in load_groups(cfg.fem_load_group):
+            quads = group_faces(mesh, name, "-ssi_fem_load_group")
+            fq = quad_pressure_forces(mesh.coords[quads], scale * cfg.fem_load_p0)
+            for i in range(3):
+                F[:, i] += np.bincount(quads.ravel(), weights=fq[:, :, i].ravel(), minlength=mesh.n_nodes)
     dist = np.zeros(0)
     if cfg.fem_point_load.strip():
         pl = parse_points(cfg.fem_point_load, 6, "-ssi_fem_point_load", "x,y,z,fx,fy,fz")

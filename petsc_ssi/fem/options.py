@@ -52,7 +52,7 @@ register("fem_newmark_alpha", "real", 0.25, "", "Newmark alpha (beta in most tex
 register("fem_newmark_delta", "real", 0.5, "", "Newmark delta (gamma in most texts)", G, validator=positive)
 register("fem_solver", "enum", "direct", "", "solver of D: direct (factorise once, MUMPS) or iterative "
          "(CG + hypre BoomerAMG); -ssi_fem_ksp_*/-ssi_fem_pc_* override", G, choices=("direct", "iterative"))
-register("fem_load_group", "str", "", "", "loaded faces: comma-separated face group names (e.g. top)", G)
+register("fem_load_group", "str", "", "", "loaded faces: comma-separated face group names, each with an optional factor on p0 (e.g. top, or top_left,top_right:-1)", G)
 register("fem_load_p0", "real", 0.0, "N/m^2", "pressure on the load group; p0 > 0 pushes into the body "
          "(traction -p0 h(t) n, n the outward normal)", G)
 register("fem_load_history", "enum", "heaviside", "", "load history h(t) of the pressure and point loads: "
