@@ -70,6 +70,10 @@ register("interp_grading", "real", 1.0, "", "multi-linear node grading exponent 
 register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause", "bem")
 register("guard_factor", "real", 100.0, "", "guard: stop when |u| exceeds this times the largest |u| of the first half of the run so far", "bem",
          validator=lambda v: None if v > 1 else "must be > 1")
+register("check_stability", "bool", False, "", "only check stability: run a coarse surrogate (3x3-element quarter model, same "
+         "element size, dt, scheme, interpolation) for a few hundred steps and print a verdict (runs/stability)", "bem")
+register("check_stability_steps", "int", 400, "steps", "-ssi_check_stability: at least this many steps (and at least "
+         "3 x the surrogate's causal lags)", "bem", validator=at_least(100))
 register("warn_beta", "bool", True, "", "warn when beta = c dt / l leaves [0.3, 1.3]", "bem")
 
 

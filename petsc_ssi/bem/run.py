@@ -17,6 +17,7 @@ from . import symmetry, receivers as rec, histories, lagmats
 from .model import Material, Regions, LagSet, causal_lags, machine_memory
 from . import interp
 from .march import Marcher
+from .stability import guard_reference, guard_trips
 
 
 def _pair(text, name):
@@ -247,6 +248,9 @@ def run_bem(cfg, comm=None):
     """Collective: the whole BEM run. Returns a dict of results (rank 0 has receivers)."""
     PETSc = init()
     comm = comm or PETSc.COMM_WORLD
+    if cfg.get("check_stability"):
+        from .stability import check_stability     # -ssi_check_stability: a coarse surrogate only
+        return check_stability(cfg, comm, lambda c: run_bem(c, comm))
     t_start = time.perf_counter()
     log = printf if cfg.monitor else (lambda m: None)
     with_stage = stage("SSI BEM setup")
@@ -367,7 +371,9 @@ def _time_loop(cfg, comm, prob, march, out):
             ev_io.end()
         nrm = u.norm()
         unorm.append(nrm)
-        prog.update(n, f"t={t:.4g}s |u|={nrm:.3e}")
+        w = min(100, n - 1)       # growth of |u| over the last (up to) 100 steps, shown by -ssi_monitor
+        grow = f" growth x{nrm / unorm[-1 - w]:.3g}/{w} steps" if w and unorm[-1 - w] > 0 else ""
+        prog.update(n, f"t={t:.4g}s |u|={nrm:.3e}{grow}")
         if cfg.guard:
             _guard(cfg, prob, march, unorm, n)
     ser = None
@@ -387,8 +393,8 @@ def _guard(cfg, prob, march, unorm, n):
     nrm = unorm[-1]
     pm = march.__dict__.setdefault("_prefix_max", [])      # running max of |u|: O(1) per step
     pm.append(max(pm[-1], nrm) if pm else nrm)
-    ref = pm[n // 2 - 1] if n >= 2 else 0.0
-    if np.isfinite(nrm) and (n < 20 or nrm <= cfg.guard_factor * max(ref, 1e-300)):
+    ref = guard_reference(pm, n)
+    if not guard_trips(nrm, ref, n, cfg.guard_factor):
         return
     rate = (np.log(nrm / ref) / (n - n // 2)) if (np.isfinite(nrm) and ref > 0) else float("inf")
     causes = []
@@ -403,9 +409,11 @@ def _guard(cfg, prob, march, unorm, n):
                       "arrival (tau_L < 1.09) is inaccurate; raise -ssi_interp_tl")
     if not causes:
         causes.append("unknown (check the mesh and dt; -ssi_guard 0 disables this check)")
-    raise SSIError(f"the solution is diverging at step {n} (t = {n * prob.dt:.4g} s): |u| = {nrm:.3e}, "
+    exc = SSIError(f"the solution is diverging at step {n} (t = {n * prob.dt:.4g} s): |u| = {nrm:.3e}, "
                    f"{nrm / ref if ref > 0 else float('inf'):.3g} x the largest norm of the first half, growth "
                    f"rate {rate:.3g} per step; likely cause: {'; '.join(causes)}")
+    exc.unorm = np.array(unorm)      # the history so far (-ssi_check_stability, runs/stability)
+    raise exc
 
 
 def _traction_to_nodes(comm, prob, march):

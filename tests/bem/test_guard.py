@@ -7,6 +7,7 @@ import pytest
 
 from helpers import run_bem
 from petsc_ssi.petsc import SSIError
+from petsc_ssi.bem.stability import guard_step
 
 BETA = 0.05
 DT = BETA * 0.5 / 316.0
@@ -22,6 +23,9 @@ def test_guard_stops_diverging_plain_scheme(tmp_path):
     assert "diverging at step" in msg and "plain scheme" in msg and "\n" not in msg
     step = int(msg.split("diverging at step ")[1].split()[0])
     assert 20 < step <= 450, step
+    # the history travels with the error, and the recorded-history form of the rule agrees
+    assert len(exc.value.unorm) == step
+    assert guard_step(exc.value.unorm, 100.0) == step
 
 
 def test_guard_lets_stabilized_scheme_run(tmp_path):
