@@ -24,7 +24,8 @@ def run():
     if kind == "fem":
         from .fem.run import run_fem
         return run_fem(cfg)
-    raise SSIError("-ssi_problem ssi: the FEM-BEM coupling is not available yet in this version")
+    from .coupling.run import run_ssi
+    return run_ssi(cfg)
 
 
 def estimate():

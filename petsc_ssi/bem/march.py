@@ -20,6 +20,8 @@ AIJ, factorised once (KSP prefix ``ssi_bem_``: preonly + LU with MUMPS by
 default, any KSP/PC from the options database). The history sum runs over the
 stored lags with past states in a ring buffer of fixed length.
 """
+import time
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -91,6 +93,7 @@ class Marcher:
         self.pres = pres
         ev = event("SSI_BEM_Factor")
         ev.begin()
+        t0 = time.perf_counter()
         self.A = step_matrix(comm, lagset, self.scheme, pres)
         # DOFs a symmetry plane forces to zero: identity rows, zero columns
         # (their equations involve only these DOFs; see symmetry.zero_dofs)
@@ -105,6 +108,7 @@ class Marcher:
         self.ksp.setOperators(self.A)
         self.ksp.setFromOptions()
         self.ksp.setUp()
+        self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)

@@ -388,7 +388,13 @@ class NewmarkIntegrator(_Dynamic):
         self.w.copy(self.a)
 
     def step(self, f=None):
-        a, d, dt = self.alpha, self.delta, self.dt
+        self.predict(f)
+        return self.complete()
+
+    def predict(self, f=None):
+        """u^n for the load f (without further forces) into ``self.w``; ``complete(du)``
+        then adds a displacement D^{-1} g of further forces g of the same step
+        (the FEM-BEM coupling's interface force) and finishes the step."""
         self._check_fixed(f)
         self.rhs.zeroEntries()
         self.rhs.axpy(self.c_u, self.u)
@@ -399,6 +405,12 @@ class NewmarkIntegrator(_Dynamic):
             self.rhs.axpy(1.0, f)
         self.rhs.pointwiseMult(self.rhs, self.mask)
         self.solve(self.rhs, self.w)                              # u^n
+        return self.w
+
+    def complete(self, du=None):
+        a, d, dt = self.alpha, self.delta, self.dt
+        if du is not None:
+            self.w.axpy(1.0, du)
         # a^n = (u^n - u - dt v)/(a dt^2) - (1/(2a) - 1) a^{n-1}
         self.rhs.waxpy(-1.0, self.u, self.w)
         self.rhs.axpy(-dt, self.v)

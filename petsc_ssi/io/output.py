@@ -72,13 +72,14 @@ class Output:
                 self.fields.append(name)
         self.times.append(float(t))
 
-    def close(self, receivers=None, attrs=None, record=None):
+    def close(self, receivers=None, attrs=None, record=None, groups=None):
         """Collective: close the viewer, then rank 0 adds the serial data and
         writes the XDMF and JSON files. ``receivers``: dict with 'points'
-        (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0."""
+        (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
+        ``groups``: {group: {name: array}} more serial data (rank 0)."""
         self.viewer.destroy()
         self.comm.tompi4py().Barrier()
-        self._rank0(lambda: self._write_serial(receivers, attrs, record), f"writing {self.path}")
+        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups), f"writing {self.path}")
 
     def _rank0(self, work, what):
         """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
@@ -92,7 +93,7 @@ class Output:
                 err = f"{what}: {type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
         collective_error(err, self.comm)
 
-    def _write_serial(self, receivers, attrs, record):
+    def _write_serial(self, receivers, attrs, record, groups=None):
         """Rank 0: topology, time, attributes and receivers into the HDF5 file; XDMF; JSON."""
         import h5py
         with h5py.File(self.path, "a") as f:
@@ -109,6 +110,10 @@ class Output:
             if receivers is not None:
                 g = f.create_group("receivers")
                 for k, v in receivers.items():
+                    g.create_dataset(k, data=np.asarray(v))
+            for gname, data in (groups or {}).items():
+                g = f.create_group(gname)
+                for k, v in data.items():
                     g.create_dataset(k, data=np.asarray(v))
         self._write_xdmf()
         if record is not None:

@@ -1,0 +1,211 @@
+r"""Interface law per step: bonded, or unilateral contact with a cohesion limit.
+
+The BEM step matrix A is factorised ONCE with every interface node closed
+(traction unknown, u_b = u_f known). With the interface DOFs I, the step
+matrix's displacement part H_s = c_1 H_1 + c_2 H_2 and
+
+    y = A^{-1} (b - H_s E_I u_f)         (the bonded solution of the step)
+    Z = A^{-1} H_s E_I                   (3 n_I solves, once, at set-up),
+
+a set O of open DOFs (p_O = 0, u_O = u_f,O + delta_O unknown) changes only
+the columns O of the system, and its solution is
+
+    x = y - Z[:, O] delta_O,   Z_OO delta_O = y_O    (x_O = p_O = 0),
+
+a capacitance (Schur complement) system of size |O|: a status change costs a
+dense LU of Z_OO (cached per active set) and |O|-column products, never a
+refactorisation of the BEM system. The algebra here works on replicated
+interface arrays (3 n_I numbers: the same decisions on every rank, no
+communication); the caller applies x = y - Z[:, O] delta_O to its own rows.
+
+Kuhn-Tucker conditions (paper eq. 25), per node, n_b the soil's outward normal:
+  gap     g = (u_b - u_f) . n_f = -delta . n_b        (g >= 0)
+  traction p_N = p_b . n_b (tension positive)         (p_N <= p_C)
+A closed node whose p_N exceeds p_C + tol opens; an open node whose gap is
+below -tol (penetration) closes. Step n starts from the status of step n-1;
+B.2 closes open nodes whose predicted gap (u_b^{n-1} - u_f^n) . n_f is
+negative; then solve / check / update until nothing changes. If a status set
+repeats (cycling) only the worst violation is changed per iteration; after
+``max_iter`` iterations the step is accepted with a warning.
+"""
+import time
+
+import numpy as np
+import scipy.linalg as sla
+
+
+class Capacitance:
+    """Z_II (replicated, 3n_I x 3n_I) and LU factors of Z_OO cached per open set."""
+
+    def __init__(self, Z_II, max_cache=256):
+        self.Z = np.asarray(Z_II)
+        self.cache = {}
+        self.max_cache = max_cache
+        self.n_factor = 0
+        self.t_factor = 0.0
+
+    def solve(self, O, yO):
+        key = O.tobytes()
+        lu = self.cache.get(key)
+        if lu is None:
+            t0 = time.perf_counter()
+            lu = sla.lu_factor(self.Z[np.ix_(O, O)], check_finite=False)
+            self.t_factor += time.perf_counter() - t0
+            self.n_factor += 1
+            if len(self.cache) >= self.max_cache:
+                self.cache.pop(next(iter(self.cache)))
+            self.cache[key] = lu
+        return sla.lu_solve(lu, yO, check_finite=False)
+
+
+class ContactLaw:
+    """Replicated per-step active-set logic (see the module docstring).
+
+    ``step(solve, uf_pred)``: ``solve(closed)`` returns (O, ub, uf, p) for a
+    status (replicated interface arrays, 3 n_I); uf_pred is the structure's
+    interface displacement used by the B.2 gap prediction."""
+
+    def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25):
+        self.n_b = np.asarray(n_b, float)            # (n_I, 3)
+        self.nI = len(self.n_b)
+        self.zero = np.asarray(zero, bool).reshape(self.nI, 3)
+        self.law = law
+        self.p_C = float(p_C)
+        self.tol = float(tol)
+        self.max_iter = int(max_iter)
+        self.closed = np.ones(self.nI, bool)
+        self.ub_prev = np.zeros(3 * self.nI)
+        self.total_changes = 0
+        self.cycled_steps = []
+        self.t_algebra = 0.0
+
+    def open_dofs(self, closed):
+        m = np.repeat(~closed, 3) & ~self.zero.ravel()
+        return np.nonzero(m)[0]
+
+    def _normal(self, v):
+        return np.einsum("ij,ij->i", v.reshape(-1, 3), self.n_b)
+
+    def step(self, solve, uf_pred):
+        t0 = time.perf_counter()
+        if self.law == "bonded":
+            closed = self.closed
+            O, ub, uf, p = solve(closed)
+            its, changes, cycled = 1, 0, False
+        else:
+            closed = self.closed.copy()
+            tol_g = self.tol * max(np.abs(uf_pred).max(), np.abs(self.ub_prev).max(), 1e-300)
+            # B.2: predicted gap (u_b^{n-1} - u_f^n) . n_f of open nodes (n_f = -n_b)
+            g_pred = -self._normal(self.ub_prev - uf_pred)
+            start = closed.copy()
+            closed |= (~closed) & (g_pred < -tol_g)
+            seen = {closed.tobytes()}
+            changes = int((closed != start).sum())
+            cycled = False
+            its = 0
+            while True:
+                its += 1
+                O, ub, uf, p = solve(closed)
+                pN = self._normal(p)
+                gap = -self._normal(ub - uf)
+                tol_p = self.tol * max(np.abs(p).max(), self.p_C, 1e-300)
+                v_open = np.where(closed, pN - (self.p_C + tol_p), -np.inf)      # > 0: must open
+                v_close = np.where(~closed, -gap - tol_g, -np.inf)              # > 0: must close
+                viol = np.maximum(v_open, v_close)
+                if not np.any(viol > 0) or its >= self.max_iter:
+                    cycled = bool(np.any(viol > 0))
+                    break
+                new = closed.copy()
+                new[v_open > 0] = False
+                new[v_close > 0] = True
+                if new.tobytes() in seen:              # cycling: change the worst node only
+                    cycled = True
+                    new = closed.copy()
+                    k = int(np.argmax(viol))
+                    new[k] = not closed[k]
+                changes += int((new != closed).sum())
+                closed = new
+                seen.add(closed.tobytes())
+        pN = self._normal(p)
+        gap = -self._normal(ub - uf)
+        self.closed = closed
+        self.ub_prev = ub
+        self.total_changes += changes
+        self.t_algebra += time.perf_counter() - t0
+        return {"O": O, "p": p, "ub": ub, "uf": uf, "closed": closed.copy(), "gap": gap, "pN": pN,
+                "iterations": its, "changes": changes, "cycled": cycled}
+
+
+class StaggeredSolve:
+    """The paper's staggered step (Table 2): u_f is fixed (the FEM predictor);
+    closed DOFs get u_b = u_f, open ones p = 0 through the capacitance Z_OO."""
+
+    def __init__(self, law, cap):
+        self.law, self.cap = law, cap
+
+    def __call__(self, y, uf):
+        def solve(closed):
+            O = self.law.open_dofs(closed)
+            delta = np.zeros_like(y)
+            p = y.copy()
+            if O.size:
+                dO = self.cap.solve(O, y[O])
+                delta[O] = dO
+                p -= self.cap.Z[:, O] @ dO
+                p[O] = 0.0
+            return O, uf + delta, uf, p
+        return solve
+
+
+class ImplicitSolve:
+    r"""Interface-implicit step: the structure's interface displacement responds
+    to the interface force of the same step (trapezoidal Newmark, u_f = w + C f),
+    solved together with the soil (p = q - Z u_b) on the interface:
+
+        closed rows:  [(I - a C M3 Z) s]_C = [w - C M3 (a q + r)]_C     (u_b = u_f)
+        open rows:    [Z s]_O = q_O                                     (p_O = 0)
+
+    s = u_b, f = -M3 (a p + r) (a = 1, r = 0 for the direct traction; a = 1.5,
+    r = -0.5 p^{n-1} extrapolated), C = [D^{-1}]_II, M3 = M (x) I_3. One dense
+    LU per active set (cached), 3 n_I unknowns."""
+
+    def __init__(self, law, Z, C, M3, a, max_cache=256):
+        self.law, self.Z, self.C, self.M3, self.a = law, Z, C, M3, float(a)
+        self.CM = C @ M3
+        self.B = np.eye(len(Z)) - self.a * self.CM @ Z
+        self.cache = {}
+        self.max_cache = max_cache
+        self.n_factor = 0
+        self.t_factor = 0.0
+
+    def _lu(self, closed, O):
+        key = closed.tobytes()
+        lu = self.cache.get(key)
+        if lu is None:
+            t0 = time.perf_counter()
+            K = self.B.copy()
+            K[O] = self.Z[O]
+            lu = sla.lu_factor(K, check_finite=False)
+            self.t_factor += time.perf_counter() - t0
+            self.n_factor += 1
+            if len(self.cache) >= self.max_cache:
+                self.cache.pop(next(iter(self.cache)))
+            self.cache[key] = lu
+        return lu
+
+    def __call__(self, q, w, r):
+        g_closed = w - self.CM @ (self.a * q + r)
+
+        def solve(closed):
+            O = self.law.open_dofs(closed)
+            g = g_closed.copy()
+            g[O] = q[O]
+            s = sla.lu_solve(self._lu(closed, O), g, check_finite=False)
+            p = q - self.Z @ s
+            p[O] = 0.0
+            uf = w - self.CM @ (self.a * p + r)
+            ub = s.copy()
+            C = np.setdiff1d(np.arange(len(s)), O)
+            ub[C] = uf[C]            # equal up to round-off; exact compatibility
+            return O, ub, uf, p
+        return solve

@@ -1,0 +1,193 @@
+"""The soil-structure interface: matching nodes, normals, consistent forces.
+
+The interface is small (n_I nodes, a few hundred) and is described here by
+replicated arrays, computed identically on every rank from the replicated
+meshes; the per-step data (displacements, tractions, forces) live in PETSc
+Vecs and move between the FE and BE layouts through scatters and one AIJ
+matrix (``force_matrix``), never through rank 0.
+
+Conventions (paper eqs. 26-29). n_b: outward normal of the soil (+z on a
+flat surface), n_f = -n_b: outward normal of the structure's base.
+Interface column k (0..n_I-1) is BE node ``be_nodes[k]`` (the sorted nodes of
+the interface elements: the BEM's prescribed-displacement region, whose
+traction columns are n_load + k) and FE node ``fe_nodes[k]``.
+Consistent nodal forces from the BE traction field p(x) = sum_j N_j(x) p_j:
+    f_b,i = int_Gamma N_i p dGamma = sum_j M_ij p_j,  M_ij = int N_i N_j dGamma
+(nine-node shape functions, 4 x 4 Gauss points: exact on flat elements), and
+f_f = -f_b (eq. 27).
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from ..petsc import SSIError, init
+from ..mesh import quad9
+
+
+def _fmt(points, k=3):
+    return "; ".join(f"({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g})" for p in points[:k]) + \
+        (f"; ... ({len(points)} in all)" if len(points) > k else "")
+
+
+def fe_interface_faces(fe_mesh, groups):
+    """Outward-ordered quads of the comma-separated FE face groups."""
+    out = []
+    for name in [s.strip() for s in groups.split(",") if s.strip()]:
+        if name not in fe_mesh.faces:
+            raise SSIError(f"-ssi_fem_interface: no face group '{name}' in the structure's mesh "
+                           f"{fe_mesh.source} (face groups: {', '.join(sorted(fe_mesh.faces)) or 'none'})")
+        out.append(fe_mesh.faces[name])
+    if not out or sum(len(q) for q in out) == 0:
+        raise SSIError("-ssi_fem_interface names no faces of the structure")
+    return np.concatenate(out)
+
+
+def _face_normals(X):
+    """Unit normals of bilinear quads X (F, 4, 3) at their centres (node order outward)."""
+    n = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+class Interface:
+    """Replicated interface data (see the module docstring)."""
+
+    def __init__(self, be_elems, be_nodes, fe_nodes, x, n_b, M, zero, spacing):
+        self.be_elems, self.be_nodes, self.fe_nodes = be_elems, be_nodes, fe_nodes
+        self.x, self.n_b, self.M, self.zero, self.spacing = x, n_b, M, zero, spacing
+
+    @property
+    def n(self):
+        return len(self.be_nodes)
+
+    @property
+    def n_f(self):
+        return -self.n_b
+
+    def area(self):
+        return float(self.M.sum())
+
+
+def build_interface(be_mesh, fe_mesh, spec, fe_groups, tol_rel, planes=(), h=1.0):
+    """Match the meshes (SSIError listing unmatched nodes); normals; M.
+
+    ``spec``: 'auto', a BE group name or 'box:...'. ``planes``: symmetry planes
+    (the DOFs they force to zero are flagged in ``zero``, shape (n_I, 3))."""
+    from scipy.spatial import cKDTree
+    quads = fe_interface_faces(fe_mesh, fe_groups)
+    fnodes = np.unique(quads)
+    xf = fe_mesh.coords[fnodes]
+    edges = np.concatenate([quads[:, [0, 1]], quads[:, [1, 2]]])
+    spacing = float(np.linalg.norm(fe_mesh.coords[edges[:, 0]] - fe_mesh.coords[edges[:, 1]], axis=1).min())
+    tol = tol_rel * spacing
+    tree = cKDTree(xf)
+    xb_all = be_mesh.nodes
+    d_all, i_all = tree.query(xb_all)
+    on_fe = d_all <= tol
+    if spec == "auto":
+        elems = np.nonzero(on_fe[be_mesh.cells].all(axis=1))[0]
+        if elems.size == 0:
+            near = float(d_all.min())
+            raise SSIError(f"-ssi_interface auto: no soil element has all nine nodes on the structure's "
+                           f"'{fe_groups}' faces (closest soil node {near:.3g} m from them, tolerance "
+                           f"{tol:.3g} m): the soil mesh must have nodes at the structure's base nodes")
+    else:
+        elems = np.asarray(be_mesh.select(spec), np.int64)
+    bnodes = np.unique(be_mesh.cells[elems])
+    miss_b = bnodes[~on_fe[bnodes]]
+    if miss_b.size:
+        raise SSIError(f"interface: {miss_b.size} soil node(s) of -ssi_interface {spec} match no node of the "
+                       f"structure's '{fe_groups}' faces within {tol:.3g} m: {_fmt(xb_all[miss_b])}")
+    match = i_all[bnodes]
+    if len(np.unique(match)) != len(match):
+        raise SSIError(f"interface: two soil nodes match the same structure node (tolerance {tol:.3g} m "
+                       "too large? -ssi_interface_tol)")
+    hit = np.zeros(len(fnodes), bool)
+    hit[match] = True
+    if not hit.all():
+        raise SSIError(f"interface: {int((~hit).sum())} node(s) of the structure's '{fe_groups}' faces match no "
+                       f"soil node of the interface elements within {tol:.3g} m: {_fmt(xf[~hit])}")
+    fe_nodes = fnodes[match]
+    x = xb_all[bnodes]
+    # normals: soil (nine-node geometry at the nodes, averaged) and structure (faces, averaged)
+    lut = -np.ones(be_mesh.n_nodes, np.int64)
+    lut[bnodes] = np.arange(len(bnodes))
+    X = be_mesh.cell_coords()[elems]
+    xi = quad9.NODE_XI
+    _, jn = quad9.geometry(X[:, None, :, :], xi[None, :, 0], xi[None, :, 1])
+    jn = jn / np.linalg.norm(jn, axis=-1, keepdims=True)
+    nb = np.zeros((len(bnodes), 3))
+    np.add.at(nb, lut[be_mesh.cells[elems]].ravel(), jn.reshape(-1, 3))
+    nb /= np.linalg.norm(nb, axis=1, keepdims=True)
+    fl = -np.ones(fe_mesh.n_nodes, np.int64)
+    fl[fe_nodes] = np.arange(len(fe_nodes))
+    fn = np.zeros((len(bnodes), 3))
+    np.add.at(fn, fl[quads].ravel(), np.repeat(_face_normals(fe_mesh.coords[quads]), 4, axis=0))
+    fn /= np.linalg.norm(fn, axis=1, keepdims=True)
+    cosang = np.einsum("ij,ij->i", nb, fn)
+    if np.any(cosang > -0.999):
+        bad = np.nonzero(cosang > -0.999)[0]
+        raise SSIError(f"interface: the soil and structure normals are not opposite at {bad.size} node(s) "
+                       f"(e.g. {_fmt(x[bad], 1)}): is -ssi_fem_interface the face that rests on the soil?")
+    M = mass_matrix(X, lut[be_mesh.cells[elems]], len(bnodes))
+    zero = np.zeros((len(bnodes), 3), bool)
+    for ax, kind in planes:
+        on = np.abs(x[:, ax]) <= 1e-9 * max(h, 1.0)
+        if kind > 0:
+            zero[on, ax] = True
+        else:
+            zero[np.ix_(on, [c for c in range(3) if c != ax])] = True
+    return Interface(elems, bnodes, fe_nodes, x, nb, M, zero, spacing)
+
+
+def mass_matrix(X, conn, n, order=4):
+    """M_ij = int N_i N_j dGamma over nine-node elements X (E, 9, 3) with local
+    node numbers conn (E, 9): scipy CSR (n, n)."""
+    g, w = np.polynomial.legendre.leggauss(order)
+    xi, eta = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    ww = np.outer(w, w).ravel()
+    N = quad9.shape(xi, eta)                                     # (P, 9)
+    _, jn = quad9.geometry(X, xi, eta)                           # (E, P, 3)
+    J = np.linalg.norm(jn, axis=-1) * ww                         # (E, P)
+    Me = np.einsum("ep,pa,pb->eab", J, N, N)
+    r = np.repeat(conn, 9, axis=1).ravel()
+    c = np.tile(conn, (1, 9)).ravel()
+    return sp.csr_matrix((Me.ravel(), (r, c)), shape=(n, n))
+
+
+def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9):
+    """FE DOFs a symmetry plane fixes: on x_a = 0, u_a (sym) or the two other
+    components (anti). SSIError if the structure extends to x_a < 0."""
+    out = []
+    h = float(np.abs(fe_mesh.coords).max())
+    for ax, kind in planes:
+        x = fe_mesh.coords[:, ax]
+        if x.min() < -tol * max(h, 1.0) * 1e3:
+            raise SSIError(f"-ssi_symmetry: the structure's mesh extends to {'xy'[ax]} = {x.min():.4g} < 0; "
+                           f"with a symmetry plane {'xy'[ax]} = 0 mesh only the part {'xy'[ax]} >= 0")
+        on = np.nonzero(np.abs(x) <= tol * max(h, 1.0))[0]
+        comps = [ax] if kind > 0 else [c for c in range(3) if c != ax]
+        for c in comps:
+            out.append(3 * on + c)
+    return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
+
+
+def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, skip=()):
+    """Collective: AIJ F with f_f = F p: rows in the FE layout, columns the BE
+    traction vector (columns 3 (n_load + k) + c), entries -M (eq. 27). Rows
+    of the FE DOFs ``skip`` (fixed ones) are left empty."""
+    PETSc = init()
+    r0, r1 = fe_layout_vec.getOwnershipRange()
+    M = iface.M.tocoo()
+    rows_all = 3 * iface.fe_nodes[M.row]
+    cols_all = 3 * (n_load + M.col)
+    R, C, V = [], [], []
+    for c in range(3):
+        R.append(rows_all + c); C.append(cols_all + c); V.append(-M.data)
+    R = np.concatenate(R); C = np.concatenate(C); V = np.concatenate(V)
+    own = (R >= r0) & (R < r1) & ~np.isin(R, np.asarray(skip, np.int64))
+    A = sp.csr_matrix((V[own], (R[own] - r0, C[own])), shape=(r1 - r0, p_vec.getSize()))
+    A.sort_indices()
+    F = PETSc.Mat().createAIJ(size=((r1 - r0, fe_layout_vec.getSize()), (p_vec.getLocalSize(), p_vec.getSize())),
+                              csr=(A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data),
+                              comm=comm)
+    F.assemble()
+    return F

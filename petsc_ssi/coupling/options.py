@@ -1,0 +1,63 @@
+"""Options of the FEM-BEM coupling (group "ssi"), declared once in the registry.
+
+The soil is the BEM half-space (``-ssi_cp/_cs/_rho/_mesh...``), the structure
+the FEM model (``-ssi_fem_*``); these options say how they meet.
+"""
+from ..options import register, register_check, positive
+
+G = "ssi"
+
+register("interface", "str", "auto", "", "soil elements of the soil-structure interface: 'auto' (every "
+         "element whose nine nodes all coincide with nodes of -ssi_fem_interface), a group name or "
+         "'box:x0,x1,y0,y1'", G)
+register("fem_interface", "str", "base", "", "face group(s) of the structure in contact with the soil", G)
+register("interface_tol", "real", 1e-6, "", "FE and BE interface nodes match when closer than this times "
+         "the smallest interface node spacing", G, validator=positive)
+register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f always; linear) or unilateral "
+         "(Kuhn-Tucker contact with a cohesion limit: the structure may lift off, paper eq. 25)", G,
+         choices=("bonded", "unilateral"))
+register("contact_cohesion", "real", 0.0, "N/m^2", "cohesion limit p_C: a closed node opens when its normal "
+         "traction (tension positive) exceeds p_C", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact checks: gap < -tol max|u_f| "
+         "closes a node, p_N > p_C + tol max(|p|, p_C) opens one", G, validator=positive)
+register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "
+         "a warning (cycling)", G, validator=lambda v: None if v >= 1 else "must be >= 1")
+register("coupling", "enum", "implicit", "", "time coupling: implicit (the structure's interface "
+         "displacement and the soil traction of a step solved together on the interface: unconditionally "
+         "stable; structure by trapezoidal Newmark) or staggered (the paper's Table 2: FEM predictor, BEM, "
+         "force as an impulse; Green's-function integrator; stable only while the soil's impedance times dt "
+         "stays below about twice the structure's interface nodal masses)", G, choices=("implicit", "staggered"))
+register("coupling_traction", "enum", "direct", "", "interface force handed to the structure: "
+         "direct (p^n, as printed in Table 2) or extrapolated (1.5 p^n - 0.5 p^{n-1}: the load at t_n)", G,
+         choices=("direct", "extrapolated"))
+register("structure_receivers", "str", "", "m", "structure receivers 'x,y,z;...' (nearest FE node); "
+         "-ssi_receivers are soil surface points", G)
+
+
+def _ssi_checks(cfg):
+    if cfg.disp_group:
+        return ("-ssi_disp_group prescribes soil displacements; with -ssi_problem ssi the interface "
+                "displacements come from the structure (-ssi_interface)")
+    from ..bem.symmetry import parse
+    from ..petsc import SSIError
+    try:
+        planes = parse(cfg.symmetry)
+    except SSIError as exc:
+        return str(exc)
+    if cfg.contact == "unilateral" and any(kind < 0 for _, kind in planes):
+        return ("-ssi_contact unilateral with an antisymmetry plane (-ssi_symmetry "
+                f"{cfg.symmetry}): contact destroys the antisymmetry of the response (the side in "
+                "compression stays closed, the other may open), so an antisymmetric half model is "
+                "wrong; mesh the whole interface")
+    want = "green" if cfg.coupling == "staggered" else "newmark"
+    if cfg.user_set("fem_integrator") and cfg.fem_integrator != want:
+        return (f"-ssi_coupling {cfg.coupling} integrates the structure with {want} (the "
+                f"{'staggered step needs u^n independent of the force of step n' if want == 'green' else 'implicit step needs u^n to respond to the force of step n'}); "
+                f"drop -ssi_fem_integrator {cfg.fem_integrator}")
+    if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
+        return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
+    return None
+
+
+register_check((G,), _ssi_checks)

@@ -1,0 +1,448 @@
+r"""``-ssi_problem ssi``: the structure (FEM) on the half-space (BEM), staggered
+(paper Section 4, Table 2), with a bonded or unilateral interface.
+
+Set-up (A.1): every input check (both meshes, the interface matching, the
+contact options, the memory estimate) before any assembly; then the FE
+matrices with D factorised once, the BEM lag matrices with the step matrix
+factorised once (every interface node closed), and the interface
+capacitance Z = A^{-1} H_s E_I (``contact.py``).
+
+Per step n (B):
+  B.1 u_f^n = FEM predictor (eq. 13; independent of the forces of step n);
+  B.2 gap check with u_b^{n-1} (unilateral), compatibility u_b = u_f^n at
+      closed nodes;
+  B.3 BEM step: history sum, one solve with the factorised matrix -> bonded
+      solution y; the open nodes' correction through the capacitance system;
+  B.4 traction check (p_N <= p_C at closed nodes, no penetration at open
+      ones); B.3-B.4 repeat until the status is stable (only the small
+      capacitance algebra is repeated: y does not depend on the status);
+  B.5 interface forces f_f = -M p_b (consistent, ``interface.py``), handed
+      to the structure as the load at t_n (1.5 p^n - 0.5 p^{n-1} by default:
+      a BE traction is the mean over (t_{n-1}, t_n]; see fem/integrators.py);
+  B.6 FE velocity (eq. 14).
+
+Outputs: the soil fields in -ssi_output (quad9), the structure's in
+<stem>_structure.h5 (hex8), both with XDMF; the interface series (u_f, u_b,
+p_b, gap, p_N, status, open count, iterations, force resultants of both
+sides) in the group "interface" of -ssi_output.
+"""
+import os
+import time
+
+import numpy as np
+
+from ..petsc import init, SSIError, collective_error, printf, warn
+from ..monitor import Progress, event, stage, fmt_time
+from ..io.output import Output, provenance
+from ..options import Config
+from ..bem.run import BEMProblem, build_bem, _traction_to_nodes
+from ..bem import receivers as bem_rec
+from ..bem.model import Regions
+from ..fem.assembly import assemble
+from ..fem.model import build_model
+from ..fem.run import ReceiverSeries, make_model_integrator, _history as fem_history
+from ..mesh import quad9
+from .interface import build_interface, fem_symmetry_dofs, force_matrix
+from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
+
+
+def _view(cfg, **changes):
+    """A copy of the options with some values replaced."""
+    vals = cfg.as_dict()
+    vals.update(changes)
+    return Config(vals, cfg.sources())
+
+
+def setup(cfg, comm):
+    """Collective: the soil problem, the structure's model (not assembled) and the
+    interface, all checked. Returns (prob, model, iface, fe_cfg)."""
+    prob = BEMProblem(cfg, comm, log=printf)
+    fe_cfg = _view(cfg, receivers=cfg.structure_receivers,
+                   fem_integrator="green" if cfg.coupling == "staggered" else "newmark")
+    model = build_model(fe_cfg, comm, assemble_matrices=False)
+    err, iface, sym = None, None, None
+    try:
+        iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
+                                prob.planes, prob.h)
+        sym = fem_symmetry_dofs(model.mesh, prob.planes)
+        load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
+        both = np.intersect1d(load, iface.be_elems)
+        if both.size:
+            raise SSIError(f"-ssi_load_group {cfg.load_group}: {both.size} loaded soil elements lie under the "
+                           "structure (the interface); load the structure instead (-ssi_fem_load_*)")
+        prob.regions = Regions(prob.mesh, load, iface.be_elems)
+        if not np.array_equal(prob.regions.disp_nodes, iface.be_nodes):
+            raise SSIError("interface: internal error, node order of the soil regions differs")
+    except SSIError as exc:
+        err = str(exc)
+    collective_error(err, comm)
+    model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
+    return prob, model, iface, fe_cfg
+
+
+class Coupler:
+    """Collective: the interface maps between the FE and BE layouts, the
+    interface matrices (Z, and C for the implicit coupling) and the contact
+    law; ``step()`` advances both sides."""
+
+    def __init__(self, cfg, comm, prob, march, iface, integ, model):
+        PETSc = init()
+        self.PETSc, self.cfg, self.comm = PETSc, cfg, comm
+        self.prob, self.march, self.iface, self.integ, self.model = prob, march, iface, integ, model
+        self.mode = cfg.coupling
+        nI = iface.n
+        self.nI = nI
+        self.dofs_be = (3 * iface.be_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+        self.dofs_fe = (3 * iface.fe_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+        # scatters of the interface values to every rank (3 n_I numbers: the
+        # small replicated interface system; the fields stay distributed)
+        self.seq_y = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
+        self.seq_uf = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
+        self.sc_be = PETSc.Scatter().create(march.u_tmpl, PETSc.IS().createGeneral(self.dofs_be, comm=PETSc.COMM_SELF),
+                                            self.seq_y, None)
+        self.sc_fe = PETSc.Scatter().create(integ.u, PETSc.IS().createGeneral(self.dofs_fe, comm=PETSc.COMM_SELF),
+                                            self.seq_uf, None)
+        self.own_k, self.own_loc = _owned(self.dofs_be, march.u_tmpl)
+        self.fown_k, self.fown_loc = _owned(self.dofs_fe, integ.u)
+        self.zero = iface.zero.ravel()
+        ev = event("SSI_Capacitance")
+        ev.begin()
+        t0 = time.perf_counter()
+        self.Zloc = self._bem_columns()
+        Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
+        self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
+                              cfg.contact_max_iter)
+        ex = cfg.coupling_traction == "extrapolated"
+        self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
+        M3 = np.kron(iface.M.toarray(), np.eye(3))
+        self.M3 = M3
+        if self.mode == "staggered":
+            self.solver = StaggeredSolve(self.law, Capacitance(Z_II))
+        else:
+            self.DEloc = self._fem_columns()
+            C = self._gather_rows(self.DEloc, self.fown_k, self.fown_loc)
+            self.solver = ImplicitSolve(self.law, Z_II, C, M3, self.c_new)
+            self.solver._lu(self.law.closed, self.law.open_dofs(self.law.closed))   # the bonded LU, now
+        self.t_capacitance = time.perf_counter() - t0
+        ev.end()
+        # forces: f_f = F p (FE layout); rows of FE DOFs a symmetry plane (or the
+        # user) fixes are left out: their reaction is not a load on the structure
+        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, skip=model.fixed)
+        self.ff = integ.u.duplicate()
+        self.du = integ.u.duplicate()
+        self.w = march.p_tmpl.duplicate()
+        self.p_prev = march.p_tmpl.duplicate()
+        self.p_prev.set(0.0)
+        self.pI_prev = np.zeros(3 * nI)
+        self.weights = _area_weights(prob.mesh, iface)
+
+    def solver_cap(self):
+        """The object that factorises per active set (n_factor, t_factor)."""
+        return self.solver.cap if self.mode == "staggered" else self.solver
+
+    def _gather_rows(self, loc, own_k, own_loc):
+        """Collective: the interface rows of a local column block, on every rank."""
+        rows = self.comm.tompi4py().allgather((own_k, loc[own_loc]))
+        out = np.zeros((3 * self.nI, loc.shape[1]))
+        for k, zr in rows:
+            out[k] = zr
+        return out
+
+    def _bem_columns(self):
+        """Z[:, j] = A^{-1} H_s e_j for the interface DOFs (local rows; 3 n_I solves)."""
+        m = self.march
+        e, t, rhs, z = (m.u_tmpl.duplicate() for _ in range(4))
+        coef = ((1, 4.0), (2, 1.0)) if m.scheme == "stabilized" else ((1, 1.0),)
+        Z = np.zeros((e.getLocalSize(), 3 * self.nI))
+        lut = -np.ones(3 * self.nI, np.int64)
+        lut[self.own_k] = self.own_loc
+        for j in range(3 * self.nI):
+            if self.zero[j]:
+                continue
+            e.set(0.0)
+            if lut[j] >= 0:
+                e.getArray()[lut[j]] = 1.0
+            rhs.set(0.0)
+            for lag, c in coef:
+                m.H[lag - 1].mult(e, t)
+                rhs.axpy(c, t)
+            if m.zero_local.size:
+                rhs.getArray()[m.zero_local] = 0.0
+            m.solve(rhs, z)
+            Z[:, j] = z.getArray(readonly=True)
+        for v in (e, t, rhs, z):
+            v.destroy()
+        return Z
+
+    def _fem_columns(self):
+        """D^{-1} e_j for the interface DOFs of the structure (local rows; 3 n_I solves)."""
+        integ = self.integ
+        e, z = integ.u.duplicate(), integ.u.duplicate()
+        out = np.zeros((e.getLocalSize(), 3 * self.nI))
+        lut = -np.ones(3 * self.nI, np.int64)
+        lut[self.fown_k] = self.fown_loc
+        for j in range(3 * self.nI):
+            e.set(0.0)
+            if lut[j] >= 0:
+                e.getArray()[lut[j]] = 1.0
+            e.pointwiseMult(e, integ.mask)
+            integ.solve(e, z)
+            out[:, j] = z.getArray(readonly=True)
+        e.destroy(); z.destroy()
+        return out
+
+    def _set_known_p(self, n):
+        m = self.march
+        m.kv_p.set(0.0)
+        if self.comm.getRank() == 0 and m.reg.n_load:
+            m.kv_p.setValues(m.dofs_load, m.known_p(n))
+        m.kv_p.assemblyBegin(); m.kv_p.assemblyEnd()
+
+    def step(self, f_ext):
+        """Collective: one coupled step. Returns (u_soil, p_soil, info)."""
+        m, integ = self.march, self.integ
+        with event("SSI_FEM_Step"):
+            uf = integ.predict() if self.mode == "staggered" else integ.predict(f_ext)   # B.1
+        self.sc_fe.scatter(uf, self.seq_uf)
+        wI = self.seq_uf.getArray(readonly=True).copy()
+        n = m.begin_step()                                         # history sum
+        kv = m.kv_u.getArray()
+        kv[:] = 0.0
+        if self.mode == "staggered":
+            kv[self.own_loc] = wI[self.own_k]                      # B.2: u_b = u_f (all closed)
+        self._set_known_p(n)
+        b = m.add_known(m._b)
+        m.solve(b, m.x)                                            # B.3: y (staggered) or q (u_I = 0)
+        self.sc_be.scatter(m.x, self.seq_y)
+        yI = self.seq_y.getArray(readonly=True).copy()
+        ev = event("SSI_Contact")
+        ev.begin()
+        r = -self.c_old * self.pI_prev
+        if self.mode == "staggered":
+            solve = self.solver(yI, wI)
+        else:
+            solve = self.solver(yI, wI, r)
+        res = self.law.step(solve, wI)                             # B.2-B.4 (active set)
+        x = m.x.getArray()
+        if self.mode == "staggered":
+            O = res["O"]
+            if O.size:                                             # x = y - Z[:, O] delta_O
+                d = res["ub"] - wI
+                x -= self.Zloc[:, O] @ d[O]
+        else:
+            x -= self.Zloc @ res["ub"]                             # x = q - Z u_b
+        x[self.own_loc] = np.where(np.isin(self.own_k, res["O"]), 0.0, x[self.own_loc])
+        kv[self.own_loc] = res["ub"][self.own_k]
+        ev.end()
+        u, p = m.store(n, m.x)
+        # B.5: interface force at t_n, f_f = -M (c_new p^n - c_old p^{n-1})
+        fI = -self.M3 @ (self.c_new * res["p"] + r)
+        self.pI_prev = res["p"].copy()
+        p.copy(self.w)
+        self.w.scale(self.c_new)
+        self.w.axpy(-self.c_old, self.p_prev)
+        self.F.mult(self.w, self.ff)
+        p.copy(self.p_prev)
+        loc = self.ff.getArray(readonly=True).reshape(-1, 3).sum(axis=0)
+        res["force_fe"] = self.comm.tompi4py().allreduce(loc)
+        res["force_be"] = (self.weights[:, None] * (self.c_new * res["p"] + r).reshape(-1, 3)).sum(axis=0)
+        with event("SSI_FEM_Step"):
+            if self.mode == "staggered":
+                integ.correct(f_ext, self.ff)                      # B.5-B.6
+            else:
+                da = self.du.getArray()
+                da[:] = self.DEloc @ fI                            # D^{-1} E f_I
+                integ.complete(self.du)
+                self.sc_fe.scatter(integ.u, self.seq_uf)
+                res["uf_check"] = self.seq_uf.getArray(readonly=True).copy()
+        return u, p, res
+
+
+def _owned(dofs, vec):
+    r0, r1 = vec.getOwnershipRange()
+    own = (dofs >= r0) & (dofs < r1)
+    return np.nonzero(own)[0], (dofs[own] - r0).astype(np.int64)
+
+
+def _area_weights(mesh, iface, order=6):
+    """a_k = int N_k dGamma over the interface elements (an independent
+    quadrature of the traction resultant: sum_k a_k p_k = int p dGamma)."""
+    g, w = np.polynomial.legendre.leggauss(order)
+    xi, eta = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    ww = np.outer(w, w).ravel()
+    X = mesh.cell_coords()[iface.be_elems]
+    _, jn = quad9.geometry(X, xi, eta)
+    J = np.linalg.norm(jn, axis=-1) * ww
+    Ne = J @ quad9.shape(xi, eta)                     # (E, 9)
+    lut = -np.ones(mesh.n_nodes, np.int64)
+    lut[iface.be_nodes] = np.arange(iface.n)
+    a = np.zeros(iface.n)
+    np.add.at(a, lut[mesh.cells[iface.be_elems]].ravel(), Ne.ravel())
+    return a
+
+
+def run_ssi(cfg):
+    """Collective: the coupled run. Returns a dict of results (series on rank 0)."""
+    PETSc = init()
+    comm = PETSc.COMM_WORLD
+    t_start = time.perf_counter()
+    log = printf if cfg.monitor else (lambda m: None)
+    st = stage("SSI setup")
+    st.push()
+    hist = fem_history(cfg, comm)
+    prob, model, iface, fe_cfg = setup(cfg, comm)
+    printf(prob.summary())
+    printf(f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
+           f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
+           + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
+           + f", interface force {cfg.coupling_traction}")
+    plan = prob.interp_plan()
+    printf("[ssi] " + plan.describe())
+    ls = prob.lagset()
+    prob.check_memory(ls, plan)
+    st.pop()
+    st = stage("SSI FEM assembly")
+    st.push()
+    model.K, model.m = assemble(model.mesh, model.material, model.layout)
+    _, integ, am = make_model_integrator(fe_cfg, comm, model)
+    st.pop()
+    st = stage("SSI BEM assembly")
+    st.push()
+    march, info = build_bem(cfg, comm, prob, plan, ls, None, prob.known_p(), log)
+    coupler = Coupler(cfg, comm, prob, march, iface, integ, model)
+    printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
+           f"{fe_cfg.fem_integrator}): {3 * iface.n} BEM" + (" and FEM" if cfg.coupling == "implicit" else "")
+           + f" solves in {fmt_time(coupler.t_capacitance)} "
+           f"(BEM step matrix factorised once in {fmt_time(march.t_factor)})")
+    st.pop()
+    st = stage("SSI time loop")
+    st.push()
+    res = _time_loop(cfg, comm, prob, model, iface, coupler, hist)
+    st.pop()
+    law = coupler.law
+    nch = law.total_changes
+    stats = {"wall_s": time.perf_counter() - t_start, "assembly_s": info["t_asm"], "lag_bytes": info["mem"],
+             "bem_factor_s": march.t_factor, "capacitance_setup_s": coupler.t_capacitance,
+             "status_changes": int(nch), "capacitance_factorisations": coupler.solver_cap().n_factor,
+             "capacitance_factor_s": coupler.solver_cap().t_factor, "contact_algebra_s": law.t_algebra,
+             "cycled_steps": law.cycled_steps, "interface_nodes": iface.n, "lags": prob.L,
+             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
+             "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": am}
+    res["stats"] = stats
+    if cfg.contact == "unilateral":
+        per = law.t_algebra / max(nch, 1)
+        printf(f"[ssi] contact: {nch} status changes in {int((res['interface']['changes'] > 0).sum())} steps, "
+               f"{coupler.solver_cap().n_factor} interface factorisations ({fmt_time(coupler.solver_cap().t_factor)}), active-set "
+               f"algebra {fmt_time(law.t_algebra)} in all ({per * 1e3:.3g} ms per status change) vs "
+               f"{fmt_time(march.t_factor)} for one factorisation of the BEM step matrix")
+    _finish(cfg, comm, prob, model, iface, res, am)
+    integ.destroy()
+    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
+    return res
+
+
+def structure_output_path(path):
+    stem, ext = os.path.splitext(path)
+    return stem + "_structure" + (ext or ".h5")
+
+
+def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
+    march, integ = coupler.march, coupler.integ
+    mesh = prob.mesh
+    out = Output(cfg.output, comm)
+    cvec = march.u_tmpl.duplicate()
+    r0, r1 = cvec.getOwnershipRange()
+    cvec.setArray(mesh.nodes.reshape(-1)[r0:r1])
+    out.write_mesh(cvec, mesh.cells if comm.getRank() == 0 else None, "quad9")
+    sout = Output(structure_output_path(cfg.output), comm)
+    sout.write_mesh(model.coords_vec(), model.mesh.cells if comm.getRank() == 0 else None, "hex8")
+    R = None
+    if len(prob.receivers):
+        R, _ = bem_rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
+        y = R.createVecLeft()
+    srec = ReceiverSeries(integ.u, model.receiver_nodes, comm)
+    tnode = _traction_to_nodes(comm, prob, march)
+    tfield = march.u_tmpl.duplicate()
+    vel = integ.u.duplicate()
+    F, fn = model.load_vec(), model.load_vec()
+
+    def sample(k):
+        F.copy(fn)
+        fn.scale(hist.cell_mean(k, cfg.dt))
+        return fn
+
+    integ.start(f0=sample(0))
+    srec.record(0.0, integ.u)
+    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be")
+    if cfg.coupling == "implicit":
+        keys += ("uf_check",)
+    series = {k: [] for k in keys}
+    times, soil = [], []
+    unorm = []
+    stride = cfg.output_stride
+    prog = Progress("SSI time loop", prob.n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
+    for n in range(1, prob.n_steps + 1):
+        u, p, res = coupler.step(sample(n))
+        t = n * prob.dt
+        times.append(t)
+        for k in keys:
+            series[k].append(res[k])
+        if res["cycled"]:
+            coupler.law.cycled_steps.append(n)
+            warn(f"step {n} (t = {t:.4g} s): the contact status did not settle in {res['iterations']} "
+                 f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
+        if R is not None:
+            R.mult(u, y)
+            soil.append(y.getArray().copy())
+        srec.record(t, integ.u)
+        if stride and n % stride == 0:
+            with event("SSI_IO"):
+                if tnode is not None:
+                    tnode.mult(p, tfield)
+                out.write_fields(t, {"displacement": u, "traction": tfield})
+                sout.write_fields(t, {"displacement": integ.u, "velocity": integ.velocity(vel)})
+        nrm = u.norm()
+        unorm.append(nrm)
+        if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
+            raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
+                           "(beta = c dt / l) and -ssi_coupling_traction")
+        n_open = int((~res["closed"]).sum())
+        prog.update(n, f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} it {res['iterations']}")
+    soil_u = None
+    if R is not None:
+        loc = np.array(soil).reshape(len(times), -1)
+        allp = comm.tompi4py().gather(loc, root=0)
+        if comm.getRank() == 0:
+            soil_u = np.concatenate(allp, axis=1).reshape(len(times), len(prob.receivers), 3)
+    nI = coupler.nI
+    inter = {k: np.asarray(v) for k, v in series.items()}
+    for k in ("uf", "ub", "p") + (("uf_check",) if "uf_check" in inter else ()):
+        inter[k] = inter[k].reshape(len(times), nI, 3)
+    inter["n_open"] = (~inter["closed"]).sum(axis=1)
+    inter["t"] = np.asarray(times)
+    inter["x"] = iface.x
+    inter["normal"] = iface.n_b
+    st, su = srec.arrays()
+    return {"t": np.asarray(times), "u": soil_u, "structure_t": st, "structure_u": su, "interface": inter,
+            "unorm": np.asarray(unorm), "_outputs": (out, sout)}
+
+
+def _finish(cfg, comm, prob, model, iface, res, am):
+    out, sout = res.pop("_outputs")
+    attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
+             "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
+             "structure_output": os.path.basename(structure_output_path(cfg.output))}
+    rec_ = provenance(cfg, comm, {"stats": res["stats"]})
+    recd = None
+    if res["u"] is not None:
+        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+    with event("SSI_IO"):
+        inter = res["interface"] if comm.getRank() == 0 else None
+        out.close(receivers=recd, attrs=attrs, record=rec_,
+                  groups={"interface": inter} if inter is not None else None)
+        srecd = None
+        if comm.getRank() == 0 and len(model.receiver_nodes):
+            srecd = {"points": model.receivers.reshape(-1, 3), "nodes": model.receiver_nodes,
+                     "node_points": model.mesh.coords[model.receiver_nodes].reshape(-1, 3),
+                     "t": res["structure_t"], "u": res["structure_u"]}
+        sout.close(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am, "dt": cfg.dt}, record=None)
