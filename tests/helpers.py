@@ -78,3 +78,21 @@ def read_h5(path):
 
 def relmax(a, b):
     return float(np.abs(np.asarray(a) - np.asarray(b)).max() / max(np.abs(np.asarray(b)).max(), 1e-300))
+
+
+def run_ssi(**opts):
+    """Run a coupled FEM-BEM case in this process with -ssi_<key> <value> options."""
+    PETSc = petsc()
+    from petsc_ssi import options
+    from petsc_ssi.coupling.run import run_ssi as _run
+    db = PETSc.Options()
+    opts = dict(opts)
+    opts.setdefault("problem", "ssi")
+    for k, v in opts.items():
+        db.setValue("ssi_" + k, str(v))
+    try:
+        cfg = options.resolve(("common", "bem", "fem", "ssi"))
+        return _run(cfg)
+    finally:
+        for k in opts:
+            db.delValue("ssi_" + k)

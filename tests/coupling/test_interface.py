@@ -1,0 +1,116 @@
+"""Interface set-up (matching, normals, consistent forces) and the contact
+algebra on small synthetic systems."""
+import numpy as np
+import pytest
+
+from petsc_ssi.petsc import SSIError
+from petsc_ssi.mesh import surface
+from petsc_ssi.fem.mesh import structured_box
+from petsc_ssi.coupling.interface import build_interface, fem_symmetry_dofs
+from petsc_ssi.coupling.contact import ContactLaw, StaggeredSolve, ImplicitSolve, Capacitance
+
+
+def meshes(cells=4, h=0.5):
+    be = surface.grid(2.0, 2.0, h, patch=(0.5, 0.5))
+    fe = structured_box((cells, cells, 1), (1.0, 1.0, 0.25), (-0.5, -0.5, 0.0))
+    return be, fe
+
+
+def test_matching_normals_and_consistent_forces():
+    be, fe = meshes()
+    it = build_interface(be, fe, "auto", "base", 1e-6)
+    assert it.n == 25 and len(it.be_elems) == 4
+    assert np.allclose(be.nodes[it.be_nodes], fe.coords[it.fe_nodes], atol=1e-12)
+    assert np.allclose(it.n_b, [0, 0, 1]) and np.allclose(it.n_f, [0, 0, -1])
+    # sum_ij M_ij = area; M reproduces int x^2 dA for a quadratic field (nine-node exact)
+    assert it.area() == pytest.approx(1.0, rel=1e-13)
+    x = it.x[:, 0]
+    assert x @ (it.M @ x) == pytest.approx(1.0 / 12.0, rel=1e-12)     # int_{-1/2}^{1/2} x^2 dx
+    # the same interface named by a group (the grid's 'load' patch)
+    it2 = build_interface(be, fe, "load", "base", 1e-6)
+    assert np.array_equal(it2.be_nodes, it.be_nodes)
+
+
+def test_unmatched_nodes_are_listed():
+    be, _ = meshes()
+    fe = structured_box((5, 5, 1), (1.0, 1.0, 0.25), (-0.5, -0.5, 0.0))     # 0.2 m spacing: no match
+    with pytest.raises(SSIError, match="no soil element has all nine nodes"):
+        build_interface(be, fe, "auto", "base", 1e-6)
+    with pytest.raises(SSIError, match=r"soil node\(s\) of -ssi_interface load match no node .*\(-0\.5, -0\.25, 0\).*\(21 in all\)"):
+        build_interface(be, fe, "load", "base", 1e-6)
+    with pytest.raises(SSIError, match="no face group 'bottom'"):
+        build_interface(be, fe, "auto", "bottom", 1e-6)
+
+
+def test_wrong_face_is_refused():
+    be, fe = meshes()
+    fe.coords[:, 2] -= 0.25            # the block's top now lies on the soil: normals agree
+    with pytest.raises(SSIError, match="normals are not opposite"):
+        build_interface(be, fe, "auto", "top", 1e-6)
+
+
+def test_symmetry_dofs():
+    fe = structured_box((2, 2, 1), (0.5, 0.5, 0.25), (0.0, 0.0, 0.0))
+    d = fem_symmetry_dofs(fe, [(0, 1), (1, 1)])
+    on_x = np.nonzero(np.abs(fe.coords[:, 0]) < 1e-12)[0]
+    assert set(3 * on_x) <= set(d) and not set(3 * on_x + 2) & set(d)
+    with pytest.raises(SSIError, match="extends to x"):
+        fem_symmetry_dofs(structured_box((2, 2, 1), (1, 1, 0.25), (-0.5, -0.5, 0)), [(0, 1)])
+
+
+def _toy(nI=3, seed=0):
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(3 * nI, 3 * nI))
+    Z = -(A @ A.T + 3 * nI * np.eye(3 * nI))       # soil: p = q - Z u = q + K u, K SPD
+    nb = np.tile([0.0, 0.0, 1.0], (nI, 1))
+    return Z, nb
+
+
+def test_capacitance_equals_direct_solution():
+    """Staggered: open DOFs get p = 0 and u_b from the soil alone; the
+    capacitance update equals solving the soil system with those columns."""
+    Z, nb = _toy()
+    law = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", 0.0)
+    uf = np.array([0, 0, -1e-3, 0, 0, -1e-3, 0, 0, 1e-3])
+    q = np.zeros(9)
+    y = q - Z @ uf                                  # bonded traction
+    solve = StaggeredSolve(law, Capacitance(Z))(y, uf)
+    closed = np.array([True, True, False])
+    O, ub, uf_, p = solve(closed)
+    assert np.allclose(p[O], 0) and np.allclose(ub[:6], uf[:6])
+    # direct: p = q - Z ub with ub_C = uf_C and p_O = 0
+    C = np.arange(6)
+    ubO = np.linalg.solve(Z[np.ix_(O, O)], q[O] - Z[np.ix_(O, C)] @ uf[C])
+    assert np.allclose(ub[O], ubO, rtol=1e-12)
+
+
+def test_implicit_interface_system():
+    """Implicit: u_f = w + C f, f = -M3 p, p = q - Z u_b; closed u_b = u_f, open p = 0."""
+    Z, nb = _toy()
+    rng = np.random.default_rng(1)
+    B = rng.normal(size=(9, 9))
+    C = 1e-3 * (B @ B.T + 9 * np.eye(9))
+    M3 = np.kron(np.diag([0.3, 0.5, 0.2]), np.eye(3))
+    law = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", 0.0)
+    w, q = rng.normal(size=9) * 1e-3, rng.normal(size=9)
+    O, ub, uf, p = ImplicitSolve(law, Z, C, M3, 1.0)(q, w, np.zeros(9))(np.array([True, False, True]))
+    assert np.allclose(uf, w - C @ M3 @ p, rtol=1e-12, atol=1e-15)
+    assert np.allclose(p[O], 0.0) and np.allclose(ub[[0, 1, 2, 6, 7, 8]], uf[[0, 1, 2, 6, 7, 8]], atol=1e-15)
+    pfull = q - Z @ ub
+    assert np.allclose(pfull[O], 0.0, atol=1e-10) and np.allclose(p, pfull, atol=1e-10)
+
+
+def test_active_set_opens_tension_and_closes_penetration():
+    Z, nb = _toy()
+    law = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", p_C=0.5)
+    uf = np.zeros(9)
+    y = np.array([0, 0, -2.0, 0, 0, 0.3, 0, 0, 5.0])   # node 2 in tension beyond p_C
+    res = law.step(StaggeredSolve(law, Capacitance(Z))(y, uf), uf)
+    assert not res["closed"][2] and res["closed"][0]
+    assert np.all(res["pN"][res["closed"]] <= 0.5 + 1e-9)
+    assert np.all(res["gap"][~res["closed"]] >= -1e-12)
+    # compression everywhere: nothing opens, bonded answer
+    law2 = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", p_C=0.0)
+    y2 = -np.abs(y)
+    r2 = law2.step(StaggeredSolve(law2, Capacitance(Z))(y2, uf), uf)
+    assert r2["closed"].all() and np.array_equal(r2["p"], y2)
