@@ -12,7 +12,8 @@ the columns O of the system, and its solution is
 
     x = y - Z[:, O] delta_O,   Z_OO delta_O = y_O    (x_O = p_O = 0),
 
-a capacitance (Schur complement) system of size |O|: a status change costs a
+(p_O = t_O instead of 0 with -ssi_contact_open_traction cohesion: then
+Z_OO delta_O = y_O - t_O), a capacitance (Schur complement) system of size |O|: a status change costs a
 dense LU of Z_OO (cached per active set) and |O|-column products, never a
 refactorisation of the BEM system. The algebra here works on replicated
 interface arrays (3 n_I numbers: the same decisions on every rank, no
@@ -22,7 +23,10 @@ Kuhn-Tucker conditions (paper eq. 25), per node, n_b the soil's outward normal:
   gap     g = (u_b - u_f) . n_f = -delta . n_b        (g >= 0)
   traction p_N = p_b . n_b (tension positive)         (p_N <= p_C)
 A closed node whose p_N exceeds p_C + tol opens; an open node whose gap is
-below -tol (penetration) closes. Step n starts from the status of step n-1;
+below -tol (penetration) closes. An open node carries no traction (the method
+notes' reading: p_C is a strength, lost when the node opens) or, with
+open_traction 'cohesion', the normal tension p_C (eq. 25 read literally: the
+complementarity (p_C - p_N) g = 0 makes p_N = p_C wherever g > 0). Step n starts from the status of step n-1;
 B.2 closes open nodes whose predicted gap (u_b^{n-1} - u_f^n) . n_f is
 negative; then solve / check / update until nothing changes. If a status set
 repeats (cycling) only the worst violation is changed per iteration; after
@@ -65,8 +69,9 @@ class ContactLaw:
     status (replicated interface arrays, 3 n_I); uf_pred is the structure's
     interface displacement used by the B.2 gap prediction."""
 
-    def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25):
+    def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero"):
         self.n_b = np.asarray(n_b, float)            # (n_I, 3)
+        self.open_traction = open_traction
         self.nI = len(self.n_b)
         self.zero = np.asarray(zero, bool).reshape(self.nI, 3)
         self.law = law
@@ -82,6 +87,17 @@ class ContactLaw:
     def open_dofs(self, closed):
         m = np.repeat(~closed, 3) & ~self.zero.ravel()
         return np.nonzero(m)[0]
+
+    def target(self, closed):
+        """Traction prescribed at open DOFs (3n_I, zero elsewhere): 0, or with
+        open_traction 'cohesion' the normal tension p_C n_b (eq. 25 read
+        literally: an open node, g > 0, carries p_N = p_C)."""
+        t = np.zeros(3 * self.nI)
+        if self.open_traction == "cohesion" and self.p_C > 0:
+            tt = (self.p_C * self.n_b) * (~closed)[:, None]
+            t[:] = tt.ravel()
+            t[self.zero.ravel()] = 0.0
+        return t
 
     def _normal(self, v):
         return np.einsum("ij,ij->i", v.reshape(-1, 3), self.n_b)
@@ -146,13 +162,14 @@ class StaggeredSolve:
     def __call__(self, y, uf):
         def solve(closed):
             O = self.law.open_dofs(closed)
+            t = self.law.target(closed)
             delta = np.zeros_like(y)
             p = y.copy()
             if O.size:
-                dO = self.cap.solve(O, y[O])
+                dO = self.cap.solve(O, y[O] - t[O])
                 delta[O] = dO
                 p -= self.cap.Z[:, O] @ dO
-                p[O] = 0.0
+                p[O] = t[O]
             return O, uf + delta, uf, p
         return solve
 
@@ -163,7 +180,7 @@ class ImplicitSolve:
     solved together with the soil (p = q - Z u_b) on the interface:
 
         closed rows:  [(I - a C M3 Z) s]_C = [w - C M3 (a q + r)]_C     (u_b = u_f)
-        open rows:    [Z s]_O = q_O                                     (p_O = 0)
+        open rows:    [Z s]_O = q_O - t_O                               (p_O = t_O)
 
     s = u_b, f = -M3 (a p + r) (a = 1, r = 0 for the direct traction; a = 1.5,
     r = -0.5 p^{n-1} extrapolated), C = [D^{-1}]_II, M3 = M (x) I_3. One dense
@@ -198,11 +215,12 @@ class ImplicitSolve:
 
         def solve(closed):
             O = self.law.open_dofs(closed)
+            t = self.law.target(closed)
             g = g_closed.copy()
-            g[O] = q[O]
+            g[O] = q[O] - t[O]
             s = sla.lu_solve(self._lu(closed, O), g, check_finite=False)
             p = q - self.Z @ s
-            p[O] = 0.0
+            p[O] = t[O]
             uf = w - self.CM @ (self.a * p + r)
             ub = s.copy()
             C = np.setdiff1d(np.arange(len(s)), O)

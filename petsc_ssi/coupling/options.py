@@ -19,6 +19,9 @@ register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f alwa
 register("contact_cohesion", "real", 0.0, "N/m^2", "cohesion limit p_C: a closed node opens when its normal "
          "traction (tension positive) exceeds p_C", G,
          validator=lambda v: None if v >= 0 else "must be >= 0")
+register("contact_open_traction", "enum", "zero", "", "traction an open node carries: zero (p_C is a "
+         "strength lost on opening) or cohesion (the normal tension p_C, eq. 25 read literally: "
+         "(p_C - p_N) g = 0 with g > 0)", G, choices=("zero", "cohesion"))
 register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact checks: gap < -tol max|u_f| "
          "closes a node, p_N > p_C + tol max(|p|, p_C) opens one", G, validator=positive)
 register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "

@@ -111,7 +111,7 @@ class Coupler:
         self.Zloc = self._bem_columns()
         Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
-                              cfg.contact_max_iter)
+                              cfg.contact_max_iter, cfg.contact_open_traction)
         ex = cfg.coupling_traction == "extrapolated"
         self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
         M3 = np.kron(iface.M.toarray(), np.eye(3))
@@ -231,7 +231,7 @@ class Coupler:
                 x -= self.Zloc[:, O] @ d[O]
         else:
             x -= self.Zloc @ res["ub"]                             # x = q - Z u_b
-        x[self.own_loc] = np.where(np.isin(self.own_k, res["O"]), 0.0, x[self.own_loc])
+        x[self.own_loc] = np.where(np.isin(self.own_k, res["O"]), res["p"][self.own_k], x[self.own_loc])
         kv[self.own_loc] = res["ub"][self.own_k]
         ev.end()
         u, p = m.store(n, m.x)

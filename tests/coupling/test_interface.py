@@ -114,3 +114,24 @@ def test_active_set_opens_tension_and_closes_penetration():
     y2 = -np.abs(y)
     r2 = law2.step(StaggeredSolve(law2, Capacitance(Z))(y2, uf), uf)
     assert r2["closed"].all() and np.array_equal(r2["p"], y2)
+
+
+def test_open_nodes_carry_the_cohesion_when_asked():
+    """open_traction 'cohesion' (eq. 25 literally): an open node carries p_N = p_C;
+    'zero' (default): no traction. Both for the staggered and implicit algebra."""
+    Z, nb = _toy()
+    rng = np.random.default_rng(2)
+    Cm = 1e-3 * np.eye(9)
+    M3 = np.eye(9) * 0.3
+    y = np.array([0, 0, -2.0, 0, 0, -0.3, 0, 0, 5.0])
+    for mode, expect in (("zero", 0.0), ("cohesion", 0.5)):
+        for kind in ("staggered", "implicit"):
+            law = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", p_C=0.5, open_traction=mode)
+            if kind == "staggered":
+                solve = StaggeredSolve(law, Capacitance(Z))(y, np.zeros(9))
+            else:
+                solve = ImplicitSolve(law, Z, Cm, M3, 1.0)(y, np.zeros(9), np.zeros(9))
+            res = law.step(solve, np.zeros(9))
+            assert not res["closed"][2], (mode, kind)
+            assert res["p"][8] == pytest.approx(expect) and res["p"][6] == 0.0 and res["p"][7] == 0.0
+            assert res["gap"][2] >= 0

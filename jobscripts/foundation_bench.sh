@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Benchmark of the coupled foundation example (issue 5): the five cases of
+# runs/foundation (symmetric/antisymmetric load, bonded/unilateral interface, and the
+# antisymmetric unilateral case with cohesive open nodes) at
+# 1 and 2 ranks with -log_view -memory_view; then the table in
+# runs/foundation/README.md (jobscripts/foundation_table.py) and the figures
+# (runs/foundation/figures.py) from the logs and HDF5 outputs.
+#   bash jobscripts/foundation_bench.sh [CASES...]   (default: all five)
+# On a cluster, put the mpirun line in a job script (jobscripts/slurm.sbatch).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=${PY:-.venv/bin/python}
+RANKS=${RANKS:-"1 2"}
+CASES=${*:-"sym-bonded sym-unilateral anti-bonded anti-unilateral anti-unilateral-cohesive"}
+OUT=out/bench
+mkdir -p "$OUT"
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+export PETSC_DIR=${PETSC_DIR:-/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache}
+for case in $CASES; do
+  for n in $RANKS; do
+    log="$OUT/foundation-$case-n$n.log"
+    echo "[bench] $case on $n rank(s) -> $log"
+    mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi \
+      -options_file "runs/foundation/$case.opts" -ssi_output "$OUT/foundation-$case-n$n.h5" \
+      -log_view -memory_view > "$log" 2>&1
+  done
+done
+"$PY" jobscripts/foundation_table.py "$OUT" runs/foundation/README.md runs/foundation/bench.csv
+"$PY" runs/foundation/figures.py "$OUT" runs/foundation
