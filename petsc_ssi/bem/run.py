@@ -399,7 +399,8 @@ def _guard(cfg, prob, march, unorm, n):
     rate = (np.log(nrm / ref) / (n - n // 2)) if (np.isfinite(nrm) and ref > 0) else float("inf")
     causes = []
     if march.scheme == "plain":
-        causes.append("the plain scheme (eq. 6) is unstable for small beta: use -ssi_scheme stabilized")
+        causes.append(f"the plain scheme (eq. 6) is unstable for small beta = c_s dt / l (here {prob.beta[0]:.3g}; "
+                      "runs/stability/README.md maps where): use -ssi_scheme stabilized")
     if prob.beta[0] < 0.3 or prob.beta[1] > 1.3:
         causes.append(f"beta = c dt / l spans [{prob.beta[0]:.2f}, {prob.beta[1]:.2f}], outside [0.3, 1.3]: "
                       "change -ssi_dt or the mesh")
