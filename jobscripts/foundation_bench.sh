@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Benchmark of the coupled foundation example (issue 5): the five cases of
+# Benchmark of the coupled foundation example (issue 5): the six cases of
 # runs/foundation (symmetric/antisymmetric load, bonded/unilateral interface, and the
-# antisymmetric unilateral case with cohesive open nodes) at
+# antisymmetric unilateral case with cohesive open nodes, and the staggered step) at
 # 1 and 2 ranks with -log_view -memory_view; then the table in
 # runs/foundation/README.md (jobscripts/foundation_table.py) and the figures
 # (runs/foundation/figures.py) from the logs and HDF5 outputs.
-#   bash jobscripts/foundation_bench.sh [CASES...]   (default: all five)
+#   bash jobscripts/foundation_bench.sh [CASES...]   (default: all six)
 # On a cluster, put the mpirun line in a job script (jobscripts/slurm.sbatch).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PY:-.venv/bin/python}
 RANKS=${RANKS:-"1 2"}
-CASES=${*:-"sym-bonded sym-unilateral anti-bonded anti-unilateral anti-unilateral-cohesive"}
+CASES=${*:-"sym-bonded sym-unilateral anti-bonded anti-unilateral anti-unilateral-cohesive sym-bonded-staggered"}
 OUT=out/bench
 mkdir -p "$OUT"
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1

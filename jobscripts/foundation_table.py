@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""Table of the foundation benchmark from its logs (-log_view, -memory_view)
-and the runs' JSON records (contact statistics): writes the CSV and the table
+"""Table of the foundation benchmark from its logs (-log_view: stages, events)
+and the runs' JSON records (contact statistics; peak RSS from getrusage, which
+unlike -memory_view's samples also catches the transient peak of the BEM
+assembly): writes the CSV and the table
 between <!-- ssi-bench:begin/end --> in the README.
 
     python jobscripts/foundation_table.py OUT README CSV
@@ -16,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from logview import parse  # noqa: E402
 
 COLS = ["case", "ranks", "wall [s]", "BEM assembly [s]", "BEM factor [s]", "interface set-up [s]",
-        "time loop [s]", "per step [ms]", "peak memory [GB]", "lags stored [GB]", "status changes",
+        "time loop [s]", "per step [ms]", "peak RSS, all ranks [GB]", "peak RSS per rank [GB]", "lags stored [GB]", "status changes",
         "steps with changes", "interface LUs", "cost per change [ms]", "max open nodes"]
 
 
@@ -40,7 +42,8 @@ def row(log):
     return {"case": case, "ranks": n, "wall [s]": lv["total_s"],
             "BEM assembly [s]": st.get("assembly_s"), "BEM factor [s]": st.get("bem_factor_s"),
             "interface set-up [s]": st.get("capacitance_setup_s"), "time loop [s]": loop,
-            "per step [ms]": 1e3 * loop / steps, "peak memory [GB]": (lv["peak_rss_bytes"] or 0) / 1e9,
+            "per step [ms]": 1e3 * loop / steps, "peak RSS, all ranks [GB]": st.get("peak_rss_sum_bytes", float("nan")) / 1e9,
+            "peak RSS per rank [GB]": st.get("peak_rss_max_rank_bytes", float("nan")) / 1e9,
             "lags stored [GB]": st.get("lag_bytes", 0) / 1e9, "status changes": nch,
             "steps with changes": int((changes > 0).sum()), "interface LUs": st.get("capacitance_factorisations"),
             "cost per change [ms]": per, "max open nodes": int(nopen.max())}
@@ -55,7 +58,8 @@ def fmt(v):
 def main(out, readme, csvpath):
     logs = sorted(glob.glob(os.path.join(out, "foundation-*-n*.log")))
     rows = [row(l) for l in logs]
-    order = ["sym-bonded", "sym-unilateral", "anti-bonded", "anti-unilateral", "anti-unilateral-cohesive"]
+    order = ["sym-bonded", "sym-unilateral", "anti-bonded", "anti-unilateral", "anti-unilateral-cohesive",
+             "sym-bonded-staggered"]
     rows.sort(key=lambda r: (order.index(r["case"]) if r["case"] in order else 9, r["ranks"]))
     with open(csvpath, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLS)

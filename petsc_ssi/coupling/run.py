@@ -328,6 +328,11 @@ def run_ssi(cfg):
              "cycled_steps": law.cycled_steps, "interface_nodes": iface.n, "lags": prob.L,
              "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
              "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": am}
+    import resource
+    hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+    mpi = comm.tompi4py()
+    stats["peak_rss_max_rank_bytes"] = mpi.allreduce(hwm, op=__import__("mpi4py").MPI.MAX)
+    stats["peak_rss_sum_bytes"] = mpi.allreduce(hwm)
     res["stats"] = stats
     if cfg.contact == "unilateral":
         per = law.t_algebra / max(nch, 1)

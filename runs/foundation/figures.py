@@ -20,7 +20,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-CASES = ["sym-bonded", "sym-unilateral", "anti-bonded", "anti-unilateral", "anti-unilateral-cohesive"]
+CASES = ["sym-bonded", "sym-unilateral", "anti-bonded", "anti-unilateral", "anti-unilateral-cohesive",
+         "sym-bonded-staggered"]
 POINTS = {"sym": {"A": (0.0, 0.0), "B": (0.5, 0.0)}, "anti": {"A": (-0.5, 0.0), "B": (0.5, 0.0)}}
 
 
@@ -44,7 +45,6 @@ def load(out, case):
 
 def histories(data, figdir):
     fig, axs = plt.subplots(3, 2, figsize=(10, 10), sharex=True)
-    axs.ravel()[-1].axis("off")
     for ax, case in zip(axs.ravel(), CASES):
         d = data.get(case)
         ax.set_title(case)
@@ -57,6 +57,8 @@ def histories(data, figdir):
             ax.plot(t, 1e3 * np.r_[0.0, d["ub"][:, k, 2]], color=style[0], ls=style[1], label=f"{name}$^s$ (soil)")
             ax.plot(t, 1e3 * np.r_[0.0, d["uf"][:, k, 2]], color=style[0], ls="none", marker=style[2], ms=3,
                     mfc="none", label=f"{name}$^f$ (block)")
+        if "staggered" in case:
+            ax.set_yscale("symlog", linthresh=0.05)
         if "unilateral" in case:
             ax2 = ax.twinx()
             ax2.fill_between(d["t"], 0, d["n_open"], color="tab:red", alpha=0.12, step="pre")
@@ -67,7 +69,6 @@ def histories(data, figdir):
         ax.legend(fontsize=7, loc="lower right")
     for ax in axs[-1]:
         ax.set_xlabel("t [s]")
-    axs[1, 1].xaxis.set_tick_params(labelbottom=True)
     fig.suptitle("Vertical displacement at the soil-block interface (A, B: see figures.py)")
     fig.tight_layout()
     fig.savefig(os.path.join(figdir, "histories.png"), dpi=120)
@@ -109,10 +110,37 @@ def snapshots(d, case, figdir, n_panels=6):
     plt.close(fig)
 
 
+def findings(data, readme):
+    """Table of what the runs show, between <!-- ssi-findings:begin/end --> in the README."""
+    cols = ["case", "min u_z block at A [mm]", "max u_z block at B [mm]", "max gap [mm]", "max open nodes",
+            "first opening [s]", "open at t_end", "mean u_z block at t_end [mm]", "max |f_fe + f_be| / max |f_be|"]
+    rows = []
+    for case, d in data.items():
+        pts = POINTS[case.split("-")[0]]
+        kA = int(np.argmin(np.linalg.norm(d["x"][:, :2] - np.array(pts["A"]), axis=1)))
+        kB = int(np.argmin(np.linalg.norm(d["x"][:, :2] - np.array(pts["B"]), axis=1)))
+        op = np.nonzero(d["n_open"] > 0)[0]
+        fb = np.abs(d["force_be"]).max()
+        rows.append([case, f"{1e3 * d['uf'][:, kA, 2].min():.4g}", f"{1e3 * d['uf'][:, kB, 2].max():.4g}",
+                     f"{1e3 * d['gap'].max():.3g}", str(int(d["n_open"].max())),
+                     f"{d['t'][op[0]]:.4g}" if op.size else "-", str(int(d["n_open"][-1])),
+                     f"{1e3 * d['uf'][-1, :, 2].mean():.3g}",
+                     f"{np.abs(d['force_fe'] + d['force_be']).max() / fb:.1e}"])
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)] + ["| " + " | ".join(r) + " |" for r in rows]
+    text = open(readme).read()
+    a, b = "<!-- ssi-findings:begin -->", "<!-- ssi-findings:end -->"
+    if a in text:
+        import re
+        text = re.sub(re.escape(a) + ".*?" + re.escape(b), a + "\n" + "\n".join(lines) + "\n" + b, text, flags=re.S)
+        open(readme, "w").write(text)
+    print("\n".join(lines))
+
+
 def main(out, figdir):
     data = {c: load(out, c) for c in CASES}
     data = {c: d for c, d in data.items() if d is not None}
     histories(data, figdir)
+    findings(data, os.path.join(figdir, "README.md"))
     for c, d in data.items():
         snapshots(d, c, figdir)
     print(f"[figures] wrote {figdir}/histories.png and {len(data)} snapshot figures")
