@@ -4,6 +4,8 @@ Commands:
   (none) | run    run the case the options describe (-ssi_problem bem|fem|ssi)
   post FILE.h5    post-process an output file (--receivers --csv)
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
+  estimate        predicted time per stage and memory of the run, per rank count, and
+                  whether it fits the nodes (no assembly; -ssi_estimate_* options)
   help            list every -ssi_ option with default, unit and meaning
 
 Errors in the input end the run with one line, ``petsc-ssi: error: ...``,
@@ -29,6 +31,8 @@ def main(argv=None):
     from .petsc import init, SSIError
     PETSc = init(rest)
     from . import options
+    if cmd == "estimate":
+        from . import estimate  # noqa: F401  (declares the -ssi_estimate_ options, also for -help)
     if cmd == "help" or "-help" in rest or "--help" in rest:
         PETSc.Sys.Print(options.help_text())
         if cmd == "help":

@@ -29,4 +29,15 @@ def run():
 
 
 def estimate():
-    raise SSIError("petsc-ssi estimate is not available yet in this version")
+    """Collective: print the predicted cost (time per stage, memory, whether it
+    fits the nodes) of the case the options describe, without assembling
+    (petsc_ssi/estimate.py)."""
+    kind = problem_kind()
+    if kind == "fem":
+        raise SSIError("petsc-ssi estimate models the BEM half-space (-ssi_problem bem, and the BEM part of "
+                       "-ssi_problem ssi); the FEM structure alone is cheap: run it with -log_view")
+    from . import estimate as cost     # registers the -ssi_estimate_ options
+    cfg = options.resolve(GROUPS[kind] + ("estimate",))
+    if kind == "ssi":
+        init().Sys.Print("[ssi] estimate: -ssi_problem ssi: the BEM half-space part only (no FEM, no coupling)")
+    return cost.report(cfg, init().COMM_WORLD)

@@ -1,0 +1,386 @@
+"""Cost model of a BEM run: wall time per stage and peak memory before the run
+(``petsc-ssi estimate -options_file ...``; issue 6, part 4).
+
+The model counts the work of a run from the same set-up as the run itself
+(mesh, regions, lags, interpolation plan, the per-lag block estimate of
+``LagSet.estimate_memory``; no kernel is integrated) and turns the counts
+into seconds and bytes with a few machine constants fitted to ``-log_view``
+logs (``jobscripts/calibrate.py``). Per rank r of p (rows split as PETSc
+splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
+
+  assembly   a0 + a_blk * B_r                         B_r = sum of nb over assembled lags
+             + a_dense * D_r + a_sparse * S_r          (exact + interpolating); Mats: dense
+                                                       bytes D_r, block-sparse blocks S_r
+  factor     c_fac * N^1.5                              (sparse LU of the local step matrix)
+  history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
+             * (1 + sigma (m - 1)) + c_op * P_r        the run (a dense lag: 72 N n_r B,
+                                                       sparse: 76 B per block), m ranks per
+                                                       node sharing the memory bus; P_r
+                                                       matrix-vector products
+  solve      c_sol * steps * N^1.5 * (1 + kappa (p - 1))
+  setup      s0 + s1 * N * E_v / p                    (block estimate, free terms)
+  rest       c_step * steps + c_main + c_plot [-ssi_plot]
+
+with N the nodes (3N DOFs) and E_v the elements with symmetry images. Times
+are the maximum over ranks; with more ranks per node than cores
+(oversubscribed) every compute term is multiplied by ranks / cores.
+
+Memory (peak of the processes, summed over ranks as -memory_view reports):
+  p * m0 + gamma * max(rho_trip * (T + c_cache * C + p * m_asm),
+                       max_k [Mats of lags <= k + T of lags > k] + G)
+with T = 84 B per block the triplets of the assembly, C the bytes of the
+element caches (pair_table: the distinct pair geometries each rank meets,
+capped as the assembly caps them) and m_asm a per-rank transient.
+
+It covers the BEM half-space (-ssi_problem bem; for ssi the BEM part only).
+"""
+import json
+import math
+import os
+import time
+
+import numpy as np
+
+from .options import register, SSIError
+
+G = "estimate"
+register("estimate_ranks", "str", "1,2,4", "", "estimate: rank counts to predict, e.g. '1,2,4,8,16'", G)
+register("estimate_ranks_per_node", "int", 0, "", "estimate: MPI ranks per node (0: the cores of this machine)", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_cores_per_node", "int", 0, "", "estimate: cores per node (0: this machine's); more ranks than "
+         "cores on a node are oversubscribed", G, validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_node_memory", "real", 0.0, "GB", "estimate: memory of one node (0: this machine's)", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_constants", "str", "", "", "estimate: JSON file of machine constants (default: "
+         "petsc_ssi/estimate_constants.json; jobscripts/calibrate.py writes one)", G)
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DEFAULT_CONSTANTS = os.path.join(HERE, "estimate_constants.json")
+
+# Starting values (this code's 2-core development machine) if no table is found.
+FALLBACK = {"a0": 0.5, "a_blk": 6e-7, "a_int": 0.0, "c_cache": 1.0, "rho_trip": 1.0, "a_dense": 1.0e-9, "a_sparse": 5e-7, "c_fac": 1e-6, "b_dense": 16e9,
+            "b_sparse": 9e9, "sigma": 0.4, "c_op": 2e-5, "c_sol": 2.5e-8, "kappa": 0.3, "s0": 0.2,
+            "s1": 3e-7, "c_step": 1e-3, "c_main": 0.7, "c_plot": 1.8, "m0": 0.15e9, "m_asm": 0.15e9,
+            "gamma": 1.0}
+
+
+def load_constants(path=""):
+    path = path or DEFAULT_CONSTANTS
+    if not os.path.exists(path):
+        if path != DEFAULT_CONSTANTS:
+            raise SSIError(f"-ssi_estimate_constants {path}: no such file")
+        return dict(FALLBACK), "built-in starting values (no calibration table)"
+    try:
+        with open(path) as fh:
+            d = json.load(fh)
+        c = dict(FALLBACK)
+        c.update({k: float(v) for k, v in d["constants"].items()})
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise SSIError(f"-ssi_estimate_constants {path}: not a constants table ({type(exc).__name__}: {exc})") from None
+    return c, f"{os.path.relpath(path)} ({d.get('machine', '?')}, {d.get('fitted_from', '?')})"
+
+
+def parse_ranks(text):
+    try:
+        r = sorted({int(s) for s in str(text).split(",") if s.strip()})
+    except ValueError:
+        raise SSIError(f"-ssi_estimate_ranks '{text}': expected rank counts 'p1,p2,...'") from None
+    if not r or r[0] < 1:
+        raise SSIError(f"-ssi_estimate_ranks '{text}': expected positive rank counts")
+    return r
+
+
+def pair_table(prob, ls, L, chunk=64):
+    """Every (collocation node, element) pair that the assembly integrates for
+    lags 1..L: (row, geometry key, first and last lag of its wave window). The
+    key is the element's node coordinates relative to the collocation point,
+    quantised as the assembly's element cache keys them, so equal keys are the
+    pairs the cache integrates once (translated copies on a structured mesh)."""
+    x = prob.mesh.nodes
+    VX, Vc, VR, Vh = ls.VX, ls.Vc, ls.VR, ls.Vh
+    cp, cs, dt = prob.mat.cp, prob.mat.cs, prob.dt
+    qinv = 1.0 / (1e-9 * float(Vh.min()))
+    mult = np.random.default_rng(12345).integers(1, 2 ** 62, size=27, dtype=np.int64) | 1
+    rows, keys, los, his = [], [], [], []
+    for s in range(0, len(x), chunk):
+        xc = x[s:s + chunk]
+        d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
+        dmin = np.maximum(d - VR, 0.0)
+        lo = np.maximum(1, np.floor(dmin / cp / dt).astype(np.int64) + 1)
+        hi = np.minimum(L, np.floor((d + VR) / cs / dt).astype(np.int64) + 2)
+        r, v = np.nonzero((dmin < cp * dt * L) & (hi >= lo))
+        rel = np.rint((VX[v] - xc[r][:, None, :]) * qinv).astype(np.int64).reshape(len(v), 27)
+        with np.errstate(over="ignore"):
+            keys.append((rel * mult).sum(axis=1))
+        rows.append((r + s).astype(np.int32))
+        los.append(lo[r, v].astype(np.int32))
+        his.append(hi[r, v].astype(np.int32))
+    return np.concatenate(rows), np.concatenate(keys), np.concatenate(los), np.concatenate(his)
+
+
+def cache_counts(table, a, b, cap_floats, Lx, interp_lags=()):
+    """Rows a..b-1 (one rank): the pair-lags it integrates (the element cache's
+    misses, and every pair met after the cache is full) for the exact lags
+    1..Lx and for each interpolating matrix (its own call, one lag), and the
+    floats of the element cache of the exact lags."""
+    rows, keys, lo, hi = table
+    m = (rows >= a) & (rows < b) & (lo <= Lx)
+    k, n = keys[m], (np.minimum(hi[m], Lx) - lo[m] + 1).astype(np.int64)
+    _, first = np.unique(k, return_index=True)
+    order = np.sort(first)                   # distinct geometries in the order met
+    need = np.cumsum(n[order] * 81)
+    stored = need <= cap_floats
+    pool = float(need[stored][-1]) if stored.any() else 0.0
+    integ = float(n[order].sum())
+    if not stored.all():                     # geometries met after the cache filled: every pair integrates
+        cached = np.isin(k, k[order[stored]])
+        integ = float(n[order[stored]].sum() + n[~cached].sum())
+    if len(interp_lags):
+        m = (rows >= a) & (rows < b)
+        _, first = np.unique(keys[m], return_index=True)
+        lo_u, hi_u = lo[m][first], hi[m][first]
+        for l in interp_lags:
+            integ += float(np.count_nonzero((lo_u <= l) & (hi_u >= l)))
+    return integ, pool
+
+
+def partition(N, p):
+    """Node ranges of PETSc's split of a block-3 Vec of 3N entries over p ranks."""
+    n = [N // p + (1 if r < N % p else 0) for r in range(p)]
+    s = np.r_[0, np.cumsum(n)]
+    return [(int(s[r]), int(s[r + 1])) for r in range(p)]
+
+
+class Counts:
+    """The work of one run, counted from the set-up (no assembly).
+
+    ``per_rank[p]``: a list over ranks of dicts of counts for p ranks."""
+
+    def __init__(self, prob, plan, ls, ranks, limit, comm):
+        from .bem.model import estimate_blocks
+        cfg = prob.cfg
+        self.N = N = prob.mesh.n_nodes
+        self.Ev = len(ls.Vc)
+        self.nt = prob.regions.n_t
+        self.steps = prob.n_steps
+        self.L = prob.L
+        self.active = bool(plan.active)
+        self.Lx = plan.Lx
+        self.k = plan.k if plan.active else 0
+        self.interp_lags = [plan.kernel_time(j)[0] for j in range(self.k)]
+        self.plot = bool(cfg.plot)
+        self.stabilized = cfg.scheme.startswith("stabili")
+        self.writes = (self.steps // cfg.output_stride) if cfg.output_stride else 0
+        nimg = len(ls.Vc) // prob.mesh.n_cells
+        Lmax = max([self.Lx] + self.interp_lags)
+        mpi = comm.tompi4py()
+        # blocks per lag of every rank of every rank count (spread over the ranks of this process)
+        jobs = [(p, r, a, b) for p in ranks for r, (a, b) in enumerate(partition(N, p))]
+        nb = {}
+        for i, (p, r, a, b) in enumerate(jobs):
+            if i % comm.getSize() == comm.getRank():
+                rows = np.arange(a, b, dtype=np.int64)
+                nb[(p, r)] = estimate_blocks(prob.mesh.nodes, rows, ls.Vc, ls.VR, Lmax, prob.mat, prob.dt, nimg)
+        for part in mpi.allgather(nb):
+            nb.update(part)
+        # element cache of the assembly of the exact lags (one cache per rank and call)
+        self.cache = {}
+        if cfg.cache:
+            from .bem.model import LagSet
+            table = pair_table(prob, ls, Lmax)
+            cc = {}
+            for i, (p, r, a, b) in enumerate(jobs):
+                if i % comm.getSize() == comm.getRank():
+                    cc[(p, r)] = cache_counts(table, a, b, LagSet.CACHE_MAX / 8, self.Lx, self.interp_lags)
+            for part in mpi.allgather(cc):
+                self.cache.update(part)
+            del table
+        total = nb[(ranks[0], 0)] * 0
+        for r in range(ranks[0]):
+            total = total + nb[(ranks[0], r)]
+        self.nb_total = total
+        # storage rule of lagmats (and the all-sparse fallback of check_memory)
+        self.limit = limit
+        used = np.r_[total[:self.Lx], [total[l - 1] for l in self.interp_lags]]
+        self.storage, self.fill = self._storage(cfg, used, limit)
+        self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
+                             in enumerate(partition(N, p))] for p in ranks}
+
+    def _storage(self, cfg, used, limit):
+        N = self.N
+        f = used / float(N * N)
+        fill = cfg.lag_fill
+        if cfg.lag_storage == "auto":
+            dense = f > fill
+            if self._peak_rule(used, dense) > limit:
+                dense_sp = np.zeros_like(dense)
+                if self._peak_rule(used, dense_sp) <= limit:
+                    return dense_sp, 1.01
+            return dense, fill
+        return np.full(len(used), cfg.lag_storage == "dense"), fill
+
+    def _peak_rule(self, used, dense, p=1):
+        """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
+        storage decision the run will take."""
+        from .bem.model import LagSet
+        N = self.N
+        mats = np.where(dense, 72.0 * N * N, 76.0 * used)
+        trip = 84.0 * used
+        g = 9.0 * N * max(self.nt, 1) * 8
+        build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
+        transient = 2 * LagSet.CACHE_MAX + 2 * 256e6 + 0.5e9
+        return 1.1 * max(trip.sum(), build.max()) + g * len(used) + transient * p
+
+    def _rank(self, nb, nrows, p, cache=None):
+        """Counts of one rank (``nb``: its blocks per lag, ``nrows``: its nodes,
+        ``cache``: its integrated pair-lags and cache floats, None: no cache)."""
+        N, Lx = self.N, self.Lx
+        used = np.r_[nb[:Lx], [nb[l - 1] for l in self.interp_lags]]
+        dense = self.storage
+        nonempty = self.nb_total_used() > 0
+        mat_bytes = np.where(dense, 72.0 * N * nrows, 76.0 * used) * nonempty
+        g_bytes = 72.0 * nrows * self.nt * nonempty if self.nt else np.zeros(len(used))
+        trip = 84.0 * used
+        build = np.cumsum(mat_bytes) + (trip.sum() - np.cumsum(trip))
+        # history: at step n the exact lags 2..min(Lx, n+1) (plain: n) and, once
+        # lags beyond Lx are reached, the k interpolating matrices
+        n = np.arange(1, self.steps + 1)
+        jmax = np.minimum(Lx, n + 1) if self.stabilized else np.minimum(Lx, n)
+        jmax = np.where(n >= 2, jmax, 1)
+        uses = np.zeros(len(used))                  # steps in which each stored matrix is used
+        for j in range(2, Lx + 1):
+            uses[j - 1] = np.count_nonzero(jmax >= j)
+        if self.k:
+            reach = n + 1 if self.stabilized else n
+            uses[Lx:] = np.count_nonzero((reach > Lx) & (n >= 2))
+        hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
+        hs = float(np.sum(uses * mat_bytes * ~dense) + np.sum(uses * g_bytes * ~dense))
+        prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
+        # integrated pair-lags: with the cache its misses; without, every pair (~ blocks / 4)
+        integ, pool = cache if cache is not None else (float(used.sum()) / 4.0, 0.0)
+        return {"B": float(used.sum()), "I": integ, "C": 16.0 * pool, "D": float(np.sum(mat_bytes * dense)),
+                "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods,
+                "mats": float(mat_bytes.sum() + g_bytes.sum()), "trip": float(trip.sum()),
+                "build": float(build.max() + g_bytes.sum()), "rows": nrows}
+
+    def nb_total_used(self):
+        t = self.nb_total
+        return np.r_[t[:self.Lx], [t[l - 1] for l in self.interp_lags]]
+
+    def lag_bytes(self):
+        return sum(r["mats"] for r in self.per_rank[min(self.per_rank)])
+
+
+def features(cnt, p, q, cores):
+    """Model terms for p ranks, q per node, ``cores`` per node: the maxima over
+    ranks of each count, the oversubscription factor and the concurrency m."""
+    rk = cnt.per_rank[p]
+    mx = {key: max(r[key] for r in rk) for key in ("B", "I", "D", "S", "HD", "HS", "P")}
+    qn = min(q, p)
+    over = max(1.0, qn / float(cores))
+    m = min(qn, cores)
+    return mx, over, m
+
+
+def predict(cnt, c, p, q, cores):
+    """Seconds per stage and bytes for p ranks (dict)."""
+    mx, over, m = features(cnt, p, q, cores)
+    N15 = cnt.N ** 1.5
+    t = {}
+    t["setup"] = c["s0"] + c["s1"] * cnt.N * cnt.Ev / p
+    t["assembly"] = c["a0"] + over * (c["a_blk"] * mx["B"] + c["a_int"] * mx["I"] + c["a_dense"] * mx["D"]
+                                      + c["a_sparse"] * mx["S"])
+    t["factor"] = c["c_fac"] * N15
+    t["history"] = over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
+                           + c["c_op"] * mx["P"])
+    t["solve"] = c["c_sol"] * cnt.steps * N15 * (1 + c["kappa"] * (p - 1))
+    t["loop"] = t["history"] + t["solve"] + c["c_step"] * cnt.steps
+    t["total"] = t["setup"] + t["assembly"] + t["factor"] + t["loop"] + c["c_main"] + (c["c_plot"] if cnt.plot else 0)
+    rk = cnt.per_rank[p]
+    asm = lambda r: c["rho_trip"] * (r["trip"] + c["c_cache"] * r["C"] + c["m_asm"])
+    t["peak_bytes"] = p * c["m0"] + c["gamma"] * max(sum(asm(r) for r in rk), sum(r["build"] for r in rk))
+    t["peak_rank_bytes"] = max(c["m0"] + c["gamma"] * max(asm(r), r["build"]) for r in rk)
+    t["lag_bytes"] = sum(r["mats"] for r in rk)
+    return t
+
+
+def setup(cfg, comm, ranks, node_mem):
+    """Collective: the BEM set-up of a run without assembly, and its counts."""
+    from .bem.run import BEMProblem
+    from .bem.model import machine_memory
+    quiet = lambda m: None
+    t0 = time.perf_counter()
+    prob = BEMProblem(cfg, comm, log=quiet)
+    plan = prob.interp_plan()
+    ls = prob.lagset()
+    limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
+    cnt = Counts(prob, plan, ls, ranks, limit, comm)
+    cnt.setup_s = time.perf_counter() - t0
+    return prob, plan, cnt
+
+
+def report(cfg, comm, out=None):
+    """Collective: print the estimate block (rank 0) and return its numbers."""
+    from .petsc import printf
+    from .bem.model import machine_memory
+    out = out or printf
+    ranks = parse_ranks(cfg.estimate_ranks)
+    cores = cfg.estimate_cores_per_node or (os.cpu_count() or 1)
+    q = cfg.estimate_ranks_per_node or cores
+    node_mem = cfg.estimate_node_memory * 1e9 if cfg.estimate_node_memory > 0 else machine_memory()
+    c, source = load_constants(cfg.estimate_constants)
+    prob, plan, cnt = setup(cfg, comm, ranks, node_mem)
+    nd = int(cnt.storage.sum())
+    ns = len(cnt.storage) - nd
+    lines = [f"[ssi] estimate of this BEM run (model petsc_ssi/estimate.py; constants {source})",
+             f"[ssi]   {3 * cnt.N} DOFs ({cnt.N} nodes), {cnt.Ev} elements with images, {cnt.steps} steps, "
+             f"{cnt.nt} traction nodes; lags stored {cnt.Lx + cnt.k} ({cnt.Lx} exact + {cnt.k} interpolating, "
+             f"of {cnt.L} the run reaches): {nd} dense, {ns} block-sparse"
+             + (" (all block-sparse: the dense choice would not fit the limit)" if cnt.fill > 1 else ""),
+             f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
+             f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",
+             "[ssi]   ranks nodes | setup_s assembly_s factor_s history_s solve_s time_loop_s | total | "
+             "peak_GB GB/rank_max GB/node | fits"]
+    rows = []
+    for p in ranks:
+        t = predict(cnt, c, p, q, cores)
+        nodes = int(math.ceil(p / float(q)))
+        per_node = t["peak_bytes"] / p * min(q, p)
+        per_node = max(per_node, t["peak_rank_bytes"] * min(q, p) if p == 1 else per_node)
+        fits = per_node <= 0.9 * node_mem
+        refuse = _refuses(cnt, p)
+        flag = "yes" if fits else "NO"
+        if refuse:
+            flag += "; the run's memory check would refuse it (-ssi_memory_limit)"
+        if min(q, p) > cores:
+            flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
+        t.update({"ranks": p, "nodes": nodes, "node_bytes": per_node, "fits": fits})
+        rows.append(t)
+        lines.append(f"[ssi]   {p:5d} {nodes:5d} | {t['setup']:7.3g} {t['assembly']:10.4g} {t['factor']:8.3g} "
+                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {_hms(t['total'])} | "
+                     f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
+    ok = [r for r in rows if r["fits"]]
+    if ok:
+        best = min(ok, key=lambda r: r["total"])
+        lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
+                     f"{_hms(best['total'])} on {best['ranks']} rank(s)")
+    else:
+        lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
+                     f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
+                 f"-log_view times; the model's measured error: jobscripts/README.md)")
+    out("\n".join(lines))
+    return {"counts": cnt, "rows": rows}
+
+
+def _refuses(cnt, p):
+    used = cnt.nb_total_used()
+    return cnt._peak_rule(used, cnt.storage, p) > cnt.limit
+
+
+def _hms(s):
+    if s < 60:
+        return f"{s:6.3g} s"
+    if s < 3600:
+        return f"{int(s // 60)}m{int(s % 60):02d}s"
+    return f"{int(s // 3600)}h{int(s % 3600 // 60):02d}m"

@@ -1,0 +1,140 @@
+"""The cost model (petsc_ssi/estimate.py, ``petsc-ssi estimate``; issue 6).
+
+What is checked without timing anything on a loaded machine:
+- the model counts the work a run does: the matrix-vector products of the
+  history sum equal the run's VecMAXPY count in -log_view (one per product),
+  the estimated blocks and lag memory match what the run assembled, and the
+  predicted peak memory is within 30% of -memory_view;
+- with the committed constants, predicted wall time and peak memory are
+  within 30% of the measured benchmark in runs/pekeris/bench.csv (small and
+  medium cases, 1 and 2 ranks: times measured once, under the CPU lock);
+- the command prints its table without assembling, and bad input ends in a
+  one-line error.
+"""
+import csv
+import os
+import re
+
+import pytest
+
+from helpers import ROOT, cli
+
+SMALL = os.path.join(ROOT, "runs", "pekeris", "small.opts")
+
+
+_MODEL = r"""
+import json, sys
+from petsc_ssi.petsc import init
+PETSc = init([sys.argv[0], "-options_file", sys.argv[1]] + sys.argv[4:])
+from petsc_ssi import options, estimate
+cfg = options.resolve(("common", "bem", "estimate"))
+ranks = [int(r) for r in sys.argv[2].split(",")]
+_, _, cnt = estimate.setup(cfg, PETSc.COMM_WORLD, ranks, 0.0)
+c, _ = estimate.load_constants()
+out = {"N": cnt.N, "Lx": cnt.Lx, "steps": cnt.steps, "blocks": float(cnt.nb_total_used().sum()),
+       "rank0": cnt.per_rank[ranks[0]][0], "pred": {}}
+for p in ranks:
+    cores = int(sys.argv[3])
+    out["pred"][p] = {k: v for k, v in estimate.predict(cnt, c, p, p, cores).items()}
+print("MODEL" + json.dumps(out))
+"""
+
+
+def _model(opts_file, ranks, extra=(), cores=2):
+    """The model's counts and predictions for an options file (in a subprocess:
+    the -ssi_estimate_ options stay out of this process's registry, whose
+    README table test_docs checks)."""
+    import json
+    import subprocess
+    from helpers import PY
+    p = subprocess.run([PY, "-c", _MODEL, opts_file, ",".join(map(str, ranks)), str(cores), *extra],
+                       cwd=ROOT, capture_output=True, text=True, timeout=300)
+    line = [x for x in p.stdout.splitlines() if x.startswith("MODEL")]
+    assert p.returncode == 0 and line, p.stdout[-2000:] + p.stderr[-2000:]
+    d = json.loads(line[0][len("MODEL"):])
+    d["pred"] = {int(k): v for k, v in d["pred"].items()}
+    return d
+
+
+def _stage_count(text, stage, name):
+    sec = text.split(f"--- Event Stage", )
+    for s in sec:
+        if s.strip().split(":", 1)[-1].strip().startswith(stage):
+            m = re.search(rf"^{name}\s+(\d+)", s, re.M)
+            return int(m.group(1)) if m else 0
+    raise AssertionError(f"stage {stage} not in the log")
+
+
+REDUCED = ["-ssi_t_end", "0.02", "-ssi_output_stride", "0"]
+
+
+def test_counts_match_a_run(tmp_path):
+    """Products, blocks, lag memory and peak memory of a reduced small case."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from logview import parse
+    out = str(tmp_path / "r.h5")
+    p = cli(["-options_file", SMALL, *REDUCED, "-ssi_output", out, "-log_view", "-memory_view"])
+    text = p.stdout
+    m = _model(SMALL, [1], REDUCED)
+    rk = m["rank0"]
+    # one VecMAXPY (weighted history) per matrix-vector product of the history sum
+    assert rk["P"] == _stage_count(text, "SSI BEM time loop", "VecMAXPY")
+    assert m["steps"] == _stage_count(text, "SSI BEM time loop", "SSI_BEM_Solve")
+    mm = re.search(r"(\d+) exact lags .*?mean block fill (\S+)%, stored (\S+) GB", text)
+    lags, fill, gb = int(mm.group(1)), float(mm.group(2)), float(mm.group(3))
+    assert lags == m["Lx"]
+    blocks = fill / 100 * lags * m["N"] ** 2
+    assert abs(m["blocks"] / blocks - 1) < 0.10
+    assert abs(rk["mats"] / 1e9 / gb - 1) < 0.05
+    # integrated pair-lags against the kernel evaluations (tens of quadrature points per pair-lag)
+    kev = float(re.search(r"(\S+) kernel evaluations", text).group(1))
+    assert 30 < kev / rk["I"] < 100
+    peak = parse(text)["peak_rss_bytes"]
+    pred = m["pred"][1]["peak_bytes"]
+    assert abs(pred / peak - 1) < 0.30, (pred, peak)
+
+
+def _bench():
+    with open(os.path.join(ROOT, "runs", "pekeris", "bench.csv")) as fh:
+        return {(r["case"], int(r["ranks"])): r for r in csv.DictReader(fh)}
+
+
+@pytest.mark.parametrize("case", ["small", "medium"])
+def test_model_within_30pct_of_the_benchmark(case):
+    """Committed constants against the measured benchmark (no timing here)."""
+    bench = _bench()
+    m = _model(os.path.join(ROOT, "runs", "pekeris", f"{case}.opts"), [1, 2], ["-ssi_plot"])
+    for p in (1, 2):
+        meas = bench[(case, p)]
+        t = m["pred"][p]                    # measured on a 2-core machine, one node
+        for key, col in (("total", "total_s"), ("assembly", "assembly_s"), ("loop", "time_loop_s")):
+            assert abs(t[key] / float(meas[col]) - 1) < 0.30, (case, p, key, t[key], meas[col])
+        assert abs(t["peak_bytes"] / 1e9 / float(meas["peak_mem_GB"]) - 1) < 0.30, (case, p, t["peak_bytes"])
+
+
+def test_estimate_command_does_not_assemble():
+    p = cli(["estimate", "-options_file", SMALL, "-ssi_estimate_ranks", "1,2,4",
+             "-ssi_estimate_node_memory", "0.5", "-ssi_estimate_ranks_per_node", "2", "-log_view"])
+    out = p.stdout
+    assert "[ssi] estimate of this BEM run" in out
+    assert "867 DOFs" in out and "lags stored 55 (55 exact + 0 interpolating" in out
+    rows = re.findall(r"^\[ssi\]\s+(\d+)\s+(\d+) \|.*\| (yes|NO)", out, re.M)
+    assert [(int(a), int(b)) for a, b, _ in rows] == [(1, 1), (2, 1), (4, 2)]
+    assert rows[0][2] == "NO"          # 0.56 GB predicted on 1 rank: does not fit a 0.5 GB node
+    assert "verdict" in out
+    assert "SSI_BEM_Assembly" not in out and "SSI BEM assembly" not in out
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["-ssi_estimate_ranks", "0"], "-ssi_estimate_ranks '0': expected positive rank counts"),
+    (["-ssi_estimate_ranks", "two"], "expected rank counts"),
+    (["-ssi_estimate_constants", "/nonexistent.json"], "no such file"),
+    (["-ssi_estimate_node_memory", "-1"], "-ssi_estimate_node_memory -1.0: must be >= 0"),
+    (["-ssi_problem", "fem"], "estimate models the BEM half-space"),
+])
+def test_estimate_bad_input(args, msg):
+    p = cli(["estimate", "-options_file", SMALL] + args, check=False)
+    assert p.returncode == 2
+    err = [line for line in p.stdout.splitlines() if line.startswith("petsc-ssi: error:")]
+    assert len(err) == 1 and msg in err[0], p.stdout
