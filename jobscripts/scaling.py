@@ -118,17 +118,19 @@ def plot(groups, results):
         P = [r["ranks"] for r in rs]
         over = [r["oversubscribed"] for r in rs]
         fig, ax = plt.subplots(1, 3, figsize=(15, 4.3))
-        for key, label in STAGES + [("total_s", "total")]:
+        colors = plt.get_cmap("tab10").colors
+        for i, (key, label) in enumerate(STAGES + [("total_s", "total")]):
             y = [r[key] for r in rs]
             if max(y) < 1e-3:
                 continue
-            ln, = ax[0].plot(P, y, "-", marker="o", lw=2 if key == "total_s" else 1, label=label)
+            ln, = ax[0].plot(P, y, "-", marker="o", lw=2 if key == "total_s" else 1, label=label,
+                             color="k" if key == "total_s" else colors[i])
             for x, yy, o in zip(P, y, over):
                 if o:
                     ax[0].plot([x], [yy], "o", mfc="white", mec=ln.get_color())
         if study == "strong":
             t1 = rs[0]["total_s"]
-            ax[0].plot(P, [t1 * P[0] / p for p in P], "k:", label="ideal (total)")
+            ax[0].plot(P, [t1 * P[0] / p for p in P], color="0.5", ls=":", label="ideal (total)")
         ax[0].set(xscale="log", yscale="log", xlabel="ranks", ylabel="time (s, -log_view)",
                   title=f"{study} scaling, {case}: time per stage")
         ax[0].set_xticks(P)
@@ -151,6 +153,8 @@ def plot(groups, results):
         ax[2].set_xticks(P)
         ax[2].set_xticklabels([f"{p}*" if o else str(p) for p, o in zip(P, over)])
         ax[2].legend(fontsize=8)
+        for a in ax:
+            a.minorticks_off()
         cores = rs[0].get("cores_per_node", "")
         fig.suptitle(f"{study} scaling of {case} on a {cores}-core machine (* = oversubscribed, open markers)",
                      fontsize=10)
