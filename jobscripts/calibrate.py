@@ -150,8 +150,9 @@ def fit(runs):
                   arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["I"])], 1)
     c["a0"], c["a_blk"], c["a_int"] = _nnls(A, arr(lambda me, ms, *r: ms["kernels"]))
     A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["D"]),
-                  arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["S"])], 1)
-    c["a_dense"], c["a_sparse"] = _nnls(A, arr(lambda me, ms, *r: ms["assembly"] - ms["kernels"]))
+                  arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["S"]),
+                  arr(lambda me, ms, cn, p, q, mx, o, m: o * (cn.Lx + cn.k))], 1)
+    c["a_dense"], c["a_sparse"], c["a_lag"] = _nnls(A, arr(lambda me, ms, *r: ms["assembly"] - ms["kernels"]))
     # factorisation, solve
     N15 = arr(lambda me, ms, cn, *r: cn.N ** 1.5)
     c["c_fac"] = float(_nnls(N15[:, None], arr(lambda me, ms, *r: ms["factor"]))[0])
@@ -165,12 +166,13 @@ def fit(runs):
     for sigma in np.linspace(0.0, 1.5, 61):
         A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["HD"] * (1 + sigma * (m - 1))),
                       arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["HS"] * (1 + sigma * (m - 1))),
-                      arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["P"])], 1)
+                      arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["P"]),
+                      arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["P"] * (p > 1))], 1)
         x = _nnls(A, hist)
         err = np.sum(((A @ x - hist) / hist) ** 2)
         if best is None or err < best[0]:
             best = (err, sigma, x)
-    _, c["sigma"], (ibd, ibs, c["c_op"]) = best
+    _, c["sigma"], (ibd, ibs, c["c_op"], c["c_op_mpi"]) = best
     c["b_dense"] = 1.0 / ibd if ibd > 0 else 1e12
     c["b_sparse"] = 1.0 / ibs if ibs > 0 else 1e12
     # set-up, the rest of the time loop, the rest of the run

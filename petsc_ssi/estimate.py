@@ -8,12 +8,15 @@ into seconds and bytes with a few machine constants fitted to ``-log_view``
 logs (``jobscripts/calibrate.py``). Per rank r of p (rows split as PETSc
 splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
 
-  assembly   a0 + a_blk * B_r                         B_r = sum of nb over assembled lags
-             + a_dense * D_r + a_sparse * S_r          (exact + interpolating); Mats: dense
-                                                       bytes D_r, block-sparse blocks S_r
+  assembly   a0 + a_blk * B_r + a_int * I_r           B_r = sum of nb over assembled lags
+             + a_dense * D_r + a_sparse * S_r          (exact + interpolating); I_r pair-lags
+             + a_lag * (L_x + k)                       integrated (pair_table); Mats: dense
+                                                       bytes D_r, block-sparse blocks S_r, and
+                                                       a cost per Mat (creation, collectives)
   factor     c_fac * N^1.5                              (sparse LU of the local step matrix)
   history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
-             * (1 + sigma (m - 1)) + c_op * P_r        the run (a dense lag: 72 N n_r B,
+             * (1 + sigma (m - 1))                     the run (a dense lag: 72 N n_r B,
+             + (c_op + c_op_mpi [p > 1]) * P_r
                                                        sparse: 76 B per block), m ranks per
                                                        node sharing the memory bus; P_r
                                                        matrix-vector products
@@ -58,8 +61,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_CONSTANTS = os.path.join(HERE, "estimate_constants.json")
 
 # Starting values (this code's 2-core development machine) if no table is found.
-FALLBACK = {"a0": 0.5, "a_blk": 6e-7, "a_int": 0.0, "c_cache": 1.0, "rho_trip": 1.0, "a_dense": 1.0e-9, "a_sparse": 5e-7, "c_fac": 1e-6, "b_dense": 16e9,
-            "b_sparse": 9e9, "sigma": 0.4, "c_op": 2e-5, "c_sol": 2.5e-8, "kappa": 0.3, "s0": 0.2,
+FALLBACK = {"a0": 0.5, "a_blk": 6e-7, "a_int": 0.0, "a_lag": 0.0, "c_cache": 1.0, "rho_trip": 1.0, "a_dense": 1.0e-9, "a_sparse": 5e-7, "c_fac": 1e-6, "b_dense": 16e9,
+            "b_sparse": 9e9, "sigma": 0.4, "c_op": 2e-5, "c_op_mpi": 0.0, "c_sol": 2.5e-8, "kappa": 0.3, "s0": 0.2,
             "s1": 3e-7, "c_step": 1e-3, "c_main": 0.7, "c_plot": 1.8, "m0": 0.15e9, "m_asm": 0.15e9,
             "gamma": 1.0}
 
@@ -289,10 +292,10 @@ def predict(cnt, c, p, q, cores):
     t = {}
     t["setup"] = c["s0"] + c["s1"] * cnt.N * cnt.Ev / p
     t["assembly"] = c["a0"] + over * (c["a_blk"] * mx["B"] + c["a_int"] * mx["I"] + c["a_dense"] * mx["D"]
-                                      + c["a_sparse"] * mx["S"])
+                                      + c["a_sparse"] * mx["S"] + c["a_lag"] * (cnt.Lx + cnt.k))
     t["factor"] = c["c_fac"] * N15
     t["history"] = over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
-                           + c["c_op"] * mx["P"])
+                           + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"])
     t["solve"] = c["c_sol"] * cnt.steps * N15 * (1 + c["kappa"] * (p - 1))
     t["loop"] = t["history"] + t["solve"] + c["c_step"] * cnt.steps
     t["total"] = t["setup"] + t["assembly"] + t["factor"] + t["loop"] + c["c_main"] + (c["c_plot"] if cnt.plot else 0)

