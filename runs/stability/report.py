@@ -197,6 +197,7 @@ def history_plot(rows, outdir, png):
         ax.legend(fontsize=6, ncol=2)
     axs[0].set_ylabel("|u^n| (m)")
     axs[0].set_ylim(1e-7, 1e2)
+    axs[0].set_xlim(0, 4)
     fig.tight_layout()
     if found:
         fig.savefig(png, dpi=120)

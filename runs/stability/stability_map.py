@@ -60,8 +60,8 @@ CUT_FACTOR = 1e6                 # runs are cut at this guard factor (blow-up)
 GUARD_DEFAULT = 100.0
 # interpolation part
 I_SIZE, I_H, I_DT, I_R = 12.0, 1.0, 7.5e-4, 3.0
-TAUS = (0.6, 0.9, 1.2, 1.5, 2.0)
-KS = (2, 4, 8, 12, 16)
+TAUS = (0.6, 0.9, 1.2, 1.5)
+KS = (2, 4, 8, 16)
 TAU_R = 1.0877
 MAP_CSV = os.path.join(HERE, "stability_map.csv")
 INTERP_CSV = os.path.join(HERE, "stability_interp.csv")
