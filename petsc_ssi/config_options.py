@@ -97,7 +97,7 @@ def _bem_checks(cfg):
 register_check(("bem",), _bem_checks)
 
 # Modules that own further options declare them when imported.
-for _mod in ("petsc_ssi.fem.options", "petsc_ssi.coupling.options"):
+for _mod in ("petsc_ssi.fem.options", "petsc_ssi.coupling.options", "petsc_ssi.estimate"):
     try:
         importlib.import_module(_mod)
     except ModuleNotFoundError as _exc:
