@@ -45,7 +45,7 @@ register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), spa
          choices=("auto", "dense", "sparse"))
 register("lag_fill", "real", 0.35, "", "auto storage: lags with block fill above this are dense", "bem",
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
-register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this (0: 80% of this machine's memory)", "bem",
+register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this per node (0: 80% of this machine's memory); the run's estimated peak is shared by its ranks", "bem",
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("load_group", "str", "", "", "loaded elements: a physical group name, or 'box:x0,x1,y0,y1' (element centres inside)", "bem")
 register("load_p0", "real", 0.0, "N/m^2", "uniform pressure on the loaded elements (p0 > 0 pushes the surface down)", "bem")

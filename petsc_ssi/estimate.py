@@ -351,7 +351,7 @@ def report(cfg, comm, out=None):
         per_node = t["peak_bytes"] / p * min(q, p)
         per_node = max(per_node, t["peak_rank_bytes"] * min(q, p) if p == 1 else per_node)
         fits = per_node <= 0.9 * node_mem
-        refuse = _refuses(cnt, p)
+        refuse = _refuses(cnt, p, q)
         flag = "yes" if fits else "NO"
         if refuse:
             flag += "; the run's memory check would refuse it (-ssi_memory_limit)"
@@ -376,9 +376,11 @@ def report(cfg, comm, out=None):
     return {"counts": cnt, "rows": rows}
 
 
-def _refuses(cnt, p):
+def _refuses(cnt, p, q):
+    """Whether the run's own check (BEMProblem.check_memory: the estimated peak shared
+    by the ranks, the most loaded node's part against the per-node limit) refuses it."""
     used = cnt.nb_total_used()
-    return cnt._peak_rule(used, cnt.storage, p) > cnt.limit
+    return cnt._peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
 
 
 def _hms(s):

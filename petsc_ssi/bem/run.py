@@ -197,23 +197,33 @@ class BEMProblem:
         sparse storage would, store every lag block-sparse (and say so)."""
         c = self.cfg
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
+        # the limit holds per node: the run's peak is shared by its ranks, of which
+        # ``share`` run on the most loaded node (all of them on one machine)
+        mpi = self.comm.tompi4py()
+        from mpi4py import MPI
+        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
+        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
+        n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
+        node.Free()
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
         est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra)
-        if peak > limit and c.lag_storage == "auto":
+        if share * peak > limit and c.lag_storage == "auto":
             est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra)
-            if peak2 <= limit:
+            if share * peak2 <= limit:
                 self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
                          f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
                 self.lag_fill = 1.01
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
+        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags), assembly "
-                 f"peak {peak / 1e9:.3g} GB (limit {limit / 1e9:.3g} GB)")
-        if peak > limit:
-            raise SSIError(f"the lag matrices need about {peak / 1e9:.3g} GB at assembly, more than the "
-                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit); use symmetry planes, "
+                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
+        if share * peak > limit:
+            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
+                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
                            f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
 
     def known_p(self):
