@@ -29,8 +29,9 @@ open_traction 'cohesion', the normal tension p_C (eq. 25 read literally: the
 complementarity (p_C - p_N) g = 0 makes p_N = p_C wherever g > 0). Step n starts from the status of step n-1;
 B.2 closes open nodes whose predicted gap (u_b^{n-1} - u_f^n) . n_f is
 negative; then solve / check / update until nothing changes. If a status set
-repeats (cycling) only the worst violation is changed per iteration; after
-``max_iter`` iterations the step is accepted with a warning.
+repeats only the worst violation (relative to the traction and displacement
+scales) is changed per iteration; if violations remain after ``max_iter``
+iterations the step is accepted with a warning (cycling).
 """
 import time
 
@@ -41,8 +42,9 @@ import scipy.linalg as sla
 class Capacitance:
     """Z_II (replicated, 3n_I x 3n_I) and LU factors of Z_OO cached per open set."""
 
-    def __init__(self, Z_II, max_cache=256):
+    def __init__(self, Z_II, cache_bytes=512e6):
         self.Z = np.asarray(Z_II)
+        max_cache = max(1, int(cache_bytes // (8.0 * len(self.Z) ** 2)))
         self.cache = {}
         self.max_cache = max_cache
         self.n_factor = 0
@@ -67,7 +69,9 @@ class ContactLaw:
 
     ``step(solve, uf_pred)``: ``solve(closed)`` returns (O, ub, uf, p) for a
     status (replicated interface arrays, 3 n_I); uf_pred is the structure's
-    interface displacement used by the B.2 gap prediction."""
+    interface displacement used by the B.2 gap prediction (staggered step: the
+    FEM predictor u_f^n), None to start from the previous status (implicit step:
+    u_f^n depends on the interface force, there is no prediction)."""
 
     def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero"):
         self.n_b = np.asarray(n_b, float)            # (n_I, 3)
@@ -110,11 +114,12 @@ class ContactLaw:
             its, changes, cycled = 1, 0, False
         else:
             closed = self.closed.copy()
-            tol_g = self.tol * max(np.abs(uf_pred).max(), np.abs(self.ub_prev).max(), 1e-300)
-            # B.2: predicted gap (u_b^{n-1} - u_f^n) . n_f of open nodes (n_f = -n_b)
-            g_pred = -self._normal(self.ub_prev - uf_pred)
             start = closed.copy()
-            closed |= (~closed) & (g_pred < -tol_g)
+            scale_u = max(np.abs(self.ub_prev).max(), 1e-300 if uf_pred is None else np.abs(uf_pred).max(), 1e-300)
+            if uf_pred is not None:
+                # B.2: predicted gap (u_b^{n-1} - u_f^n) . n_f of open nodes (n_f = -n_b)
+                g_pred = -self._normal(self.ub_prev - uf_pred)
+                closed |= (~closed) & (g_pred < -self.tol * scale_u)
             seen = {closed.tobytes()}
             changes = int((closed != start).sum())
             cycled = False
@@ -124,18 +129,19 @@ class ContactLaw:
                 O, ub, uf, p = solve(closed)
                 pN = self._normal(p)
                 gap = -self._normal(ub - uf)
-                tol_p = self.tol * max(np.abs(p).max(), self.p_C, 1e-300)
-                v_open = np.where(closed, pN - (self.p_C + tol_p), -np.inf)      # > 0: must open
-                v_close = np.where(~closed, -gap - tol_g, -np.inf)              # > 0: must close
+                # violations relative to their own scales (tractions and displacements)
+                sp = max(np.abs(p).max(), self.p_C, 1e-300)
+                su = max(scale_u, np.abs(uf).max(), np.abs(ub).max(), 1e-300)
+                v_open = np.where(closed, (pN - self.p_C) / sp - self.tol, -np.inf)     # > 0: must open
+                v_close = np.where(~closed, -gap / su - self.tol, -np.inf)              # > 0: must close
                 viol = np.maximum(v_open, v_close)
                 if not np.any(viol > 0) or its >= self.max_iter:
-                    cycled = bool(np.any(viol > 0))
+                    cycled = bool(np.any(viol > 0))      # accepted with violations left
                     break
                 new = closed.copy()
                 new[v_open > 0] = False
                 new[v_close > 0] = True
-                if new.tobytes() in seen:              # cycling: change the worst node only
-                    cycled = True
+                if new.tobytes() in seen:              # a repeated set: change the worst node only
                     new = closed.copy()
                     k = int(np.argmax(viol))
                     new[k] = not closed[k]
@@ -186,8 +192,9 @@ class ImplicitSolve:
     r = -0.5 p^{n-1} extrapolated), C = [D^{-1}]_II, M3 = M (x) I_3. One dense
     LU per active set (cached), 3 n_I unknowns."""
 
-    def __init__(self, law, Z, C, M3, a, max_cache=256):
+    def __init__(self, law, Z, C, M3, a, cache_bytes=512e6):
         self.law, self.Z, self.C, self.M3, self.a = law, Z, C, M3, float(a)
+        max_cache = max(1, int(cache_bytes // (8.0 * len(Z) ** 2)))
         self.CM = C @ M3
         self.B = np.eye(len(Z)) - self.a * self.CM @ Z
         self.cache = {}

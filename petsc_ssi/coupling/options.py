@@ -27,12 +27,14 @@ register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact che
 register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "
          "a warning (cycling)", G, validator=lambda v: None if v >= 1 else "must be >= 1")
 register("coupling", "enum", "implicit", "", "time coupling: implicit (the structure's interface "
-         "displacement and the soil traction of a step solved together on the interface: unconditionally "
-         "stable; structure by trapezoidal Newmark) or staggered (the paper's Table 2: FEM predictor, BEM, "
-         "force as an impulse; Green's-function integrator; stable only while the soil's impedance times dt "
-         "stays below about twice the structure's interface nodal masses)", G, choices=("implicit", "staggered"))
+         "displacement and the soil traction of a step solved together on the interface; structure by the "
+         "trapezoidal rule in midpoint form with the traction as the interval-mean force) or staggered (the "
+         "paper's Table 2: FEM predictor, BEM, force as an impulse; Green's-function integrator; stable only "
+         "while the soil's impedance times dt stays below about twice the interface nodal masses)", G,
+         choices=("implicit", "staggered"))
 register("coupling_traction", "enum", "direct", "", "interface force handed to the structure: "
-         "direct (p^n, as printed in Table 2) or extrapolated (1.5 p^n - 0.5 p^{n-1}: the load at t_n)", G,
+         "direct (p^n, as printed in Table 2) or extrapolated (1.5 p^n - 0.5 p^{n-1}: the load at t_n; "
+         "staggered coupling only)", G,
          choices=("direct", "extrapolated"))
 register("structure_receivers", "str", "", "m", "structure receivers 'x,y,z;...' (nearest FE node); "
          "-ssi_receivers are soil surface points", G)
@@ -53,11 +55,15 @@ def _ssi_checks(cfg):
                 f"{cfg.symmetry}): contact destroys the antisymmetry of the response (the side in "
                 "compression stays closed, the other may open), so an antisymmetric half model is "
                 "wrong; mesh the whole interface")
-    want = "green" if cfg.coupling == "staggered" else "newmark"
-    if cfg.user_set("fem_integrator") and cfg.fem_integrator != want:
-        return (f"-ssi_coupling {cfg.coupling} integrates the structure with {want} (the "
-                f"{'staggered step needs u^n independent of the force of step n' if want == 'green' else 'implicit step needs u^n to respond to the force of step n'}); "
-                f"drop -ssi_fem_integrator {cfg.fem_integrator}")
+    if cfg.user_set("fem_integrator") and cfg.coupling == "staggered" and cfg.fem_integrator != "green":
+        return ("-ssi_coupling staggered integrates the structure with green (u^n independent of the force "
+                f"of step n); drop -ssi_fem_integrator {cfg.fem_integrator}")
+    if cfg.user_set("fem_integrator") and cfg.coupling == "implicit":
+        return ("-ssi_coupling implicit integrates the structure with the trapezoidal rule in midpoint form "
+                f"(the interface force as an interval mean); drop -ssi_fem_integrator {cfg.fem_integrator}")
+    if cfg.coupling == "implicit" and cfg.coupling_traction == "extrapolated":
+        return ("-ssi_coupling_traction extrapolated is for -ssi_coupling staggered; the implicit step takes "
+                "the traction as the mean force over the step, which it is")
     if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
         return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
     return None

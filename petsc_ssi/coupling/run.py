@@ -7,19 +7,29 @@ matrices with D factorised once, the BEM lag matrices with the step matrix
 factorised once (every interface node closed), and the interface
 capacitance Z = A^{-1} H_s E_I (``contact.py``).
 
-Per step n (B):
+Per step n (B), two time couplings (-ssi_coupling):
+staggered (the paper's Table 2; structure by the Green's-function integrator)
   B.1 u_f^n = FEM predictor (eq. 13; independent of the forces of step n);
-  B.2 gap check with u_b^{n-1} (unilateral), compatibility u_b = u_f^n at
-      closed nodes;
+  B.2 gap check with u_b^{n-1}, compatibility u_b = u_f^n at closed nodes;
   B.3 BEM step: history sum, one solve with the factorised matrix -> bonded
-      solution y; the open nodes' correction through the capacitance system;
+      solution y; the open nodes' correction through the capacitance Z_OO;
   B.4 traction check (p_N <= p_C at closed nodes, no penetration at open
       ones); B.3-B.4 repeat until the status is stable (only the small
-      capacitance algebra is repeated: y does not depend on the status);
-  B.5 interface forces f_f = -M p_b (consistent, ``interface.py``), handed
-      to the structure as the load at t_n (1.5 p^n - 0.5 p^{n-1} by default:
-      a BE traction is the mean over (t_{n-1}, t_n]; see fem/integrators.py);
+      interface algebra is repeated: y does not depend on the status);
+  B.5 interface forces f_f = -M p_b (consistent, ``interface.py``) as the
+      load at t_n: p^n (direct, the paper) or 1.5 p^n - 0.5 p^{n-1}
+      (extrapolated; not across a status change);
   B.6 FE velocity (eq. 14).
+  Conditionally stable: the soil's impedance acts explicitly on the
+  interface nodes (diverges when rho c_p A dt / m exceeds about 2).
+implicit (default; structure by the trapezoidal rule in midpoint form,
+  fem/integrators.py MidpointIntegrator): the structure's predictor w (no
+  interface force), the BEM solution q with zero interface displacement, then
+  the interface system of contact.ImplicitSolve couples u_f = w + 2 C f,
+  f = -M p, p = q - Z u_b on the interface (C = [D^{-1}]_II), with the same
+  active-set loop. The BE traction (the mean over (t_{n-1}, t_n]) enters the
+  structure as the mean force of that interval, so both sides exchange the same
+  discrete work per step.
 
 Outputs: the soil fields in -ssi_output (quad9), the structure's in
 <stem>_structure.h5 (hex8), both with XDMF; the interface series (u_f, u_b,
@@ -58,7 +68,7 @@ def setup(cfg, comm):
     interface, all checked. Returns (prob, model, iface, fe_cfg)."""
     prob = BEMProblem(cfg, comm, log=printf)
     fe_cfg = _view(cfg, receivers=cfg.structure_receivers,
-                   fem_integrator="green" if cfg.coupling == "staggered" else "newmark")
+                   fem_integrator="green" if cfg.coupling == "staggered" else "midpoint")
     model = build_model(fe_cfg, comm, assemble_matrices=False)
     err, iface, sym = None, None, None
     try:
@@ -121,7 +131,7 @@ class Coupler:
         else:
             self.DEloc = self._fem_columns()
             C = self._gather_rows(self.DEloc, self.fown_k, self.fown_loc)
-            self.solver = ImplicitSolve(self.law, Z_II, C, M3, self.c_new)
+            self.solver = ImplicitSolve(self.law, Z_II, 2.0 * C, M3, 1.0)     # midpoint: u = w + D^-1 (2 f)
             self.solver._lu(self.law.closed, self.law.open_dofs(self.law.closed))   # the bonded LU, now
         self.t_capacitance = time.perf_counter() - t0
         ev.end()
@@ -134,6 +144,8 @@ class Coupler:
         self.p_prev = march.p_tmpl.duplicate()
         self.p_prev.set(0.0)
         self.pI_prev = np.zeros(3 * nI)
+        self.closed_prev = self.law.closed.copy()
+        self.fixed_I = np.isin(self.dofs_fe, np.asarray(model.fixed, np.int64))
         self.weights = _area_weights(prob.mesh, iface)
 
     def solver_cap(self):
@@ -211,18 +223,19 @@ class Coupler:
         if self.mode == "staggered":
             kv[self.own_loc] = wI[self.own_k]                      # B.2: u_b = u_f (all closed)
         self._set_known_p(n)
+        if not hasattr(self, "_kv_initial"):
+            self._kv_initial = m.kv_u.duplicate()
+        m.kv_u.copy(self._kv_initial)
         b = m.add_known(m._b)
         m.solve(b, m.x)                                            # B.3: y (staggered) or q (u_I = 0)
         self.sc_be.scatter(m.x, self.seq_y)
         yI = self.seq_y.getArray(readonly=True).copy()
         ev = event("SSI_Contact")
         ev.begin()
-        r = -self.c_old * self.pI_prev
         if self.mode == "staggered":
-            solve = self.solver(yI, wI)
+            res = self.law.step(self.solver(yI, wI), wI)           # B.2-B.4 (active set)
         else:
-            solve = self.solver(yI, wI, r)
-        res = self.law.step(solve, wI)                             # B.2-B.4 (active set)
+            res = self.law.step(self.solver(yI, wI, np.zeros_like(yI)), None)
         x = m.x.getArray()
         if self.mode == "staggered":
             O = res["O"]
@@ -235,27 +248,63 @@ class Coupler:
         kv[self.own_loc] = res["ub"][self.own_k]
         ev.end()
         u, p = m.store(n, m.x)
-        # B.5: interface force at t_n, f_f = -M (c_new p^n - c_old p^{n-1})
-        fI = -self.M3 @ (self.c_new * res["p"] + r)
+        # the BEM equations of the step with the final interface values: A x - b = 0
+        res["bem_residual"] = self._bem_residual(b, kv)
+        # B.5: the traction handed over (interface order) and the force on the structure
+        tr = res["p"].copy()
+        if self.c_old:                          # extrapolated, except at DOFs whose status changed
+            same = np.repeat(res["closed"] == self.closed_prev, 3)
+            tr = np.where(same, self.c_new * res["p"] - self.c_old * self.pI_prev, res["p"])
+        self.closed_prev = res["closed"].copy()
         self.pI_prev = res["p"].copy()
-        p.copy(self.w)
-        self.w.scale(self.c_new)
-        self.w.axpy(-self.c_old, self.p_prev)
-        self.F.mult(self.w, self.ff)
-        p.copy(self.p_prev)
-        loc = self.ff.getArray(readonly=True).reshape(-1, 3).sum(axis=0)
-        res["force_fe"] = self.comm.tompi4py().allreduce(loc)
-        res["force_be"] = (self.weights[:, None] * (self.c_new * res["p"] + r).reshape(-1, 3)).sum(axis=0)
+        fI = -self.M3 @ tr
+        fI[self.fixed_I] = 0.0                  # supports (symmetry planes) take these
+        res["force_fe"] = fI.reshape(-1, 3).sum(axis=0)
+        res["force_be"] = (self.weights[:, None] * tr.reshape(-1, 3)).sum(axis=0)
+        res["force_map_error"] = self._force_map_error(p, res["p"])
         with event("SSI_FEM_Step"):
             if self.mode == "staggered":
+                ff = self.ff.getArray()
+                ff[:] = 0.0
+                ff[self.fown_loc] = fI[self.fown_k]
                 integ.correct(f_ext, self.ff)                      # B.5-B.6
             else:
                 da = self.du.getArray()
-                da[:] = self.DEloc @ fI                            # D^{-1} E f_I
+                da[:] = self.DEloc @ (2.0 * fI)                    # D^{-1} (2 f_I), midpoint form
                 integ.complete(self.du)
                 self.sc_fe.scatter(integ.u, self.seq_uf)
                 res["uf_check"] = self.seq_uf.getArray(readonly=True).copy()
         return u, p, res
+
+    def _bem_residual(self, b, kv):
+        """Collective: ||A x - b_final|| / ||b_final||, b_final = b - H_s (kv_final - kv_initial)
+        (the known interface displacements changed at open nodes)."""
+        m = self.march
+        if not hasattr(self, "_r"):
+            self._r, self._t, self._kv0 = (m.u_tmpl.duplicate() for _ in range(3))
+        m.A.mult(m.x, self._r)
+        self._r.axpy(-1.0, b)
+        self._kv0.getArray()[:] = kv
+        self._kv0.axpy(-1.0, self._kv_initial)
+        coef = ((1, 4.0), (2, 1.0)) if m.scheme == "stabilized" else ((1, 1.0),)
+        for lag, c in coef:
+            m.H[lag - 1].mult(self._kv0, self._t)
+            self._r.axpy(c, self._t)
+        if m.zero_local.size:
+            self._r.getArray()[m.zero_local] = 0.0
+        nb = b.norm()
+        return self._r.norm() / nb if nb > 0 else self._r.norm()
+
+    def _force_map_error(self, p, pI):
+        """Collective: max |F p + M p_I| over the structure's interface DOFs (the force
+        matrix against the interface-order computation, node by node) [N]."""
+        self.F.mult(p, self.ff)
+        ref = -self.M3 @ pI
+        ref[self.fixed_I] = 0.0
+        a = self.ff.getArray(readonly=True)[self.fown_loc]
+        err = np.abs(a - ref[self.fown_k]).max() if a.size else 0.0
+        mpi = self.comm.tompi4py()
+        return mpi.allreduce(float(err), op=__import__("mpi4py").MPI.MAX)
 
 
 def _owned(dofs, vec):
@@ -372,13 +421,19 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
     F, fn = model.load_vec(), model.load_vec()
 
     def sample(k):
+        """The structure's load of step k: at t_k as the cell mean (Green, staggered), or
+        the mean over (t_{k-1}, t_k] (midpoint form, implicit)."""
         F.copy(fn)
-        fn.scale(hist.cell_mean(k, cfg.dt))
+        if cfg.coupling == "staggered" or k == 0:
+            fn.scale(hist.cell_mean(k, cfg.dt))
+        else:
+            fn.scale(hist.step_mean(k, cfg.dt))
         return fn
 
     integ.start(f0=sample(0))
     srec.record(0.0, integ.u)
-    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be")
+    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
+            "bem_residual", "force_map_error")
     if cfg.coupling == "implicit":
         keys += ("uf_check",)
     series = {k: [] for k in keys}

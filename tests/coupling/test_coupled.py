@@ -88,24 +88,46 @@ def test_liftoff_onset(tmp_path, ramp):
             assert np.all(r["x"][~r["closed"][-1], 0] < 0)
 
 
-def test_equilibrium_compatibility_every_step(tmp_path):
-    """Box pulse with lift-off (p_C = 100 N/m^2): the force resultant on the structure is equal and
-    opposite to the integral of the handed-over soil traction (independent
-    quadrature), closed nodes share u_b = u_f after the step, open nodes carry
-    no traction and no penetration."""
-    r = rigid(tmp_path, fem_E=300e6, fem_rho=2000, fem_load_group="top", fem_load_p0=1000.0,
-              fem_load_history="box", fem_load_t0=0.025, t_end=0.4, contact="unilateral",
-              contact_cohesion=100.0)["interface"]
-    assert r["n_open"].max() > 0          # the rebound lifts the block off (no gravity: it stays off)
+@pytest.mark.parametrize("coupling, traction, rho", [("implicit", "direct", 2000),
+                                                    ("staggered", "direct", 8000),
+                                                    ("staggered", "extrapolated", 8000)])
+def test_equilibrium_compatibility_every_step(tmp_path, coupling, traction, rho):
+    """Box pulse with lift-off (p_C = 100 N/m^2), both time couplings: the BEM
+    equations of every step hold with the final interface values (residual
+    1e-10: open nodes really carry no traction); the force applied to the
+    structure is equal and opposite to the integral of the handed-over soil
+    traction (independent quadrature) and the force matrix reproduces it node
+    by node; closed nodes share u_b = u_f after the step (implicit), open nodes
+    do not penetrate, closed ones stay within the cohesion limit."""
+    r = rigid(tmp_path, fem_E=300e6, fem_rho=rho, fem_box_cells="4,4,2", fem_box_size="1,1,0.5",
+              fem_load_group="top", fem_load_p0=1000.0, fem_load_history="box", fem_load_t0=0.025,
+              t_end=0.4, contact="unilateral", contact_cohesion=100.0, coupling=coupling,
+              coupling_traction=traction)["interface"]
+    assert r["n_open"].max() > 0
+    assert r["bem_residual"].max() <= 1e-10
     scale = np.abs(r["force_be"]).max()
+    assert r["force_map_error"].max() <= 1e-12 * scale
     assert np.abs(r["force_fe"] + r["force_be"]).max() <= 1e-10 * scale
     closed = r["closed"]
     uscale = np.abs(r["uf"]).max()
-    d = np.abs(r["uf_check"] - r["ub"]).max(axis=2)
-    assert d[closed].max() <= 1e-9 * uscale
-    assert np.abs(r["p"][~closed]).max() == 0.0 if (~closed).any() else True
+    if coupling == "implicit":
+        d = np.abs(r["uf_check"] - r["ub"]).max(axis=2)
+        assert d[closed].max() <= 1e-9 * uscale
     assert r["gap"][~closed].min() >= -1e-6 * uscale
     assert r["pN"][closed].max() <= 100.0 * (1 + 1e-6)
+
+
+def test_implicit_step_stable_over_dt(tmp_path):
+    """The light block that makes the staggered step diverge: the implicit step
+    decays after the pulse for beta = c_s dt / l from 0.25 to 1 (dt = 0.0125 to
+    0.003125 s on 0.25 m node spacing)."""
+    for dt in (0.0125, 0.003125):
+        r = rigid(tmp_path, fem_E=300e6, fem_rho=500, fem_box_cells="4,4,4", fem_box_size="1,1,0.5",
+                  fem_load_group="top", fem_load_p0=1000.0, fem_load_history="box", fem_load_t0=0.025,
+                  dt=dt, t_end=0.8)
+        un = r["unorm"]
+        assert np.isfinite(un).all()
+        assert un[-len(un) // 4:].max() < 0.01 * un.max(), dt
 
 
 def test_symmetric_quarter_equals_full(tmp_path):

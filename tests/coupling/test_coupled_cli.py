@@ -42,7 +42,7 @@ def test_two_ranks_reproduce_one(tmp_path):
     (["-ssi_symmetry", "x=anti"], "contact destroys the antisymmetry"),
     (["-ssi_fem_box_cells", "5,5,2"], "no soil element has all nine nodes"),
     (["-ssi_fem_interface", "bottom"], "no face group 'bottom'"),
-    (["-ssi_fem_integrator", "green"], "-ssi_coupling implicit integrates the structure with newmark"),
+    (["-ssi_fem_integrator", "green"], "-ssi_coupling implicit integrates the structure with the trapezoidal rule"),
     (["-ssi_disp_group", "load"], "-ssi_disp_group prescribes soil displacements"),
     (["-ssi_contact", "bonded", "-ssi_contact_cohesion", "10"], "-ssi_contact_cohesion needs -ssi_contact unilateral"),
 ])

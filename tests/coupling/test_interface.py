@@ -135,3 +135,21 @@ def test_open_nodes_carry_the_cohesion_when_asked():
             assert not res["closed"][2], (mode, kind)
             assert res["p"][8] == pytest.approx(expect) and res["p"][6] == 0.0 and res["p"][7] == 0.0
             assert res["gap"][2] >= 0
+
+
+def test_open_node_closes_on_penetration():
+    """An open node whose soil would rise above the structure (gap < 0) closes,
+    both by the B.2 prediction (staggered: u_b^{n-1} vs u_f^n) and after a solve."""
+    Z, nb = _toy()
+    law = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", p_C=0.0)
+    law.closed[:] = [True, True, False]
+    uf = np.array([0, 0, -1e-3, 0, 0, -1e-3, 0, 0, -1e-3])      # the structure moves down
+    law.ub_prev = np.zeros(9)                                     # the soil was at rest: gap -1e-3
+    y = np.array([0, 0, -2.0, 0, 0, -2.0, 0, 0, -2.0])
+    res = law.step(StaggeredSolve(law, Capacitance(Z))(y, uf), uf)
+    assert res["closed"].all() and res["changes"] == 1
+    # without a prediction (implicit step): the solve finds the penetration and closes it
+    law2 = ContactLaw(nb, np.zeros((3, 3), bool), "unilateral", p_C=0.0)
+    law2.closed[:] = [True, True, False]
+    res2 = law2.step(StaggeredSolve(law2, Capacitance(Z))(y, uf), None)
+    assert res2["closed"].all() and res2["iterations"] == 2 and res2["changes"] == 1
