@@ -9,12 +9,7 @@
 #   bash jobscripts/fem_bench.sh            # from the repository root
 #   STEPS=400 bash jobscripts/fem_bench.sh  # more time steps
 set -euo pipefail
-cd "$(dirname "$0")/.."
-PY=${PY:-.venv/bin/python}
-export PETSC_DIR=${PETSC_DIR:-/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real}
-export SLEPC_DIR=${SLEPC_DIR:-/usr/lib/slepcdir/slepc3.18/x86_64-linux-gnu-real}
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+source "$(dirname "$0")/bench_env.sh"
 STEPS=${STEPS:-200}
 DT=2.5e-4
 TEND=$("$PY" -c "print($STEPS * $DT)")

@@ -5,16 +5,11 @@
 #   bash jobscripts/pekeris_bench.sh [CASES...]     (default: small medium paper)
 # On a cluster, put the mpirun line in a job script (see jobscripts/README.md).
 set -euo pipefail
-cd "$(dirname "$0")/.."
-PY=${PY:-.venv/bin/python}
+source "$(dirname "$0")/bench_env.sh"
 RANKS=${RANKS:-"1 2"}
 CASES=${*:-"small medium paper"}
 OUT=out/bench
 mkdir -p "$OUT"
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
-export PETSC_DIR=${PETSC_DIR:-/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real}
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-export NUMBA_CACHE_DIR=${NUMBA_CACHE_DIR:-$PWD/.numba_cache}
 for case in $CASES; do
   for n in $RANKS; do
     log="$OUT/pekeris-$case-n$n.log"

@@ -182,6 +182,18 @@ class BEMProblem:
         self.plan = plan
         return plan
 
+    def prepare(self, extra=()):
+        """Collective: print the summary (and ``extra`` lines), choose the interpolation
+        plan, set up the LagSet and check the memory; returns (plan, lagset)."""
+        printf(self.summary())
+        for line in extra:
+            printf(line)
+        plan = self.interp_plan()
+        printf("[ssi] " + plan.describe())
+        ls = self.lagset()
+        self.check_memory(ls, plan)
+        return plan, ls
+
     def quad_options(self):
         c = self.cfg
         return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
@@ -266,11 +278,7 @@ def run_bem(cfg, comm=None):
     with_stage = stage("SSI BEM setup")
     with_stage.push()
     prob = BEMProblem(cfg, comm, log=printf)
-    printf(prob.summary())
-    plan = prob.interp_plan()
-    printf("[ssi] " + plan.describe())
-    ls = prob.lagset()
-    prob.check_memory(ls, plan)
+    plan, ls = prob.prepare()
     with_stage.pop()
     st = stage("SSI BEM assembly")
     st.push()

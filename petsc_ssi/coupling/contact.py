@@ -39,28 +39,39 @@ import numpy as np
 import scipy.linalg as sla
 
 
-class Capacitance:
-    """Z_II (replicated, 3n_I x 3n_I) and LU factors of Z_OO cached per open set."""
+class LUCache:
+    """Dense LU factors cached per key (an active set), bounded by bytes (oldest out);
+    counts the factorisations and their time (the cost of status changes)."""
 
-    def __init__(self, Z_II, cache_bytes=512e6):
-        self.Z = np.asarray(Z_II)
-        max_cache = max(1, int(cache_bytes // (8.0 * len(self.Z) ** 2)))
+    def __init__(self, n, cache_bytes=512e6):
+        self.max_cache = max(1, int(cache_bytes // (8.0 * max(n, 1) ** 2)))
         self.cache = {}
-        self.max_cache = max_cache
         self.n_factor = 0
         self.t_factor = 0.0
 
-    def solve(self, O, yO):
-        key = O.tobytes()
+    def get(self, key, matrix):
+        """LU of ``matrix()`` (called only on a miss)."""
         lu = self.cache.get(key)
         if lu is None:
             t0 = time.perf_counter()
-            lu = sla.lu_factor(self.Z[np.ix_(O, O)], check_finite=False)
+            lu = sla.lu_factor(matrix(), check_finite=False)
             self.t_factor += time.perf_counter() - t0
             self.n_factor += 1
             if len(self.cache) >= self.max_cache:
                 self.cache.pop(next(iter(self.cache)))
             self.cache[key] = lu
+        return lu
+
+
+class Capacitance(LUCache):
+    """Z_II (replicated, 3n_I x 3n_I) and LU factors of Z_OO cached per open set."""
+
+    def __init__(self, Z_II, cache_bytes=512e6):
+        self.Z = np.asarray(Z_II)
+        super().__init__(len(self.Z), cache_bytes)
+
+    def solve(self, O, yO):
+        lu = self.get(O.tobytes(), lambda: self.Z[np.ix_(O, O)])
         return sla.lu_solve(lu, yO, check_finite=False)
 
 
@@ -180,7 +191,7 @@ class StaggeredSolve:
         return solve
 
 
-class ImplicitSolve:
+class ImplicitSolve(LUCache):
     r"""Interface-implicit step: the structure's interface displacement responds
     to the interface force of the same step (trapezoidal Newmark, u_f = w + C f),
     solved together with the soil (p = q - Z u_b) on the interface:
@@ -193,29 +204,18 @@ class ImplicitSolve:
     LU per active set (cached), 3 n_I unknowns."""
 
     def __init__(self, law, Z, C, M3, a, cache_bytes=512e6):
+        super().__init__(len(Z), cache_bytes)
         self.law, self.Z, self.C, self.M3, self.a = law, Z, C, M3, float(a)
-        max_cache = max(1, int(cache_bytes // (8.0 * len(Z) ** 2)))
         self.CM = C @ M3
         self.B = np.eye(len(Z)) - self.a * self.CM @ Z
-        self.cache = {}
-        self.max_cache = max_cache
-        self.n_factor = 0
-        self.t_factor = 0.0
+
+    def _matrix(self, O):
+        K = self.B.copy()
+        K[O] = self.Z[O]
+        return K
 
     def _lu(self, closed, O):
-        key = closed.tobytes()
-        lu = self.cache.get(key)
-        if lu is None:
-            t0 = time.perf_counter()
-            K = self.B.copy()
-            K[O] = self.Z[O]
-            lu = sla.lu_factor(K, check_finite=False)
-            self.t_factor += time.perf_counter() - t0
-            self.n_factor += 1
-            if len(self.cache) >= self.max_cache:
-                self.cache.pop(next(iter(self.cache)))
-            self.cache[key] = lu
-        return lu
+        return self.get(closed.tobytes(), lambda: self._matrix(O))
 
     def __call__(self, q, w, r):
         g_closed = w - self.CM @ (self.a * q + r)

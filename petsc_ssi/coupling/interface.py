@@ -21,6 +21,7 @@ import scipy.sparse as sp
 
 from ..petsc import SSIError, init
 from ..mesh import quad9
+from ..fem.loads import group_faces
 
 
 def _fmt(points, k=3):
@@ -30,15 +31,10 @@ def _fmt(points, k=3):
 
 def fe_interface_faces(fe_mesh, groups):
     """Outward-ordered quads of the comma-separated FE face groups."""
-    out = []
-    for name in [s.strip() for s in groups.split(",") if s.strip()]:
-        if name not in fe_mesh.faces:
-            raise SSIError(f"-ssi_fem_interface: no face group '{name}' in the structure's mesh "
-                           f"{fe_mesh.source} (face groups: {', '.join(sorted(fe_mesh.faces)) or 'none'})")
-        out.append(fe_mesh.faces[name])
-    if not out or sum(len(q) for q in out) == 0:
+    quads = group_faces(fe_mesh, groups, "-ssi_fem_interface")
+    if len(quads) == 0:
         raise SSIError("-ssi_fem_interface names no faces of the structure")
-    return np.concatenate(out)
+    return quads
 
 
 def _face_normals(X):

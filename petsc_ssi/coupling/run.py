@@ -340,15 +340,11 @@ def run_ssi(cfg):
     st.push()
     hist = fem_history(cfg, comm)
     prob, model, iface, fe_cfg = setup(cfg, comm)
-    printf(prob.summary())
-    printf(f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
-           f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
-           + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
-           + f", interface force {cfg.coupling_traction}")
-    plan = prob.interp_plan()
-    printf("[ssi] " + plan.describe())
-    ls = prob.lagset()
-    prob.check_memory(ls, plan)
+    plan, ls = prob.prepare([
+        f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
+        f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
+        + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
+        + f", {cfg.coupling} coupling"])
     st.pop()
     st = stage("SSI FEM assembly")
     st.push()

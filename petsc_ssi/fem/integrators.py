@@ -493,11 +493,6 @@ class MidpointIntegrator(NewmarkIntegrator):
         self.n += 1
         return self.u
 
-    def velocity(self, out=None):
-        out = self.v.duplicate() if out is None else out
-        self.v.copy(out)
-        return out
-
     def destroy(self):
         self.ku.destroy()
         super().destroy()
