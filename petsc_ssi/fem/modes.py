@@ -9,7 +9,13 @@ sigma, so "nearest the target" means "lowest"). The inner solve is a direct
 factorisation chosen by ``petsc.direct_solver_defaults`` (MUMPS, else
 SuperLU_dist; PETSc's serial LU only on one rank, with a warning; an error in
 parallel without either). Options prefix ``ssi_modes_`` (``-ssi_modes_eps_nev`` is set
-from ``-ssi_modes_n``; any ``-ssi_modes_eps_*``/``-ssi_modes_st_*`` wins).
+to -ssi_modes_n plus max(4, n/2) spares; any ``-ssi_modes_eps_*``/``-ssi_modes_st_*`` wins).
+
+Krylov methods can miss one copy of a multiple eigenvalue, and symmetric
+structures have many. The result is checked by Sylvester's law of inertia:
+the negative pivots of an LDL^T factorisation of K - sigma M (MUMPS), with
+sigma in the first gap above the reported modes, count the eigenvalues below
+sigma; if SLEPc found fewer, it solves again with twice the nev.
 
 Output: a table ``mode,frequency_hz`` on stdout (rank 0), the mode shapes
 (max |u| = 1) as snapshots ``mode_shape_<k>`` of -ssi_output with "time" =
@@ -47,8 +53,50 @@ def default_target(mat, coords):
     return -1e-3 * cs2 / L ** 2
 
 
-def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_"):
-    """Collective: (frequencies [Hz] (k,), list of full-size mode Vecs (max |u| = 1))."""
+def count_below(Kf, Mf, sigma):
+    """Collective: the number of eigenvalues of K x = lambda M x below sigma (Sylvester's law of inertia:
+    the negative pivots of the LDL^T factor of K - sigma M, MUMPS INFOG(12), ICNTL(13) = 1 so that a
+    ScaLAPACK root node is counted too), or None when PETSc has no MUMPS."""
+    PETSc = init()
+    from ..petsc import has_package
+    if not has_package("mumps"):
+        return None
+    A = Kf.copy()
+    A.axpy(-sigma, Mf, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    ksp = PETSc.KSP().create(Kf.getComm())
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("cholesky")
+    pc.setFactorSolverType("mumps")
+    pc.setFactorSetUpSolverType()
+    F = pc.getFactorMatrix()
+    F.setMumpsIcntl(13, 1)
+    ksp.setUp()
+    n = int(F.getMumpsInfog(12))
+    ksp.destroy()
+    A.destroy()
+    return n
+
+
+def _check_sigma(lam, n_modes):
+    """(sigma, expected count): a shift in the first clear gap of the sorted converged eigenvalues at or
+    after the n-th, so that an unconverged copy of a multiple eigenvalue cannot straddle it."""
+    scale = max(float(np.abs(lam).max()), 1e-300)
+    for j in range(n_modes, len(lam)):
+        if lam[j] - lam[j - 1] > 1e-6 * scale:
+            return 0.5 * (lam[j - 1] + lam[j]), j
+    return lam[-1] + 1e-6 * scale, len(lam)
+
+
+def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_", max_attempts=4):
+    """Collective: (frequencies [Hz] (k,), list of full-size mode Vecs (max |u| = 1)).
+
+    Krylov methods can miss one copy of a multiple eigenvalue (symmetric structures have many). Extra
+    eigenpairs are requested (nev = n + max(4, n/2)), and the result is checked by an inertia count of
+    K - sigma M with sigma just above the reported modes: if fewer eigenvalues were found than lie below
+    sigma, the solve is repeated with twice as many, and a clear error follows after ``max_attempts``."""
     PETSc = init()
     from slepc4py import SLEPc
     comm = K.getComm()
@@ -60,26 +108,44 @@ def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_"):
     eps.setOptionsPrefix(prefix)
     eps.setOperators(Kf, Mf)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-    eps.setDimensions(nev=n_modes)
+    eps.setDimensions(nev=n_modes + max(4, n_modes // 2))
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     eps.setTarget(target)
     eps.setTolerances(tol=1e-10)
     eps.setFromOptions()
-    with event("FEM_modes"):
-        eps.solve()
-    nconv = eps.getConverged()
-    collective_error(None if nconv >= n_modes else f"SLEPc converged {nconv} of {n_modes} modes", comm)
-    lam = np.array([eps.getEigenvalue(i).real for i in range(n_modes)])
-    order = np.argsort(lam)
+    ndof = Kf.getSize()[0]
+    for attempt in range(1, max_attempts + 1):
+        with event("FEM_modes"):
+            eps.solve()
+        nconv = eps.getConverged()
+        collective_error(None if nconv >= n_modes else f"SLEPc converged {nconv} of {n_modes} modes", comm)
+        lam_all = np.array([eps.getEigenvalue(i).real for i in range(nconv)])
+        order = np.argsort(lam_all)
+        lam = lam_all[order]
+        sigma, expected = _check_sigma(lam, n_modes)
+        with event("FEM_modes_inertia"):
+            below = count_below(Kf, Mf, sigma)
+        if below is None or below == expected:
+            if below is not None:
+                printf(f"[modes] inertia check: {below} eigenvalues below {sigma:.6g} rad^2/s^2, all found")
+            break
+        nev = eps.getDimensions()[0]
+        collective_error(None if below > expected and attempt < max_attempts and nev < ndof else
+                         f"SLEPc found {expected} eigenvalues below {sigma:.6g} rad^2/s^2 but the inertia of "
+                         f"K - sigma M counts {below} (after {attempt} solves, nev = {nev}); "
+                         f"try -{prefix}eps_nev/-{prefix}eps_ncv larger", comm)
+        printf(f"[modes] inertia check: {below} eigenvalues below {sigma:.6g} rad^2/s^2, {expected} found; "
+               f"solving again with nev = {min(2 * nev, ndof)}")
+        eps.setDimensions(nev=min(2 * nev, ndof), ncv=PETSc.DECIDE)
     xr = Kf.createVecRight()
     freqs, shapes = [], []
-    for i in order:
+    for i in order[:n_modes]:
         eps.getEigenvector(int(i), xr)
         full = m.duplicate()
         full.zeroEntries()
         full.getArray()[free - K.getOwnershipRange()[0]] = xr.getArray(readonly=True)
         full.scale(1.0 / max(full.norm(PETSc.NormType.INFINITY), 1e-300))
-        freqs.append(math.sqrt(max(lam[i], 0.0)) / (2 * math.pi))
+        freqs.append(math.sqrt(max(lam_all[i], 0.0)) / (2 * math.pi))
         shapes.append(full)
     for obj in (eps, Kf, Mf, isf, xr):
         obj.destroy()
