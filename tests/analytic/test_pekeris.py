@@ -4,7 +4,6 @@ Conventions: z up, the point force pushes down, tau = c_s t / r,
 u~ = pi mu r u / P; u~_z > 0 up, u~_r > 0 away from the load.
 """
 import math
-import time
 
 import numpy as np
 import pytest
@@ -271,10 +270,7 @@ def test_patch_quadrature_converges(xy):
     a, b, p0 = 1.0, 0.5, 1e5
     rmax = max(math.hypot(x + sa * a, y + sb * b) for sa in (-1, 1) for sb in (-1, 1))
     t = np.linspace(0.0, 3.0 * rmax / CS, 200)
-    t0 = time.perf_counter()
     u32 = pk.patch_displacement(x, y, t, a, b, p0, CS, CP, RHO)
-    elapsed = time.perf_counter() - t0
-    assert elapsed < 3.0
     u64 = pk.patch_displacement(x, y, t, a, b, p0, CS, CP, RHO, n=64)
     scale = np.max(np.abs(u64[2]))
     for i in range(3):
