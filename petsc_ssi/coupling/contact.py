@@ -16,8 +16,12 @@ the columns O of the system, and its solution is
 Z_OO delta_O = y_O - t_O), a capacitance (Schur complement) system of size |O|: a status change costs a
 dense LU of Z_OO (cached per active set) and |O|-column products, never a
 refactorisation of the BEM system. The algebra here works on replicated
-interface arrays (3 n_I numbers: the same decisions on every rank, no
-communication); the caller applies x = y - Z[:, O] delta_O to its own rows.
+interface arrays (3 n_I numbers); the caller applies x = y - Z[:, O] delta_O
+to its own rows. Every rank solves the small system itself, but the status
+decisions (which nodes open or close, when to stop) are taken on rank 0 and
+broadcast (n_I booleans per iteration): ranks whose BLAS differ in the last
+bit (heterogeneous nodes, run-time-dispatched kernels) could otherwise take
+different active sets and deadlock or diverge.
 
 Kuhn-Tucker conditions (paper eq. 25), per node, n_b the soil's outward normal:
   gap     g = (u_b - u_f) . n_f = -delta . n_b        (g >= 0)
@@ -84,7 +88,9 @@ class ContactLaw:
     FEM predictor u_f^n), None to start from the previous status (implicit step:
     u_f^n depends on the interface force, there is no prediction)."""
 
-    def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero"):
+    def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero",
+                 comm=None):
+        self.comm = comm if comm is not None and comm.Get_size() > 1 else None   # mpi4py
         self.n_b = np.asarray(n_b, float)            # (n_I, 3)
         self.open_traction = open_traction
         self.nI = len(self.n_b)
@@ -114,6 +120,10 @@ class ContactLaw:
             t[self.zero.ravel()] = 0.0
         return t
 
+    def _agree(self, obj):
+        """Collective (with a comm): rank 0's decision on every rank."""
+        return obj if self.comm is None else self.comm.bcast(obj, root=0)
+
     def _normal(self, v):
         return np.einsum("ij,ij->i", v.reshape(-1, 3), self.n_b)
 
@@ -131,6 +141,7 @@ class ContactLaw:
                 # B.2: predicted gap (u_b^{n-1} - u_f^n) . n_f of open nodes (n_f = -n_b)
                 g_pred = -self._normal(self.ub_prev - uf_pred)
                 closed |= (~closed) & (g_pred < -self.tol * scale_u)
+                closed = self._agree(closed)
             seen = {closed.tobytes()}
             changes = int((closed != start).sum())
             cycled = False
@@ -146,16 +157,18 @@ class ContactLaw:
                 v_open = np.where(closed, (pN - self.p_C) / sp - self.tol, -np.inf)     # > 0: must open
                 v_close = np.where(~closed, -gap / su - self.tol, -np.inf)              # > 0: must close
                 viol = np.maximum(v_open, v_close)
-                if not np.any(viol > 0) or its >= self.max_iter:
-                    cycled = bool(np.any(viol > 0))      # accepted with violations left
-                    break
-                new = closed.copy()
-                new[v_open > 0] = False
-                new[v_close > 0] = True
-                if new.tobytes() in seen:              # a repeated set: change the worst node only
+                new = None
+                if np.any(viol > 0) and its < self.max_iter:
                     new = closed.copy()
-                    k = int(np.argmax(viol))
-                    new[k] = not closed[k]
+                    new[v_open > 0] = False
+                    new[v_close > 0] = True
+                    if new.tobytes() in seen:          # a repeated set: change the worst node only
+                        new = closed.copy()
+                        k = int(np.argmax(viol))
+                        new[k] = not closed[k]
+                new, cycled = self._agree((new, bool(np.any(viol > 0))))
+                if new is None:
+                    break                               # cycled: accepted with violations left
                 changes += int((new != closed).sum())
                 closed = new
                 seen.add(closed.tobytes())

@@ -121,7 +121,7 @@ class Coupler:
         self.Zloc = self._bem_columns()
         Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
-                              cfg.contact_max_iter, cfg.contact_open_traction)
+                              cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py())
         ex = cfg.coupling_traction == "extrapolated"
         self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
         M3 = np.kron(iface.M.toarray(), np.eye(3))
