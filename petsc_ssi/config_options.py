@@ -40,6 +40,8 @@ register("gauss", "int", 2, "per direction", "Gauss points per subdivision and d
 register("singular_order", "int", 12, "", "Gauss order of the polar (radial and angular) singular integration", "bem",
          validator=at_least(2))
 register("cache", "bool", True, "", "integrate each distinct (collocation point, element) geometry once and reuse it for translated copies (exact)", "bem")
+register("cache_share", "bool", True, "", "with -ssi_cache on several ranks: integrate each distinct geometry once over all "
+         "ranks (its owner rank integrates it and sends it to the ranks that meet it) instead of once per rank", "bem")
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))

@@ -42,6 +42,54 @@ def _geom_key(X, xc, qinv, key):
 
 
 @njit(cache=True)
+def _pair_window(xc, X, c, R, h, reach, alpha, beta, dt, L, lag_lo, toff, tol, ns_base, ns_max, near_factor):
+    """(lo, hi, sing, ns) of a (collocation point, element) pair: the lags its wave window touches
+    (lo > hi: none), the local node at the point (-1: regular) and the subdivisions."""
+    dcen = math.sqrt((c[0] - xc[0]) ** 2 + (c[1] - xc[1]) ** 2 + (c[2] - xc[2]) ** 2)
+    dmin = max(dcen - R, 0.0)
+    if dmin >= reach:
+        return 1, 0, -1, 0
+    dmax = dcen + R
+    lo = max(lag_lo, int(math.floor((dmin / alpha - toff) / dt)) + 1)
+    hi = min(L, int(math.floor((dmax / beta - toff) / dt)) + 2)
+    sing = -1
+    for a in range(9):
+        d = math.sqrt((X[a, 0] - xc[0]) ** 2 + (X[a, 1] - xc[1]) ** 2 + (X[a, 2] - xc[2]) ** 2)
+        if d < tol * h:
+            sing = a
+    if sing >= 0:
+        ns = min(ns_max, 2 * ns_base)
+        if lag_lo == 1:
+            lo = 1
+        else:
+            sing = -1   # lags >= 2 vanish near xi: regular
+    else:
+        ns = ns_base
+        if near_factor > 0.0:
+            dd = max(dmin, 1e-3 * h)
+            ns = min(ns_max, max(ns_base, int(math.ceil(near_factor * h / dd))))
+    return lo, hi, sing, ns
+
+
+@njit(cache=True)
+def _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u, toff, h_ref,
+               Ub, Pb, Us, Ps):
+    """Element integrals of one pair into Ub, Pb[:hi-lo+1] (the static singular part added at the
+    first lag of a singular pair); returns the kernel evaluations."""
+    nl = hi - lo + 1
+    Ub[:nl] = 0.0
+    Pb[:nl] = 0.0
+    nev = integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu, Ub, Pb, want_u, toff)
+    if sing >= 0:
+        Us[:] = 0.0
+        Ps[:] = 0.0
+        singular_static(X, sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps, h_ref)
+        Ub[0] += Us
+        Pb[0] += Ps
+    return nev
+
+
+@njit(cache=True)
 def lag_order(lag, L):
     """Stable counting sort by lag (1..L): the permutation and the bucket
     bounds. Triplets come out row-major, so within a lag rows stay sorted."""
@@ -114,29 +162,8 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
         h0 = nh
         g0 = ng_
         for v in range(nv):
-            dcen = math.sqrt((Vc[v, 0] - xc[0]) ** 2 + (Vc[v, 1] - xc[1]) ** 2 + (Vc[v, 2] - xc[2]) ** 2)
-            dmin = max(dcen - VR[v], 0.0)
-            if dmin >= reach:
-                continue
-            dmax = dcen + VR[v]
-            lo = max(lag_lo, int(math.floor((dmin / alpha - toff) / dt)) + 1)
-            hi = min(L, int(math.floor((dmax / beta - toff) / dt)) + 2)
-            sing = -1
-            for a in range(9):
-                d = math.sqrt((VX[v, a, 0] - xc[0]) ** 2 + (VX[v, a, 1] - xc[1]) ** 2 + (VX[v, a, 2] - xc[2]) ** 2)
-                if d < tol * Vh[v]:
-                    sing = a
-            if sing >= 0:
-                ns = min(ns_max, 2 * ns_base)
-                if lag_lo == 1:
-                    lo = 1
-                else:
-                    sing = -1   # lags >= 2 vanish near xi: regular
-            else:
-                ns = ns_base
-                if near_factor > 0.0:
-                    dd = max(dmin, 1e-3 * Vh[v])
-                    ns = min(ns_max, max(ns_base, int(math.ceil(near_factor * Vh[v] / dd))))
+            lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
+                                            toff, tol, ns_base, ns_max, near_factor)
             if lo > hi:
                 continue
             want_u = False
@@ -145,34 +172,33 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                     want_u = True
             nl = hi - lo + 1
             found = -1
+            fill_u = -1
             if use_cache:
                 hsh = _geom_key(VX[v], xc, qinv, key)
                 if hsh in cidx:
                     c = cidx[hsh]
-                    same = cmeta[c, 0] == lo and cmeta[c, 1] == hi and (cmeta[c, 3] == 1 or not want_u)
+                    same = cmeta[c, 0] == lo and cmeta[c, 1] == hi
                     for k in range(27):
                         if ckeys[c, k] != key[k]:
                             same = False
                     if same:
-                        found = c
+                        if cmeta[c, 3] == 1 or not want_u:
+                            found = c
+                        else:
+                            fill_u = c      # stored without U blocks: integrate and complete the entry
             if found >= 0:
                 off = cmeta[found, 2]
                 Psrc = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
                 Usrc = cpoolU[off:off + nl * 81].reshape((nl, 9, 3, 3)) if want_u else Ub[:nl]
                 hits += 1
             else:
-                Ub[:nl] = 0.0
-                Pb[:nl] = 0.0
-                nev += integrate_pair(xc, VX[v], sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
-                                      Ub, Pb, want_u, toff)
-                if sing >= 0:
-                    Us[:] = 0.0
-                    Ps[:] = 0.0
-                    singular_static(VX[v], sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps,
-                                    h_ref)
-                    Ub[0] += Us
-                    Pb[0] += Ps
-                if use_cache and hsh not in cidx and 8 * (pool_n + nl * 81) <= cache_max:
+                nev += _integrate(xc, VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu,
+                                  want_u, toff, h_ref, Ub, Pb, Us, Ps)
+                if fill_u >= 0:
+                    off = cmeta[fill_u, 2]
+                    cpoolU[off:off + nl * 81] = Ub[:nl].ravel()
+                    cmeta[fill_u, 3] = 1
+                elif use_cache and hsh not in cidx and 8 * (pool_n + nl * 81) <= cache_max:
                     c = ncache
                     ckeys = _grow(ckeys, c)
                     cmeta = _grow(cmeta, c)
@@ -255,3 +281,132 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
             slotG[glag[k], gcol[k]] = -1
     return (hrow[:nh], hlag[:nh], hcol[:nh], hval[:nh], grw[:ng_], glag[:ng_], gcol[:ng_],
             gval[:ng_], nev, hits, ckeys, cmeta, cpoolP, cpoolU)
+
+
+# ---------------------------------------------------------------------------
+# Element cache shared between ranks (model.LagSet.assemble): each rank lists
+# the distinct pair geometries its rows meet (enumerate_pairs), an owner rank
+# per geometry (its hash modulo the ranks) integrates it once (integrate_records)
+# and sends it back, and each rank fills its cache with what it asked for
+# (cache_insert) before assemble_rows runs, which then finds every pair there.
+
+@njit(cache=True)
+def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_base, near_factor, ns_max,
+                    tol, qinv, lag_lo=1, toff=0.0, cache_max=1 << 62):
+    """The distinct pair geometries that ``assemble_rows`` with a cache would store for ``rows``, in the
+    order it meets them, up to the same cache cap: (keys (m, 27), hashes (m,), meta (m, 6) = [lo, hi,
+    sing, ns, want_u, element], points (m, 3)). A hash met again with a different key or lag window is
+    left out (assemble_rows integrates such pairs itself, as it does now)."""
+    nv = VX.shape[0]
+    cidx = Dict.empty(key_type=types.int64, value_type=types.int64)
+    keys = np.zeros((64, 27), np.int64)
+    hs = np.zeros(64, np.int64)
+    meta = np.zeros((64, 6), np.int64)
+    pts = np.zeros((64, 3))
+    m = 0
+    pool_n = 0
+    key = np.zeros(27, np.int64)
+    reach = alpha * (dt * L + toff)
+    for ii in range(rows.shape[0]):
+        xc = xnodes[rows[ii]]
+        for v in range(nv):
+            lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
+                                            toff, tol, ns_base, ns_max, near_factor)
+            if lo > hi:
+                continue
+            want_u = 0
+            for a in range(9):
+                if Vtcol[v, a] >= 0:
+                    want_u = 1
+            hsh = _geom_key(VX[v], xc, qinv, key)
+            if hsh in cidx:
+                c = cidx[hsh]
+                same = meta[c, 0] == lo and meta[c, 1] == hi
+                for k in range(27):
+                    if keys[c, k] != key[k]:
+                        same = False
+                if same and want_u == 1:
+                    meta[c, 4] = 1
+                continue
+            nl = hi - lo + 1
+            if 8 * (pool_n + nl * 81) > cache_max:
+                continue
+            keys = _grow(keys, m); hs = _grow(hs, m); meta = _grow(meta, m); pts = _grow(pts, m)
+            keys[m] = key
+            hs[m] = hsh
+            meta[m, 0] = lo; meta[m, 1] = hi; meta[m, 2] = sing; meta[m, 3] = ns; meta[m, 4] = want_u
+            meta[m, 5] = v
+            pts[m] = xc
+            cidx[hsh] = m
+            pool_n += nl * 81
+            m += 1
+    return keys[:m], hs[:m], meta[:m], pts[:m]
+
+
+@njit(cache=True)
+def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff=0.0, h_ref=1.0):
+    """Integrals of the listed pairs (meta, points as from enumerate_pairs): (offsets (m + 1,) into the
+    pools, P pool, U pool (zeros where want_u is 0), kernel evaluations)."""
+    m = meta.shape[0]
+    off = np.zeros(m + 1, np.int64)
+    for r in range(m):
+        off[r + 1] = off[r] + (meta[r, 1] - meta[r, 0] + 1) * 81
+    P = np.zeros(off[m])
+    U = np.zeros(off[m])
+    mu = rho * beta * beta
+    Ub = np.zeros((L, 9, 3, 3))
+    Pb = np.zeros((L, 9, 3, 3))
+    Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
+    nev = 0
+    for r in range(m):
+        lo, hi = meta[r, 0], meta[r, 1]
+        nl = hi - lo + 1
+        nev += _integrate(pts[r], VX[meta[r, 5]], meta[r, 2], meta[r, 3], gq, gw, gr, gwr, lo, hi, dt, alpha,
+                          beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps)
+        P[off[r]:off[r + 1]] = Pb[:nl].ravel()
+        if meta[r, 4] == 1:
+            U[off[r]:off[r + 1]] = Ub[:nl].ravel()
+    return off, P, U, nev
+
+
+@njit(cache=True)
+def gather_segments(src, starts, lengths):
+    """The segments src[starts[i]:starts[i] + lengths[i]], concatenated."""
+    out = np.empty(lengths.sum())
+    pos = 0
+    for i in range(starts.shape[0]):
+        out[pos:pos + lengths[i]] = src[starts[i]:starts[i] + lengths[i]]
+        pos += lengths[i]
+    return out
+
+
+@njit(cache=True)
+def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs, uoffs):
+    """Add records (keys, hashes, meta as from enumerate_pairs) to an element cache, their P blocks at
+    buf[poffs[r]:] and U blocks at buf[uoffs[r]:] (uoffs[r] < 0: no U); returns the cache arrays."""
+    ncache = len(cidx)
+    pool_n = 0
+    for k in range(ncache):
+        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
+        if e > pool_n:
+            pool_n = e
+    for r in range(keys.shape[0]):
+        if hs[r] in cidx:
+            continue
+        n = (meta[r, 1] - meta[r, 0] + 1) * 81
+        c = ncache
+        ckeys = _grow(ckeys, c)
+        cmeta = _grow(cmeta, c)
+        while pool_n + n > cpoolP.shape[0]:
+            cpoolP = _grow(cpoolP, cpoolP.shape[0])
+            cpoolU = _grow(cpoolU, cpoolU.shape[0])
+        ckeys[c] = keys[r]
+        cmeta[c, 0] = meta[r, 0]; cmeta[c, 1] = meta[r, 1]; cmeta[c, 2] = pool_n
+        cmeta[c, 3] = 1 if uoffs[r] >= 0 else 0
+        cpoolP[pool_n:pool_n + n] = buf[poffs[r]:poffs[r] + n]
+        if uoffs[r] >= 0:
+            cpoolU[pool_n:pool_n + n] = buf[uoffs[r]:uoffs[r] + n]
+        pool_n += n
+        cidx[hs[r]] = c
+        ncache += 1
+    return ckeys, cmeta, cpoolP, cpoolU

@@ -13,7 +13,8 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import assemble_rows, new_cache, lag_order
+from .assemble import (assemble_rows, new_cache, lag_order, enumerate_pairs, integrate_records, cache_insert,
+                       gather_segments)
 
 
 class Material:
@@ -134,6 +135,19 @@ class Buckets:
         return sum(len(p[0]) for p in self._b[lag - 1])
 
 
+def _mix64(h):
+    """A 64-bit finaliser (splitmix64) of the element-cache hashes: their low bits alone are not
+    uniform, and the owner rank of a geometry is the hash modulo the ranks."""
+    x = h.astype(np.uint64)
+    with np.errstate(over="ignore"):
+        x ^= x >> np.uint64(30)
+        x *= np.uint64(0xBF58476D1CE4E5B9)
+        x ^= x >> np.uint64(27)
+        x *= np.uint64(0x94D049BB133111EB)
+        x ^= x >> np.uint64(31)
+    return x
+
+
 class LagSet:
     """The assembled H_l, G_l (l = 1..L) of one rank as triplets, then Mats."""
 
@@ -190,6 +204,69 @@ class LagSet:
         per_row = 96.0 * 2 * N * max(lag_hi, 1) * 0.6
         return int(max(1, min(64, 256e6 // per_row, len(self.rows) // 20 + 1)))
 
+    def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr):
+        """Collective: fill this rank's element cache with every distinct pair geometry its rows meet,
+        each integrated once over all ranks. A geometry's owner is its hash modulo the ranks; requests
+        go to the owners (all-to-all of keys), the owner integrates the representative of the lowest
+        requesting rank (the pair a single rank would meet first, so -n p reproduces -n 1) and sends
+        the blocks back (all-to-all-v of doubles). Returns the cache arrays and the owned evaluations."""
+        o = self.opts
+        mpi = self.comm.tompi4py()
+        from mpi4py import MPI
+        p = mpi.Get_size()
+        keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
+                                              self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
+                                              o["subdivisions"], o["near_factor"], o["max_subdivisions"], 1e-8,
+                                              qinv, lag_lo, toff, self.CACHE_MAX)
+        owner = np.mod(_mix64(hs), p)
+        mine = [np.nonzero(owner == r)[0] for r in range(p)]
+        got = mpi.alltoall([(keys[i], meta[i], pts[i]) for i in mine])
+        # owner: the distinct requests, first occurrence in rank order; want_u if any requester wants it
+        allk = np.concatenate([np.c_[g[0], g[1][:, :2]] for g in got])
+        allm = np.concatenate([g[1] for g in got])
+        allp = np.concatenate([g[2] for g in got])
+        if len(allk):
+            _, first, inv = np.unique(allk, axis=0, return_index=True, return_inverse=True)
+            inv = inv.ravel()
+        else:
+            first, inv = np.zeros(0, np.int64), np.zeros(0, np.int64)
+        umeta = allm[first].copy()
+        np.maximum.at(umeta[:, 4], inv, allm[:, 4])
+        off, P, U, nev = integrate_records(umeta, allp[first], self.VX, lag_hi, self.dt, self.mat.cp,
+                                           self.mat.cs, self.mat.rho, self.mat.nu, gq, gw, gr, gwr, toff,
+                                           float(self.Vh.min()))
+        # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
+        seg = np.cumsum([0] + [len(g[1]) for g in got])
+        starts, lens, scount = [], [], []
+        for r in range(p):
+            u = inv[seg[r]:seg[r + 1]]
+            w = u[got[r][1][:, 4] == 1]
+            starts += [off[u], off.max(initial=0) + off[w]]          # U blocks follow P in one source
+            lens += [off[u + 1] - off[u], off[w + 1] - off[w]]
+            scount.append(int(lens[-2].sum() + lens[-1].sum()))
+        sbuf = gather_segments(np.concatenate([P, U]), np.concatenate(starts).astype(np.int64),
+                               np.concatenate(lens).astype(np.int64))
+        P = U = None
+        nl81 = (meta[:, 1] - meta[:, 0] + 1) * 81
+        wu = meta[:, 4] == 1
+        rcount = [int(nl81[i].sum() + nl81[i][wu[i]].sum()) for i in mine]
+        rbuf = np.empty(sum(rcount))
+        sd = np.r_[0, np.cumsum(scount)[:-1]].astype(np.int64)
+        rd = np.r_[0, np.cumsum(rcount)[:-1]].astype(np.int64)
+        mpi.Alltoallv([sbuf, (scount, sd), MPI.DOUBLE], [rbuf, (rcount, rd), MPI.DOUBLE])
+        sbuf = None
+        # where each of this rank's records landed in rbuf
+        poffs = np.zeros(len(keys), np.int64)
+        uoffs = np.full(len(keys), -1, np.int64)
+        for r in range(p):
+            i = mine[r]
+            cp = np.cumsum(nl81[i])
+            poffs[i] = rd[r] + cp - nl81[i]
+            w = i[wu[i]]
+            uoffs[w] = rd[r] + (cp[-1] if len(i) else 0) + np.cumsum(nl81[w]) - nl81[w]
+        ckeys, cmeta, cpP, cpU = cache_insert(cidx, ckeys, cmeta, cpP, cpU, keys, hs, meta, rbuf, poffs, uoffs)
+        return ckeys, cmeta, cpP, cpU, int(nev)
+
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly"):
         """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
         each rank its rows; sets and returns (H, G) Buckets."""
@@ -207,6 +284,9 @@ class LagSet:
         cidx, ckeys, cmeta, cpP, cpU = new_cache()
         qinv = 1.0 / (1e-9 * float(self.Vh.min()))
         hits = 0
+        if o.get("cache", True) and o.get("cache_share", True) and self.comm.getSize() > 1:
+            ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
+                                                            qinv, gq, gw, gr, gwr)
         for s in range(0, len(rows), chunk):
             res = assemble_rows(rows[s:s + chunk], self.mesh.nodes, self.VX, self.VN, self.VS, self.VT,
                                 self.Vc, self.VR, self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,

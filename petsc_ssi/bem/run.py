@@ -197,7 +197,8 @@ class BEMProblem:
     def quad_options(self):
         c = self.cfg
         return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
-                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions, "cache": c.cache}
+                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions, "cache": c.cache,
+                "cache_share": c.cache_share}
 
     def lagset(self):
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,

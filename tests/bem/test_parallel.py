@@ -27,3 +27,30 @@ def test_two_ranks_reproduce_one(tmp_path, storage, extra):
     assert np.abs(r1["u"]).max() > 0
     assert relmax(r2["u"], r1["u"]) <= 1e-10
     assert relmax(r2["last"], r1["last"]) <= 1e-10
+
+
+def _evaluations(p):
+    import re
+    m = re.search(r"([0-9.e+]+) kernel evaluations", p.stdout)
+    assert m, p.stdout
+    return float(m.group(1))
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
+def test_shared_element_cache(tmp_path):
+    """-ssi_cache_share (default): on 2 ranks every distinct pair geometry is integrated once over both
+    ranks, so the kernel evaluations summed over the ranks are no more than one rank's (the per-rank
+    caches of -ssi_cache_share 0 integrate the geometries both ranks meet twice: more than one rank), and the
+    solution equals -n 1 to 1e-12 (the owner integrates the representative a single rank meets first),
+    with a traction-unknown (G) region so that the displacement-kernel blocks travel too."""
+    extra = ["-ssi_disp_group", "box:2,3,-1,1", "-ssi_disp_value", "0,0,-1e-6"]
+    out = {k: tmp_path / f"{k}.h5" for k in ("n1", "shared", "own")}
+    p1 = cli(ARGS + extra + ["-ssi_output", str(out["n1"])], nranks=1)
+    ps = cli(ARGS + extra + ["-ssi_output", str(out["shared"])], nranks=2)
+    po = cli(ARGS + extra + ["-ssi_output", str(out["own"]), "-ssi_cache_share", "0"], nranks=2)
+    e1, es, eo = _evaluations(p1), _evaluations(ps), _evaluations(po)
+    assert es <= e1 < eo, (e1, es, eo)
+    r1, rs, ro = (read_h5(out[k]) for k in ("n1", "shared", "own"))
+    assert np.abs(r1["u"]).max() > 0
+    assert relmax(rs["u"], r1["u"]) <= 1e-12 and relmax(rs["last"], r1["last"]) <= 1e-12
+    assert relmax(ro["u"], r1["u"]) <= 1e-10
