@@ -18,6 +18,9 @@ from numba.typed import Dict
 from .quadrature import integrate_pair, singular_static
 
 
+SING_TOL = 1e-8      # a collocation point within SING_TOL * h of an element node is that node (singular pair)
+
+
 @njit(cache=True)
 def _grow(a, n):
     if n < a.shape[0]:
@@ -346,13 +349,17 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
 @njit(cache=True)
 def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff=0.0, h_ref=1.0):
     """Integrals of the listed pairs (meta, points as from enumerate_pairs): (offsets (m + 1,) into the
-    pools, P pool, U pool (zeros where want_u is 0), kernel evaluations)."""
+    P pool, P pool, offsets (m + 1,) into the U pool (only records with want_u take room), U pool,
+    kernel evaluations)."""
     m = meta.shape[0]
     off = np.zeros(m + 1, np.int64)
+    uoff = np.zeros(m + 1, np.int64)
     for r in range(m):
-        off[r + 1] = off[r] + (meta[r, 1] - meta[r, 0] + 1) * 81
+        n = (meta[r, 1] - meta[r, 0] + 1) * 81
+        off[r + 1] = off[r] + n
+        uoff[r + 1] = uoff[r] + (n if meta[r, 4] == 1 else 0)
     P = np.zeros(off[m])
-    U = np.zeros(off[m])
+    U = np.zeros(uoff[m])
     mu = rho * beta * beta
     Ub = np.zeros((L, 9, 3, 3))
     Pb = np.zeros((L, 9, 3, 3))
@@ -365,19 +372,18 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
                           beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps)
         P[off[r]:off[r + 1]] = Pb[:nl].ravel()
         if meta[r, 4] == 1:
-            U[off[r]:off[r + 1]] = Ub[:nl].ravel()
-    return off, P, U, nev
+            U[uoff[r]:uoff[r + 1]] = Ub[:nl].ravel()
+    return off, P, uoff, U, nev
 
 
 @njit(cache=True)
-def gather_segments(src, starts, lengths):
-    """The segments src[starts[i]:starts[i] + lengths[i]], concatenated."""
-    out = np.empty(lengths.sum())
-    pos = 0
+def gather_into(out, pos, src, starts, lengths):
+    """Copy the segments src[starts[i]:starts[i] + lengths[i]] one after the other into out from
+    position pos; returns the position after the last."""
     for i in range(starts.shape[0]):
         out[pos:pos + lengths[i]] = src[starts[i]:starts[i] + lengths[i]]
         pos += lengths[i]
-    return out
+    return pos
 
 
 @njit(cache=True)
@@ -390,16 +396,22 @@ def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs,
         e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
         if e > pool_n:
             pool_n = e
+    total = pool_n
+    for r in range(keys.shape[0]):
+        total += (meta[r, 1] - meta[r, 0] + 1) * 81
+    if total > cpoolP.shape[0]:                  # sized once (not by doubling): the pools hold what was asked
+        P2 = np.zeros(total)
+        P2[:cpoolP.shape[0]] = cpoolP
+        U2 = np.zeros(total)
+        U2[:cpoolU.shape[0]] = cpoolU
+        cpoolP, cpoolU = P2, U2
+    ckeys = _grow(ckeys, ncache + keys.shape[0])
+    cmeta = _grow(cmeta, ncache + keys.shape[0])
     for r in range(keys.shape[0]):
         if hs[r] in cidx:
             continue
         n = (meta[r, 1] - meta[r, 0] + 1) * 81
         c = ncache
-        ckeys = _grow(ckeys, c)
-        cmeta = _grow(cmeta, c)
-        while pool_n + n > cpoolP.shape[0]:
-            cpoolP = _grow(cpoolP, cpoolP.shape[0])
-            cpoolU = _grow(cpoolU, cpoolU.shape[0])
         ckeys[c] = keys[r]
         cmeta[c, 0] = meta[r, 0]; cmeta[c, 1] = meta[r, 1]; cmeta[c, 2] = pool_n
         cmeta[c, 3] = 1 if uoffs[r] >= 0 else 0

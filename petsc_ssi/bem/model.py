@@ -14,7 +14,7 @@ from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
 from .assemble import (assemble_rows, new_cache, lag_order, enumerate_pairs, integrate_records, cache_insert,
-                       gather_segments)
+                       gather_into, SING_TOL)
 
 
 class Material:
@@ -135,6 +135,28 @@ class Buckets:
         return sum(len(p[0]) for p in self._b[lag - 1])
 
 
+def _first_occurrences(h, meta, full_keys):
+    """(first, inverse) of the distinct requests: first occurrence (in the order given) of each
+    (hash, lo, hi), and for each request the index of its distinct one. Hash collisions (equal
+    hash, different key) are rare: if the keys of a group differ, the full keys decide
+    (``full_keys()``: the (m, 29) rows key + lo + hi)."""
+    m = len(h)
+    if m == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    order = np.lexsort((np.arange(m), meta[:, 1], meta[:, 0], h))
+    hs, lo, hi = h[order], meta[order, 0], meta[order, 1]
+    new = np.r_[True, (hs[1:] != hs[:-1]) | (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])]
+    group = np.cumsum(new) - 1
+    first = order[new]
+    inv = np.empty(m, np.int64)
+    inv[order] = group
+    keys = full_keys()
+    if np.any(keys != keys[first[inv]]):
+        _, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        inv = inv.ravel()
+    return first, inv
+
+
 def _mix64(h):
     """A 64-bit finaliser (splitmix64) of the element-cache hashes: their low bits alone are not
     uniform, and the owner rank of a geometry is the hash modulo the ranks."""
@@ -190,8 +212,10 @@ class LagSet:
         trip = 84.0 * use
         g = 9.0 * N * max(self.regions.n_t, 1) * 8
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        # + element cache (capped), one chunk's raw triplets, process baseline
-        transient = 2 * self.CACHE_MAX + 2 * 256e6 + 0.5e9
+        # + element cache (capped), one chunk's raw triplets, process baseline; with the cache shared
+        # between ranks, its exchange holds a send and a receive buffer of about the cache's size
+        shared = self.opts.get("cache", True) and self.opts.get("cache_share", True) and self.comm.getSize() > 1
+        transient = (4 if shared else 2) * self.CACHE_MAX + 2 * 256e6 + 0.5e9
         peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient * self.comm.getSize()
         return float(mats.sum() + g * len(use)), float(peak), int(dense.sum())
 
@@ -214,39 +238,48 @@ class LagSet:
         mpi = self.comm.tompi4py()
         from mpi4py import MPI
         p = mpi.Get_size()
-        keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
-                                              self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
-                                              o["subdivisions"], o["near_factor"], o["max_subdivisions"], 1e-8,
-                                              qinv, lag_lo, toff, self.CACHE_MAX)
+        err = None
+        try:
+            keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
+                                                  self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
+                                                  o["subdivisions"], o["near_factor"], o["max_subdivisions"],
+                                                  SING_TOL, qinv, lag_lo, toff, self.CACHE_MAX)
+        except Exception as exc:         # e.g. MemoryError on one rank: every rank stops, none waits
+            err = f"listing the element-cache geometries failed on rank {mpi.Get_rank()}: {exc!r}"
+        collective_error(err, self.comm)
         owner = np.mod(_mix64(hs), p)
         mine = [np.nonzero(owner == r)[0] for r in range(p)]
-        got = mpi.alltoall([(keys[i], meta[i], pts[i]) for i in mine])
-        # owner: the distinct requests, first occurrence in rank order; want_u if any requester wants it
-        allk = np.concatenate([np.c_[g[0], g[1][:, :2]] for g in got])
-        allm = np.concatenate([g[1] for g in got])
-        allp = np.concatenate([g[2] for g in got])
-        if len(allk):
-            _, first, inv = np.unique(allk, axis=0, return_index=True, return_inverse=True)
-            inv = inv.ravel()
-        else:
-            first, inv = np.zeros(0, np.int64), np.zeros(0, np.int64)
+        got = mpi.alltoall([(keys[i], hs[i], meta[i], pts[i]) for i in mine])
+        # owner: the distinct requests (key, lo, hi), first occurrence in rank order; want_u if any wants it
+        allh = np.concatenate([g[1] for g in got])
+        allm = np.concatenate([g[2] for g in got])
+        first, inv = _first_occurrences(allh, allm, lambda: np.concatenate([np.c_[g[0], g[2][:, :2]] for g in got]))
         umeta = allm[first].copy()
         np.maximum.at(umeta[:, 4], inv, allm[:, 4])
-        off, P, U, nev = integrate_records(umeta, allp[first], self.VX, lag_hi, self.dt, self.mat.cp,
-                                           self.mat.cs, self.mat.rho, self.mat.nu, gq, gw, gr, gwr, toff,
-                                           float(self.Vh.min()))
+        allh = None
+        try:
+            off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
+                                                     lag_hi, self.dt, self.mat.cp, self.mat.cs, self.mat.rho,
+                                                     self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()))
+            err = None
+        except Exception as exc:
+            err = f"integrating the shared element-cache geometries failed on rank {mpi.Get_rank()}: {exc!r}"
+        collective_error(err, self.comm)
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
-        seg = np.cumsum([0] + [len(g[1]) for g in got])
-        starts, lens, scount = [], [], []
+        seg = np.cumsum([0] + [len(g[2]) for g in got])
+        jobs, scount = [], []
         for r in range(p):
             u = inv[seg[r]:seg[r + 1]]
-            w = u[got[r][1][:, 4] == 1]
-            starts += [off[u], off.max(initial=0) + off[w]]          # U blocks follow P in one source
-            lens += [off[u + 1] - off[u], off[w + 1] - off[w]]
-            scount.append(int(lens[-2].sum() + lens[-1].sum()))
-        sbuf = gather_segments(np.concatenate([P, U]), np.concatenate(starts).astype(np.int64),
-                               np.concatenate(lens).astype(np.int64))
-        P = U = None
+            w = u[got[r][2][:, 4] == 1]
+            jobs.append((off[u], off[u + 1] - off[u], uoff[w], uoff[w + 1] - uoff[w]))
+            scount.append(int(jobs[-1][1].sum() + jobs[-1][3].sum()))
+        got = None
+        sbuf = np.empty(sum(scount))
+        pos = 0
+        for ps, pl, us, ul in jobs:
+            pos = gather_into(sbuf, pos, P, ps, pl)
+            pos = gather_into(sbuf, pos, U, us, ul)
+        P = U = jobs = None
         nl81 = (meta[:, 1] - meta[:, 0] + 1) * 81
         wu = meta[:, 4] == 1
         rcount = [int(nl81[i].sum() + nl81[i][wu[i]].sum()) for i in mine]
@@ -292,7 +325,7 @@ class LagSet:
                                 self.Vc, self.VR, self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
                                 self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
                                 o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
-                                self.regions.n_t, self.cfree, 1e-8, o.get("cache", True), cidx, ckeys, cmeta,
+                                self.regions.n_t, self.cfree, SING_TOL, o.get("cache", True), cidx, ckeys, cmeta,
                                 cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()), self.CACHE_MAX)
             parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
             nev += res[8]
