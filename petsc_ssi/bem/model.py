@@ -212,10 +212,9 @@ class LagSet:
         trip = 84.0 * use
         g = 9.0 * N * max(self.regions.n_t, 1) * 8
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        # + element cache (capped), one chunk's raw triplets, process baseline; with the cache shared
-        # between ranks, its exchange holds a send and a receive buffer of about the cache's size
-        shared = self.opts.get("cache", True) and self.opts.get("cache_share", True) and self.comm.getSize() > 1
-        transient = (4 if shared else 2) * self.CACHE_MAX + 2 * 256e6 + 0.5e9
+        # + element cache (capped), one chunk's raw triplets, process baseline. (The shared cache's
+        # exchange buffers, about the cache's size each, are freed before the first triplet exists.)
+        transient = 2 * self.CACHE_MAX + 2 * 256e6 + 0.5e9
         peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient * self.comm.getSize()
         return float(mats.sum() + g * len(use)), float(peak), int(dense.sum())
 
