@@ -155,7 +155,7 @@ def test_open_node_closes_on_penetration():
     assert res2["closed"].all() and res2["iterations"] == 2 and res2["changes"] == 1
 
 
-def test_contact_decisions_agree_across_ranks():
+def test_contact_decisions_agree_across_ranks(tmp_path):
     """Under mpirun -n 2, a rank whose interface solve differs in the last digits (node 0's traction just
     over p_C on rank 1, just under on rank 0) still takes rank 0's active set: both ranks keep every node
     closed after one solve (the same iterations, so the collective calls that follow stay matched). The same
@@ -168,10 +168,10 @@ case without the communicator splits the ranks (checked, so the test case does p
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OPENBLAS_NUM_THREADS="1")
     r = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable,
-                        os.path.join(here, "mpi_contact_agree.py")], env=env, capture_output=True, text=True,
+                        os.path.join(here, "mpi_contact_agree.py"), str(tmp_path)], env=env, capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 0, r.stdout + r.stderr
-    res = sorted((json.loads(ln) for ln in r.stdout.splitlines() if ln.startswith("{")), key=lambda d: d["rank"])
+    res = [json.loads((tmp_path / f"rank{k}.json").read_text()) for k in (0, 1)]
     assert [d["rank"] for d in res] == [0, 1]
     # without the agreement the case does split the ranks: rank 1 opens node 0 and solves twice
     assert res[0]["alone"]["closed"] == [True, True, True] and res[1]["alone"]["closed"] == [False, True, True]
