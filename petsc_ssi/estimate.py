@@ -49,6 +49,7 @@ import time
 import numpy as np
 
 from .options import register, SSIError
+from .monitor import fmt_time
 
 G = "estimate"
 register("estimate_ranks", "str", "1,2,4", "", "estimate: rank counts to predict, e.g. '1,2,4,8,16'", G)
@@ -387,13 +388,13 @@ def report(cfg, comm, out=None):
         t.update({"ranks": p, "nodes": nodes, "node_bytes": per_node, "fits": fits})
         rows.append(t)
         lines.append(f"[ssi]   {p:5d} {nodes:5d} | {t['setup']:7.3g} {t['assembly']:10.4g} {t['factor']:8.3g} "
-                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {_hms(t['total'])} | "
+                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
                      f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
     ok = [r for r in rows if r["fits"]]
     if ok:
         best = min(ok, key=lambda r: r["total"])
         lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
-                     f"{_hms(best['total'])} on {best['ranks']} rank(s)")
+                     f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
     else:
         lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
                      f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
@@ -409,10 +410,3 @@ def _refuses(cnt, p, q):
     used = cnt.nb_total_used()
     return cnt._peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
 
-
-def _hms(s):
-    if s < 60:
-        return f"{s:6.3g} s"
-    if s < 3600:
-        return f"{int(s // 60)}m{int(s % 60):02d}s"
-    return f"{int(s // 3600)}h{int(s % 3600 // 60):02d}m"

@@ -93,6 +93,21 @@ def _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, n
 
 
 @njit(cache=True)
+def _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi):
+    """The cache entry of a pair (its hash, key and lag window lo..hi; cmeta[:, 0:2] = lo, hi), or -1
+    (absent, or a different key or window under the same hash)."""
+    if hsh not in cidx:
+        return -1
+    c = cidx[hsh]
+    if cmeta[c, 0] != lo or cmeta[c, 1] != hi:
+        return -1
+    for k in range(27):
+        if ckeys[c, k] != key[k]:
+            return -1
+    return c
+
+
+@njit(cache=True)
 def lag_order(lag, L):
     """Stable counting sort by lag (1..L): the permutation and the bucket
     bounds. Triplets come out row-major, so within a lag rows stay sorted."""
@@ -178,17 +193,12 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
             fill_u = -1
             if use_cache:
                 hsh = _geom_key(VX[v], xc, qinv, key)
-                if hsh in cidx:
-                    c = cidx[hsh]
-                    same = cmeta[c, 0] == lo and cmeta[c, 1] == hi
-                    for k in range(27):
-                        if ckeys[c, k] != key[k]:
-                            same = False
-                    if same:
-                        if cmeta[c, 3] == 1 or not want_u:
-                            found = c
-                        else:
-                            fill_u = c      # stored without U blocks: integrate and complete the entry
+                c = _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi)
+                if c >= 0:
+                    if cmeta[c, 3] == 1 or not want_u:
+                        found = c
+                    else:
+                        fill_u = c      # stored without U blocks: integrate and complete the entry
             if found >= 0:
                 off = cmeta[found, 2]
                 Psrc = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
@@ -323,12 +333,8 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
                     want_u = 1
             hsh = _geom_key(VX[v], xc, qinv, key)
             if hsh in cidx:
-                c = cidx[hsh]
-                same = meta[c, 0] == lo and meta[c, 1] == hi
-                for k in range(27):
-                    if keys[c, k] != key[k]:
-                        same = False
-                if same and want_u == 1:
+                c = _lookup(cidx, keys, meta, hsh, key, lo, hi)
+                if c >= 0 and want_u == 1:
                     meta[c, 4] = 1
                 continue
             nl = hi - lo + 1
