@@ -4,6 +4,7 @@ Commands:
   (none) | run    run the case the options describe (-ssi_problem bem|fem|ssi)
   post FILE.h5    post-process an output file (--receivers --csv)
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
+  static          static solution K u = F of a FE structure (loads at h = 1), written like a run
   estimate        predicted time per stage and memory of the run, per rank count, and
                   whether it fits the nodes (no assembly; -ssi_estimate_* options)
   help            list every -ssi_ option with default, unit and meaning
@@ -13,7 +14,7 @@ and exit status 2 on every rank.
 """
 import sys
 
-COMMANDS = ("run", "post", "modes", "help", "estimate")
+COMMANDS = ("run", "post", "modes", "static", "help", "estimate")
 
 
 def _split(argv):
@@ -41,6 +42,9 @@ def main(argv=None):
         if cmd == "run":
             from .driver import run
             run()
+        elif cmd == "static":
+            from .fem.static import main as static_main
+            static_main()
         elif cmd == "modes":
             from .fem.modes import main as modes_main
             modes_main()

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from .petsc import init, SSIError, collective_error
 
 PREFIX = "ssi_"
+PART_PREFIX = "fem_part_"     # -ssi_fem_part_<NAME>_<property>: checked by fem/parts.py
 
 _REGISTRY = {}
 _CHECKS = []
@@ -137,7 +138,7 @@ def resolve(groups=None, comm=None):
     for key in allopts:
         if key.startswith(PREFIX):
             name = key[len(PREFIX):]
-            if name in _REGISTRY or _is_petsc_object_option(name):
+            if name in _REGISTRY or _is_petsc_object_option(name) or name.startswith(PART_PREFIX):
                 continue
             near = difflib.get_close_matches(name, list(_REGISTRY), n=1)
             hint = f" (did you mean -ssi_{near[0]}?)" if near else ""
@@ -149,8 +150,10 @@ def resolve(groups=None, comm=None):
             if groups is not None and opt.group not in groups and opt.group != "common":
                 continue
             key = PREFIX + name
-            if db.hasName(key):
-                raw = db.getString(key, "")
+            if key in allopts:
+                # getAll, not getString: petsc4py's getString truncates values to 1023 characters
+                # (a long -ssi_fem_point_load or -ssi_receivers list would be cut silently)
+                raw = allopts[key] if allopts[key] is not None else ""
                 try:
                     val = _convert(opt, raw)
                 except ValueError as exc:
@@ -203,6 +206,9 @@ def help_text():
             unit = f" [{opt.unit}]" if opt.unit else ""
             lines.append(f"  -ssi_{opt.name} <{opt.default}> ({kind}){unit}: {opt.help}")
         lines.append("")
+    from .fem.parts import help_text as parts_help
+    lines.append(parts_help())
+    lines.append("")
     return "\n".join(lines)
 
 

@@ -13,6 +13,7 @@ from ..petsc import init, SSIError, check, collective_error, printf, warn
 from ..monitor import Progress, event, stage, fmt_time
 from ..mesh import surface
 from ..io.output import Output, provenance
+from .. import timegrid
 from . import symmetry, receivers as rec, histories, lagmats
 from .model import Material, Regions, LagSet, causal_lags, machine_memory
 from . import interp
@@ -83,7 +84,7 @@ class BEMProblem:
                    f"free term from the interior solid angle (Hartmann)")
         self.dt = cfg.dt
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
-        self.n_steps = int(math.ceil(cfg.t_end / cfg.dt - 1e-9))
+        self.n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
         load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
         if cfg.load_group and cfg.load_p0 == 0.0:

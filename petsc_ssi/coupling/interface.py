@@ -149,9 +149,12 @@ def mass_matrix(X, conn, n, order=4):
     return sp.csr_matrix((Me.ravel(), (r, c)), shape=(n, n))
 
 
-def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9):
-    """FE DOFs a symmetry plane fixes: on x_a = 0, u_a (sym) or the two other
-    components (anti). SSIError if the structure extends to x_a < 0."""
+def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
+    """FE DOFs a symmetry plane fixes: on x_a = 0, u_a and the rotations about the two
+    other axes (sym), or the two other translations and the rotation about a (anti);
+    rotations only where the nodes have them. SSIError if the structure extends to x_a < 0."""
+    from ..fem.dofmap import DofMap, TRANSLATIONS, ROTATIONS
+    dm = dofmap if dofmap is not None else DofMap(fe_mesh.has_rotation())
     out = []
     h = float(np.abs(fe_mesh.coords).max())
     for ax, kind in planes:
@@ -160,24 +163,27 @@ def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9):
             raise SSIError(f"-ssi_symmetry: the structure's mesh extends to {'xy'[ax]} = {x.min():.4g} < 0; "
                            f"with a symmetry plane {'xy'[ax]} = 0 mesh only the part {'xy'[ax]} >= 0")
         on = np.nonzero(np.abs(x) <= tol * max(h, 1.0))[0]
-        comps = [ax] if kind > 0 else [c for c in range(3) if c != ax]
-        for c in comps:
-            out.append(3 * on + c)
+        others = [c for c in range(3) if c != ax]
+        names = ([TRANSLATIONS[ax]] + [ROTATIONS[c] for c in others] if kind > 0 else
+                 [TRANSLATIONS[c] for c in others] + [ROTATIONS[ax]])
+        out.append(dm.dofs(on, names))
     return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
 
 
-def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, skip=()):
-    """Collective: AIJ F with f_f = F p: rows in the FE layout, columns the BE
-    traction vector (columns 3 (n_load + k) + c), entries -M (eq. 27). Rows
-    of the FE DOFs ``skip`` (fixed ones) are left empty."""
+def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, skip=(), dofmap=None):
+    """Collective: AIJ F with f_f = F p: rows in the FE layout (the translations of the
+    interface nodes, from the dof map), columns the BE traction vector (columns
+    3 (n_load + k) + c), entries -M (eq. 27). Rows of the FE DOFs ``skip`` (fixed ones)
+    are left empty."""
     PETSc = init()
     r0, r1 = fe_layout_vec.getOwnershipRange()
     M = iface.M.tocoo()
-    rows_all = 3 * iface.fe_nodes[M.row]
+    tdofs = dofmap.translation_dofs(iface.fe_nodes) if dofmap is not None else \
+        3 * iface.fe_nodes[:, None] + np.arange(3)
     cols_all = 3 * (n_load + M.col)
     R, C, V = [], [], []
     for c in range(3):
-        R.append(rows_all + c); C.append(cols_all + c); V.append(-M.data)
+        R.append(tdofs[M.row, c]); C.append(cols_all + c); V.append(-M.data)
     R = np.concatenate(R); C = np.concatenate(C); V = np.concatenate(V)
     own = (R >= r0) & (R < r1) & ~np.isin(R, np.asarray(skip, np.int64))
     A = sp.csr_matrix((V[own], (R[own] - r0, C[own])), shape=(r1 - r0, p_vec.getSize()))

@@ -50,7 +50,8 @@ from ..bem import receivers as bem_rec
 from ..bem.model import Regions
 from ..fem.assembly import assemble
 from ..fem.model import build_model
-from ..fem.run import ReceiverSeries, make_model_integrator, _history as fem_history
+from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, \
+    _history as fem_history
 from ..mesh import quad9
 from .interface import build_interface, fem_symmetry_dofs, force_matrix
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -74,7 +75,7 @@ def setup(cfg, comm):
     try:
         iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
                                 prob.planes, prob.h)
-        sym = fem_symmetry_dofs(model.mesh, prob.planes)
+        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.layout)
         load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
         both = np.intersect1d(load, iface.be_elems)
         if both.size:
@@ -87,6 +88,7 @@ def setup(cfg, comm):
         err = str(exc)
     collective_error(err, comm)
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
+    model.layout.set_fixed(model.fixed)
     return prob, model, iface, fe_cfg
 
 
@@ -103,7 +105,7 @@ class Coupler:
         nI = iface.n
         self.nI = nI
         self.dofs_be = (3 * iface.be_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
-        self.dofs_fe = (3 * iface.fe_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+        self.dofs_fe = model.layout.translation_dofs(iface.fe_nodes).ravel().astype(PETSc.IntType)
         # scatters of the interface values to every rank (3 n_I numbers: the
         # small replicated interface system; the fields stay distributed)
         self.seq_y = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
@@ -137,7 +139,8 @@ class Coupler:
         ev.end()
         # forces: f_f = F p (FE layout); rows of FE DOFs a symmetry plane (or the
         # user) fixes are left out: their reaction is not a load on the structure
-        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, skip=model.fixed)
+        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, skip=model.fixed,
+                              dofmap=model.layout)
         self.ff = integ.u.duplicate()
         self.du = integ.u.duplicate()
         self.w = march.p_tmpl.duplicate()
@@ -405,12 +408,12 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
     cvec.setArray(mesh.nodes.reshape(-1)[r0:r1])
     out.write_mesh(cvec, mesh.cells if comm.getRank() == 0 else None, "quad9")
     sout = Output(structure_output_path(cfg.output), comm)
-    sout.write_mesh(model.coords_vec(), model.mesh.cells if comm.getRank() == 0 else None, "hex8")
+    sout.fw = FieldWriter(sout, model, comm)
     R = None
     if len(prob.receivers):
         R, _ = bem_rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
         y = R.createVecLeft()
-    srec = ReceiverSeries(integ.u, model.receiver_nodes, comm)
+    srec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
     tnode = _traction_to_nodes(comm, prob, march)
     tfield = march.u_tmpl.duplicate()
     vel = integ.u.duplicate()
@@ -427,7 +430,7 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
         return fn
 
     integ.start(f0=sample(0))
-    srec.record(0.0, integ.u)
+    srec.record(0.0, integ.u, integ.velocity(vel))
     keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
             "bem_residual", "force_map_error")
     if cfg.coupling == "implicit":
@@ -450,13 +453,13 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
         if R is not None:
             R.mult(u, y)
             soil.append(y.getArray().copy())
-        srec.record(t, integ.u)
+        srec.record(t, integ.u, integ.velocity(vel))
         if stride and n % stride == 0:
             with event("SSI_IO"):
                 if tnode is not None:
                     tnode.mult(p, tfield)
                 out.write_fields(t, {"displacement": u, "traction": tfield})
-                sout.write_fields(t, {"displacement": integ.u, "velocity": integ.velocity(vel)})
+                sout.fw.write(t, integ.u, integ.velocity(vel))
         nrm = u.norm()
         unorm.append(nrm)
         if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
@@ -479,7 +482,9 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
     inter["x"] = iface.x
     inter["normal"] = iface.n_b
     st, su = srec.arrays()
-    return {"t": np.asarray(times), "u": soil_u, "structure_t": st, "structure_u": su, "interface": inter,
+    sall = srec.all_arrays() if comm.getRank() == 0 else None
+    return {"t": np.asarray(times), "u": soil_u, "structure_t": st, "structure_u": su, "structure": sall,
+            "interface": inter,
             "unorm": np.asarray(unorm), "_outputs": (out, sout)}
 
 
@@ -498,7 +503,5 @@ def _finish(cfg, comm, prob, model, iface, res, am):
                   groups={"interface": inter} if inter is not None else None)
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
-            srecd = {"points": model.receivers.reshape(-1, 3), "nodes": model.receiver_nodes,
-                     "node_points": model.mesh.coords[model.receiver_nodes].reshape(-1, 3),
-                     "t": res["structure_t"], "u": res["structure_u"]}
+            srecd = receiver_record(model, res["structure"])
         sout.close(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am, "dt": cfg.dt}, record=None)

@@ -1,15 +1,12 @@
-"""Hex8 element matrices and the distributed stiffness K and lumped mass M.
+"""The distributed stiffness K and lumped mass M of a structure of any mix of elements.
 
-Element kernels (vectorised over elements with numpy einsum, 2x2x2 Gauss):
-  K_e[a i, b j] = int  lambda N_a,i N_b,j + mu (N_a,j N_b,i + delta_ij N_a,k N_b,k) dV
-  m_a           = rho int N_a dV            (row sum of the consistent mass;
-                                             positive for trilinear bricks)
-``hex8_stiffness_reference`` is the slow textbook B^T D B version the fast
-kernel is tested against.
+Element kernels live in the registry (``fem/elements/``: hex8, frame, shell),
+vectorised over the cells of a block; this module only scatters them.
 
-Parallel layout (``Layout``): node-blocked, bs 3, dof 3*node + component; rank
-r owns the nodes [n0, n1) of PETSc's split. Each rank computes the element
-matrices of every brick that touches one of its nodes, keeps the rows it
+Parallel layout: the dof map (``dofmap.DofMap``): dofs numbered node by node,
+rank r owns the nodes [n0, n1) and their dofs [r0, r1) (block size 3; a hex8
+model: dof 3*node + component, as before the dof map). Each rank computes the
+element matrices of every cell that touches one of its nodes, keeps the rows it
 owns, sums them into a local CSR (global columns) that also gives the exact
 preallocation, and adds them with ``setValuesCSR(..., ADD_VALUES)``. No
 matrix is ever assembled serially and scattered. M is stored as a Vec (the
@@ -30,98 +27,10 @@ from ..petsc import init, SSIError, collective_error
 from ..monitor import event
 from .mesh import one_line
 
-XI_NODES = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                     [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
-
-
-def gauss_hex(order=2):
-    """Tensor Gauss-Legendre points (G, 3) and weights (G,) on [-1, 1]^3."""
-    x, w = np.polynomial.legendre.leggauss(order)
-    P = np.array(np.meshgrid(x, x, x, indexing="ij")).reshape(3, -1).T
-    W = np.prod(np.array(np.meshgrid(w, w, w, indexing="ij")).reshape(3, -1).T, axis=1)
-    return P, W
-
-
-def hex8_shape(xi):
-    """Trilinear shape functions N (G, 8) and derivatives dN/dxi (G, 8, 3)."""
-    t = 1.0 + xi[:, None, :] * XI_NODES[None, :, :]          # (G, 8, 3)
-    N = 0.125 * np.prod(t, axis=2)
-    dN = np.empty(t.shape)
-    for k in range(3):
-        others = [j for j in range(3) if j != k]
-        dN[:, :, k] = 0.125 * XI_NODES[None, :, k] * t[:, :, others[0]] * t[:, :, others[1]]
-    return N, dN
-
-
-def hex8_geometry(X, order=2):
-    """Physical derivatives dN/dx (E, G, 8, 3), weights |J| w (E, G) and N (G, 8).
-
-    ``X``: (E, 8, 3) node coordinates. Raises SSIError on a non-positive
-    Jacobian (inverted or degenerate brick, or a wrong node order).
-    """
-    P, W = gauss_hex(order)
-    N, dN = hex8_shape(P)
-    J = np.matmul(X.transpose(0, 2, 1)[:, None], dN[None])   # (E, G, 3, 3): dx_i / dxi_k
-    det = np.linalg.det(J)
-    if np.any(det <= 0):
-        bad = np.unique(np.nonzero(det <= 0)[0])
-        raise SSIError(f"{bad.size} hex8 cell(s) have a non-positive Jacobian (first: cell {bad[0]}): "
-                       "inverted or degenerate bricks, or a node order other than gmsh's")
-    Jinv = np.linalg.inv(J)                                  # dxi_k / dx_i
-    dNdx = np.matmul(dN[None], Jinv)                         # (E, G, 8, 3)
-    return dNdx, det * W[None, :], N
-
-
-def lame(E, nu):
-    """Lame constants (lambda, mu) from Young's modulus and Poisson's ratio."""
-    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
-
-
-def hex8_stiffness(X, E, nu):
-    """Element stiffness matrices (E, 24, 24), dof order 3*a + i. Vectorised.
-
-    Both terms are batched products over (Gauss point, direction):
-    T1[a i, b j] = sum_g w N_a,i N_b,j and T2[a, b] = sum_g,k w N_a,k N_b,k.
-    """
-    lam, mu = lame(E, nu)
-    G, wd, _ = hex8_geometry(X)
-    ne, ng = G.shape[:2]
-    Gf = G.reshape(ne, ng, 24)                               # (a, i) -> 3a + i
-    T1 = np.matmul((Gf * wd[:, :, None]).transpose(0, 2, 1), Gf).reshape(ne, 8, 3, 8, 3)
-    Gk = G.transpose(0, 2, 1, 3).reshape(ne, 8, 3 * ng)      # a x (g, k)
-    T2 = np.matmul(Gk * np.repeat(wd, 3, axis=1)[:, None, :], Gk.transpose(0, 2, 1))
-    Ke = lam * T1 + mu * T1.transpose(0, 1, 4, 3, 2)
-    Ke += mu * T2[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-    return Ke.reshape(-1, 24, 24)
-
-
-def hex8_lumped_mass(X, rho):
-    """Lumped nodal masses (E, 8): rho int N_a dV (row sums of the consistent mass)."""
-    _, wd, N = hex8_geometry(X)
-    return rho * np.einsum("ga,eg->ea", N, wd)
-
-
-def hex8_stiffness_reference(X, E, nu):
-    """Slow textbook K_e = sum_g B^T D B |J| w, one element and point at a time."""
-    lam, mu = lame(E, nu)
-    D = np.zeros((6, 6))
-    D[:3, :3] = lam
-    D[np.arange(3), np.arange(3)] += 2 * mu
-    D[np.arange(3, 6), np.arange(3, 6)] = mu
-    P, W = gauss_hex(2)
-    N, dN = hex8_shape(P)
-    out = np.zeros((X.shape[0], 24, 24))
-    for e in range(X.shape[0]):
-        for g in range(P.shape[0]):
-            J = X[e].T @ dN[g]
-            dx = dN[g] @ np.linalg.inv(J)                    # (8, 3)
-            B = np.zeros((6, 24))
-            for a in range(8):
-                gx, gy, gz = dx[a]
-                B[:, 3 * a:3 * a + 3] = [[gx, 0, 0], [0, gy, 0], [0, 0, gz],
-                                         [0, gz, gy], [gz, 0, gx], [gy, gx, 0]]
-            out[e] += B.T @ D @ B * np.linalg.det(J) * W[g]
-    return out
+from .elements.hex8 import (XI_NODES, gauss_hex, hex8_shape, hex8_geometry, lame,  # noqa: F401 (compat)
+                             hex8_stiffness, hex8_lumped_mass, hex8_stiffness_reference)
+from .elements import Props
+from .dofmap import DofMap, Layout  # noqa: F401  (Layout: the dof map of a hex8-only model)
 
 
 @dataclass
@@ -131,55 +40,38 @@ class Material:
     rho: float
 
 
-class Layout:
-    """Node-blocked ownership of the 3N dofs on ``comm`` (collective)."""
-
-    def __init__(self, n_nodes, comm):
-        PETSc = init()
-        self.comm = comm
-        self.n_nodes = int(n_nodes)
-        self._tmpl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * self.n_nodes), bsize=3, comm=comm)
-        r0, r1 = self._tmpl.getOwnershipRange()
-        self.r0, self.r1 = r0, r1
-        self.n0, self.n1 = r0 // 3, r1 // 3
-
-    def vec(self):
-        v = self._tmpl.duplicate()
-        v.zeroEntries()
-        return v
-
-    @property
-    def n_local(self):
-        return self.r1 - self.r0
-
-    def nodal_vec(self, values):
-        """Vec from a replicated (N, 3) array."""
-        v = self.vec()
-        v.getArray()[:] = np.asarray(values, float)[self.n0:self.n1].ravel()
-        return v
+def _props(block, material):
+    """The block's properties, or the legacy material (a hex8 mesh assembled with a Material)."""
+    if block.props is not None:
+        return block.props
+    if material is None:
+        raise SSIError(f"part '{block.part}' has no properties")
+    return Props(E=material.E, nu=material.nu, rho=material.rho)
 
 
-def local_cells(mesh, layout):
-    """Bricks touching at least one node this rank owns."""
-    owned = (mesh.cells >= layout.n0) & (mesh.cells < layout.n1)
+def local_cells(cells, dofmap):
+    """Indices of the cells touching at least one node this rank owns."""
+    owned = (cells >= dofmap.n0) & (cells < dofmap.n1)
     return np.nonzero(owned.any(axis=1))[0]
 
 
-def local_stiffness_csr(mesh, mat, layout, chunk=20000):
-    """Owned rows of K as a scipy CSR (local rows, global columns), summed."""
+def local_stiffness_csr(mesh, mat, dofmap, chunk=20000):
+    """Owned rows of K as a scipy CSR (local rows, global columns), summed over the blocks."""
     from scipy.sparse import csr_matrix
-    cells = mesh.cells[local_cells(mesh, layout)]
-    n = 3 * layout.n_nodes
-    A = csr_matrix((layout.n_local, n))
-    for s in range(0, cells.shape[0], chunk):
-        c = cells[s:s + chunk]
-        Ke = hex8_stiffness(mesh.coords[c], mat.E, mat.nu)
-        dofs = (3 * c[:, :, None] + np.arange(3)).reshape(-1, 24)
-        rows = np.broadcast_to(dofs[:, :, None], Ke.shape).ravel()
-        cols = np.broadcast_to(dofs[:, None, :], Ke.shape).ravel()
-        keep = (rows >= layout.r0) & (rows < layout.r1)
-        A = A + csr_matrix((Ke.ravel()[keep], (rows[keep] - layout.r0, cols[keep])),
-                           shape=(layout.n_local, n))
+    n = dofmap.size
+    A = csr_matrix((dofmap.n_local, n))
+    for blk in mesh.blocks:
+        el, props = blk.element, _props(blk, mat)
+        cells = blk.cells[local_cells(blk.cells, dofmap)]
+        for s in range(0, cells.shape[0], chunk):
+            c = cells[s:s + chunk]
+            Ke = el.stiffness(mesh.coords[c], props)
+            dofs = dofmap.cell_dofs(c, el.dof_names)
+            rows = np.broadcast_to(dofs[:, :, None], Ke.shape).ravel()
+            cols = np.broadcast_to(dofs[:, None, :], Ke.shape).ravel()
+            keep = (rows >= dofmap.r0) & (rows < dofmap.r1)
+            A = A + csr_matrix((Ke.ravel()[keep], (rows[keep] - dofmap.r0, cols[keep])),
+                               shape=(dofmap.n_local, n))
     A.sum_duplicates()
     A.sort_indices()
     return A
@@ -202,19 +94,46 @@ def csr_to_petsc(A, layout):
     return M
 
 
-def local_lumped_mass(mesh, mat, layout):
-    """Nodal masses of the nodes this rank owns (numpy, no communication)."""
-    cells = mesh.cells[local_cells(mesh, layout)]
-    me = hex8_lumped_mass(mesh.coords[cells], mat.rho)
-    return np.bincount(cells.ravel(), weights=me.ravel(), minlength=mesh.n_nodes)[layout.n0:layout.n1]
+def block_masses(mesh, mat=None):
+    """Replicated: [(block, lumped masses (E, nd))] of every block (numpy, no communication)."""
+    return [(blk, blk.element.lumped_mass(mesh.coords[blk.cells], _props(blk, mat))) for blk in mesh.blocks]
+
+
+def local_lumped_mass(mesh, mat, dofmap):
+    """Lumped masses of the dofs this rank owns (numpy, no communication)."""
+    m = np.zeros(dofmap.n_local)
+    for blk in mesh.blocks:
+        el = blk.element
+        cells = blk.cells[local_cells(blk.cells, dofmap)]
+        me = el.lumped_mass(mesh.coords[cells], _props(blk, mat))
+        d = dofmap.cell_dofs(cells, el.dof_names).ravel()
+        own = (d >= dofmap.r0) & (d < dofmap.r1)
+        m += np.bincount(d[own] - dofmap.r0, weights=me.ravel()[own], minlength=dofmap.n_local)
+    return m
 
 
 def lumped_mass_vec(mesh, mat, layout, local=None):
-    """Collective: Vec of nodal masses (each repeated for the 3 components)."""
+    """Collective: Vec of the lumped mass per dof."""
     m = local_lumped_mass(mesh, mat, layout) if local is None else local
     v = layout.vec()
-    v.getArray()[:] = np.repeat(m, 3)
+    v.getArray()[:] = m
     return v
+
+
+def mass_report(mesh, mat=None):
+    """Replicated: per part, the total mass [kg] (x translations) and the rotary inertia
+    [kg m^2] summed over its rotation dofs (rx, ry, rz), and the structure's total mass."""
+    parts = {}
+    for blk, me in block_masses(mesh, mat):
+        k = len(blk.element.dof_names)
+        me = me.reshape(me.shape[0], -1, k)
+        r = parts.setdefault(blk.part, {"element": blk.element.name, "cells": 0, "mass": 0.0,
+                                        "rotary": np.zeros(3)})
+        r["cells"] += me.shape[0]
+        r["mass"] += float(me[:, :, 0].sum())
+        if k == 6:
+            r["rotary"] += me[:, :, 3:].sum(axis=(0, 1))
+    return parts, sum(r["mass"] for r in parts.values())
 
 
 def diagonal_mat(d):
@@ -250,8 +169,10 @@ def eliminate_dofs(A, owned):
 
 
 def assemble(mesh, mat, layout):
-    """Collective: (K Mat, lumped mass Vec). Checks the brick Jacobians first; an error on
-    any rank (SSIError or not) is raised on every rank as a one-line SSIError."""
+    """Collective: (K Mat, lumped mass Vec) of every block of ``mesh`` in the dof map
+    ``layout``; ``mat`` (a Material) gives the properties of blocks without their own
+    (a hex8 mesh built without parts), else None. An error on any rank (SSIError or
+    not) is raised on every rank as a one-line SSIError."""
     with event("FEM_assembly"):
         err = None
         A = m = None

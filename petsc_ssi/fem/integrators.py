@@ -129,16 +129,21 @@ SOLVER_ITERATIVE = {"ksp_type": "cg", "ksp_rtol": "1e-12", "ksp_atol": "1e-50",
                     "pc_hypre_boomeramg_agg_nl": "1"}
 
 
-def make_solver(A, prefix, solver, comm, coords_vec=None, log=printf):
+def make_solver(A, prefix, solver, comm, coords_vec=None, log=printf, near_null=None):
     """Collective: KSP on A with prefix; defaults only where the user set none.
 
+    The AMG near-null space: ``near_null`` (a PETSc NullSpace: the dof map's six
+    rigid-body modes, rotation dofs included), or PETSc's rigid-body modes of the
+    coordinates ``coords_vec`` (a translations-only layout, bs 3).
     A Krylov method starts from the previous solution (the step-to-step
     change is small); preonly (LU) ignores it.
     """
     PETSc = init()
     defaults = direct_solver_defaults(comm) if solver == "direct" else dict(SOLVER_ITERATIVE)
     set_default_options(prefix, defaults, log=log)
-    if coords_vec is not None:
+    if near_null is not None:
+        A.setNearNullSpace(near_null)
+    elif coords_vec is not None:
         A.setNearNullSpace(PETSc.NullSpace().createRigidBody(coords_vec))
     ksp = PETSc.KSP().create(comm)
     ksp.setOptionsPrefix(prefix)
@@ -191,7 +196,7 @@ class _Dynamic:
     """Shared set-up: D = K + c M, the mask of free dofs, M^{-1} on free dofs."""
 
     def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5,
-                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf):
+                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf, near_null=None):
         comm = K.getComm()
         check(dt > 0, f"time step dt = {dt} must be > 0", comm)
         self.comm, self.K, self.m, self.dt = comm, K, m, float(dt)
@@ -200,7 +205,7 @@ class _Dynamic:
         check_mass(m, self.mask, comm)
         with event("FEM_assembly"):
             self.D = self._assemble_D()
-        self.ksp = make_solver(self.D, prefix, solver, comm, coords_vec, log)
+        self.ksp = make_solver(self.D, prefix, solver, comm, coords_vec, log, near_null)
         with event("FEM_factor"):
             setup_or_fail(self.ksp, self.mask, "D (eq. 15)", comm)
         self.u, self.v, self.w, self.rhs = (self._zeros() for _ in range(4))

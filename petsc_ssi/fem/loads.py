@@ -1,13 +1,17 @@
 """Loads and constraints of the structure: f(t) = h(t) F, fixed dofs.
 
-Spatial part F: a pressure p0 on named face groups, converted to consistent
-nodal forces over the bilinear face quads,
+Spatial part F: a pressure p0 on named groups of brick faces or shell cells,
+converted to consistent nodal forces over the bilinear quads,
     F_a = -p0 int_face N_a n dA = -p0 int N_a (x_s x x_t) ds dt   (2x2 Gauss, exact
 for flat or warped bilinear quads), with n the outward normal (p0 > 0 pushes
 into the body: the paper's top load p(t) = -p0 (H(t) - H(t - 0.025 s)) is
 p0 = 1000 N/m^2 on "top" with the box history; 'name:factor' scales p0 on a
-group, e.g. 'top_left,top_right:-1' for the antisymmetric case); plus point loads at the
-nearest FE nodes (refused farther away than the largest element size).
+group, e.g. 'top_left,top_right:-1' for the antisymmetric case; on shells, whose
+cells are oriented "up" (fem/mesh.py), p0 > 0 pushes a slab down); plus point
+forces and moments at the nearest FE nodes (refused farther away than the largest
+element size; a moment needs a node with rotations).
+
+Fixed dofs: 'group[:dofs]' items (``fixed_dofs``), dof names ux uy uz rx ry rz.
 
 Time part h(t): ``petsc_ssi.histories.History``, shared with the BEM:
 heaviside H(t) = 1 for t > 0, box 1 on (0, t0], or a table of (t, h) rows
@@ -85,40 +89,113 @@ def load_groups(spec):
     return out
 
 
-def nodal_load(mesh, cfg):
-    """Replicated (N, 3) spatial load F [N] and the point-load snap distances."""
+def pressure_groups(mesh, names, what="-ssi_fem_load_group"):
+    """Quads of the comma-separated groups: brick faces (outward) or shell cells (oriented up,
+    see fem/mesh.py); SSIError naming what exists."""
+    out = []
+    for name in [s.strip() for s in names.split(",") if s.strip()]:
+        if name in mesh.faces:
+            out.append(mesh.faces[name])
+        elif name in mesh.shells:
+            out.append(mesh.shells[name])
+        else:
+            avail = sorted(set(mesh.faces) | set(mesh.shells))
+            raise SSIError(f"{what}: no face group '{name}' in mesh {mesh.source} "
+                           f"(face groups: {', '.join(avail) or 'none'}; a pressure acts on brick faces or "
+                           "shell cells)")
+    return np.concatenate(out) if out else np.zeros((0, 4), np.int64)
+
+
+def parse_point_loads(text, what="-ssi_fem_point_load"):
+    """'x,y,z,fx,fy,fz[,mx,my,mz];...' -> (R, 9) (moments 0 where not given)."""
+    rows = [r.strip() for r in str(text or "").replace("\n", ";").split(";") if r.strip()]
+    out = []
+    for r in rows:
+        try:
+            vals = [float(v) for v in r.split(",")]
+        except ValueError:
+            vals = []
+        if len(vals) not in (6, 9) or not np.all(np.isfinite(vals)):
+            raise SSIError(f"{what}: '{r}' is not 6 or 9 comma-separated numbers (each point needs x,y,z,fx,fy,fz "
+                           "and optionally mx,my,mz)")
+        out.append(vals + [0.0] * (9 - len(vals)))
+    return np.array(out, float).reshape(-1, 9)
+
+
+def nodal_load(mesh, cfg, dofmap=None):
+    """Replicated spatial load F [N, N m] and the point-load snap distances.
+
+    With ``dofmap``: a global dof array (size dofmap.size), moments on rotation dofs.
+    Without (hex8 meshes, the form before the dof map): an (N, 3) array of forces."""
     F = np.zeros((mesh.n_nodes, 3))
+    M = np.zeros((mesh.n_nodes, 3))
     if cfg.fem_load_p0 != 0:
         for name, scale in load_groups(cfg.fem_load_group):
-            quads = group_faces(mesh, name, "-ssi_fem_load_group")
+            quads = pressure_groups(mesh, name)
             fq = quad_pressure_forces(mesh.coords[quads], scale * cfg.fem_load_p0)
             for i in range(3):
                 F[:, i] += np.bincount(quads.ravel(), weights=fq[:, :, i].ravel(), minlength=mesh.n_nodes)
     dist = np.zeros(0)
     if cfg.fem_point_load.strip():
-        pl = parse_points(cfg.fem_point_load, 6, "-ssi_fem_point_load", "x,y,z,fx,fy,fz")
+        pl = parse_point_loads(cfg.fem_point_load)
         nodes, dist = snap_points(mesh, pl[:, :3], "-ssi_fem_point_load")
-        np.add.at(F, nodes, pl[:, 3:])
-    return F, dist
+        np.add.at(F, nodes, pl[:, 3:6])
+        np.add.at(M, nodes, pl[:, 6:9])
+        if np.any(pl[:, 6:9] != 0):
+            rot = mesh.has_rotation() if dofmap is None else dofmap.has_rotation
+            bad = np.nonzero((np.abs(pl[:, 6:9]).sum(axis=1) > 0) & ~rot[nodes])[0]
+            if bad.size:
+                p = pl[bad[0]]
+                raise SSIError(f"-ssi_fem_point_load: the moment at ({p[0]:g}, {p[1]:g}, {p[2]:g}) acts on a node "
+                               "without rotation dofs (a brick node); load a frame or shell node")
+    if dofmap is None:
+        return F, dist
+    return dofmap.nodal_array(F, M), dist
 
 
-def fixed_dofs(mesh, spec):
-    """Sorted global dofs fixed by 'name[:xyz],...' (all components by default)."""
+FIXED_LEGACY = set("xyz")
+
+
+def _fixed_names(item):
+    """Dof names of 'group[:spec]': legacy letters (x, xz, xyz: translations), names joined by '+'
+    (ux+ry+rz), or all (None) for a bare group."""
+    from .dofmap import DOF_NAMES
+    name, sep, comps = item.partition(":")
+    comps = comps.strip()
+    if not sep or not comps:
+        return name.strip(), None
+    low = comps.lower()
+    if set(low) <= FIXED_LEGACY and "+" not in low:
+        return name.strip(), tuple("u" + c for c in sorted(set(low)))
+    names = tuple(c.strip() for c in comps.split("+") if c.strip())
+    for c in names:
+        if c not in DOF_NAMES:
+            import difflib
+            near = difflib.get_close_matches(c, DOF_NAMES, n=1)
+            raise SSIError(f"-ssi_fem_fixed '{item}': unknown dof name '{c}' (dof names: {', '.join(DOF_NAMES)}, "
+                           "joined by '+'; or letters of xyz)" + (f"; did you mean {near[0]}?" if near else ""))
+    return name.strip(), names
+
+
+def fixed_dofs(mesh, spec, dofmap=None):
+    """Sorted global dofs fixed by 'group[:dofs],...': a bare group fixes all its dofs
+    (translations, and rotations where its nodes have them); 'group:ux+ry+rz' the named
+    ones; 'group:x' (letters of xyz) the translations, as before rotations existed."""
+    from .dofmap import DofMap
+    dm = dofmap if dofmap is not None else DofMap(mesh.has_rotation())
     dofs = []
     for item in [s.strip() for s in str(spec).split(",") if s.strip()]:
-        name, _, comps = item.partition(":")
-        comps = comps.strip().lower() or "xyz"
-        if set(comps) - set("xyz"):
-            raise SSIError(f"-ssi_fem_fixed '{item}': components must be letters of xyz")
-        if name not in mesh.nodes and name not in mesh.faces:
+        name, names = _fixed_names(item)
+        if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
             raise SSIError(f"-ssi_fem_fixed: no group '{name}' in mesh {mesh.source} "
                            f"(groups: {', '.join(mesh.group_names()) or 'none'})")
-        nodes = mesh.group_nodes(name)
-        for c in sorted(set(comps)):
-            dofs.append(3 * nodes + "xyz".index(c))
+        nodes = mesh.group_nodes(name, "-ssi_fem_fixed")
+        if names is None:
+            names = ("ux", "uy", "uz", "rx", "ry", "rz")
+        elif any(c[0] == "r" for c in names) and not dm.has_rotation[nodes].any():
+            raise SSIError(f"-ssi_fem_fixed '{item}': the nodes of group '{name}' have no rotation dofs (bricks only)")
+        dofs.append(dm.dofs(nodes, names))
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)
-
-
 def rigid_body_modes(coords):
     """(3N, 6) rigid-body displacement fields: 3 translations, 3 rotations."""
     n = coords.shape[0]

@@ -1,17 +1,33 @@
-"""Hex8 meshes of the structure: gmsh reader, structured generator, groups.
+"""The structure's mesh: cell blocks bound to parts, node groups, faces; reader and generator.
 
-A ``HexMesh`` is replicated on every rank (structures here have at most
+A ``StructureMesh`` is replicated on every rank (structures here have at most
 ~1e5 nodes); the PETSc matrices built from it are distributed by node
-ownership ranges (see ``assembly.Layout``). Node order of a hex8 cell is
-gmsh's (= VTK's): 0-3 the face zeta = -1 counter-clockwise seen from +z,
-4-7 the face zeta = +1 above them.
+ownership (``dofmap.DofMap``). It holds
 
-Groups (gmsh physical groups, or the generator's names):
-  ``faces[name]``  (F, 4) boundary quads, node order giving the outward normal
-                   of the brick that owns the face (re-oriented here, whatever
-                   order the file had);
-  ``nodes[name]``  node ids of any physical group (points, curves, surfaces,
-                   volumes); a face group's nodes are also a node group.
+  coords           (N, 3) node coordinates (only nodes of part cells)
+  blocks           [Block(part, element, cells, props)]: the cells of each part
+                   (a frame part may be split in two blocks: members along z get
+                   the default orientation x, the others z)
+  nodes[name]      node ids of any physical group (points, curves, surfaces,
+                   volumes) and of the generator's groups
+  faces[name]      (F, 4) boundary quads of the bricks, node order giving the
+                   outward normal of the brick that owns the face (re-oriented
+                   here, whatever order the file had)
+  shells[name]     (F, 4) quads of a 2-D group that are shell cells, oriented
+                   "up" (normal with n_z > 0; vertical walls n_x > 0, then n_y > 0)
+  dims[name]       the dimension of each group
+
+Node order of a hex8 cell is gmsh's (= VTK's): 0-3 the face zeta = -1
+counter-clockwise seen from +z, 4-7 the face zeta = +1 above them.
+
+Reading (``build_mesh``, rank 0 only; ``load_mesh`` broadcasts, with one
+collective error path): the one gmsh reader (``mesh/gmsh.py``), the part cells
+(``parts.py``: each part is a physical group of the element's dimension),
+compaction to the nodes of part cells, then the checks: a part on a group of
+the wrong dimension or without cells of its type, a cell in two parts,
+coincident nodes that should be merged, each element's own geometry check
+(zero length or area, inverted cells, a frame orientation parallel to the
+member), and a group with nodes in no element (unconnected) when it is used.
 """
 from dataclasses import dataclass, field
 
@@ -19,6 +35,7 @@ import numpy as np
 
 from ..petsc import SSIError, collective_error
 from ..points import parse_triple
+from .elements import Props
 
 # Local faces of a hex8, each ordered so that (x1-x0) x (x3-x0) points outward.
 HEX_FACES = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4],
@@ -30,12 +47,23 @@ GMSH_HEX8, GMSH_QUAD4, GMSH_QUAD9 = 5, 3, 10
 
 
 @dataclass
-class HexMesh:
-    coords: np.ndarray                          # (N, 3) float
-    cells: np.ndarray                           # (E, 8) int64
-    faces: dict = field(default_factory=dict)   # name -> (F, 4) outward quads
-    nodes: dict = field(default_factory=dict)   # name -> (k,) node ids
+class Block:
+    part: str
+    element: object                  # elements.ElementType
+    cells: np.ndarray                # (E, nodes_per_cell) node ids
+    props: Props = None              # None: the material passed to assembly (legacy hex8 calls)
+
+
+@dataclass
+class StructureMesh:
+    coords: np.ndarray
+    blocks: list = field(default_factory=list)
+    faces: dict = field(default_factory=dict)
+    nodes: dict = field(default_factory=dict)
     source: str = ""
+    shells: dict = field(default_factory=dict)
+    dims: dict = field(default_factory=dict)
+    unconnected: dict = field(default_factory=dict)   # group -> nodes of it in no part cell
 
     @property
     def n_nodes(self):
@@ -43,16 +71,49 @@ class HexMesh:
 
     @property
     def n_cells(self):
-        return self.cells.shape[0]
+        return int(sum(b.cells.shape[0] for b in self.blocks))
+
+    @property
+    def cells(self):
+        """The hex8 cells of every hex8 block (E, 8) (the brick mesh; empty without bricks)."""
+        hx = [b.cells for b in self.blocks if b.element.name == "hex8"]
+        return np.concatenate(hx) if hx else np.zeros((0, 8), np.int64)
+
+    def element_counts(self):
+        out = {}
+        for b in self.blocks:
+            out[b.element.name] = out.get(b.element.name, 0) + b.cells.shape[0]
+        return out
+
+    def has_rotation(self):
+        """(N,) bool: nodes touched by an element with rotation dofs."""
+        rot = np.zeros(self.n_nodes, bool)
+        for b in self.blocks:
+            if len(b.element.dof_names) > 3:
+                rot[b.cells.ravel()] = True
+        return rot
 
     def group_names(self):
-        return sorted(set(self.faces) | set(self.nodes))
+        return sorted(set(self.faces) | set(self.nodes) | set(self.shells))
 
-    def group_nodes(self, name):
-        """Node ids of a face or node group (KeyError if absent)."""
+    def group_nodes(self, name, what="group"):
+        """Node ids of a group (KeyError if absent; SSIError if some of its nodes
+        belong to no element of any part)."""
+        if self.unconnected.get(name):
+            raise SSIError(f"{what} '{name}': {self.unconnected[name]} of its nodes belong to no element of any "
+                           "part (unconnected nodes; is the group on the structure?)")
         if name in self.nodes:
             return self.nodes[name]
-        return np.unique(self.faces[name])
+        if name in self.faces:
+            return np.unique(self.faces[name])
+        return np.unique(self.shells[name])
+
+
+def HexMesh(coords, cells, faces=None, nodes=None, source=""):
+    """A brick-only StructureMesh (one hex8 block; the material comes with the assembly call)."""
+    from .elements import get
+    return StructureMesh(np.asarray(coords, float), [Block("structure", get("hex8"), np.asarray(cells, np.int64))],
+                         dict(faces or {}), dict(nodes or {}), source)
 
 
 def one_line(exc):
@@ -138,100 +199,212 @@ def orient_faces(cells, quads, name="?"):
 
 
 # ------------------------------------------------------------------ gmsh
-def read_gmsh(path):
-    """Serial: read a .msh, or mesh a .geo in 3D, with gmsh; return a HexMesh.
+def read_gmsh(path, specs=None):
+    """Serial: read a .msh, or mesh a .geo in 3D, with gmsh; return a StructureMesh.
 
-    Only nodes used by hex8 cells are kept (renumbered 0..N-1). Raises
-    SSIError on a mesh without hex8 cells or with other 3D cell types.
-    """
-    import gmsh
-    gmsh.initialize(readConfigFiles=False, interruptible=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        try:
-            gmsh.open(path)
-            if not path.endswith(".msh"):
-                gmsh.model.mesh.generate(3)
-        except Exception as exc:
-            raise SSIError(f"gmsh could not read/mesh '{path}': {exc}") from None
-        return _gmsh_model_to_mesh(gmsh, path)
-    finally:
-        gmsh.finalize()
+    ``specs``: the parts ([parts.PartSpec]); None: one hex8 part of every brick
+    (only nodes used by hex8 cells are kept, renumbered 0..N-1, as before parts
+    existed). Raises SSIError on any check of the module docstring."""
+    from ..mesh import gmsh as reader
+    from .parts import parse_parts
+    model = reader.read(path, dim=3)
+    if specs is None:
+        from types import SimpleNamespace
+        specs = parse_parts(SimpleNamespace(get=lambda *a: "", fem_E=1.0, fem_nu=0.0, fem_rho=1.0), raw={})
+        specs[0].props = None
+    return structure_from_model(model, specs, path)
 
 
-def _gmsh_model_to_mesh(gmsh, path):
-    tags, xyz, _ = gmsh.model.mesh.getNodes()
-    types, _, enodes = gmsh.model.mesh.getElements(3)
-    found = {int(t): len(n) // gmsh.model.mesh.getElementProperties(t)[3] for t, n in zip(types, enodes)}
-    if GMSH_HEX8 not in found:
-        desc = ", ".join(f"{gmsh.model.mesh.getElementProperties(t)[0]} x{c}" for t, c in found.items())
-        raise SSIError(f"mesh '{path}' has no hex8 (8-node brick) cells (3D cells found: {desc or 'none'}); "
-                       "use Transfinite/Recombine or extrusion with Layers/Recombine in the .geo")
-    others = {t: c for t, c in found.items() if t != GMSH_HEX8}
-    if others:
-        desc = ", ".join(f"{gmsh.model.mesh.getElementProperties(t)[0]} x{c}" for t, c in others.items())
-        raise SSIError(f"mesh '{path}' mixes hex8 with other 3D cells ({desc}); only hex8 is supported")
-    tag2idx = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-    tag2idx[tags.astype(np.int64)] = np.arange(len(tags))
-    coords_all = xyz.reshape(-1, 3)
-    hex_tags = np.asarray(enodes[list(types).index(GMSH_HEX8)], dtype=np.int64).reshape(-1, 8)
-    used = np.unique(hex_tags)
-    new = np.full(tag2idx.shape[0], -1, dtype=np.int64)
-    new[used] = np.arange(len(used))
-    cells = new[hex_tags]
-    coords = coords_all[tag2idx[used]]
-    mesh = HexMesh(coords, cells, source=path)
-    for dim, ptag in gmsh.model.getPhysicalGroups():
-        name = gmsh.model.getPhysicalName(dim, ptag) or f"{dim}:{ptag}"
-        ntags, _ = gmsh.model.mesh.getNodesForPhysicalGroup(dim, ptag)
-        ids = new[np.asarray(ntags, dtype=np.int64)]
+def _legacy_cells(model, path):
+    from ..mesh.gmsh import describe, unknown_of_dim
+    other3d = unknown_of_dim(model, 3)
+    if "hex8" not in model.blocks:
+        raise SSIError(f"mesh '{path}' has no hex8 (8-node brick) cells (3D cells found: "
+                       f"{describe(other3d) or 'none'}); use Transfinite/Recombine or extrusion with "
+                       "Layers/Recombine in the .geo, or name frame/shell parts with -ssi_fem_parts")
+    if other3d:
+        raise SSIError(f"mesh '{path}' mixes hex8 with other 3D cells ({describe(other3d)}); only hex8 is supported")
+    return model.blocks["hex8"]
+
+
+def _part_cells(model, spec, path):
+    from ..mesh.gmsh import describe
+    from .parts import CELL_TYPE, DIM
+    grp = model.groups.get(spec.name)
+    if grp is None:
+        names = sorted(model.groups)
+        raise SSIError(f"part '{spec.name}': no physical group '{spec.name}' in mesh {path} "
+                       f"(groups: {', '.join(names) or 'none'})")
+    want = DIM[spec.element]
+    if grp.dim != want:
+        raise SSIError(f"part '{spec.name}' is a {spec.element} part ({want}-D cells) but the physical group "
+                       f"'{spec.name}' has dimension {grp.dim}")
+    ct = CELL_TYPE[spec.element]
+    idx = grp.cells.get(ct, np.zeros(0, np.int64))
+    if idx.size == 0:
+        found = {k: len(v) for k, v in grp.cells.items() if len(v)}
+        raise SSIError(f"part '{spec.name}' ({spec.element}): the group has no {ct} cells (found: "
+                       f"{describe(found) or 'none'}; shells need quads: Recombine the surfaces)")
+    other = [k for k, v in grp.cells.items() if k != ct and len(v) and k != "point"]
+    if other:
+        raise SSIError(f"part '{spec.name}' ({spec.element}): the group also has {', '.join(other)} cells; "
+                       f"a {spec.element} part takes {ct} cells only")
+    return ct, idx
+
+
+def _orient_up(X):
+    """(F,) bool: quads whose normal (x2 - x0) x (x3 - x1) points 'down' (n_z < 0; vertical: n_x < 0,
+    then n_y < 0)."""
+    n = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
+    tol = 1e-8 * np.linalg.norm(n, axis=1)
+    key = np.where(np.abs(n[:, 2]) > tol, n[:, 2], np.where(np.abs(n[:, 0]) > tol, n[:, 0], n[:, 1]))
+    return key < 0
+
+
+def _frame_blocks(spec, cells, coords):
+    """Blocks of a frame part: with no orientation given, members along z get x, others z."""
+    from .elements import get
+    from copy import deepcopy
+    el = get("frame")
+    if spec.orientation_given:
+        return [Block(spec.name, el, cells, spec.props)]
+    d = coords[cells[:, 1]] - coords[cells[:, 0]]
+    L = np.linalg.norm(d, axis=1)
+    vertical = np.abs(d[:, 2]) >= (1 - 1e-9) * np.where(L > 0, L, 1.0)
+    out = []
+    for sel, o in ((~vertical, (0.0, 0.0, 1.0)), (vertical, (1.0, 0.0, 0.0))):
+        if sel.any():
+            pr = deepcopy(spec.props)
+            pr.orientation = np.array(o)
+            out.append(Block(spec.name, el, cells[sel], pr))
+    return out
+
+
+def structure_from_model(model, specs, path):
+    """Serial: the StructureMesh of a gmsh model (``mesh.gmsh.GmshModel``) and the parts."""
+    from .elements import get
+    chosen = []                                       # (spec, cell type, cells in model node ids)
+    seen = {}
+    for spec in specs:
+        if spec.legacy:
+            chosen.append((spec, "hex8", _legacy_cells(model, path)))
+            continue
+        ct, idx = _part_cells(model, spec, path)
+        key = set(zip([ct] * len(idx), idx.tolist()))
+        for other, okeys in seen.items():
+            both = key & okeys
+            if both:
+                raise SSIError(f"parts '{other}' and '{spec.name}' share {len(both)} cell(s): a cell belongs to one "
+                               "part")
+        seen[spec.name] = key
+        chosen.append((spec, ct, model.blocks[ct][idx]))
+    used = np.unique(np.concatenate([c.ravel() for _, _, c in chosen]))
+    new = np.full(model.coords.shape[0], -1, np.int64)
+    new[used] = np.arange(used.size)
+    coords = model.coords[used]
+    blocks = []
+    for spec, ct, c in chosen:
+        cells = new[c]
+        if spec.element == "shell":
+            flip = _orient_up(coords[cells])
+            cells[flip] = cells[flip][:, [0, 3, 2, 1]]
+        if spec.element == "frame":
+            blocks += _frame_blocks(spec, cells, coords)
+        else:
+            blocks.append(Block(spec.name, get(spec.element), cells, spec.props))
+    mesh = StructureMesh(coords, blocks, source=path)
+    legacy = all(s.legacy for s in specs)
+    hexcells = mesh.cells
+    shell_keys = {}
+    for b in blocks:
+        if b.element.name == "shell":
+            for k, q in zip(map(tuple, np.sort(b.cells, axis=1)), b.cells):
+                shell_keys[k] = q
+    for name, grp in model.groups.items():
+        ids = new[grp.nodes]
+        mesh.dims[name] = grp.dim
         mesh.nodes[name] = np.unique(ids[ids >= 0])
-        if dim == 2:
-            quads = _gmsh_group_quads(gmsh, dim, ptag, name)
-            mesh.faces[name] = orient_faces(cells, new[quads], name)
+        if np.any(ids < 0):
+            mesh.unconnected[name] = int(np.sum(ids < 0))
+        if grp.dim != 2:
+            continue
+        quads = [model.blocks[t][grp.cells[t]][:, :4] for t in ("quad4", "quad9") if t in grp.cells]
+        if not quads:
+            continue
+        q = new[np.concatenate(quads)]
+        if np.any(q < 0):
+            if legacy:
+                raise SSIError(f"face group '{name}': some quads are not boundary faces of the hex8 mesh")
+            continue
+        if hexcells.size:
+            try:
+                mesh.faces[name] = orient_faces(hexcells, q, name)
+                continue
+            except SSIError:
+                if legacy:
+                    raise
+        keys = list(map(tuple, np.sort(q, axis=1)))
+        if shell_keys and all(k in shell_keys for k in keys):
+            mesh.shells[name] = np.array([shell_keys[k] for k in keys], np.int64).reshape(-1, 4)
+    check_structure(mesh)
     return mesh
 
 
-def _gmsh_group_quads(gmsh, dim, ptag, name):
-    out = []
-    for ent in gmsh.model.getEntitiesForPhysicalGroup(dim, ptag):
-        types, _, enodes = gmsh.model.mesh.getElements(dim, ent)
-        for t, n in zip(types, enodes):
-            nper = gmsh.model.mesh.getElementProperties(t)[3]
-            if t not in (GMSH_QUAD4, GMSH_QUAD9):
-                raise SSIError(f"face group '{name}' has {gmsh.model.mesh.getElementProperties(t)[0]} "
-                               "elements; hex8 faces must be quads")
-            out.append(np.asarray(n, dtype=np.int64).reshape(-1, nper)[:, :4])
-    return np.concatenate(out) if out else np.zeros((0, 4), np.int64)
+def check_structure(mesh):
+    """Serial: coincident nodes and each element's own geometry check (SSIError, one line)."""
+    from scipy.spatial import cKDTree
+    ext = float(np.ptp(mesh.coords, axis=0).max()) if mesh.n_nodes else 0.0
+    pairs = cKDTree(mesh.coords).query_pairs(max(ext, 1e-300) * 1e-9, output_type="ndarray")
+    if len(pairs):
+        x = mesh.coords[pairs[0, 0]]
+        raise SSIError(f"{len(pairs)} pair(s) of coincident nodes (first at ({x[0]:.6g}, {x[1]:.6g}, {x[2]:.6g})): "
+                       "duplicate nodes that should be merged (gmsh: Coherence; Coherence Mesh)")
+    for b in mesh.blocks:
+        msg = b.element.check(mesh.coords[b.cells], b.props if b.props is not None else Props())
+        if msg:
+            raise SSIError(f"part '{b.part}' ({b.element.name}): {msg}")
 
 
 # ------------------------------------------------------------------ ordering
 def renumber_rcm(mesh):
-    """Reverse Cuthill-McKee renumbering: compact, banded rank partitions."""
+    """Reverse Cuthill-McKee renumbering over the cells of every block: compact, banded
+    rank partitions."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import reverse_cuthill_mckee
     n = mesh.n_nodes
-    i = np.repeat(mesh.cells, 8, axis=1).ravel()
-    j = np.tile(mesh.cells, (1, 8)).ravel()
+    ii, jj = [], []
+    for b in mesh.blocks:
+        k = b.cells.shape[1]
+        ii.append(np.repeat(b.cells, k, axis=1).ravel())
+        jj.append(np.tile(b.cells, (1, k)).ravel())
+    i, j = np.concatenate(ii), np.concatenate(jj)
     graph = coo_matrix((np.ones(i.size, np.int8), (i, j)), shape=(n, n)).tocsr()
     perm = reverse_cuthill_mckee(graph, symmetric_mode=True)   # new -> old
     old2new = np.empty(n, dtype=np.int64)
     old2new[perm] = np.arange(n)
-    return HexMesh(mesh.coords[perm], old2new[mesh.cells],
-                   {k: old2new[v] for k, v in mesh.faces.items()},
-                   {k: old2new[v] for k, v in mesh.nodes.items()}, mesh.source)
+    blocks = [Block(b.part, b.element, old2new[b.cells], b.props) for b in mesh.blocks]
+    return StructureMesh(mesh.coords[perm], blocks,
+                         {k: old2new[v] for k, v in mesh.faces.items()},
+                         {k: old2new[v] for k, v in mesh.nodes.items()}, mesh.source,
+                         {k: old2new[v] for k, v in mesh.shells.items()}, dict(mesh.dims), dict(mesh.unconnected))
 
 
-def build_mesh(cfg):
-    """Serial: the mesh the options describe (no renumbering)."""
+def build_mesh(cfg, specs=None):
+    """Serial: the mesh the options describe (no renumbering). ``specs``: the parts."""
     if cfg.fem_mesh == "box":
-        return structured_box(parse_triple(cfg.fem_box_cells, int, "-ssi_fem_box_cells"),
+        if specs is not None and not all(s.legacy for s in specs):
+            raise SSIError("-ssi_fem_parts needs a gmsh mesh (-ssi_fem_mesh FILE.geo|.msh); the box generator "
+                           "makes one hex8 part")
+        mesh = structured_box(parse_triple(cfg.fem_box_cells, int, "-ssi_fem_box_cells"),
                               parse_triple(cfg.fem_box_size, float, "-ssi_fem_box_size"),
                               parse_triple(cfg.fem_box_origin, float, "-ssi_fem_box_origin"))
-    return read_gmsh(cfg.fem_mesh)
+        if specs is not None:
+            mesh.blocks[0].props = specs[0].props
+        return mesh
+    return read_gmsh(cfg.fem_mesh, specs)
 
 
-def load_mesh(cfg, comm):
+def load_mesh(cfg, comm, specs=None):
     """Collective: build or read the mesh on rank 0, renumber, broadcast.
 
     gmsh runs on rank 0 only; any error there (SSIError or not) is raised on
@@ -241,7 +414,7 @@ def load_mesh(cfg, comm):
     mesh, err = None, None
     if mpi.rank == 0:
         try:
-            mesh = build_mesh(cfg)
+            mesh = build_mesh(cfg, specs)
             if cfg.fem_renumber:
                 mesh = renumber_rcm(mesh)
         except SSIError as exc:
@@ -254,12 +427,17 @@ def load_mesh(cfg, comm):
 
 # ------------------------------------------------------------------ queries
 def largest_element_size(mesh):
-    """The longest edge of any brick: the mesh's largest element size h_max."""
-    if mesh.n_cells == 0:
-        return 0.0
-    X = mesh.coords[mesh.cells]
-    a, b = HEX_EDGES.T
-    return float(np.linalg.norm(X[:, a] - X[:, b], axis=2).max())
+    """The longest edge of any cell: the mesh's largest element size h_max."""
+    h = 0.0
+    for blk in mesh.blocks:
+        X = mesh.coords[blk.cells]
+        k = blk.cells.shape[1]
+        edges = HEX_EDGES if k == 8 else np.array([[i, (i + 1) % k] for i in range(k)]) if k > 2 else \
+            np.array([[0, 1]])
+        a, b = edges.T
+        if len(X):
+            h = max(h, float(np.linalg.norm(X[:, a] - X[:, b], axis=2).max()))
+    return h
 
 
 def snap_points(mesh, points, what="-ssi_receivers"):

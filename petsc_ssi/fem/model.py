@@ -1,72 +1,117 @@
-"""The structure a set of options describes: mesh, K, lumped M, loads, fixed dofs.
+"""The structure a set of options describes: parts, mesh, dof map, K, lumped M, loads, fixed dofs.
 
-``build_model`` is collective and checks every input (groups, receivers,
-point loads) on the replicated mesh before the matrices are assembled, so a
-bad input costs no assembly and raises the same SSIError on every rank.
-Receivers and point loads snap to the nearest FE node; one farther away than
-the largest element size is refused (it lies outside the structure).
+``build_model`` is collective and checks every input (parts and their
+properties, groups, receivers, point loads) on the replicated mesh before the
+matrices are assembled, so a bad input costs no assembly and raises the same
+SSIError on every rank. Receivers and point loads snap to the nearest FE node;
+one farther away than the largest element size is refused (it lies outside the
+structure). At start-up it prints each part's element count, total mass and
+rotary inertia, and the structure's total mass.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..petsc import init, SSIError, collective_error, printf
-from .assembly import Layout, Material, assemble
-from .loads import fixed_dofs, nodal_load, restrains_rigid_motion
+from .assembly import Material, assemble, mass_report
+from .dofmap import DofMap
+from .loads import fixed_dofs, nodal_load
 from .mesh import load_mesh, snap_points
+from .parts import parse_parts
 from ..points import parse_points
 
 
 @dataclass
 class Model:
     mesh: object
-    layout: object
-    material: object
+    layout: object               # the dof map (fem/dofmap.py)
+    material: object             # legacy Material of a hex8 model without parts, else None
     fixed: np.ndarray            # replicated sorted global dofs
-    F: np.ndarray                # replicated (N, 3) spatial load [N]
+    F: np.ndarray                # replicated global dof array: spatial load [N, N m]
     receivers: np.ndarray        # (R, 3) requested points
     receiver_nodes: np.ndarray   # (R,) nearest nodes
     receiver_dist: np.ndarray    # (R,) snapping distances
     K: object = None             # PETSc Mat
     m: object = None             # PETSc Vec (lumped mass per dof)
+    specs: list = None           # [parts.PartSpec]
+
+    @property
+    def dofmap(self):
+        return self.layout
 
     def coords_vec(self):
+        """Collective: node coordinates in the dof layout (translation dofs; rotations 0)."""
         return self.layout.nodal_vec(self.mesh.coords)
 
     def load_vec(self):
-        return self.layout.nodal_vec(self.F)
+        return self.layout.vec_from_global(self.F)
 
     def constrained(self):
-        return restrains_rigid_motion(self.mesh.coords, self.fixed)
+        return self.layout.restrains_rigid_motion(self.mesh.coords, self.fixed)
+
+    def max_wave_speed_ratio(self):
+        """max over parts of E/rho (for the modes' default shift)."""
+        out = 0.0
+        for b in self.mesh.blocks:
+            p = b.props
+            E, rho = (p.E, p.rho) if p is not None else (self.material.E, self.material.rho)
+            if b.element.name == "shell" and p is not None and p.mass_per_area > 0:
+                rho = p.mass_per_area / p.thickness
+            out = max(out, E / max(rho + (p.added_mass / max(p.thickness, 1e-300) if b.element.name == "shell"
+                                          and p is not None else 0.0), 1e-300))
+        return out
 
 
-def _inputs(mesh, cfg):
-    fixed = fixed_dofs(mesh, cfg.fem_fixed)
-    F, pdist = nodal_load(mesh, cfg)
+def _inputs(mesh, cfg, dofmap):
+    fixed = fixed_dofs(mesh, cfg.fem_fixed, dofmap)
+    F, pdist = nodal_load(mesh, cfg, dofmap)
     pts = parse_points(cfg.receivers, 3, "-ssi_receivers")
     nodes, dist = snap_points(mesh, pts, "-ssi_receivers")
     return fixed, F, pts, nodes, dist, pdist
 
 
+def describe_parts(mesh, material=None, log=printf):
+    """Rank 0: one line per part (element, cells, mass, rotary inertia) and the total mass."""
+    parts, total = mass_report(mesh, material)
+    for name, r in parts.items():
+        rot = "" if r["element"] == "hex8" else \
+            " rotary inertia (rx, ry, rz) = ({:.4g}, {:.4g}, {:.4g}) kg m^2".format(*r["rotary"])
+        log(f"[fem] part {name}: {r['cells']} {r['element']} cells, mass {r['mass']:.6g} kg{rot}")
+    log(f"[fem] structure: total mass {total:.6g} kg")
+    return parts, total
+
+
 def build_model(cfg, comm, assemble_matrices=True, log=printf):
-    """Collective: read the mesh, check the inputs, then assemble K and M."""
+    """Collective: parse the parts, read the mesh, check the inputs, then assemble K and M."""
     init()
-    mesh = load_mesh(cfg, comm)
-    err = None
+    err, specs = None, None
     try:
-        fixed, F, pts, nodes, dist, pdist = _inputs(mesh, cfg)
+        specs = parse_parts(cfg)
     except SSIError as exc:
         err = str(exc)
     collective_error(err, comm)
-    log(f"[fem] mesh {mesh.source}: {mesh.n_nodes} nodes, {mesh.n_cells} hex8, {3 * mesh.n_nodes} dofs, "
-        f"{len(fixed)} fixed, groups: {', '.join(mesh.group_names())}")
+    mesh = load_mesh(cfg, comm, specs)
+    dofmap = DofMap(mesh.has_rotation(), comm)
+    err = None
+    try:
+        fixed, F, pts, nodes, dist, pdist = _inputs(mesh, cfg, dofmap)
+    except SSIError as exc:
+        err = str(exc)
+    collective_error(err, comm)
+    dofmap.set_fixed(fixed)
+    counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())
+    log(f"[fem] mesh {mesh.source}: {mesh.n_nodes} nodes ({int(mesh.has_rotation().sum())} with rotations), "
+        f"{counts}, {dofmap.size} dofs, {len(fixed)} fixed, groups: {', '.join(mesh.group_names())}")
+    legacy = all(s.legacy for s in specs)
+    mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho) if legacy else None
+    if not legacy:
+        describe_parts(mesh, None, log)
     for p, n, d in zip(pts, nodes, dist):
         log(f"[fem] receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) -> node {n} at "
             f"({mesh.coords[n, 0]:g}, {mesh.coords[n, 1]:g}, {mesh.coords[n, 2]:g}), snapping distance {d:.3g} m")
     for d in pdist:
         log(f"[fem] point load snapped to the nearest node at distance {d:.3g} m")
-    mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho)
-    model = Model(mesh, Layout(mesh.n_nodes, comm), mat, fixed, F, pts, nodes, dist)
+    model = Model(mesh, dofmap, mat, fixed, F, pts, nodes, dist, specs=specs)
     if assemble_matrices:
         model.K, model.m = assemble(mesh, mat, model.layout)
     return model

@@ -47,10 +47,27 @@ def _submatrices(K, m, fixed):
 
 
 def default_target(mat, coords):
-    """-1e-3 (c_s / L)^2: a negative shift well below the lowest flexible omega^2."""
+    """-1e-3 (c_s / L)^2: a negative shift well below the lowest flexible omega^2 of a solid.
+    ``mat``: a Material, or a Model (then the smallest diagonal ratio K_ii / M_ii over the
+    translations replaces c_s^2 / L^2, which suits frames and shells too)."""
+    if hasattr(mat, "K") and mat.K is not None:
+        return -1e-6 * _min_diag_ratio(mat)
     L = float(np.max(np.ptp(coords, axis=0)))
     cs2 = mat.E / (2 * (1 + mat.nu)) / mat.rho
     return -1e-3 * cs2 / L ** 2
+
+
+def _min_diag_ratio(model):
+    """Collective: min over free dofs of K_ii / M_ii."""
+    d = model.K.getDiagonal()
+    a = d.getArray(readonly=True) / np.maximum(model.m.getArray(readonly=True), 1e-300)
+    free = np.ones(a.size, bool)
+    free[owned_dofs(model.fixed, model.K) - model.K.getOwnershipRange()[0]] = False
+    a = a[free & (a > 0)]
+    from mpi4py import MPI
+    v = model.K.getComm().tompi4py().allreduce(float(a.min()) if a.size else np.inf, op=MPI.MIN)
+    d.destroy()
+    return v if np.isfinite(v) else 1.0
 
 
 def count_below(Kf, Mf, sigma):
@@ -159,7 +176,9 @@ def main():
     cfg = ssi_options.resolve(("common", "fem"))
     from .model import build_model
     model = build_model(cfg, comm)
-    target = PETSc.Options().getReal("ssi_modes_eps_target", default_target(model.material, model.mesh.coords))
+    target = PETSc.Options().getReal("ssi_modes_eps_target",
+                                     default_target(model.material if model.material is not None else model,
+                                                    model.mesh.coords))
     free = "free (6 rigid-body modes at 0 Hz)" if len(model.fixed) == 0 else "fixed: " + cfg.fem_fixed
     printf(f"[modes] {cfg.modes_n} lowest modes, {free}, shift-and-invert target {target:.4g} rad^2/s^2")
     freqs, shapes = compute_modes(model.K, model.m, model.fixed, cfg.modes_n, target)
@@ -184,10 +203,11 @@ def _damping_note(cfg, freqs):
 
 def _write(cfg, model, freqs, shapes, comm):
     from ..io.output import Output, provenance
+    from .run import FieldWriter
     out = Output(cfg.output, comm)
-    out.write_mesh(model.coords_vec(), model.mesh.cells if comm.getRank() == 0 else None, "hex8")
+    fw = FieldWriter(out, model, comm)
     for k, s in enumerate(shapes, 1):
-        out.write_fields(float(k), {"mode_shape": s})
+        fw.write(float(k), s, names=("mode_shape", "mode_shape_rotation", None))
     out.close(attrs={"problem": "modes", "frequencies_hz": np.asarray(freqs), "time_is": "mode number"},
               record=provenance(cfg, comm, {"modes": {"frequencies_hz": [float(f) for f in freqs]}}))
     printf(f"[modes] wrote {cfg.output} (+ .xmf, .json)")

@@ -28,8 +28,11 @@ def _triple(kind):
 
 
 register("fem_mesh", "str", "box", "",
-         "hex8 mesh of the structure: 'box' (structured generator, see -ssi_fem_box_*) "
-         "or a gmsh .geo/.msh file with hex8 cells (paths relative to the working directory)", G)
+         "mesh of the structure: 'box' (structured hex8 generator, see -ssi_fem_box_*) "
+         "or a gmsh .geo/.msh file (hex8, quad4 shells, line2 frames; paths relative to the working directory)", G)
+register("fem_parts", "str", "", "", "parts of the structure: physical groups that carry elements, 'NAME,...', each "
+         "with -ssi_fem_part_NAME_element hex8|frame|shell and its properties (petsc-ssi help lists them); "
+         "empty: one hex8 part of every brick with -ssi_fem_E/_nu/_rho", G)
 register("fem_box_cells", "str", "10,10,4", "cells", "box: number of bricks 'nx,ny,nz'", G,
          validator=_triple(int))
 register("fem_box_size", "str", "1,1,0.5", "m", "box: edge lengths 'lx,ly,lz'", G, validator=_triple(float))
@@ -52,18 +55,20 @@ register("fem_newmark_alpha", "real", 0.25, "", "Newmark alpha (beta in most tex
 register("fem_newmark_delta", "real", 0.5, "", "Newmark delta (gamma in most texts)", G, validator=positive)
 register("fem_solver", "enum", "direct", "", "solver of D: direct (factorise once, MUMPS) or iterative "
          "(CG + hypre BoomerAMG); -ssi_fem_ksp_*/-ssi_fem_pc_* override", G, choices=("direct", "iterative"))
-register("fem_load_group", "str", "", "", "loaded faces: comma-separated face group names, each with an optional factor on p0 (e.g. top, or top_left,top_right:-1)", G)
+register("fem_load_group", "str", "", "", "loaded faces: comma-separated groups of brick faces or shell cells, "
+         "each with an optional factor on p0 (e.g. top, or top_left,top_right:-1)", G)
 register("fem_load_p0", "real", 0.0, "N/m^2", "pressure on the load group; p0 > 0 pushes into the body "
-         "(traction -p0 h(t) n, n the outward normal)", G)
+         "(traction -p0 h(t) n, n the outward normal; on shells, cells oriented up: pushes a slab down)", G)
 register("fem_load_history", "enum", "heaviside", "", "load history h(t) of the pressure and point loads: "
          "heaviside (1 for t > 0), box (1 on (0, t0]), table", G, choices=("heaviside", "box", "table"))
 register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse", G, validator=positive)
 register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (0 before the first "
          "time, the last value after the last)", G)
-register("fem_point_load", "str", "", "m, N", "point loads 'x,y,z,fx,fy,fz;...' at the nearest FE node, "
-         "times h(t)", G)
-register("fem_fixed", "str", "", "", "fixed (zero displacement) node groups 'name[:xyz],...', e.g. 'base' or "
-         "'xmin:x' (only the x component)", G)
+register("fem_point_load", "str", "", "m, N, N m", "point loads 'x,y,z,fx,fy,fz[,mx,my,mz];...' at the nearest "
+         "FE node, times h(t) (moments need a frame or shell node)", G)
+register("fem_fixed", "str", "", "", "fixed dofs by node group 'group[:dofs],...': a bare group fixes all its dofs, "
+         "dof names ux uy uz rx ry rz joined by '+' (e.g. 'base,symx:ux+ry+rz,pin:uz'), letters of xyz fix "
+         "translations ('xmin:x')", G)
 register("modes_n", "int", 6, "", "petsc-ssi modes: number of natural modes", G, validator=at_least(1))
 
 

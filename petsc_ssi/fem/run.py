@@ -15,6 +15,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf
 from ..monitor import Progress, event
 from ..io.output import Output, provenance
+from .. import timegrid
 from .integrators import make_integrator, green_constants
 from .loads import history_from
 from .model import build_model
@@ -22,27 +23,74 @@ from .options import alpha_m
 
 
 class ReceiverSeries:
-    """Collective: the displacement of a few nodes every step, on rank 0."""
+    """Collective: displacement, rotation and velocity of a few nodes every step, on rank 0.
 
-    def __init__(self, template, nodes, comm):
+    ``dofmap``: the structure's dof map (``dofmap.DofMap``), or a Vec template of a
+    translations-only layout (dof 3 * node + c). Rotations are 0 at nodes without
+    them (``has_rotation`` says which). Accelerations (``arrays``) are the central
+    differences of the recorded velocities, (v^{n+1} - v^{n-1}) / (2 dt), one-sided
+    at the first and last step."""
+
+    def __init__(self, dofmap, nodes, comm):
         PETSc = init()
+        from .dofmap import DofMap
         self.rank = comm.getRank()
-        idx = (3 * np.asarray(nodes, np.int64)[:, None] + np.arange(3)).ravel() if self.rank == 0 else []
-        idx = np.asarray(idx, dtype=PETSc.IntType)
+        nodes = np.asarray(nodes, np.int64)
         self.n = len(nodes)
+        if isinstance(dofmap, DofMap):
+            tdofs = dofmap.node_dofs(nodes, 3)
+            self.has_rotation = dofmap.has_rotation[nodes]
+            rdofs = np.where(self.has_rotation[:, None], tdofs + 3, tdofs)
+            template = dofmap.vec()
+        else:
+            template = dofmap
+            tdofs = 3 * nodes[:, None] + np.arange(3)
+            self.has_rotation = np.zeros(self.n, bool)
+            rdofs = tdofs
+        idx = np.concatenate([tdofs.ravel(), rdofs.ravel()]) if self.rank == 0 else []
+        idx = np.asarray(idx, dtype=PETSc.IntType)
         self.seq = PETSc.Vec().createSeq(len(idx), comm=PETSc.COMM_SELF)
         is_from = PETSc.IS().createGeneral(idx, comm=PETSc.COMM_SELF)
         self.scatter = PETSc.Scatter().create(template, is_from, self.seq, None)
-        self.t, self.u = [], []
+        self.t, self.u, self.r, self.v = [], [], [], []
 
-    def record(self, t, u):
-        self.scatter.scatter(u, self.seq)
+    def _grab(self, x):
+        """Collective: (2, n, 3) translations and rotations on rank 0 (None elsewhere)."""
+        self.scatter.scatter(x, self.seq)
+        if self.rank != 0:
+            return None
+        a = self.seq.getArray(readonly=True).reshape(2, self.n, 3).copy()
+        a[1][~self.has_rotation] = 0.0
+        return a
+
+    def record(self, t, u, v=None):
+        """Collective: the values of step t (u, and the velocity Vec ``v`` when given)."""
+        au = self._grab(u)
+        av = self._grab(v) if v is not None else None
         if self.rank == 0:
             self.t.append(t)
-            self.u.append(self.seq.getArray(readonly=True).reshape(self.n, 3).copy())
+            self.u.append(au[0])
+            self.r.append(au[1])
+            if av is not None:
+                self.v.append(av[0])
 
     def arrays(self):
         return np.asarray(self.t), np.asarray(self.u).reshape(len(self.t), self.n, 3)
+
+    def all_arrays(self):
+        """Rank 0: {t, u, rotation, velocity, acceleration} (velocity/acceleration when recorded)."""
+        t, u = self.arrays()
+        out = {"t": t, "u": u, "rotation": np.asarray(self.r).reshape(len(t), self.n, 3),
+               "has_rotation": self.has_rotation}
+        if len(self.v) == len(t) and len(t) > 1:
+            v = np.asarray(self.v).reshape(len(t), self.n, 3)
+            out["velocity"] = v
+            a = np.empty_like(v)
+            a[1:-1] = (v[2:] - v[:-2]) / (t[2:] - t[:-2])[:, None, None]
+            a[0] = (v[1] - v[0]) / (t[1] - t[0])
+            a[-1] = (v[-1] - v[-2]) / (t[-1] - t[-2])
+            out["acceleration"] = a
+        return out
 
 
 def _history(cfg, comm):
@@ -56,15 +104,25 @@ def _history(cfg, comm):
     return hist
 
 
+def near_null_args(solver, model):
+    """(coords_vec, near_null) for make_solver: none for a direct solver; PETSc's rigid-body
+    modes of the coordinates for a brick-only model; the dof map's six modes otherwise."""
+    if solver != "iterative":
+        return None, None
+    if model.layout.uniform3:
+        return model.coords_vec(), None
+    return None, model.layout.near_null_space(model.mesh.coords)
+
+
 def make_model_integrator(cfg, comm, model=None):
     """Collective: (model, integrator, alpha_m) for the options ``cfg``."""
     model = model or build_model(cfg, comm)
     am, note = alpha_m(cfg)
     printf(f"[fem] {note}; integrator {cfg.fem_integrator}, solver {cfg.fem_solver}")
-    coords = model.coords_vec() if cfg.fem_solver == "iterative" else None
+    coords, near = near_null_args(cfg.fem_solver, model)
     integ = make_integrator(cfg.fem_integrator, model.K, model.m, cfg.dt, am, model.fixed,
                             cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
-                            coords_vec=coords)
+                            coords_vec=coords, near_null=near)
     return model, integ, am
 
 
@@ -74,10 +132,10 @@ def run_fem(cfg):
     comm = PETSc.COMM_WORLD
     hist = _history(cfg, comm)                     # before assembly and factorisation
     model, integ, am = make_model_integrator(cfg, comm)
-    n_steps = int(round(cfg.t_end / cfg.dt))
+    n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
     F, fn = model.load_vec(), model.load_vec()
     out = _open_output(cfg, model, comm)
-    rec = ReceiverSeries(integ.u, model.receiver_nodes, comm)
+    rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
     vel = integ.u.duplicate()
 
     def sample(n):
@@ -102,33 +160,74 @@ def run_fem(cfg):
     return {"t": t, "u": u, "n_steps": n_steps, "alpha_m": am, "model": model}
 
 
+def structure_topology(mesh):
+    """(cell type, cells) for ``Output.write_mesh``: 'hex8' and the bricks for a brick-only
+    mesh (as before parts existed), else 'mixed' and [(XDMF type, cells)] of every block."""
+    if all(b.element.name == "hex8" for b in mesh.blocks):
+        return "hex8", mesh.cells
+    return "mixed", [(b.element.xdmf_type, b.cells) for b in mesh.blocks]
+
+
+class FieldWriter:
+    """Collective: the structure's mesh and nodal fields in an Output: displacement (and
+    rotation where the model has rotations) of a dof-layout Vec, and the velocity. A
+    brick-only model writes its dof-layout Vecs directly (dof = 3 * node + c)."""
+
+    def __init__(self, out, model, comm):
+        self.out, self.dm = out, model.layout
+        self.rot = bool(self.dm.has_rotation.any())
+        ctype, cells = structure_topology(model.mesh)
+        cvec = model.coords_vec() if not self.rot else self.dm.nodal_coords(model.mesh.coords)
+        out.write_mesh(cvec, cells if comm.getRank() == 0 else None, ctype)
+        if self.rot:
+            self.bu, self.br, self.bv = self.dm.node_vec(), self.dm.node_vec(), self.dm.node_vec()
+
+    def write(self, t, u, v=None, names=("displacement", "rotation", "velocity")):
+        if not self.rot:
+            fields = {names[0]: u}
+            if v is not None:
+                fields[names[2]] = v
+        else:
+            fields = {names[0]: self.dm.extract(u, self.bu, 0), names[1]: self.dm.extract(u, self.br, 1)}
+            if v is not None:
+                fields[names[2]] = self.dm.extract(v, self.bv, 0)
+        self.out.write_fields(t, fields)
+
+
+def receiver_record(model, rec_arrays):
+    """Rank 0: the structure receivers' group of an output file."""
+    d = {"points": model.receivers.reshape(-1, 3), "nodes": model.receiver_nodes,
+         "node_points": model.mesh.coords[model.receiver_nodes].reshape(-1, 3),
+         "snap_distance": model.receiver_dist}
+    d.update(rec_arrays)
+    return d
+
+
 def _open_output(cfg, model, comm):
     if not cfg.output:
         return None
     with event("FEM_io"):
         out = Output(cfg.output, comm)
-        out.write_mesh(model.coords_vec(), model.mesh.cells if comm.getRank() == 0 else None, "hex8")
+        out.fw = FieldWriter(out, model, comm)
     return out
 
 
 def _record(cfg, out, rec, integ, vel, n):
-    rec.record(n * cfg.dt, integ.u)
+    v = integ.velocity(vel)
+    rec.record(n * cfg.dt, integ.u, v)
     if out is not None and cfg.output_stride > 0 and n % cfg.output_stride == 0:
         with event("FEM_io"):
-            out.write_fields(n * cfg.dt, {"displacement": integ.u, "velocity": integ.velocity(vel)})
+            out.fw.write(n * cfg.dt, integ.u, v)
 
 
 def _close_output(cfg, out, model, rec, comm, am, n_steps, integ):
     if out is None:
         return
     t, u = rec.arrays()
-    receivers = None
-    if comm.getRank() == 0:
-        receivers = {"points": model.receivers.reshape(-1, 3), "nodes": model.receiver_nodes,
-                     "node_points": model.mesh.coords[model.receiver_nodes].reshape(-1, 3),
-                     "snap_distance": model.receiver_dist, "t": t, "u": u}
+    receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
     extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
-                     "n_cells": model.mesh.n_cells, "mesh": model.mesh.source,
+                     "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
+                     "elements": model.mesh.element_counts(),
                      "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
     if cfg.fem_integrator == "green":
         extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)

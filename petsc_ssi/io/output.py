@@ -31,6 +31,24 @@ from ..petsc import init, collective_error
 
 XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
              "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
+# XDMF "Mixed" topology: per cell its type id (a Polyline also its node count), then its nodes
+XDMF_MIXED_ID = {"Polyline": 2, "Triangle": 4, "Quadrilateral": 5, "Hexahedron": 9, "Quadrilateral_9": 0x23}
+
+
+def mixed_topology(blocks):
+    """Flat XDMF Mixed topology of [(xdmf type name, cells (E, n))]: per cell
+    [type id, (n for a Polyline), nodes...]; and the cell count."""
+    parts, ne = [], 0
+    for name, cells in blocks:
+        cells = np.asarray(cells, np.int64)
+        if cells.size == 0:
+            continue
+        head = [np.full((cells.shape[0], 1), XDMF_MIXED_ID[name], np.int64)]
+        if name == "Polyline":
+            head.append(np.full((cells.shape[0], 1), cells.shape[1], np.int64))
+        parts.append(np.hstack(head + [cells]).ravel())
+        ne += cells.shape[0]
+    return (np.concatenate(parts) if parts else np.zeros(0, np.int64)), ne
 
 
 class Output:
@@ -53,11 +71,18 @@ class Output:
 
     def write_mesh(self, coords_vec, cells, cell_type):
         """``coords_vec``: PETSc Vec (bs 3) of node coordinates in the field
-        layout; ``cells``: (E, n) int array, needed on rank 0 only."""
+        layout; ``cells``: (E, n) int array, needed on rank 0 only; or, with
+        ``cell_type`` 'mixed', a list [(xdmf type name, (E, n) cells)] of blocks
+        (written as one XDMF Mixed topology)."""
         coords_vec.setName("coordinates")
         coords_vec.view(self.viewer)
         self.n_nodes = coords_vec.getSize() // 3
-        self.cells = None if cells is None else np.asarray(cells, dtype=np.int64)
+        self.n_cells = 0
+        if cell_type == "mixed":
+            self.cells, self.n_cells = (None, 0) if cells is None else mixed_topology(cells)
+        else:
+            self.cells = None if cells is None else np.asarray(cells, dtype=np.int64)
+            self.n_cells = 0 if cells is None else self.cells.shape[0]
         self.cell_type = cell_type
 
     def write_fields(self, t, fields):
@@ -124,9 +149,17 @@ class Output:
         if self.cells is None:
             return
         base = os.path.basename(self.path)
-        ctype, npc = XDMF_CELL[self.cell_type]
-        ne = self.cells.shape[0]
+        ne = self.n_cells
         nn = self.n_nodes
+        if self.cell_type == "mixed":
+            topo = (f'<Topology TopologyType="Mixed" NumberOfElements="{ne}">'
+                    f'<DataItem Dimensions="{self.cells.size}" NumberType="Int" Precision="8" '
+                    f'Format="HDF">{base}:/topology</DataItem></Topology>')
+        else:
+            ctype, npc = XDMF_CELL[self.cell_type]
+            topo = (f'<Topology TopologyType="{ctype}" NumberOfElements="{ne}">'
+                    f'<DataItem Dimensions="{ne} {npc}" NumberType="Int" Precision="8" '
+                    f'Format="HDF">{base}:/topology</DataItem></Topology>')
         lines = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', "<Domain>",
                  '<Grid Name="TimeSeries" GridType="Collection" CollectionType="Temporal">']
         steps = range(len(self.times)) if self.times else [None]
@@ -134,15 +167,14 @@ class Output:
             lines.append('<Grid Name="mesh" GridType="Uniform">')
             if k is not None:
                 lines.append(f'<Time Value="{self.times[k]:.9g}"/>')
-            lines.append(f'<Topology TopologyType="{ctype}" NumberOfElements="{ne}">'
-                         f'<DataItem Dimensions="{ne} {npc}" NumberType="Int" Precision="8" '
-                         f'Format="HDF">{base}:/topology</DataItem></Topology>')
-            lines.append(f'<Geometry GeometryType="XYZ"><DataItem Dimensions="{nn} 3" '
-                         f'Format="HDF">{base}:/coordinates</DataItem></Geometry>')
+            lines.append(topo)
+            lines.append(f'<Geometry GeometryType="XYZ"><DataItem Dimensions="{nn} 3" NumberType="Float" '
+                         f'Precision="8" Format="HDF">{base}:/coordinates</DataItem></Geometry>')
             if k is not None:
                 for name in self.fields:
                     lines.append(f'<Attribute Name="{name}" AttributeType="Vector" Center="Node">'
-                                 f'<DataItem Dimensions="{nn} 3" Format="HDF">'
+                                 f'<DataItem Dimensions="{nn} 3" NumberType="Float" Precision="8" '
+                                 f'Format="HDF">'
                                  f'{base}:/{name}_{k:06d}</DataItem></Attribute>')
             lines.append("</Grid>")
         lines += ["</Grid>", "</Domain>", "</Xdmf>"]

@@ -147,55 +147,28 @@ def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
 
 
 def read_gmsh(path, params=None):
-    """Read nine-node quads (gmsh type 10) from a .msh, or mesh a .geo first.
+    """Read nine-node quads (gmsh type 10) from a .msh, or mesh a .geo first
+    (order 2), through the one gmsh reader (``mesh/gmsh.py``).
 
     ``params``: {name: value} set with gmsh.onelab/setNumber before meshing a
     .geo (DefineConstant parameters). Physical surface groups become element
     groups. Collective callers should call this on every rank (it is cheap)
     or broadcast the result.
     """
-    import gmsh
-    own = not gmsh.isInitialized()
-    if own:
-        gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        if path.endswith(".geo"):
-            for k, v in (params or {}).items():
-                gmsh.onelab.setNumber(f"Parameters/{k}", [float(v)])
-            gmsh.open(path)
-            gmsh.model.mesh.generate(2)
-            gmsh.model.mesh.setOrder(2)
-        else:
-            gmsh.open(path)
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        coords = coords.reshape(-1, 3)
-        order = np.argsort(tags)
-        tags = tags[order]; coords = coords[order]
-        tag2idx = {int(t): i for i, t in enumerate(tags)}
-        etypes, etags, enodes = gmsh.model.mesh.getElements(2)
-        if 10 not in list(etypes):
-            names = [gmsh.model.mesh.getElementProperties(t)[0] for t in etypes]
-            raise SSIError(f"{path}: the surface mesh has no nine-node quadrilaterals "
-                           f"(found: {', '.join(names) or 'no 2D elements'})")
-        if len(etypes) > 1:
-            raise SSIError(f"{path}: the surface mesh mixes element types; use nine-node quadrilaterals only")
-        i = list(etypes).index(10)
-        cell_tags = etags[i]
-        conn = np.array([tag2idx[int(t)] for t in enodes[i]], dtype=np.int64).reshape(-1, 9)
-        tag2cell = {int(t): k for k, t in enumerate(cell_tags)}
-        groups = {}
-        for dim, ptag in gmsh.model.getPhysicalGroups(2):
-            name = gmsh.model.getPhysicalName(dim, ptag) or f"group{ptag}"
-            ids = []
-            for ent in gmsh.model.getEntitiesForPhysicalGroup(dim, ptag):
-                _, et, _ = gmsh.model.mesh.getElements(dim, ent)
-                for arr in et:
-                    ids += [tag2cell[int(t)] for t in arr if int(t) in tag2cell]
-            groups[name] = np.array(sorted(ids), dtype=np.int64)
-    finally:
-        if own:
-            gmsh.finalize()
+    from . import gmsh as gmsh_reader
+    model = gmsh_reader.read(path, dim=2, order=2, params=params)
+    other2d = dict(gmsh_reader.unknown_of_dim(model, 2))
+    if "quad4" in model.blocks:
+        other2d["Quadrilateral 4"] = len(model.blocks["quad4"])
+    if "quad9" not in model.blocks:
+        raise SSIError(f"{path}: the surface mesh has no nine-node quadrilaterals "
+                       f"(found: {', '.join(other2d) or 'no 2D elements'})")
+    if other2d:
+        raise SSIError(f"{path}: the surface mesh mixes element types; use nine-node quadrilaterals only")
+    conn = model.blocks["quad9"]
+    groups = {name: np.sort(g.cells.get("quad9", np.zeros(0, np.int64)))
+              for name, g in model.groups.items() if g.dim == 2}
+    coords = model.coords
     used = np.unique(conn)
     remap = -np.ones(len(coords), np.int64)
     remap[used] = np.arange(len(used))

@@ -44,8 +44,8 @@ CASES = [
      "than the largest element size 0.5 m: it lies outside the structure"),
     (["-ssi_fem_point_load", "3,0,0.5,1,0,0"], "-ssi_fem_point_load: point (3, 0, 0.5) is 2.5 m from the "
      "nearest FE node, more than the largest element size 0.5 m"),
-    (["-ssi_fem_point_load", "0,0,0.5"], "-ssi_fem_point_load: '0,0,0.5' is not 6 comma-separated numbers "
-     "(each point needs x,y,z,fx,fy,fz)"),
+    (["-ssi_fem_point_load", "0,0,0.5"], "-ssi_fem_point_load: '0,0,0.5' is not 6 or 9 comma-separated numbers "
+     "(each point needs x,y,z,fx,fy,fz and optionally mx,my,mz)"),
 ]
 
 
