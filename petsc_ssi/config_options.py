@@ -15,7 +15,8 @@ register("t_end", "real", 0.04, "s", "end time of the run", "common", validator=
 register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it)", "common")
 register("output_stride", "int", 1, "steps", "write the fields every this many steps (0: receivers only)", "common",
          validator=lambda v: None if v >= 0 else "must be >= 0")
-register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE node)", "common")
+register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE "
+         "node); for a structure also 'group:NAME' (every node of a physical group)", "common")
 register("monitor", "bool", False, "", "print progress: assembly, per-step time, elapsed, ETA (rank 0)", "common")
 register("monitor_every", "int", 0, "steps", "monitor line every this many steps (0: about 20 lines per run)", "common",
          validator=lambda v: None if v >= 0 else "must be >= 0")

@@ -36,7 +36,8 @@ register("coupling_traction", "enum", "direct", "", "interface force handed to t
          "direct (p^n, as printed in Table 2) or extrapolated (1.5 p^n - 0.5 p^{n-1}: the load at t_n; "
          "staggered coupling only)", G,
          choices=("direct", "extrapolated"))
-register("structure_receivers", "str", "", "m", "structure receivers 'x,y,z;...' (nearest FE node); "
+register("structure_receivers", "str", "", "m", "structure receivers 'x,y,z;...' (nearest FE node) or "
+         "'group:NAME'; "
          "-ssi_receivers are soil surface points", G)
 
 

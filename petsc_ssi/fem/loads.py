@@ -106,11 +106,23 @@ def pressure_groups(mesh, names, what="-ssi_fem_load_group"):
     return np.concatenate(out) if out else np.zeros((0, 4), np.int64)
 
 
+def _is_group_row(r):
+    head = r.split(",")[0].strip()
+    try:
+        float(head)
+        return False
+    except ValueError:
+        return True
+
+
 def parse_point_loads(text, what="-ssi_fem_point_load"):
-    """'x,y,z,fx,fy,fz[,mx,my,mz];...' -> (R, 9) (moments 0 where not given)."""
+    """'x,y,z,fx,fy,fz[,mx,my,mz];...' -> (R, 9) (moments 0 where not given); rows that start
+    with a group name are left out (see ``group_point_loads``)."""
     rows = [r.strip() for r in str(text or "").replace("\n", ";").split(";") if r.strip()]
     out = []
     for r in rows:
+        if _is_group_row(r):
+            continue
         try:
             vals = [float(v) for v in r.split(",")]
         except ValueError:
@@ -120,6 +132,27 @@ def parse_point_loads(text, what="-ssi_fem_point_load"):
                            "and optionally mx,my,mz)")
         out.append(vals + [0.0] * (9 - len(vals)))
     return np.array(out, float).reshape(-1, 9)
+
+
+def group_point_loads(mesh, text, what="-ssi_fem_point_load"):
+    """[(node ids, (6,) force and moment)] of the rows 'GROUP,fx,fy,fz[,mx,my,mz]' (the force acts
+    on every node of the physical group GROUP)."""
+    out = []
+    for r in [r.strip() for r in str(text or "").replace("\n", ";").split(";") if r.strip()]:
+        if not _is_group_row(r):
+            continue
+        name, *rest = [v.strip() for v in r.split(",")]
+        try:
+            vals = [float(v) for v in rest]
+        except ValueError:
+            vals = []
+        if len(vals) not in (3, 6) or not np.all(np.isfinite(vals)):
+            raise SSIError(f"{what}: '{r}': a group row is GROUP,fx,fy,fz[,mx,my,mz]")
+        if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
+            raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
+                           f"{', '.join(mesh.group_names()) or 'none'})")
+        out.append((mesh.group_nodes(name, what), np.array(vals + [0.0] * (6 - len(vals)))))
+    return out
 
 
 def nodal_load(mesh, cfg, dofmap=None):
@@ -136,13 +169,19 @@ def nodal_load(mesh, cfg, dofmap=None):
             for i in range(3):
                 F[:, i] += np.bincount(quads.ravel(), weights=fq[:, :, i].ravel(), minlength=mesh.n_nodes)
     dist = np.zeros(0)
+    rot = mesh.has_rotation() if dofmap is None else dofmap.has_rotation
+    for nodes, fm in group_point_loads(mesh, cfg.fem_point_load):
+        F[nodes] += fm[:3]
+        M[nodes] += fm[3:]
+        if np.any(fm[3:] != 0) and not rot[nodes].all():
+            raise SSIError("-ssi_fem_point_load: a moment on a group with nodes without rotation dofs (brick "
+                           "nodes); load frame or shell nodes")
     if cfg.fem_point_load.strip():
         pl = parse_point_loads(cfg.fem_point_load)
         nodes, dist = snap_points(mesh, pl[:, :3], "-ssi_fem_point_load")
         np.add.at(F, nodes, pl[:, 3:6])
         np.add.at(M, nodes, pl[:, 6:9])
         if np.any(pl[:, 6:9] != 0):
-            rot = mesh.has_rotation() if dofmap is None else dofmap.has_rotation
             bad = np.nonzero((np.abs(pl[:, 6:9]).sum(axis=1) > 0) & ~rot[nodes])[0]
             if bad.size:
                 p = pl[bad[0]]

@@ -62,11 +62,32 @@ class Model:
         return out
 
 
+def structure_receivers(mesh, text, what="-ssi_receivers"):
+    """(points (R, 3), nodes (R,), snapping distances (R,)) of 'x,y,z;...' items (nearest node)
+    and 'group:NAME' items (every node of a physical group, in node order)."""
+    items = [r.strip() for r in str(text or "").replace("\n", ";").split(";") if r.strip()]
+    pts, nodes, dist = [], [], []
+    for it in items:
+        if it.startswith("group:"):
+            name = it[len("group:"):].strip()
+            if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
+                raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
+                               f"{', '.join(mesh.group_names()) or 'none'})")
+            g = mesh.group_nodes(name, what)
+            pts.append(mesh.coords[g]); nodes.append(g); dist.append(np.zeros(len(g)))
+        else:
+            p = parse_points(it, 3, what)
+            n, d = snap_points(mesh, p, what)
+            pts.append(p); nodes.append(n); dist.append(d)
+    if not items:
+        return np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(pts), np.concatenate(nodes).astype(np.int64), np.concatenate(dist)
+
+
 def _inputs(mesh, cfg, dofmap):
     fixed = fixed_dofs(mesh, cfg.fem_fixed, dofmap)
     F, pdist = nodal_load(mesh, cfg, dofmap)
-    pts = parse_points(cfg.receivers, 3, "-ssi_receivers")
-    nodes, dist = snap_points(mesh, pts, "-ssi_receivers")
+    pts, nodes, dist = structure_receivers(mesh, cfg.receivers)
     return fixed, F, pts, nodes, dist, pdist
 
 

@@ -65,7 +65,8 @@ register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse", G, vali
 register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (0 before the first "
          "time, the last value after the last)", G)
 register("fem_point_load", "str", "", "m, N, N m", "point loads 'x,y,z,fx,fy,fz[,mx,my,mz];...' at the nearest "
-         "FE node, times h(t) (moments need a frame or shell node)", G)
+         "FE node, or 'GROUP,fx,fy,fz[,mx,my,mz]' on every node of a group, times h(t) (moments need frame or "
+         "shell nodes)", G)
 register("fem_fixed", "str", "", "", "fixed dofs by node group 'group[:dofs],...': a bare group fixes all its dofs, "
          "dof names ux uy uz rx ry rz joined by '+' (e.g. 'base,symx:ux+ry+rz,pin:uz'), letters of xyz fix "
          "translations ('xmin:x')", G)

@@ -337,3 +337,15 @@ def test_xdmf_of_a_mixed_model_opens_in_paraview(tmp_path):
     assert got["points"] == u.shape[0]
     assert got["dtype"] == "float64"
     assert np.array_equal(np.array(got["u"]), u)
+
+
+def test_group_receivers_and_group_point_loads(tmp_path):
+    """'group:NAME' receivers and 'GROUP,fx,fy,fz' point loads act on the group's nodes: the same
+    answer as the coordinates of that node (top_corner is the point 4,3,3)."""
+    a, b = str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
+    ok(run_cli(["static", "-options_file", SLAB, "-ssi_output", a, "-ssi_receivers", "4,3,3"]))
+    ok(run_cli(["static", "-options_file", SLAB, "-ssi_output", b, "-ssi_receivers", "group:top_corner",
+                "-ssi_fem_point_load", "top_corner,1e4,0,0"]))
+    ra, rb = receivers(a), receivers(b)
+    assert rb["u"].shape == (1, 1, 3)
+    assert relmax(rb["u"], ra["u"]) < 1e-12 and relmax(rb["rotation"], ra["rotation"]) < 1e-12
