@@ -170,7 +170,7 @@ def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
     return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
 
 
-def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, skip=(), dofmap=None):
+def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, dofmap, skip=()):
     """Collective: AIJ F with f_f = F p: rows in the FE layout (the translations of the
     interface nodes, from the dof map), columns the BE traction vector (columns
     3 (n_load + k) + c), entries -M (eq. 27). Rows of the FE DOFs ``skip`` (fixed ones)
@@ -178,8 +178,7 @@ def force_matrix(comm, iface, fe_layout_vec, n_load, p_vec, skip=(), dofmap=None
     PETSc = init()
     r0, r1 = fe_layout_vec.getOwnershipRange()
     M = iface.M.tocoo()
-    tdofs = dofmap.translation_dofs(iface.fe_nodes) if dofmap is not None else \
-        3 * iface.fe_nodes[:, None] + np.arange(3)
+    tdofs = dofmap.translation_dofs(iface.fe_nodes)
     cols_all = 3 * (n_load + M.col)
     R, C, V = [], [], []
     for c in range(3):

@@ -48,7 +48,6 @@ from ..options import Config
 from ..bem.run import BEMProblem, build_bem, _traction_to_nodes
 from ..bem import receivers as bem_rec
 from ..bem.model import Regions
-from ..fem.assembly import assemble
 from ..fem.model import build_model
 from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, \
     _history as fem_history
@@ -139,8 +138,8 @@ class Coupler:
         ev.end()
         # forces: f_f = F p (FE layout); rows of FE DOFs a symmetry plane (or the
         # user) fixes are left out: their reaction is not a load on the structure
-        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, skip=model.fixed,
-                              dofmap=model.layout)
+        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, model.layout,
+                              skip=model.fixed)
         self.ff = integ.u.duplicate()
         self.du = integ.u.duplicate()
         self.w = march.p_tmpl.duplicate()
@@ -351,7 +350,7 @@ def run_ssi(cfg):
     st.pop()
     st = stage("SSI FEM assembly")
     st.push()
-    model.K, model.m = assemble(model.mesh, model.material, model.layout)
+    model.assemble()
     _, integ, am = make_model_integrator(fe_cfg, comm, model)
     st.pop()
     st = stage("SSI BEM assembly")

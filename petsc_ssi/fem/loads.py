@@ -192,6 +192,41 @@ def nodal_load(mesh, cfg, dofmap=None):
     return dofmap.nodal_array(F, M), dist
 
 
+def point_masses(mesh, text, dofmap, what="-ssi_fem_point_mass"):
+    """Replicated global dof array of added point masses: rows 'x,y,z,m[,I]' (nearest node) or
+    'GROUP,m[,I]' (every node of the group); m on the translations, I on the rotations (nodes
+    with rotations only; I > 0 at a brick node is an error). Also the snapping distances."""
+    out = np.zeros(dofmap.size)
+    dist = []
+    for r in [r.strip() for r in str(text or "").replace("\n", ";").split(";") if r.strip()]:
+        fields = [v.strip() for v in r.split(",")]
+        if _is_group_row(r):
+            name, vals = fields[0], fields[1:]
+        else:
+            name, vals = None, fields[3:]
+        try:
+            vals = [float(v) for v in vals]
+            xyz = None if name else np.array([float(v) for v in fields[:3]])
+        except ValueError:
+            vals = []
+        if len(vals) not in (1, 2) or not np.all(np.isfinite(vals)) or min(vals) < 0:
+            raise SSIError(f"{what}: '{r}' is not x,y,z,m[,I] or GROUP,m[,I] with m, I >= 0")
+        if name:
+            if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
+                raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
+                               f"{', '.join(mesh.group_names()) or 'none'})")
+            nodes = mesh.group_nodes(name, what)
+        else:
+            nodes, d = snap_points(mesh, xyz[None], what)
+            dist.append(float(d[0]))
+        out[dofmap.dofs(nodes, ("ux", "uy", "uz"))] += vals[0]
+        if len(vals) == 2 and vals[1] > 0:
+            if not dofmap.has_rotation[nodes].all():
+                raise SSIError(f"{what}: '{r}': a rotary inertia on a node without rotation dofs (a brick node)")
+            out[dofmap.dofs(nodes, ("rx", "ry", "rz"))] += vals[1]
+    return out, np.array(dist)
+
+
 FIXED_LEGACY = set("xyz")
 
 
@@ -236,22 +271,16 @@ def fixed_dofs(mesh, spec, dofmap=None):
         dofs.append(dm.dofs(nodes, names))
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)
 def rigid_body_modes(coords):
-    """(3N, 6) rigid-body displacement fields: 3 translations, 3 rotations."""
-    n = coords.shape[0]
-    R = np.zeros((n, 3, 6))
-    R[:, [0, 1, 2], [0, 1, 2]] = 1.0
-    x, y, z = coords.T
-    R[:, 1, 3], R[:, 2, 3] = -z, y        # about x
-    R[:, 0, 4], R[:, 2, 4] = z, -x        # about y
-    R[:, 0, 5], R[:, 1, 5] = -y, x        # about z
-    return R.reshape(3 * n, 6)
+    """(3N, 6) rigid-body displacement fields of a translations-only model: 3 translations,
+    3 rotations about the origin (the dof map's modes, ``DofMap.rigid_body_modes``)."""
+    from .dofmap import DofMap
+    c = np.asarray(coords, float)
+    return DofMap(np.zeros(c.shape[0], bool)).rigid_body_modes(c, centre=np.zeros(3))
 
 
 def restrains_rigid_motion(coords, fixed):
-    """Whether the fixed dofs remove all six rigid-body modes (K nonsingular)."""
-    if len(fixed) == 0:
-        return False
-    c = coords - coords.mean(axis=0)
-    R = rigid_body_modes(c / max(np.abs(c).max(), 1e-300))[fixed]
-    s = np.linalg.svd(R, compute_uv=False)
-    return s.size == 6 and s[-1] > 1e-8 * s[0]
+    """Whether the fixed dofs remove all six rigid-body modes (K nonsingular) of a
+    translations-only model (``DofMap.restrains_rigid_motion``)."""
+    from .dofmap import DofMap
+    c = np.asarray(coords, float)
+    return DofMap(np.zeros(c.shape[0], bool)).restrains_rigid_motion(c, fixed)

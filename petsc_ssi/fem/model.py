@@ -15,7 +15,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf
 from .assembly import Material, assemble, mass_report
 from .dofmap import DofMap
-from .loads import fixed_dofs, nodal_load
+from .loads import fixed_dofs, nodal_load, point_masses
 from .mesh import load_mesh, snap_points
 from .parts import parse_parts
 from ..points import parse_points
@@ -34,6 +34,14 @@ class Model:
     K: object = None             # PETSc Mat
     m: object = None             # PETSc Vec (lumped mass per dof)
     specs: list = None           # [parts.PartSpec]
+    point_mass: np.ndarray = None  # replicated global dof array of added point masses [kg, kg m^2]
+
+    def assemble(self):
+        """Collective: K and the lumped M (point masses added) of the model."""
+        self.K, self.m = assemble(self.mesh, self.material, self.layout)
+        if self.point_mass is not None and np.any(self.point_mass):
+            self.m.getArray()[:] += self.point_mass[self.layout.r0:self.layout.r1]
+        return self.K, self.m
 
     @property
     def dofmap(self):
@@ -48,18 +56,6 @@ class Model:
 
     def constrained(self):
         return self.layout.restrains_rigid_motion(self.mesh.coords, self.fixed)
-
-    def max_wave_speed_ratio(self):
-        """max over parts of E/rho (for the modes' default shift)."""
-        out = 0.0
-        for b in self.mesh.blocks:
-            p = b.props
-            E, rho = (p.E, p.rho) if p is not None else (self.material.E, self.material.rho)
-            if b.element.name == "shell" and p is not None and p.mass_per_area > 0:
-                rho = p.mass_per_area / p.thickness
-            out = max(out, E / max(rho + (p.added_mass / max(p.thickness, 1e-300) if b.element.name == "shell"
-                                          and p is not None else 0.0), 1e-300))
-        return out
 
 
 def structure_receivers(mesh, text, what="-ssi_receivers"):
@@ -87,8 +83,9 @@ def structure_receivers(mesh, text, what="-ssi_receivers"):
 def _inputs(mesh, cfg, dofmap):
     fixed = fixed_dofs(mesh, cfg.fem_fixed, dofmap)
     F, pdist = nodal_load(mesh, cfg, dofmap)
+    pm, mdist = point_masses(mesh, cfg.get("fem_point_mass", ""), dofmap)
     pts, nodes, dist = structure_receivers(mesh, cfg.receivers)
-    return fixed, F, pts, nodes, dist, pdist
+    return fixed, F, pts, nodes, dist, np.r_[pdist, mdist], pm
 
 
 def describe_parts(mesh, material=None, log=printf):
@@ -115,7 +112,7 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
     dofmap = DofMap(mesh.has_rotation(), comm)
     err = None
     try:
-        fixed, F, pts, nodes, dist, pdist = _inputs(mesh, cfg, dofmap)
+        fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap)
     except SSIError as exc:
         err = str(exc)
     collective_error(err, comm)
@@ -127,12 +124,15 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
     mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho) if legacy else None
     if not legacy:
         describe_parts(mesh, None, log)
+    if np.any(pm):
+        t = dofmap.node_dofs(np.arange(mesh.n_nodes))[:, 0]
+        log(f"[fem] point masses: {pm[t].sum():.6g} kg in all")
     for p, n, d in zip(pts, nodes, dist):
         log(f"[fem] receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) -> node {n} at "
             f"({mesh.coords[n, 0]:g}, {mesh.coords[n, 1]:g}, {mesh.coords[n, 2]:g}), snapping distance {d:.3g} m")
     for d in pdist:
-        log(f"[fem] point load snapped to the nearest node at distance {d:.3g} m")
-    model = Model(mesh, dofmap, mat, fixed, F, pts, nodes, dist, specs=specs)
+        log(f"[fem] point load/mass snapped to the nearest node at distance {d:.3g} m")
+    model = Model(mesh, dofmap, mat, fixed, F, pts, nodes, dist, specs=specs, point_mass=pm)
     if assemble_matrices:
-        model.K, model.m = assemble(mesh, mat, model.layout)
+        model.assemble()
     return model

@@ -67,6 +67,9 @@ register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interp
 register("fem_point_load", "str", "", "m, N, N m", "point loads 'x,y,z,fx,fy,fz[,mx,my,mz];...' at the nearest "
          "FE node, or 'GROUP,fx,fy,fz[,mx,my,mz]' on every node of a group, times h(t) (moments need frame or "
          "shell nodes)", G)
+register("fem_point_mass", "str", "", "m, kg, kg m^2", "added point masses 'x,y,z,m[,I];...' at the nearest "
+         "FE node or 'GROUP,m[,I]' on every node of a group: m on the translations, I (default 0) on the "
+         "rotations of frame/shell nodes", G)
 register("fem_fixed", "str", "", "", "fixed dofs by node group 'group[:dofs],...': a bare group fixes all its dofs, "
          "dof names ux uy uz rx ry rz joined by '+' (e.g. 'base,symx:ux+ry+rz,pin:uz'), letters of xyz fix "
          "translations ('xmin:x')", G)

@@ -25,28 +25,20 @@ from .options import alpha_m
 class ReceiverSeries:
     """Collective: displacement, rotation and velocity of a few nodes every step, on rank 0.
 
-    ``dofmap``: the structure's dof map (``dofmap.DofMap``), or a Vec template of a
-    translations-only layout (dof 3 * node + c). Rotations are 0 at nodes without
-    them (``has_rotation`` says which). Accelerations (``arrays``) are the central
+    ``dofmap``: the structure's dof map (``dofmap.DofMap``). Rotations are 0 at nodes
+    without them (``has_rotation`` says which). Accelerations (``arrays``) are the central
     differences of the recorded velocities, (v^{n+1} - v^{n-1}) / (2 dt), one-sided
     at the first and last step."""
 
     def __init__(self, dofmap, nodes, comm):
         PETSc = init()
-        from .dofmap import DofMap
         self.rank = comm.getRank()
         nodes = np.asarray(nodes, np.int64)
         self.n = len(nodes)
-        if isinstance(dofmap, DofMap):
-            tdofs = dofmap.node_dofs(nodes, 3)
-            self.has_rotation = dofmap.has_rotation[nodes]
-            rdofs = np.where(self.has_rotation[:, None], tdofs + 3, tdofs)
-            template = dofmap.vec()
-        else:
-            template = dofmap
-            tdofs = 3 * nodes[:, None] + np.arange(3)
-            self.has_rotation = np.zeros(self.n, bool)
-            rdofs = tdofs
+        tdofs = dofmap.node_dofs(nodes, 3)
+        self.has_rotation = dofmap.has_rotation[nodes]
+        rdofs = np.where(self.has_rotation[:, None], tdofs + 3, tdofs)
+        template = dofmap.vec()
         idx = np.concatenate([tdofs.ravel(), rdofs.ravel()]) if self.rank == 0 else []
         idx = np.asarray(idx, dtype=PETSc.IntType)
         self.seq = PETSc.Vec().createSeq(len(idx), comm=PETSc.COMM_SELF)

@@ -349,3 +349,31 @@ def test_group_receivers_and_group_point_loads(tmp_path):
     ra, rb = receivers(a), receivers(b)
     assert rb["u"].shape == (1, 1, 3)
     assert relmax(rb["u"], ra["u"]) < 1e-12 and relmax(rb["rotation"], ra["rotation"]) < 1e-12
+
+
+def test_point_masses_add_to_M_and_lower_the_frequencies(tmp_path):
+    """-ssi_fem_point_mass: a 1000 kg mass at each slab corner adds exactly 4000 kg to the
+    lumped M (the printed total) and lowers every frequency of the slab on columns."""
+    a = ok(run_cli(["modes", "-options_file", SLAB, "-ssi_modes_n", "3", "-ssi_output", str(tmp_path / "a.h5")]))
+    b = ok(run_cli(["modes", "-options_file", SLAB, "-ssi_modes_n", "3", "-ssi_output", str(tmp_path / "b.h5"),
+                    "-ssi_fem_point_mass", "0,0,3,1000;4,0,3,1000;4,3,3,1000,50;0,3,3,1000"]))
+    assert "[fem] point masses: 4000 kg in all" in b.stdout
+
+    def freqs(r):
+        lines = r.stdout[r.stdout.index("mode,frequency_hz"):].splitlines()[1:4]
+        return np.array([float(x.split(",")[1]) for x in lines])
+    assert np.all(freqs(b) < freqs(a))
+
+
+def test_one_time_grid_for_fem_runs(tmp_path):
+    """t_end / dt not a whole number: the FEM takes ceil(t_end / dt) steps like the BEM
+    (t_end 0.04, dt 7.5e-4: 54 steps, the last at 0.0405 s); a whole number up to round-off
+    takes exactly that number (0.03 / 7.5e-4 = 40)."""
+    from petsc_ssi.timegrid import n_steps
+    assert n_steps(0.04, 7.5e-4) == 54 and n_steps(0.03, 7.5e-4) == 40 and n_steps(0.1, 0.01) == 10
+    out = str(tmp_path / "g.h5")
+    ok(run_cli(["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_fixed", "base",
+                "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_t_end", "0.04", "-ssi_dt", "7.5e-4",
+                "-ssi_receivers", "0,0,0.5", "-ssi_output", out, "-ssi_output_stride", "0"]))
+    t = receivers(out)["t"]
+    assert t.size == 55 and t[-1] == pytest.approx(0.0405, rel=1e-12)
