@@ -30,11 +30,97 @@ def _fmt(points, k=3):
 
 
 def fe_interface_faces(fe_mesh, groups):
-    """Outward-ordered quads of the comma-separated FE face groups."""
-    quads = group_faces(fe_mesh, groups, "-ssi_fem_interface")
+    """Quads of the comma-separated FE groups that rest on the soil, ordered so that their
+    normal points out of the structure (into the soil): brick faces as they are (outward),
+    shell cells reversed (shells are oriented up: the soil is under a foundation slab)."""
+    out = []
+    for name in [g.strip() for g in str(groups).split(",") if g.strip()]:
+        if name in fe_mesh.shells and name not in fe_mesh.faces:
+            out.append(fe_mesh.shells[name][:, [0, 3, 2, 1]])
+        else:
+            out.append(group_faces(fe_mesh, name, "-ssi_fem_interface"))
+    quads = np.concatenate(out) if out else np.zeros((0, 4), np.int64)
     if len(quads) == 0:
         raise SSIError("-ssi_fem_interface names no faces of the structure")
     return quads
+
+
+def interface_offsets(fe_mesh, iface, groups):
+    """(n_I, 3) offsets r_k from each interface node of a shell slab to the slab's underside,
+    r_k = -(t/2) n_k (t the shell part's thickness, n_k = n_b the soil's outward normal, i.e.
+    the slab's upward normal); zero at brick nodes. SSIError if a node lies on shells of two
+    thicknesses."""
+    t = np.zeros(fe_mesh.n_nodes)
+    for b in fe_mesh.blocks:
+        if b.element.name != "shell":
+            continue
+        nodes = np.unique(b.cells)
+        clash = (t[nodes] > 0) & (np.abs(t[nodes] - b.props.thickness) > 1e-12 * b.props.thickness)
+        if clash.any():
+            raise SSIError("-ssi_interface_offset: an interface node lies on shells of two thicknesses")
+        t[nodes] = b.props.thickness
+    return -0.5 * t[iface.fe_nodes][:, None] * iface.n_b
+
+
+class InterfaceOperator:
+    """Collective: T, the PETSc Mat (3 n_I x structure dofs) that gives the displacement of the
+    soil side of the interface from the structure's dofs (built from the dof map):
+        u_I,k = u_k + theta_k x r_k      (r_k = 0: translations only; the slab offset otherwise),
+    so the force of the soil on the structure is T^T f_I and the structure's interface
+    flexibility is T D^-1 T^T (paper eqs. 26-29 with a shell foundation slab: translations are
+    coupled, rotations only through the offset). Rows are split across the ranks (PETSc's
+    default); ``gather`` brings T u to every rank (3 n_I numbers), ``spread`` applies T^T to a
+    replicated interface vector."""
+
+    def __init__(self, comm, iface, dofmap, offsets=None):
+        PETSc = init()
+        self.PETSc, self.comm = PETSc, comm
+        n = 3 * iface.n
+        self.tI = PETSc.Vec().createMPI((PETSc.DECIDE, n), comm=comm)
+        r0, r1 = self.tI.getOwnershipRange()
+        self.r0, self.r1 = r0, r1
+        tdofs = dofmap.translation_dofs(iface.fe_nodes)              # (n_I, 3)
+        rows, cols, vals = [], [], []
+        for c in range(3):
+            rows.append(3 * np.arange(iface.n) + c); cols.append(tdofs[:, c]); vals.append(np.ones(iface.n))
+        if offsets is not None and np.any(offsets):
+            has = dofmap.has_rotation[iface.fe_nodes] & (np.abs(offsets).sum(axis=1) > 0)
+            k = np.nonzero(has)[0]
+            rdofs = dofmap.offset[iface.fe_nodes[k]][:, None] + np.arange(3, 6)
+            # theta x r = -[r]x theta: d(u_c)/d(theta_j) = -eps_{c m j} r_m = eps_{c j m} r_m
+            eps = np.zeros((3, 3, 3))
+            eps[0, 1, 2] = eps[1, 2, 0] = eps[2, 0, 1] = 1.0
+            eps[0, 2, 1] = eps[2, 1, 0] = eps[1, 0, 2] = -1.0
+            B = np.einsum("cjm,km->kcj", eps, offsets[k])             # (k, c, j)
+            for c in range(3):
+                for j in range(3):
+                    nz = B[:, c, j] != 0
+                    rows.append(3 * k[nz] + c); cols.append(rdofs[nz, j]); vals.append(B[nz, c, j])
+        R, C, V = (np.concatenate(a) for a in (rows, cols, vals))
+        own = (R >= r0) & (R < r1)
+        A = sp.csr_matrix((V[own], (R[own] - r0, C[own])), shape=(r1 - r0, dofmap.size))
+        A.sort_indices()
+        self.T = PETSc.Mat().createAIJ(size=((r1 - r0, n), (dofmap.n_local, dofmap.size)),
+                                       csr=(A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType),
+                                            A.data), comm=comm)
+        self.T.assemble()
+        self.scatter, self.seq = PETSc.Scatter.toAll(self.tI)
+
+    def gather(self, u):
+        """Collective: T u on every rank (numpy, 3 n_I)."""
+        self.T.mult(u, self.tI)
+        self.scatter.scatter(self.tI, self.seq)
+        return self.seq.getArray(readonly=True).copy()
+
+    def spread(self, fI, out):
+        """Collective: out = T^T f_I for a replicated interface vector f_I (3 n_I)."""
+        self.tI.getArray()[:] = np.asarray(fI)[self.r0:self.r1]
+        self.T.multTranspose(self.tI, out)
+        return out
+
+    def destroy(self):
+        for o in (self.T, self.tI, self.seq, self.scatter):
+            o.destroy()
 
 
 def _face_normals(X):

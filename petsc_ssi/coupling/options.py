@@ -10,7 +10,11 @@ G = "ssi"
 register("interface", "str", "auto", "", "soil elements of the soil-structure interface: 'auto' (every "
          "element whose nine nodes all coincide with nodes of -ssi_fem_interface), a group name or "
          "'box:x0,x1,y0,y1'", G)
-register("fem_interface", "str", "base", "", "face group(s) of the structure in contact with the soil", G)
+register("fem_interface", "str", "base", "", "group(s) of the structure in contact with the soil: brick faces, "
+         "or the shell cells of a foundation slab", G)
+register("interface_offset", "bool", False, "", "shell foundation slab: the soil touches the slab's underside, "
+         "u + theta x (-t/2 n) (rotations coupled through the offset); off: the slab's mid-surface "
+         "translations", G)
 register("interface_tol", "real", 1e-6, "", "FE and BE interface nodes match when closer than this times "
          "the smallest interface node spacing", G, validator=positive)
 register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f always; linear) or unilateral "

@@ -52,7 +52,7 @@ from ..fem.model import build_model
 from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, \
     _history as fem_history
 from ..mesh import quad9
-from .interface import build_interface, fem_symmetry_dofs, force_matrix
+from .interface import build_interface, fem_symmetry_dofs, force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
 
 
@@ -105,14 +105,16 @@ class Coupler:
         self.nI = nI
         self.dofs_be = (3 * iface.be_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
         self.dofs_fe = model.layout.translation_dofs(iface.fe_nodes).ravel().astype(PETSc.IntType)
-        # scatters of the interface values to every rank (3 n_I numbers: the
-        # small replicated interface system; the fields stay distributed)
+        # the interface values on every rank (3 n_I numbers: the small replicated
+        # interface system; the fields stay distributed): the soil's by a scatter,
+        # the structure's through the interface operator T (translations, and the
+        # rotations through the slab offset when -ssi_interface_offset)
         self.seq_y = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
-        self.seq_uf = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
         self.sc_be = PETSc.Scatter().create(march.u_tmpl, PETSc.IS().createGeneral(self.dofs_be, comm=PETSc.COMM_SELF),
                                             self.seq_y, None)
-        self.sc_fe = PETSc.Scatter().create(integ.u, PETSc.IS().createGeneral(self.dofs_fe, comm=PETSc.COMM_SELF),
-                                            self.seq_uf, None)
+        self.Top = InterfaceOperator(comm, iface, model.layout,
+                                     interface_offsets(model.mesh, iface, cfg.fem_interface)
+                                     if cfg.interface_offset else None)
         self.own_k, self.own_loc = _owned(self.dofs_be, march.u_tmpl)
         self.fown_k, self.fown_loc = _owned(self.dofs_fe, integ.u)
         self.zero = iface.zero.ravel()
@@ -130,8 +132,7 @@ class Coupler:
         if self.mode == "staggered":
             self.solver = StaggeredSolve(self.law, Capacitance(Z_II))
         else:
-            self.DEloc = self._fem_columns()
-            C = self._gather_rows(self.DEloc, self.fown_k, self.fown_loc)
+            self.DEloc, C = self._fem_columns()
             self.solver = ImplicitSolve(self.law, Z_II, 2.0 * C, M3, 1.0)     # midpoint: u = w + D^-1 (2 f)
             self.solver._lu(self.law.closed, self.law.open_dofs(self.law.closed))   # the bonded LU, now
         self.t_capacitance = time.perf_counter() - t0
@@ -189,21 +190,23 @@ class Coupler:
         return Z
 
     def _fem_columns(self):
-        """D^{-1} e_j for the interface DOFs of the structure (local rows; 3 n_I solves)."""
+        """D^{-1} T^T e_j (local rows) and C = T D^{-1} T^T (replicated) for the interface
+        dofs j (3 n_I solves; T^T e_j masked: a fixed dof takes no interface force)."""
         integ = self.integ
         e, z = integ.u.duplicate(), integ.u.duplicate()
         out = np.zeros((e.getLocalSize(), 3 * self.nI))
-        lut = -np.ones(3 * self.nI, np.int64)
-        lut[self.fown_k] = self.fown_loc
+        C = np.zeros((3 * self.nI, 3 * self.nI))
+        unit = np.zeros(3 * self.nI)
         for j in range(3 * self.nI):
-            e.set(0.0)
-            if lut[j] >= 0:
-                e.getArray()[lut[j]] = 1.0
+            unit[:] = 0.0
+            unit[j] = 1.0
+            self.Top.spread(unit, e)
             e.pointwiseMult(e, integ.mask)
             integ.solve(e, z)
             out[:, j] = z.getArray(readonly=True)
+            C[:, j] = self.Top.gather(z)
         e.destroy(); z.destroy()
-        return out
+        return out, C
 
     def _set_known_p(self, n):
         m = self.march
@@ -217,8 +220,7 @@ class Coupler:
         m, integ = self.march, self.integ
         with event("SSI_FEM_Step"):
             uf = integ.predict() if self.mode == "staggered" else integ.predict(f_ext)   # B.1
-        self.sc_fe.scatter(uf, self.seq_uf)
-        wI = self.seq_uf.getArray(readonly=True).copy()
+        wI = self.Top.gather(uf)
         n = m.begin_step()                                         # history sum
         kv = m.kv_u.getArray()
         kv[:] = 0.0
@@ -266,16 +268,14 @@ class Coupler:
         res["force_map_error"] = self._force_map_error(p, res["p"])
         with event("SSI_FEM_Step"):
             if self.mode == "staggered":
-                ff = self.ff.getArray()
-                ff[:] = 0.0
-                ff[self.fown_loc] = fI[self.fown_k]
+                self.Top.spread(fI, self.ff)                       # f_f = T^T f_I
+                self.ff.pointwiseMult(self.ff, integ.mask)
                 integ.correct(f_ext, self.ff)                      # B.5-B.6
             else:
                 da = self.du.getArray()
                 da[:] = self.DEloc @ (2.0 * fI)                    # D^{-1} (2 f_I), midpoint form
                 integ.complete(self.du)
-                self.sc_fe.scatter(integ.u, self.seq_uf)
-                res["uf_check"] = self.seq_uf.getArray(readonly=True).copy()
+                res["uf_check"] = self.Top.gather(integ.u)
         return u, p, res
 
     def _bem_residual(self, b, kv):

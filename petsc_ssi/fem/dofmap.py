@@ -158,7 +158,7 @@ class DofMap:
         ks = np.array([self.dof_index(d) for d in dof_names], np.int64)
         if ks.max(initial=0) >= 3 and not self.has_rotation[cells].all():
             raise SSIError("internal error: an element with rotation dofs on nodes without rotations")
-        return (self.offset[cells][:, :, None] + ks).reshape(cells.shape[0], -1)
+        return (self.offset[cells][:, :, None] + ks).reshape(cells.shape[0], cells.shape[1] * len(ks))
 
     def owner_of_dofs(self, dofs):
         return np.searchsorted(self.dof_bounds, np.asarray(dofs, np.int64), side="right") - 1

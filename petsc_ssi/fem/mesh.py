@@ -199,7 +199,21 @@ def orient_faces(cells, quads, name="?"):
 
 
 # ------------------------------------------------------------------ gmsh
-def read_gmsh(path, specs=None):
+def parse_mesh_params(text, what="-ssi_fem_mesh_params"):
+    """{name: float} of 'name=value,...'."""
+    out = {}
+    for item in [s.strip() for s in str(text or "").split(",") if s.strip()]:
+        name, sep, val = item.partition("=")
+        try:
+            out[name.strip()] = float(val)
+        except ValueError:
+            raise SSIError(f"{what}: '{item}' is not name=value") from None
+        if not sep or not name.strip():
+            raise SSIError(f"{what}: '{item}' is not name=value")
+    return out
+
+
+def read_gmsh(path, specs=None, params=None):
     """Serial: read a .msh, or mesh a .geo in 3D, with gmsh; return a StructureMesh.
 
     ``specs``: the parts ([parts.PartSpec]); None: one hex8 part of every brick
@@ -207,7 +221,7 @@ def read_gmsh(path, specs=None):
     existed). Raises SSIError on any check of the module docstring."""
     from ..mesh import gmsh as reader
     from .parts import parse_parts
-    model = reader.read(path, dim=3)
+    model = reader.read(path, dim=3, params=params)
     if specs is None:
         from types import SimpleNamespace
         specs = parse_parts(SimpleNamespace(get=lambda *a: "", fem_E=1.0, fem_nu=0.0, fem_rho=1.0), raw={})
@@ -401,7 +415,10 @@ def build_mesh(cfg, specs=None):
         if specs is not None:
             mesh.blocks[0].props = specs[0].props
         return mesh
-    return read_gmsh(cfg.fem_mesh, specs)
+    params = parse_mesh_params(cfg.get("fem_mesh_params", ""))
+    if params and not cfg.fem_mesh.endswith(".geo"):
+        raise SSIError("-ssi_fem_mesh_params needs a .geo mesh (-ssi_fem_mesh)")
+    return read_gmsh(cfg.fem_mesh, specs, params)
 
 
 def load_mesh(cfg, comm, specs=None):

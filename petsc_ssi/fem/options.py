@@ -30,6 +30,8 @@ def _triple(kind):
 register("fem_mesh", "str", "box", "",
          "mesh of the structure: 'box' (structured hex8 generator, see -ssi_fem_box_*) "
          "or a gmsh .geo/.msh file (hex8, quad4 shells, line2 frames; paths relative to the working directory)", G)
+register("fem_mesh_params", "str", "", "", "parameters of a .geo structure mesh 'name=value,...' (gmsh ONELAB "
+         "'Parameters/name', e.g. DefineConstant[ nbx = {4, Name \"Parameters/nbx\"} ])", G)
 register("fem_parts", "str", "", "", "parts of the structure: physical groups that carry elements, 'NAME,...', each "
          "with -ssi_fem_part_NAME_element hex8|frame|shell and its properties (petsc-ssi help lists them); "
          "empty: one hex8 part of every brick with -ssi_fem_E/_nu/_rho", G)

@@ -178,3 +178,56 @@ case without the communicator splits the ranks (checked, so the test case does p
     for d in res:
         a = d["agreed"]
         assert a["closed"] == [True, True, True] and a["iterations"] == 1 and len(a["calls"]) == 1, d
+
+
+def test_interface_operator_of_a_shell_slab(tmp_path):
+    """T from the dof map for a shell foundation slab: for every rigid-body motion of the
+    structure (rotations included), T u is that motion at the soil side of the interface:
+    the slab's nodes (translations only) or its underside x - (t/2) n (with the offset);
+    T^T is its transpose (spread . gather is the adjoint pairing); the slab's faces are matched
+    with normals opposite to the soil's."""
+    from helpers import petsc
+    PETSc = petsc()
+    from petsc_ssi.mesh.gmsh import write_msh
+    from petsc_ssi.fem.mesh import read_gmsh
+    from petsc_ssi.fem.parts import PartSpec
+    from petsc_ssi.fem.elements import Props
+    from petsc_ssi.fem.dofmap import DofMap
+    from petsc_ssi.coupling.interface import InterfaceOperator, interface_offsets
+    x = np.linspace(-0.5, 0.5, 5)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    coords = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
+    idx = np.arange(X.size).reshape(5, 5)
+    cells = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
+    cells[::2] = cells[::2][:, [0, 3, 2, 1]]             # mixed orientations in the file: the reader fixes them
+    path = str(tmp_path / "slab.msh")
+    write_msh(path, coords, {"slab": ("quad4", cells)})
+    t = 0.3
+    fe = read_gmsh(path, [PartSpec("slab", "shell", Props(E=1e9, nu=0.2, rho=1.0, thickness=t))])
+    be = surface.grid(2.0, 2.0, 0.5, patch=(0.5, 0.5))
+    it = build_interface(be, fe, "auto", "slab", 1e-6)
+    assert it.n == 25 and np.allclose(it.n_b, [0, 0, 1])
+    dm = DofMap(fe.has_rotation(), PETSc.COMM_SELF)
+    R = dm.rigid_body_modes(fe.coords, centre=np.zeros(3))
+    for offset in (None, interface_offsets(fe, it, "slab")):
+        T = InterfaceOperator(PETSc.COMM_SELF, it, dm, offset)
+        pts = fe.coords[it.fe_nodes] + (0 if offset is None else offset)
+        if offset is not None:
+            assert np.allclose(offset, [0, 0, -t / 2])
+        for k in range(6):
+            u = dm.vec_from_global(R[:, k])
+            got = T.gather(u).reshape(-1, 3)
+            want = np.zeros_like(pts)
+            if k < 3:
+                want[:, k] = 1.0
+            else:
+                w = np.zeros(3)
+                w[k - 3] = 1.0
+                want = np.cross(w, pts)
+            assert np.allclose(got, want, atol=1e-14), (k, offset is not None)
+        f = np.random.default_rng(1).standard_normal(3 * it.n)
+        out = dm.vec()
+        T.spread(f, out)
+        v = np.random.default_rng(2).standard_normal(dm.size)
+        assert out.getArray() @ v == pytest.approx(f @ T.gather(dm.vec_from_global(v)), rel=1e-12)
+        T.destroy()
