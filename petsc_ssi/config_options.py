@@ -30,6 +30,8 @@ register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator)
 register("mesh_size", "str", "16,16", "m", "grid/.geo: full extent 'Lx,Ly' of the surface, centred at the origin", "bem")
 register("mesh_h", "real", 1.0, "m", "grid/.geo: element size (node spacing is h/2)", "bem", validator=positive)
 register("mesh_patch", "str", "", "m", "grid/.geo: half-widths 'a,b' of a central patch named 'load' whose edges the mesh follows", "bem")
+register("mesh_params", "str", "", "", ".geo soil mesh: more parameters 'name=value,...' (gmsh ONELAB 'Parameters/name'), "
+         "beside Lx, Ly, xmin, ymin, h, a, b", "bem")
 register("scheme", "enum", "stabilized", "", "time marching: plain (paper eq. 6) or stabilized (eq. 7)", "bem",
          choices=("plain", "stabilized", "stabilised"))
 register("subdivisions", "int", 4, "per side", "equal subdivisions of each element side in natural coordinates", "bem",

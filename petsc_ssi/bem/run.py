@@ -49,6 +49,8 @@ def load_mesh(cfg, planes, comm):
                           "ymin": -Ly / 2 if ymin is None else 0.0}
                 if patch:
                     params.update({"a": patch[0], "b": patch[1]})
+                from ..fem.mesh import parse_mesh_params
+                params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
                 mesh = surface.read_gmsh(cfg.mesh, params)
             mesh.check()
         except SSIError as exc:
