@@ -1,4 +1,4 @@
-"""``petsc-ssi post FILE.h5 [--receivers] [--csv] [--plot PNG] [--info]``.
+"""``petsc-ssi post FILE.h5 [--receivers --csv] [--plot PNG] [--info] [--spectrum | --transfer A B]``.
 
 Reads an output file with h5py (serial; no PETSc needed):
   --receivers --csv   one row per receiver and step, header
@@ -6,11 +6,64 @@ Reads an output file with h5py (serial; no PETSc needed):
   --plot PNG          receiver time histories (with the Pekeris patch solution
                       when the run was a Lamb problem)
   --info              what the file holds
+
+Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
+  --spectrum          one-sided amplitude spectrum |X(f)| of a series, scaled so
+                      that a sine of amplitude A gives a peak A (exact with
+                      --window none and an integer number of periods; other
+                      windows divide out their coherent gain).  Prints the
+                      highest peaks (component,rank,f_hz,amplitude) on stdout.
+  --transfer A B      transfer function H = B / A of two series on the same time
+                      grid, magnitude and phase.  A and B are each
+                        K                  receiver K of the selected series of FILE
+                        FILE2.h5:K         receiver K of the same series of FILE2
+                        [FILE2.h5:]GROUP/NAME[@K]   any series, e.g. interface/force_be
+                      H is a regularised single-record ratio (water level)
+                      H = B conj(A) / (|A|^2 + (eps max|A|)^2), no averaging and
+                      no coherence: rows with reliable=0 (|A| < 5% max|A|) are
+                      not to be trusted.
+ Series selection (both):
+  --quantity Q        u (default) | velocity | acceleration | rotation: the
+                      dataset receivers/Q (structure outputs hold all four)
+  --series G/NAME     any time series dataset with a sibling G/t, shape (K,),
+                      (K, 3) or (K, R, 3); e.g. interface/force_be,
+                      interface/force_fe of coupled runs (overrides --quantity)
+  --receiver K        receiver index for (K, R, 3) series (default 0)
+  --component C       x | y | z | all (default all)
+ Spectral options:
+  --pad P             zero-pad to the next power of two >= P * N samples
+                      (default: none, nfft = N).  Refines the grid df = 1/(nfft dt),
+                      not the resolution 1/(N dt)
+  --window W          none (default) | hann | tukey (--tukey-alpha, default 0.25)
+  --detrend D         none (default) | mean | linear, before windowing
+  --fmax F            output, peaks and plot limited to f <= F Hz
+  --peaks N           the N highest peaks printed and marked (default 5), at
+                      least --min-sep Hz apart (default: the resolution 1/(N dt)),
+                      at f >= --fmin (default 1/(N dt): less than one period in
+                      the record is not told apart from the mean; the first bins
+                      also carry the one-sided 2x scaling step next to f = 0)
+  --eps E             transfer regularisation (default 1e-3)
+  --csv [OUT.csv]     write the spectrum (stdout without a name): '#' header lines
+                      (file, series, window, padding, dt, df, resolution,
+                      scaling), then columns f_hz and one per component
+                      (transfer: f_hz, then |H|, phase_deg, reliable per component)
+  --png OUT.png       plot (matplotlib Agg) with the peaks marked in Hz; the
+                      title states window, padding and df
+Errors (missing series, non-uniform time grid, different grids) end with one
+line ``petsc-ssi post: error: ...`` on stderr and exit status 2.
 """
 import argparse
+import os
 import sys
 
 import numpy as np
+
+COMPONENTS = ("x", "y", "z")
+QUANTITIES = ("u", "velocity", "acceleration", "rotation")
+
+
+class PostError(Exception):
+    """A one-line error of the post command (exit status 2)."""
 
 
 def receivers(path):
@@ -39,15 +92,289 @@ def info(path, out=sys.stdout):
         out.write("datasets: " + ", ".join(sorted(f.keys())[:12]) + (" ..." if len(f.keys()) > 12 else "") + "\n")
 
 
+# ---------------------------------------------------------------- series selection
+
+def read_series(path, series="receivers/u", receiver=0, component="all"):
+    """(t, x (N, C), labels, description) of one series of an output file.
+
+    series: 'GROUP/NAME' with a sibling 'GROUP/t'; a (K, R, 3) dataset is taken at
+    ``receiver``, (K, 3) and (K,) as they are.  component: x|y|z|all (3-component series).
+    """
+    import h5py
+    if not os.path.exists(path):
+        raise PostError(f"{path}: no such file")
+    series = series.strip("/")
+    grp, _, name = series.rpartition("/")
+    with h5py.File(path, "r") as f:
+        if series not in f:
+            have = [k for k in (f[grp].keys() if grp in f else []) if k != "t"]
+            hint = f" (the group {grp} holds: {', '.join(sorted(have))})" if have else \
+                (f" ({path} has no group {grp})" if grp else "")
+            raise PostError(f"{path} holds no series {series}{hint}")
+        tkey = (grp + "/t") if grp else "t"
+        if tkey not in f:
+            raise PostError(f"{path}: the series {series} has no time grid {tkey}")
+        t = np.asarray(f[tkey][:], dtype=float)
+        d = f[series]
+        shape = d.shape
+        where = ""
+        if len(shape) == 3:
+            if not 0 <= receiver < shape[1]:
+                raise PostError(f"{path}: receiver {receiver} out of range, {series} has {shape[1]} receivers")
+            x = np.asarray(d[:, receiver, :], dtype=float)
+            where = f" receiver {receiver}"
+            if grp and grp + "/points" in f:
+                p = f[grp + "/points"][receiver]
+                where += f" at ({p[0]:g}, {p[1]:g}, {p[2]:g})"
+            if series.endswith("/rotation") and grp + "/has_rotation" in f \
+                    and not bool(f[grp + "/has_rotation"][receiver]):
+                raise PostError(f"{path}: receiver {receiver} has no rotation (not at a frame or shell node)")
+        elif len(shape) in (1, 2):
+            x = np.asarray(d[:], dtype=float)
+        else:
+            raise PostError(f"{path}: {series} has shape {shape}, not a time series")
+    if x.ndim == 1:
+        x = x[:, None]
+        labels = [name]
+        if component not in ("all", None):
+            raise PostError(f"{series} is a scalar series: no --component {component}")
+    else:
+        if x.shape[1] != 3:
+            labels = [f"{name}_{j}" for j in range(x.shape[1])]
+        else:
+            labels = [f"{name}_{c}" for c in COMPONENTS]
+        if component not in ("all", None):
+            j = COMPONENTS.index(component)
+            if j >= x.shape[1]:
+                raise PostError(f"{series} has {x.shape[1]} components: no --component {component}")
+            x, labels = x[:, [j]], [labels[j]]
+    if x.shape[0] != t.size:
+        raise PostError(f"{path}: {series} has {x.shape[0]} samples, its time grid {tkey} {t.size}")
+    return t, x, labels, f"{path}:{series}{where}"
+
+
+def _parse_ref(ref, path, series):
+    """'K' | 'FILE:K' | '[FILE:]GROUP/NAME[@K]' -> (file, series, receiver)."""
+    fpath, sel = path, ref
+    head, sep, tail = ref.rpartition(":")
+    if sep and (head.endswith((".h5", ".hdf5")) or os.path.exists(head)):
+        fpath, sel = head, tail
+    rec = 0
+    if sel.lstrip("-").isdigit():
+        return fpath, series, int(sel)
+    if "@" in sel:
+        sel, _, k = sel.partition("@")
+        try:
+            rec = int(k)
+        except ValueError:
+            raise PostError(f"--transfer {ref}: receiver index {k!r} is not an integer") from None
+    if not sel:
+        raise PostError(f"--transfer {ref}: give K, FILE.h5:K or [FILE.h5:]GROUP/NAME[@K]")
+    return fpath, sel, rec
+
+
+# ---------------------------------------------------------------- output
+
+def _header(lines):
+    return "".join(f"# {ln}\n" for ln in lines)
+
+
+def _limit(f, arrays, fmax):
+    if fmax is None:
+        return f, arrays
+    m = f <= fmax
+    return f[m], [a[m] for a in arrays]
+
+
+def _write_table(out, header, names, cols):
+    out.write(header)
+    out.write(",".join(names) + "\n")
+    data = np.column_stack(cols)
+    for row in data:
+        out.write(",".join(f"{v:.9g}" for v in row) + "\n")
+
+
+def _open_out(dest):
+    if dest in (True, "-"):
+        return sys.stdout, False
+    return open(dest, "w"), True
+
+
+def _mpl():
+    import warnings
+    import matplotlib
+    matplotlib.use("Agg")
+    with warnings.catch_warnings():  # "Unable to import Axes3D" of a mixed matplotlib install
+        warnings.simplefilter("ignore", UserWarning)
+        import matplotlib.pyplot as plt
+    return plt
+
+
+def spectrum_command(a, out=sys.stdout):
+    from .spectrum import amplitude_spectrum, peaks
+    t, x, labels, desc = read_series(a.file, a.series, a.receiver, a.component)
+    f, A, inf = amplitude_spectrum(t, x, pad=a.pad, window=a.window, tukey_alpha=a.tukey_alpha,
+                                   detrend=a.detrend)
+    f, (A,) = _limit(f, [A], a.fmax)
+    sep = inf["resolution"] if a.min_sep is None else a.min_sep
+    fmin = inf["resolution"] if a.fmin is None else a.fmin
+    found = [peaks(f, A[:, j], a.peaks, sep, fmin=fmin) for j in range(A.shape[1])]
+    hdr = _header([
+        "petsc-ssi post --spectrum: one-sided amplitude spectrum",
+        f"file: {os.path.abspath(a.file)}",
+        f"series: {desc}, components {', '.join(labels)}",
+        f"window: {inf['window_text']}",
+        f"padding: {inf['padding']}",
+        f"dt: {inf['dt']:.9g} s, N: {inf['n']}, duration: {inf['duration']:.9g} s",
+        f"df: {inf['df']:.9g} Hz (grid), resolution 1/(N dt): {inf['resolution']:.9g} Hz",
+        f"detrend: {inf['detrend']}" + (f", fmax: {a.fmax:g} Hz" if a.fmax is not None else ""),
+        f"scaling: {inf['scaling']}",
+    ])
+    out.write(f"# {desc}: {inf['summary']}\n")
+    out.write("component,rank,f_hz,amplitude\n")
+    for lab, (fp, ap, _) in zip(labels, found):
+        for r, (ff, aa) in enumerate(zip(fp, ap), 1):
+            out.write(f"{lab},{r},{ff:.6g},{aa:.6g}\n")
+    if a.csv is not None and a.csv is not False:
+        fh, close = _open_out(a.csv)
+        try:
+            _write_table(fh, hdr, ["f_hz"] + labels, [f] + [A[:, j] for j in range(A.shape[1])])
+        finally:
+            if close:
+                fh.close()
+    if a.png:
+        plt = _mpl()
+        fig, ax = plt.subplots(figsize=(9, 4.8))
+        for j, lab in enumerate(labels):
+            line, = ax.plot(f, A[:, j], lw=1.2, label=lab)
+            fp, ap, _ = found[j]
+            ax.plot(fp, ap, "v", color=line.get_color(), ms=6)
+            for ff, aa in zip(fp, ap):
+                ax.annotate(f"{ff:.3g} Hz", (ff, aa), textcoords="offset points", xytext=(3, 6),
+                            fontsize=8, color=line.get_color())
+        ax.set_xlabel("f [Hz]")
+        ax.set_ylabel("amplitude |X(f)|")
+        ax.set_xlim(0, f[-1] if f.size else 1)
+        ax.set_title(f"{os.path.basename(a.file)}: {desc.split(':', 1)[1]}\n"
+                     f"window {inf['window_text']}, {inf['padding']}, df {inf['df']:.4g} Hz",
+                     fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(a.png, dpi=120)
+        plt.close(fig)
+    return f, A, inf, found
+
+
+def transfer_command(a, out=sys.stdout):
+    from .spectrum import transfer
+    fa, sa, ra = _parse_ref(a.transfer[0], a.file, a.series)
+    fb, sb, rb = _parse_ref(a.transfer[1], a.file, a.series)
+    ta, xa, la, da = read_series(fa, sa, ra, a.component)
+    tb, xb, lb, db = read_series(fb, sb, rb, a.component)
+    if ta.size != tb.size or not np.allclose(ta, tb, rtol=0, atol=1e-9 * max(abs(ta[-1]), 1e-300)):
+        raise PostError(f"--transfer: {da} and {db} are on different time grids "
+                        f"({ta.size} samples to {ta[-1]:.6g} s, {tb.size} to {tb[-1]:.6g} s)")
+    if xa.shape != xb.shape:
+        raise PostError(f"--transfer: {da} and {db} have {xa.shape[1]} and {xb.shape[1]} components")
+    f, H, inf = transfer(ta, xa, xb, pad=a.pad, window=a.window, tukey_alpha=a.tukey_alpha,
+                         detrend=a.detrend, eps=a.eps)
+    mag, ph, rel = inf["magnitude"], inf["phase"], inf["reliable"]
+    f, (mag, ph, rel) = _limit(f, [mag, ph, rel], a.fmax)
+    comps = [lab.rsplit("_", 1)[-1] for lab in lb]
+    out.write(f"# H = B / A, A = {da}, B = {db}: {inf['summary']}\n")
+    out.write(f"# {inf['method']}\n")
+    if a.csv is not None and a.csv is not False:
+        hdr = _header([
+            "petsc-ssi post --transfer: H(f) = B(f) / A(f)",
+            f"file: {os.path.abspath(a.file)}",
+            f"series A: {da}", f"series B: {db}",
+            f"method: {inf['method']}",
+            f"window: {inf['window_text']}", f"padding: {inf['padding']}",
+            f"dt: {inf['dt']:.9g} s, N: {inf['n']}",
+            f"df: {inf['df']:.9g} Hz (grid), resolution 1/(N dt): {inf['resolution']:.9g} Hz",
+            f"detrend: {inf['detrend']}; phase in degrees, (-180, 180]",
+        ])
+        names, cols = ["f_hz"], [f]
+        for j, c in enumerate(comps):
+            names += [f"mag_{c}", f"phase_deg_{c}", f"reliable_{c}"]
+            cols += [mag[:, j], np.degrees(ph[:, j]), rel[:, j].astype(float)]
+        fh, close = _open_out(a.csv)
+        try:
+            _write_table(fh, hdr, names, cols)
+        finally:
+            if close:
+                fh.close()
+    if a.png:
+        plt = _mpl()
+        fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+        for j, c in enumerate(comps):
+            m = rel[:, j]
+            line, = ax1.plot(f, mag[:, j], lw=0.8, alpha=0.4)
+            ax1.plot(f, np.where(m, mag[:, j], np.nan), lw=1.4, color=line.get_color(), label=c)
+            ax2.plot(f, np.where(m, np.degrees(ph[:, j]), np.nan), ".", ms=2, color=line.get_color(), label=c)
+        ax1.set_yscale("log")
+        ax1.set_ylabel("|H|")
+        ax2.set_ylabel("phase [deg]")
+        ax2.set_xlabel("f [Hz]")
+        ax1.set_title(f"H = B/A, A = {da}\nB = {db}\nwindow {inf['window_text']}, {inf['padding']}, "
+                      f"df {inf['df']:.4g} Hz, eps {inf['eps']:g} (faint: |A| < 5% max)", fontsize=8)
+        for ax in (ax1, ax2):
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(a.png, dpi=120)
+        plt.close(fig)
+    return f, H, inf
+
+
+# ---------------------------------------------------------------- command line
+
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0])
-    ap.add_argument("file")
+    ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog="\n".join(__doc__.splitlines()[2:]))
+    ap.add_argument("file", nargs="?")
     ap.add_argument("--receivers", action="store_true", help="receiver series")
-    ap.add_argument("--csv", action="store_true", help="as CSV on standard output")
+    ap.add_argument("--csv", nargs="?", const=True, default=None, metavar="OUT.csv",
+                    help="CSV (receivers: on standard output; spectrum/transfer: to OUT.csv, "
+                         "standard output without a name)")
     ap.add_argument("--plot", metavar="PNG", help="plot receiver histories to PNG")
     ap.add_argument("--info", action="store_true")
+    ap.add_argument("--spectrum", action="store_true", help="amplitude spectrum of a series")
+    ap.add_argument("--transfer", nargs=2, metavar=("A", "B"), help="transfer function B/A")
+    ap.add_argument("--quantity", choices=QUANTITIES, default="u")
+    ap.add_argument("--series", metavar="GROUP/NAME", help="e.g. interface/force_be (overrides --quantity)")
+    ap.add_argument("--receiver", type=int, default=0, metavar="K")
+    ap.add_argument("--component", choices=COMPONENTS + ("all",), default="all")
+    ap.add_argument("--pad", type=float, default=None, metavar="P")
+    ap.add_argument("--window", choices=("none", "hann", "tukey"), default="none")
+    ap.add_argument("--tukey-alpha", type=float, default=0.25)
+    ap.add_argument("--detrend", choices=("none", "mean", "linear"), default="none")
+    ap.add_argument("--fmax", type=float, default=None, metavar="F")
+    ap.add_argument("--peaks", type=int, default=5, metavar="N")
+    ap.add_argument("--min-sep", type=float, default=None, metavar="HZ")
+    ap.add_argument("--fmin", type=float, default=None, metavar="HZ")
+    ap.add_argument("--eps", type=float, default=1e-3)
+    ap.add_argument("--png", metavar="OUT.png")
     a = ap.parse_args(argv)
+    # legacy order 'post --receivers --csv FILE.h5': the optional --csv value is the file
+    if a.file is None and isinstance(a.csv, str) and a.csv.endswith((".h5", ".hdf5")) \
+            and not (a.spectrum or a.transfer):
+        a.file, a.csv = a.csv, True
+    if a.file is None:
+        ap.error("the following arguments are required: file")
+    a.series = a.series or f"receivers/{a.quantity}"
+    from .spectrum import SpectrumError
     try:
+        if a.spectrum and a.transfer:
+            raise PostError("give either --spectrum or --transfer, not both")
+        if a.spectrum:
+            spectrum_command(a)
+            return 0
+        if a.transfer:
+            transfer_command(a)
+            return 0
         if a.info:
             info(a.file)
         if a.receivers and a.csv:
@@ -56,8 +383,9 @@ def main(argv=None):
             from .plot import receiver_plot
             receiver_plot(a.file, png=a.plot)
         if not (a.info or (a.receivers and a.csv) or a.plot):
-            ap.error("nothing to do: give --receivers --csv, --plot PNG or --info")
-    except OSError as exc:
-        print(f"petsc-ssi post: error: {exc}", file=sys.stderr)
+            ap.error("nothing to do: give --receivers --csv, --plot PNG, --info, --spectrum or --transfer A B")
+    except (OSError, PostError, SpectrumError) as exc:
+        msg = " ".join(str(exc).split())
+        print(f"petsc-ssi post: error: {msg}", file=sys.stderr)
         return 2
     return 0

@@ -132,17 +132,28 @@ class BEMProblem:
             warn(f"beta = c dt / l spans [{self.beta[0]:.3f}, {self.beta[1]:.3f}] (c_s with the largest, "
                  f"c_p with the smallest node spacing), outside [0.3, 1.3]: the time marching may be "
                  f"inaccurate or unstable")
-        if len(self.receivers) and self.regions.n_load:
-            src = self.mesh.nodes[self.regions.load_nodes]
-            edge = self._edge_points()
-            if len(edge):
-                d_se = np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0)
-                for p in self.receivers:
-                    q, _ = symmetry.map_point(p, self.planes)
-                    t_d = (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp
-                    if t_d < cfg.t_end:
-                        warn(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}): waves diffracted at the mesh edge "
-                             f"arrive at t = {t_d:.4g} s < t_end = {cfg.t_end:g} s")
+        for p in self.receivers:
+            self.diffraction_warning(p[None], f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g})")
+
+    def diffraction_warning(self, points, what):
+        """Warn (rank 0) when waves from the load diffracted at the truncation edge reach any of
+        ``points`` (e.g. a receiver, or the structure's interface nodes) before t_end: the
+        earliest arrival over the points, path load -> edge -> point at c_p."""
+        if not self.regions.n_load or not len(points):
+            return None
+        src = self.mesh.nodes[self.regions.load_nodes]
+        edge = self._edge_points()
+        if not len(edge):
+            return None
+        d_se = np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0)
+        t_d = np.inf
+        for p in np.atleast_2d(points):
+            q, _ = symmetry.map_point(p, self.planes)
+            t_d = min(t_d, (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp)
+        if t_d < self.cfg.t_end:
+            warn(f"{what}: waves diffracted at the mesh edge arrive at t = {t_d:.4g} s < t_end = "
+                 f"{self.cfg.t_end:g} s")
+        return t_d
 
     def _edge_points(self):
         """Nodes on the truncation edge (not on a symmetry plane)."""
@@ -176,7 +187,11 @@ class BEMProblem:
                    else np.zeros(3))
             for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
                 src[ax] = 0.0
-            TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, self.receivers, src)
+            sites = getattr(self, "sites", np.zeros((0, 3)))
+            pts = np.vstack([np.asarray(self.receivers).reshape(-1, 3), sites])
+            TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, pts, src)
+            if len(sites):
+                why += f" (points of interest: {len(self.receivers)} receivers and {len(sites)} interface nodes)"
             method = "chebyshev"
             printf(f"[ssi] -ssi_interp auto: {why}")
         plan = interp.Plan(method, self.dt, self.L, TL if TL else None, k, c.interp_grading)

@@ -86,6 +86,10 @@ def setup(cfg, comm):
     except SSIError as exc:
         err = str(exc)
     collective_error(err, comm)
+    # a load on the soil away from the structure (an incident wave field, total field): the
+    # structure is a point of interest for the edge-diffraction warning and the interpolation rule
+    prob.sites = iface.x
+    prob.diffraction_warning(iface.x, "the structure (interface nodes)")
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
     model.layout.set_fixed(model.fixed)
     return prob, model, iface, fe_cfg
@@ -149,7 +153,12 @@ class Coupler:
         self.pI_prev = np.zeros(3 * nI)
         self.closed_prev = self.law.closed.copy()
         self.fixed_I = np.isin(self.dofs_fe, np.asarray(model.fixed, np.int64))
-        self.weights = _area_weights(prob.mesh, iface)
+        self.weights, self.first_moments = _area_weights(prob.mesh, iface)
+        self.offsets = (interface_offsets(model.mesh, iface, cfg.fem_interface) if cfg.interface_offset
+                        else np.zeros((nI, 3)))
+        # points where the interface forces act on the structure's side (the slab's underside
+        # with the offset): moments of both sides are taken about the origin
+        self.arm = iface.x + self.offsets
 
     def solver_cap(self):
         """The object that factorises per active set (n_factor, t_factor)."""
@@ -263,8 +272,14 @@ class Coupler:
         self.pI_prev = res["p"].copy()
         fI = -self.M3 @ tr
         fI[self.fixed_I] = 0.0                  # supports (symmetry planes) take these
-        res["force_fe"] = fI.reshape(-1, 3).sum(axis=0)
-        res["force_be"] = (self.weights[:, None] * tr.reshape(-1, 3)).sum(axis=0)
+        f3, t3 = fI.reshape(-1, 3), tr.reshape(-1, 3)
+        res["force_fe"] = f3.sum(axis=0)
+        res["force_be"] = (self.weights[:, None] * t3).sum(axis=0)
+        # moments about the origin: the structure's sum (x_k + r_k) x f_k (T^T f includes r x f
+        # on the rotations), the soil's int (x + r) x p dGamma by its own quadrature
+        res["moment_fe"] = np.cross(self.arm, f3).sum(axis=0)
+        res["moment_be"] = (np.cross(self.first_moments, t3)
+                            + np.cross(self.offsets * self.weights[:, None], t3)).sum(axis=0)
         res["force_map_error"] = self._force_map_error(p, res["p"])
         with event("SSI_FEM_Step"):
             if self.mode == "staggered":
@@ -316,20 +331,26 @@ def _owned(dofs, vec):
 
 
 def _area_weights(mesh, iface, order=6):
-    """a_k = int N_k dGamma over the interface elements (an independent
-    quadrature of the traction resultant: sum_k a_k p_k = int p dGamma)."""
+    """a_k = int N_k dGamma and the first moments b_k = int x N_k dGamma over the interface
+    elements (an independent quadrature of the traction resultants: sum_k a_k p_k = int p dGamma,
+    sum_k b_k x p_k = int x x p dGamma)."""
     g, w = np.polynomial.legendre.leggauss(order)
     xi, eta = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
     ww = np.outer(w, w).ravel()
     X = mesh.cell_coords()[iface.be_elems]
-    _, jn = quad9.geometry(X, xi, eta)
+    xg, jn = quad9.geometry(X, xi, eta)
     J = np.linalg.norm(jn, axis=-1) * ww
-    Ne = J @ quad9.shape(xi, eta)                     # (E, 9)
+    Nq = quad9.shape(xi, eta)                         # (P, 9)
+    Ne = J @ Nq                                       # (E, 9)
+    Be = np.einsum("ep,pa,epi->eai", J, Nq, xg)       # (E, 9, 3)
     lut = -np.ones(mesh.n_nodes, np.int64)
     lut[iface.be_nodes] = np.arange(iface.n)
     a = np.zeros(iface.n)
-    np.add.at(a, lut[mesh.cells[iface.be_elems]].ravel(), Ne.ravel())
-    return a
+    b = np.zeros((iface.n, 3))
+    loc = lut[mesh.cells[iface.be_elems]].ravel()
+    np.add.at(a, loc, Ne.ravel())
+    np.add.at(b, loc, Be.reshape(-1, 3))
+    return a, b
 
 
 def run_ssi(cfg):
@@ -431,6 +452,7 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
     integ.start(f0=sample(0))
     srec.record(0.0, integ.u, integ.velocity(vel))
     keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
+            "moment_fe", "moment_be",
             "bem_residual", "force_map_error")
     if cfg.coupling == "implicit":
         keys += ("uf_check",)
