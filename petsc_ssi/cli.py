@@ -2,7 +2,7 @@
 
 Commands:
   (none) | run    run the case the options describe (-ssi_problem bem|fem|ssi)
-  post FILE.h5    post-process an output file (--receivers --csv)
+  post FILE.h5    post-process an output file (--receivers --csv, --spectrum, --transfer A B)
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
   static          static solution K u = F of a FE structure (loads at h = 1), written like a run
   estimate        predicted time per stage and memory of the run, per rank count, and

@@ -75,7 +75,8 @@ def receivers(path):
         return g["points"][:], g["t"][:], g["u"][:]
 
 
-def write_csv(path, out=sys.stdout):
+def write_csv(path, out=None):
+    out = sys.stdout if out is None else out
     pts, t, u = receivers(path)
     out.write("receiver,x,y,z,t,ux,uy,uz\n")
     for k, p in enumerate(pts):
@@ -84,7 +85,8 @@ def write_csv(path, out=sys.stdout):
             out.write(f"{k},{p[0]:.9g},{p[1]:.9g},{p[2]:.9g},{ti:.9g},{ux:.9e},{uy:.9e},{uz:.9e}\n")
 
 
-def info(path, out=sys.stdout):
+def info(path, out=None):
+    out = sys.stdout if out is None else out
     import h5py
     with h5py.File(path, "r") as f:
         for k, v in f.attrs.items():
@@ -210,7 +212,8 @@ def _mpl():
     return plt
 
 
-def spectrum_command(a, out=sys.stdout):
+def spectrum_command(a, out=None):
+    out = sys.stdout if out is None else out
     from .spectrum import amplitude_spectrum, peaks
     t, x, labels, desc = read_series(a.file, a.series, a.receiver, a.component)
     f, A, inf = amplitude_spectrum(t, x, pad=a.pad, window=a.window, tukey_alpha=a.tukey_alpha,
@@ -266,7 +269,8 @@ def spectrum_command(a, out=sys.stdout):
     return f, A, inf, found
 
 
-def transfer_command(a, out=sys.stdout):
+def transfer_command(a, out=None):
+    out = sys.stdout if out is None else out
     from .spectrum import transfer
     fa, sa, ra = _parse_ref(a.transfer[0], a.file, a.series)
     fb, sb, rb = _parse_ref(a.transfer[1], a.file, a.series)
