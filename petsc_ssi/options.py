@@ -151,9 +151,11 @@ def resolve(groups=None, comm=None):
                 continue
             key = PREFIX + name
             if key in allopts:
-                # getAll, not getString: petsc4py's getString truncates values to 1023 characters
-                # (a long -ssi_fem_point_load or -ssi_receivers list would be cut silently)
-                raw = allopts[key] if allopts[key] is not None else ""
+                try:
+                    raw = option_value(db, key, allopts)
+                except SSIError as exc:
+                    err = str(exc)
+                    break
                 try:
                     val = _convert(opt, raw)
                 except ValueError as exc:
@@ -180,6 +182,25 @@ def resolve(groups=None, comm=None):
                 break
     collective_error(err, comm)
     return cfg
+
+
+GETSTRING_MAX = 1023
+
+
+def option_value(db, key, allopts=None):
+    """The value of option ``key`` (without '-'): petsc4py's getString keeps spaces but cuts values
+    at 1023 characters; getAll keeps long values but splits at whitespace. The longer of the two
+    is the value; a value that is both longer than 1023 characters and contains whitespace cannot
+    be read whole: SSIError (remove the spaces)."""
+    allopts = db.getAll() if allopts is None else allopts
+    a = db.getString(key, "") or ""
+    b = allopts.get(key) or ""
+    if len(a) < GETSTRING_MAX or b == a:
+        return a
+    if len(b) > len(a):
+        return b
+    raise SSIError(f"-{key}: the value is longer than {GETSTRING_MAX} characters and contains spaces; "
+                   "write it without spaces (petsc4py cannot return it whole otherwise)")
 
 
 def _is_petsc_object_option(name):

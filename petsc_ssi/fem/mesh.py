@@ -14,7 +14,8 @@ ownership (``dofmap.DofMap``). It holds
                    outward normal of the brick that owns the face (re-oriented
                    here, whatever order the file had)
   shells[name]     (F, 4) quads of a 2-D group that are shell cells, oriented
-                   "up" (normal with n_z > 0; vertical walls n_x > 0, then n_y > 0)
+                   consistently over each connected surface and "up" (mean normal with
+                   n_z > 0; vertical walls n_x > 0, then n_y > 0), or outward when closed
   dims[name]       the dimension of each group
 
 Node order of a hex8 cell is gmsh's (= VTK's): 0-3 the face zeta = -1
@@ -260,19 +261,92 @@ def _part_cells(model, spec, path):
         raise SSIError(f"part '{spec.name}' ({spec.element}): the group has no {ct} cells (found: "
                        f"{describe(found) or 'none'}; shells need quads: Recombine the surfaces)")
     other = [k for k, v in grp.cells.items() if k != ct and len(v) and k != "point"]
+    if grp.unknown:
+        raise SSIError(f"part '{spec.name}' ({spec.element}): the group also has {describe(grp.unknown)} cells, "
+                       f"which a {spec.element} part cannot take (shells need quads only: Recombine with "
+                       "Transfinite surfaces or Mesh.RecombinationAlgorithm 2 + Mesh.SubdivisionAlgorithm 1)")
     if other:
         raise SSIError(f"part '{spec.name}' ({spec.element}): the group also has {', '.join(other)} cells; "
                        f"a {spec.element} part takes {ct} cells only")
     return ct, idx
 
 
-def _orient_up(X):
-    """(F,) bool: quads whose normal (x2 - x0) x (x3 - x1) points 'down' (n_z < 0; vertical: n_x < 0,
-    then n_y < 0)."""
-    n = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])
-    tol = 1e-8 * np.linalg.norm(n, axis=1)
-    key = np.where(np.abs(n[:, 2]) > tol, n[:, 2], np.where(np.abs(n[:, 0]) > tol, n[:, 0], n[:, 1]))
-    return key < 0
+def _up_key(n, scale):
+    """The 'up' sign of a normal n: n_z, else n_x, else n_y (each if larger than 1e-8 scale)."""
+    tol = 1e-8 * scale
+    return n[2] if abs(n[2]) > tol else n[0] if abs(n[0]) > tol else n[1]
+
+
+def orient_shells(cells, coords, name="?"):
+    """Serial: the shell cells reordered so that neighbours agree (a surface keeps one side up) and
+    each connected surface faces 'up' (the area-weighted mean normal has n_z > 0; vertical surfaces
+    n_x > 0, then n_y > 0) or, for a closed surface or a tube (mean normal ~ 0), outward from its
+    centroid. Cells are connected across edges that
+    exactly two cells share (T-junctions split a part into separately oriented surfaces). A
+    non-orientable surface (a Moebius strip) is an SSIError."""
+    from collections import deque
+    cells = np.array(cells, np.int64)
+    E = cells.shape[0]
+    if E == 0:
+        return cells
+    a = cells.reshape(-1)
+    b = np.roll(cells, -1, axis=1).reshape(-1)
+    owner = np.repeat(np.arange(E), 4)
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    key = lo * (int(cells.max()) + 1) + hi
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    starts = np.r_[0, np.nonzero(np.diff(ks))[0] + 1]
+    counts = np.diff(np.r_[starts, ks.size])
+    two = starts[counts == 2]
+    e1, e2 = order[two], order[two + 1]
+    c1, c2 = owner[e1], owner[e2]
+    same = a[e1] == a[e2]                     # the shared edge runs the same way in both cells
+    adj = [[] for _ in range(E)]
+    for i, j, s_ in zip(c1.tolist(), c2.tolist(), same.tolist()):
+        adj[i].append((j, s_))
+        adj[j].append((i, s_))
+    flip = np.zeros(E, bool)
+    seen = np.zeros(E, bool)
+    X = coords[cells]
+    nA = np.cross(X[:, 2] - X[:, 0], X[:, 3] - X[:, 1])        # 2 x area-weighted normals
+    closed_edge = np.zeros(E, bool)
+    np.logical_or.at(closed_edge, owner[order[starts[counts != 2]]], True)   # cells on a free edge
+    for start in range(E):
+        if seen[start]:
+            continue
+        comp = [start]
+        seen[start] = True
+        queue = deque([start])
+        while queue:
+            i = queue.popleft()
+            for j, s_ in adj[i]:
+                want = flip[i] ^ s_
+                if seen[j]:
+                    if flip[j] != want:
+                        raise SSIError(f"shell part '{name}': the surface is not orientable (a Moebius strip?) "
+                                       f"near cell {j}")
+                    continue
+                seen[j] = True
+                flip[j] = want
+                comp.append(j)
+                queue.append(j)
+        comp = np.array(comp)
+        sgn = np.where(flip[comp], -1.0, 1.0)[:, None]
+        n = (sgn * nA[comp]).sum(axis=0)
+        scale = np.linalg.norm(nA[comp], axis=1).sum()
+        if not closed_edge[comp].any() or np.linalg.norm(n) <= 1e-6 * scale:
+            # closed (or a tube, whose mean normal vanishes): outward from the surface's centroid
+            cen = X[comp].mean(axis=1)
+            cen = cen - cen.mean(axis=0)
+            turn = np.sum(sgn[:, 0] * np.einsum("ij,ij->i", cen, nA[comp])) < 0
+        else:
+            turn = _up_key(n, scale) < 0
+        if turn:
+            flip[comp] = ~flip[comp]
+    out = cells.copy()
+    out[flip] = out[flip][:, [0, 3, 2, 1]]
+    return out
 
 
 def _frame_blocks(spec, cells, coords):
@@ -284,7 +358,9 @@ def _frame_blocks(spec, cells, coords):
         return [Block(spec.name, el, cells, spec.props)]
     d = coords[cells[:, 1]] - coords[cells[:, 0]]
     L = np.linalg.norm(d, axis=1)
-    vertical = np.abs(d[:, 2]) >= (1 - 1e-9) * np.where(L > 0, L, 1.0)
+    # "along z" within 1e-3 rad (cos = 1 - 5e-7): a column out of plumb by less keeps the
+    # column's default (x), so its strong axis does not turn with the direction of the lean
+    vertical = np.abs(d[:, 2]) >= np.cos(1e-3) * np.where(L > 0, L, 1.0)
     out = []
     for sel, o in ((~vertical, (0.0, 0.0, 1.0)), (vertical, (1.0, 0.0, 0.0))):
         if sel.any():
@@ -320,8 +396,7 @@ def structure_from_model(model, specs, path):
     for spec, ct, c in chosen:
         cells = new[c]
         if spec.element == "shell":
-            flip = _orient_up(coords[cells])
-            cells[flip] = cells[flip][:, [0, 3, 2, 1]]
+            cells = orient_shells(cells, coords, spec.name)
         if spec.element == "frame":
             blocks += _frame_blocks(spec, cells, coords)
         else:

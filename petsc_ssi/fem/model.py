@@ -124,6 +124,14 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
     mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho) if legacy else None
     if not legacy:
         describe_parts(mesh, None, log)
+        hexnodes = np.zeros(mesh.n_nodes, bool)
+        hexnodes[mesh.cells.ravel()] = True
+        joined = int(np.sum(hexnodes & dofmap.has_rotation))
+        if joined:
+            from ..petsc import warn
+            warn(f"{joined} node(s) join frames or shells to bricks: bricks carry no moments, so these joints are "
+                 "pinned (no moment is transferred); embed the member in the brick over several nodes to clamp it",
+                 comm)
     if np.any(pm):
         t = dofmap.node_dofs(np.arange(mesh.n_nodes))[:, 0]
         log(f"[fem] point masses: {pm[t].sum():.6g} kg in all")

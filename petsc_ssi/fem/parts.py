@@ -117,7 +117,9 @@ def raw_part_options(db=None):
     if db is None:
         from ..petsc import init
         db = init().Options()
-    return {k[len(KEY):]: v for k, v in db.getAll().items() if k.startswith(KEY)}
+    from ..options import option_value
+    allopts = db.getAll()
+    return {k[len(KEY):]: option_value(db, k, allopts) for k in allopts if k.startswith(KEY)}
 
 
 def _split_key(rest, names):

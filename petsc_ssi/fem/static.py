@@ -40,8 +40,22 @@ def static_solve(K, f, fixed, coords, prefix="ssi_fem_", solver="direct", dofmap
     u = b.duplicate()
     u.zeroEntries()
     ksp.solve(b, u)
+    # a mechanism (e.g. a frame pinned to a brick: bricks carry no moments) leaves K singular even
+    # with the six rigid-body modes restrained; a direct factorisation may then return garbage
+    # without complaint, so check the residual
+    r = b.duplicate()
+    A.mult(u, r)
+    r.axpy(-1.0, b)
+    nb = b.norm()
+    rel = r.norm() / nb if nb > 0 else r.norm()
+    r.destroy()
     ksp.destroy()
     A.destroy()
+    if not np.isfinite(rel) or rel > 1e-6 or not np.isfinite(u.norm()):
+        collective_error(f"K is singular (relative residual {rel:.2g} of the static solve): the structure is a "
+                         "mechanism (a joint or member free to turn: frames or shells joined to bricks at single "
+                         "nodes are pinned there, as bricks carry no moments; or supports that leave a part "
+                         "free)", comm)
     return u
 
 

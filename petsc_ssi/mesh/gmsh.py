@@ -34,6 +34,7 @@ class Group:
     dim: int
     cells: dict = field(default_factory=dict)     # type -> indices into GmshModel.blocks[type]
     nodes: np.ndarray = None                      # sorted node indices
+    unknown: dict = field(default_factory=dict)   # gmsh type name -> count of elements of other types
 
 
 @dataclass
@@ -110,6 +111,8 @@ def _model(gmsh, path):
             ts, ets, _ = gmsh.model.mesh.getElements(gdim, ent)
             for t, et in zip(ts, ets):
                 if int(t) not in GMSH_TYPES:
+                    tn = gmsh.model.mesh.getElementProperties(int(t))[0]
+                    grp.unknown[tn] = grp.unknown.get(tn, 0) + len(et)
                     continue
                 tname = GMSH_TYPES[int(t)][0]
                 perm, st = sorted_tags[tname]

@@ -28,6 +28,8 @@ def args(parts="slab,columns", drop=(), fixed="base", **extra):
 
 
 def one_line_error(r):
+    if "-ssi_fem_part_pole_element" in r.args:               # the mechanism case warns first
+        assert "joints are pinned" in r.stdout, r.stdout
     lines = [ln for ln in r.stdout.splitlines() if ln.strip()]
     errs = [ln for ln in lines if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout + r.stderr
@@ -55,6 +57,11 @@ def bad_meshes(tmp_path_factory):
     out["zero_length"] = str(d / "zero_length.msh")
     write_msh(out["zero_length"], X[:5], {"slab": ("quad4", [[0, 1, 2, 3]]),
                                           "columns": ("line2", [[4, 0], [0, 0]]), "base": ("point", [[4]])})
+    Xm = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1],
+                   [1, 1, 1.5], [1, 1, 2.0]], float)
+    out["mechanism"] = str(d / "mechanism.msh")     # a pole pinned to a brick at one node
+    write_msh(out["mechanism"], Xm, {"block": ("hex8", [list(range(8))]), "pole": ("line2", [[6, 8], [8, 9]]),
+                                     "bottom": ("quad4", [[0, 3, 2, 1]]), "tip": ("point", [[9]])})
     out["zero_area"] = str(d / "zero_area.msh")
     write_msh(out["zero_area"], X[:5], {"slab": ("quad4", [[0, 1, 2, 3], [0, 1, 1, 0]]),
                                         "columns": ("line2", [[4, 0]]), "base": ("point", [[4]])})
@@ -62,6 +69,11 @@ def bad_meshes(tmp_path_factory):
 
 
 COLUMNS = tuple(k for k in SLAB if k.startswith("columns_"))
+MECH = ["-ssi_problem", "fem", "-ssi_fem_parts", "block,pole", "-ssi_fem_part_block_element", "hex8",
+        "-ssi_fem_part_block_E", "1e9", "-ssi_fem_part_block_nu", "0.2", "-ssi_fem_part_block_rho", "2000",
+        "-ssi_fem_part_pole_element", "frame", "-ssi_fem_part_pole_E", "1e9", "-ssi_fem_part_pole_nu", "0.2",
+        "-ssi_fem_part_pole_rho", "2000", "-ssi_fem_part_pole_section", "0.1,0.1", "-ssi_fem_fixed", "bottom",
+        "-ssi_fem_point_load", "tip,1000,0,0", "-ssi_output", ""]
 CASES = {
     "shell without thickness": (lambda m: args(drop=("slab_thickness",)),
                                 "part 'slab' (shell) needs -ssi_fem_part_slab_thickness"),
@@ -102,6 +114,7 @@ CASES = {
                         "coincident nodes"),
     "zero-length frame": (lambda m: [a if a != "meshes/slab_on_columns.geo" else m["zero_length"] for a in args()],
                           "part 'columns' (frame)"),
+    "mechanism (static)": (lambda m: ["static", "-ssi_fem_mesh", m["mechanism"]] + MECH, "K is singular (relative residual"),
     "zero-area shell": (lambda m: [a if a != "meshes/slab_on_columns.geo" else m["zero_area"] for a in args()],
                         "part 'slab' (shell)"),
 }
