@@ -179,7 +179,16 @@ class DofMap:
 
     @property
     def fixed(self):
-        return self._fixed
+        """The fixed dofs, as recorded in the section's constraints (global, sorted)."""
+        return self.constrained_dofs()
+
+    def constrained_dofs(self):
+        """Global dofs of the section's constraint indices (node by node)."""
+        sec = self.section
+        out = [self.offset[p] + np.asarray(sec.getConstraintIndices(p), np.int64)
+               for p in np.unique(np.searchsorted(self.offset, self._fixed, side="right") - 1)
+               if sec.getConstraintDof(int(p))]
+        return np.sort(np.concatenate(out)) if out else np.zeros(0, np.int64)
 
     # ------------------------------------------------------------ fields
     def nodal_array(self, values_u=None, values_r=None):

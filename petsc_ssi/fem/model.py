@@ -117,6 +117,7 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
         err = str(exc)
     collective_error(err, comm)
     dofmap.set_fixed(fixed)
+    fixed = dofmap.fixed                  # the section's constraints are the record of the supports
     counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())
     log(f"[fem] mesh {mesh.source}: {mesh.n_nodes} nodes ({int(mesh.has_rotation().sum())} with rotations), "
         f"{counts}, {dofmap.size} dofs, {len(fixed)} fixed, groups: {', '.join(mesh.group_names())}")

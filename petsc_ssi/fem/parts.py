@@ -9,7 +9,7 @@ that carry elements. Each part takes its element and properties from
   thickness     shell thickness [m]                                           (shell, required)
   mass_per_area shell: mass per area [kg/m^2] used instead of rho * thickness
   section b,h   frame: rectangle of width b and depth h [m] (h along the orientation
-                vector; area, Iy = b h^3/12, Iz = h b^3/12 and St-Venant J from it)
+                vector; area, Iy = b h^3/12, Iz = h b^3/12 and the exact St-Venant J)
   area, Iy, Iz, J   frame: section constants [m^2, m^4] (instead of, or overriding, section)
   orientation x,y,z frame: a vector not parallel to the member that fixes the section's
                 depth direction (the local z axis, as a beam's "up"); default: global z,
@@ -75,12 +75,10 @@ class PartSpec:
 
 
 def rect_section(b, h):
-    """area, Iy, Iz, J of a b x h rectangle (h along the local z axis); St-Venant J of a
-    rectangle with long side a and short side c: a c^3 [1/3 - 0.21 (c/a)(1 - c^4/(12 a^4))]
-    (Roark; within 0.5% of the exact series for every aspect ratio)."""
-    a, c = max(b, h), min(b, h)
-    J = a * c ** 3 * (1.0 / 3.0 - 0.21 * (c / a) * (1.0 - c ** 4 / (12.0 * a ** 4)))
-    return dict(area=b * h, Iy=b * h ** 3 / 12.0, Iz=h * b ** 3 / 12.0, J=J)
+    """area, Iy, Iz, J of a b x h rectangle (h along the local z axis), J from the exact St-Venant
+    series (``elements.frame.rect_section``)."""
+    from .elements.frame import rect_section as exact
+    return exact(b, h)
 
 
 def _suggest(word, choices):

@@ -51,7 +51,7 @@ def test_dofmap_offsets_ownership_and_rigid_modes(PETSc):
         dm.dofs([1], ("rxx",))
     fixed = dm.set_fixed(dm.dofs([1], ("ux", "rz")))
     assert dm.section.getConstraintDof(1) == 2 and list(dm.section.getConstraintIndices(1)) == [0, 5]
-    assert list(fixed) == [dm.offset[1], dm.offset[1] + 5]
+    assert list(fixed) == [dm.offset[1], dm.offset[1] + 5] == list(dm.fixed)     # read back from the Section
     # rigid-body modes: a rotation about z moves node (x, y) by (-y, x) and turns rz by 1
     x = np.random.default_rng(0).standard_normal((8, 3))
     R = dm.rigid_body_modes(x, centre=np.zeros(3))
