@@ -159,17 +159,62 @@ class Marcher:
         self.dofs_pres = dofs
         self.dofs_load = ldofs
 
+    # ------------------------------------------------------------ the public coupling API
+    # Known values: traction at load DOFs (a replicated history, set by rank 0 and assembled)
+    # and displacement at prescribed DOFs, either from the prescribed history (rank 0) or set
+    # by the rank that owns each DOF (the FEM-BEM coupling: the structure's interface
+    # displacement), without communication.
+    def coefficients(self):
+        """((lag, c), ...): the step matrix's lag coefficients, A = sum c (H_lag | -G_lag) (stabilised
+        4 H_1 + H_2, plain H_1): the one place the scheme's coefficients live."""
+        return ((1, 4.0), (2, 1.0)) if self.scheme == "stabilized" else ((1, 1.0),)
+
+    def set_known_p(self, n):
+        """Collective: the known traction of step n into kv_p (rank 0 sets, assembled)."""
+        self.kv_p.set(0.0)
+        if self.comm.getRank() == 0 and self.reg.n_load:
+            self.kv_p.setValues(self.dofs_load, self.known_p(n))
+        self.kv_p.assemblyBegin(); self.kv_p.assemblyEnd()
+
+    def set_known_u_owned(self, local, values):
+        """Local (no communication): kv_u = 0, then kv_u[local] = values at DOFs this rank owns
+        (``local``: indices into the owned part)."""
+        kv = self.kv_u.getArray()
+        kv[:] = 0.0
+        kv[np.asarray(local, np.int64)] = values
+        return kv
+
+    def mult_step_H(self, x, out):
+        """Collective: out = H_s x = sum c H_lag x (the step matrix's displacement part), rows of
+        symmetry-zero DOFs set to 0."""
+        out.set(0.0)
+        if not hasattr(self, "_t"):
+            self._t = self.u_tmpl.duplicate()
+        for lag, c in self.coefficients():
+            self.H[lag - 1].mult(x, self._t)
+            out.axpy(c, self._t)
+        if self.zero_local.size:
+            out.getArray()[self.zero_local] = 0.0
+        return out
+
+    def residual(self, x, b, out):
+        """Collective: out = A x - b (the step equations)."""
+        self.A.mult(x, out)
+        out.axpy(-1.0, b)
+        return out
+
+    @property
+    def history_rhs(self):
+        """The right-hand side of the current step after ``begin_step`` (the history sum)."""
+        return self._b
+
     def _set_known(self, n):
         """Known values of step n into kv_u / kv_p (set by rank 0, assembled)."""
         self.kv_u.set(0.0)
-        self.kv_p.set(0.0)
-        if self.comm.getRank() == 0:
-            if self.reg.n_disp:
-                self.kv_u.setValues(self.dofs_pres, self.known_u(n))
-            if self.reg.n_load:
-                self.kv_p.setValues(self.dofs_load, self.known_p(n))
-        for v in (self.kv_u, self.kv_p):
-            v.assemblyBegin(); v.assemblyEnd()
+        if self.comm.getRank() == 0 and self.reg.n_disp:
+            self.kv_u.setValues(self.dofs_pres, self.known_u(n))
+        self.kv_u.assemblyBegin(); self.kv_u.assemblyEnd()
+        self.set_known_p(n)
 
     def _slot(self, m):
         return m % self.depth
@@ -258,9 +303,8 @@ class Marcher:
     def add_known(self, b):
         """Collective: b += the terms of the known values in kv_u / kv_p (step matrix
         coefficients of lags 1 and 2); rows of symmetry-zero DOFs set to 0."""
-        coef = (4.0, 1.0) if self.scheme == "stabilized" else (1.0, 0.0)
-        for lag, c in ((1, coef[0]), (2, coef[1])):
-            if c == 0.0 or lag > self.L:
+        for lag, c in self.coefficients():
+            if lag > self.L:
                 continue
             if self.reg.n_load and self.G[lag - 1] is not None:
                 self.G[lag - 1].mult(self.kv_p, self.rhs)

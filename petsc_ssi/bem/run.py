@@ -200,16 +200,17 @@ class BEMProblem:
         self.plan = plan
         return plan
 
-    def prepare(self, extra=()):
+    def prepare(self, extra=(), extra_bytes=0.0, extra_what=""):
         """Collective: print the summary (and ``extra`` lines), choose the interpolation
-        plan, set up the LagSet and check the memory; returns (plan, lagset)."""
+        plan, set up the LagSet and check the memory (with ``extra_bytes`` of the run's other
+        dense data); returns (plan, lagset)."""
         printf(self.summary())
         for line in extra:
             printf(line)
         plan = self.interp_plan()
         printf("[ssi] " + plan.describe())
         ls = self.lagset()
-        self.check_memory(ls, plan)
+        self.check_memory(ls, plan, extra_bytes, extra_what)
         return plan, ls
 
     def quad_options(self):
@@ -222,10 +223,12 @@ class BEMProblem:
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,
                       self.quad_options())
 
-    def check_memory(self, ls, plan=None):
+    def check_memory(self, ls, plan=None, extra_bytes=0.0, extra_what=""):
         """Collective: refuse runs whose lag matrices would not fit; if the
         dense lags of the automatic storage choice would not fit but block-
-        sparse storage would, store every lag block-sparse (and say so)."""
+        sparse storage would, store every lag block-sparse (and say so).
+        ``extra_bytes``: memory of the whole run (all ranks) that lives beside the
+        stored lags after assembly (the coupling's dense interface matrices)."""
         c = self.cfg
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
         # the limit holds per node: the run's peak is shared by its ranks, of which
@@ -236,12 +239,15 @@ class BEMProblem:
         share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
         n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
         node.Free()
+        extra_bytes = float(extra_bytes)
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
         est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra)
+        peak = max(peak, est + extra_bytes)
         if share * peak > limit and c.lag_storage == "auto":
             est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra)
+            peak2 = max(peak2, est2 + extra_bytes)
             if share * peak2 <= limit:
                 self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
                          f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
@@ -249,7 +255,8 @@ class BEMProblem:
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
-        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags), assembly "
+        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
                  f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
         if share * peak > limit:
             raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
@@ -385,7 +392,7 @@ def _time_loop(cfg, comm, prob, march, out):
     if nrec:
         R, where = rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
         y = R.createVecLeft()
-    tnode = _traction_to_nodes(comm, prob, march)
+    tnode = traction_to_nodes(comm, prob, march)
     tfield = march.u_tmpl.duplicate()
     series = []
     times = []
@@ -454,7 +461,7 @@ def _guard(cfg, prob, march, unorm, n):
     raise exc
 
 
-def _traction_to_nodes(comm, prob, march):
+def traction_to_nodes(comm, prob, march):
     """AIJ mapping traction columns to a nodal traction field (for output)."""
     PETSc = init()
     reg = prob.regions

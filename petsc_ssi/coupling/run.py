@@ -45,12 +45,11 @@ from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event, stage, fmt_time
 from ..io.output import Output, provenance
 from ..options import Config
-from ..bem.run import BEMProblem, build_bem, _traction_to_nodes
+from ..bem.run import BEMProblem, build_bem, traction_to_nodes
 from ..bem import receivers as bem_rec
 from ..bem.model import Regions
 from ..fem.model import build_model
-from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, \
-    _history as fem_history
+from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, load_history
 from ..mesh import quad9
 from .interface import build_interface, fem_symmetry_dofs, force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -67,8 +66,7 @@ def setup(cfg, comm):
     """Collective: the soil problem, the structure's model (not assembled) and the
     interface, all checked. Returns (prob, model, iface, fe_cfg)."""
     prob = BEMProblem(cfg, comm, log=printf)
-    fe_cfg = _view(cfg, receivers=cfg.structure_receivers,
-                   fem_integrator="green" if cfg.coupling == "staggered" else "midpoint")
+    fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
     model = build_model(fe_cfg, comm, assemble_matrices=False)
     err, iface, sym = None, None, None
     try:
@@ -95,10 +93,84 @@ def setup(cfg, comm):
     return prob, model, iface, fe_cfg
 
 
+class StaggeredStep:
+    """The paper's staggered step (Table 2): FEM predictor (Green's-function integrator), the BEM
+    with every interface node closed at u_b = u_f, the active-set corrections through the
+    capacitance Z_OO, and the soil's force handed to the structure as an impulse (B.5-B.6)."""
+    integrator = "green"
+
+    def __init__(self, cp):
+        self.cp = cp
+        self.solver = StaggeredSolve(cp.law, Capacitance(cp.Z_II))
+
+    def predict(self, f_ext):
+        return self.cp.integ.predict()                              # B.1 (no load of step n)
+
+    def known_interface_u(self, wI):
+        return wI                                                   # B.2: u_b = u_f (all closed)
+
+    def interface(self, yI, wI):
+        return self.cp.law.step(self.solver(yI, wI), wI)            # B.2-B.4 (active set)
+
+    def correct_soil(self, x, res, wI):
+        O = res["O"]
+        if O.size:                                                  # x = y - Z[:, O] delta_O
+            x -= self.cp.Zloc[:, O] @ (res["ub"] - wI)[O]
+
+    def finish(self, f_ext, fI, res):
+        cp = self.cp
+        cp.Top.spread(fI, cp.ff)                                    # f_f = T^T f_I
+        cp.ff.pointwiseMult(cp.ff, cp.integ.mask)
+        cp.integ.correct(f_ext, cp.ff)                              # B.5-B.6
+
+    def factoriser(self):
+        return self.solver.cap
+
+
+class ImplicitStep:
+    """The interface-implicit step: the structure's predictor w (trapezoidal rule in midpoint
+    form, no interface force), the BEM solution q with zero interface displacement, then the
+    interface system u_f = w + 2 C f, f = -M p, p = q - Z u_b with the active-set loop
+    (contact.ImplicitSolve), C = T D^-1 T^T."""
+    integrator = "midpoint"
+
+    def __init__(self, cp):
+        self.cp = cp
+        cp.DEloc, C = cp.fem_columns()
+        self.solver = ImplicitSolve(cp.law, cp.Z_II, 2.0 * C, cp.M3, 1.0)   # midpoint: u = w + D^-1 (2 f)
+        self.solver._lu(cp.law.closed, cp.law.open_dofs(cp.law.closed))      # the bonded LU, now
+
+    def predict(self, f_ext):
+        return self.cp.integ.predict(f_ext)
+
+    def known_interface_u(self, wI):
+        return np.zeros_like(wI)                                    # q: the soil with u_I = 0
+
+    def interface(self, yI, wI):
+        return self.cp.law.step(self.solver(yI, wI, np.zeros_like(yI)), None)
+
+    def correct_soil(self, x, res, wI):
+        x -= self.cp.Zloc @ res["ub"]                               # x = q - Z u_b
+
+    def finish(self, f_ext, fI, res):
+        cp = self.cp
+        cp.du.getArray()[:] = cp.DEloc @ (2.0 * fI)                 # D^{-1} (2 f_I), midpoint form
+        cp.integ.complete(cp.du)
+        res["uf_check"] = cp.Top.gather(cp.integ.u)
+
+    def factoriser(self):
+        return self.solver
+
+
+STRATEGIES = {"staggered": StaggeredStep, "implicit": ImplicitStep}
+
+
 class Coupler:
-    """Collective: the interface maps between the FE and BE layouts, the
-    interface matrices (Z, and C for the implicit coupling) and the contact
-    law; ``step()`` advances both sides."""
+    """Collective: the interface maps between the FE and BE layouts (the interface operator T,
+    a scatter of the soil's interface values), the interface matrices (Z = A^-1 H_s E_I, and
+    C = T D^-1 T^T for the implicit step) and the contact law; ``step()`` advances both sides
+    with the time-coupling strategy of -ssi_coupling (``StaggeredStep`` or ``ImplicitStep``),
+    through the marcher's public coupling API (bem/march.py)."""
 
     def __init__(self, cfg, comm, prob, march, iface, integ, model):
         PETSc = init()
@@ -116,53 +188,52 @@ class Coupler:
         self.seq_y = PETSc.Vec().createSeq(3 * nI, comm=PETSc.COMM_SELF)
         self.sc_be = PETSc.Scatter().create(march.u_tmpl, PETSc.IS().createGeneral(self.dofs_be, comm=PETSc.COMM_SELF),
                                             self.seq_y, None)
-        self.Top = InterfaceOperator(comm, iface, model.layout,
-                                     interface_offsets(model.mesh, iface, cfg.fem_interface)
-                                     if cfg.interface_offset else None)
+        self.offsets = (interface_offsets(model.mesh, iface, cfg.fem_interface) if cfg.interface_offset
+                        else np.zeros((nI, 3)))
+        self.Top = InterfaceOperator(comm, iface, model.layout, self.offsets if cfg.interface_offset else None)
         self.own_k, self.own_loc = _owned(self.dofs_be, march.u_tmpl)
         self.fown_k, self.fown_loc = _owned(self.dofs_fe, integ.u)
         self.zero = iface.zero.ravel()
+        self.ff = integ.u.duplicate()
+        self.du = integ.u.duplicate()
         ev = event("SSI_Capacitance")
         ev.begin()
         t0 = time.perf_counter()
         self.Zloc = self._bem_columns()
-        Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
+        self.Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
                               cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py())
         ex = cfg.coupling_traction == "extrapolated"
         self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
-        M3 = np.kron(iface.M.toarray(), np.eye(3))
-        self.M3 = M3
-        if self.mode == "staggered":
-            self.solver = StaggeredSolve(self.law, Capacitance(Z_II))
-        else:
-            self.DEloc, C = self._fem_columns()
-            self.solver = ImplicitSolve(self.law, Z_II, 2.0 * C, M3, 1.0)     # midpoint: u = w + D^-1 (2 f)
-            self.solver._lu(self.law.closed, self.law.open_dofs(self.law.closed))   # the bonded LU, now
+        self.M3 = np.kron(iface.M.toarray(), np.eye(3))
+        self.strategy = STRATEGIES[self.mode](self)
         self.t_capacitance = time.perf_counter() - t0
         ev.end()
         # forces: f_f = F p (FE layout); rows of FE DOFs a symmetry plane (or the
         # user) fixes are left out: their reaction is not a load on the structure
         self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, model.layout,
                               skip=model.fixed)
-        self.ff = integ.u.duplicate()
-        self.du = integ.u.duplicate()
-        self.w = march.p_tmpl.duplicate()
-        self.p_prev = march.p_tmpl.duplicate()
-        self.p_prev.set(0.0)
         self.pI_prev = np.zeros(3 * nI)
         self.closed_prev = self.law.closed.copy()
         self.fixed_I = np.isin(self.dofs_fe, np.asarray(model.fixed, np.int64))
         self.weights, self.first_moments = _area_weights(prob.mesh, iface)
-        self.offsets = (interface_offsets(model.mesh, iface, cfg.fem_interface) if cfg.interface_offset
-                        else np.zeros((nI, 3)))
         # points where the interface forces act on the structure's side (the slab's underside
         # with the offset): moments of both sides are taken about the origin
         self.arm = iface.x + self.offsets
+        self._kv_initial, self._r, self._dkv, self._t = (march.u_tmpl.duplicate() for _ in range(4))
 
     def solver_cap(self):
         """The object that factorises per active set (n_factor, t_factor)."""
-        return self.solver.cap if self.mode == "staggered" else self.solver
+        return self.strategy.factoriser()
+
+    def dense_bytes(self):
+        """Bytes of the dense interface matrices this rank holds (Z's and D^-1 T^T's local rows,
+        Z_II, M3, C)."""
+        n = 3 * self.nI
+        b = self.Zloc.nbytes + self.Z_II.nbytes + self.M3.nbytes
+        if hasattr(self, "DEloc"):
+            b += self.DEloc.nbytes + 8 * n * n
+        return b
 
     def _gather_rows(self, loc, own_k, own_loc):
         """Collective: the interface rows of a local column block, on every rank."""
@@ -175,8 +246,7 @@ class Coupler:
     def _bem_columns(self):
         """Z[:, j] = A^{-1} H_s e_j for the interface DOFs (local rows; 3 n_I solves)."""
         m = self.march
-        e, t, rhs, z = (m.u_tmpl.duplicate() for _ in range(4))
-        coef = ((1, 4.0), (2, 1.0)) if m.scheme == "stabilized" else ((1, 1.0),)
+        e, rhs, z = (m.u_tmpl.duplicate() for _ in range(3))
         Z = np.zeros((e.getLocalSize(), 3 * self.nI))
         lut = -np.ones(3 * self.nI, np.int64)
         lut[self.own_k] = self.own_loc
@@ -186,19 +256,14 @@ class Coupler:
             e.set(0.0)
             if lut[j] >= 0:
                 e.getArray()[lut[j]] = 1.0
-            rhs.set(0.0)
-            for lag, c in coef:
-                m.H[lag - 1].mult(e, t)
-                rhs.axpy(c, t)
-            if m.zero_local.size:
-                rhs.getArray()[m.zero_local] = 0.0
+            m.mult_step_H(e, rhs)
             m.solve(rhs, z)
             Z[:, j] = z.getArray(readonly=True)
-        for v in (e, t, rhs, z):
+        for v in (e, rhs, z):
             v.destroy()
         return Z
 
-    def _fem_columns(self):
+    def fem_columns(self):
         """D^{-1} T^T e_j (local rows) and C = T D^{-1} T^T (replicated) for the interface
         dofs j (3 n_I solves; T^T e_j masked: a fixed dof takes no interface force)."""
         integ = self.integ
@@ -217,53 +282,40 @@ class Coupler:
         e.destroy(); z.destroy()
         return out, C
 
-    def _set_known_p(self, n):
-        m = self.march
-        m.kv_p.set(0.0)
-        if self.comm.getRank() == 0 and m.reg.n_load:
-            m.kv_p.setValues(m.dofs_load, m.known_p(n))
-        m.kv_p.assemblyBegin(); m.kv_p.assemblyEnd()
-
     def step(self, f_ext):
         """Collective: one coupled step. Returns (u_soil, p_soil, info)."""
-        m, integ = self.march, self.integ
+        m, st = self.march, self.strategy
         with event("SSI_FEM_Step"):
-            uf = integ.predict() if self.mode == "staggered" else integ.predict(f_ext)   # B.1
+            uf = st.predict(f_ext)                                 # B.1
         wI = self.Top.gather(uf)
         n = m.begin_step()                                         # history sum
-        kv = m.kv_u.getArray()
-        kv[:] = 0.0
-        if self.mode == "staggered":
-            kv[self.own_loc] = wI[self.own_k]                      # B.2: u_b = u_f (all closed)
-        self._set_known_p(n)
-        if not hasattr(self, "_kv_initial"):
-            self._kv_initial = m.kv_u.duplicate()
+        kv = m.set_known_u_owned(self.own_loc, st.known_interface_u(wI)[self.own_k])
+        m.set_known_p(n)
         m.kv_u.copy(self._kv_initial)
-        b = m.add_known(m._b)
+        b = m.add_known(m.history_rhs)
         m.solve(b, m.x)                                            # B.3: y (staggered) or q (u_I = 0)
         self.sc_be.scatter(m.x, self.seq_y)
         yI = self.seq_y.getArray(readonly=True).copy()
         ev = event("SSI_Contact")
         ev.begin()
-        if self.mode == "staggered":
-            res = self.law.step(self.solver(yI, wI), wI)           # B.2-B.4 (active set)
-        else:
-            res = self.law.step(self.solver(yI, wI, np.zeros_like(yI)), None)
+        res = st.interface(yI, wI)
         x = m.x.getArray()
-        if self.mode == "staggered":
-            O = res["O"]
-            if O.size:                                             # x = y - Z[:, O] delta_O
-                d = res["ub"] - wI
-                x -= self.Zloc[:, O] @ d[O]
-        else:
-            x -= self.Zloc @ res["ub"]                             # x = q - Z u_b
+        st.correct_soil(x, res, wI)
         x[self.own_loc] = np.where(np.isin(self.own_k, res["O"]), res["p"][self.own_k], x[self.own_loc])
         kv[self.own_loc] = res["ub"][self.own_k]
         ev.end()
         u, p = m.store(n, m.x)
         # the BEM equations of the step with the final interface values: A x - b = 0
-        res["bem_residual"] = self._bem_residual(b, kv)
-        # B.5: the traction handed over (interface order) and the force on the structure
+        res["bem_residual"] = self._bem_residual(b)
+        fI = self._handover(res)
+        res["force_map_error"] = self._force_map_error(p, res["p"])
+        with event("SSI_FEM_Step"):
+            st.finish(f_ext, fI, res)
+        return u, p, res
+
+    def _handover(self, res):
+        """B.5: the traction handed to the structure (interface order), the force f_I = -M p on it
+        (zero on its fixed dofs: the supports take those), and the resultants of both sides."""
         tr = res["p"].copy()
         if self.c_old:                          # extrapolated, except at DOFs whose status changed
             same = np.repeat(res["closed"] == self.closed_prev, 3)
@@ -280,33 +332,16 @@ class Coupler:
         res["moment_fe"] = np.cross(self.arm, f3).sum(axis=0)
         res["moment_be"] = (np.cross(self.first_moments, t3)
                             + np.cross(self.offsets * self.weights[:, None], t3)).sum(axis=0)
-        res["force_map_error"] = self._force_map_error(p, res["p"])
-        with event("SSI_FEM_Step"):
-            if self.mode == "staggered":
-                self.Top.spread(fI, self.ff)                       # f_f = T^T f_I
-                self.ff.pointwiseMult(self.ff, integ.mask)
-                integ.correct(f_ext, self.ff)                      # B.5-B.6
-            else:
-                da = self.du.getArray()
-                da[:] = self.DEloc @ (2.0 * fI)                    # D^{-1} (2 f_I), midpoint form
-                integ.complete(self.du)
-                res["uf_check"] = self.Top.gather(integ.u)
-        return u, p, res
+        return fI
 
-    def _bem_residual(self, b, kv):
+    def _bem_residual(self, b):
         """Collective: ||A x - b_final|| / ||b_final||, b_final = b - H_s (kv_final - kv_initial)
         (the known interface displacements changed at open nodes)."""
         m = self.march
-        if not hasattr(self, "_r"):
-            self._r, self._t, self._kv0 = (m.u_tmpl.duplicate() for _ in range(3))
-        m.A.mult(m.x, self._r)
-        self._r.axpy(-1.0, b)
-        self._kv0.getArray()[:] = kv
-        self._kv0.axpy(-1.0, self._kv_initial)
-        coef = ((1, 4.0), (2, 1.0)) if m.scheme == "stabilized" else ((1, 1.0),)
-        for lag, c in coef:
-            m.H[lag - 1].mult(self._kv0, self._t)
-            self._r.axpy(c, self._t)
+        m.residual(m.x, b, self._r)
+        m.kv_u.copy(self._dkv)
+        self._dkv.axpy(-1.0, self._kv_initial)
+        self._r.axpy(1.0, m.mult_step_H(self._dkv, self._t))
         if m.zero_local.size:
             self._r.getArray()[m.zero_local] = 0.0
         nb = b.norm()
@@ -361,13 +396,14 @@ def run_ssi(cfg):
     log = printf if cfg.monitor else (lambda m: None)
     st = stage("SSI setup")
     st.push()
-    hist = fem_history(cfg, comm)
+    hist = load_history(cfg, comm)
     prob, model, iface, fe_cfg = setup(cfg, comm)
     plan, ls = prob.prepare([
         f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
         f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
         + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
-        + f", {cfg.coupling} coupling"])
+        + f", {cfg.coupling} coupling"], interface_bytes(cfg, prob, model, iface, comm.getSize()),
+        "interface matrices")
     st.pop()
     st = stage("SSI FEM assembly")
     st.push()
@@ -414,6 +450,20 @@ def run_ssi(cfg):
     return res
 
 
+def interface_bytes(cfg, prob, model, iface, ranks):
+    """Estimated bytes of the coupling's dense interface matrices over all ranks: the local rows
+    of Z = A^-1 H_s E_I (soil dofs x 3 n_I) and, implicit, of D^-1 T^T (structure dofs x 3 n_I);
+    on every rank Z_II, M3, C (3 n_I)^2 each and the interface LUs (one bonded; a cache of at
+    most 512 MB with unilateral contact)."""
+    n = 3 * iface.n
+    b = 8.0 * 3 * prob.mesh.n_nodes * n + 3 * 8.0 * n * n * ranks
+    if cfg.coupling == "implicit":
+        b += 8.0 * model.layout.size * n + 8.0 * n * n * ranks
+    lu = 8.0 * n * n
+    b += ranks * (max(lu, 512e6) if cfg.contact == "unilateral" else lu)
+    return b
+
+
 def structure_output_path(path):
     stem, ext = os.path.splitext(path)
     return stem + "_structure" + (ext or ".h5")
@@ -434,7 +484,7 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
         R, _ = bem_rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
         y = R.createVecLeft()
     srec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
-    tnode = _traction_to_nodes(comm, prob, march)
+    tnode = traction_to_nodes(comm, prob, march)
     tfield = march.u_tmpl.duplicate()
     vel = integ.u.duplicate()
     F, fn = model.load_vec(), model.load_vec()

@@ -87,7 +87,7 @@ class ReceiverSeries:
         return out
 
 
-def _history(cfg, comm):
+def load_history(cfg, comm):
     """Collective: the load history (the option checks read it once already)."""
     err, hist = None, None
     try:
@@ -124,7 +124,7 @@ def run_fem(cfg):
     """Collective: run the case; returns a summary dict (receiver series on rank 0)."""
     PETSc = init()
     comm = PETSc.COMM_WORLD
-    hist = _history(cfg, comm)                     # before assembly and factorisation
+    hist = load_history(cfg, comm)                     # before assembly and factorisation
     model, integ, am = make_model_integrator(cfg, comm)
     n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
     F, fn = model.load_vec(), model.load_vec()

@@ -1,7 +1,7 @@
 """A CI-sized building of frames and shells on the half-space under a remote soil load (issue 11):
 a 2 m x 2 m one-storey frame (four columns, a roof slab) on a shell foundation slab whose nodes
 are soil nodes, the soil of the paper's building (c_p 208, c_s 100 m/s, rho 1800 kg/m^3) meshed
-by the grid generator (h = 1 m, nodes every 0.5 m, 14 m x 10 m), dt = 2.5 ms (beta_s = 0.25, as
+by the grid generator (h = 1 m, nodes every 0.5 m, 14 m x 10 m), dt = 2.5 ms (beta_s = c_s dt / l = 0.5 with the node spacing l, as the 0.47 of
 in the Lamb tests), and a vertical pressure on a 2 m x 2 m patch centred 3 m from the building's
 centre (total field: the soil mesh covers source and building).
 
