@@ -324,7 +324,8 @@ class Coupler:
         self.pI_prev = res["p"].copy()
         fI = -self.M3 @ tr
         fI[self.fixed_I] = 0.0                  # supports (symmetry planes) take these
-        f3, t3 = fI.reshape(-1, 3), tr.reshape(-1, 3)
+        f3, t3 = fI.reshape(-1, 3), tr.reshape(-1, 3).copy()
+        t3[self.fixed_I.reshape(-1, 3)] = 0.0   # the same components on the soil's side (symmetry planes)
         res["force_fe"] = f3.sum(axis=0)
         res["force_be"] = (self.weights[:, None] * t3).sum(axis=0)
         # moments about the origin: the structure's sum (x_k + r_k) x f_k (T^T f includes r x f
