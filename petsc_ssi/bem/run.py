@@ -10,7 +10,7 @@ import time
 import numpy as np
 
 from ..petsc import init, SSIError, check, collective_error, printf, warn
-from ..monitor import Progress, event, stage, fmt_time
+from ..monitor import event, stage, fmt_time
 from ..mesh import surface
 from ..io.output import Output, provenance
 from .. import timegrid
@@ -381,52 +381,19 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
 
 
 def _time_loop(cfg, comm, prob, march, out):
-    PETSc = init()
-    mesh = prob.mesh
-    cvec = march.u_tmpl.duplicate()
-    r0, r1 = cvec.getOwnershipRange()
-    cvec.setArray(mesh.nodes.reshape(-1)[r0:r1])
-    out.write_mesh(cvec, mesh.cells if comm.getRank() == 0 else None, "quad9")
-    nrec = len(prob.receivers)
-    R = None
-    if nrec:
-        R, where = rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
-        y = R.createVecLeft()
-    tnode = traction_to_nodes(comm, prob, march)
-    tfield = march.u_tmpl.duplicate()
-    series = []
-    times = []
-    prog = Progress("BEM time loop", prob.n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
-    ev_io = event("SSI_IO")
-    stride = cfg.output_stride
-    unorm = []
+    from ..io.recorder import Recorder, SoilRecorder
+    rec = Recorder(cfg, comm, "BEM time loop", prob.n_steps, soil=SoilRecorder(out, comm, prob, march))
     for n in range(1, prob.n_steps + 1):
         u, p = march.step()
-        t = n * prob.dt
-        times.append(t)
-        if R is not None:
-            R.mult(u, y)
-            series.append(y.getArray().copy())
-        if stride and n % stride == 0:
-            ev_io.begin()
-            if tnode is not None:
-                tnode.mult(p, tfield)
-            out.write_fields(t, {"displacement": u, "traction": tfield})
-            ev_io.end()
         nrm = u.norm()
-        unorm.append(nrm)
         w = min(100, n - 1)       # growth of |u| over the last (up to) 100 steps, shown by -ssi_monitor
-        grow = f" growth x{nrm / unorm[-1 - w]:.3g}/{w} steps" if w and unorm[-1 - w] > 0 else ""
-        prog.update(n, f"t={t:.4g}s |u|={nrm:.3e}{grow}")
+        prev = rec.unorm[-w] if w else 0.0
+        grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
+        t = n * prob.dt
+        rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
         if cfg.guard:
-            _guard(cfg, prob, march, unorm, n)
-    ser = None
-    if nrec:
-        loc = np.array(series).reshape(len(times), -1)
-        allp = comm.tompi4py().gather(loc, root=0)
-        if comm.getRank() == 0:
-            ser = np.concatenate(allp, axis=1).reshape(len(times), nrec, 3)
-    return {"t": np.array(times), "u": ser, "unorm": np.array(unorm)}
+            _guard(cfg, prob, march, rec.unorm, n)
+    return {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm)}
 
 
 def _guard(cfg, prob, march, unorm, n):

@@ -42,14 +42,13 @@ import time
 import numpy as np
 
 from ..petsc import init, SSIError, collective_error, printf, warn
-from ..monitor import Progress, event, stage, fmt_time
+from ..monitor import event, stage, fmt_time
 from ..io.output import Output, provenance
 from ..options import Config
-from ..bem.run import BEMProblem, build_bem, traction_to_nodes
-from ..bem import receivers as bem_rec
+from ..bem.run import BEMProblem, build_bem
 from ..bem.model import Regions
 from ..fem.model import build_model
-from ..fem.run import ReceiverSeries, FieldWriter, receiver_record, make_model_integrator, load_history
+from ..fem.run import receiver_record, make_model_integrator, load_history
 from ..mesh import quad9
 from .interface import build_interface, fem_symmetry_dofs, force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -471,22 +470,16 @@ def structure_output_path(path):
 
 
 def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
+    from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
     march, integ = coupler.march, coupler.integ
-    mesh = prob.mesh
+    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
+            "moment_fe", "moment_be", "bem_residual", "force_map_error")
+    if cfg.coupling == "implicit":
+        keys += ("uf_check",)
     out = Output(cfg.output, comm)
-    cvec = march.u_tmpl.duplicate()
-    r0, r1 = cvec.getOwnershipRange()
-    cvec.setArray(mesh.nodes.reshape(-1)[r0:r1])
-    out.write_mesh(cvec, mesh.cells if comm.getRank() == 0 else None, "quad9")
     sout = Output(structure_output_path(cfg.output), comm)
-    sout.fw = FieldWriter(sout, model, comm)
-    R = None
-    if len(prob.receivers):
-        R, _ = bem_rec.operator(comm, mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
-        y = R.createVecLeft()
-    srec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
-    tnode = traction_to_nodes(comm, prob, march)
-    tfield = march.u_tmpl.duplicate()
+    rec = Recorder(cfg, comm, "SSI time loop", prob.n_steps, soil=SoilRecorder(out, comm, prob, march),
+                   structure=StructureRecorder(sout, model, comm), interface_keys=keys)
     vel = integ.u.duplicate()
     F, fn = model.load_vec(), model.load_vec()
 
@@ -501,63 +494,36 @@ def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
         return fn
 
     integ.start(f0=sample(0))
-    srec.record(0.0, integ.u, integ.velocity(vel))
-    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
-            "moment_fe", "moment_be",
-            "bem_residual", "force_map_error")
-    if cfg.coupling == "implicit":
-        keys += ("uf_check",)
-    series = {k: [] for k in keys}
-    times, soil = [], []
-    unorm = []
-    stride = cfg.output_stride
-    prog = Progress("SSI time loop", prob.n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
+    rec.structure.record(0.0, integ.u, integ.velocity(vel))
     for n in range(1, prob.n_steps + 1):
         u, p, res = coupler.step(sample(n))
         t = n * prob.dt
-        times.append(t)
-        for k in keys:
-            series[k].append(res[k])
         if res["cycled"]:
             coupler.law.cycled_steps.append(n)
             warn(f"step {n} (t = {t:.4g} s): the contact status did not settle in {res['iterations']} "
                  f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
-        if R is not None:
-            R.mult(u, y)
-            soil.append(y.getArray().copy())
-        srec.record(t, integ.u, integ.velocity(vel))
-        if stride and n % stride == 0:
-            with event("SSI_IO"):
-                if tnode is not None:
-                    tnode.mult(p, tfield)
-                out.write_fields(t, {"displacement": u, "traction": tfield})
-                sout.fw.write(t, integ.u, integ.velocity(vel))
         nrm = u.norm()
-        unorm.append(nrm)
+        n_open = int((~res["closed"]).sum())
+        rec.step(n, t, soil=(u, p), structure=(integ.u, integ.velocity(vel)), interface=res, norm=nrm,
+                 status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} it {res['iterations']}")
         if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
             raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
                            "(beta = c dt / l) and -ssi_coupling_traction")
-        n_open = int((~res["closed"]).sum())
-        prog.update(n, f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} it {res['iterations']}")
-    soil_u = None
-    if R is not None:
-        loc = np.array(soil).reshape(len(times), -1)
-        allp = comm.tompi4py().gather(loc, root=0)
-        if comm.getRank() == 0:
-            soil_u = np.concatenate(allp, axis=1).reshape(len(times), len(prob.receivers), 3)
+    times = rec.times
+    soil_u = rec.soil_receivers()
     nI = coupler.nI
-    inter = {k: np.asarray(v) for k, v in series.items()}
+    inter = rec.interface_arrays()
     for k in ("uf", "ub", "p") + (("uf_check",) if "uf_check" in inter else ()):
         inter[k] = inter[k].reshape(len(times), nI, 3)
     inter["n_open"] = (~inter["closed"]).sum(axis=1)
     inter["t"] = np.asarray(times)
     inter["x"] = iface.x
     inter["normal"] = iface.n_b
-    st, su = srec.arrays()
-    sall = srec.all_arrays() if comm.getRank() == 0 else None
+    st, su = rec.structure.rec.arrays()
+    sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
     return {"t": np.asarray(times), "u": soil_u, "structure_t": st, "structure_u": su, "structure": sall,
             "interface": inter,
-            "unorm": np.asarray(unorm), "_outputs": (out, sout)}
+            "unorm": np.asarray(rec.unorm), "_outputs": (out, sout)}
 
 
 def _finish(cfg, comm, prob, model, iface, res, am):

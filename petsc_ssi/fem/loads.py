@@ -29,7 +29,6 @@ import numpy as np
 
 from ..petsc import SSIError
 from ..histories import History  # noqa: F401  (the FEM's load histories)
-from ..points import parse_points
 from .mesh import snap_points
 
 

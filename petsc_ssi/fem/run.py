@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from ..petsc import init, SSIError, collective_error, printf
-from ..monitor import Progress, event
+from ..monitor import event
 from ..io.output import Output, provenance
 from .. import timegrid
 from .integrators import make_integrator, green_constants
@@ -128,8 +128,11 @@ def run_fem(cfg):
     model, integ, am = make_model_integrator(cfg, comm)
     n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
     F, fn = model.load_vec(), model.load_vec()
-    out = _open_output(cfg, model, comm)
-    rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
+    from ..io.recorder import Recorder, StructureRecorder
+    with event("FEM_io"):
+        out = Output(cfg.output, comm) if cfg.output else None
+        rec = Recorder(cfg, comm, "FEM time loop", n_steps,
+                       structure=StructureRecorder(out, model, comm, io_event="FEM_io"))
     vel = integ.u.duplicate()
 
     def sample(n):
@@ -138,15 +141,13 @@ def run_fem(cfg):
         return fn
 
     integ.start(f0=sample(0))
-    _record(cfg, out, rec, integ, vel, 0)
-    prog = Progress("FEM time loop", n_steps, cfg.monitor, cfg.monitor_every, comm)
+    rec.structure.record(0.0, integ.u, integ.velocity(vel), write=rec.due(0))
     with event("FEM_timeloop"):
         for n in range(1, n_steps + 1):
             integ.step(sample(n))
-            _record(cfg, out, rec, integ, vel, n)
-            prog.update(n, f"t = {n * cfg.dt:.5g} s")
-    t, u = rec.arrays()
-    _close_output(cfg, out, model, rec, comm, am, n_steps, integ)
+            rec.step(n, n * cfg.dt, structure=(integ.u, integ.velocity(vel)), status=f"t = {n * cfg.dt:.5g} s")
+    t, u = rec.structure.rec.arrays()
+    _close_output(cfg, out, model, rec.structure, comm, am, n_steps, integ)
     if comm.getRank() == 0 and len(model.receiver_nodes):
         printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                f"{u[-1, 0, 2]:.6e}) m")
@@ -197,28 +198,11 @@ def receiver_record(model, rec_arrays):
     return d
 
 
-def _open_output(cfg, model, comm):
-    if not cfg.output:
-        return None
-    with event("FEM_io"):
-        out = Output(cfg.output, comm)
-        out.fw = FieldWriter(out, model, comm)
-    return out
-
-
-def _record(cfg, out, rec, integ, vel, n):
-    v = integ.velocity(vel)
-    rec.record(n * cfg.dt, integ.u, v)
-    if out is not None and cfg.output_stride > 0 and n % cfg.output_stride == 0:
-        with event("FEM_io"):
-            out.fw.write(n * cfg.dt, integ.u, v)
-
-
-def _close_output(cfg, out, model, rec, comm, am, n_steps, integ):
+def _close_output(cfg, out, model, srec, comm, am, n_steps, integ):
     if out is None:
         return
-    t, u = rec.arrays()
-    receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
+    t, u = srec.rec.arrays()
+    receivers = srec.receivers() if comm.getRank() == 0 else None
     extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                      "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
                      "elements": model.mesh.element_counts(),

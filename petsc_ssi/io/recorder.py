@@ -1,0 +1,125 @@
+"""What a run keeps, for the three problem kinds (BEM, FEM, coupled): one recorder.
+
+``Recorder`` holds up to three parts and the run's progress and |u| history:
+
+  SoilRecorder       the soil's mesh and fields in an Output (displacement, nodal
+                     traction) and the soil receiver series (a PETSc operator from
+                     the nodal field to the receiver points; gathered to rank 0 once,
+                     at the end)
+  StructureRecorder  the structure's mesh and fields (``fem.run.FieldWriter``:
+                     displacement, rotation, velocity) and its receiver series
+                     (``fem.run.ReceiverSeries``: displacement, rotation, velocity,
+                     acceleration, on rank 0)
+  interface series   per-step arrays of the coupling (a dict of lists, rank 0's copy)
+
+Fields are written every -ssi_output_stride steps (``due``); receivers every step. The
+drivers (bem/run.py, fem/run.py, coupling/run.py) step their problem and hand the
+results here; ``step`` also prints the -ssi_monitor progress line and keeps |u| for the
+divergence guard. Collective unless said otherwise.
+"""
+import numpy as np
+
+from ..monitor import Progress, event
+
+
+class SoilRecorder:
+    """Collective: the soil's fields and receiver series. ``out``: an Output (or None: receivers
+    only); ``prob``: the BEM problem (bem/run.py BEMProblem); ``march``: its Marcher."""
+
+    def __init__(self, out, comm, prob, march):
+        from ..bem import receivers as bem_rec
+        from ..bem.run import traction_to_nodes
+        self.out, self.comm, self.prob = out, comm, prob
+        if out is not None:
+            cvec = march.u_tmpl.duplicate()
+            r0, r1 = cvec.getOwnershipRange()
+            cvec.setArray(prob.mesh.nodes.reshape(-1)[r0:r1])
+            out.write_mesh(cvec, prob.mesh.cells if comm.getRank() == 0 else None, "quad9")
+        self.R = None
+        if len(prob.receivers):
+            self.R, _ = bem_rec.operator(comm, prob.mesh, prob.receivers, prob.planes, march.u_tmpl.getLocalSize())
+            self.y = self.R.createVecLeft()
+        self.tnode = traction_to_nodes(comm, prob, march)
+        self.tfield = march.u_tmpl.duplicate()
+        self.series = []
+
+    def record(self, u, p, t=None, write=False):
+        if self.R is not None:
+            self.R.mult(u, self.y)
+            self.series.append(self.y.getArray().copy())
+        if write and self.out is not None:
+            with event("SSI_IO"):
+                if self.tnode is not None:
+                    self.tnode.mult(p, self.tfield)
+                self.out.write_fields(t, {"displacement": u, "traction": self.tfield})
+
+    def receivers(self, n_times):
+        """Collective: the receiver series (K, R, 3) on rank 0 (None elsewhere, or without receivers)."""
+        if self.R is None:
+            return None
+        loc = np.array(self.series).reshape(n_times, -1)
+        allp = self.comm.tompi4py().gather(loc, root=0)
+        if self.comm.getRank() == 0:
+            return np.concatenate(allp, axis=1).reshape(n_times, len(self.prob.receivers), 3)
+        return None
+
+
+class StructureRecorder:
+    """Collective: the structure's fields (an Output, or None) and receiver series."""
+
+    def __init__(self, out, model, comm, io_event="SSI_IO"):
+        from ..fem.run import FieldWriter, ReceiverSeries
+        self.out, self.model, self.comm, self.io_event = out, model, comm, io_event
+        self.fw = FieldWriter(out, model, comm) if out is not None else None
+        self.rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
+
+    def record(self, t, u, v=None, write=False):
+        self.rec.record(t, u, v)
+        if write and self.fw is not None:
+            with event(self.io_event):
+                self.fw.write(t, u, v)
+
+    def receivers(self):
+        """Rank 0: the output group of the structure receivers (points, nodes, t, u, rotation, ...)."""
+        from ..fem.run import receiver_record
+        return receiver_record(self.model, self.rec.all_arrays())
+
+
+class Recorder:
+    """Collective: a run's soil and/or structure recorders, its interface series, progress line
+    and |u| history (see the module docstring)."""
+
+    def __init__(self, cfg, comm, what, n_steps, soil=None, structure=None, interface_keys=()):
+        self.cfg, self.comm = cfg, comm
+        self.soil, self.structure = soil, structure
+        self.interface = {k: [] for k in interface_keys}
+        self.times, self.unorm = [], []
+        self.progress = Progress(what, n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
+
+    def due(self, n):
+        """Whether step n writes fields (-ssi_output_stride; 0: never)."""
+        s = self.cfg.output_stride
+        return bool(s) and n % s == 0
+
+    def step(self, n, t, soil=None, structure=None, interface=None, norm=None, status=""):
+        """Record step n at time t: ``soil`` (u, p) Vecs, ``structure`` (u, v) Vecs, ``interface``
+        a dict with the interface keys; ``norm`` the |u| kept for the guard; ``status`` the
+        progress line's tail."""
+        self.times.append(t)
+        write = self.due(n)
+        if soil is not None and self.soil is not None:
+            self.soil.record(soil[0], soil[1], t, write)
+        if structure is not None and self.structure is not None:
+            self.structure.record(t, structure[0], structure[1], write)
+        if interface is not None:
+            for k in self.interface:
+                self.interface[k].append(interface[k])
+        if norm is not None:
+            self.unorm.append(norm)
+        self.progress.update(n, status)
+
+    def soil_receivers(self):
+        return self.soil.receivers(len(self.times)) if self.soil is not None else None
+
+    def interface_arrays(self):
+        return {k: np.asarray(v) for k, v in self.interface.items()}
