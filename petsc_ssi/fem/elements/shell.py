@@ -418,18 +418,20 @@ def _stiffness_reference(X, props):
 
         eA, eC = cov_shear(0, -1, 0), cov_shear(0, 1, 0)
         eD, eB = cov_shear(-1, 0, 1), cov_shear(1, 0, 1)
+        def at(s, r):
+            """Shape functions, physical derivatives, |J| and J^-1 at (s, r)."""
+            Nn, Ns, Nr = N_dN(s, r)
+            J = jac(Ns, Nr)
+            Ji = np.linalg.inv(J)
+            return Nn, Ji[0, 0] * Ns + Ji[0, 1] * Nr, Ji[1, 0] * Ns + Ji[1, 1] * Nr, np.linalg.det(J), Ji
+
         Km = np.zeros((12, 12))
         Kp = np.zeros((12, 12))
         pts3, w3 = np.polynomial.legendre.leggauss(MEMBRANE_ORDER)
         for i3 in range(len(w3)):
             for j3 in range(len(w3)):
                 s, r, wt = pts3[i3], pts3[j3], w3[i3] * w3[j3]
-                Nn, Ns, Nr = N_dN(s, r)
-                J = jac(Ns, Nr)
-                detJ = np.linalg.det(J)
-                Ji = np.linalg.inv(J)
-                Nx = Ji[0, 0] * Ns + Ji[0, 1] * Nr
-                Ny = Ji[1, 0] * Ns + Ji[1, 1] * Nr
+                Nn, Nx, Ny, detJ, Ji = at(s, r)
                 # mid-side functions of edges 0-1, 1-2, 2-3, 3-0 and their xi, eta derivatives
                 Ms = [-s * (1 - r), (1 - r * r) / 2, -s * (1 + r), -(1 - r * r) / 2]
                 Mr = [-(1 - s * s) / 2, -(1 + s) * r, (1 - s * s) / 2, -(1 - s) * r]
@@ -453,12 +455,7 @@ def _stiffness_reference(X, props):
                     bsk[3 * a:3 * a + 3] = [-Ny[a] / 2, Nx[a] / 2, (dvx - duy) / 2 - Nn[a]]
                 Km += (Bm.T @ Dm @ Bm + gam * t * np.outer(bsk, bsk)) * detJ * wt
         for s, r in ((-g, -g), (g, -g), (g, g), (-g, g)):
-            Nn, Ns, Nr = N_dN(s, r)
-            J = jac(Ns, Nr)
-            detJ = np.linalg.det(J)
-            Ji = np.linalg.inv(J)
-            Nx = Ji[0, 0] * Ns + Ji[0, 1] * Nr
-            Ny = Ji[1, 0] * Ns + Ji[1, 1] * Nr
+            Nn, Nx, Ny, detJ, Ji = at(s, r)
             Bb = np.zeros((3, 12))
             for a in range(4):
                 Bb[:, 3 * a:3 * a + 3] = [[0, 0, Nx[a]], [0, -Ny[a], 0], [0, -Nx[a], Ny[a]]]
