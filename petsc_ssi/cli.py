@@ -35,6 +35,7 @@ def main(argv=None):
     if cmd == "estimate":
         from . import estimate  # noqa: F401  (declares the -ssi_estimate_ options, also for -help)
     if cmd == "help" or "-help" in rest or "--help" in rest:
+        PETSc.Sys.Print(__doc__.split("Errors in the input")[0].rstrip() + "\n")
         PETSc.Sys.Print(options.help_text())
         if cmd == "help":
             return 0
