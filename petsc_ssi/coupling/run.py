@@ -321,10 +321,12 @@ class Coupler:
             tr = np.where(same, self.c_new * res["p"] - self.c_old * self.pI_prev, res["p"])
         self.closed_prev = res["closed"].copy()
         self.pI_prev = res["p"].copy()
-        fI = -self.M3 @ tr
+        f_all = -self.M3 @ tr
+        fI = f_all.copy()
         fI[self.fixed_I] = 0.0                  # supports (symmetry planes) take these
-        f3, t3 = fI.reshape(-1, 3), tr.reshape(-1, 3).copy()
-        t3[self.fixed_I.reshape(-1, 3)] = 0.0   # the same components on the soil's side (symmetry planes)
+        # resultants of the whole interface force (the part on fixed dofs included: it goes to the
+        # supports), so that both sides balance exactly: sum_i (M p)_i = sum_j (int N_j) p_j
+        f3, t3 = f_all.reshape(-1, 3), tr.reshape(-1, 3)
         res["force_fe"] = f3.sum(axis=0)
         res["force_be"] = (self.weights[:, None] * t3).sum(axis=0)
         # moments about the origin: the structure's sum (x_k + r_k) x f_k (T^T f includes r x f
