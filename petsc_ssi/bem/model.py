@@ -62,7 +62,12 @@ def causal_lags(r_max, mat, dt):
 def bounding_spheres(VX):
     c = VX[:, 8, :].copy()
     R = 1.1 * np.linalg.norm(VX - c[:, None, :], axis=2).max(axis=1) + 1e-12
-    h = np.maximum(np.linalg.norm(VX[:, 4] - VX[:, 0], axis=1), np.linalg.norm(VX[:, 7] - VX[:, 0], axis=1)) * 2
+    # element size: the longest of the four sides (corner to mid-side node, twice), independent of
+    # which corner is node 0 (an element and its mirror image get the same size, so the same
+    # near-field subdivisions: half and full models then integrate the same pairs alike)
+    sides = [np.linalg.norm(VX[:, m] - VX[:, a], axis=1) for a, m in ((0, 4), (1, 5), (2, 6), (3, 7),
+                                                                      (1, 4), (2, 5), (3, 6), (0, 7))]
+    h = np.max(sides, axis=0) * 2
     return c, R, h
 
 
