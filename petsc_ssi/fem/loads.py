@@ -147,9 +147,6 @@ def group_point_loads(mesh, text, what="-ssi_fem_point_load"):
             vals = []
         if len(vals) not in (3, 6) or not np.all(np.isfinite(vals)):
             raise SSIError(f"{what}: '{r}': a group row is GROUP,fx,fy,fz[,mx,my,mz]")
-        if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
-            raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
-                           f"{', '.join(mesh.group_names()) or 'none'})")
         out.append((mesh.group_nodes(name, what), np.array(vals + [0.0] * (6 - len(vals)))))
     return out
 
@@ -211,9 +208,6 @@ def point_masses(mesh, text, dofmap, what="-ssi_fem_point_mass"):
         if len(vals) not in (1, 2) or not np.all(np.isfinite(vals)) or min(vals) < 0:
             raise SSIError(f"{what}: '{r}' is not x,y,z,m[,I] or GROUP,m[,I] with m, I >= 0")
         if name:
-            if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
-                raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
-                               f"{', '.join(mesh.group_names()) or 'none'})")
             nodes = mesh.group_nodes(name, what)
         else:
             nodes, d = snap_points(mesh, xyz[None], what)
@@ -259,9 +253,6 @@ def fixed_dofs(mesh, spec, dofmap=None):
     dofs = []
     for item in [s.strip() for s in str(spec).split(",") if s.strip()]:
         name, names = _fixed_names(item)
-        if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
-            raise SSIError(f"-ssi_fem_fixed: no group '{name}' in mesh {mesh.source} "
-                           f"(groups: {', '.join(mesh.group_names()) or 'none'})")
         nodes = mesh.group_nodes(name, "-ssi_fem_fixed")
         if names is None:
             names = ("ux", "uy", "uz", "rx", "ry", "rz")

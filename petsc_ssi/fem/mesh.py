@@ -98,8 +98,11 @@ class StructureMesh:
         return sorted(set(self.faces) | set(self.nodes) | set(self.shells))
 
     def group_nodes(self, name, what="group"):
-        """Node ids of a group (KeyError if absent; SSIError if some of its nodes
-        belong to no element of any part)."""
+        """Node ids of a group; SSIError (naming ``what``, e.g. the option) if there is no such
+        group or some of its nodes belong to no element of any part."""
+        if name not in self.nodes and name not in self.faces and name not in self.shells:
+            raise SSIError(f"{what}: no group '{name}' in mesh {self.source} "
+                           f"(groups: {', '.join(self.group_names()) or 'none'})")
         if self.unconnected.get(name):
             raise SSIError(f"{what} '{name}': {self.unconnected[name]} of its nodes belong to no element of any "
                            "part (unconnected nodes; is the group on the structure?)")

@@ -66,9 +66,6 @@ def structure_receivers(mesh, text, what="-ssi_receivers"):
     for it in items:
         if it.startswith("group:"):
             name = it[len("group:"):].strip()
-            if name not in mesh.nodes and name not in mesh.faces and name not in mesh.shells:
-                raise SSIError(f"{what}: no group '{name}' in mesh {mesh.source} (groups: "
-                               f"{', '.join(mesh.group_names()) or 'none'})")
             g = mesh.group_nodes(name, what)
             pts.append(mesh.coords[g]); nodes.append(g); dist.append(np.zeros(len(g)))
         else:
