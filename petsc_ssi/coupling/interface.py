@@ -62,6 +62,15 @@ def interface_offsets(fe_mesh, iface, groups):
     return -0.5 * t[iface.fe_nodes][:, None] * iface.n_b
 
 
+def _released_shell_nodes(fe_mesh, dofmap):
+    """(N,) bool: nodes with a released rotation triple that belong to a released shell part."""
+    on = np.zeros(dofmap.n_nodes, bool)
+    for b in fe_mesh.blocks:
+        if b.element.name == "shell" and b.props is not None and b.props.released:
+            on[b.cells.ravel()] = True
+    return on & dofmap.released
+
+
 class InterfaceOperator:
     """Collective: T, the PETSc Mat (3 n_I x structure dofs) that gives the displacement of the
     soil side of the interface from the structure's dofs (built from the dof map):
@@ -72,7 +81,7 @@ class InterfaceOperator:
     default); ``gather`` brings T u to every rank (3 n_I numbers), ``spread`` applies T^T to a
     replicated interface vector."""
 
-    def __init__(self, comm, iface, dofmap, offsets=None):
+    def __init__(self, comm, iface, dofmap, offsets=None, fe_mesh=None):
         PETSc = init()
         self.PETSc, self.comm = PETSc, comm
         n = 3 * iface.n
@@ -86,7 +95,11 @@ class InterfaceOperator:
         if offsets is not None and np.any(offsets):
             has = dofmap.has_rotation[iface.fe_nodes] & (np.abs(offsets).sum(axis=1) > 0)
             k = np.nonzero(has)[0]
-            rdofs = dofmap.offset[iface.fe_nodes[k]][:, None] + np.arange(3, 6)
+            # the slab's own rotations: the released triple where the slab is hinged to beams
+            slab_rel = _released_shell_nodes(fe_mesh, dofmap) if fe_mesh is not None else np.zeros(dofmap.n_nodes, bool)
+            nk = iface.fe_nodes[k]
+            rdofs = np.where(slab_rel[nk][:, None], dofmap.rotation_dofs(nk, released=True),
+                             dofmap.rotation_dofs(nk))
             # theta x r = -[r]x theta: d(u_c)/d(theta_j) = -eps_{c m j} r_m = eps_{c j m} r_m
             eps = np.zeros((3, 3, 3))
             eps[0, 1, 2] = eps[1, 2, 0] = eps[2, 0, 1] = 1.0
@@ -252,7 +265,7 @@ def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
         others = [c for c in range(3) if c != ax]
         names = ([TRANSLATIONS[ax]] + [ROTATIONS[c] for c in others] if kind > 0 else
                  [TRANSLATIONS[c] for c in others] + [ROTATIONS[ax]])
-        out.append(dm.dofs(on, names))
+        out.append(dm.dofs(on, names, all_rotations=True))
     return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
 
 

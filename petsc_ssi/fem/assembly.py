@@ -66,7 +66,7 @@ def local_stiffness_csr(mesh, mat, dofmap, chunk=20000):
         for s in range(0, cells.shape[0], chunk):
             c = cells[s:s + chunk]
             Ke = el.stiffness(mesh.coords[c], props)
-            dofs = dofmap.cell_dofs(c, el.dof_names)
+            dofs = dofmap.cell_dofs(c, el.dof_names, props.released)
             rows = np.broadcast_to(dofs[:, :, None], Ke.shape).ravel()
             cols = np.broadcast_to(dofs[:, None, :], Ke.shape).ravel()
             keep = (rows >= dofmap.r0) & (rows < dofmap.r1)
@@ -105,8 +105,9 @@ def local_lumped_mass(mesh, mat, dofmap):
     for blk in mesh.blocks:
         el = blk.element
         cells = blk.cells[local_cells(blk.cells, dofmap)]
-        me = el.lumped_mass(mesh.coords[cells], _props(blk, mat))
-        d = dofmap.cell_dofs(cells, el.dof_names).ravel()
+        props = _props(blk, mat)
+        me = el.lumped_mass(mesh.coords[cells], props)
+        d = dofmap.cell_dofs(cells, el.dof_names, props.released).ravel()
         own = (d >= dofmap.r0) & (d < dofmap.r1)
         m += np.bincount(d[own] - dofmap.r0, weights=me.ravel()[own], minlength=dofmap.n_local)
     return m

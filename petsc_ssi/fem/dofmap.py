@@ -16,6 +16,16 @@ rotations, the node ranges are chosen so the dof counts are balanced. Every
 node's dof count is a multiple of 3 and its offset too, so matrices and
 vectors keep block size 3.
 
+Released joints: a part with ``-ssi_fem_part_NAME_release rotations`` is
+hinged to the other rotational parts at the nodes they share (a slab simply
+supported on its beams): such a node carries a second rotation triple (field
+2, "released_rotation", local dofs 6-8) used by the released parts' cells,
+while its translations stay one set shared by all (the tie is exact: the same
+dofs). Released parts are joined to each other by that second triple. Node
+rotations (output, receivers, point moments) are the first triple, the
+rotations of the parts that are not released; fixing a rotation by name fixes
+both triples.
+
 Fixed dofs are recorded as constraint dofs of the section
 (``setConstraintDof``/``setConstraintIndices``, local indices within the
 node's dofs) and returned by ``fixed``.
@@ -51,14 +61,17 @@ def _balanced_split(ndof, size):
 class DofMap:
     """Collective constructor: dofs per node (3 or 6) -> offsets and ownership on ``comm``."""
 
-    def __init__(self, has_rotation, comm=None):
+    def __init__(self, has_rotation, comm=None, released=None):
         PETSc = init()
         comm = PETSc.COMM_SELF if comm is None else comm
         self.comm = comm
         self.has_rotation = np.asarray(has_rotation, bool)
         n = self.has_rotation.size
         self.n_nodes = n
-        self.ndof = np.where(self.has_rotation, 6, 3).astype(np.int64)
+        self.released = np.zeros(n, bool) if released is None else np.asarray(released, bool)
+        if self.released.shape != (n,) or np.any(self.released & ~self.has_rotation):
+            raise SSIError("internal error: released rotations at nodes without rotations")
+        self.ndof = (3 + 3 * self.has_rotation + 3 * self.released).astype(np.int64)
         self.section = sec = self._section({})
         self.offset = np.array([sec.getOffset(p) for p in range(n)], np.int64) if n else np.zeros(0, np.int64)
         self.size = int(sec.getStorageSize())
@@ -76,20 +89,22 @@ class DofMap:
         (constraint dofs are set before setUp, their indices after)."""
         PETSc = init()
         sec = PETSc.Section().create(comm=PETSc.COMM_SELF)
-        sec.setNumFields(2)
-        sec.setFieldName(0, "displacement")
-        sec.setFieldName(1, "rotation")
-        sec.setFieldComponents(0, 3)
-        sec.setFieldComponents(1, 3)
+        nf = 3 if self.released.any() else 2
+        sec.setNumFields(nf)
+        for f, name in enumerate(("displacement", "rotation", "released_rotation")[:nf]):
+            sec.setFieldName(f, name)
+            sec.setFieldComponents(f, 3)
         sec.setChart(0, self.n_nodes)
         for p in range(self.n_nodes):
             sec.setDof(p, int(self.ndof[p]))
             sec.setFieldDof(p, 0, 3)
             sec.setFieldDof(p, 1, 3 if self.has_rotation[p] else 0)
+            if nf == 3:
+                sec.setFieldDof(p, 2, 3 if self.released[p] else 0)
         for p, loc in constraints.items():
             sec.setConstraintDof(int(p), len(loc))
-            sec.setFieldConstraintDof(int(p), 0, int(np.sum(loc < 3)))
-            sec.setFieldConstraintDof(int(p), 1, int(np.sum(loc >= 3)))
+            for f in range(nf):
+                sec.setFieldConstraintDof(int(p), f, int(np.sum((loc >= 3 * f) & (loc < 3 * f + 3))))
         sec.setUp()
         for p, loc in constraints.items():
             sec.setConstraintIndices(int(p), loc.astype(PETSc.IntType))
@@ -121,11 +136,13 @@ class DofMap:
                            + (f"; did you mean {near[0]}?" if near else ""))
         return DOF_NAMES.index(name)
 
-    def dofs(self, nodes, names=DOF_NAMES, where_present=True):
+    def dofs(self, nodes, names=DOF_NAMES, where_present=True, all_rotations=False):
         """Global dofs of ``nodes`` for the dof ``names`` (flat, node-major).
 
         Rotation names at nodes without rotations are skipped when
-        ``where_present`` (SSIError otherwise)."""
+        ``where_present`` (SSIError otherwise). A rotation name gives the node's
+        first rotation triple, and with ``all_rotations`` also the released one
+        (supports and symmetry planes fix both)."""
         nodes = np.asarray(nodes, np.int64).ravel()
         out = []
         for name in names:
@@ -138,7 +155,19 @@ class DofMap:
                                    "(nodes of bricks only)")
                 sel = nodes[ok]
             out.append(self.offset[sel] + k)
+            if k >= 3 and all_rotations:
+                rel = sel[self.released[sel]]
+                out.append(self.offset[rel] + k + 3)
         return np.concatenate(out) if out else np.zeros(0, np.int64)
+
+    def rotation_dofs(self, nodes, released=False):
+        """(n, 3) global rotation dofs of ``nodes`` (every node must carry rotations): the first
+        triple, or with ``released`` the released triple where a node has one."""
+        nodes = np.asarray(nodes, np.int64).ravel()
+        if not self.has_rotation[nodes].all():
+            raise SSIError("rotations requested at nodes of bricks only")
+        base = self.offset[nodes] + 3 + (3 * self.released[nodes] if released else 0)
+        return base[:, None] + np.arange(3)
 
     def node_dofs(self, nodes, k=3):
         """(n, k) global dofs of the first k dofs of each node (k = 3: translations;
@@ -151,14 +180,18 @@ class DofMap:
     def translation_dofs(self, nodes):
         return self.node_dofs(nodes, 3)
 
-    def cell_dofs(self, cells, dof_names):
+    def cell_dofs(self, cells, dof_names, released=False):
         """(E, n * len(dof_names)) global dofs of element cells (node-major, the
-        element's dof order)."""
+        element's dof order). ``released``: the cells of a released part, whose rotations at
+        released nodes are the second triple."""
         cells = np.asarray(cells, np.int64)
         ks = np.array([self.dof_index(d) for d in dof_names], np.int64)
         if ks.max(initial=0) >= 3 and not self.has_rotation[cells].all():
             raise SSIError("internal error: an element with rotation dofs on nodes without rotations")
-        return (self.offset[cells][:, :, None] + ks).reshape(cells.shape[0], cells.shape[1] * len(ks))
+        d = self.offset[cells][:, :, None] + ks
+        if released and ks.max(initial=0) >= 3:
+            d = d + 3 * (self.released[cells][:, :, None] & (ks >= 3))
+        return d.reshape(cells.shape[0], cells.shape[1] * len(ks))
 
     def owner_of_dofs(self, dofs):
         return np.searchsorted(self.dof_bounds, np.asarray(dofs, np.int64), side="right") - 1
@@ -269,8 +302,10 @@ class DofMap:
         R[t[:, 0], 4], R[t[:, 2], 4] = Z, -X          # about y
         R[t[:, 0], 5], R[t[:, 1], 5] = -Y, X          # about z
         rn = np.nonzero(self.has_rotation)[0]
+        rel = np.nonzero(self.released)[0]
         for c in range(3):
             R[self.offset[rn] + 3 + c, 3 + c] = 1.0
+            R[self.offset[rel] + 6 + c, 3 + c] = 1.0
         return R
 
     def restrains_rigid_motion(self, coords, fixed):

@@ -258,7 +258,7 @@ def fixed_dofs(mesh, spec, dofmap=None):
             names = ("ux", "uy", "uz", "rx", "ry", "rz")
         elif any(c[0] == "r" for c in names) and not dm.has_rotation[nodes].any():
             raise SSIError(f"-ssi_fem_fixed '{item}': the nodes of group '{name}' have no rotation dofs (bricks only)")
-        dofs.append(dm.dofs(nodes, names))
+        dofs.append(dm.dofs(nodes, names, all_rotations=True))
     return np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)
 def rigid_body_modes(coords):
     """(3N, 6) rigid-body displacement fields of a translations-only model: 3 translations,

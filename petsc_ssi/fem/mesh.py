@@ -94,6 +94,16 @@ class StructureMesh:
                 rot[b.cells.ravel()] = True
         return rot
 
+    def released_nodes(self):
+        """(N,) bool: nodes where a released part (``-ssi_fem_part_NAME_release rotations``) meets
+        a rotational part that is not released: they carry a second rotation triple."""
+        rel = np.zeros(self.n_nodes, bool)
+        other = np.zeros(self.n_nodes, bool)
+        for b in self.blocks:
+            if len(b.element.dof_names) > 3:
+                (rel if (b.props is not None and b.props.released) else other)[b.cells.ravel()] = True
+        return rel & other
+
     def group_names(self):
         return sorted(set(self.faces) | set(self.nodes) | set(self.shells))
 

@@ -106,7 +106,7 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
         err = str(exc)
     collective_error(err, comm)
     mesh = load_mesh(cfg, comm, specs)
-    dofmap = DofMap(mesh.has_rotation(), comm)
+    dofmap = DofMap(mesh.has_rotation(), comm, mesh.released_nodes())
     err = None
     try:
         fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap)
@@ -118,6 +118,10 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
     counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())
     log(f"[fem] mesh {mesh.source}: {mesh.n_nodes} nodes ({int(mesh.has_rotation().sum())} with rotations), "
         f"{counts}, {dofmap.size} dofs, {len(fixed)} fixed, groups: {', '.join(mesh.group_names())}")
+    if dofmap.released.any():
+        rel = [s.name for s in specs if s.props.released]
+        log(f"[fem] released joints: {int(dofmap.released.sum())} node(s) where part(s) {', '.join(rel)} meet the "
+            "other frame/shell parts carry a second rotation triple (translations tied, rotations released)")
     legacy = all(s.legacy for s in specs)
     mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho) if legacy else None
     if not legacy:

@@ -18,6 +18,10 @@ that carry elements. Each part takes its element and properties from
                 frame: 0 = no shear deformation (Euler-Bernoulli)
   added_mass    non-structural mass: kg/m^2 on shells, kg/m on frames
   drilling      shell: scale of the drilling-rotation stiffness (default 1)
+  release       frame, shell: 'rotations' hinges the part to the other frame and shell
+                parts at the nodes they share (translations tied, rotations independent:
+                a slab simply supported on its beams); released parts stay rigidly joined
+                to each other; 'none' (default) joins monolithically
 
 Without ``-ssi_fem_parts`` the structure is one hex8 part made of every brick
 of the mesh with ``-ssi_fem_E/_nu/_rho`` (the behaviour before parts existed).
@@ -53,12 +57,15 @@ PROPERTIES = {
     "shear_factor": ("real", "", "shear correction factor k (frame: 0 = Euler-Bernoulli; default 5/6)"),
     "added_mass": ("real", "kg/m^2 | kg/m", "non-structural mass: per area on shells, per length on frames"),
     "drilling": ("real", "", "shell: scale of the drilling-rotation stiffness (default 1)"),
+    "release": ("rotations|none", "", "frame, shell: hinge the part to the other frame/shell parts at shared nodes "
+                "(translations tied, rotations released; default none: monolithic)"),
 }
 ALLOWED = {
     "hex8": ("element", "E", "nu", "rho"),
-    "shell": ("element", "E", "nu", "rho", "thickness", "mass_per_area", "shear_factor", "added_mass", "drilling"),
+    "shell": ("element", "E", "nu", "rho", "thickness", "mass_per_area", "shear_factor", "added_mass", "drilling",
+              "release"),
     "frame": ("element", "E", "nu", "rho", "section", "area", "Iy", "Iz", "J", "orientation", "shear_factor",
-              "added_mass"),
+              "added_mass", "release"),
 }
 REQUIRED = {"hex8": ("E", "nu", "rho"), "shell": ("E", "nu", "rho", "thickness"), "frame": ("E", "nu", "rho")}
 CELL_TYPE = {"hex8": "hex8", "shell": "quad4", "frame": "line2"}
@@ -170,7 +177,7 @@ def _spec(name, g):
     missing = [p for p in REQUIRED[el] if p not in g]
     if missing:
         raise SSIError(f"part '{name}' ({el}) needs {', '.join(opt(p) for p in missing)}")
-    v = {p: _real(g[p], opt(p)) for p in g if p not in ("element", "section", "orientation")}
+    v = {p: _real(g[p], opt(p)) for p in g if p not in ("element", "section", "orientation", "release")}
     if not v["E"] > 0:
         raise SSIError(f"{opt('E')} {v['E']:g}: must be > 0")
     if not -1.0 < v["nu"] < 0.5:
@@ -187,6 +194,12 @@ def _spec(name, g):
     for p in ("thickness", "mass_per_area", "added_mass", "shear_factor", "drilling"):
         if p in v:
             setattr(props, p, v[p])
+    if "release" in g:
+        rel = str(g["release"]).strip().lower()
+        if rel not in ("rotations", "none"):
+            raise SSIError(f"{opt('release')} '{g['release']}': must be rotations or none"
+                           + _suggest(rel, ("rotations", "none")))
+        props.released = rel == "rotations"
     oriented = False
     if el == "frame":
         sec = {}

@@ -1,6 +1,7 @@
 """Fig. 14 of the paper for the fixed-base building: classify the modes, compare the half model, draw.
 
-  .venv/bin/python runs/building/modes_figure.py [FULL.h5 [HALF.h5]]     (from the repository root)
+  .venv/bin/python runs/building/modes_figure.py [FULL.h5 [HALF.h5]] [--released RELEASED.h5]
+                                                                    (from the repository root)
 
 Reads the `petsc-ssi modes` outputs (defaults: out/building/modes-full.h5 and
 out/building/modes-half.h5; see runs/building/README.md for the commands) and
@@ -10,6 +11,10 @@ out/building/modes-half.h5; see runs/building/README.md for the commands) and
   planes y = 0 and x = 0 (+1 symmetric, -1 antisymmetric: <u, S u(mirror)> / <u, u>);
 - matches each half-model mode to the full model's modes (frequency and MAC on the nodes
   y >= 0, which the two meshes share) and prints the relative frequency difference;
+- with the released-slab model (default out/building/modes-released.h5, the same command with
+  -ssi_fem_part_floors_release rotations -ssi_fem_part_roof_release rotations), classifies its
+  modes too, pairs each with the monolithic mode of largest MAC (translations, same nodes) and
+  writes runs/building/modes_release.csv (monolithic vs released frequencies);
 - writes runs/building/modes.png: the first
   translational x1 mode and the first slab-bending mode, drawn in 3D from the HDF5 output
   (shells coloured by |u|, frames as lines, undeformed frame in grey).
@@ -143,7 +148,36 @@ def draw(ax, m, k, scale, title):
     ax.set_title(title, fontsize=9)
 
 
+def compare_release(full, rows, rel_path):
+    """Monolithic vs released slabs: each released mode with the monolithic mode of largest MAC."""
+    rel = load(rel_path)
+    rrows = classify(rel)
+    out = []
+    for r, Ur in zip(rrows, rel["U"]):
+        a = Ur.ravel()
+        macs = [float(np.dot(a, Uf.ravel()) ** 2 / (np.dot(a, a) * np.dot(Uf.ravel(), Uf.ravel()))) for Uf in full["U"]]
+        j = int(np.argmax(macs))
+        out.append(dict(mode_released=r["mode"], f_released=r["f"], kind_released=r["kind"],
+                        mode_monolithic=j + 1, f_monolithic=rows[j]["f"], kind_monolithic=rows[j]["kind"],
+                        mac=macs[j], shift_pct=100 * (r["f"] - rows[j]["f"]) / rows[j]["f"]))
+    path = os.path.join(HERE, "modes_release.csv")
+    with open(path, "w") as fh:
+        fh.write("mode_released,f_released_hz,kind_released,mode_monolithic,f_monolithic_hz,kind_monolithic,MAC,"
+                 "shift_pct\n")
+        for r in out:
+            fh.write(f"{r['mode_released']},{r['f_released']:.4f},{r['kind_released']},{r['mode_monolithic']},"
+                     f"{r['f_monolithic']:.4f},{r['kind_monolithic']},{r['mac']:.4f},{r['shift_pct']:.2f}\n")
+    print(open(path).read().rstrip())
+    print(f"wrote {os.path.relpath(path, ROOT)}")
+    return out
+
+
 def main(argv):
+    rel_path = os.path.join(ROOT, "out", "building", "modes-released.h5")
+    if "--released" in argv:
+        i = argv.index("--released")
+        rel_path = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
     full_path = argv[0] if argv else os.path.join(ROOT, "out", "building", "modes-full.h5")
     half_path = argv[1] if len(argv) > 1 else os.path.join(ROOT, "out", "building", "modes-half.h5")
     full = load(full_path)
@@ -151,6 +185,8 @@ def main(argv):
     print("mode,frequency_hz,kind,vertical_share,parity_y,parity_x")
     for r in rows:
         print(f"{r['mode']},{r['f']:.4f},{r['kind']},{r['vertical_share']:.3f},{r['sym_y']:+.3f},{r['sym_x']:+.3f}")
+    if os.path.isfile(rel_path):
+        compare_release(full, rows, rel_path)
     matches = []
     if os.path.isfile(half_path):
         half = load(half_path)

@@ -56,6 +56,8 @@ class Props:
     added_mass: float = 0.0        # non-structural mass: kg/m^2 (shell), kg/m (frame)
     mass_per_area: float = 0.0     # shell: rho t replaced by this when > 0 [kg/m^2]
     drilling: float = 1.0          # shell: scale of the drilling-rotation stiffness
+    released: bool = False         # frame, shell: rotations released from the other parts at
+                                   # shared nodes (translations tied; dofmap.py)
 
     def G(self):
         return self.E / (2.0 * (1.0 + self.nu))
