@@ -27,6 +27,21 @@ def stage(name):
     return _STAGES[name]
 
 
+class staged:
+    """Context manager: the PETSc log stage ``name`` pushed for the block (popped on errors too)."""
+
+    def __init__(self, name):
+        self.st = stage(name)
+
+    def __enter__(self):
+        self.st.push()
+        return self.st
+
+    def __exit__(self, *exc):
+        self.st.pop()
+        return False
+
+
 class Progress:
     """Rank-0 progress of a loop of ``total`` items."""
 

@@ -1,18 +1,16 @@
-"""``-ssi_problem bem``: the half-space BEM run, from options to HDF5.
+"""``-ssi_problem bem``: the half-space BEM run, from options to HDF5 (the stages: ``problem.py``).
 
 Order of work: every input check (collective, one-line errors) and the memory
 estimate come before any assembly.
 """
-import math
-import os
 import time
 
 import numpy as np
 
-from ..petsc import init, SSIError, check, collective_error, printf, warn
-from ..monitor import event, stage, fmt_time
+from ..petsc import init, SSIError, collective_error, printf, warn
+from ..monitor import event, fmt_time
 from ..mesh import surface
-from ..io.output import Output, provenance
+from ..io.output import provenance
 from .. import timegrid
 from . import symmetry, receivers as rec, histories, lagmats
 from .model import Material, Regions, LagSet, causal_lags, machine_memory
@@ -293,41 +291,15 @@ class BEMProblem:
 
 
 def run_bem(cfg, comm=None):
-    """Collective: the whole BEM run. Returns a dict of results (rank 0 has receivers)."""
+    """Collective: the whole BEM run (``problem.BEMTransient``). Returns a dict of results (rank 0
+    has receivers)."""
     PETSc = init()
     comm = comm or PETSc.COMM_WORLD
     if cfg.get("check_stability"):
         from .stability import check_stability     # -ssi_check_stability: a coarse surrogate only
         return check_stability(cfg, comm, lambda c: run_bem(c, comm))
-    t_start = time.perf_counter()
-    log = printf if cfg.monitor else (lambda m: None)
-    with_stage = stage("SSI BEM setup")
-    with_stage.push()
-    prob = BEMProblem(cfg, comm, log=printf)
-    plan, ls = prob.prepare()
-    with_stage.pop()
-    st = stage("SSI BEM assembly")
-    st.push()
-    march, info = build_bem(cfg, comm, prob, plan, ls, prob.known_u(), prob.known_p(), log)
-    t_asm, mem_exact, mem_interp = info["t_asm"], info["mem_exact"], info["mem_interp"]
-    ndense, nbaij, fill, mem = info["ndense"], info["nbaij"], info["fill"], info["mem"]
-    st.pop()
-    st = stage("SSI BEM time loop")
-    st.push()
-    out = Output(cfg.output, comm)
-    res = _time_loop(cfg, comm, prob, march, out)
-    st.pop()
-    stats = {"assembly_s": t_asm, "wall_s": time.perf_counter() - t_start, "lags": prob.L,
-             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
-             "T_L": plan.TL if plan.active else None, "lag_bytes_exact": mem_exact,
-             "lag_bytes_interp": mem_interp,
-             "dense_lags": ndense, "baij_lags": nbaij, "mean_fill": fill, "lag_bytes": mem,
-             "mem_estimate": prob.mem_estimate, "T_N": prob.T_N, "r_max": prob.r_max,
-             "kernel_evaluations": ls.kernel_evaluations, "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
-    res["stats"] = stats
-    _finish(cfg, comm, prob, out, res)
-    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
-    return res
+    from .problem import BEMTransient
+    return BEMTransient(cfg, comm).run()
 
 
 def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
@@ -378,22 +350,6 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     ls.H = ls.G = None   # the triplets are in the Mats now
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
                    "nbaij": nbaij, "fill": fill, "mem": mem}
-
-
-def _time_loop(cfg, comm, prob, march, out):
-    from ..io.recorder import Recorder, SoilRecorder
-    rec = Recorder(cfg, comm, "BEM time loop", prob.n_steps, soil=SoilRecorder(out, comm, prob, march))
-    for n in range(1, prob.n_steps + 1):
-        u, p = march.step()
-        nrm = u.norm()
-        w = min(100, n - 1)       # growth of |u| over the last (up to) 100 steps, shown by -ssi_monitor
-        prev = rec.unorm[-w] if w else 0.0
-        grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
-        t = n * prob.dt
-        rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
-        if cfg.guard:
-            _guard(cfg, prob, march, rec.unorm, n)
-    return {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm)}
 
 
 def _guard(cfg, prob, march, unorm, n):

@@ -41,14 +41,14 @@ import time
 
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error, printf, warn
-from ..monitor import event, stage, fmt_time
-from ..io.output import Output, provenance
+from ..petsc import init, SSIError, collective_error, printf
+from ..monitor import event
+from ..io.output import provenance
 from ..options import Config
-from ..bem.run import BEMProblem, build_bem
+from ..bem.run import BEMProblem
 from ..bem.model import Regions
 from ..fem.model import build_model
-from ..fem.run import receiver_record, make_model_integrator, load_history
+from ..fem.run import receiver_record
 from ..mesh import quad9
 from .interface import build_interface, fem_symmetry_dofs, force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -189,7 +189,8 @@ class Coupler:
                                             self.seq_y, None)
         self.offsets = (interface_offsets(model.mesh, iface, cfg.fem_interface) if cfg.interface_offset
                         else np.zeros((nI, 3)))
-        self.Top = InterfaceOperator(comm, iface, model.layout, self.offsets if cfg.interface_offset else None)
+        self.Top = InterfaceOperator(comm, iface, model.layout, self.offsets if cfg.interface_offset else None,
+                                     fe_mesh=model.mesh)
         self.own_k, self.own_loc = _owned(self.dofs_be, march.u_tmpl)
         self.fown_k, self.fown_loc = _owned(self.dofs_fe, integ.u)
         self.zero = iface.zero.ravel()
@@ -390,66 +391,11 @@ def _area_weights(mesh, iface, order=6):
     return a, b
 
 
-def run_ssi(cfg):
-    """Collective: the coupled run. Returns a dict of results (series on rank 0)."""
-    PETSc = init()
-    comm = PETSc.COMM_WORLD
-    t_start = time.perf_counter()
-    log = printf if cfg.monitor else (lambda m: None)
-    st = stage("SSI setup")
-    st.push()
-    hist = load_history(cfg, comm)
-    prob, model, iface, fe_cfg = setup(cfg, comm)
-    plan, ls = prob.prepare([
-        f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
-        f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
-        + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
-        + f", {cfg.coupling} coupling"], interface_bytes(cfg, prob, model, iface, comm.getSize()),
-        "interface matrices")
-    st.pop()
-    st = stage("SSI FEM assembly")
-    st.push()
-    model.assemble()
-    _, integ, am = make_model_integrator(fe_cfg, comm, model)
-    st.pop()
-    st = stage("SSI BEM assembly")
-    st.push()
-    march, info = build_bem(cfg, comm, prob, plan, ls, None, prob.known_p(), log)
-    coupler = Coupler(cfg, comm, prob, march, iface, integ, model)
-    printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
-           f"{fe_cfg.fem_integrator}): {3 * iface.n} BEM" + (" and FEM" if cfg.coupling == "implicit" else "")
-           + f" solves in {fmt_time(coupler.t_capacitance)} "
-           f"(BEM step matrix factorised once in {fmt_time(march.t_factor)})")
-    st.pop()
-    st = stage("SSI time loop")
-    st.push()
-    res = _time_loop(cfg, comm, prob, model, iface, coupler, hist)
-    st.pop()
-    law = coupler.law
-    nch = law.total_changes
-    stats = {"wall_s": time.perf_counter() - t_start, "assembly_s": info["t_asm"], "lag_bytes": info["mem"],
-             "bem_factor_s": march.t_factor, "capacitance_setup_s": coupler.t_capacitance,
-             "status_changes": int(nch), "capacitance_factorisations": coupler.solver_cap().n_factor,
-             "capacitance_factor_s": coupler.solver_cap().t_factor, "contact_algebra_s": law.t_algebra,
-             "cycled_steps": law.cycled_steps, "interface_nodes": iface.n, "lags": prob.L,
-             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
-             "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": am}
-    import resource
-    hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
-    mpi = comm.tompi4py()
-    stats["peak_rss_max_rank_bytes"] = mpi.allreduce(hwm, op=__import__("mpi4py").MPI.MAX)
-    stats["peak_rss_sum_bytes"] = mpi.allreduce(hwm)
-    res["stats"] = stats
-    if cfg.contact == "unilateral":
-        per = law.t_algebra / max(nch, 1)
-        printf(f"[ssi] contact: {nch} status changes in {int((res['interface']['changes'] > 0).sum())} steps, "
-               f"{coupler.solver_cap().n_factor} interface factorisations ({fmt_time(coupler.solver_cap().t_factor)}), active-set "
-               f"algebra {fmt_time(law.t_algebra)} in all ({per * 1e3:.3g} ms per status change) vs "
-               f"{fmt_time(march.t_factor)} for one factorisation of the BEM step matrix")
-    _finish(cfg, comm, prob, model, iface, res, am)
-    integ.destroy()
-    printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
-    return res
+def run_ssi(cfg, comm=None):
+    """Collective: the coupled run (``problem.SSITransient``). Returns a dict of results (series on
+    rank 0)."""
+    from .problem import SSITransient
+    return SSITransient(cfg, comm).run()
 
 
 def interface_bytes(cfg, prob, model, iface, ranks):
@@ -469,63 +415,6 @@ def interface_bytes(cfg, prob, model, iface, ranks):
 def structure_output_path(path):
     stem, ext = os.path.splitext(path)
     return stem + "_structure" + (ext or ".h5")
-
-
-def _time_loop(cfg, comm, prob, model, iface, coupler, hist):
-    from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
-    march, integ = coupler.march, coupler.integ
-    keys = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
-            "moment_fe", "moment_be", "bem_residual", "force_map_error")
-    if cfg.coupling == "implicit":
-        keys += ("uf_check",)
-    out = Output(cfg.output, comm)
-    sout = Output(structure_output_path(cfg.output), comm)
-    rec = Recorder(cfg, comm, "SSI time loop", prob.n_steps, soil=SoilRecorder(out, comm, prob, march),
-                   structure=StructureRecorder(sout, model, comm), interface_keys=keys)
-    vel = integ.u.duplicate()
-    F, fn = model.load_vec(), model.load_vec()
-
-    def sample(k):
-        """The structure's load of step k: at t_k as the cell mean (Green, staggered), or
-        the mean over (t_{k-1}, t_k] (midpoint form, implicit)."""
-        F.copy(fn)
-        if cfg.coupling == "staggered" or k == 0:
-            fn.scale(hist.cell_mean(k, cfg.dt))
-        else:
-            fn.scale(hist.step_mean(k, cfg.dt))
-        return fn
-
-    integ.start(f0=sample(0))
-    rec.structure.record(0.0, integ.u, integ.velocity(vel))
-    for n in range(1, prob.n_steps + 1):
-        u, p, res = coupler.step(sample(n))
-        t = n * prob.dt
-        if res["cycled"]:
-            coupler.law.cycled_steps.append(n)
-            warn(f"step {n} (t = {t:.4g} s): the contact status did not settle in {res['iterations']} "
-                 f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
-        nrm = u.norm()
-        n_open = int((~res["closed"]).sum())
-        rec.step(n, t, soil=(u, p), structure=(integ.u, integ.velocity(vel)), interface=res, norm=nrm,
-                 status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} it {res['iterations']}")
-        if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
-            raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
-                           "(beta = c dt / l) and -ssi_coupling_traction")
-    times = rec.times
-    soil_u = rec.soil_receivers()
-    nI = coupler.nI
-    inter = rec.interface_arrays()
-    for k in ("uf", "ub", "p") + (("uf_check",) if "uf_check" in inter else ()):
-        inter[k] = inter[k].reshape(len(times), nI, 3)
-    inter["n_open"] = (~inter["closed"]).sum(axis=1)
-    inter["t"] = np.asarray(times)
-    inter["x"] = iface.x
-    inter["normal"] = iface.n_b
-    st, su = rec.structure.rec.arrays()
-    sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
-    return {"t": np.asarray(times), "u": soil_u, "structure_t": st, "structure_u": su, "structure": sall,
-            "interface": inter,
-            "unorm": np.asarray(rec.unorm), "_outputs": (out, sout)}
 
 
 def _finish(cfg, comm, prob, model, iface, res, am):

@@ -14,8 +14,7 @@ import numpy as np
 
 from ..petsc import init, SSIError, collective_error, printf
 from ..monitor import event
-from ..io.output import Output, provenance
-from .. import timegrid
+from ..io.output import provenance
 from .integrators import make_integrator, green_constants
 from .loads import history_from
 from .model import build_model
@@ -120,39 +119,11 @@ def make_model_integrator(cfg, comm, model=None):
     return model, integ, am
 
 
-def run_fem(cfg):
-    """Collective: run the case; returns a summary dict (receiver series on rank 0)."""
-    PETSc = init()
-    comm = PETSc.COMM_WORLD
-    hist = load_history(cfg, comm)                     # before assembly and factorisation
-    model, integ, am = make_model_integrator(cfg, comm)
-    n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
-    F, fn = model.load_vec(), model.load_vec()
-    from ..io.recorder import Recorder, StructureRecorder
-    with event("FEM_io"):
-        out = Output(cfg.output, comm) if cfg.output else None
-        rec = Recorder(cfg, comm, "FEM time loop", n_steps,
-                       structure=StructureRecorder(out, model, comm, io_event="FEM_io"))
-    vel = integ.u.duplicate()
-
-    def sample(n):
-        F.copy(fn)
-        fn.scale(hist.cell_mean(n, cfg.dt))
-        return fn
-
-    integ.start(f0=sample(0))
-    rec.structure.record(0.0, integ.u, integ.velocity(vel), write=rec.due(0))
-    with event("FEM_timeloop"):
-        for n in range(1, n_steps + 1):
-            integ.step(sample(n))
-            rec.step(n, n * cfg.dt, structure=(integ.u, integ.velocity(vel)), status=f"t = {n * cfg.dt:.5g} s")
-    t, u = rec.structure.rec.arrays()
-    _close_output(cfg, out, model, rec.structure, comm, am, n_steps, integ)
-    if comm.getRank() == 0 and len(model.receiver_nodes):
-        printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
-               f"{u[-1, 0, 2]:.6e}) m")
-    integ.destroy()
-    return {"t": t, "u": u, "n_steps": n_steps, "alpha_m": am, "model": model}
+def run_fem(cfg, comm=None):
+    """Collective: run the case (``problem.FEMTransient``); returns a summary dict (receiver series
+    on rank 0)."""
+    from .problem import FEMTransient
+    return FEMTransient(cfg, comm).run()
 
 
 def structure_topology(mesh):

@@ -13,7 +13,7 @@
   interface series   per-step arrays of the coupling (a dict of lists, rank 0's copy)
 
 Fields are written every -ssi_output_stride steps (``due``); receivers every step. The
-drivers (bem/run.py, fem/run.py, coupling/run.py) step their problem and hand the
+problems (bem/problem.py, fem/problem.py, coupling/problem.py) step and hand the
 results here; ``step`` also prints the -ssi_monitor progress line and keeps |u| for the
 divergence guard. Collective unless said otherwise.
 """

@@ -1,0 +1,80 @@
+"""``BEMTransient``: the half-space alone (-ssi_problem bem) as an importable problem.
+
+The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads the mesh, checks
+every input and estimates the memory (``run.BEMProblem.prepare``); ``setup`` assembles the lag
+matrices and factorises the step matrix (``run.build_bem``); ``step`` advances the Marcher one
+step, records (``io.recorder``) and applies the divergence guard; ``finish`` writes receivers,
+sidecars and the run record. ``state`` between steps: (u, p), the soil's displacement and
+traction Vecs of the last step (owned layout).
+"""
+import time
+
+import numpy as np
+
+from ..petsc import printf
+from ..monitor import staged, fmt_time
+from ..io.output import Output
+from ..problem import TransientProblem
+from .run import BEMProblem, build_bem, _guard, _finish
+
+
+class BEMTransient(TransientProblem):
+    kind = "bem"
+
+    def __init__(self, cfg, comm=None):
+        super().__init__(cfg, comm)
+        self.log = printf if cfg.monitor else (lambda m: None)
+        with staged("SSI BEM setup"):
+            self.prob = BEMProblem(cfg, self.comm, log=printf)
+            self.plan, self.ls = self.prob.prepare()
+        self.n_steps = self.prob.n_steps
+        self.march = self.rec = self.out = None
+        self.state = None
+
+    def setup(self):
+        self._advance("created", "set up")
+        p = self.prob
+        with staged("SSI BEM assembly"):
+            self.march, self.info = build_bem(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
+                                              p.known_p(), self.log)
+
+    def start(self):
+        self._advance("set up", "started")
+        from ..io.recorder import Recorder, SoilRecorder
+        self.out = Output(self.cfg.output, self.comm)
+        self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.n_steps,
+                            soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
+
+    def step(self, n):
+        self._check_step(n)
+        with staged("SSI BEM time loop"):
+            u, p = self.march.step()
+            nrm = u.norm()
+            rec = self.rec
+            w = min(100, n - 1)       # growth of |u| over the last (up to) 100 steps, shown by -ssi_monitor
+            prev = rec.unorm[-w] if w else 0.0
+            grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
+            t = self.time(n)
+            rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
+            self.n = n
+            if self.cfg.guard:
+                _guard(self.cfg, self.prob, self.march, rec.unorm, n)
+        self.state = (u, p)
+        return self.state
+
+    def finish(self):
+        self._advance("stepping" if self.n else "started", "finished")
+        cfg, prob, plan, ls, info = self.cfg, self.prob, self.plan, self.ls, self.info
+        rec = self.rec
+        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm)}
+        res["stats"] = {
+            "assembly_s": info["t_asm"], "wall_s": time.perf_counter() - self.t_start, "lags": prob.L,
+            "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
+            "T_L": plan.TL if plan.active else None, "lag_bytes_exact": info["mem_exact"],
+            "lag_bytes_interp": info["mem_interp"], "dense_lags": info["ndense"], "baij_lags": info["nbaij"],
+            "mean_fill": info["fill"], "lag_bytes": info["mem"], "mem_estimate": prob.mem_estimate,
+            "T_N": prob.T_N, "r_max": prob.r_max, "kernel_evaluations": ls.kernel_evaluations,
+            "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
+        _finish(cfg, self.comm, prob, self.out, res)
+        printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
+        return res

@@ -1,0 +1,160 @@
+"""``SSITransient``: structure and half-space coupled (-ssi_problem ssi) as an importable problem.
+
+The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads both meshes and the
+interface and checks every input, then the memory (``run.setup``, ``BEMProblem.prepare`` with the
+interface matrices counted); ``setup`` assembles K and M and factorises D, assembles the BEM lag
+matrices and factorises the step matrix, then builds the interface matrices (``run.Coupler``,
+with the staggered or implicit strategy); ``step`` is one coupled step with the contact
+iteration (``Coupler.step``); ``finish`` writes both outputs, the interface series and the run
+record. ``state`` between steps: (u_soil, p_soil, u_structure, res) with ``res`` the step's
+interface record (u_f, u_b, p, gap, p_N, status, iterations, resultants).
+"""
+import time
+
+import numpy as np
+
+from ..petsc import printf, warn, SSIError
+from ..monitor import staged, fmt_time
+from ..io.output import Output
+from ..problem import TransientProblem
+from ..bem.run import build_bem
+from ..fem.run import make_model_integrator, load_history
+from .run import setup, interface_bytes, Coupler, structure_output_path, _finish
+
+INTERFACE_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
+                  "moment_fe", "moment_be", "bem_residual", "force_map_error")
+
+
+class SSITransient(TransientProblem):
+    kind = "ssi"
+
+    def __init__(self, cfg, comm=None):
+        super().__init__(cfg, comm)
+        self.log = printf if cfg.monitor else (lambda m: None)
+        comm = self.comm
+        with staged("SSI setup"):
+            self.hist = load_history(cfg, comm)
+            self.prob, self.model, self.iface, self.fe_cfg = setup(cfg, comm)
+            iface = self.iface
+            self.plan, self.ls = self.prob.prepare([
+                f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
+                f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
+                + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
+                + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
+                "interface matrices")
+        self.n_steps = self.prob.n_steps
+        self.coupler = self.rec = None
+        self.state = None
+
+    def setup(self):
+        self._advance("created", "set up")
+        cfg, comm, prob = self.cfg, self.comm, self.prob
+        with staged("SSI FEM assembly"):
+            self.model.assemble()
+            _, self.integ, self.am = make_model_integrator(self.fe_cfg, comm, self.model)
+        with staged("SSI BEM assembly"):
+            self.march, self.info = build_bem(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
+            self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
+            printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
+                   f"{self.fe_cfg.fem_integrator}): {3 * self.iface.n} BEM"
+                   + (" and FEM" if cfg.coupling == "implicit" else "")
+                   + f" solves in {fmt_time(self.coupler.t_capacitance)} "
+                   f"(BEM step matrix factorised once in {fmt_time(self.march.t_factor)})")
+        self.F, self.fn = self.model.load_vec(), self.model.load_vec()
+        self.vel = self.integ.u.duplicate()
+
+    def load(self, k):
+        """The structure's load of step k: at t_k as the cell mean (Green, staggered), or the mean
+        over (t_{k-1}, t_k] (midpoint form, implicit)."""
+        self.F.copy(self.fn)
+        if self.cfg.coupling == "staggered" or k == 0:
+            self.fn.scale(self.hist.cell_mean(k, self.cfg.dt))
+        else:
+            self.fn.scale(self.hist.step_mean(k, self.cfg.dt))
+        return self.fn
+
+    def start(self):
+        self._advance("set up", "started")
+        from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
+        cfg, comm = self.cfg, self.comm
+        keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ())
+        self.out = Output(cfg.output, comm)
+        self.sout = Output(structure_output_path(cfg.output), comm)
+        self.rec = Recorder(cfg, comm, "SSI time loop", self.n_steps,
+                            soil=SoilRecorder(self.out, comm, self.prob, self.march),
+                            structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
+        self.integ.start(f0=self.load(0))
+        self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel))
+
+    def step(self, n):
+        self._check_step(n)
+        coupler, integ = self.coupler, self.integ
+        with staged("SSI time loop"):
+            u, p, res = coupler.step(self.load(n))
+            t = self.time(n)
+            if res["cycled"]:
+                coupler.law.cycled_steps.append(n)
+                warn(f"step {n} (t = {t:.4g} s): the contact status did not settle in {res['iterations']} "
+                     f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
+            nrm = u.norm()
+            n_open = int((~res["closed"]).sum())
+            self.rec.step(n, t, soil=(u, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
+                          norm=nrm, status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} "
+                                           f"it {res['iterations']}")
+            self.n = n
+            if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
+                raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
+                               "(beta = c dt / l) and -ssi_coupling_traction")
+        self.state = (u, p, integ.u, res)
+        return self.state
+
+    def results(self):
+        """Collective: the series so far (soil receivers, structure, interface; rank 0)."""
+        rec, iface, comm = self.rec, self.iface, self.comm
+        times = rec.times
+        nI = self.coupler.nI
+        inter = rec.interface_arrays()
+        for k in ("uf", "ub", "p") + (("uf_check",) if "uf_check" in inter else ()):
+            inter[k] = inter[k].reshape(len(times), nI, 3)
+        inter["n_open"] = (~inter["closed"]).sum(axis=1)
+        inter["t"] = np.asarray(times)
+        inter["x"] = iface.x
+        inter["normal"] = iface.n_b
+        st, su = rec.structure.rec.arrays()
+        sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
+        return {"t": np.asarray(times), "u": rec.soil_receivers(), "structure_t": st, "structure_u": su,
+                "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm)}
+
+    def finish(self):
+        self._advance("stepping" if self.n else "started", "finished")
+        cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob
+        res = self.results()
+        res["_outputs"] = (self.out, self.sout)
+        law = coupler.law
+        nch = law.total_changes
+        stats = {"wall_s": time.perf_counter() - self.t_start, "assembly_s": self.info["t_asm"],
+                 "lag_bytes": self.info["mem"], "bem_factor_s": march.t_factor,
+                 "capacitance_setup_s": coupler.t_capacitance, "status_changes": int(nch),
+                 "capacitance_factorisations": coupler.solver_cap().n_factor,
+                 "capacitance_factor_s": coupler.solver_cap().t_factor, "contact_algebra_s": law.t_algebra,
+                 "cycled_steps": law.cycled_steps, "interface_nodes": self.iface.n, "lags": prob.L,
+                 "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
+                 "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am}
+        import resource
+        from mpi4py import MPI
+        hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+        mpi = comm.tompi4py()
+        stats["peak_rss_max_rank_bytes"] = mpi.allreduce(hwm, op=MPI.MAX)
+        stats["peak_rss_sum_bytes"] = mpi.allreduce(hwm)
+        res["stats"] = stats
+        if cfg.contact == "unilateral":
+            per = law.t_algebra / max(nch, 1)
+            printf(f"[ssi] contact: {nch} status changes in {int((res['interface']['changes'] > 0).sum())} steps, "
+                   f"{coupler.solver_cap().n_factor} interface factorisations "
+                   f"({fmt_time(coupler.solver_cap().t_factor)}), active-set algebra {fmt_time(law.t_algebra)} in "
+                   f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
+                   "factorisation of the BEM step matrix")
+        _finish(cfg, comm, prob, self.model, self.iface, res, self.am)
+        self.integ.destroy()
+        printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
+        return res

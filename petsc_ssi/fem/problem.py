@@ -1,0 +1,77 @@
+"""``FEMTransient``: the structure alone (-ssi_problem fem) as an importable problem.
+
+The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads the load history,
+the parts and the mesh and checks every input (``model.build_model`` without assembly);
+``setup`` assembles K and M and factorises D (``run.make_model_integrator``); ``start`` takes the
+initial impulse of the load and records t = 0; ``step`` is one step of the integrator (paper eqs.
+13-16) with the load sample f^n; ``finish`` writes receivers and sidecars. ``state`` between
+steps: (u, v), displacement and velocity in the dof map's layout.
+"""
+from ..petsc import printf
+from ..monitor import event, staged
+from ..io.output import Output
+from ..problem import TransientProblem
+from .. import timegrid
+from .model import build_model
+from .run import load_history, make_model_integrator, _close_output
+
+
+class FEMTransient(TransientProblem):
+    kind = "fem"
+
+    def __init__(self, cfg, comm=None):
+        super().__init__(cfg, comm)
+        with staged("FEM setup"):
+            self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
+            self.model = build_model(cfg, self.comm, assemble_matrices=False)
+        self.n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
+        self.integ = self.rec = self.out = None
+        self.state = None
+
+    def setup(self):
+        self._advance("created", "set up")
+        with staged("FEM assembly"):
+            self.model.assemble()
+            _, self.integ, self.am = make_model_integrator(self.cfg, self.comm, self.model)
+        self.F, self.fn = self.model.load_vec(), self.model.load_vec()
+        self.vel = self.integ.u.duplicate()
+
+    def load(self, n):
+        """The load sample of step n: the spatial load times the mean of the history over the
+        step's cell [t_n - dt/2, t_n + dt/2]."""
+        self.F.copy(self.fn)
+        self.fn.scale(self.hist.cell_mean(n, self.cfg.dt))
+        return self.fn
+
+    def start(self):
+        self._advance("set up", "started")
+        from ..io.recorder import Recorder, StructureRecorder
+        cfg, comm = self.cfg, self.comm
+        with event("FEM_io"):
+            self.out = Output(cfg.output, comm) if cfg.output else None
+            self.rec = Recorder(cfg, comm, "FEM time loop", self.n_steps,
+                                structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
+        self.integ.start(f0=self.load(0))
+        self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel), write=self.rec.due(0))
+        self.state = (self.integ.u, self.vel)
+
+    def step(self, n):
+        self._check_step(n)
+        with staged("FEM time loop"), event("FEM_timeloop"):
+            self.integ.step(self.load(n))
+            t = self.time(n)
+            self.rec.step(n, t, structure=(self.integ.u, self.integ.velocity(self.vel)), status=f"t = {t:.5g} s")
+            self.n = n
+        self.state = (self.integ.u, self.vel)
+        return self.state
+
+    def finish(self):
+        self._advance("stepping" if self.n else "started", "finished")
+        cfg, comm, model = self.cfg, self.comm, self.model
+        t, u = self.rec.structure.rec.arrays()
+        _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ)
+        if comm.getRank() == 0 and len(model.receiver_nodes):
+            printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
+                   f"{u[-1, 0, 2]:.6e}) m")
+        self.integ.destroy()
+        return {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}

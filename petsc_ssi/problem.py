@@ -1,0 +1,110 @@
+"""The life cycle every problem kind shares (PyLith's Problem: initialise, solve, finalise).
+
+``TransientProblem`` is the base of the three importable problems:
+
+  petsc_ssi.bem.problem.BEMTransient        the half-space alone (-ssi_problem bem)
+  petsc_ssi.fem.problem.FEMTransient        the structure alone (-ssi_problem fem)
+  petsc_ssi.coupling.problem.SSITransient   structure and half-space coupled (-ssi_problem ssi)
+
+Each one goes through the same stages, all collective:
+
+  __init__(cfg, comm)   read and check every input (mesh, parts, options); nothing heavy, so bad
+                        input fails here in one line on every rank
+  setup()               assemble and factorise (BEM lag matrices, K and M, interface matrices)
+  start()               the state at t = 0, outputs opened, recorder ready
+  step(n)               one time step; returns the new state (PETSc Vecs, owned layout)
+  finish()              outputs closed (receivers, sidecars, run record); returns the results
+
+``run()`` does all of it and is what ``petsc-ssi`` calls; a script can step by itself:
+
+    from petsc_ssi import options
+    from petsc_ssi.problem import from_options
+    p = from_options()                    # -ssi_problem and the rest from the options database
+    p.setup(); p.start()
+    for n in range(1, p.n_steps + 1):
+        state = p.step(n)                 # look at, or act on, the state between steps
+    results = p.finish()
+
+``cfg`` is the resolved options (``options.resolve``); the options database stays the one
+source of settings (no keyword arguments that bypass it).
+"""
+import time
+
+from .petsc import init, SSIError
+
+
+class TransientProblem:
+    """Base class; see the module docstring."""
+    kind = ""
+
+    def __init__(self, cfg, comm=None):
+        PETSc = init()
+        self.cfg = cfg
+        self.comm = comm if comm is not None else PETSc.COMM_WORLD
+        self.t_start = time.perf_counter()
+        self.n = 0                      # the last step taken
+        self.n_steps = 0
+        self._state = "created"
+
+    _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
+
+    def _advance(self, expected, new):
+        if self._state != expected:
+            raise SSIError(f"{type(self).__name__}: {self._METHOD[new]}() out of order, the problem is "
+                           f"'{self._state}' (order: setup, start, step 1..n_steps, finish)")
+        self._state = new
+
+    def time(self, n):
+        return n * self.cfg.dt
+
+    def setup(self):
+        raise NotImplementedError
+
+    def start(self):
+        raise NotImplementedError
+
+    def step(self, n):
+        raise NotImplementedError
+
+    def finish(self):
+        raise NotImplementedError
+
+    def _check_step(self, n):
+        if self._state not in ("started", "stepping"):
+            raise SSIError(f"{type(self).__name__}: step {n} before start()")
+        if n != self.n + 1 or n > self.n_steps:
+            raise SSIError(f"{type(self).__name__}: step {n} out of order (last step {self.n} of {self.n_steps})")
+        self._state = "stepping"
+
+    def run(self):
+        """Collective: setup, start, every step, finish; returns the results."""
+        self.setup()
+        self.start()
+        for n in range(1, self.n_steps + 1):
+            self.step(n)
+        return self.finish()
+
+
+KINDS = ("bem", "fem", "ssi")
+
+
+def problem_class(kind):
+    if kind == "bem":
+        from .bem.problem import BEMTransient
+        return BEMTransient
+    if kind == "fem":
+        from .fem.problem import FEMTransient
+        return FEMTransient
+    if kind == "ssi":
+        from .coupling.problem import SSITransient
+        return SSITransient
+    raise SSIError(f"-ssi_problem {kind}: must be one of {'|'.join(KINDS)}")
+
+
+def from_options(comm=None):
+    """Collective: the problem the options database describes (-ssi_problem and its options,
+    resolved and checked), constructed but not set up."""
+    from . import driver, options
+    kind = driver.problem_kind()
+    cfg = options.resolve(driver.GROUPS[kind])
+    return problem_class(kind)(cfg, comm)
