@@ -43,7 +43,20 @@ FIXED = [(1, 3.8779, "x2 1st"), (2, 3.9151, "x1 1st"), (3, 4.2316, "torsion 1st"
          (10, 29.0215, "slab bending, sym"), (11, 30.2531, "slab bending, anti x"),
          (12, 31.1304, "slab bending, anti y")]
 CASES = ["ssi-full-bonded", "ssi-full-unilateral", "ssi-half-bonded", "ssi-half-unilateral",
-         "ssi-full-bonded-ny4"]
+         "ssi-full-bonded-ny4", "ssi-full-bonded-released"]
+RELEASED = "ssi-full-bonded-released"
+# fixed-base modes of the building with released slabs: runs/building/modes_release.csv (modes_figure.py)
+RELEASE_CSV = os.path.join(HERE, "modes_release.csv")
+
+
+def fixed_released():
+    """[(mode, f, kind)] of the released-slab building on a fixed base, or None."""
+    if not os.path.exists(RELEASE_CSV):
+        return None
+    with open(RELEASE_CSV) as fh:
+        rows = list(csv.DictReader(fh))
+    return [(int(r["mode_released"]), float(r["f_released_hz"]), r["kind_released"].replace(" (", " ").replace(")", ""))
+            for r in rows]
 PRIMARY = "ssi-full-bonded"
 
 sys.path.insert(0, HERE)
@@ -243,7 +256,7 @@ def fig16(path, png, csv_acc, csv_spec):
     return found
 
 
-def peak_table(found):
+def peak_table(found, fixed=FIXED):
     """Match the paper's peaks with the peaks found (A and B, x and z spectra) and the fixed-base modes."""
     allp = []
     for (rcv, c), pk in found.items():
@@ -260,7 +273,7 @@ def peak_table(found):
         else:
             f, rel, where = float("nan"), float("nan"), "-"
         # only the modes symmetric about y = 0 (x1 sway, slab bending) can be excited by this load
-        sym = [m for m in FIXED if m[0] in (2, 5, 8, 10, 11)]
+        sym = [m for m in fixed if m[0] in (2, 5, 8, 10, 11)]
         fb = min(sym, key=lambda m: abs(m[1] - (f if np.isfinite(f) else fp)))
         rows.append(dict(paper=name, paper_hz=fp, paper_kind=kind, ssi_hz=f, rel_height=rel, spectrum=where,
                          diff_pct=100 * (f - fp) / fp if np.isfinite(f) else float("nan"),
@@ -279,7 +292,8 @@ def compare():
     pairs = [("ssi-half-bonded", "ssi-full-bonded-ny4", "half vs full (4 y-bays), bonded"),
              ("ssi-half-unilateral", "ssi-half-bonded", "unilateral vs bonded, half"),
              ("ssi-full-unilateral", "ssi-full-bonded", "unilateral vs bonded, full"),
-             ("ssi-full-bonded-ny4", "ssi-full-bonded", "4 y-bays vs 3 y-bays (paper), full bonded")]
+             ("ssi-full-bonded-ny4", "ssi-full-bonded", "4 y-bays vs 3 y-bays (paper), full bonded"),
+             ("ssi-full-bonded-released", "ssi-full-bonded", "slabs released vs monolithic, full bonded")]
     for a, b, what in pairs:
         pa, pb = find(a), find(b)
         if not (pa and pb):
@@ -408,6 +422,18 @@ def main():
               f"{fmt(r['diff_pct'])} %), fixed-base mode {r['fixed_mode']} {r['fixed_hz']} Hz ({r['fixed_kind']})")
     print("  all peaks (f, height relative to the spectrum's largest, spectrum):",
           ", ".join(f"{f:.2f} ({h:.2f} {w})" for f, h, w in allp))
+    rel_rows = None
+    prel = find(RELEASED)
+    if prel is not None and fixed_released() is not None:
+        import tempfile
+        with tempfile.TemporaryDirectory() as tmp:
+            found_rel = fig16(prel, os.path.join(HERE, "ssi_fig16_released.png"), os.path.join(tmp, "a.csv"),
+                              os.path.join(tmp, "s.csv"))
+        rel_rows, _ = peak_table(found_rel, fixed_released())
+        write_csv(os.path.join(HERE, "ssi_peaks_released.csv"), rel_rows)
+        for r in rel_rows:
+            print(f"  released: {r['paper']} {r['paper_hz']:6.2f} Hz -> {fmt(r['ssi_hz'], 4)} Hz ({r['spectrum']}, "
+                  f"{fmt(r['diff_pct'])} %), fixed-base mode {r['fixed_mode']} {r['fixed_hz']} Hz ({r['fixed_kind']})")
     cmp_rows = compare()
     write_csv(os.path.join(HERE, "ssi_compare.csv"), cmp_rows)
     for r in cmp_rows:
@@ -431,6 +457,12 @@ def main():
                "fixed_hz", "fixed_kind", "shift_pct"],
         ["paper", "paper [Hz]", "paper's kind", "here (SSI) [Hz]", "here vs paper [%]", "spectrum", "rel. height",
          "fixed-base mode", "fixed-base [Hz]", "kind", "SSI shift [%]"]))
+    if rel_rows is not None:
+        text = replace_block(text, "peaks-released", md_table(
+            rel_rows, ["paper", "paper_hz", "paper_kind", "ssi_hz", "diff_pct", "spectrum", "rel_height",
+                       "fixed_mode", "fixed_hz", "fixed_kind", "shift_pct"],
+            ["paper", "paper [Hz]", "paper's kind", "here, slabs released (SSI) [Hz]", "here vs paper [%]",
+             "spectrum", "rel. height", "fixed-base mode (released)", "fixed-base [Hz]", "kind", "SSI shift [%]"]))
     text = replace_block(text, "compare", md_table(
         cmp_rows, ["what", "acc_Ax", "acc_Az", "acc_Bx", "acc_Bz", "u_Ax", "u_Az", "u_Bx", "u_Bz"],
         ["comparison", "a_x A", "a_z A", "a_x B", "a_z B", "u_x A", "u_z A", "u_x B", "u_z B"]))
