@@ -17,7 +17,7 @@ APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
 PIP_PKGS := numba gmsh matplotlib pytest pytest-timeout
 
-.PHONY: all deps demo test test-fast bench clean help-options
+.PHONY: all deps demo test bench clean help-options
 
 all: test
 

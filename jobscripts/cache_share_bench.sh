@@ -16,11 +16,11 @@ run() {  # ranks share rep
   local log="$OUT/n$1-share$2-rep$3.log"
   echo "[cache_share] $1 rank(s), -ssi_cache_share $2, run $3 -> $log"
   ${LOCK:-} mpirun --allow-run-as-root --oversubscribe -n "$1" "$PY" -m petsc_ssi -options_file "$OPTS" \
-    -ssi_output "$OUT/n$1-share$2-rep$3.h5" -ssi_output_stride 0 -ssi_cache_share "$2" -log_view > "$log" 2>&1
+    -ssi_output "$OUT/n$1-share$2-rep$3.h5" -ssi_output_overwrite -ssi_output_stride 0 -ssi_cache_share "$2" -log_view > "$log" 2>&1
 }
 # warm-up (not recorded): numba compiles the kernels into its cache on first use
 ${LOCK:-} mpirun --allow-run-as-root --oversubscribe -n 2 "$PY" -m petsc_ssi -options_file runs/pekeris/small.opts \
-  -ssi_output "$OUT/warmup.h5" -ssi_output_stride 0 > "$OUT/warmup.log" 2>&1
+  -ssi_output "$OUT/warmup.h5" -ssi_output_overwrite -ssi_output_stride 0 > "$OUT/warmup.log" 2>&1
 run 1 1 1
 for n in $RANKS; do
   for rep in $(seq 1 "$REPS"); do run "$n" 0 "$rep"; run "$n" 1 "$rep"; done

@@ -18,7 +18,7 @@ for case in $CASES; do
     log="$OUT/foundation-$case-n$n.log"
     echo "[bench] $case on $n rank(s) -> $log"
     mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi \
-      -options_file "runs/foundation/$case.opts" -ssi_output "$OUT/foundation-$case-n$n.h5" \
+      -options_file "runs/foundation/$case.opts" -ssi_output "$OUT/foundation-$case-n$n.h5" -ssi_output_overwrite \
       -log_view -memory_view > "$log" 2>&1
   done
 done

@@ -15,7 +15,7 @@ for case in $CASES; do
     log="$OUT/pekeris-$case-n$n.log"
     echo "[bench] $case on $n rank(s) -> $log"
     mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi \
-      -options_file "runs/pekeris/$case.opts" -ssi_output "$OUT/pekeris-$case-n$n.h5" \
+      -options_file "runs/pekeris/$case.opts" -ssi_output "$OUT/pekeris-$case-n$n.h5" -ssi_output_overwrite \
       -ssi_output_stride 0 -ssi_plot -log_view -memory_view > "$log" 2>&1
   done
 done

@@ -49,6 +49,6 @@ run_case() {
   echo "[scaling] $study $case on $n rank(s)$([ "$over" = 1 ] && echo " (oversubscribed: $CORES cores per node)") -> $log"
   {
     echo "# scaling: study=$study case=$case ranks=$n nodes=$nodes cores_per_node=$CORES oversubscribed=$over host=$(hostname) date=$(date -u +%FT%TZ)"
-    $LOCK "${launch[@]}" "$PY" -m petsc_ssi "$@" -log_view -memory_view 2>&1
+    $LOCK "${launch[@]}" "$PY" -m petsc_ssi "$@" -ssi_output_overwrite -log_view -memory_view 2>&1
   } > "$log"
 }

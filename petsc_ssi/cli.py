@@ -7,7 +7,8 @@ Commands:
   static          static solution K u = F of a FE structure (loads at h = 1), written like a run
   estimate        predicted time per stage and memory of the run, per rank count, and
                   whether it fits the nodes (no assembly; -ssi_estimate_* options)
-  help            list every -ssi_ option with default, unit and meaning
+  help            list every -ssi_ option with default, unit and meaning (also -help, --help)
+  --version       the versions of petsc-ssi, PETSc, petsc4py, mpi4py, numpy, numba
 
 Errors in the input end the run with one line, ``petsc-ssi: error: ...``,
 and exit status 2 on every rank.
@@ -23,8 +24,51 @@ def _split(argv):
     return "run", list(argv)
 
 
+def _bad_command(argv):
+    """The one-line error for a first argument that is neither a command nor an option, or None."""
+    if len(argv) > 1 and argv[1] not in COMMANDS and not argv[1].startswith("-"):
+        import difflib
+        near = difflib.get_close_matches(argv[1], COMMANDS, n=1)
+        return (f"petsc-ssi: error: unknown command '{argv[1]}'" + (f" (did you mean {near[0]}?)" if near else "")
+                + f"; commands: {', '.join(COMMANDS)}; options start with '-'")
+    return None
+
+
+def versions():
+    """One line per component: petsc-ssi, Python, PETSc, petsc4py, mpi4py, numpy."""
+    import platform
+    from . import __version__
+    lines = [f"petsc-ssi {__version__}", f"Python {platform.python_version()}"]
+    try:
+        from .petsc import init
+        PETSc = init([sys.argv[0]])
+        import petsc4py
+        lines.append("PETSc {}.{}.{}".format(*PETSc.Sys.getVersion()) + f", petsc4py {petsc4py.__version__}")
+    except Exception as exc:  # noqa: BLE001 -- report, do not fail
+        lines.append(f"PETSc: not available ({exc})")
+    for mod in ("mpi4py", "numpy", "numba"):
+        try:
+            lines.append(f"{mod} {__import__(mod).__version__}")
+        except Exception:  # noqa: BLE001
+            lines.append(f"{mod}: not available")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
+    bad = _bad_command(argv)
+    if bad:                    # before PETSc starts: every rank exits, rank 0 says why
+        from mpi4py import MPI
+        if MPI.COMM_WORLD.Get_rank() == 0:
+            print(bad, flush=True)
+        return 2
+    if any(a in ("--version", "-version") for a in argv[1:]):
+        from .petsc import init
+        init([argv[0]])
+        from mpi4py import MPI
+        if MPI.COMM_WORLD.Get_rank() == 0:
+            print(versions(), flush=True)
+        return 0
     cmd, rest = _split(argv)
     if cmd == "post":
         from .post import main as post_main
@@ -37,8 +81,7 @@ def main(argv=None):
     if cmd == "help" or "-help" in rest or "--help" in rest:
         PETSc.Sys.Print(__doc__.split("Errors in the input")[0].rstrip() + "\n")
         PETSc.Sys.Print(options.help_text())
-        if cmd == "help":
-            return 0
+        return 0                # help prints and exits: it never starts a run
     try:
         if cmd == "run":
             from .driver import run

@@ -20,6 +20,8 @@ register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to
 register("monitor", "bool", False, "", "print progress: assembly, per-step time, elapsed, ETA (rank 0)", "common")
 register("monitor_every", "int", 0, "steps", "monitor line every this many steps (0: about 20 lines per run)", "common",
          validator=lambda v: None if v >= 0 else "must be >= 0")
+register("output_overwrite", "bool", False, "", "replace an existing -ssi_output (and its sidecars); without it a run "
+         "refuses to start when the output exists", "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
 
 # ---------------------------------------------------------------- BEM soil
@@ -94,6 +96,15 @@ def _bem_checks(cfg):
         return f"-ssi_mesh {cfg.mesh}: no such file"
     if cfg.interp in ("chebyshev", "linear") and (cfg.interp_k < 1 or cfg.interp_tl <= 0):
         return f"-ssi_interp {cfg.interp} needs -ssi_interp_tl > 0 and -ssi_interp_k >= 1 (or use -ssi_interp auto)"
+    if cfg.mesh_patch:
+        try:
+            a, b = (float(v) for v in str(cfg.mesh_patch).split(","))
+            lx, ly = (float(v) for v in str(cfg.mesh_size).split(","))
+        except ValueError:
+            a = b = lx = ly = None           # the mesh generator reports the format
+        if a is not None and (a >= lx / 2 or b >= ly / 2):
+            return (f"-ssi_mesh_patch {cfg.mesh_patch}: the patch (half-widths) reaches the edge of the mesh "
+                    f"-ssi_mesh_size {cfg.mesh_size} (full extent); make the mesh larger or the patch smaller")
     if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
         return f"-ssi_load_table '{cfg.load_table}': no such file"
     return None

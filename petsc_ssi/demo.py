@@ -91,7 +91,7 @@ def main():
 def building():
     opts = os.path.join(ROOT, "runs", "building", "demo.opts")
     out = os.path.join(ROOT, "out", "demo", "building.h5")
-    cmd = _mpi([sys.executable, "-m", "petsc_ssi", "-options_file", opts, "-ssi_output", out,
+    cmd = _mpi([sys.executable, "-m", "petsc_ssi", "-options_file", opts, "-ssi_output", out, "-ssi_output_overwrite",
                 "-ssi_monitor", "-ssi_monitor_every", "40"])
     print("[demo] the reduced building on the half-space: " + " ".join(cmd), flush=True)
     rc = subprocess.call(cmd, cwd=ROOT)
@@ -107,7 +107,7 @@ def building():
 def lamb():
     opts = os.path.join(ROOT, "runs", "pekeris", "small.opts")
     out = os.path.join(ROOT, "out", "demo", "pekeris-small.h5")
-    cmd = [sys.executable, "-m", "petsc_ssi", "-options_file", opts, "-ssi_output", out,
+    cmd = [sys.executable, "-m", "petsc_ssi", "-options_file", opts, "-ssi_output", out, "-ssi_output_overwrite",
            "-ssi_monitor", "-ssi_monitor_every", "10", "-ssi_plot"]
     ncores = os.cpu_count() or 1
     if ncores >= 2 and shutil.which("mpirun"):

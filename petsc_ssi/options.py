@@ -12,6 +12,7 @@ Misspelt ``-ssi_`` options are an error (with a suggestion), so a typo never
 silently runs the default case.
 """
 import difflib
+import math
 from dataclasses import dataclass, field
 
 from .petsc import init, SSIError, collective_error
@@ -100,7 +101,10 @@ class Config:
 
 def _convert(opt, text):
     if opt.kind == "real":
-        return float(text)
+        v = float(text)
+        if not math.isfinite(v):
+            raise ValueError(f"'{text}' is not a finite number")
+        return v
     if opt.kind == "int":
         return int(text)
     if opt.kind == "bool":

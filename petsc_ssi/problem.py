@@ -48,6 +48,13 @@ class TransientProblem:
 
     _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
 
+    def check_output(self, also=()):
+        """Collective: the output can be written and replaces nothing unless asked
+        (``io.output.check_output``); called first by every constructor."""
+        from .io.output import check_output
+        if self.cfg.get("output"):
+            check_output(self.cfg.output, self.comm, bool(self.cfg.get("output_overwrite")), also=also)
+
     def _advance(self, expected, new):
         if self._state != expected:
             raise SSIError(f"{type(self).__name__}: {self._METHOD[new]}() out of order, the problem is "

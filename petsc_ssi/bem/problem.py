@@ -23,6 +23,7 @@ class BEMTransient(TransientProblem):
 
     def __init__(self, cfg, comm=None):
         super().__init__(cfg, comm)
+        self.check_output()
         self.log = printf if cfg.monitor else (lambda m: None)
         with staged("SSI BEM setup"):
             self.prob = BEMProblem(cfg, self.comm, log=printf)

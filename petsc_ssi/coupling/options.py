@@ -71,6 +71,10 @@ def _ssi_checks(cfg):
                 "the traction as the mean force over the step, which it is")
     if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
         return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
+    for name in ("contact_open_traction", "contact_tol", "contact_max_iter"):
+        if cfg.user_set(name) and cfg.contact != "unilateral":
+            return (f"-ssi_{name} acts only with -ssi_contact unilateral (the interface is {cfg.contact}: "
+                    "no contact iteration); drop it or set -ssi_contact unilateral")
     return None
 
 

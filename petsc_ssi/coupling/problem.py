@@ -30,6 +30,7 @@ class SSITransient(TransientProblem):
 
     def __init__(self, cfg, comm=None):
         super().__init__(cfg, comm)
+        self.check_output(also=(structure_output_path(cfg.output),))
         self.log = printf if cfg.monitor else (lambda m: None)
         comm = self.comm
         with staged("SSI setup"):

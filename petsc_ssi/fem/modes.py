@@ -174,6 +174,9 @@ def main():
     PETSc = init()
     comm = PETSc.COMM_WORLD
     cfg = ssi_options.resolve(("common", "fem"))
+    if cfg.output:
+        from ..io.output import check_output
+        check_output(cfg.output, comm, cfg.output_overwrite)
     from .model import build_model
     model = build_model(cfg, comm)
     target = PETSc.Options().getReal("ssi_modes_eps_target",

@@ -21,6 +21,7 @@ class FEMTransient(TransientProblem):
 
     def __init__(self, cfg, comm=None):
         super().__init__(cfg, comm)
+        self.check_output()
         with staged("FEM setup"):
             self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
             self.model = build_model(cfg, self.comm, assemble_matrices=False)

@@ -51,6 +51,65 @@ def mixed_topology(blocks):
     return (np.concatenate(parts) if parts else np.zeros(0, np.int64)), ne
 
 
+SIDECARS = (".xmf", ".json")
+
+
+def output_files(path):
+    """The files a run with -ssi_output ``path`` writes: the HDF5 file and its sidecars."""
+    stem = os.path.splitext(path)[0]
+    return [path] + [stem + s for s in SIDECARS]
+
+
+def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
+    """Collective, before any heavy work: SSIError (one line, every rank) unless ``path`` (and the
+    outputs ``also``, e.g. the structure's file of a coupled run) can be written: not a sidecar
+    name, not a directory or special file, its directory creatable and writable by every rank,
+    and no existing result replaced unless ``overwrite`` (-ssi_output_overwrite)."""
+    paths = [path] + list(also)
+    err = None
+    ext = os.path.splitext(path)[1].lower()
+    if ext in SIDECARS:
+        err = (f"{what} {path}: '{ext}' is the name of a sidecar the run writes beside its HDF5 file; "
+               "give the .h5 name")
+    d = os.path.dirname(os.path.abspath(path))
+    if err is None and comm.getRank() == 0:
+        try:
+            os.makedirs(d, exist_ok=True)
+        except OSError as exc:
+            err = f"{what} {path}: cannot create the directory {d} ({exc.strerror or exc})"
+    collective_error(err, comm)
+    for p in paths:
+        for f in output_files(p):
+            if os.path.isdir(f):
+                err = f"{what} {p}: {f} is a directory"
+            elif os.path.lexists(f) and not os.path.isfile(f):
+                err = f"{what} {p}: {f} exists and is not a regular file"
+            elif os.path.lexists(f) and not overwrite:
+                err = (f"{what} {p}: {f} exists (a previous result); add -ssi_output_overwrite to replace it, "
+                       f"or choose another {what}")
+            if err:
+                break
+        if err:
+            break
+    if err is None and not os.access(d, os.W_OK | os.X_OK):
+        err = f"{what} {path}: the directory {d} is not writable (rank {comm.getRank()})"
+    if err is None:
+        probe = os.path.join(d, f".petsc-ssi-probe-{os.getpid()}-{comm.getRank()}")
+        try:
+            with open(probe, "wb") as fh:
+                fh.write(b"\0" * 4096)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            err = f"{what} {path}: cannot write in {d} ({exc.strerror or exc})"
+        finally:
+            try:
+                os.remove(probe)
+            except OSError:
+                pass
+    collective_error(err, comm)
+
+
 class Output:
     """Collective writer of one run's fields and series."""
 
@@ -148,7 +207,8 @@ class Output:
     def _write_xdmf(self):
         if self.cells is None:
             return
-        base = os.path.basename(self.path)
+        from xml.sax.saxutils import escape
+        base = escape(os.path.basename(self.path))      # '&', '<', '>' in a file name: valid XML
         ne = self.n_cells
         nn = self.n_nodes
         if self.cell_type == "mixed":

@@ -30,7 +30,7 @@ PY = sys.executable
 
 def run(opts, out, *extra):
     path = os.path.join(OUT, out)
-    cmd = [PY, "-m", "petsc_ssi", "-options_file", f"runs/foundation/{opts}.opts", "-ssi_output", path,
+    cmd = [PY, "-m", "petsc_ssi", "-options_file", f"runs/foundation/{opts}.opts", "-ssi_output", path, "-ssi_output_overwrite",
            "-ssi_output_stride", "0"] + list(extra)
     subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True)
     return h5py.File(path, "r")["interface"]
@@ -79,7 +79,7 @@ def interp():
 def long():
     path = os.path.join(OUT, "long.h5")
     subprocess.run([PY, "-m", "petsc_ssi", "-options_file", "runs/foundation/sym-bonded.opts", "-ssi_t_end", "3",
-                    "-ssi_output", path, "-ssi_output_stride", "0", "-ssi_receivers", "0,0,0;1,0,0;2,0,0"],
+                    "-ssi_output", path, "-ssi_output_overwrite", "-ssi_output_stride", "0", "-ssi_receivers", "0,0,0;1,0,0;2,0,0"],
                    cwd=ROOT, check=True, capture_output=True)
     with h5py.File(path, "r") as f:
         t, u = f["receivers/t"][:], f["receivers/u"][:]

@@ -56,7 +56,7 @@ def run_one(name, opts, out):
         for k, v in opts.items():
             args += [f"-ssi_{k}", str(v)]
         cmd = [sys.executable, "-m", "petsc_ssi", "-options_file", os.path.join(HERE, "small.opts"),
-               "-ssi_output", h5, "-ssi_output_stride", "0", "-ssi_warn_beta", "0", "-log_view",
+               "-ssi_output", h5, "-ssi_output_overwrite", "-ssi_output_stride", "0", "-ssi_warn_beta", "0", "-log_view",
                "-memory_view"] + args
         print("[sweep]", name, flush=True)
         with open(log, "w") as fh:

@@ -54,7 +54,7 @@ def run(name, extra, out, ranks):
     h5 = os.path.join(out, name + ".h5")
     if not os.path.exists(log) or "petsc-ssi: error" in open(log).read() or "done in" not in open(log).read():
         cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(ranks), sys.executable, "-m",
-               "petsc_ssi", "-options_file", os.path.join(HERE, "paper.opts"), "-ssi_output", h5,
+               "petsc_ssi", "-options_file", os.path.join(HERE, "paper.opts"), "-ssi_output", h5, "-ssi_output_overwrite",
                "-ssi_output_stride", "0", "-ssi_lag_storage", "sparse", "-log_view", "-memory_view"] + extra
         print("[table1]", " ".join(cmd), flush=True)
         with open(log, "w") as fh:

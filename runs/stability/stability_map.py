@@ -129,6 +129,7 @@ def worker(c, outdir):
     from petsc_ssi.bem import stability as st
     o, n = options(c)
     o["output"] = os.path.join(outdir, c["case"] + ".h5")
+    o["output_overwrite"] = 1
     db = PETSc.Options()
     for k, v in o.items():
         db.setValue("ssi_" + k, str(v))

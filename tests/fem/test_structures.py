@@ -310,15 +310,17 @@ def test_iterative_solver_with_rotation_near_null_space(tmp_path):
     assert relmax(receivers(b)["u"], receivers(a)["u"]) < 1e-8
 
 
-def test_xdmf_of_a_mixed_model_opens_in_paraview(tmp_path):
+@pytest.mark.parametrize("name", ["s.h5", "r&d <1>.h5"])
+def test_xdmf_of_a_mixed_model_opens_in_paraview(name, tmp_path):
     """ParaView reads the Mixed-topology XDMF: every cell (48 shells + 24 frames), and the
-    displacement equals the HDF5 data in double precision."""
+    displacement equals the HDF5 data in double precision; also when the file name has XML's
+    special characters (escaped in the .xmf)."""
     import shutil
     import subprocess
     pv = shutil.which("pvpython")
     if pv is None:
         pytest.skip("ParaView (pvpython) is not installed: apt-get install paraview")
-    s = str(tmp_path / "s.h5")
+    s = str(tmp_path / name)
     ok(run_cli(["static", "-options_file", SLAB, "-ssi_output", s]))
     script = tmp_path / "read.py"
     script.write_text(
