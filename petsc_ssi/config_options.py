@@ -22,6 +22,9 @@ register("monitor_every", "int", 0, "steps", "monitor line every this many steps
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("output_overwrite", "bool", False, "", "replace an existing -ssi_output (and its sidecars); without it a run "
          "refuses to start when the output exists", "common")
+register("output_flush", "real", 10.0, "s", "make the output file readable (time, receivers, sidecars, run "
+         "status) at least this often during the run, so a stopped run keeps its results; 0: only at the end",
+         "common", validator=lambda v: None if v >= 0 else "must be >= 0")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
 
 # ---------------------------------------------------------------- BEM soil

@@ -28,9 +28,44 @@ Each one goes through the same stages, all collective:
 ``cfg`` is the resolved options (``options.resolve``); the options database stays the one
 source of settings (no keyword arguments that bypass it).
 """
+import signal
 import time
 
 from .petsc import init, SSIError
+
+SIGNALS = ("SIGTERM", "SIGINT", "SIGUSR1")
+
+
+class _Signals:
+    """Context manager: SIGTERM, SIGINT and SIGUSR1 (what schedulers send before the kill) set a
+    flag instead of killing the process; ``caught(comm)`` (collective) is the name of the signal
+    any rank received, or None. The previous handlers come back on exit."""
+
+    def __init__(self):
+        self.got = 0
+        self.old = {}
+
+    def _handler(self, signum, frame):
+        self.got = signum
+
+    def __enter__(self):
+        for name in SIGNALS:
+            sig = getattr(signal, name)
+            try:
+                self.old[sig] = signal.signal(sig, self._handler)
+            except (ValueError, OSError):        # not the main thread: leave the handlers alone
+                pass
+        return self
+
+    def __exit__(self, *exc):
+        for sig, h in self.old.items():
+            signal.signal(sig, h)
+        return False
+
+    def caught(self, comm):
+        from mpi4py import MPI
+        got = comm.tompi4py().allreduce(self.got, op=MPI.MAX)
+        return signal.Signals(got).name if got else None
 
 
 class TransientProblem:
@@ -83,12 +118,48 @@ class TransientProblem:
             raise SSIError(f"{type(self).__name__}: step {n} out of order (last step {self.n} of {self.n_steps})")
         self._state = "stepping"
 
+    # ------------------------------------------------------------ output that survives
+    def write_partial(self, status):
+        """Collective: the output file made readable with the results up to the last step and
+        ``status`` (subclasses; the base has no output)."""
+
+    def _flush_due(self):
+        """Collective: whether -ssi_output_flush seconds have passed since the last flush (rank
+        0's clock decides)."""
+        every = float(self.cfg.get("output_flush") or 0.0)
+        if not every or not self.cfg.get("output"):
+            return False
+        now = time.perf_counter()
+        due = self.comm.tompi4py().bcast(now - getattr(self, "_last_flush", self.t_start) >= every, root=0)
+        if due:
+            self._last_flush = now
+        return due
+
     def run(self):
-        """Collective: setup, start, every step, finish; returns the results."""
+        """Collective: setup, start, every step, finish; returns the results.
+
+        While stepping, the output is made readable every -ssi_output_flush seconds (attribute
+        ``run_status`` 'running'); SIGTERM, SIGINT or SIGUSR1 stops the run at the end of the
+        current step, and a stop (signal, divergence guard, any SSIError) writes the results up
+        to the last step with ``run_status`` 'stopped ...' before the error is raised."""
         self.setup()
         self.start()
-        for n in range(1, self.n_steps + 1):
-            self.step(n)
+        with _Signals() as sig:
+            try:
+                for n in range(1, self.n_steps + 1):
+                    self.step(n)
+                    name = sig.caught(self.comm)
+                    if name:
+                        raise SSIError(f"stopped by {name} after step {n} of {self.n_steps} (t = {self.time(n):.6g} s)"
+                                       + (f"; the results up to that step are in {self.cfg.output}"
+                                          if self.cfg.get("output") else ""))
+                    if n < self.n_steps and self._flush_due():
+                        self.write_partial("running")
+            except SSIError as exc:
+                if self._state in ("started", "stepping"):
+                    self.write_partial(f"stopped after step {self.n} of {self.n_steps}: {exc}")
+                    self._state = "stopped"
+                raise
         return self.finish()
 
 

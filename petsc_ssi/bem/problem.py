@@ -63,6 +63,11 @@ class BEMTransient(TransientProblem):
         self.state = (u, p)
         return self.state
 
+    def write_partial(self, status):
+        rec = self.rec
+        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n}}
+        _finish(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
+
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, prob, plan, ls, info = self.cfg, self.prob, self.plan, self.ls, self.info

@@ -402,7 +402,9 @@ def traction_to_nodes(comm, prob, march):
     return T
 
 
-def _finish(cfg, comm, prob, out, res):
+def _finish(cfg, comm, prob, out, res, status="completed", final=True):
+    """Collective: write the receivers, attributes and run record; ``final``: close the output
+    (else flush it: readable, still open)."""
     ev = event("SSI_IO")
     ev.begin()
     recd = None
@@ -413,8 +415,10 @@ def _finish(cfg, comm, prob, out, res):
     if cfg.mesh_patch and cfg.load_group == "load":
         attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
     rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
-    out.close(receivers=recd, attrs=attrs, record=rec_)
+    (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status)
     ev.end()
+    if not final:
+        return
     if cfg.plot and comm.getRank() == 0 and recd is not None:
         from ..plot import receiver_plot
         receiver_plot(cfg.output, cfg)

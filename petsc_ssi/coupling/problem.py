@@ -126,6 +126,12 @@ class SSITransient(TransientProblem):
         return {"t": np.asarray(times), "u": rec.soil_receivers(), "structure_t": st, "structure_u": su,
                 "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm)}
 
+    def write_partial(self, status):
+        res = self.results()
+        res["_outputs"] = (self.out, self.sout)
+        res["stats"] = {"steps_done": self.n}
+        _finish(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False)
+
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob

@@ -417,7 +417,9 @@ def structure_output_path(path):
     return stem + "_structure" + (ext or ".h5")
 
 
-def _finish(cfg, comm, prob, model, iface, res, am):
+def _finish(cfg, comm, prob, model, iface, res, am, status="completed", final=True):
+    """Collective: both outputs (soil with the interface series, structure) with receivers,
+    attributes and the run record; ``final``: close them (else flush: readable, still open)."""
     out, sout = res.pop("_outputs")
     attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
              "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
@@ -428,9 +430,10 @@ def _finish(cfg, comm, prob, model, iface, res, am):
         recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
     with event("SSI_IO"):
         inter = res["interface"] if comm.getRank() == 0 else None
-        out.close(receivers=recd, attrs=attrs, record=rec_,
-                  groups={"interface": inter} if inter is not None else None)
+        (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
+                                            groups={"interface": inter} if inter is not None else None)
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
-        sout.close(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am, "dt": cfg.dt}, record=None)
+        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
+                                                                      "dt": cfg.dt}, record=None, status=status)

@@ -66,6 +66,10 @@ class FEMTransient(TransientProblem):
         self.state = (self.integ.u, self.vel)
         return self.state
 
+    def write_partial(self, status):
+        _close_output(self.cfg, self.out, self.model, self.rec.structure, self.comm, self.am, self.n_steps,
+                      self.integ, status=status, final=False)
+
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, model = self.cfg, self.comm, self.model

@@ -169,7 +169,9 @@ def receiver_record(model, rec_arrays):
     return d
 
 
-def _close_output(cfg, out, model, srec, comm, am, n_steps, integ):
+def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True):
+    """Collective: receivers, attributes and run record into the output; ``final``: close it
+    (else flush it: readable, still open)."""
     if out is None:
         return
     t, u = srec.rec.arrays()
@@ -181,8 +183,10 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ):
     if cfg.fem_integrator == "green":
         extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
     with event("FEM_io"):
-        out.close(receivers=receivers, attrs={"problem": "fem", "alpha_m": am, "dt": cfg.dt},
-                  record=provenance(cfg, comm, extra))
+        (out.close if final else out.flush)(receivers=receivers, attrs={"problem": "fem", "alpha_m": am, "dt": cfg.dt},
+                                            record=provenance(cfg, comm, extra), status=status)
+    if not final:
+        return
     if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
         _plot(cfg.output, t, u)
     printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")

@@ -156,14 +156,25 @@ class Output:
                 self.fields.append(name)
         self.times.append(float(t))
 
-    def close(self, receivers=None, attrs=None, record=None, groups=None):
+    def close(self, receivers=None, attrs=None, record=None, groups=None, status="completed"):
         """Collective: close the viewer, then rank 0 adds the serial data and
         writes the XDMF and JSON files. ``receivers``: dict with 'points'
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
-        ``groups``: {group: {name: array}} more serial data (rank 0)."""
+        ``groups``: {group: {name: array}} more serial data (rank 0). ``status``: how the run
+        ended (the file's attribute ``run_status`` and the record's)."""
         self.viewer.destroy()
+        self.viewer = None
         self.comm.tompi4py().Barrier()
-        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups), f"writing {self.path}")
+        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status), f"writing {self.path}")
+
+    def flush(self, receivers=None, attrs=None, record=None, groups=None, status="running"):
+        """Collective: make the file readable as it stands (a run killed or stopped later keeps
+        it): the viewer is closed, rank 0 (re)writes time, topology, receivers, groups, the
+        attributes with ``run_status`` and the sidecars, and the viewer reopens to append."""
+        if self.viewer is None:
+            return
+        self.close(receivers, attrs, record, groups, status)
+        self.viewer = self.PETSc.Viewer().createHDF5(self.path, mode="a", comm=self.comm)
 
     def _rank0(self, work, what):
         """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
@@ -177,13 +188,18 @@ class Output:
                 err = f"{what}: {type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
         collective_error(err, self.comm)
 
-    def _write_serial(self, receivers, attrs, record, groups=None):
-        """Rank 0: topology, time, attributes and receivers into the HDF5 file; XDMF; JSON."""
+    def _write_serial(self, receivers, attrs, record, groups=None, status="completed"):
+        """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
+        earlier flush wrote); XDMF; JSON."""
         import h5py
         with h5py.File(self.path, "a") as f:
+            for name in ("topology", "time", "receivers") + tuple(groups or ()):
+                if name in f:
+                    del f[name]
             if self.cells is not None:
                 f.create_dataset("topology", data=self.cells)
             f.create_dataset("time", data=np.asarray(self.times))
+            f.attrs["run_status"] = status
             f.attrs["cell_type"] = self.cell_type or ""
             f.attrs["fields"] = ",".join(self.fields)
             f.attrs["n_snapshots"] = len(self.times)
@@ -201,8 +217,11 @@ class Output:
                     g.create_dataset(k, data=np.asarray(v))
         self._write_xdmf()
         if record is not None:
-            with open(os.path.splitext(self.path)[0] + ".json", "w") as fh:
+            record = dict(record, run_status=status)
+            tmp = os.path.splitext(self.path)[0] + ".json.tmp"
+            with open(tmp, "w") as fh:
                 json.dump(record, fh, indent=1, sort_keys=True, default=str)
+            os.replace(tmp, os.path.splitext(self.path)[0] + ".json")
 
     def _write_xdmf(self):
         if self.cells is None:
@@ -238,8 +257,10 @@ class Output:
                                  f'{base}:/{name}_{k:06d}</DataItem></Attribute>')
             lines.append("</Grid>")
         lines += ["</Grid>", "</Domain>", "</Xdmf>"]
-        with open(os.path.splitext(self.path)[0] + ".xmf", "w") as fh:
+        tmp = os.path.splitext(self.path)[0] + ".xmf.tmp"
+        with open(tmp, "w") as fh:
             fh.write("\n".join(lines) + "\n")
+        os.replace(tmp, os.path.splitext(self.path)[0] + ".xmf")
 
 
 def provenance(cfg, comm, extra=None):
