@@ -159,9 +159,16 @@ def direct_solver_defaults(comm):
 
     MUMPS when PETSc has it; PETSc's own LU only on one rank, with a warning;
     a clear error in parallel without MUMPS or SuperLU_dist (never a silent
-    fall back to a serial-only factorisation, Firedrake's rule).
+    fall back to a serial-only factorisation, Firedrake's rule). With
+    ``-ssi_reproducible`` on more than one rank, SuperLU_dist first: MUMPS's parallel
+    factorisation sums in an order that changes from run to run (reruns at -n 2 differ at
+    1e-15 relative), SuperLU_dist's does not.
     """
-    for pkg in ("mumps", "superlu_dist"):
+    PETSc = init()
+    order = ("mumps", "superlu_dist")
+    if comm.getSize() > 1 and PETSc.Options().getBool("ssi_reproducible", False):
+        order = ("superlu_dist", "mumps")
+    for pkg in order:
         if has_package(pkg):
             return {"ksp_type": "preonly", "pc_type": "lu",
                     "pc_factor_mat_solver_type": pkg}
