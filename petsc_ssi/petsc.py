@@ -168,6 +168,8 @@ def direct_solver_defaults(comm):
     order = ("mumps", "superlu_dist")
     if comm.getSize() > 1 and PETSc.Options().getBool("ssi_reproducible", False):
         order = ("superlu_dist", "mumps")
+        if not has_package("superlu_dist"):
+            warn("-ssi_reproducible: this PETSc has no SuperLU_dist; MUMPS reruns may differ at round-off", comm)
     for pkg in order:
         if has_package(pkg):
             return {"ksp_type": "preonly", "pc_type": "lu",

@@ -123,6 +123,10 @@ class TransientProblem:
         """Collective: the output file made readable with the results up to the last step and
         ``status`` (subclasses; the base has no output)."""
 
+    def final_status(self):
+        """'completed' after the last step, else how far a script stepped before finish()."""
+        return "completed" if self.n == self.n_steps else f"finished after step {self.n} of {self.n_steps}"
+
     def _flush_due(self):
         """Collective: whether -ssi_output_flush seconds have passed since the last flush (rank
         0's clock decides)."""
@@ -130,37 +134,47 @@ class TransientProblem:
         if not every or not self.cfg.get("output"):
             return False
         now = time.perf_counter()
-        due = self.comm.tompi4py().bcast(now - getattr(self, "_last_flush", self.t_start) >= every, root=0)
-        if due:
-            self._last_flush = now
-        return due
+        return self.comm.tompi4py().bcast(now - getattr(self, "_last_flush", self.t_start) >= every, root=0)
+
+    def _flush(self):
+        """Collective: a 'running' flush; a failure (a reader holding the file) is a warning."""
+        from .petsc import warn
+        try:
+            self.write_partial("running")
+        except SSIError as exc:
+            warn(f"could not update {self.cfg.output} during the run ({exc}); the run goes on", self.comm)
+        self._last_flush = time.perf_counter()      # after the write: a slow write does not make every step flush
 
     def run(self):
         """Collective: setup, start, every step, finish; returns the results.
 
-        While stepping, the output is made readable every -ssi_output_flush seconds (attribute
-        ``run_status`` 'running'); SIGTERM, SIGINT or SIGUSR1 stops the run at the end of the
-        current step, and a stop (signal, divergence guard, any SSIError) writes the results up
-        to the last step with ``run_status`` 'stopped ...' before the error is raised."""
+        While stepping, the output is made readable every -ssi_output_flush seconds, checked at the
+        end of each step (attribute ``run_status`` 'running'); SIGTERM, SIGINT or SIGUSR1 stops
+        the run at the end of the current step (after the last step the run just finishes), and
+        a stop by a signal or by an SSIError (the divergence guard, a non-finite solution) writes
+        the results up to the last step with ``run_status`` 'stopped ...' before the error is
+        raised. Other exceptions (a bug, PETSc or MPI failures) write nothing more."""
         self.setup()
         self.start()
-        with _Signals() as sig:
+        with _Signals() as sig:                      # kept through finish: a signal there waits for the end
             try:
                 for n in range(1, self.n_steps + 1):
                     self.step(n)
+                    if n == self.n_steps:
+                        break                        # the run is done: finish it, whatever arrived
                     name = sig.caught(self.comm)
                     if name:
                         raise SSIError(f"stopped by {name} after step {n} of {self.n_steps} (t = {self.time(n):.6g} s)"
                                        + (f"; the results up to that step are in {self.cfg.output}"
                                           if self.cfg.get("output") else ""))
-                    if n < self.n_steps and self._flush_due():
-                        self.write_partial("running")
+                    if self._flush_due():
+                        self._flush()
             except SSIError as exc:
                 if self._state in ("started", "stepping"):
                     self.write_partial(f"stopped after step {self.n} of {self.n_steps}: {exc}")
                     self._state = "stopped"
                 raise
-        return self.finish()
+            return self.finish()
 
 
 KINDS = ("bem", "fem", "ssi")

@@ -81,6 +81,6 @@ class BEMTransient(TransientProblem):
             "mean_fill": info["fill"], "lag_bytes": info["mem"], "mem_estimate": prob.mem_estimate,
             "T_N": prob.T_N, "r_max": prob.r_max, "kernel_evaluations": ls.kernel_evaluations,
             "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
-        _finish(cfg, self.comm, prob, self.out, res)
+        _finish(cfg, self.comm, prob, self.out, res, status=self.final_status())
         printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
         return res

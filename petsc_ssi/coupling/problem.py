@@ -161,7 +161,7 @@ class SSITransient(TransientProblem):
                    f"({fmt_time(coupler.solver_cap().t_factor)}), active-set algebra {fmt_time(law.t_algebra)} in "
                    f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
                    "factorisation of the BEM step matrix")
-        _finish(cfg, comm, prob, self.model, self.iface, res, self.am)
+        _finish(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
         self.integ.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
         return res

@@ -21,7 +21,10 @@ that carry elements. Each part takes its element and properties from
   release       frame, shell: 'rotations' hinges the part to the other frame and shell
                 parts at the nodes they share (translations tied, rotations independent:
                 a slab simply supported on its beams); released parts stay rigidly joined
-                to each other; 'none' (default) joins monolithically
+                to each other; 'none' (default) joins monolithically. Point moments, point
+                masses, receivers and output use the rotations of the parts that are not
+                released. A released frame member hinged at both ends twists freely (a
+                mechanism the static solve refuses): fix its torsion at one end
 
 Without ``-ssi_fem_parts`` the structure is one hex8 part made of every brick
 of the mesh with ``-ssi_fem_E/_nu/_rho`` (the behaviour before parts existed).

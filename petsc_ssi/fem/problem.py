@@ -74,7 +74,8 @@ class FEMTransient(TransientProblem):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, model = self.cfg, self.comm, self.model
         t, u = self.rec.structure.rec.arrays()
-        _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ)
+        _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ,
+                      status=self.final_status())
         if comm.getRank() == 0 and len(model.receiver_nodes):
             printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                    f"{u[-1, 0, 2]:.6e}) m")

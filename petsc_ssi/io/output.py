@@ -120,7 +120,13 @@ class Output:
         self.comm = comm
         self.rank = comm.getRank()
         d = os.path.dirname(os.path.abspath(path))
-        self._rank0(lambda: os.makedirs(d, exist_ok=True), f"cannot create the output directory {d}")
+
+        def prepare():
+            os.makedirs(d, exist_ok=True)
+            for f in output_files(path)[1:]:          # an older run's sidecars must not describe this file
+                if os.path.isfile(f):
+                    os.remove(f)
+        self._rank0(prepare, f"cannot prepare the output {path}")
         self.viewer = PETSc.Viewer().createHDF5(path, mode="w", comm=comm)
         self.times = []
         self.fields = []
@@ -173,8 +179,10 @@ class Output:
         attributes with ``run_status`` and the sidecars, and the viewer reopens to append."""
         if self.viewer is None:
             return
-        self.close(receivers, attrs, record, groups, status)
-        self.viewer = self.PETSc.Viewer().createHDF5(self.path, mode="a", comm=self.comm)
+        try:
+            self.close(receivers, attrs, record, groups, status)
+        finally:                                   # a failed flush (a reader holding the file) keeps writing
+            self.viewer = self.PETSc.Viewer().createHDF5(self.path, mode="a", comm=self.comm)
 
     def _rank0(self, work, what):
         """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
@@ -192,7 +200,11 @@ class Output:
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
         earlier flush wrote); XDMF; JSON."""
         import h5py
-        with h5py.File(self.path, "a") as f:
+        try:                                       # no lock: a reader may hold the file open mid-run
+            f = h5py.File(self.path, "a", locking=False)
+        except (TypeError, ValueError):            # h5py < 3.5, or an HDF5 without the locking switch
+            f = h5py.File(self.path, "a")
+        with f:
             for name in ("topology", "time", "receivers") + tuple(groups or ()):
                 if name in f:
                     del f[name]
@@ -263,6 +275,21 @@ class Output:
         os.replace(tmp, os.path.splitext(self.path)[0] + ".xmf")
 
 
+_GIT = []
+
+
+def _git_revision():
+    """``git describe --always --dirty`` of the package (once per process)."""
+    if not _GIT:
+        try:
+            here = os.path.dirname(os.path.abspath(__file__))
+            _GIT.append(subprocess.run(["git", "-C", here, "describe", "--always", "--dirty"],
+                                       capture_output=True, text=True, timeout=5).stdout.strip())
+        except Exception:  # noqa: BLE001 -- not a git checkout, no git
+            _GIT.append("")
+    return _GIT[0]
+
+
 def provenance(cfg, comm, extra=None):
     """The run record: resolved options, library versions, git revision, ranks."""
     PETSc = init()
@@ -286,12 +313,7 @@ def provenance(cfg, comm, extra=None):
         rec["gmsh"] = gmsh.__version__
     except Exception:  # gmsh is optional for runs on structured meshes
         pass
-    try:
-        here = os.path.dirname(os.path.abspath(__file__))
-        rec["git"] = subprocess.run(["git", "-C", here, "describe", "--always", "--dirty"],
-                                    capture_output=True, text=True, timeout=5).stdout.strip()
-    except Exception:
-        rec["git"] = ""
+    rec["git"] = _git_revision()
     if extra:
         rec.update(extra)
     return rec

@@ -172,3 +172,14 @@ def test_release_bad_input(tmp_path):
     r = run_cli(_beam_opts(msh, False, str(tmp_path / "x.h5"), 1.0) + ["-ssi_fem_part_b_release", "rotation"])
     assert r.returncode != 0
     assert "-ssi_fem_part_b_release 'rotation': must be rotations or none (did you mean rotations?)" in r.stdout + r.stderr
+
+
+def test_released_member_free_to_twist_is_refused(tmp_path):
+    """Part b hinged at both ends (released at the joint, pinned at its end without rx) twists
+    freely: the static solve refuses the mechanism in one line."""
+    msh = str(tmp_path / "beam.msh")
+    _beam_msh(msh)
+    o = [x.replace("root,end:ux+uy+uz+rx", "root,end:ux+uy+uz") for x in _beam_opts(msh, True, str(tmp_path / "m.h5"), 1e4)]
+    r = run_cli(o)
+    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    assert r.returncode == 2 and len(errs) == 1 and "singular" in errs[0], r.stdout[-2000:]
