@@ -20,6 +20,8 @@ def run_bem(**opts):
     from petsc_ssi import options
     from petsc_ssi.bem.run import run_bem as _run
     db = PETSc.Options()
+    opts = dict(opts)
+    opts.setdefault("output_overwrite", 1)     # tests rerun cases into the same scratch file
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
@@ -88,6 +90,7 @@ def run_ssi(**opts):
     db = PETSc.Options()
     opts = dict(opts)
     opts.setdefault("problem", "ssi")
+    opts.setdefault("output_overwrite", 1)     # tests rerun cases into the same scratch file
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:

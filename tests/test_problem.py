@@ -71,7 +71,7 @@ def test_acting_between_steps_changes_the_run(tmp_path):
     scaling the spatial load Vec): the receiver equals the plain run's up to step 3 and differs
     by more than 0.1% from step 5 on."""
     from petsc_ssi.problem import from_options
-    with opts(**{**FEM, "output": tmp_path / "a.h5", "fem_load_history": "heaviside"}):
+    with opts(**{**FEM, "output": tmp_path / "a.h5", "fem_load_history": "heaviside", "output_overwrite": 1}):
         a = from_options().run()
         p = from_options()
         p.setup()

@@ -121,12 +121,12 @@ class Output:
         self.rank = comm.getRank()
         d = os.path.dirname(os.path.abspath(path))
 
-        def prepare():
-            os.makedirs(d, exist_ok=True)
+        def stale():
             for f in output_files(path)[1:]:          # an older run's sidecars must not describe this file
                 if os.path.isfile(f):
                     os.remove(f)
-        self._rank0(prepare, f"cannot prepare the output {path}")
+        self._rank0(lambda: os.makedirs(d, exist_ok=True), f"cannot create the output directory {d}")
+        self._rank0(stale, f"cannot remove the old sidecars of {path}")
         self.viewer = PETSc.Viewer().createHDF5(path, mode="w", comm=comm)
         self.times = []
         self.fields = []
