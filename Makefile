@@ -11,7 +11,8 @@ export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.numba_cache
+# numba's cache: ~/.cache/petsc_ssi/numba/<hash of the sources> (petsc_ssi/__init__.py), the same
+# for make and for direct calls; `make deps` fills it (petsc_ssi/warmup.py)
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
@@ -41,6 +42,7 @@ $(VENV)/.stamp: .deps/apt.stamp setup.py
 	@touch $@
 
 deps: $(VENV)/.stamp
+	@$(PY) -m petsc_ssi.warmup
 
 demo: deps
 	$(PY) -m petsc_ssi.demo

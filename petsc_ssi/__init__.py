@@ -39,3 +39,14 @@ def _numba_cache_dir():
 
 if "numba" not in __import__("sys").modules:
     _os.environ["NUMBA_CACHE_DIR"] = _numba_cache_dir()
+
+
+def numba_cache_warm():
+    """Whether numba's cache for this version of the sources holds compiled kernels (else the
+    first BEM assembly compiles them: about a minute; ``python -m petsc_ssi.warmup`` does it
+    ahead, and ``make deps`` runs that)."""
+    d = _os.environ.get("NUMBA_CACHE_DIR", "")
+    for _, _, files in _os.walk(d):
+        if any(f.endswith(".nbi") for f in files):
+            return True
+    return False

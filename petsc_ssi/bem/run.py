@@ -3,6 +3,7 @@
 Order of work: every input check (collective, one-line errors) and the memory
 estimate come before any assembly.
 """
+import os
 import time
 
 import numpy as np
@@ -306,6 +307,11 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     """Collective: assemble the lag matrices (exact and interpolating), factorise
     the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
     PETSc = init()
+    from .. import numba_cache_warm
+    if not numba_cache_warm():
+        printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
+               f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
+               "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
     t0 = time.perf_counter()
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx)
     N = prob.mesh.n_nodes

@@ -1,0 +1,40 @@
+"""``python -m petsc_ssi.warmup``: compile the numba kernels into the cache ahead of the first run.
+
+The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``) are compiled by numba
+the first time a version of the sources runs on a machine (about a minute) and cached under
+``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
+case on one process so that they are compiled now, says so, and exits at once when the cache is
+already warm. ``make deps`` calls it.
+"""
+import os
+import sys
+import tempfile
+import time
+
+
+def main():
+    import petsc_ssi
+    d = os.environ.get("NUMBA_CACHE_DIR", "")
+    if petsc_ssi.numba_cache_warm():
+        print(f"[warmup] numba cache is warm ({d})")
+        return 0
+    print(f"[warmup] compiling the BEM kernels with numba into {d} (about a minute, once per version)", flush=True)
+    t0 = time.perf_counter()
+    from .petsc import init
+    PETSc = init([sys.argv[0]])
+    from . import options
+    from .bem.run import run_bem
+    with tempfile.TemporaryDirectory() as tmp:
+        opts = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
+                "load_p0": 1000, "dt": 0.005, "t_end": 0.01, "output": os.path.join(tmp, "w.h5"),
+                "output_stride": 0, "warn_beta": 0}
+        db = PETSc.Options()
+        for k, v in opts.items():
+            db.setValue("ssi_" + k, str(v))
+        run_bem(options.resolve(("common", "bem")))
+    print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,28 @@
+"""No silent minute on the first run (issue 13, item 4): with an empty numba cache a run says in
+one line that it is compiling; `python -m petsc_ssi.warmup` compiles ahead (make deps runs it), and
+afterwards a run does not compile again."""
+import os
+import subprocess
+import sys
+
+from helpers import ROOT
+
+RUN = ["-m", "petsc_ssi", "-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch",
+       "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_t_end", "0.01",
+       "-ssi_warn_beta", "0", "-ssi_output_overwrite"]
+
+
+def test_cold_cache_is_announced_then_warm(tmp_path):
+    """One compile: a run with an empty cache announces it (one line), then the warm-up finds the
+    cache warm and a second run compiles nothing. (The warm-up's own compiling path runs in
+    every fresh `make deps`.)"""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), OPENBLAS_NUM_THREADS="1")
+    py = lambda args: subprocess.run([sys.executable] + args, cwd=ROOT, env=env, capture_output=True,  # noqa: E731
+                                     text=True, timeout=600)
+    r = py(RUN + ["-ssi_output", str(tmp_path / "a.h5")])
+    lines = [ln for ln in r.stdout.splitlines() if "compiling the BEM kernels" in ln]
+    assert r.returncode == 0 and len(lines) == 1, r.stdout
+    w = py(["-m", "petsc_ssi.warmup"])
+    assert w.returncode == 0 and "[warmup] numba cache is warm" in w.stdout, w.stdout + w.stderr
+    r = py(RUN + ["-ssi_output", str(tmp_path / "b.h5")])
+    assert r.returncode == 0 and "compiling" not in r.stdout, r.stdout
