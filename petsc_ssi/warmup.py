@@ -18,7 +18,9 @@ def main():
     if petsc_ssi.numba_cache_warm():
         print(f"[warmup] numba cache is warm ({d})")
         return 0
-    print(f"[warmup] compiling the BEM kernels with numba into {d} (about a minute, once per version)", flush=True)
+    print(f"[warmup] compiling the BEM kernels with numba into {d} (about half a minute, once per version)",
+          flush=True)
+    os.environ["PETSC_SSI_WARMUP"] = "1"       # the run below does not announce the compile again
     t0 = time.perf_counter()
     from .petsc import init
     PETSc = init([sys.argv[0]])

@@ -308,7 +308,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
     PETSc = init()
     from .. import numba_cache_warm
-    if not numba_cache_warm():
+    if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
         printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
                f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
                "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
