@@ -29,35 +29,8 @@ E, NU, RC = 30e9, 0.2, 2500.0
 def building_msh(path, half=False, n=4, H=1.5, nz=3):
     """Foundation slab (n x n shells on [-1, 1]^2 at z = 0), four corner columns (nz frames) and a
     roof slab at z = H; the half model keeps y >= 0 (the columns at y = 1)."""
-    from helpers import petsc
-    petsc()
-    from petsc_ssi.mesh.gmsh import write_msh
-    x = np.linspace(-1, 1, n + 1)
-    y = x[x >= -1e-12] if half else x
-    nodes, groups = [], {}
-
-    def slab(z):
-        X, Y = np.meshgrid(x, y, indexing="ij")
-        base = len(nodes)
-        nodes.extend(np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z)]).tolist())
-        idx = base + np.arange(X.size).reshape(X.shape)
-        return np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4), idx
-
-    fcells, fidx = slab(0.0)
-    rcells, ridx = slab(H)
-    cols = []
-    for i in (0, n):
-        for j in ((len(y) - 1,) if half else (0, len(y) - 1)):
-            chain = [int(fidx[i, j])]
-            for k in range(1, nz):
-                nodes.append([x[i], y[j], H * k / nz])
-                chain.append(len(nodes) - 1)
-            chain.append(int(ridx[i, j]))
-            cols += [[a, b] for a, b in zip(chain[:-1], chain[1:])]
-    groups = {"foundation": ("quad4", fcells), "roof": ("quad4", rcells), "columns": ("line2", cols),
-              "A": ("point", [[int(ridx[n // 2, 0 if half else n // 2])]])}
-    write_msh(path, np.array(nodes, float), groups)
-    return path
+    from slab_building import one_storey_msh
+    return one_storey_msh(path, n, B=1.0, H=H, nz=nz, half=half)
 
 
 def structure_opts(msh, scale=1.0):

@@ -77,7 +77,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import cli, petsc, run_ssi
+from helpers import cli, run_ssi
 
 CP, CS, RHO = 208.0, 100.0, 1800.0
 G = RHO * CS ** 2
@@ -101,34 +101,8 @@ KR_GAZ = 3.0 * G / (1 - NU_S) * ((2 * B) ** 4 / 12) ** 0.75
 def building_msh(path, n, roof=True):
     """Foundation slab (n x n shells on [-B, B]^2, z = 0; its nodes are soil nodes), four corner
     columns of NZ frames and a roof slab of n x n shells at z = H (roof=False: the slab alone)."""
-    petsc()
-    from petsc_ssi.mesh.gmsh import write_msh
-    x = np.linspace(-B, B, n + 1)
-    nodes = []
-
-    def slab(z):
-        X, Y = np.meshgrid(x, x, indexing="ij")
-        base = len(nodes)
-        nodes.extend(np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z)]).tolist())
-        idx = base + np.arange(X.size).reshape(X.shape)
-        return np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4), idx
-
-    fcells, fidx = slab(0.0)
-    groups = {"foundation": ("quad4", fcells)}
-    if roof:
-        rcells, ridx = slab(H)
-        cols = []
-        for i in (0, n):
-            for j in (0, n):
-                chain = [int(fidx[i, j])]
-                for k in range(1, NZ):
-                    nodes.append([x[i], x[j], H * k / NZ])
-                    chain.append(len(nodes) - 1)
-                chain.append(int(ridx[i, j]))
-                cols += [[a, b] for a, b in zip(chain[:-1], chain[1:])]
-        groups.update(roof=("quad4", rcells), columns=("line2", cols))
-    write_msh(path, np.array(nodes, float), groups)
-    return path
+    from slab_building import one_storey_msh
+    return one_storey_msh(path, n, B=B, H=H, nz=NZ, roof=roof)
 
 
 def structure_opts(msh, roof=True):
