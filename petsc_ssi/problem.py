@@ -31,15 +31,17 @@ source of settings (no keyword arguments that bypass it).
 import signal
 import time
 
+import numpy as np
+
 from .petsc import init, SSIError
 
 SIGNALS = ("SIGTERM", "SIGINT", "SIGUSR1")
 
 
 class _Signals:
-    """Context manager: SIGTERM, SIGINT and SIGUSR1 (what schedulers send before the kill) set a
-    flag instead of killing the process; ``caught(comm)`` (collective) is the name of the signal
-    any rank received, or None. The previous handlers come back on exit."""
+    """Context manager: SIGTERM, SIGINT and SIGUSR1 (what schedulers send before the kill) set the
+    flag ``got`` (the signal number) instead of killing the process (``TransientProblem._poll``
+    reduces it over the ranks). The previous handlers come back on exit."""
 
     def __init__(self):
         self.got = 0
@@ -62,10 +64,6 @@ class _Signals:
             signal.signal(sig, h)
         return False
 
-    def caught(self, comm):
-        from mpi4py import MPI
-        got = comm.tompi4py().allreduce(self.got, op=MPI.MAX)
-        return signal.Signals(got).name if got else None
 
 
 class TransientProblem:
@@ -127,14 +125,17 @@ class TransientProblem:
         """'completed' after the last step, else how far a script stepped before finish()."""
         return "completed" if self.n == self.n_steps else f"finished after step {self.n} of {self.n_steps}"
 
-    def _flush_due(self):
-        """Collective: whether -ssi_output_flush seconds have passed since the last flush (rank
-        0's clock decides)."""
+    def _poll(self, sig):
+        """Collective, one reduction per step: (the name of a signal any rank caught, or None;
+        whether -ssi_output_flush seconds have passed since the last flush, by rank 0's clock)."""
+        from mpi4py import MPI
         every = float(self.cfg.get("output_flush") or 0.0)
-        if not every or not self.cfg.get("output"):
-            return False
-        now = time.perf_counter()
-        return self.comm.tompi4py().bcast(now - getattr(self, "_last_flush", self.t_start) >= every, root=0)
+        due = 0
+        if every and self.cfg.get("output") and self.comm.getRank() == 0:
+            due = int(time.perf_counter() - getattr(self, "_last_flush", self.t_start) >= every)
+        flags = np.array([sig.got, due], np.int64)
+        self.comm.tompi4py().Allreduce(MPI.IN_PLACE, flags, op=MPI.MAX)     # elementwise
+        return (signal.Signals(int(flags[0])).name if flags[0] else None), bool(flags[1])
 
     def _flush(self):
         """Collective: a 'running' flush; a failure (a reader holding the file) is a warning."""
@@ -162,12 +163,12 @@ class TransientProblem:
                     self.step(n)
                     if n == self.n_steps:
                         break                        # the run is done: finish it, whatever arrived
-                    name = sig.caught(self.comm)
+                    name, due = self._poll(sig)
                     if name:
                         raise SSIError(f"stopped by {name} after step {n} of {self.n_steps} (t = {self.time(n):.6g} s)"
                                        + (f"; the results up to that step are in {self.cfg.output}"
                                           if self.cfg.get("output") else ""))
-                    if self._flush_due():
+                    if due:
                         self._flush()
             except SSIError as exc:
                 if self._state in ("started", "stepping"):
