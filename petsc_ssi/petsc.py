@@ -161,8 +161,9 @@ def direct_solver_defaults(comm):
     a clear error in parallel without MUMPS or SuperLU_dist (never a silent
     fall back to a serial-only factorisation, Firedrake's rule). With
     ``-ssi_reproducible`` on more than one rank, SuperLU_dist first: MUMPS's parallel
-    factorisation sums in an order that changes from run to run (reruns at -n 2 differ at
-    1e-15 relative), SuperLU_dist's does not.
+    factorisation may sum in another order from run to run (jobscripts/rerun_determinism.sh:
+    a coupled contact case at -n 2 differed in 2 of 3 reruns, by 1e-11 in the tractions), and
+    SuperLU_dist's reruns were identical.
     """
     PETSc = init()
     order = ("mumps", "superlu_dist")

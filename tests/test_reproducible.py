@@ -1,6 +1,6 @@
 """Reruns at a fixed rank count (issue 14): with -ssi_reproducible, two runs of the same FEM or
-BEM case at -n 2 are bitwise identical (the direct solves use SuperLU_dist; with MUMPS's parallel
-factorisation two FEM reruns differ at 1e-15 relative). Coupled runs refuse the option in one
+BEM case at -n 2 are bitwise identical (the direct solves use SuperLU_dist; with MUMPS, reruns
+may differ at round-off: jobscripts/rerun_determinism.sh). Coupled runs refuse the option in one
 line (two SuperLU_dist factorisations in one process crash PETSc 3.18's build at exit)."""
 import h5py
 import numpy as np

@@ -72,7 +72,7 @@ def _ssi_checks(cfg):
     if cfg.get("reproducible"):
         return ("-ssi_reproducible is for -ssi_problem bem and fem: with two SuperLU_dist factorisations in one "
                 "process (the soil's and the structure's) PETSc 3.18's build corrupts the heap at exit; coupled "
-                "reruns at -n 2 differ at round-off (about 1e-11) with MUMPS")
+                "reruns at -n 2 may differ at round-off (1e-11 in the tractions) with MUMPS")
     if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
         return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
     for name in ("contact_open_traction", "contact_tol", "contact_max_iter"):
