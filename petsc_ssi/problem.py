@@ -17,7 +17,8 @@ Each one goes through the same stages, all collective:
 
 ``run()`` does all of it and is what ``petsc-ssi`` calls; a script can step by itself:
 
-    from petsc_ssi import options
+    from petsc_ssi.petsc import init
+    init()                                # PETSc from sys.argv: -options_file ... -ssi_...
     from petsc_ssi.problem import from_options
     p = from_options()                    # -ssi_problem and the rest from the options database
     p.setup(); p.start()
@@ -63,7 +64,6 @@ class _Signals:
         for sig, h in self.old.items():
             signal.signal(sig, h)
         return False
-
 
 
 class TransientProblem:
