@@ -2,7 +2,7 @@
 # Are reruns at -n 2 bitwise identical? Runs each case four times and prints max |a - b| / max |b|
 # of the receivers (and of the interface series for the coupled case), then the exit status of a
 # coupled run with both factorisations in SuperLU_dist. From the repository root, after make deps:
-#   bash jobscripts/rerun_determinism.sh            (writes out/determinism/, ~1.5 minutes on 2 cores)
+#   bash jobscripts/rerun_determinism.sh            (writes out/determinism/, ~3 minutes on 2 cores)
 # The numbers in issue 14's note and tests/test_reproducible.py's docstring come from here.
 set -u
 cd "$(dirname "$0")/.."
@@ -20,7 +20,8 @@ SSI="-ssi_problem ssi -ssi_cp 42 -ssi_cs 20 -ssi_rho 1800 -ssi_mesh_size 2,2 -ss
 run() { local name=$1; shift; mpirun -n 2 "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" -ssi_output_overwrite \
           > "$OUT/$name.log" 2>&1; echo "$name: exit $?"; }
 # shellcheck disable=SC2086
-{ for r in a b c d; do run fem-mumps-$r $FEM; run fem-repro-$r $FEM -ssi_reproducible; run ssi-mumps-$r $SSI; done
+{ for r in a b c d; do run fem-mumps-$r $FEM; run fem-repro-$r $FEM -ssi_reproducible; run ssi-mumps-$r $SSI
+    run ssi-femslu-$r $SSI -ssi_fem_pc_factor_mat_solver_type superlu_dist; run ssi-repro-$r $SSI -ssi_reproducible; done
   run ssi-superlu-both $SSI -ssi_bem_pc_factor_mat_solver_type superlu_dist -ssi_fem_pc_factor_mat_solver_type superlu_dist
   run ssi-superlu-bem $SSI -ssi_bem_pc_factor_mat_solver_type superlu_dist
   run ssi-superlu-fem $SSI -ssi_fem_pc_factor_mat_solver_type superlu_dist; }
@@ -32,7 +33,9 @@ def rel(a, b, key):
         x, y = f[key][:], g[key][:]
     return float(np.abs(x - y).max() / max(np.abs(y).max(), 1e-300))
 for case, keys in (("fem-mumps", ["receivers/u"]), ("fem-repro", ["receivers/u"]),
-                   ("ssi-mumps", ["receivers/u", "interface/p", "interface/uf"])):
+                   ("ssi-mumps", ["receivers/u", "interface/p", "interface/uf"]),
+                   ("ssi-femslu", ["receivers/u", "interface/p", "interface/uf"]),
+                   ("ssi-repro", ["receivers/u", "interface/p", "interface/uf"])):
     for r in "bcd":                          # rerun r against the first run
         print(f"{case} {r} vs a: " + ", ".join(f"{k} {rel(f'{case}-{r}', f'{case}-a', k):.2e}" for k in keys))
 PYEOF

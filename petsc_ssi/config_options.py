@@ -25,9 +25,10 @@ register("output_overwrite", "bool", False, "", "replace an existing -ssi_output
 register("output_flush", "real", 10.0, "s", "make the output file readable (time, receivers, sidecars, run "
          "status) at least this often during the run, so a stopped run keeps its results; 0: only at the end",
          "common", validator=lambda v: None if v >= 0 else "must be >= 0")
-register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed rank count (-ssi_problem bem, "
-         "fem): the direct solves default to SuperLU_dist instead of MUMPS on more than one rank (MUMPS's parallel "
-         "sums change order between runs)", "common")
+register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed rank count: on more than one rank "
+         "the direct solves default to SuperLU_dist instead of MUMPS (MUMPS's parallel sums change order between "
+         "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
+         "(-ssi_bem_pc_type redundant)", "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
 
 # ---------------------------------------------------------------- BEM soil

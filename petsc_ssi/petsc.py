@@ -154,7 +154,7 @@ def has_package(name):
         return True
 
 
-def direct_solver_defaults(comm):
+def direct_solver_defaults(comm, soil=False):
     """KSP defaults for a factorise-once direct solve.
 
     MUMPS when PETSc has it; PETSc's own LU only on one rank, with a warning;
@@ -162,12 +162,19 @@ def direct_solver_defaults(comm):
     fall back to a serial-only factorisation, Firedrake's rule). With
     ``-ssi_reproducible`` on more than one rank, SuperLU_dist first: MUMPS's parallel
     factorisation may sum in another order from run to run (jobscripts/rerun_determinism.sh:
-    a coupled contact case at -n 2 differed in 2 of 3 reruns, by 1e-11 in the tractions), and
-    SuperLU_dist's reruns were identical.
+    the structure's D of a coupled contact case at -n 2 gave other bits in every rerun, 1e-8 in
+    u_f, and identical ones with SuperLU_dist). A coupled run has two factorisations, and two
+    SuperLU_dist ones in one process corrupt PETSc 3.18's heap at exit, so there the soil's step
+    matrix (``soil``) is factorised redundantly, whole on every rank, by PETSc's sequential LU
+    (deterministic; the step matrix holds only the local lags 1 and 2).
     """
     PETSc = init()
     order = ("mumps", "superlu_dist")
     if comm.getSize() > 1 and PETSc.Options().getBool("ssi_reproducible", False):
+        if soil and PETSc.Options().getString("ssi_problem", "bem").strip().lower() == "ssi":
+            return {"ksp_type": "preonly", "pc_type": "redundant", "redundant_pc_type": "lu",
+                    "redundant_pc_factor_mat_solver_type": "petsc",
+                    "redundant_pc_factor_mat_ordering_type": "nd"}
         order = ("superlu_dist", "mumps")
         if not has_package("superlu_dist"):
             warn("-ssi_reproducible: this PETSc has no SuperLU_dist; MUMPS reruns may differ at round-off", comm)

@@ -1,7 +1,8 @@
 """Reruns at a fixed rank count (issue 14): with -ssi_reproducible, two runs of the same FEM or
 BEM case at -n 2 are bitwise identical (the direct solves use SuperLU_dist; with MUMPS, reruns
-may differ at round-off: jobscripts/rerun_determinism.sh). Coupled runs refuse the option in one
-line (two SuperLU_dist factorisations in one process crash PETSc 3.18's build at exit)."""
+may differ at round-off: jobscripts/rerun_determinism.sh). A coupled contact run too: there the
+structure uses SuperLU_dist and the soil's step matrix PETSc's LU, whole on every rank (two
+SuperLU_dist factorisations in one process crash PETSc 3.18's build at exit)."""
 import h5py
 import numpy as np
 import pytest
@@ -30,8 +31,26 @@ def test_reruns_are_bitwise_identical(case, tmp_path):
         assert np.abs(res[0][k]).max() > 0
 
 
-def test_coupled_runs_refuse_the_option(tmp_path):
-    r = cli(["-ssi_problem", "ssi", "-ssi_reproducible", "-ssi_output", str(tmp_path / "x.h5")], nranks=2,
-            check=False)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
-    assert r.returncode == 2 and len(errs) == 1 and "-ssi_reproducible is for -ssi_problem bem and fem" in errs[0]
+SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
+       "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",
+       "1,1,0.25", "-ssi_fem_box_origin", "-0.5,-0.5,0", "-ssi_fem_E", "300e9", "-ssi_fem_rho", "200",
+       "-ssi_dt", "0.0125", "-ssi_t_end", "0.3", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000",
+       "-ssi_fem_load_history", "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral",
+       "-ssi_receivers", "1,0,0", "-ssi_output_stride", "8", "-ssi_warn_beta", "0", "-ssi_monitor"]
+
+
+def test_coupled_contact_reruns_are_bitwise_identical(tmp_path):
+    """The case of jobscripts/rerun_determinism.sh, whose u_f differed in every MUMPS rerun (the
+    structure's D): with -ssi_reproducible the structure is factorised by SuperLU_dist and the soil's
+    step matrix redundantly by PETSc's LU, and two runs agree bit for bit, contact status included."""
+    res = []
+    for k in range(2):
+        out = str(tmp_path / f"s{k}.h5")
+        r = cli(SSI + ["-ssi_output", out, "-ssi_reproducible"], nranks=2)
+        assert "ssi_bem_pc_type redundant" in r.stdout and "ssi_fem_pc_factor_mat_solver_type superlu_dist" in r.stdout
+        with h5py.File(out) as f:
+            res.append({k: f[k][:] for k in ("receivers/u", "interface/p", "interface/uf", "interface/closed",
+                                             "displacement_000001")})
+    assert not res[0]["interface/closed"].all()          # the interface opened: contact did act
+    for k in res[0]:
+        assert np.array_equal(res[0][k], res[1][k]), k

@@ -104,7 +104,7 @@ class Marcher:
         self.zero_local = zd - r0
         self.ksp = PETSc.KSP().create(comm=comm)
         self.ksp.setOptionsPrefix("ssi_bem_")
-        set_default_options("ssi_bem_", direct_solver_defaults(comm), log)
+        set_default_options("ssi_bem_", direct_solver_defaults(comm, soil=True), log)
         self.ksp.setOperators(self.A)
         self.ksp.setFromOptions()
         self.ksp.setUp()

@@ -69,10 +69,6 @@ def _ssi_checks(cfg):
     if cfg.coupling == "implicit" and cfg.coupling_traction == "extrapolated":
         return ("-ssi_coupling_traction extrapolated is for -ssi_coupling staggered; the implicit step takes "
                 "the traction as the mean force over the step, which it is")
-    if cfg.get("reproducible"):
-        return ("-ssi_reproducible is for -ssi_problem bem and fem: with two SuperLU_dist factorisations in one "
-                "process (the soil's and the structure's) PETSc 3.18's build corrupts the heap at exit; coupled "
-                "reruns at -n 2 may differ at round-off (1e-11 in the tractions) with MUMPS")
     if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
         return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
     for name in ("contact_open_traction", "contact_tol", "contact_max_iter"):
