@@ -29,6 +29,14 @@ register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed
          "the direct solves default to SuperLU_dist instead of MUMPS (MUMPS's parallel sums change order between "
          "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
          "(-ssi_bem_pc_type redundant)", "common")
+register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
+         "becomes the step, to keep every checkpoint", "common")
+register("checkpoint_every", "int", 0, "steps", "write a checkpoint every this many steps (0: never; a signal "
+         "always writes one)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this much wall time has passed since "
+         "the last one (0: never)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("restart", "str", "", "", "resume the run from this checkpoint (same options, any rank count; the "
+         "output of the interrupted run is continued)", "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
 
 # ---------------------------------------------------------------- BEM soil

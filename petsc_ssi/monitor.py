@@ -53,13 +53,14 @@ class Progress:
         self.comm = comm
         self.unit = unit
         self.t0 = time.perf_counter()
+        self.first = 0                   # items done before t0 (a restarted run)
 
     def update(self, k, extra=""):
         """Report after item ``k`` (1-based) when due."""
         if not self.enabled or (k % self.every and k != self.total):
             return
         el = time.perf_counter() - self.t0
-        eta = el / k * (self.total - k)
+        eta = el / max(k - self.first, 1) * (self.total - k)
         printf(f"[ssi] {self.what}: {self.unit} {k}/{self.total} ({100.0 * k / self.total:5.1f}%) "
                f"elapsed {fmt_time(el)} eta {fmt_time(eta)}{(' ' + extra) if extra else ''}", self.comm)
 

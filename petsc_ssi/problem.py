@@ -15,7 +15,10 @@ Each one goes through the same stages, all collective:
   step(n)               one time step; returns the new state (PETSc Vecs, owned layout)
   finish()              outputs closed (receivers, sidecars, run record); returns the results
 
-``run()`` does all of it and is what ``petsc-ssi`` calls; a script can step by itself:
+``run()`` does all of it and is what ``petsc-ssi`` calls; it also writes checkpoints
+(-ssi_checkpoint_every, -ssi_checkpoint_interval, and on SIGTERM/SIGINT/SIGUSR1;
+``io.checkpoint``), and with -ssi_restart ``start()`` resumes from one and ``run()`` goes on from
+the step after it. A script can step by itself:
 
     from petsc_ssi.petsc import init
     init()                                # PETSc from sys.argv: -options_file ... -ssi_...
@@ -29,12 +32,13 @@ Each one goes through the same stages, all collective:
 ``cfg`` is the resolved options (``options.resolve``); the options database stays the one
 source of settings (no keyword arguments that bypass it).
 """
+import os
 import signal
 import time
 
 import numpy as np
 
-from .petsc import init, SSIError
+from .petsc import init, SSIError, printf
 
 SIGNALS = ("SIGTERM", "SIGINT", "SIGUSR1")
 
@@ -78,15 +82,87 @@ class TransientProblem:
         self.n = 0                      # the last step taken
         self.n_steps = 0
         self._state = "created"
+        self.restart = None             # the header of -ssi_restart's checkpoint (check_output)
+        self._key = None
 
     _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
 
     def check_output(self, also=()):
         """Collective: the output can be written and replaces nothing unless asked
-        (``io.output.check_output``); called first by every constructor."""
+        (``io.output.check_output``), the checkpoint location too, and -ssi_restart's checkpoint
+        belongs to this run (``io.checkpoint.check_restart``); called first by every constructor.
+        A restart continues the output of the interrupted run, so that one may exist."""
         from .io.output import check_output
-        if self.cfg.get("output"):
-            check_output(self.cfg.output, self.comm, bool(self.cfg.get("output_overwrite")), also=also)
+        from .io import checkpoint
+        cfg = self.cfg
+        if cfg.get("restart"):
+            self.restart = checkpoint.check_restart(cfg, self.comm, self.kind)
+        overwrite = bool(cfg.get("output_overwrite"))
+        if cfg.get("output"):
+            check_output(cfg.output, self.comm, overwrite or self.restart is not None, also=also)
+        ck = checkpoint.checkpoint_path(cfg, 0)
+        if ck and (cfg.get("checkpoint") or cfg.get("checkpoint_every") or cfg.get("checkpoint_interval")):
+            same = self.restart is not None and os.path.abspath(ck) == os.path.abspath(cfg.restart)
+            check_output(ck, self.comm, overwrite or same or "%d" in (cfg.get("checkpoint") or ""),
+                         what="-ssi_checkpoint")
+
+    # ------------------------------------------------------------ checkpoint and restart
+    def checkpoint_state(self):
+        """({name: Vec}, {name: array on rank 0}): what the next step needs (subclasses)."""
+        raise NotImplementedError
+
+    def restore_state(self, reader):
+        """Collective: the state of a checkpoint (``io.checkpoint.Reader``) into this problem, after
+        start() made its objects (subclasses)."""
+        raise NotImplementedError
+
+    def write_checkpoint(self):
+        """Collective: a checkpoint after the last step taken; returns its path (None without an
+        output or -ssi_checkpoint)."""
+        from .io import checkpoint
+        from .monitor import staged
+        path = checkpoint.checkpoint_path(self.cfg, self.n)
+        if path is None:
+            return None
+        if self._key is None:
+            self._key = checkpoint.run_key(self.cfg)
+        with staged("SSI checkpoint"):
+            vecs, serial = self.checkpoint_state()
+            checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial)
+        self._last_ckpt = time.perf_counter()
+        if self.cfg.get("monitor"):
+            printf(f"[ssi] checkpoint after step {self.n} of {self.n_steps}: {path}")
+        return path
+
+    def _open_restart(self):
+        """Collective, first in start(): the -ssi_restart checkpoint's reader (None without one)."""
+        self._reader = None
+        if self.restart is not None:
+            from .io.checkpoint import Reader
+            self._reader = Reader(self.cfg.restart, self.comm)
+        return self._reader
+
+    @staticmethod
+    def _output_state(prefix, out):
+        """{prefix_times, prefix_fields} of an Output (or nothing without one), for a checkpoint."""
+        if out is None:
+            return {}
+        return {f"{prefix}_{k}": v for k, v in out.state().items()}
+
+    def _resume(self):
+        """Collective, at the end of start(): with -ssi_restart, the checkpoint's state; the run goes
+        on from the step after it."""
+        if self._reader is None:
+            return
+        try:
+            self.restore_state(self._reader)
+        finally:
+            self._reader.close()
+            self._reader = None
+        self.n = int(self.restart["step"])
+        self._state = "stepping"
+        printf(f"[ssi] restarted from {self.cfg.restart} after step {self.n} of {self.n_steps} "
+               f"(written on {self.restart['ranks']} rank(s), running on {self.comm.getSize()})")
 
     def _advance(self, expected, new):
         if self._state != expected:
@@ -127,15 +203,21 @@ class TransientProblem:
 
     def _poll(self, sig):
         """Collective, one reduction per step: (the name of a signal any rank caught, or None;
-        whether -ssi_output_flush seconds have passed since the last flush, by rank 0's clock)."""
+        whether -ssi_output_flush seconds have passed since the last flush; whether
+        -ssi_checkpoint_interval seconds have passed since the last checkpoint), by rank 0's clock."""
         from mpi4py import MPI
         every = float(self.cfg.get("output_flush") or 0.0)
-        due = 0
-        if every and self.cfg.get("output") and self.comm.getRank() == 0:
-            due = int(time.perf_counter() - getattr(self, "_last_flush", self.t_start) >= every)
-        flags = np.array([sig.got, due], np.int64)
+        ck_every = float(self.cfg.get("checkpoint_interval") or 0.0)
+        due = ck_due = 0
+        if self.comm.getRank() == 0:
+            now = time.perf_counter()
+            if every and self.cfg.get("output"):
+                due = int(now - getattr(self, "_last_flush", self.t_start) >= every)
+            if ck_every:
+                ck_due = int(now - getattr(self, "_last_ckpt", self.t_start) >= ck_every)
+        flags = np.array([sig.got, due, ck_due], np.int64)
         self.comm.tompi4py().Allreduce(MPI.IN_PLACE, flags, op=MPI.MAX)     # elementwise
-        return (signal.Signals(int(flags[0])).name if flags[0] else None), bool(flags[1])
+        return (signal.Signals(int(flags[0])).name if flags[0] else None), bool(flags[1]), bool(flags[2])
 
     def _flush(self):
         """Collective: a 'running' flush; a failure (a reader holding the file) is a warning."""
@@ -150,24 +232,31 @@ class TransientProblem:
         """Collective: setup, start, every step, finish; returns the results.
 
         While stepping, the output is made readable every -ssi_output_flush seconds, checked at the
-        end of each step (attribute ``run_status`` 'running'); SIGTERM, SIGINT or SIGUSR1 stops
-        the run at the end of the current step (after the last step the run just finishes), and
-        a stop by a signal or by an SSIError (the divergence guard, a non-finite solution) writes
-        the results up to the last step with ``run_status`` 'stopped ...' before the error is
-        raised. Other exceptions (a bug, PETSc or MPI failures) write nothing more."""
+        end of each step (attribute ``run_status`` 'running'), and a checkpoint is written every
+        -ssi_checkpoint_every steps and -ssi_checkpoint_interval seconds. SIGTERM, SIGINT or
+        SIGUSR1 stops the run at the end of the current step with a checkpoint (after the last step
+        the run just finishes); a stop by a signal or by an SSIError (the divergence guard, a
+        non-finite solution) writes the results up to the last step with ``run_status`` 'stopped
+        ...' before the error is raised. Other exceptions (a bug, PETSc or MPI failures) write
+        nothing more. With -ssi_restart the steps start after the checkpoint's."""
         self.setup()
         self.start()
+        every = int(self.cfg.get("checkpoint_every") or 0)
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end
             try:
-                for n in range(1, self.n_steps + 1):
+                for n in range(self.n + 1, self.n_steps + 1):
                     self.step(n)
                     if n == self.n_steps:
                         break                        # the run is done: finish it, whatever arrived
-                    name, due = self._poll(sig)
+                    name, due, ck_due = self._poll(sig)
+                    path = None
+                    if name or ck_due or (every and n % every == 0):
+                        path = self.write_checkpoint()
                     if name:
                         raise SSIError(f"stopped by {name} after step {n} of {self.n_steps} (t = {self.time(n):.6g} s)"
                                        + (f"; the results up to that step are in {self.cfg.output}"
-                                          if self.cfg.get("output") else ""))
+                                          if self.cfg.get("output") else "")
+                                       + (f"; resume with -ssi_restart {path}" if path else ""))
                     if due:
                         self._flush()
             except SSIError as exc:

@@ -343,6 +343,28 @@ class Marcher:
         p.axpy(1.0, self.kv_p)
         return u, p
 
+    # ------------------------------------------------------------ checkpoint
+    def _kept_steps(self):
+        """The steps whose states the ring buffer still holds (all the history sum can read)."""
+        return range(max(1, self.n - self.depth + 1), self.n + 1)
+
+    def checkpoint_vecs(self):
+        """{name: Vec}: the states u^m, p^m the next steps read (``io.checkpoint``)."""
+        out = {}
+        for m in self._kept_steps():
+            out[f"bem_u_{m:06d}"] = self.ubuf[self._slot(m)]
+            if self.p_tmpl.getSize():
+                out[f"bem_p_{m:06d}"] = self.pbuf[self._slot(m)]
+        return out
+
+    def restore(self, reader, n):
+        """Collective: the states of a checkpoint after step n (``checkpoint_vecs``)."""
+        self.n = int(n)
+        for m in self._kept_steps():
+            reader.load(f"bem_u_{m:06d}", self.ubuf[self._slot(m)])
+            if self.p_tmpl.getSize():
+                reader.load(f"bem_p_{m:06d}", self.pbuf[self._slot(m)])
+
     def dofs_pres_local(self, r0, nloc):
         if not hasattr(self, "_pres_local"):
             d = np.where(np.repeat(self.pres, 3))[0]

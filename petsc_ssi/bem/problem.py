@@ -42,9 +42,22 @@ class BEMTransient(TransientProblem):
     def start(self):
         self._advance("set up", "started")
         from ..io.recorder import Recorder, SoilRecorder
-        self.out = Output(self.cfg.output, self.comm)
+        rd = self._open_restart()
+        self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None)
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.n_steps,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
+        self._resume()
+
+    def checkpoint_state(self):
+        serial = self.rec.state()
+        serial.update(self._output_state("out", self.out))
+        return self.march.checkpoint_vecs(), serial
+
+    def restore_state(self, reader):
+        n = int(self.restart["step"])
+        self.march.restore(reader, n)
+        self.rec.restore(reader.serial, n)
+        self.march._prefix_max = list(np.maximum.accumulate(self.rec.unorm))    # the guard's running max
 
     def step(self, n):
         self._check_step(n)

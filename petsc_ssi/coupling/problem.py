@@ -79,13 +79,42 @@ class SSITransient(TransientProblem):
         from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ())
-        self.out = Output(cfg.output, comm)
-        self.sout = Output(structure_output_path(cfg.output), comm)
+        rd = self._open_restart()
+        self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
+        self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None)
         self.rec = Recorder(cfg, comm, "SSI time loop", self.n_steps,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
         self.integ.start(f0=self.load(0))
-        self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel))
+        if rd is None:
+            self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel))
+        self._resume()
+
+    def checkpoint_state(self):
+        cp, law = self.coupler, self.coupler.law
+        serial = self.rec.state()
+        serial.update(self._output_state("out", self.out))
+        serial.update(self._output_state("sout", self.sout))
+        serial.update(self.integ.checkpoint_scalars())
+        serial.update({"law_closed": law.closed, "law_ub_prev": law.ub_prev, "law_total_changes": law.total_changes,
+                       "law_cycled_steps": np.asarray(law.cycled_steps, np.int64), "cp_pI_prev": cp.pI_prev,
+                       "cp_closed_prev": cp.closed_prev})
+        vecs = self.march.checkpoint_vecs()
+        vecs.update(self.integ.checkpoint_vecs())
+        return vecs, serial
+
+    def restore_state(self, reader):
+        s, cp, law = reader.serial, self.coupler, self.coupler.law
+        n = int(self.restart["step"])
+        self.march.restore(reader, n)
+        self.integ.restore(reader)
+        self.rec.restore(s, n)
+        law.closed = np.asarray(s["law_closed"], bool).copy()
+        law.ub_prev = np.asarray(s["law_ub_prev"], float).copy()
+        law.total_changes = int(s["law_total_changes"])
+        law.cycled_steps = [int(k) for k in s["law_cycled_steps"]]
+        cp.pI_prev = np.asarray(s["cp_pI_prev"], float).copy()
+        cp.closed_prev = np.asarray(s["cp_closed_prev"], bool).copy()
 
     def step(self, n):
         self._check_step(n)

@@ -212,6 +212,25 @@ class _Dynamic:
         self.n = 0
         self.fixed_load_warning = None       # the warning, once a load acted on fixed dofs
 
+    # ------------------------------------------------------------ checkpoint
+    def checkpoint_vecs(self, prefix="fem_"):
+        """{name: Vec} of the state the next step needs (``io.checkpoint``)."""
+        return {prefix + k: getattr(self, a) for k, a in self._STATE}
+
+    def checkpoint_scalars(self, prefix="fem_"):
+        return {prefix + "n": self.n, prefix + "warned": int(self.fixed_load_warning is not None)}
+
+    def restore(self, reader, prefix="fem_"):
+        """Collective: the state of a checkpoint (``checkpoint_vecs``, ``checkpoint_scalars``)."""
+        for k, a in self._STATE:
+            reader.load(prefix + k, getattr(self, a))
+        s = reader.serial
+        self.n = int(s[prefix + "n"])
+        if int(s[prefix + "warned"]):
+            self.fixed_load_warning = "(warned before the restart)"
+
+    _STATE = (("u", "u"), ("v", "v"))
+
     def _zeros(self):
         v = self.m.duplicate()
         v.zeroEntries()
@@ -306,6 +325,16 @@ class GreenIntegrator(_Dynamic):
         self._predicted = False
         self._kick = 1.0                      # v = v(t_n-) + kick * vhalf (1 after start, 2 after correct)
 
+    _STATE = (("u", "u"), ("v", "v"), ("vhalf", "vhalf"))
+
+    def checkpoint_scalars(self, prefix="fem_"):
+        return dict(super().checkpoint_scalars(prefix), **{prefix + "kick": self._kick})
+
+    def restore(self, reader, prefix="fem_"):
+        super().restore(reader, prefix)
+        self._kick = float(reader.serial[prefix + "kick"])
+        self._predicted = False
+
     def start(self, u0=None, v0=None, f0=None):
         """Initial state; f0 = mean load over [0, dt/2] enters as a half impulse."""
         self._set_initial(u0, v0)
@@ -383,6 +412,8 @@ class NewmarkIntegrator(_Dynamic):
         self.c_u = 1 / (a * dt ** 2) + am * d / (a * dt)
         self.c_v = 1 / (a * dt) + am * (d / a - 1)
         self.c_a = (1 / (2 * a) - 1) + am * dt * (d / (2 * a) - 1)
+
+    _STATE = (("u", "u"), ("v", "v"), ("a", "a"))
 
     def start(self, u0=None, v0=None, f0=None):
         """Initial state; a^0 = M^{-1}(f^0 - C v^0 - K u^0) on free dofs."""
@@ -468,6 +499,8 @@ class MidpointIntegrator(NewmarkIntegrator):
               K.getComm())
         super().__init__(K, m, dt, alpha_m, fixed, alpha, delta, **kw)
         self.ku = m.duplicate()
+
+    _STATE = (("u", "u"), ("v", "v"))           # (no acceleration: the midpoint form has none)
 
     def start(self, u0=None, v0=None, f0=None):
         self._set_initial(u0, v0)

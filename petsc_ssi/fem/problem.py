@@ -48,13 +48,27 @@ class FEMTransient(TransientProblem):
         self._advance("set up", "started")
         from ..io.recorder import Recorder, StructureRecorder
         cfg, comm = self.cfg, self.comm
+        rd = self._open_restart()
         with event("FEM_io"):
-            self.out = Output(cfg.output, comm) if cfg.output else None
+            self.out = (Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
+                        if cfg.output else None)
             self.rec = Recorder(cfg, comm, "FEM time loop", self.n_steps,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
         self.integ.start(f0=self.load(0))
-        self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel), write=self.rec.due(0))
+        if rd is None:
+            self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel), write=self.rec.due(0))
+        self._resume()
         self.state = (self.integ.u, self.vel)
+
+    def checkpoint_state(self):
+        serial = self.rec.state()
+        serial.update(self._output_state("out", self.out))
+        serial.update(self.integ.checkpoint_scalars())
+        return self.integ.checkpoint_vecs(), serial
+
+    def restore_state(self, reader):
+        self.integ.restore(reader)
+        self.rec.restore(reader.serial, int(self.restart["step"]))
 
     def step(self, n):
         self._check_step(n)

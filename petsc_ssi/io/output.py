@@ -113,7 +113,10 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
 class Output:
     """Collective writer of one run's fields and series."""
 
-    def __init__(self, path, comm):
+    def __init__(self, path, comm, resume=None):
+        """``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
+        its file is continued (opened to append; later snapshots overwrite those the interrupted run
+        wrote after its checkpoint); a missing file is started anew, with a warning."""
         PETSc = init()
         self.PETSc = PETSc
         self.path = path
@@ -126,13 +129,29 @@ class Output:
                 if os.path.isfile(f):
                     os.remove(f)
         self._rank0(lambda: os.makedirs(d, exist_ok=True), f"cannot create the output directory {d}")
-        self._rank0(stale, f"cannot remove the old sidecars of {path}")
-        self.viewer = PETSc.Viewer().createHDF5(path, mode="w", comm=comm)
         self.times = []
         self.fields = []
+        mode = "w"
+        if resume is not None:
+            exists = comm.tompi4py().bcast(os.path.isfile(path) if self.rank == 0 else None, root=0)
+            if exists:
+                mode = "a"
+                self.times = [float(t) for t in resume["times"]]
+                self.fields = [f for f in resume["fields"].split(",") if f]
+            elif len(resume["times"]):
+                from ..petsc import warn
+                warn(f"{path} (the output of the interrupted run) is missing: a new one is written, without the "
+                     f"{len(resume['times'])} field snapshots before the restart (the receiver series are whole)", comm)
+        if mode == "w":
+            self._rank0(stale, f"cannot remove the old sidecars of {path}")
+        self.viewer = PETSc.Viewer().createHDF5(path, mode=mode, comm=comm)
         self.cells = None
         self.cell_type = None
         self.n_nodes = 0
+
+    def state(self):
+        """The snapshot list, for a checkpoint: {'times', 'fields'}."""
+        return {"times": np.asarray(self.times, float), "fields": ",".join(self.fields)}
 
     def write_mesh(self, coords_vec, cells, cell_type):
         """``coords_vec``: PETSc Vec (bs 3) of node coordinates in the field

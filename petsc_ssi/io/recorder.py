@@ -53,6 +53,19 @@ class SoilRecorder:
                     self.tnode.mult(p, self.tfield)
                 self.out.write_fields(t, {"displacement": u, "traction": self.tfield})
 
+    def state(self, n_times):
+        """Collective: {'soil_receivers': (K, R, 3)} on rank 0, for a checkpoint."""
+        u = self.receivers(n_times)
+        return {"soil_receivers": u} if u is not None else {}
+
+    def restore(self, s):
+        """The series of a checkpoint: each rank takes its rows of R."""
+        if self.R is None:
+            return
+        full = np.asarray(s["soil_receivers"]).reshape(len(s["times"]), -1)
+        r0, r1 = self.R.getOwnershipRange()
+        self.series = [row[r0:r1].copy() for row in full]
+
     def receivers(self, n_times):
         """Collective: the receiver series (K, R, 3) on rank 0 (None elsewhere, or without receivers)."""
         if self.R is None:
@@ -78,6 +91,27 @@ class StructureRecorder:
         if write and self.fw is not None:
             with event(self.io_event):
                 self.fw.write(t, u, v)
+
+    def state(self):
+        """Rank 0: the receiver series, for a checkpoint."""
+        r = self.rec
+        if self.comm.getRank() != 0:
+            return {}
+        K = len(r.t)
+        s = {"structure_t": np.asarray(r.t, float), "structure_u": np.asarray(r.u).reshape(K, r.n, 3),
+             "structure_r": np.asarray(r.r).reshape(K, r.n, 3)}
+        if len(r.v) == K:
+            s["structure_v"] = np.asarray(r.v).reshape(K, r.n, 3)
+        return s
+
+    def restore(self, s):
+        r = self.rec
+        if self.comm.getRank() != 0:
+            return
+        r.t = [float(t) for t in s["structure_t"]]
+        r.u = [a.copy() for a in s["structure_u"]]
+        r.r = [a.copy() for a in s["structure_r"]]
+        r.v = [a.copy() for a in s["structure_v"]] if "structure_v" in s else []
 
     def receivers(self):
         """Rank 0: the output group of the structure receivers (points, nodes, t, u, rotation, ...)."""
@@ -117,6 +151,29 @@ class Recorder:
         if norm is not None:
             self.unorm.append(norm)
         self.progress.update(n, status)
+
+    def state(self):
+        """Collective: the series so far, for a checkpoint ({name: array}, rank 0's)."""
+        s = {"times": np.asarray(self.times, float), "unorm": np.asarray(self.unorm, float)}
+        if self.soil is not None:
+            s.update(self.soil.state(len(self.times)))
+        if self.structure is not None:
+            s.update(self.structure.state())
+        for k, v in self.interface.items():
+            s["interface_" + k] = np.asarray(v)
+        return s
+
+    def restore(self, s, n):
+        """The series of a checkpoint after step ``n`` (``state``)."""
+        self.times = [float(t) for t in s["times"]]
+        self.unorm = [float(x) for x in s["unorm"]]
+        if self.soil is not None:
+            self.soil.restore(s)
+        if self.structure is not None:
+            self.structure.restore(s)
+        for k in self.interface:
+            self.interface[k] = list(np.asarray(s["interface_" + k]))
+        self.progress.first = n
 
     def soil_receivers(self):
         return self.soil.receivers(len(self.times)) if self.soil is not None else None

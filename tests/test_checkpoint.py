@@ -1,0 +1,216 @@
+"""Checkpoint and restart (issue 14, item 2; petsc_ssi/io/checkpoint.py).
+
+A run writes checkpoints (-ssi_checkpoint_every, and on a signal); -ssi_restart continues the
+interrupted run's output in place. Each test compares every dataset of the restarted run's files
+(fields, receivers, interface series, time) with an uninterrupted run of the same options:
+bit for bit at the rank count of the checkpoint (one rank, or two with -ssi_reproducible, whose
+solves are deterministic: tests/test_reproducible.py), to 1e-10 relative on another rank count.
+A restart whose options change the run is refused in one line naming the option."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import ROOT, cli
+from test_output_survives import _wait_for
+
+BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
+       "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
+       "-ssi_t_end", "0.15", "-ssi_receivers", "3,0,0;0,0,0", "-ssi_output_stride", "10", "-ssi_warn_beta", "0"]
+INTERP = ["-ssi_interp", "linear", "-ssi_interp_tl", "0.01", "-ssi_interp_k", "3"]
+FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_fixed", "base", "-ssi_fem_load_group", "top",
+       "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history", "box", "-ssi_fem_load_t0", "0.01", "-ssi_dt", "1e-3",
+       "-ssi_t_end", "0.05", "-ssi_receivers", "0,0,0.5", "-ssi_output_stride", "10"]
+SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
+       "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",
+       "1,1,0.25", "-ssi_fem_box_origin", "-0.5,-0.5,0", "-ssi_fem_E", "300e9", "-ssi_fem_rho", "200",
+       "-ssi_dt", "0.0125", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history",
+       "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral", "-ssi_receivers", "1,0,0",
+       "-ssi_structure_receivers", "0,0,0.25", "-ssi_output_stride", "8", "-ssi_warn_beta", "0"]
+
+
+def datasets(path):
+    """{name: array} of every dataset of an HDF5 file, groups walked."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
+        out["@run_status"] = str(f.attrs["run_status"])
+    return out
+
+
+def assert_same_files(a, b, rtol=0.0):
+    """Every dataset of ``a`` equals ``b``'s (bitwise with rtol 0; else max |a-b| <= rtol max |b|)."""
+    A, B = datasets(a), datasets(b)
+    assert sorted(A) == sorted(B), set(A) ^ set(B)
+    assert A["@run_status"] == B["@run_status"] == "completed"
+    for k in A:
+        x, y = np.asarray(A[k]), np.asarray(B[k])
+        assert x.shape == y.shape, k
+        if rtol and x.dtype.kind == "f" and x.size:
+            assert np.abs(x - y).max() <= rtol * max(np.abs(y).max(), 1e-300), k
+        else:
+            assert np.array_equal(x, y), k
+    return A
+
+
+def run_and_restart(args, tmp_path, nranks, every, restart_step, nranks_restart=None, outputs=("r.h5",)):
+    """An uninterrupted run with checkpoints every ``every`` steps (kept: '%d' in the name), then a
+    restart from the one after ``restart_step`` into a copy of the run's files as they stood at
+    the end (the steps after the checkpoint are written again); returns (reference, restarted)."""
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    r = cli(args + ["-ssi_output", str(ref / outputs[0]), "-ssi_checkpoint", str(tmp_path / "ck-%d.h5"),
+                    "-ssi_checkpoint_every", str(every)], nranks=nranks)
+    ck = tmp_path / f"ck-{restart_step}.h5"
+    assert ck.exists() and not (tmp_path / f"ck-{restart_step}.h5.tmp").exists(), r.stdout[-2000:]
+    rs = tmp_path / "rs"
+    shutil.copytree(ref, rs)
+    r = cli(args + ["-ssi_output", str(rs / outputs[0]), "-ssi_restart", str(ck)],
+            nranks=nranks_restart or nranks)
+    assert f"restarted from {ck} after step {restart_step}" in r.stdout, r.stdout[-2000:]
+    return [(str(ref / o), str(rs / o)) for o in outputs]
+
+
+@pytest.mark.parametrize("case", ["stabilised", "plain", "interpolated"])
+def test_bem_restart_is_bitwise(case, tmp_path):
+    """The quarter-model half-space (two symmetry planes), 60 steps, restarted after step 25 on
+    2 ranks with -ssi_reproducible (with MUMPS, restarts of the plain case differed from each other
+    by 1 ulp from the third step on; at -n 1, or with SuperLU_dist, never): every dataset bit for bit (the history sum reads up to the 23 lags of this mesh, all
+    from the checkpoint's ring of past states; 'interpolated' reads them through 3 interpolating
+    matrices beyond T_L = 0.01 s)."""
+    extra = {"stabilised": [], "plain": ["-ssi_scheme", "plain"], "interpolated": INTERP}[case]
+    for a, b in run_and_restart(BEM + extra + ["-ssi_reproducible"], tmp_path, 2, 25, 25):
+        d = assert_same_files(b, a)
+        assert np.abs(d["receivers/u"]).max() > 0 and len(d["time"]) == 6
+
+
+def test_bem_restart_on_another_rank_count(tmp_path):
+    """A checkpoint written on 2 ranks, restarted on 1 (the Vecs are saved globally): the same
+    result to 1e-10 relative (the order of the parallel sums differs)."""
+    for a, b in run_and_restart(BEM + INTERP, tmp_path, 2, 25, 50, nranks_restart=1):
+        assert_same_files(b, a, rtol=1e-10)
+
+
+@pytest.mark.parametrize("integrator", ["green", "newmark"])
+def test_fem_restart_is_bitwise(integrator, tmp_path):
+    """The block alone on one rank, restarted after step 17 of 50 (Green's integrator: u, v and the
+    last half impulse; Newmark: u, v, a)."""
+    for a, b in run_and_restart(FEM + ["-ssi_fem_integrator", integrator], tmp_path, 1, 17, 17):
+        d = assert_same_files(b, a)
+        assert np.abs(d["receivers/u"]).max() > 0
+
+
+@pytest.mark.parametrize("coupling", ["implicit", "staggered"])
+def test_coupled_contact_restart_is_bitwise(coupling, tmp_path):
+    """The block on the half-space with unilateral contact, 80 steps on 2 ranks with
+    -ssi_reproducible, restarted after step 30 while part of the interface is open: both files
+    (soil with the interface series and contact status; structure) bit for bit."""
+    args = SSI + ["-ssi_t_end", "1.0", "-ssi_coupling", coupling, "-ssi_reproducible"]
+    pairs = run_and_restart(args, tmp_path, 2, 30, 30, outputs=("r.h5", "r_structure.h5"))
+    for a, b in pairs:
+        assert_same_files(b, a)
+    closed = datasets(pairs[0][0])["interface/closed"]
+    assert not closed[30:].all() and not closed[:30].all()      # open before and after the checkpoint
+
+
+def test_a_signal_writes_a_checkpoint_that_restarts_a_coupled_contact_run(tmp_path):
+    """SIGTERM to both ranks (as a scheduler sends it to every task; mpirun itself would kill
+    the job on SIGTERM, and forwards only SIGUSR1/2) in the middle of a coupled contact run: one
+    line, the results
+    up to the last step in the file, a checkpoint after that step; the restart from it finishes
+    the run, and its files equal the uninterrupted run's bit for bit (-ssi_reproducible)."""
+    args = SSI + ["-ssi_t_end", "12.0", "-ssi_reproducible"]      # 960 steps: the signal comes well before the end
+    out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable, "-m", "petsc_ssi"] + args + [
+        "-ssi_output", out, "-ssi_monitor", "-ssi_monitor_every", "1"]
+    with open(log, "w") as fh:
+        p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
+                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    try:
+        assert _wait_for(log, "step 20/", p), open(log).read()[-2000:]
+        subprocess.run(["pkill", "-TERM", "-P", str(p.pid)], check=True)     # the ranks, mpirun's children
+        rc = p.wait(timeout=120)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    text = open(log).read()
+    ck = str(tmp_path / "k-checkpoint.h5")
+    errs = [ln for ln in text.splitlines() if ln.startswith("petsc-ssi: error: stopped by SIGTERM")]
+    assert rc == 2 and len(errs) == 1 and f"resume with -ssi_restart {ck}" in errs[0], text[-2000:]
+    with h5py.File(out) as f:
+        n = len(f["receivers/t"])
+        assert str(f.attrs["run_status"]).startswith(f"stopped after step {n} of 960")
+    with h5py.File(ck) as f:
+        assert int(f.attrs["step"]) == n and 20 <= n < 960
+    r = cli(args + ["-ssi_output", out, "-ssi_restart", ck], nranks=2)
+    assert f"after step {n} of 960" in r.stdout
+    ref = str(tmp_path / "ref.h5")
+    cli(args + ["-ssi_output", ref], nranks=2)
+    assert_same_files(out, ref)
+    assert_same_files(str(tmp_path / "k_structure.h5"), str(tmp_path / "ref_structure.h5"))
+
+
+def test_a_signal_writes_a_checkpoint_that_restarts_a_bem_run(tmp_path):
+    """SIGTERM to a one-rank BEM run: the checkpoint restarts it to the uninterrupted result bit
+    for bit (and the stopped file held the steps up to the stop)."""
+    args = BEM[:]
+    args[args.index("-ssi_t_end") + 1] = "5.0"                 # 2000 steps: the signal comes well before the end
+    args[args.index("-ssi_output_stride") + 1] = "200"
+    out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
+    with open(log, "w") as fh:
+        p = subprocess.Popen([sys.executable, "-m", "petsc_ssi"] + args + ["-ssi_output", out, "-ssi_monitor",
+                                                                           "-ssi_monitor_every", "1"],
+                             cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
+                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    try:
+        assert _wait_for(log, "step 30/", p), open(log).read()[-2000:]
+        p.send_signal(signal.SIGTERM)
+        rc = p.wait(timeout=120)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert rc == 2, open(log).read()[-2000:]
+    with h5py.File(out) as f:
+        n = len(f["receivers/t"])
+    assert 30 <= n < 2000
+    cli(args + ["-ssi_output", out, "-ssi_restart", str(tmp_path / "k-checkpoint.h5")])
+    ref = str(tmp_path / "ref.h5")
+    cli(args + ["-ssi_output", ref])
+    assert_same_files(out, ref)
+
+
+BAD = [
+    (["-ssi_cs", "21"], "-ssi_cs is 21.0 here and was 20.0"),
+    (["-ssi_contact", "bonded"], "-ssi_contact is bonded here and was unilateral"),
+    (["-ssi_t_end", "2.0"], "-ssi_t_end is 2.0 here and was 1.0"),
+    (["-ssi_problem", "bem"], "the checkpoint is of -ssi_problem ssi, this run is bem"),
+]
+
+
+def test_a_restart_that_changes_the_run_is_refused(tmp_path):
+    """Options that define the run (soil, contact, end time, problem kind) may not change on
+    restart: one line naming the option, on every rank of 2, before any assembly; a missing file
+    and a file that is not a checkpoint (a result) are refused too. Changing how the run is
+    watched or written (monitor, stride, solver) is allowed."""
+    args = SSI + ["-ssi_t_end", "1.0"]
+    out = str(tmp_path / "a.h5")
+    cli(args + ["-ssi_output", out, "-ssi_checkpoint_every", "40"], nranks=2)
+    ck = str(tmp_path / "a-checkpoint.h5")
+    cases = BAD + [([], None)]
+    for extra, msg in cases:
+        p = cli(args + extra + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_output_overwrite",
+                                "-ssi_restart", ck], nranks=2, check=False)
+        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        if msg is None:
+            assert p.returncode == 0, p.stdout[-2000:]
+            continue
+        assert p.returncode == 2 and len(errs) == 1 and msg in errs[0], (extra, p.stdout[-2000:])
+        assert "assembly" not in p.stdout
+    for path, msg in ((str(tmp_path / "none.h5"), "no such file"), (out, "not a petsc-ssi checkpoint")):
+        p = cli(args + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_restart", path], nranks=2, check=False)
+        assert p.returncode == 2 and msg in p.stdout and "Traceback" not in p.stdout + p.stderr, p.stdout[-2000:]
