@@ -75,9 +75,10 @@ def step_matrix(comm, lagset, scheme, pres_node_mask):
 class Marcher:
     """Collective: steps the BEM in time. ``H``, ``G``: lists of Mats (lag 1..L)."""
 
-    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=()):
+    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=(), A=None):
         """Collective: step matrix and its factorisation (from the lag-1 and
-        lag-2 triplets of ``lagset``); ``set_lags`` then hands over the Mats."""
+        lag-2 triplets of ``lagset``, or ``A`` as saved, ``bem.lagstore``); ``set_lags`` then
+        hands over the Mats."""
         PETSc = init()
         self.PETSc = PETSc
         self.comm = comm
@@ -94,7 +95,7 @@ class Marcher:
         ev = event("SSI_BEM_Factor")
         ev.begin()
         t0 = time.perf_counter()
-        self.A = step_matrix(comm, lagset, self.scheme, pres)
+        self.A = step_matrix(comm, lagset, self.scheme, pres) if A is None else A
         # DOFs a symmetry plane forces to zero: identity rows, zero columns
         # (their equations involve only these DOFs; see symmetry.zero_dofs)
         r0, r1 = self.A.getOwnershipRange()

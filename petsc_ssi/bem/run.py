@@ -210,6 +210,13 @@ class BEMProblem:
         printf("[ssi] " + plan.describe())
         ls = self.lagset()
         self.check_memory(ls, plan, extra_bytes, extra_what)
+        from . import lagstore
+        err = None
+        try:
+            self.lags_manifest = lagstore.check(self.cfg, self.comm, self, plan)
+        except SSIError as exc:
+            err = str(exc)
+        collective_error(err, self.comm)
         return plan, ls
 
     def quad_options(self):
@@ -313,6 +320,8 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
                f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
                "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
     t0 = time.perf_counter()
+    if cfg.get("lags_load"):
+        return _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
@@ -354,8 +363,49 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
     march.set_lags(H, G, plan, HI, GI)
     ls.H = ls.G = None   # the triplets are in the Mats now
+    if cfg.get("lags_save"):
+        from . import lagstore
+        t1 = time.perf_counter()
+        size = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
+        printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
+               f"{fmt_time(time.perf_counter() - t1)}; -ssi_lags_load {cfg.lags_save} reuses them)")
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
                    "nbaij": nbaij, "fill": fill, "mem": mem}
+
+
+def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
+    """Collective: build_bem with the matrices of -ssi_lags_load (checked in ``prepare``)."""
+    PETSc = init()
+    from . import lagstore
+    N = prob.mesh.n_nodes
+    nt = prob.regions.n_t
+    tcol_loc = 0
+    if nt:
+        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+        tcol_loc = pl.getLocalSize() // 3
+        pl.destroy()
+    A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
+    if not nt:
+        G = [None] * plan.Lx
+    t_asm = time.perf_counter() - t0
+    mpi = comm.tompi4py()
+    mem_exact = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in H + G))
+    mem_interp = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in HI + GI))
+    kinds = dict(prob.lags_manifest["mats"])
+    ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "dense")
+    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "baij")
+    ls.kernel_evaluations = ls.cache_hits = 0
+    ls.cache_bytes = 0.0
+    printf(f"[ssi] lag matrices loaded from {cfg.lags_load} in {fmt_time(t_asm)} (no assembly): {plan.Lx} exact "
+           f"lags ({ndense} dense, {nbaij} block-sparse)"
+           + (f", {plan.k} interpolating matrices" if plan.active else "")
+           + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
+    march.set_lags(H, G, plan, HI, GI)
+    ls.H = ls.G = None
+    return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
+                   "nbaij": nbaij, "fill": float("nan"), "mem": mem_exact + mem_interp}
 
 
 def _guard(cfg, prob, march, unorm, n):

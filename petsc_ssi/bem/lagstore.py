@@ -1,0 +1,176 @@
+"""Reusable lag matrices: ``-ssi_lags_save FILE`` and ``-ssi_lags_load FILE``.
+
+The lag matrices depend on the soil mesh, its material, dt, the scheme, the symmetry planes, the
+interpolation plan, the quadrature options and which soil nodes carry traction unknowns (the load
+and prescribed-displacement regions, or a structure's interface): not on the loads' size or
+history, the structure, or the receivers. A parameter study over those, or a restart, can skip
+the assembly by loading the matrices a first run saved.
+
+``FILE`` is a PETSc binary file with the step matrix (after the symmetry rows and columns are
+set), the exact lags H_l and G_l and the interpolating matrices HI_j, GI_j, in that order, each
+in the storage it had (dense or 3x3 block-sparse; an empty lag is not written). ``FILE.json``
+lists them and holds the key (``lag_key``: the values above, SHA-256 of the mesh and of the
+traction nodes), written last, so a save that was cut short has no ``.json`` and is refused.
+Loading checks the key before any heavy work and names the first entry that differs; the
+matrices load on any number of ranks (rows by the run's node ranges). A run with loaded matrices
+is bitwise the run that saved them when the solves are deterministic (one rank, or
+-ssi_reproducible; ``tests/bem/test_lagstore.py``).
+"""
+import hashlib
+import json
+import os
+
+import numpy as np
+
+from ..petsc import init, collective_error, SSIError
+
+FORMAT = 1
+
+
+def _h(a):
+    return hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest()
+
+
+def lag_key(cfg, prob, plan):
+    """{name: text}: everything the lag matrices depend on (module docstring)."""
+    reg = prob.regions
+    key = {"mesh_nodes": _h(np.asarray(prob.mesh.nodes, float)), "mesh_cells": _h(np.asarray(prob.mesh.cells, np.int64)),
+           "cp": repr(float(cfg.cp)), "cs": repr(float(cfg.cs)), "rho": repr(float(cfg.rho)), "dt": repr(float(cfg.dt)),
+           "scheme": str(cfg.scheme), "symmetry": str(cfg.symmetry), "lags": str(prob.L), "exact_lags": str(plan.Lx),
+           "traction_nodes": _h(np.asarray(reg.tnode, np.int64)), "load_nodes": str(reg.n_load),
+           "disp_nodes": _h(np.asarray(reg.disp_nodes, np.int64))}
+    for k, v in sorted(prob.quad_options().items()):
+        if k != "cache_share":
+            key["quadrature_" + k] = str(v)
+    if plan.active:
+        key["interp"] = f"{plan.method} k={plan.k} T_L={plan.TL!r} grading={cfg.interp_grading!r}"
+        key["interp_times"] = " ".join(f"{lag}:{toff!r}" for lag, toff in (plan.kernel_time(j) for j in range(plan.k)))
+    else:
+        key["interp"] = "none"
+    return key
+
+
+def _difference(saved, now):
+    """The first entry (in ``lag_key``'s order: mesh, material, dt, ...) that differs."""
+    for name in list(now) + [k for k in saved if k not in now]:
+        if saved.get(name) != now.get(name):
+            return f"{name} differs ({saved.get(name)} there, {now.get(name)} here)"
+    return None
+
+
+def _read_json(path, comm, what):
+    err, data = None, None
+    if comm.getRank() == 0:
+        try:
+            if not os.path.isfile(path) or not os.path.isfile(path + ".json"):
+                raise SSIError(f"{what} {path}: no such file, or its {os.path.basename(path)}.json is missing "
+                               "(a save that did not finish)")
+            with open(path + ".json") as fh:
+                data = json.load(fh)
+            if data.get("format") != FORMAT or "key" not in data:
+                raise SSIError(f"{what} {path}: not a petsc-ssi lag file (format {FORMAT})")
+        except SSIError as exc:
+            err = str(exc)
+        except (OSError, ValueError) as exc:
+            err = f"{what} {path}: cannot read {path}.json ({type(exc).__name__})"
+    collective_error(err, comm)
+    return comm.tompi4py().bcast(data, root=0)
+
+
+def check(cfg, comm, prob, plan):
+    """Collective, before any heavy work: -ssi_lags_load's key against this run (SSIError naming
+    what differs; returns its manifest), and -ssi_lags_save's location (writable, not replacing a
+    file without -ssi_output_overwrite). Returns the manifest or None."""
+    manifest = None
+    if cfg.get("lags_load"):
+        manifest = _read_json(cfg.lags_load, comm, "-ssi_lags_load")
+        diff = _difference(manifest["key"], lag_key(cfg, prob, plan))
+        if diff:
+            raise SSIError(f"-ssi_lags_load {cfg.lags_load}: the saved lag matrices are of another soil problem: "
+                           f"{diff}")
+    if cfg.get("lags_save"):
+        from ..io.output import check_output
+        if cfg.get("lags_load"):
+            raise SSIError("-ssi_lags_save with -ssi_lags_load: the loaded matrices are already saved")
+        check_output(cfg.lags_save, comm, bool(cfg.get("output_overwrite")), what="-ssi_lags_save")
+    return manifest
+
+
+def _mats(march):
+    """[(name, Mat or None)] in file order."""
+    out = [("A", march.A)]
+    out += [(f"H{i + 1}", M) for i, M in enumerate(march.H)]
+    out += [(f"G{i + 1}", M) for i, M in enumerate(march.G)]
+    out += [(f"HI{i + 1}", M) for i, M in enumerate(march.HI)]
+    out += [(f"GI{i + 1}", M) for i, M in enumerate(march.GI)]
+    return out
+
+
+def _kind(M):
+    if M is None:
+        return "empty"
+    t = M.getType()
+    return "dense" if "dense" in t else ("baij" if "baij" in t else "aij")
+
+
+def save(path, comm, march, key):
+    """Collective: the Marcher's matrices to ``path`` (PETSc binary) and ``path``.json; returns bytes."""
+    PETSc = init()
+    tmp = path + ".tmp"
+    mats = _mats(march)
+    err = None
+    try:
+        viewer = PETSc.Viewer().createBinary(tmp, mode="w", comm=comm)
+        for _, M in mats:
+            if M is not None:
+                M.view(viewer)
+        viewer.destroy()
+    except PETSc.Error as exc:
+        err = f"-ssi_lags_save {path}: the PETSc binary viewer failed (error {exc.ierr}: disk full?)"
+    collective_error(err, comm)
+    size = 0
+    if comm.getRank() == 0:
+        try:
+            if os.path.exists(tmp + ".info"):
+                os.remove(tmp + ".info")
+            if os.path.exists(path + ".json"):
+                os.remove(path + ".json")          # the old key must not describe the new matrices
+            os.replace(tmp, path)
+            size = os.path.getsize(path)
+            manifest = {"format": FORMAT, "key": key, "mats": [[n, _kind(M)] for n, M in mats],
+                        "ranks": comm.getSize(), "bytes": size}
+            with open(path + ".json.tmp", "w") as fh:
+                json.dump(manifest, fh, indent=1)
+            os.replace(path + ".json.tmp", path + ".json")
+        except OSError as exc:
+            err = f"-ssi_lags_save {path}: {exc.strerror or exc}"
+    collective_error(err, comm)
+    return comm.tompi4py().bcast(size, root=0)
+
+
+def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
+    """Collective: (A, H, G, HI, GI) from ``path`` in this run's layout (rows: the nodes
+    ``node_range`` of ``n_nodes``; G's columns the ``n_t`` traction nodes, ``tcol_loc`` here)."""
+    PETSc = init()
+    nloc = node_range[1] - node_range[0]
+    types = {"dense": PETSc.Mat.Type.DENSE, "baij": PETSc.Mat.Type.BAIJ, "aij": PETSc.Mat.Type.AIJ}
+    viewer = PETSc.Viewer().createBinary(path, mode="r", comm=comm)
+    out = {"A": [], "H": [], "G": [], "HI": [], "GI": []}
+    try:
+        for name, kind in manifest["mats"]:
+            group = name.rstrip("0123456789")
+            if kind == "empty":
+                out[group].append(None)
+                continue
+            cols = (3 * tcol_loc, 3 * n_t) if group in ("G", "GI") else (3 * nloc, 3 * n_nodes)
+            M = PETSc.Mat().create(comm=comm)
+            M.setSizes(((3 * nloc, 3 * n_nodes), cols), bsize=3)
+            M.setType(types[kind])
+            M.load(viewer)
+            out[group].append(M)
+    except PETSc.Error as exc:
+        raise SSIError(f"-ssi_lags_load {path}: the PETSc binary viewer failed (error {exc.ierr}: a truncated "
+                       "or changed file?)") from None
+    finally:
+        viewer.destroy()
+    return out["A"][0], out["H"], out["G"], out["HI"], out["GI"]
