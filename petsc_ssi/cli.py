@@ -54,9 +54,29 @@ def versions():
     return "\n".join(lines)
 
 
+def _bad_options_file(argv):
+    """One line if an -options_file is missing, unreadable or has a line PETSc would reject (a value
+    without its option: PETSc stops in PetscInitialize with a page of diagnostics), else None."""
+    for i, a in enumerate(argv[:-1]):
+        if a != "-options_file":
+            continue
+        path = argv[i + 1]
+        try:
+            with open(path) as fh:
+                lines = fh.read().splitlines()
+        except OSError as exc:
+            return f"petsc-ssi: error: -options_file {path}: {exc.strerror or exc}"
+        for k, line in enumerate(lines, 1):
+            text = line.split("#", 1)[0].strip()
+            if text and not text.startswith("-") and text.split()[0] not in ("alias",):
+                return (f"petsc-ssi: error: -options_file {path}, line {k}: '{text.split()[0]}' is not an option "
+                        "(one '-name value' per line)")
+    return None
+
+
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
-    bad = _bad_command(argv)
+    bad = _bad_command(argv) or _bad_options_file(argv)
     if bad:                    # before PETSc starts: every rank exits, rank 0 says why
         from mpi4py import MPI
         if MPI.COMM_WORLD.Get_rank() == 0:
@@ -95,6 +115,9 @@ def main(argv=None):
         elif cmd == "estimate":
             from .driver import estimate
             estimate()
+        if cmd != "estimate":
+            from .petsc import warn_unused_options
+            warn_unused_options()
     except SSIError as exc:
         PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
         sys.stdout.flush()

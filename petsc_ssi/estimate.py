@@ -253,13 +253,13 @@ class Counts:
     def _peak_rule(self, used, dense, p=1):
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
-        from .bem.model import LagSet
+        from .bem.model import transient_bytes
         N = self.N
         mats = np.where(dense, 72.0 * N * N, 76.0 * used)
         trip = 84.0 * used
         g = 9.0 * N * max(self.nt, 1) * 8
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        transient = 2 * LagSet.CACHE_MAX + 2 * 256e6 + 0.5e9
+        transient = transient_bytes(used.sum() / p, N, len(used), N / p)
         return 1.1 * max(trip.sum(), build.max()) + g * len(used) + transient * p
 
     def _rank(self, nb, nrows, p, cache=None):

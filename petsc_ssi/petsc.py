@@ -126,6 +126,51 @@ def warn(msg, comm=None):
     printf("petsc-ssi: warning: " + msg, comm)
 
 
+def _options_used():
+    """A function name -> whether PETSc queried the option, or None where it cannot be known:
+    petsc4py's ``Options.used`` where it exists, else PETSc's ``PetscOptionsUsed`` through ctypes
+    (petsc4py 3.18 does not wrap it) from the libpetsc this process loaded (Linux)."""
+    PETSc = init()
+    db = PETSc.Options()
+    if hasattr(db, "used"):
+        return lambda name: bool(db.used(name))
+    try:
+        import ctypes
+        with open("/proc/self/maps") as fh:
+            path = next((ln.split()[-1] for ln in fh if "/libpetsc" in ln and ".so" in ln), None)
+        if path is None:
+            return None
+        fn = ctypes.CDLL(path).PetscOptionsUsed
+        fn.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+        fn.restype = ctypes.c_int
+
+        def used(name):
+            flag = ctypes.c_int(0)
+            return fn(None, name.encode(), ctypes.byref(flag)) == 0 and bool(flag.value)
+        return used
+    except (OSError, AttributeError):
+        return None
+
+
+def unused_petsc_options():
+    """The PETSc object options under our prefixes (-ssi_bem_ksp_..., -ssi_fem_pc_..., ...) that
+    nothing read, e.g. misspelt ones (-ssi_bem_ksp_tpye); None where it cannot be known."""
+    from .options import PREFIX, _is_petsc_object_option
+    used = _options_used()
+    if used is None:
+        return None
+    keys = [k for k in init().Options().getAll() if k.startswith(PREFIX) and _is_petsc_object_option(k[len(PREFIX):])]
+    return sorted(k for k in keys if not used(k))
+
+
+def warn_unused_options(comm=None):
+    """Collective (same options on every rank): one warning line naming the unused ones."""
+    left = unused_petsc_options()
+    if left:
+        warn("options set but never used (misspelt, or for a solver this run does not have): "
+             + " ".join("-" + k for k in left), comm)
+
+
 def set_default_options(prefix, defaults, log=None):
     """Insert PETSc options ``prefix+key`` only where the user set nothing.
 

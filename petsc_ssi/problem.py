@@ -267,6 +267,15 @@ class TransientProblem:
             return self.finish()
 
 
+def peak_rss(comm):
+    """Collective: (largest, summed) peak resident memory of the ranks so far, bytes (Linux)."""
+    import resource
+    from mpi4py import MPI
+    hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+    mpi = comm.tompi4py()
+    return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
+
+
 KINDS = ("bem", "fem", "ssi")
 
 

@@ -92,15 +92,84 @@ def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
     return np.cumsum(diff)[1:L + 1]
 
 
+def _cgroup_limit(proc="/proc/self/cgroup", root="/sys/fs/cgroup"):
+    """The memory limit of this process's cgroup (v2 memory.max, or v1 memory.limit_in_bytes), in
+    bytes, or inf: a batch job or container may have less than the machine."""
+    paths = []
+    try:
+        with open(proc) as fh:
+            for line in fh:
+                parts = line.strip().split(":", 2)
+                if len(parts) == 3 and (parts[1] == "" or "memory" in parts[1].split(",")):
+                    rel = parts[2].lstrip("/")
+                    if parts[1] == "":
+                        paths += [os.path.join(root, rel, "memory.max"), os.path.join(root, "memory.max")]
+                    else:
+                        paths += [os.path.join(root, "memory", rel, "memory.limit_in_bytes"),
+                                  os.path.join(root, "memory", "memory.limit_in_bytes")]
+    except OSError:
+        pass
+    best = float("inf")
+    for p in paths:
+        try:
+            with open(p) as fh:
+                v = fh.read().strip()
+        except OSError:
+            continue
+        if v and v != "max":
+            try:
+                best = min(best, float(v))
+            except ValueError:
+                pass
+    return best if best < 2 ** 60 else float("inf")      # cgroup v1 writes ~2^63 for "no limit"
+
+
 def machine_memory():
+    """Bytes of memory this process may use: the machine's (MemTotal), or its cgroup's limit when
+    that is lower (``_cgroup_limit``)."""
+    total = float("inf")
     try:
         with open("/proc/meminfo") as fh:
             for line in fh:
                 if line.startswith("MemTotal"):
+                    total = float(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    return min(total, _cgroup_limit())
+
+
+CACHE_MAX = 512 << 20
+
+
+def _per_row(n_nodes, lag_hi):
+    """Bytes of raw triplets one row may need in a numba call (96 B per block, 2x over-allocated)."""
+    return 96.0 * 2 * n_nodes * max(lag_hi, 1) * 0.6
+
+
+def _chunk_rows(n_nodes, lag_hi, n_rows):
+    return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
+
+
+def transient_bytes(blocks, n_nodes, lags, n_rows):
+    """Bytes a rank holds during the assembly beside the triplets and Mats: the element cache (at
+    most 324 B per block of its rows, each of its two pools capped at CACHE_MAX), one chunk of raw
+    triplets and the process as it stands (resident size now, measured)."""
+    cache = min(2.0 * CACHE_MAX, 324.0 * blocks)
+    chunk = 2.0 * _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
+    return cache + chunk + process_rss()
+
+
+def process_rss():
+    """This process's resident memory now (bytes; 0 where /proc is missing)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
                     return float(line.split()[1]) * 1024
     except OSError:
         pass
-    return float("inf")
+    return 0.0
 
 
 def _by_lag(trip, L):
@@ -197,18 +266,30 @@ class LagSet:
         self.n_nonsmooth = self.comm.tompi4py().allreduce(
             int(np.sum(np.abs(self.cfree[self.rows] - 0.5 * np.eye(3)).max(axis=(1, 2)) > 1e-14)))
 
-    def estimate_memory(self, lags, storage="auto", fill=0.35, extra_lags=()):
-        """Collective: estimated bytes of the stored Mats and the assembly peak.
+    def estimate_memory(self, lags, storage="auto", fill=0.35, extra_lags=(), sample=0):
+        """Collective: estimated bytes of the stored Mats and the assembly peak (all ranks).
 
         ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
         for interpolating matrices. Each lag is stored dense (N^2 x 72 B) or
         block-sparse (76 B per block) by the same rule as the build; triplets
         (84 B per block) are freed lag by lag as the Mats are built, so the
-        peak is max_k [Mats of lags <= k + triplets of lags > k]."""
+        peak is max_k [Mats of lags <= k + triplets of lags > k]. Per rank on top:
+        the element cache (at most 324 B per block of its rows, 162 B per pool: the
+        (node, element) pairs are about a quarter of the node blocks and hold 81 doubles per
+        lag; each pool capped at CACHE_MAX), one chunk of raw triplets (``chunk_rows``, up
+        to twice over-allocated) and the process as it stands now (its resident size,
+        measured). ``sample`` > 0: the blocks counted on every k-th local row only (at most
+        ``sample`` rows per rank) and scaled up, a fast estimate."""
         nimg = len(self.Vc) // self.mesh.n_cells
         L = max([lags] + list(extra_lags))
-        nb = estimate_blocks(self.mesh.nodes, self.rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
-        nb = self.comm.tompi4py().allreduce(nb)
+        rows = self.rows
+        if sample and len(rows) > sample:
+            rows = rows[::int(np.ceil(len(rows) / sample))]
+        nb = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
+        nb = nb * (len(self.rows) / max(len(rows), 1))
+        mpi = self.comm.tompi4py()
+        local_blocks = float(nb[:lags].sum())
+        nb = mpi.allreduce(nb)
         use = np.r_[nb[:lags], [nb[l - 1] for l in extra_lags]] if len(extra_lags) else nb[:lags]
         N = self.mesh.n_nodes
         f = use / float(N * N)
@@ -217,20 +298,19 @@ class LagSet:
         trip = 84.0 * use
         g = 9.0 * N * max(self.regions.n_t, 1) * 8
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        # + element cache (capped), one chunk's raw triplets, process baseline. (The shared cache's
-        # exchange buffers, about the cache's size each, are freed before the first triplet exists.)
-        transient = 2 * self.CACHE_MAX + 2 * 256e6 + 0.5e9
-        peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient * self.comm.getSize()
+        transient = mpi.allreduce(transient_bytes(local_blocks, N, L, len(self.rows)))
+        peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient
         return float(mats.sum() + g * len(use)), float(peak), int(dense.sum())
 
-    CACHE_MAX = 512 << 20        # bytes per cache pool (P and U): 1 GiB per rank at most
+    CACHE_MAX = CACHE_MAX        # bytes per cache pool (P and U): 1 GiB per rank at most
+
+    def _per_row(self, lag_hi):
+        return _per_row(self.mesh.n_nodes, lag_hi)
 
     def chunk_rows(self, lag_hi):
         """Rows per numba call: about 256 MB of triplets (96 B per block, up to
         2x over-allocated) per call, at least one row."""
-        N = self.mesh.n_nodes
-        per_row = 96.0 * 2 * N * max(lag_hi, 1) * 0.6
-        return int(max(1, min(64, 256e6 // per_row, len(self.rows) // 20 + 1)))
+        return _chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
     def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr):
         """Collective: fill this rank's element cache with every distinct pair geometry its rows meet,

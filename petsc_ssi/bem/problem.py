@@ -93,7 +93,10 @@ class BEMTransient(TransientProblem):
             "lag_bytes_interp": info["mem_interp"], "dense_lags": info["ndense"], "baij_lags": info["nbaij"],
             "mean_fill": info["fill"], "lag_bytes": info["mem"], "mem_estimate": prob.mem_estimate,
             "T_N": prob.T_N, "r_max": prob.r_max, "kernel_evaluations": ls.kernel_evaluations,
-            "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1]}
+            "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1],
+            "mem_peak_estimate": prob.mem_peak_estimate}
+        from ..problem import peak_rss
+        res["stats"]["peak_rss_max_rank_bytes"], res["stats"]["peak_rss_sum_bytes"] = peak_rss(self.comm)
         _finish(cfg, self.comm, prob, self.out, res, status=self.final_status())
         printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
         return res

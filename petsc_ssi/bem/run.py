@@ -52,6 +52,12 @@ def load_mesh(cfg, planes, comm):
                 params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
                 mesh = surface.read_gmsh(cfg.mesh, params)
             mesh.check()
+            z = np.abs(mesh.nodes[:, 2])
+            ext = float(np.ptp(mesh.nodes[:, :2], axis=0).max()) or 1.0
+            if z.max() > 1e-9 * ext:
+                k = int(z.argmax())
+                raise SSIError(f"-ssi_mesh {cfg.mesh}: the surface mesh must lie in the plane z = 0 (the free "
+                               f"surface of the half-space z < 0); node {k} is at z = {mesh.nodes[k, 2]:.6g} m")
         except SSIError as exc:
             err = str(exc)
         except Exception as exc:  # unreadable file, gmsh failure
@@ -249,6 +255,15 @@ class BEMProblem:
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
+        # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
+        # block-sparse is refused now, before the full O(N E) count
+        est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64)
+        peak0 = max(peak0, est0 + extra_bytes)
+        if share * peak0 > 1.5 * limit:
+            raise SSIError(f"the lag matrices need about {share * peak0 / 1e9:.3g} GB at assembly (estimated from a "
+                           f"sample of rows, every lag block-sparse) on {'the most loaded node' if n_nodes > 1 else 'this node'}, "
+                           f"more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry "
+                           "planes, -ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
         est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra)
         peak = max(peak, est + extra_bytes)
         if share * peak > limit and c.lag_storage == "auto":
@@ -260,6 +275,7 @@ class BEMProblem:
                 self.lag_fill = 1.01
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
+        self.mem_peak_estimate = peak
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "

@@ -176,12 +176,8 @@ class SSITransient(TransientProblem):
                  "cycled_steps": law.cycled_steps, "interface_nodes": self.iface.n, "lags": prob.L,
                  "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
                  "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am}
-        import resource
-        from mpi4py import MPI
-        hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
-        mpi = comm.tompi4py()
-        stats["peak_rss_max_rank_bytes"] = mpi.allreduce(hwm, op=MPI.MAX)
-        stats["peak_rss_sum_bytes"] = mpi.allreduce(hwm)
+        from ..problem import peak_rss
+        stats["peak_rss_max_rank_bytes"], stats["peak_rss_sum_bytes"] = peak_rss(comm)
         res["stats"] = stats
         if cfg.contact == "unilateral":
             per = law.t_algebra / max(nch, 1)

@@ -174,8 +174,9 @@ def main():
     PETSc = init()
     comm = PETSc.COMM_WORLD
     cfg = ssi_options.resolve(("common", "fem"))
+    from ..io.output import check_output, command_output
+    cfg.set("output", command_output(cfg.output, "modes"))       # never the transient run's file
     if cfg.output:
-        from ..io.output import check_output
         check_output(cfg.output, comm, cfg.output_overwrite)
     from .model import build_model
     model = build_model(cfg, comm)

@@ -68,8 +68,9 @@ def main():
     from .model import build_model
     from .run import ReceiverSeries, FieldWriter, receiver_record, near_null_args
     cfg = ssi_options.resolve(("common", "fem"))
+    from ..io.output import check_output, command_output
+    cfg.set("output", command_output(cfg.output, "static"))       # never the transient run's file
     if cfg.output:
-        from ..io.output import check_output
         check_output(cfg.output, comm, cfg.output_overwrite)
     model = build_model(cfg, comm)
     _, near = near_null_args(cfg.fem_solver, model)

@@ -60,6 +60,21 @@ def output_files(path):
     return [path] + [stem + s for s in SIDECARS]
 
 
+def command_output(path, command, argv=None):
+    """The output of ``petsc-ssi modes`` or ``static``: -ssi_output as given on the command line;
+    from an options file (or the default) ``<stem>-<command>.h5``, so the command run with a
+    transient case's options never replaces that run's result (kept when the stem already ends
+    with the command's name: out/block-modes.h5)."""
+    import sys
+    argv = sys.argv[1:] if argv is None else argv
+    if not path or "-ssi_output" in argv:
+        return path
+    stem, ext = os.path.splitext(path)
+    if stem.lower().endswith(command):
+        return path
+    return f"{stem}-{command}{ext or '.h5'}"
+
+
 def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     """Collective, before any heavy work: SSIError (one line, every rank) unless ``path`` (and the
     outputs ``also``, e.g. the structure's file of a coupled run) can be written: not a sidecar
