@@ -121,6 +121,7 @@ def main(argv=None):
     except SSIError as exc:
         PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
         sys.stdout.flush()
+
         PETSc.COMM_WORLD.tompi4py().Barrier()
         return 2
     except Exception:  # a bug or an I/O failure on some ranks only: never hang mpirun

@@ -82,6 +82,52 @@ class SSIError(RuntimeError):
     """An input or set-up error, raised on every rank with the same message."""
 
 
+class DiskFullError(SSIError):
+    """The output's file system has no room for the next write (checked before it): the run stops
+    cleanly, keeping what it wrote."""
+
+
+def collective_io(fn, what, comm):
+    """``fn()``: PETSc viewer calls, collective. A PETSc error there (the disk filled up during the
+    write, a quota, a file system gone) leaves the viewer's file unflushable and may leave the other
+    ranks waiting inside an HDF5 collective: the failing rank prints one line and ends the job
+    (MPI_Abort on more than one rank, which also ends ranks stuck in the collective; exit status 2
+    on one). ``ensure_space`` before large writes stops cleanly in the common case instead."""
+    PETSc = init()
+    try:
+        fn()
+    except PETSc.Error as exc:
+        import os
+        sys.stdout.write(f"petsc-ssi: error: {what} failed (PETSc error {exc.ierr} in the viewer: disk full, "
+                         f"a quota or the file system; the file may be unreadable)\n")
+        sys.stdout.flush()
+        sys.stderr.flush()
+        if comm.getSize() > 1:
+            comm.tompi4py().Abort(2)
+        os._exit(2)
+
+
+def ensure_space(path, nbytes, comm, what):
+    """Collective: DiskFullError on every rank if the file system of ``path`` has less than
+    ``nbytes`` (plus 10 % and 1 MB for HDF5 metadata) free for this user (rank 0's statvfs; a quota
+    is not seen)."""
+    import os
+    short = None
+    if comm.getRank() == 0:
+        try:
+            st = os.statvfs(os.path.dirname(os.path.abspath(path)))
+            free = st.f_bavail * st.f_frsize
+            need = 1.1 * nbytes + 1e6
+            if free < need:
+                short = (f"{what}: the file system of {path} has {free / 1e6:.3g} MB free, the write needs about "
+                         f"{need / 1e6:.3g} MB; the run stops here")
+        except OSError:
+            pass
+    short = comm.tompi4py().bcast(short, root=0)
+    if short:
+        raise DiskFullError(short)
+
+
 def comm_world():
     PETSc = init()
     return PETSc.COMM_WORLD

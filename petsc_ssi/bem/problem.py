@@ -69,8 +69,8 @@ class BEMTransient(TransientProblem):
             prev = rec.unorm[-w] if w else 0.0
             grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
             t = self.time(n)
+            self.n = n                        # the step is taken; its records follow
             rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
-            self.n = n
             if self.cfg.guard:
                 _guard(self.cfg, self.prob, self.march, rec.unorm, n)
         self.state = (u, p)

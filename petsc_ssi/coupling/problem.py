@@ -128,10 +128,10 @@ class SSITransient(TransientProblem):
                      f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
             nrm = u.norm()
             n_open = int((~res["closed"]).sum())
+            self.n = n                        # the step is taken; its records follow
             self.rec.step(n, t, soil=(u, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
                           norm=nrm, status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} "
                                            f"it {res['iterations']}")
-            self.n = n
             if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
                 raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
                                "(beta = c dt / l) and -ssi_coupling_traction")

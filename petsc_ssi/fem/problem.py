@@ -75,8 +75,8 @@ class FEMTransient(TransientProblem):
         with staged("FEM time loop"), event("FEM_timeloop"):
             self.integ.step(self.load(n))
             t = self.time(n)
+            self.n = n                        # the step is taken; its records follow
             self.rec.step(n, t, structure=(self.integ.u, self.integ.velocity(self.vel)), status=f"t = {t:.5g} s")
-            self.n = n
         self.state = (self.integ.u, self.vel)
         return self.state
 

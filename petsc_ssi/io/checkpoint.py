@@ -32,7 +32,7 @@ import os
 
 import numpy as np
 
-from ..petsc import init, collective_error, SSIError
+from ..petsc import init, collective_error, collective_io, ensure_space, SSIError
 
 FORMAT = 1
 
@@ -153,18 +153,19 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial):
         except OSError as exc:
             err = f"checkpoint {path}: {exc.strerror or exc}"
     collective_error(err, comm)
-    try:
-        viewer = PETSc.Viewer().createHDF5(tmp, mode="w", comm=comm)
+    ensure_space(path, 8.0 * sum(v.getSize() for v in vecs.values()), comm, f"checkpoint after step {step}")
+    viewer = PETSc.Viewer().createHDF5(tmp, mode="w", comm=comm)
+
+    def write_vecs():
         for name, v in vecs.items():
             old = v.getName()
             v.setName(name)
-            v.view(viewer)
-            v.setName(old)
-        viewer.destroy()
-    except PETSc.Error as exc:
-        err = f"checkpoint {path}: the PETSc HDF5 viewer failed (error {exc.ierr}: disk full or no permission?)"
-    collective_error(err, comm)
-    comm.tompi4py().Barrier()
+            try:
+                v.view(viewer)
+            finally:
+                v.setName(old)
+    collective_io(write_vecs, f"writing the checkpoint {tmp}", comm)
+    collective_io(viewer.destroy, f"closing the checkpoint {tmp}", comm)
     if comm.getRank() == 0:
         try:
             from .. import __version__

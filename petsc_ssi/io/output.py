@@ -27,7 +27,7 @@ import time as _time
 
 import numpy as np
 
-from ..petsc import init, collective_error
+from ..petsc import init, collective_error, collective_io, ensure_space
 
 XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
              "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
@@ -174,7 +174,7 @@ class Output:
         ``cell_type`` 'mixed', a list [(xdmf type name, (E, n) cells)] of blocks
         (written as one XDMF Mixed topology)."""
         coords_vec.setName("coordinates")
-        coords_vec.view(self.viewer)
+        collective_io(lambda: coords_vec.view(self.viewer), f"writing {self.path}", self.comm)
         self.n_nodes = coords_vec.getSize() // 3
         self.n_cells = 0
         if cell_type == "mixed":
@@ -187,11 +187,19 @@ class Output:
     def write_fields(self, t, fields):
         """Collective: one snapshot of nodal fields ``{name: Vec(bs 3)}``."""
         k = len(self.times)
-        for name, vec in fields.items():
-            old = vec.getName()
-            vec.setName(f"{name}_{k:06d}")
-            vec.view(self.viewer)
-            vec.setName(old)
+        ensure_space(self.path, 8.0 * sum(v.getSize() for v in fields.values()),
+                     self.comm, f"snapshot {k} (t = {t:.6g} s)")
+
+        def write():
+            for name, vec in fields.items():
+                old = vec.getName()
+                vec.setName(f"{name}_{k:06d}")
+                try:
+                    vec.view(self.viewer)
+                finally:
+                    vec.setName(old)
+        collective_io(write, f"writing {self.path} (snapshot {k}, t = {t:.6g} s)", self.comm)
+        for name in fields:
             if name not in self.fields:
                 self.fields.append(name)
         self.times.append(float(t))
@@ -202,9 +210,8 @@ class Output:
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
         ``groups``: {group: {name: array}} more serial data (rank 0). ``status``: how the run
         ended (the file's attribute ``run_status`` and the record's)."""
-        self.viewer.destroy()
-        self.viewer = None
-        self.comm.tompi4py().Barrier()
+        viewer, self.viewer = self.viewer, None
+        collective_io(viewer.destroy, f"closing {self.path}", self.comm)
         self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status), f"writing {self.path}")
 
     def flush(self, receivers=None, attrs=None, record=None, groups=None, status="running"):
@@ -215,7 +222,13 @@ class Output:
             return
         try:
             self.close(receivers, attrs, record, groups, status)
-        finally:                                   # a failed flush (a reader holding the file) keeps writing
+        except BaseException:                      # a failed flush (a reader holding the file) keeps writing
+            self._reopen()
+            raise
+        self._reopen()
+
+    def _reopen(self):
+        if self.viewer is None:
             self.viewer = self.PETSc.Viewer().createHDF5(self.path, mode="a", comm=self.comm)
 
     def _rank0(self, work, what):

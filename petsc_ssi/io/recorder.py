@@ -47,7 +47,12 @@ class SoilRecorder:
         if self.R is not None:
             self.R.mult(u, self.y)
             self.series.append(self.y.getArray().copy())
-        if write and self.out is not None:
+        if write:
+            self.write(t, u, p)
+
+    def write(self, t, u, p):
+        """Collective: a snapshot of the fields (displacement, nodal traction)."""
+        if self.out is not None:
             with event("SSI_IO"):
                 if self.tnode is not None:
                     self.tnode.mult(p, self.tfield)
@@ -88,7 +93,12 @@ class StructureRecorder:
 
     def record(self, t, u, v=None, write=False):
         self.rec.record(t, u, v)
-        if write and self.fw is not None:
+        if write:
+            self.write(t, u, v)
+
+    def write(self, t, u, v=None):
+        """Collective: a snapshot of the fields."""
+        if self.fw is not None:
             with event(self.io_event):
                 self.fw.write(t, u, v)
 
@@ -140,16 +150,20 @@ class Recorder:
         a dict with the interface keys; ``norm`` the |u| kept for the guard; ``status`` the
         progress line's tail."""
         self.times.append(t)
-        write = self.due(n)
         if soil is not None and self.soil is not None:
-            self.soil.record(soil[0], soil[1], t, write)
+            self.soil.record(soil[0], soil[1], t)
         if structure is not None and self.structure is not None:
-            self.structure.record(t, structure[0], structure[1], write)
+            self.structure.record(t, structure[0], structure[1])
         if interface is not None:
             for k in self.interface:
                 self.interface[k].append(interface[k])
         if norm is not None:
             self.unorm.append(norm)
+        if self.due(n):               # the series of step n are whole before a snapshot can fail (disk full)
+            if soil is not None and self.soil is not None:
+                self.soil.write(t, soil[0], soil[1])
+            if structure is not None and self.structure is not None:
+                self.structure.write(t, structure[0], structure[1])
         self.progress.update(n, status)
 
     def state(self):

@@ -1,0 +1,69 @@
+"""A disk that fills up during a run (issue 14, item 1): on a 2 MB tmpfs the run stops before
+the snapshot that would not fit, in one line with exit status 2 and no traceback, and its file
+holds every step up to the stop (receivers whole, run_status saying why). When the check cannot
+see the shortage (a quota), the failed PETSc write ends the job in one line, exit 2, without a
+hang or a segfault. Needs permission to mount a tmpfs (root); skipped otherwise."""
+import os
+import subprocess
+import sys
+
+import h5py
+import pytest
+
+from helpers import ROOT, PY
+
+BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
+       "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
+       "-ssi_t_end", "0.5", "-ssi_output_stride", "1", "-ssi_warn_beta", "0", "-ssi_receivers", "3,0,0"]
+
+NO_CHECK = """import sys
+import petsc_ssi.io.output as O
+O.ensure_space = lambda *a, **k: None          # as if the shortage were a quota statvfs cannot see
+from petsc_ssi.cli import main
+sys.exit(main(["petsc-ssi"] + sys.argv[1:]))
+"""
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    d = tmp_path / "small"
+    d.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(d)], capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip()})")
+    try:
+        yield d
+    finally:
+        subprocess.run(["umount", str(d)], check=False)
+
+
+def _run(cmd, n):
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(n)] + cmd
+    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=180,
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_full_disk_stops_the_run_and_keeps_its_steps(small_disk, n):
+    out = str(small_disk / "r.h5")
+    r = _run([PY, "-m", "petsc_ssi"] + BEM + ["-ssi_output", out], n)
+    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    assert r.returncode == 2 and len(errs) == 1 and "MB free" in errs[0], r.stdout[-2000:] + r.stderr[-2000:]
+    assert "Traceback" not in r.stderr and "Segmentation" not in r.stderr + r.stdout
+    with h5py.File(out) as f:
+        k = len(f["receivers/t"])
+        assert 10 < k < 200 and str(f.attrs["run_status"]).startswith(f"stopped after step {k} of 200")
+        snaps = sorted(x for x in f if x.startswith("displacement_"))
+        assert len(snaps) == k - 1 == len(f["time"])              # the snapshot of step k did not fit
+        assert abs(f[snaps[-1]][:]).max() > 0
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_failed_write_ends_the_job_in_one_line(small_disk, tmp_path, n):
+    script = tmp_path / "no_check.py"
+    script.write_text(NO_CHECK)
+    r = _run([PY, str(script)] + BEM + ["-ssi_output", str(small_disk / "q.h5")], n)
+    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    assert r.returncode == 2 and 1 <= len(errs) <= n, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "failed (PETSc error" in errs[0] and "Traceback" not in r.stderr
+    assert "Segmentation" not in r.stderr + r.stdout
