@@ -28,7 +28,8 @@ register("output_flush", "real", 10.0, "s", "make the output file readable (time
 register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed rank count: on more than one rank "
          "the direct solves default to SuperLU_dist instead of MUMPS (MUMPS's parallel sums change order between "
          "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
-         "(-ssi_bem_pc_type redundant)", "common")
+         "(-ssi_bem_pc_type redundant); the finished HDF5 files are rewritten without modification times, so "
+         "identical results give identical files", "common")
 register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
          "becomes the step, to keep every checkpoint", "common")
 register("checkpoint_every", "int", 0, "steps", "write a checkpoint every this many steps (0: never; a signal "

@@ -267,11 +267,25 @@ class TransientProblem:
             return self.finish()
 
 
+def _hwm():
+    """This process's peak resident memory, bytes: VmHWM of /proc/self/status (the peak of this
+    program alone; getrusage's ru_maxrss also keeps the RSS of the process it was forked from, e.g.
+    a large pytest), else ru_maxrss."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+
+
 def peak_rss(comm):
     """Collective: (largest, summed) peak resident memory of the ranks so far, bytes (Linux)."""
-    import resource
     from mpi4py import MPI
-    hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+    hwm = _hwm()
     mpi = comm.tompi4py()
     return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
 

@@ -99,3 +99,49 @@ def run_ssi(**opts):
     finally:
         for k in opts:
             db.delValue("ssi_" + k)
+
+
+def signal_midway(args, log, after, send, nranks=1, timeout=240):
+    """Start ``petsc-ssi args`` (under mpirun for ``nranks`` > 1) with a progress line every step,
+    wait for the line of step ``after``, then ``send(p)`` (p: the Popen of python or of mpirun);
+    returns (exit status, the log's text). The run must be long enough to be signalled midway."""
+    import time
+    cmd = [PY, "-m", "petsc_ssi"] + list(args) + ["-ssi_monitor", "-ssi_monitor_every", "1"]
+    if nranks > 1:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
+    with open(log, "w") as fh:
+        p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
+                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    try:
+        t0, seen = time.time(), False
+        while time.time() - t0 < timeout and p.poll() is None:
+            if os.path.exists(log) and f"step {after}/" in open(log).read():
+                seen = True
+                break
+            time.sleep(0.2)
+        assert seen, open(log).read()[-2000:]
+        send(p)
+        rc = p.wait(timeout=120)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    return rc, open(log).read()
+
+
+def write_surface_msh(path, order=2, xmin=-2.0, z=0.0):
+    """A 4 m x 4 m gmsh surface of quadrilaterals (order 2: nine-node) at height z."""
+    import gmsh
+    gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
+    try:
+        gmsh.model.add("t")
+        s = gmsh.model.occ.addRectangle(xmin, -2, z, 4, 4)
+        gmsh.model.occ.synchronize()
+        gmsh.model.addPhysicalGroup(2, [s], name="surface")
+        gmsh.option.setNumber("Mesh.RecombineAll", 1)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
+        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(order)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()

@@ -6,18 +6,15 @@ interrupted run's output in place. Each test compares every dataset of the resta
 bit for bit at the rank count of the checkpoint (one rank, or two with -ssi_reproducible, whose
 solves are deterministic: tests/test_reproducible.py), to 1e-10 relative on another rank count.
 A restart whose options change the run is refused in one line naming the option."""
-import os
 import shutil
 import signal
 import subprocess
-import sys
 
 import h5py
 import numpy as np
 import pytest
 
-from helpers import ROOT, cli
-from test_output_survives import _wait_for
+from helpers import cli, signal_midway
 
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
@@ -126,19 +123,8 @@ def test_a_signal_writes_a_checkpoint_that_restarts_a_coupled_contact_run(tmp_pa
     the run, and its files equal the uninterrupted run's bit for bit (-ssi_reproducible)."""
     args = SSI + ["-ssi_t_end", "12.0", "-ssi_reproducible"]      # 960 steps: the signal comes well before the end
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable, "-m", "petsc_ssi"] + args + [
-        "-ssi_output", out, "-ssi_monitor", "-ssi_monitor_every", "1"]
-    with open(log, "w") as fh:
-        p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
-                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    try:
-        assert _wait_for(log, "step 20/", p), open(log).read()[-2000:]
-        subprocess.run(["pkill", "-TERM", "-P", str(p.pid)], check=True)     # the ranks, mpirun's children
-        rc = p.wait(timeout=120)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    text = open(log).read()
+    rc, text = signal_midway(args + ["-ssi_output", out], log, 20, nranks=2,
+                             send=lambda p: subprocess.run(["pkill", "-TERM", "-P", str(p.pid)], check=True))
     ck = str(tmp_path / "k-checkpoint.h5")
     errs = [ln for ln in text.splitlines() if ln.startswith("petsc-ssi: error: stopped by SIGTERM")]
     assert rc == 2 and len(errs) == 1 and f"resume with -ssi_restart {ck}" in errs[0], text[-2000:]
@@ -162,19 +148,8 @@ def test_a_signal_writes_a_checkpoint_that_restarts_a_bem_run(tmp_path):
     args[args.index("-ssi_t_end") + 1] = "5.0"                 # 2000 steps: the signal comes well before the end
     args[args.index("-ssi_output_stride") + 1] = "200"
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
-    with open(log, "w") as fh:
-        p = subprocess.Popen([sys.executable, "-m", "petsc_ssi"] + args + ["-ssi_output", out, "-ssi_monitor",
-                                                                           "-ssi_monitor_every", "1"],
-                             cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
-                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    try:
-        assert _wait_for(log, "step 30/", p), open(log).read()[-2000:]
-        p.send_signal(signal.SIGTERM)
-        rc = p.wait(timeout=120)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    assert rc == 2, open(log).read()[-2000:]
+    rc, text = signal_midway(args + ["-ssi_output", out], log, 30, lambda p: p.send_signal(signal.SIGTERM))
+    assert rc == 2, text[-2000:]
     with h5py.File(out) as f:
         n = len(f["receivers/t"])
     assert 30 <= n < 2000

@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from helpers import cli
+from helpers import cli, write_surface_msh
 
 SMALL = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
          "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_t_end", "0.01",
@@ -50,7 +50,7 @@ def previous(tmp_path_factory):
     d = tmp_path_factory.mktemp("prev")
     cli(FEM + ["-ssi_output", str(d / "out.h5")])
     assert os.path.exists(d / "out.h5") and os.path.exists(d / "out.json")
-    _write_lifted_mesh(d / "lifted.msh")
+    write_surface_msh(d / "lifted.msh", z=1.0)            # nine-node, at z = 1
     (d / "bad.opts").write_text("-ssi_problem\nfem\n")
     return d
 
@@ -151,25 +151,6 @@ def _cases(d):
     }
     cases.update(more)
     return cases
-
-
-def _write_lifted_mesh(path):
-    """A nine-node surface mesh at z = 1 (not the half-space's surface)."""
-    import gmsh
-    gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
-    try:
-        gmsh.model.add("lifted")
-        s = gmsh.model.occ.addRectangle(-2, -2, 1.0, 4, 4)
-        gmsh.model.occ.synchronize()
-        gmsh.model.addPhysicalGroup(2, [s], name="surface")
-        gmsh.option.setNumber("Mesh.RecombineAll", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-        gmsh.model.mesh.generate(2)
-        gmsh.model.mesh.setOrder(2)
-        gmsh.write(str(path))
-    finally:
-        gmsh.finalize()
 
 
 NAMES = ["existing result", "existing result, modes", "existing result, static", "existing result, bem",

@@ -3,17 +3,13 @@ goes (-ssi_output_flush), a signal (SIGTERM, SIGINT, SIGUSR1) stops the run at t
 current step, and a stop writes the results up to the last step with the file attribute
 ``run_status`` saying how the run ended. Compared bit for bit with an uninterrupted run."""
 import json
-import os
 import signal
-import subprocess
-import sys
-import time
 
 import h5py
 import numpy as np
 import pytest
 
-from helpers import ROOT, cli
+from helpers import cli, signal_midway
 
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_receivers", "2,0,0;0,0,0",
@@ -50,38 +46,15 @@ def test_flushing_every_step_changes_nothing(nranks, tmp_path):
     assert json.load(open(b.replace(".h5", ".json")))["run_status"] == "completed"
 
 
-def _wait_for(path_log, pattern, proc, timeout=240):
-    t0 = time.time()
-    while time.time() - t0 < timeout:
-        if proc.poll() is not None:
-            return False
-        if os.path.exists(path_log) and pattern in open(path_log).read():
-            return True
-        time.sleep(0.2)
-    return False
-
-
 @pytest.mark.parametrize("how", ["SIGTERM one rank", "SIGUSR1 mpirun two ranks"])
 def test_a_signal_stops_the_run_and_keeps_its_results(how, tmp_path):
     """A long BEM run is signalled once it has taken 30 steps: it ends at the end of a step with
     one line and exit status 2, and its file holds the steps done, equal bit for bit to the same
     steps of an uninterrupted run, with run_status 'stopped after step n ... by SIG...'."""
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
-    args = BEM + ["-ssi_t_end", "20", "-ssi_output", out, "-ssi_monitor", "-ssi_monitor_every", "1"]
-    cmd = [sys.executable, "-m", "petsc_ssi"] + args
-    if "two" in how:
-        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2"] + cmd
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    with open(log, "w") as fh:
-        p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT, env=env)
-    try:
-        assert _wait_for(log, "step 30/", p), open(log).read()[-2000:]
-        p.send_signal(signal.SIGUSR1 if "SIGUSR1" in how else signal.SIGTERM)
-        rc = p.wait(timeout=120)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    text = open(log).read()
+    args = BEM + ["-ssi_t_end", "20", "-ssi_output", out]
+    sig = signal.SIGUSR1 if "SIGUSR1" in how else signal.SIGTERM
+    rc, text = signal_midway(args, log, 30, lambda p: p.send_signal(sig), nranks=2 if "two" in how else 1)
     assert rc == 2, text[-2000:]
     errs = [ln for ln in text.splitlines() if ln.startswith("petsc-ssi: error: stopped by SIG")]
     assert len(errs) == 1 and "Traceback" not in text, text[-2000:]
@@ -129,19 +102,8 @@ def test_a_signal_stops_a_coupled_contact_run(tmp_path):
            "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral", "-ssi_receivers", "1,0,0",
            "-ssi_structure_receivers", "0,0,0.25", "-ssi_output_stride", "5", "-ssi_warn_beta", "0"]
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable, "-m", "petsc_ssi"] + ssi + [
-        "-ssi_t_end", "50", "-ssi_output", out, "-ssi_monitor", "-ssi_monitor_every", "1", "-ssi_output_flush", "1e-9"]
-    with open(log, "w") as fh:
-        p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
-                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    try:
-        assert _wait_for(log, "step 20/", p), open(log).read()[-2000:]
-        p.send_signal(signal.SIGUSR1)
-        rc = p.wait(timeout=120)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    text = open(log).read()
+    rc, text = signal_midway(ssi + ["-ssi_t_end", "50", "-ssi_output", out, "-ssi_output_flush", "1e-9"], log, 20,
+                             lambda p: p.send_signal(signal.SIGUSR1), nranks=2)
     assert rc == 2 and "petsc-ssi: error: stopped by SIGUSR1" in text, text[-2000:]
     r = read(out)
     n = len(r["t"])

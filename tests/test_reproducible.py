@@ -1,8 +1,10 @@
 """Reruns at a fixed rank count (issue 14): with -ssi_reproducible, two runs of the same FEM or
-BEM case at -n 2 are bitwise identical (the direct solves use SuperLU_dist; with MUMPS, reruns
+BEM case at -n 2 are bitwise identical, their HDF5 files byte for byte (the direct solves use SuperLU_dist; with MUMPS, reruns
 may differ at round-off: jobscripts/rerun_determinism.sh). A coupled contact run too: there the
 structure uses SuperLU_dist and the soil's step matrix PETSc's LU, whole on every rank (two
 SuperLU_dist factorisations in one process crash PETSc 3.18's build at exit)."""
+import filecmp
+
 import h5py
 import numpy as np
 import pytest
@@ -29,6 +31,8 @@ def test_reruns_are_bitwise_identical(case, tmp_path):
     for k in res[0]:
         assert np.array_equal(res[0][k], res[1][k]), k
         assert np.abs(res[0][k]).max() > 0
+    # ... and the files are identical byte for byte (rewritten without HDF5 modification times)
+    assert filecmp.cmp(str(tmp_path / "r0.h5"), str(tmp_path / "r1.h5"), shallow=False)
 
 
 SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
@@ -45,7 +49,8 @@ def test_coupled_contact_reruns_are_bitwise_identical(tmp_path):
     step matrix redundantly by PETSc's LU, and two runs agree bit for bit, contact status included."""
     res = []
     for k in range(2):
-        out = str(tmp_path / f"s{k}.h5")
+        (tmp_path / f"run{k}").mkdir()
+        out = str(tmp_path / f"run{k}" / "s.h5")           # the same name: the file records its structure file's
         r = cli(SSI + ["-ssi_output", out, "-ssi_reproducible"], nranks=2)
         assert "ssi_bem_pc_type redundant" in r.stdout and "ssi_fem_pc_factor_mat_solver_type superlu_dist" in r.stdout
         with h5py.File(out) as f:
@@ -54,3 +59,5 @@ def test_coupled_contact_reruns_are_bitwise_identical(tmp_path):
     assert not res[0]["interface/closed"].all()          # the interface opened: contact did act
     for k in res[0]:
         assert np.array_equal(res[0][k], res[1][k]), k
+    for name in ("s.h5", "s_structure.h5"):
+        assert filecmp.cmp(str(tmp_path / "run0" / name), str(tmp_path / "run1" / name), shallow=False), name

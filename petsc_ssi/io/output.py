@@ -125,6 +125,49 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
+def _group(parent, name):
+    """A new HDF5 group without modification times (h5py's create_group cannot say so)."""
+    import h5py
+    gcpl = h5py.h5p.create(h5py.h5p.GROUP_CREATE)
+    gcpl.set_obj_track_times(False)
+    return h5py.Group(h5py.h5g.create(parent.id, name.encode(), gcpl=gcpl))
+
+
+def rewrite_without_times(path):
+    """Rank 0: ``path`` copied object by object into a file whose objects carry no modification
+    times, then renamed over it, so identical data give identical bytes. (PETSc's HDF5 viewer
+    creates its datasets with HDF5's default, which records the times; it has no switch.)"""
+    import h5py
+    tmp = path + ".notimes.tmp"
+    fcpl = h5py.h5p.create(h5py.h5p.FILE_CREATE)
+    fcpl.set_obj_track_times(False)
+    with _h5(path, "r") as src, h5py.File(h5py.h5f.create(tmp.encode(), h5py.h5f.ACC_TRUNC, fcpl=fcpl)) as dst:
+        def copy(s, d):
+            for k, v in s.attrs.items():
+                d.attrs[k] = v
+            for name in s:
+                obj = s[name]
+                if isinstance(obj, h5py.Group):
+                    copy(obj, _group(d, name))
+                else:
+                    ds = d.create_dataset(name, data=obj[()], track_times=False, chunks=obj.chunks,
+                                          maxshape=obj.maxshape if obj.chunks else None)   # as PETSc made it:
+                    # a restart appends through PETSc's viewer, which extends chunked datasets
+                    for k, v in obj.attrs.items():
+                        ds.attrs[k] = v
+        copy(src, dst)
+    os.replace(tmp, path)
+
+
+def _h5(path, mode):
+    """h5py.File without HDF5's file locking where the library allows (a reader may hold it)."""
+    import h5py
+    try:
+        return h5py.File(path, mode, locking=False)
+    except (TypeError, ValueError):            # h5py < 3.5, or an HDF5 without the locking switch
+        return h5py.File(path, mode)
+
+
 class Output:
     """Collective writer of one run's fields and series."""
 
@@ -163,6 +206,8 @@ class Output:
         self.cells = None
         self.cell_type = None
         self.n_nodes = 0
+        # -ssi_reproducible: the finished file is rewritten without HDF5 modification times
+        self.deterministic = PETSc.Options().getBool("ssi_reproducible", False)
 
     def state(self):
         """The snapshot list, for a checkpoint: {'times', 'fields'}."""
@@ -204,7 +249,7 @@ class Output:
                 self.fields.append(name)
         self.times.append(float(t))
 
-    def close(self, receivers=None, attrs=None, record=None, groups=None, status="completed"):
+    def close(self, receivers=None, attrs=None, record=None, groups=None, status="completed", final=True):
         """Collective: close the viewer, then rank 0 adds the serial data and
         writes the XDMF and JSON files. ``receivers``: dict with 'points'
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
@@ -212,7 +257,7 @@ class Output:
         ended (the file's attribute ``run_status`` and the record's)."""
         viewer, self.viewer = self.viewer, None
         collective_io(viewer.destroy, f"closing {self.path}", self.comm)
-        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status), f"writing {self.path}")
+        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status, final), f"writing {self.path}")
 
     def flush(self, receivers=None, attrs=None, record=None, groups=None, status="running"):
         """Collective: make the file readable as it stands (a run killed or stopped later keeps
@@ -221,7 +266,7 @@ class Output:
         if self.viewer is None:
             return
         try:
-            self.close(receivers, attrs, record, groups, status)
+            self.close(receivers, attrs, record, groups, status, final=False)
         except BaseException:                      # a failed flush (a reader holding the file) keeps writing
             self._reopen()
             raise
@@ -243,21 +288,16 @@ class Output:
                 err = f"{what}: {type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
         collective_error(err, self.comm)
 
-    def _write_serial(self, receivers, attrs, record, groups=None, status="completed"):
+    def _write_serial(self, receivers, attrs, record, groups=None, status="completed", final=True):
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
         earlier flush wrote); XDMF; JSON."""
-        import h5py
-        try:                                       # no lock: a reader may hold the file open mid-run
-            f = h5py.File(self.path, "a", locking=False)
-        except (TypeError, ValueError):            # h5py < 3.5, or an HDF5 without the locking switch
-            f = h5py.File(self.path, "a")
-        with f:
+        with _h5(self.path, "a") as f:             # no lock: a reader may hold the file open mid-run
             for name in ("topology", "time", "receivers") + tuple(groups or ()):
                 if name in f:
                     del f[name]
             if self.cells is not None:
-                f.create_dataset("topology", data=self.cells)
-            f.create_dataset("time", data=np.asarray(self.times))
+                f.create_dataset("topology", data=self.cells, track_times=False)
+            f.create_dataset("time", data=np.asarray(self.times), track_times=False)
             f.attrs["run_status"] = status
             f.attrs["cell_type"] = self.cell_type or ""
             f.attrs["fields"] = ",".join(self.fields)
@@ -267,13 +307,15 @@ class Output:
             for k, v in (attrs or {}).items():
                 f.attrs[k] = v
             if receivers is not None:
-                g = f.create_group("receivers")
+                g = _group(f, "receivers")
                 for k, v in receivers.items():
-                    g.create_dataset(k, data=np.asarray(v))
+                    g.create_dataset(k, data=np.asarray(v), track_times=False)
             for gname, data in (groups or {}).items():
-                g = f.create_group(gname)
+                g = _group(f, gname)
                 for k, v in data.items():
-                    g.create_dataset(k, data=np.asarray(v))
+                    g.create_dataset(k, data=np.asarray(v), track_times=False)
+        if final and self.deterministic:
+            rewrite_without_times(self.path)
         self._write_xdmf()
         if record is not None:
             record = dict(record, run_status=status)

@@ -4,7 +4,7 @@ import shutil
 import numpy as np
 import pytest
 
-from helpers import resolve_error, cli, ROOT
+from helpers import resolve_error, cli, ROOT, write_surface_msh
 
 SMALL = dict(mesh_size="4,4", mesh_h=1.0, t_end=0.003)
 
@@ -31,21 +31,7 @@ def test_bad_input_one_line_error(opts, expect):
 
 
 def _write_msh(path, order, xmin=-2.0):
-    import gmsh
-    gmsh.initialize(["gmsh", "-v", "0"], readConfigFiles=False)
-    try:
-        gmsh.model.add("t")
-        s = gmsh.model.occ.addRectangle(xmin, -2, 0, 4, 4)
-        gmsh.model.occ.synchronize()
-        gmsh.model.addPhysicalGroup(2, [s], name="surface")
-        gmsh.option.setNumber("Mesh.RecombineAll", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 0)
-        gmsh.model.mesh.generate(2)
-        gmsh.model.mesh.setOrder(order)
-        gmsh.write(str(path))
-    finally:
-        gmsh.finalize()
+    write_surface_msh(path, order, xmin)
 
 
 def test_mesh_not_nine_node_quads(tmp_path):
