@@ -80,8 +80,8 @@ def _cases(d):
         "-inf dt": (FEM + ["-ssi_output", str(d / "n.h5"), "-ssi_dt", "-inf"], "-ssi_dt: '-inf' is not a finite number"),
         "patch beyond the mesh": (SMALL + ["-ssi_output", str(d / "n.h5"), "-ssi_mesh_patch", "2.5,1"],
                                   "-ssi_mesh_patch 2.5,1: the patch (half-widths) reaches the edge of the mesh"),
-        "contact option, bonded": (SSI + ["-ssi_output", str(d / "n.h5"), "-ssi_contact_tol", "1e-6"],
-                                   "-ssi_contact_tol acts only with -ssi_contact unilateral"),
+        "contact tolerance zero": (SSI + ["-ssi_output", str(d / "n.h5"), "-ssi_contact", "unilateral",
+                                          "-ssi_contact_tol", "0"], "-ssi_contact_tol 0.0: must be > 0"),
         "unknown command": (["mode"] + FEM, "unknown command 'mode' (did you mean modes?)"),
         "unknown command, far": (["solve"] + FEM, "unknown command 'solve'; commands: run, post"),
     }
@@ -130,8 +130,8 @@ def _cases(d):
         "options file with a bare value": (["-options_file", str(d / "bad.opts")] + FEM,
                                            "line 2: 'fem' is not an option"),
         # the coupling
-        "cohesion with bonded": (SSI + ["-ssi_output", n, "-ssi_contact_cohesion", "1e3"],
-                                 "-ssi_contact_cohesion needs -ssi_contact unilateral"),
+        "no contact iteration": (SSI + ["-ssi_output", n, "-ssi_contact", "unilateral", "-ssi_contact_max_iter", "0"],
+                                 "must be >= 1"),
         "unknown contact": (SSI + ["-ssi_output", n, "-ssi_contact", "frictional"], "is not one of"),
         "staggered with newmark": (SSI + ["-ssi_output", n, "-ssi_coupling", "staggered", "-ssi_fem_integrator",
                                           "newmark"], "drop -ssi_fem_integrator newmark"),
@@ -155,7 +155,7 @@ def _cases(d):
 
 NAMES = ["existing result", "existing result, modes", "existing result, static", "existing result, bem",
          "sidecar name .xmf", "sidecar name .json", "a directory", "/dev/full", "directory under a file", "nan load",
-         "inf density", "inf end time", "-inf dt", "patch beyond the mesh", "contact option, bonded",
+         "inf density", "inf end time", "-inf dt", "patch beyond the mesh", "contact tolerance zero",
          "unknown command", "unknown command, far", "misspelt option", "unknown problem", "bad enum",
          "int not an int", "bool not a bool", "zero dt", "negative end time", "negative stride", "negative flush",
          "nan flush", "negative monitor_every", "zero density", "cs above cp", "nan wave speed", "mesh file missing",
@@ -164,7 +164,7 @@ NAMES = ["existing result", "existing result, modes", "existing result, static",
          "interpolation unknown", "negative interp_k", "memory limit too small", "fem mesh missing",
          "Poisson ratio 0.5", "negative Young's modulus", "fixed group missing", "box cells not three",
          "unknown integrator", "point load malformed", "part without an element type",
-         "options file missing", "options file with a bare value", "cohesion with bonded",
+         "options file missing", "options file with a bare value", "no contact iteration",
          "unknown contact", "staggered with newmark", "interface group missing", "negative checkpoint_every",
          "inf checkpoint interval", "checkpoint name of a sidecar", "checkpoint replaces a file",
          "restart file missing", "restart from a result", "lag file missing", "lag file replaces a file"]
@@ -240,3 +240,12 @@ def test_unused_solver_options_are_named(tmp_path):
     assert len(w) == 1 and w[0].endswith("-ssi_bem_pc_type -ssi_fem_ksp_tpye"), r.stdout[-1500:]
     r = cli(FEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_fem_ksp_type", "preonly"], nranks=2)
     assert "never used" not in r.stdout
+
+
+def test_contact_options_on_a_bonded_interface_are_ignored_with_a_warning(tmp_path):
+    """A study switching one options file between the two contact laws keeps the unilateral
+    options; with -ssi_contact bonded they do nothing, and the run says so in one warning line."""
+    r = cli(SSI + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_contact_tol", "1e-6", "-ssi_contact_cohesion", "1e3"],
+            nranks=2)
+    w = [ln for ln in r.stdout.splitlines() if "act only with -ssi_contact unilateral" in ln]
+    assert len(w) == 1 and "-ssi_contact_cohesion -ssi_contact_tol" in w[0] and "ignored" in w[0], r.stdout[-1500:]

@@ -69,13 +69,18 @@ def _ssi_checks(cfg):
     if cfg.coupling == "implicit" and cfg.coupling_traction == "extrapolated":
         return ("-ssi_coupling_traction extrapolated is for -ssi_coupling staggered; the implicit step takes "
                 "the traction as the mean force over the step, which it is")
-    if cfg.user_set("contact_cohesion") and cfg.contact != "unilateral":
-        return "-ssi_contact_cohesion needs -ssi_contact unilateral (a bonded interface has no limit)"
-    for name in ("contact_open_traction", "contact_tol", "contact_max_iter"):
-        if cfg.user_set(name) and cfg.contact != "unilateral":
-            return (f"-ssi_{name} acts only with -ssi_contact unilateral (the interface is {cfg.contact}: "
-                    "no contact iteration); drop it or set -ssi_contact unilateral")
     return None
+
+
+CONTACT_ONLY = ("contact_cohesion", "contact_open_traction", "contact_tol", "contact_max_iter")
+
+
+def ignored_contact_options(cfg):
+    """The unilateral-contact options the user set on a bonded interface (they do nothing: a study
+    that switches one options file between the two laws keeps them; the run warns)."""
+    if cfg.contact == "unilateral":
+        return []
+    return [f"-ssi_{n}" for n in CONTACT_ONLY if cfg.user_set(n)]
 
 
 register_check((G,), _ssi_checks)

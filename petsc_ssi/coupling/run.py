@@ -64,6 +64,12 @@ def _view(cfg, **changes):
 def setup(cfg, comm):
     """Collective: the soil problem, the structure's model (not assembled) and the
     interface, all checked. Returns (prob, model, iface, fe_cfg)."""
+    from .options import ignored_contact_options
+    from ..petsc import warn
+    ignored = ignored_contact_options(cfg)
+    if ignored:
+        warn(f"{' '.join(ignored)} act{'s' if len(ignored) == 1 else ''} only with -ssi_contact unilateral; "
+             f"ignored (the interface is {cfg.contact})", comm)
     prob = BEMProblem(cfg, comm, log=printf)
     fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
     model = build_model(fe_cfg, comm, assemble_matrices=False)

@@ -44,7 +44,6 @@ def test_two_ranks_reproduce_one(tmp_path):
     (["-ssi_fem_interface", "bottom"], "no face group 'bottom'"),
     (["-ssi_fem_integrator", "green"], "-ssi_coupling implicit integrates the structure with the trapezoidal rule"),
     (["-ssi_disp_group", "load"], "-ssi_disp_group prescribes soil displacements"),
-    (["-ssi_contact", "bonded", "-ssi_contact_cohesion", "10"], "-ssi_contact_cohesion needs -ssi_contact unilateral"),
 ])
 def test_bad_input_one_line_every_rank(tmp_path, extra, msg):
     p = cli(CASE + ["-ssi_output", str(tmp_path / "x.h5")] + extra, nranks=2, check=False)
