@@ -77,7 +77,12 @@ register("load_history", "enum", "heaviside", "", "time history of the load: hea
 register("load_t0", "real", 0.025, "s", "duration of the box pulse", "bem", validator=positive)
 register("load_table", "str", "", "", "file of 't value' rows (value multiplies p0), linearly interpolated", "bem")
 register("disp_group", "str", "", "", "elements with a prescribed displacement (group name or 'box:...')", "bem")
-register("disp_value", "str", "0,0,0", "m", "prescribed displacement 'ux,uy,uz' (times the history)", "bem")
+register("disp_value", "str", "0,0,0", "m", "prescribed displacement 'ux,uy,uz' (times the history): the translation "
+         "u0 of the rigid motion u = h(t) [u0 + theta0 x (x - x_ref)]", "bem")
+register("disp_rotation", "str", "0,0,0", "rad", "small rotation 'rx,ry,rz' theta0 of the prescribed rigid motion "
+         "about the axes through -ssi_disp_ref (times the history)", "bem")
+register("disp_ref", "str", "0,0,0", "m", "reference point x_ref of the rigid motion and of the recorded moments of "
+         "the -ssi_disp_group region's traction", "bem")
 register("disp_history", "enum", "heaviside", "", "time history of the prescribed displacement: heaviside, box, table", "bem",
          choices=("heaviside", "box", "table"))
 register("disp_t0", "real", 0.025, "s", "duration of the box history", "bem", validator=positive)

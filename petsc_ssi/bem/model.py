@@ -38,6 +38,7 @@ class Regions:
         both = np.intersect1d(load_elems, disp_elems)
         if both.size:
             raise SSIError(f"{both.size} elements are both loaded and have a prescribed displacement")
+        self.load_elems, self.disp_elems = load_elems, disp_elems
         self.load_nodes = np.unique(mesh.cells[load_elems]) if load_elems.size else np.zeros(0, np.int64)
         self.disp_nodes = np.unique(mesh.cells[disp_elems]) if disp_elems.size else np.zeros(0, np.int64)
         self.n_load = len(self.load_nodes)

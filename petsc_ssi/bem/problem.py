@@ -78,14 +78,16 @@ class BEMTransient(TransientProblem):
 
     def write_partial(self, status):
         rec = self.rec
-        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n}}
+        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
+               "resultants": rec.soil.resultants(rec.times)}
         _finish(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, prob, plan, ls, info = self.cfg, self.prob, self.plan, self.ls, self.info
         rec = self.rec
-        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm)}
+        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm),
+               "resultants": rec.soil.resultants(rec.times)}
         res["stats"] = {
             "assembly_s": info["t_asm"], "wall_s": time.perf_counter() - self.t_start, "lags": prob.L,
             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,

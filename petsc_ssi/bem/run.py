@@ -14,6 +14,7 @@ from ..mesh import surface
 from ..io.output import provenance
 from .. import timegrid
 from . import symmetry, receivers as rec, histories, lagmats
+from .resultants import RigidMotion
 from .model import Material, Regions, LagSet, causal_lags, machine_memory
 from . import interp
 from .march import Marcher
@@ -104,8 +105,11 @@ class BEMProblem:
         self._load_f = _history(cfg, "load") if len(load) else None
         self._disp_f = _history(cfg, "disp") if len(disp) else None
         self.regions = Regions(self.mesh, load, disp)
-        symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None,
-                                  self._disp_value() if len(disp) else None)
+        for name in ("disp_rotation", "disp_ref"):
+            if cfg.user_set(name) and not cfg.disp_group:
+                warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
+        symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
+        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes) if len(disp) else None
         self.receivers = rec.parse(cfg.receivers)
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
@@ -296,22 +300,16 @@ class BEMProblem:
             return np.tile(tr * histories.step_mean(f, n, self.dt, c.load_history, c.load_t0), nl)
         return kp
 
-    def _disp_value(self):
-        try:
-            val = np.array([float(s) for s in self.cfg.disp_value.split(",")])
-            assert val.size == 3
-        except (ValueError, AssertionError):
-            raise SSIError(f"-ssi_disp_value '{self.cfg.disp_value}': expected 'ux,uy,uz'") from None
-        return val
+    def disp_factor(self, n):
+        """h(t_n) of the prescribed motion."""
+        return float(self._disp_f(n * self.dt))
 
     def known_u(self):
-        c = self.cfg
-        nd = self.regions.n_disp
-        if not nd:
+        """callable(n) -> the prescribed displacements of step n at the region's nodes (3 n_disp,):
+        the rigid motion h(t_n) [u0 + theta0 x (x - x_ref)] (``resultants.RigidMotion``)."""
+        if not self.regions.n_disp:
             return lambda n: np.zeros(0)
-        val = self._disp_value()
-        f = self._disp_f
-        return lambda n: np.tile(val * float(f(n * self.dt)), nd)
+        return lambda n: self.motion.values(self.disp_factor(n))
 
 
 def run_bem(cfg, comm=None):
@@ -484,10 +482,11 @@ def _finish(cfg, comm, prob, out, res, status="completed", final=True):
         recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
     attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
              "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
+    groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
     if cfg.mesh_patch and cfg.load_group == "load":
         attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
     rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
-    (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status)
+    (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status, groups=groups)
     ev.end()
     if not final:
         return

@@ -376,25 +376,9 @@ def _owned(dofs, vec):
 
 def _area_weights(mesh, iface, order=6):
     """a_k = int N_k dGamma and the first moments b_k = int x N_k dGamma over the interface
-    elements (an independent quadrature of the traction resultants: sum_k a_k p_k = int p dGamma,
-    sum_k b_k x p_k = int x x p dGamma)."""
-    g, w = np.polynomial.legendre.leggauss(order)
-    xi, eta = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
-    ww = np.outer(w, w).ravel()
-    X = mesh.cell_coords()[iface.be_elems]
-    xg, jn = quad9.geometry(X, xi, eta)
-    J = np.linalg.norm(jn, axis=-1) * ww
-    Nq = quad9.shape(xi, eta)                         # (P, 9)
-    Ne = J @ Nq                                       # (E, 9)
-    Be = np.einsum("ep,pa,epi->eai", J, Nq, xg)       # (E, 9, 3)
-    lut = -np.ones(mesh.n_nodes, np.int64)
-    lut[iface.be_nodes] = np.arange(iface.n)
-    a = np.zeros(iface.n)
-    b = np.zeros((iface.n, 3))
-    loc = lut[mesh.cells[iface.be_elems]].ravel()
-    np.add.at(a, loc, Ne.ravel())
-    np.add.at(b, loc, Be.reshape(-1, 3))
-    return a, b
+    elements (an independent quadrature of the traction resultants)."""
+    from ..bem.resultants import area_moments
+    return area_moments(mesh, iface.be_elems, iface.be_nodes, order)
 
 
 def run_ssi(cfg, comm=None):

@@ -42,11 +42,17 @@ class SoilRecorder:
         self.tnode = traction_to_nodes(comm, prob, march)
         self.tfield = march.u_tmpl.duplicate()
         self.series = []
+        self.res = None                   # the prescribed region's force and moment (bem/resultants.py)
+        if prob.regions.n_disp and getattr(prob, "motion", None) is not None:
+            from ..bem.resultants import Resultants
+            self.res = Resultants(comm, prob, march.p_tmpl)
 
     def record(self, u, p, t=None, write=False):
         if self.R is not None:
             self.R.mult(u, self.y)
             self.series.append(self.y.getArray().copy())
+        if self.res is not None:
+            self.res.record(p)
         if write:
             self.write(t, u, p)
 
@@ -59,17 +65,43 @@ class SoilRecorder:
                 self.out.write_fields(t, {"displacement": u, "traction": self.tfield})
 
     def state(self, n_times):
-        """Collective: {'soil_receivers': (K, R, 3)} on rank 0, for a checkpoint."""
+        """Collective: {'soil_receivers': (K, R, 3), 'soil_resultants': (K, 6)} on rank 0, for a
+        checkpoint."""
+        out = {}
         u = self.receivers(n_times)
-        return {"soil_receivers": u} if u is not None else {}
+        if u is not None:
+            out["soil_receivers"] = u
+        if self.res is not None:
+            fm = self.res.arrays()
+            if fm is not None:
+                out["soil_resultants"] = fm
+        return out
 
     def restore(self, s):
-        """The series of a checkpoint: each rank takes its rows of R."""
-        if self.R is None:
-            return
-        full = np.asarray(s["soil_receivers"]).reshape(len(s["times"]), -1)
-        r0, r1 = self.R.getOwnershipRange()
-        self.series = [row[r0:r1].copy() for row in full]
+        """The series of a checkpoint: each rank takes its rows of R (and of the resultants')."""
+        if self.R is not None:
+            full = np.asarray(s["soil_receivers"]).reshape(len(s["times"]), -1)
+            r0, r1 = self.R.getOwnershipRange()
+            self.series = [row[r0:r1].copy() for row in full]
+        if self.res is not None:
+            full = np.asarray(s["soil_resultants"]).reshape(len(s["times"]), 6)
+            r0, r1 = self.res.R.getOwnershipRange()
+            self.res.series = [row[r0:r1].copy() for row in full]
+
+    def resultants(self, times):
+        """Collective: the output group 'resultants' (rank 0; None elsewhere or without a
+        prescribed region): t, force (K, 3), moment (K, 3) about x_ref, h (the motion's factor at
+        t_n), u0, theta0, x_ref."""
+        if self.res is None:
+            return None
+        fm = self.res.arrays()
+        if fm is None:
+            return None
+        m = self.prob.motion
+        t = np.asarray(times, float)
+        h = np.array([self.prob.disp_factor(int(round(tk / self.prob.dt))) for tk in t])
+        return {"t": t, "force": fm[:, :3], "moment": fm[:, 3:], "h": h, "u0": m.u0, "theta0": m.theta,
+                "x_ref": m.xref}
 
     def receivers(self, n_times):
         """Collective: the receiver series (K, R, 3) on rank 0 (None elsewhere, or without receivers)."""
