@@ -5,6 +5,7 @@ Commands:
   post FILE.h5    post-process an output file (--receivers --csv, --spectrum, --transfer A B)
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
   static          static solution K u = F of a FE structure (loads at h = 1), written like a run
+  impedance       dynamic stiffness K(a0) of a surface footing (-ssi_disp_group), one run per mode
   estimate        predicted time per stage and memory of the run, per rank count, and
                   whether it fits the nodes (no assembly; -ssi_estimate_* options)
   help            list every -ssi_ option with default, unit and meaning (also -help, --help)
@@ -15,7 +16,7 @@ and exit status 2 on every rank.
 """
 import sys
 
-COMMANDS = ("run", "post", "modes", "static", "help", "estimate")
+COMMANDS = ("run", "post", "modes", "static", "help", "estimate", "impedance")
 
 
 def _split(argv):
@@ -115,6 +116,9 @@ def main(argv=None):
         elif cmd == "estimate":
             from .driver import estimate
             estimate()
+        elif cmd == "impedance":
+            from .impedance import main as impedance_main
+            impedance_main()
         if cmd != "estimate":
             from .petsc import warn_unused_options
             warn_unused_options()

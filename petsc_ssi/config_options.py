@@ -83,9 +83,9 @@ register("disp_rotation", "str", "0,0,0", "rad", "small rotation 'rx,ry,rz' thet
          "about the axes through -ssi_disp_ref (times the history)", "bem")
 register("disp_ref", "str", "0,0,0", "m", "reference point x_ref of the rigid motion and of the recorded moments of "
          "the -ssi_disp_group region's traction", "bem")
-register("disp_history", "enum", "heaviside", "", "time history of the prescribed displacement: heaviside, box, table", "bem",
-         choices=("heaviside", "box", "table"))
-register("disp_t0", "real", 0.025, "s", "duration of the box history", "bem", validator=positive)
+register("disp_history", "enum", "heaviside", "", "time history of the prescribed displacement: heaviside, box, table, "
+         "smoothstep ((1 - cos(pi t/t0))/2 up to t0, then 1)", "bem", choices=("heaviside", "box", "table", "smoothstep"))
+register("disp_t0", "real", 0.025, "s", "duration of the box history, rise time of the smoothstep", "bem", validator=positive)
 register("disp_table", "str", "", "", "file of 't value' rows for the prescribed displacement", "bem")
 register("lags_save", "str", "", "", "save the assembled lag matrices (PETSc binary FILE and FILE.json with the "
          "key of what they depend on) for -ssi_lags_load", "bem")
@@ -139,7 +139,7 @@ def _bem_checks(cfg):
 register_check(("bem",), _bem_checks)
 
 # Modules that own further options declare them when imported.
-for _mod in ("petsc_ssi.fem.options", "petsc_ssi.coupling.options", "petsc_ssi.estimate"):
+for _mod in ("petsc_ssi.fem.options", "petsc_ssi.coupling.options", "petsc_ssi.estimate", "petsc_ssi.impedance"):
     try:
         importlib.import_module(_mod)
     except ModuleNotFoundError as _exc:

@@ -30,7 +30,7 @@ import numpy as np
 
 from .petsc import SSIError
 
-KINDS = ("heaviside", "box", "table")
+KINDS = ("heaviside", "box", "table", "smoothstep")
 
 
 def read_table(table):
@@ -68,8 +68,8 @@ class History:
             raise SSIError(f"unknown history '{kind}' (one of {', '.join(KINDS)})")
         self.kind = kind
         self.t0 = None if t0 is None else float(t0)
-        if kind == "box" and not (self.t0 is not None and self.t0 > 0):
-            raise SSIError(f"box history needs a duration t0 > 0 (got {t0})")
+        if kind in ("box", "smoothstep") and not (self.t0 is not None and self.t0 > 0):
+            raise SSIError(f"{kind} history needs a duration t0 > 0 (got {t0})")
         if kind == "table":
             self.tt, self.hh = read_table(table)
             # breakpoints of h on (0, inf): 0, the table times > 0, with h just
@@ -93,6 +93,9 @@ class History:
             return np.where(t > 0, 1.0, 0.0)
         if self.kind == "box":
             return np.where((t > 0) & (t <= self.t0), 1.0, 0.0)
+        if self.kind == "smoothstep":          # (1 - cos(pi t/t0))/2 up to t0, then 1: a broadband rise
+            tc = np.clip(t, 0.0, self.t0)
+            return 0.5 * (1.0 - np.cos(np.pi * tc / self.t0))
         return np.where(t > 0, np.where(t < self.tt[0], 0.0, np.interp(t, self.tt, self.hh)), 0.0)
 
     def integral(self, t):
@@ -102,6 +105,9 @@ class History:
             return t
         if self.kind == "box":
             return np.minimum(t, self.t0)
+        if self.kind == "smoothstep":
+            tc = np.minimum(t, self.t0)
+            return 0.5 * tc - self.t0 / (2 * np.pi) * np.sin(np.pi * tc / self.t0) + np.maximum(t - self.t0, 0.0)
         k = np.clip(np.searchsorted(self._knots, t, side="right") - 1, 0, len(self._knots) - 1)
         h_end = self._limit(t, right=False)
         return self._cum[k] + 0.5 * (self._h_right[k] + h_end) * (t - self._knots[k])
