@@ -5,6 +5,7 @@ p(t) = p0 (H(t) - H(t - t0)) (Romero, Galvin & Dominguez, Section 5.1):
 
   heaviside  H(t) = 1 for t > 0, 0 for t <= 0;
   box        H(t) - H(t - t0): 1 on (0, t0], 0 elsewhere;
+  smoothstep (1 - cos(pi t/t0))/2 on [0, t0], then 1 (a smooth rise: petsc-ssi impedance);
   table      rows 't h' (exactly two numbers a row, t strictly increasing,
              finite): h piecewise linear between the rows, 0 before the
              first time (and for t <= 0: everything starts from rest at
