@@ -125,8 +125,13 @@ def main(argv=None):
     except SSIError as exc:
         PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
         sys.stdout.flush()
-
-        PETSc.COMM_WORLD.tompi4py().Barrier()
+        comm = PETSc.COMM_WORLD.tompi4py()
+        comm.Barrier()
+        if comm.Get_rank() > 0:
+            # mpirun ends the job at the first non-zero exit and may drop rank 0's last output
+            # still in its pipe (the error line): rank 0 exits first
+            import time
+            time.sleep(0.3)
         return 2
     except Exception:  # a bug or an I/O failure on some ranks only: never hang mpirun
         import traceback

@@ -138,7 +138,7 @@ def main():
         rho, cp, cs = cfg.rho, cfg.cp, cfg.cs
         C_inf = rho * (cp if speed == "cp" else cs) * {"A": A, "Iy": Iy, "J": J}[measure]
         settle = float(np.ptp(R[-max(len(R) // 5, 2):]) / abs(R[-1]))
-        h_el = cfg.mesh_h
+        h_el = p.prob.h                     # the mesh's element size (a gmsh mesh's too)
         band = (4 * np.pi * B / (cs * len(R) * cfg.dt), min(np.pi * B / (2 * h_el), 0.3 * B / (cs * cfg.dt)))
         curves[mode] = (a0, K.real / K0, c, C_inf * cs / (B * K0), band)
         for i in range(len(a0)):

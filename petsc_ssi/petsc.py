@@ -172,6 +172,9 @@ def warn(msg, comm=None):
     printf("petsc-ssi: warning: " + msg, comm)
 
 
+_APPLIED_DEFAULTS = set()
+
+
 def _options_used():
     """A function name -> whether PETSc queried the option, or None where it cannot be known:
     petsc4py's ``Options.used`` where it exists, else PETSc's ``PetscOptionsUsed`` through ctypes
@@ -205,7 +208,8 @@ def unused_petsc_options():
     used = _options_used()
     if used is None:
         return None
-    keys = [k for k in init().Options().getAll() if k.startswith(PREFIX) and _is_petsc_object_option(k[len(PREFIX):])]
+    keys = [k for k in init().Options().getAll() if k.startswith(PREFIX) and _is_petsc_object_option(k[len(PREFIX):])
+            and k not in _APPLIED_DEFAULTS]           # our own defaults: not the user's to worry about
     return sorted(k for k in keys if not used(k))
 
 
@@ -231,6 +235,7 @@ def set_default_options(prefix, defaults, log=None):
         if not opts.hasName(name):
             opts.setValue(name, value)
             applied.append(f"-{name} {value}")
+            _APPLIED_DEFAULTS.add(name)
     if log is not None and applied:
         log(f"  defaults applied: {' '.join(applied)}")
     return applied

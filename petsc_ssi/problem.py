@@ -127,6 +127,8 @@ class TransientProblem:
         if self._key is None:
             self._key = checkpoint.run_key(self.cfg)
         with staged("SSI checkpoint"):
+            if self.cfg.get("output"):
+                self._flush()              # the output holds every snapshot the checkpoint lists, even after SIGKILL
             vecs, serial = self.checkpoint_state()
             checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial)
         self._last_ckpt = time.perf_counter()

@@ -33,7 +33,8 @@ def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
     """MPIDENSE from node-block triplets of local rows."""
     PETSc = init()
     A = PETSc.Mat().createDense(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
-                                comm=comm)
+                                bsize=3, comm=comm)          # bs 3 as BAIJ and loaded Mats: the traction
+                                                             # Vecs (and their checkpoints) keep one layout
     A.setUp()
     arr = A.getDenseArray()
     arr[...] = 0.0

@@ -22,7 +22,7 @@ import os
 
 import numpy as np
 
-from ..petsc import init, collective_error, SSIError
+from ..petsc import init, collective_error, collective_io, SSIError
 
 FORMAT = 1
 
@@ -69,6 +69,9 @@ def _read_json(path, comm, what):
                 data = json.load(fh)
             if data.get("format") != FORMAT or "key" not in data:
                 raise SSIError(f"{what} {path}: not a petsc-ssi lag file (format {FORMAT})")
+            if os.path.getsize(path) != data.get("bytes"):
+                raise SSIError(f"{what} {path}: {os.path.getsize(path)} bytes, {path}.json says {data.get('bytes')} "
+                               "(a truncated or replaced file)")
         except SSIError as exc:
             err = str(exc)
         except (OSError, ValueError) as exc:
@@ -119,15 +122,14 @@ def save(path, comm, march, key):
     tmp = path + ".tmp"
     mats = _mats(march)
     err = None
-    try:
-        viewer = PETSc.Viewer().createBinary(tmp, mode="w", comm=comm)
+    viewer = PETSc.Viewer().createBinary(tmp, mode="w", comm=comm)
+
+    def write():
         for _, M in mats:
             if M is not None:
                 M.view(viewer)
-        viewer.destroy()
-    except PETSc.Error as exc:
-        err = f"-ssi_lags_save {path}: the PETSc binary viewer failed (error {exc.ierr}: disk full?)"
-    collective_error(err, comm)
+    collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
+    collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     size = 0
     if comm.getRank() == 0:
         try:
@@ -156,7 +158,8 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
     types = {"dense": PETSc.Mat.Type.DENSE, "baij": PETSc.Mat.Type.BAIJ, "aij": PETSc.Mat.Type.AIJ}
     viewer = PETSc.Viewer().createBinary(path, mode="r", comm=comm)
     out = {"A": [], "H": [], "G": [], "HI": [], "GI": []}
-    try:
+
+    def read():
         for name, kind in manifest["mats"]:
             group = name.rstrip("0123456789")
             if kind == "empty":
@@ -168,9 +171,6 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
             M.setType(types[kind])
             M.load(viewer)
             out[group].append(M)
-    except PETSc.Error as exc:
-        raise SSIError(f"-ssi_lags_load {path}: the PETSc binary viewer failed (error {exc.ierr}: a truncated "
-                       "or changed file?)") from None
-    finally:
-        viewer.destroy()
+    collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
+    viewer.destroy()
     return out["A"][0], out["H"], out["G"], out["HI"], out["GI"]

@@ -208,6 +208,8 @@ class Reader:
 
     def output_state(self, prefix):
         """The snapshot list of an Output saved under ``prefix`` (``Output.state``)."""
+        if prefix + "_times" not in self.serial:      # the interrupted run wrote no output
+            return None
         return {"times": self.serial[prefix + "_times"], "fields": self.serial[prefix + "_fields"]}
 
     def load(self, name, vec):
