@@ -273,13 +273,10 @@ def _hwm():
     """This process's peak resident memory, bytes: VmHWM of /proc/self/status (the peak of this
     program alone; getrusage's ru_maxrss also keeps the RSS of the process it was forked from, e.g.
     a large pytest), else ru_maxrss."""
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
+    from .bem.model import proc_status_bytes
+    hwm = proc_status_bytes("VmHWM")
+    if hwm is not None:
+        return hwm
     import resource
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
 

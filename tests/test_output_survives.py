@@ -95,12 +95,9 @@ def test_a_signal_stops_a_coupled_contact_run(tmp_path):
     contact case with MUMPS on 2 ranks differ by up to 1e-8 in u_f while nodes lift off); a flush
     every step (-ssi_output_flush 1e-9) is on, so the partial writes of the coupled problem are
     exercised every step too."""
-    ssi = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
-           "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",
-           "1,1,0.25", "-ssi_fem_box_origin", "-0.5,-0.5,0", "-ssi_fem_E", "300e9", "-ssi_fem_rho", "200",
-           "-ssi_dt", "0.0125", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history",
-           "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral", "-ssi_receivers", "1,0,0",
-           "-ssi_structure_receivers", "0,0,0.25", "-ssi_output_stride", "5", "-ssi_warn_beta", "0"]
+    from test_checkpoint import SSI
+    ssi = SSI[:]
+    ssi[ssi.index("-ssi_output_stride") + 1] = "5"
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
     rc, text = signal_midway(ssi + ["-ssi_t_end", "50", "-ssi_output", out, "-ssi_output_flush", "1e-9"], log, 20,
                              lambda p: p.send_signal(signal.SIGUSR1), nranks=2)

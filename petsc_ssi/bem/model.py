@@ -161,16 +161,21 @@ def transient_bytes(blocks, n_nodes, lags, n_rows):
     return cache + chunk + process_rss()
 
 
-def process_rss():
-    """This process's resident memory now (bytes; 0 where /proc is missing)."""
+def proc_status_bytes(field):
+    """A memory field of /proc/self/status ('VmRSS', 'VmHWM'), bytes; None where /proc is missing."""
     try:
         with open("/proc/self/status") as fh:
             for line in fh:
-                if line.startswith("VmRSS:"):
-                    return float(line.split()[1]) * 1024
+                if line.startswith(field + ":"):
+                    return float(line.split()[1]) * 1024.0
     except OSError:
         pass
-    return 0.0
+    return None
+
+
+def process_rss():
+    """This process's resident memory now (bytes; 0 where /proc is missing)."""
+    return proc_status_bytes("VmRSS") or 0.0
 
 
 def _by_lag(trip, L):
