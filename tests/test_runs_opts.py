@@ -1,6 +1,7 @@
 """Every options file under runs/ runs at a reduced size, so the examples
 cannot drift from the code (Firedrake's demo guard). Each run must finish
-and produce an output with finite receiver values."""
+and produce an output with finite receiver values (an impedance case, whose file names the
+`petsc-ssi impedance` command: a finite impedance table)."""
 import glob
 import os
 import re
@@ -38,6 +39,14 @@ def test_options_file_runs_reduced(path, tmp_path):
         args += ["-ssi_mesh_size", "8,8"]
         if _value(text, "receivers"):
             args += ["-ssi_receivers", "2,0,0"]
+    if "petsc-ssi impedance" in text:          # an impedance case: the command, one mode, a few steps
+        cli(["impedance"] + args + ["-ssi_t_end", repr(20 * dt), "-ssi_impedance_modes", "vertical",
+                                    "-ssi_output_overwrite"])
+        import csv
+        rows = list(csv.DictReader(open(str(tmp_path / "run-impedance.csv"))))
+        k = np.array([float(r["K_re"]) for r in rows])
+        assert len(rows) > 10 and np.all(np.isfinite(k)) and abs(float(rows[0]["K0"])) > 0
+        return
     cli(args)
     d = read_h5(out)
     assert d["u"].shape[0] in (3, 4) and np.all(np.isfinite(d["u"]))
