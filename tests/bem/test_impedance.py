@@ -53,7 +53,8 @@ def test_square_footing_vertical_and_rocking(tmp_path):
         assert K0[0] == pytest.approx(ref, rel=2e-3)
         assert abs(k[1] - 1.0) < 0.01                          # the lowest non-zero frequency
         # c near the dashpot limit for a0 in [2, pi B/(2h)]: beyond omega dt = 0.3 (a0 1.19), where k is no
-        # longer trusted, but c hardly moves with dt there (1.13, 1.11, 1.09 at a0 = 2 for dt 1.6, 0.8, 0.4 ms)
+        # longer trusted, but c hardly moves with dt there (1.13, 1.11, 1.09 at a0 = 2 for dt 1.6, 0.8, 0.4 ms:
+        # runs/impedance/dt_study.py)
         hi = (a0 >= 2.0) & (a0 <= np.pi / 2 / 0.5)
         assert np.all(np.abs(c[hi] / lim[mode] - 1.0) < 0.25), (mode, c[hi].min(), c[hi].max(), lim[mode])
     a0, k, c, _ = d["rocking"].T
