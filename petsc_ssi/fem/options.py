@@ -62,8 +62,10 @@ register("fem_load_group", "str", "", "", "loaded faces: comma-separated groups 
 register("fem_load_p0", "real", 0.0, "N/m^2", "pressure on the load group; p0 > 0 pushes into the body "
          "(traction -p0 h(t) n, n the outward normal; on shells, cells oriented up: pushes a slab down)", G)
 register("fem_load_history", "enum", "heaviside", "", "load history h(t) of the pressure and point loads: "
-         "heaviside (1 for t > 0), box (1 on (0, t0]), table", G, choices=("heaviside", "box", "table"))
-register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse", G, validator=positive)
+         "heaviside (1 for t > 0), box (1 on (0, t0]), table, smoothstep ((1 - cos(pi t/t0))/2 up to t0, then 1)", G,
+         choices=("heaviside", "box", "table", "smoothstep"))
+register("fem_load_t0", "real", 0.025, "s", "duration of the box pulse, rise time of the smoothstep", G,
+         validator=positive)
 register("fem_load_table", "str", "", "", "file of 't h' rows, h linearly interpolated (0 before the first "
          "time, the last value after the last)", G)
 register("fem_point_load", "str", "", "m, N, N m", "point loads 'x,y,z,fx,fy,fz[,mx,my,mz];...' at the nearest "
