@@ -30,6 +30,7 @@ Not yet: the published dynamic curves as references, the coupling terms, the hex
 """
 import math
 import os
+import time
 
 import numpy as np
 
@@ -42,7 +43,12 @@ register("impedance_modes", "str", "vertical,horizontal,rocking,torsion", "", "p
 register("impedance_rise", "real", 0.0, "s", "petsc-ssi impedance: rise time t0 of the smooth step (0: 4 dt)", G,
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("impedance_B", "real", 0.0, "m", "petsc-ssi impedance: half-width B of the footing for a0 = omega B / c_s "
-         "(0: half the region's extent in x)", G, validator=lambda v: None if v >= 0 else "must be >= 0")
+         "(0: half the region's smaller extent, x or y; a disk's radius)", G, validator=lambda v: None if v >= 0 else "must be >= 0")
+register("impedance_a0", "str", "", "", "petsc-ssi impedance: the a0 range 'a0_min,a0_max' wanted (a warning when "
+         "it leaves the band the mesh, dt and record length are trusted for)", G)
+register("impedance_reference", "enum", "auto", "", "petsc-ssi impedance: published curves plotted and written "
+         "(k_ref, c_ref): auto (Pais & Kausel for a rectangle, Veletsos & Verbic for a disk), pais-kausel, "
+         "veletsos-verbic, none", G, choices=("auto", "pais-kausel", "veletsos-verbic", "none"))
 register("impedance_symmetry", "bool", True, "", "petsc-ssi impedance: use the symmetry planes each mode allows", G)
 
 AMP = 1e-6
@@ -52,6 +58,9 @@ MODES = {  # name: (option, motion, symmetry, resultant, component, radiation sp
     "rocking": ("disp_rotation", "0,1,0", "x=anti,y=sym", "moment", 1, "cp", "Iy"),
     "torsion": ("disp_rotation", "0,0,1", "x=anti,y=anti", "moment", 2, "cs", "J"),
 }
+# the coupling terms each run also gives: (name, resultant, component)
+CROSS = {"horizontal": ("horizontal-rocking", "moment", 1),      # M_y per unit u_x
+         "rocking": ("rocking-horizontal", "force", 0)}          # F_x per unit theta_y
 
 
 def step_spectrum(s, dt, traction=False, pad=8):
@@ -101,8 +110,10 @@ def rigid_fit(x, u, x_ref=(0.0, 0.0, 0.0)):
 
 
 def _region_geometry(prob):
-    """(half-width in x, area, I_y, J) of the prescribed region, whole (the modelled part times its
-    symmetry images: x, x^2 and y^2 are even under the reflections), by 6 x 6 Gauss points."""
+    """The prescribed region, whole (the modelled part times its symmetry images: x, x^2 and y^2
+    are even under the reflections), by 6 x 6 Gauss points: {'hx', 'hy'} half-extents, 'A' area,
+    'Ix' = int y^2, 'Iy' = int x^2, 'J' = Ix + Iy, and 'shape': 'rectangle' (A = 4 hx hy), 'disk'
+    (hx = hy, A = pi hx^2, to 1e-3) or 'other'."""
     from .bem import symmetry
     from .mesh import quad9
     g, w = np.polynomial.legendre.leggauss(6)
@@ -111,11 +122,54 @@ def _region_geometry(prob):
     xg, jn = quad9.geometry(X, xi, eta)
     J = np.linalg.norm(jn, axis=-1) * np.outer(w, w).ravel()
     nimg = len(symmetry.images(prob.planes))
-    xs = X[..., 0]
-    half = float(xs.max() if any(ax == 0 for ax, _ in prob.planes) else 0.5 * np.ptp(xs))
+    half = []
+    for ax in (0, 1):
+        v = X[..., ax]
+        half.append(float(np.abs(v).max() if any(a == ax for a, _ in prob.planes) else 0.5 * np.ptp(v)))
     Ix = float((J * xg[..., 1] ** 2).sum()) * nimg
     Iy = float((J * xg[..., 0] ** 2).sum()) * nimg
-    return half, float(J.sum()) * nimg, Iy, Ix + Iy
+    A = float(J.sum()) * nimg
+    hx, hy = half
+    shape = "other"
+    if abs(A / (4 * hx * hy) - 1) < 1e-3:
+        shape = "rectangle"
+    elif abs(hx / hy - 1) < 1e-3 and abs(A / (np.pi * hx * hy) - 1) < 1e-3:
+        shape = "disk"
+    return dict(hx=hx, hy=hy, A=A, Ix=Ix, Iy=Iy, J=Ix + Iy, shape=shape)
+
+
+def _reference(geom, mode, a0, nu, name):
+    """(label, k(a0), c(a0)) of the published curve for this footing and mode in our
+    normalisation (a0 = omega B / c_s with our B), or None where there is none."""
+    shape = geom["shape"]
+    if name == "none" or shape == "other":
+        return None
+    from .analytic import impedance_refs as refs
+    if name in ("auto", "pais-kausel") and shape == "rectangle":
+        B, L = min(geom["hx"], geom["hy"]), max(geom["hx"], geom["hy"])
+        if geom["hx"] < geom["hy"]:          # the long side along y: our x motions are P&K's y ones
+            mode = {"horizontal": "horizontal_y", "rocking": "rocking_x"}.get(mode, mode)
+        _, k, c = refs.pais_kausel(mode, a0, LB=L / B, nu=nu)
+        return "Pais & Kausel (1988)", k, c
+    if name in ("auto", "veletsos-verbic") and shape == "disk" and mode != "torsion":
+        try:
+            _, k, c = refs.veletsos_verbic(mode, a0, nu=nu)
+        except ValueError:                   # not tabulated for this nu (0, 1/3, 0.45, 0.5 only)
+            return None
+        return f"Veletsos & Verbic (1973), nu = {nu:.3g}", k, c
+    return None
+
+
+def _a0_range(text):
+    if not text.strip():
+        return None
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise SSIError(f"-ssi_impedance_a0 {text}: give 'a0_min,a0_max'") from None
+    if not 0 <= lo < hi:
+        raise SSIError(f"-ssi_impedance_a0 {text}: needs 0 <= a0_min < a0_max")
+    return lo, hi
 
 
 def main():
@@ -135,9 +189,11 @@ def main():
     for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group"):
         if cfg0.user_set(name):
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
+    want = _a0_range(cfg0.impedance_a0)
     stem = os.path.splitext(cfg0.output or "out/impedance.h5")[0]
     rise = cfg0.impedance_rise or 4 * cfg0.dt
-    table, curves = [], {}
+    nu = ((cfg0.cp / cfg0.cs) ** 2 - 2) / (2 * ((cfg0.cp / cfg0.cs) ** 2 - 1))
+    table, curves, K0s, cross = [], {}, {}, {}
     for mode in modes:
         opt, motion, sym, what, comp, speed, measure = MODES[mode]
         for k in ("disp_value", "disp_rotation"):
@@ -149,40 +205,70 @@ def main():
         cfg = options.resolve(("common", "bem"))
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
                f"{sym if cfg0.impedance_symmetry else 'none'}, smooth step over {rise:.4g} s")
+        t_run = time.perf_counter()
         p = BEMTransient(cfg, comm)
         res = p.run()
+        t_run = time.perf_counter() - t_run
         if comm.getRank() != 0:
             continue
         r = res["resultants"]
-        R = r[what][:, comp] / AMP
-        om, K = spectrum(R, r["h"], cfg.dt)
-        B, A, Iy, J = _region_geometry(p.prob)
-        B = cfg0.impedance_B or B
-        K0 = float(R[-1] / r["h"][-1])
-        a0 = om * B / cfg.cs
-        with np.errstate(divide="ignore", invalid="ignore"):
-            c = np.where(a0 > 0, K.imag / (a0 * K0), np.nan)
+        geom = _region_geometry(p.prob)
+        B = cfg0.impedance_B or min(geom["hx"], geom["hy"])
         rho, cp, cs = cfg.rho, cfg.cp, cfg.cs
-        C_inf = rho * (cp if speed == "cp" else cs) * {"A": A, "Iy": Iy, "J": J}[measure]
-        settle = float(np.ptp(R[-max(len(R) // 5, 2):]) / abs(R[-1]))
         h_el = p.prob.h                     # the mesh's element size (a gmsh mesh's too)
-        band = (4 * np.pi * B / (cs * len(R) * cfg.dt), min(np.pi * B / (2 * h_el), 0.3 * B / (cs * cfg.dt)))
-        curves[mode] = (a0, K.real / K0, c, C_inf * cs / (B * K0), band)
-        for i in range(len(a0)):
-            table.append((mode, a0[i], om[i], K[i].real, K[i].imag, K.real[i] / K0, c[i], K0))
-        printf(f"[impedance] {mode}: K0 = {K0:.5g} (the last fifth of the record within {settle:.2g}), "
-               f"trusted a0 in [{band[0]:.3g}, {band[1]:.3g}]; high-frequency dashpot limit c = "
-               f"{C_inf * cs / (B * K0):.4g}")
-        if settle > 1e-2:
-            warn(f"impedance {mode}: the response has not settled by t_end (last fifth varies {settle:.2g}): K0 and "
-                 "the low frequencies are not converged; raise -ssi_t_end", None)
+        n_steps = len(r["h"])
+        band = (4 * np.pi * B / (cs * n_steps * cfg.dt), min(np.pi * B / (2 * h_el), 0.3 * B / (cs * cfg.dt)))
+        Dh = np.abs(step_spectrum(r["h"], cfg.dt)[1])
+        low = np.nonzero(Dh < 1e-3 * Dh[0])[0]   # K is a ratio of spectra: up to where the pulse fades
+        keep = slice(0, int(low[0]) if low.size else len(Dh))
+        terms = [(mode, what, comp)] + ([CROSS[mode]] if mode in CROSS else [])
+        for name, what_, comp_ in terms:
+            R = r[what_][:, comp_] / AMP
+            om, K = spectrum(R, r["h"], cfg.dt)
+            om, K = om[keep], K[keep]
+            a0 = om * B / cs
+            K0 = float(R[-1] / r["h"][-1])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                c = np.where(a0 > 0, K.imag / (a0 * K0), np.nan)
+            trusted = (a0 >= band[0]) & (a0 <= band[1])
+            ref = _reference(geom, name, a0, nu, cfg0.impedance_reference) if name == mode else None
+            for i in range(len(a0)):
+                table.append((name, a0[i], om[i], K[i].real, K[i].imag, K.real[i] / K0, c[i], K0, int(trusted[i]),
+                              ref[1][i] if ref else np.nan, ref[2][i] if ref else np.nan))
+            if name != mode:
+                cross[name] = K0
+                continue
+            K0s[mode] = K0
+            C_inf = rho * (cp if speed == "cp" else cs) * geom[measure]
+            settle = float(np.ptp(R[-max(len(R) // 5, 2):]) / abs(R[-1]))
+            curves[mode] = (a0, K.real / K0, c, C_inf * cs / (B * K0), band, ref)
+            printf(f"[impedance] {mode}: K0 = {K0:.5g} (the last fifth of the record within {settle:.2g}), "
+                   f"trusted a0 in [{band[0]:.3g}, {band[1]:.3g}]; high-frequency dashpot limit c = "
+                   f"{C_inf * cs / (B * K0):.4g}; the pulse covers a0 <= {a0[-1]:.3g}; {t_run:.1f} s"
+                   + (f"; reference: {ref[0]}" if ref else ""))
+            if settle > 1e-2:
+                warn(f"impedance {mode}: the response has not settled by t_end (last fifth varies {settle:.2g}): K0 "
+                     "and the low frequencies are not converged; raise -ssi_t_end", None)
+            if want and (want[0] < band[0] or want[1] > band[1]):
+                warn(f"impedance {mode}: the requested a0 in [{want[0]:g}, {want[1]:g}] leaves the band this mesh "
+                     f"and record trust, [{band[0]:.3g}, {band[1]:.3g}] (lower: the record length t_end; upper: "
+                     "omega dt <= 0.3 and four elements per shear wavelength): refine dt and h or lengthen t_end",
+                     None)
     if comm.getRank() == 0:
+        if "horizontal" in K0s and "rocking" in K0s:
+            for name, K0 in cross.items():
+                printf(f"[impedance] coupling {name}: K0 = {K0:.5g}, "
+                       f"{K0 / math.sqrt(K0s['horizontal'] * K0s['rocking']):.3g} of sqrt(K0_h K0_r)")
+            if len(cross) == 2:
+                a, b = cross["horizontal-rocking"], cross["rocking-horizontal"]
+                printf(f"[impedance] reciprocity of the coupling terms: K_hr / K_rh - 1 = {a / b - 1:.3g} "
+                       "(0 for the continuous soil; the BEM's collocation is not symmetric)")
         import csv
         with open(stem + "-impedance.csv", "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode", "a0", "omega_rad_s", "K_re", "K_im", "k", "c", "K0"])
+            w.writerow(["mode", "a0", "omega_rad_s", "K_re", "K_im", "k", "c", "K0", "trusted", "k_ref", "c_ref"])
             for row in table:
-                w.writerow([row[0]] + [f"{v:.8g}" for v in row[1:]])
+                w.writerow([row[0]] + [f"{v:.8g}" for v in row[1:8]] + [row[8]] + [f"{v:.6g}" for v in row[9:]])
         _plot(stem + "-impedance.png", curves)
         printf(f"[impedance] wrote {stem}-impedance.csv and {stem}-impedance.png")
     comm.tompi4py().Barrier()
@@ -192,18 +278,26 @@ def _plot(path, curves):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    for mode, (a0, k, c, cinf, band) in curves.items():
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    refname = None
+    for mode, (a0, k, c, cinf, band, ref) in curves.items():
         m = (a0 > 0) & (a0 <= 1.5 * band[1])
         l1, = ax1.plot(a0[m], k[m], label=mode)
         ax2.plot(a0[m], c[m], color=l1.get_color(), label=mode)
         ax2.axhline(cinf, color=l1.get_color(), ls=":", lw=0.8)
+        if ref is not None:
+            refname = ref[0]
+            ax1.plot(a0[m], ref[1][m], color=l1.get_color(), ls="-.", lw=1.0)
+            ax2.plot(a0[m], ref[2][m], color=l1.get_color(), ls="-.", lw=1.0)
         for ax in (ax1, ax2):
             ax.axvline(band[1], color=l1.get_color(), ls="--", lw=0.6)
     ax1.set_xlabel("a0 = omega B / c_s")
     ax1.set_ylabel("k = Re K / K0")
     ax2.set_xlabel("a0 = omega B / c_s")
-    ax2.set_ylabel("c = Im K / (a0 K0)   (dotted: high-frequency dashpot limit)")
+    ax2.set_ylabel("c = Im K / (a0 K0)")
     ax1.legend()
+    ax1.set_title("solid: BEM" + (f"; dash-dot: {refname}" if refname else "") + "; dashed: trusted a0 max",
+                  fontsize=8)
+    ax2.set_title("dotted: high-frequency dashpot limit", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
