@@ -26,7 +26,8 @@ record T), a0 <= pi B / (2 h) (four elements per shear wavelength) and omega dt 
 a0 <= 0.3 B / (c_s dt): the time discretisation's error grows with omega dt (on the square footing
 of runs/impedance/dt_study.py, k at a0 = 2.5 is 1.23, 0.83, 0.73 with dt = 1.6, 0.8, 0.4 ms, and
 converges as dt falls); the command prints the band.
-Not yet: the published dynamic curves as references, the coupling terms, the hex8 path.
+Also: the horizontal-rocking coupling terms (CROSS), the published curves of analytic/impedance_refs.py (k_ref,
+c_ref; -ssi_impedance_reference), and rigid_fit for the impedance of a structure coupled to the soil.
 """
 import math
 import os
