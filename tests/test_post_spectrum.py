@@ -285,3 +285,27 @@ def test_slab_spectrum_peak_at_first_natural_frequency(slab, tmp_path):
                          "--peaks", "1"])
     (fv, _), = _printed_peaks(out)["velocity_x"]
     assert rc == 0 and abs(fv - f1) <= res
+
+
+def test_cli_spectrum_of_a_runs_resultants(tmp_path):
+    """post --spectrum reads the resultants group of a rigid-motion run (issue 12, item 3): the
+    f = 0 amplitude of the vertical force is its mean (no window, no detrend), and the header
+    states the window and the padding."""
+    import h5py
+    from helpers import run_bem
+    out = str(tmp_path / "r.h5")
+    run_bem(mesh_size="2,2", mesh_h=0.5, mesh_patch="0.5,0.5", disp_group="load", disp_value="0,0,1e-6",
+            disp_history="smoothstep", disp_t0=0.05, dt=0.0125, t_end=0.25, cp=42.0, cs=20.0, rho=1800.0,
+            output=out, output_stride=0, warn_beta=0, monitor=0)
+    csv_out = str(tmp_path / "f.csv")
+    cli(["post", out, "--spectrum", "--series", "resultants/force", "--component", "z", "--pad", "2",
+         "--csv", csv_out])
+    text = open(csv_out).read()
+    assert "# window: none" in text and "# padding: zero-padded" in text and "resultants/force" in text
+    rows = np.loadtxt(csv_out, delimiter=",", comments="#", skiprows=0, dtype=str)
+    data = np.array([[float(v) for v in r] for r in rows if r[0] != "f_hz"])
+    with h5py.File(out, "r") as f:
+        fz = f["resultants/force"][:, 2]
+    nfft = 64                                          # 20 samples, padded to the power of two >= 40
+    assert data[0, 1] == pytest.approx(fz.sum() / len(fz), rel=1e-6)
+    assert data[1, 0] == pytest.approx(1.0 / (nfft * 0.0125), rel=1e-9)
