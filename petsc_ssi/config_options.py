@@ -66,6 +66,9 @@ register("cache_share", "bool", True, "", "with -ssi_cache on several ranks: int
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))
+register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "
+         "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
+         "automatic, about sqrt(2 x lags))", "bem", validator=lambda v: None if v >= 0 else "must be >= 0")
 register("lag_fill", "real", 0.35, "", "auto storage: lags with block fill above this are dense", "bem",
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
 register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this per node (0: 80% of this machine's memory); the run's estimated peak is shared by its ranks", "bem",

@@ -116,10 +116,11 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
 
-    def set_lags(self, H, G, plan=None, HI=(), GI=()):
+    def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
         empty) and, with an active interpolation ``plan``, the interpolating
-        Mats HI[j] = H(T_j), GI[j] = G(T_j) that stand for lags plan.Lx+1..L."""
+        Mats HI[j] = H(T_j), GI[j] = G(T_j) that stand for lags plan.Lx+1..L; ``block``: the
+        steps of the time-blocked history sum (1: step by step)."""
         self.H, self.G = H, G
         self.plan = plan if (plan is not None and plan.active) else None
         self.HI, self.GI = list(HI), list(GI)
@@ -132,6 +133,8 @@ class Marcher:
         self.x = self.u_tmpl.duplicate()
         self.wu = self.u_tmpl.duplicate()
         self.wp = self.p_tmpl.duplicate()
+        self.block = max(1, int(block))
+        self._blk = self._pan = None
 
     def _p_vec(self):
         PETSc = self.PETSc
@@ -229,7 +232,14 @@ class Marcher:
         return [(m, c) for m, c in terms if 1 <= m <= n - 1]
 
     def history(self, n, out_u):
-        """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n; lags beyond
+        """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n: time-blocked
+        (``_blocked_history``) when ``block`` > 1, else step by step (``history_step``)."""
+        if self.block > 1:
+            return self._blocked_history(n, out_u)
+        return self.history_step(n, out_u)
+
+    def history_step(self, n, out_u):
+        """The per-step history sum (the reference): one product per lag; lags beyond
         the plan's exact ones through the interpolating matrices: the weighted
         history w_i = sum_l I(l, i) q_l is formed first, then one product per
         interpolating matrix (k products per step, not one per lag)."""
@@ -251,17 +261,26 @@ class Marcher:
                 self._combine(self.wp, self.pbuf, terms)
                 Gj.multAdd(self.wp, out_u, out_u)
 
-    def _interp_history(self, n, out_u):
+    def _interp_coef(self, n):
+        """coef[m, i]: the weight of state m in the interpolated history w_i of step n (None: no
+        interpolated lag reaches a state yet)."""
         plan = self.plan
         lags = np.arange(plan.Lx + 1, min(plan.L, n + 1) + 1)
         if lags.size == 0:
-            return
+            return None
         offs = ((2, 1.0), (1, 2.0), (0, 1.0)) if self.scheme == "stabilized" else ((1, 1.0),)
         coef = np.zeros((n + 1, plan.k))      # coef[m, i]: weight of state m in w_i
         for off, c in offs:
             m = n - lags + off
             ok = (m >= 1) & (m <= n - 1)
             np.add.at(coef, m[ok], c * plan.W[lags[ok] - plan.Lx - 1])
+        return coef
+
+    def _interp_history(self, n, out_u):
+        plan = self.plan
+        coef = self._interp_coef(n)
+        if coef is None:
+            return
         ms = np.nonzero(np.any(coef != 0.0, axis=1))[0]
         if ms.size == 0:
             return
@@ -274,6 +293,104 @@ class Marcher:
             if self.GI and self.GI[i] is not None:
                 self._combine(self.wp, self.pbuf, terms)
                 self.GI[i].multAdd(self.wp, out_u, out_u)
+
+    # ------------------------------------------------------------ the time-blocked history sum
+    # The history sum is a discrete convolution with stationary matrices: the part of the history
+    # sums of the next b steps n0+1 .. n0+b that involves only states already known (m <= n0) is
+    # formed at the block's first step, per matrix one product with a panel of b combined states
+    # (MatMatMult; each stored matrix is read once per b steps instead of b times). The terms of
+    # states inside the block (m > n0; low lags only, j <= b + 1) are added step by step. The
+    # same terms as ``history_step``, summed in another order: equal to round-off
+    # (tests/bem/test_history_block.py). A block is recomputed whenever a step falls outside it
+    # (a restart from a checkpoint included); a contact iteration changes only the current step's
+    # state, which no block reads before the step is final.
+    def _step_terms(self, n):
+        """[(key, state m, coefficient)] of step n's history sum: key ('x', j) the exact lag j
+        (-H_j on u, +G_j on p), ('i', i) the i-th interpolating matrix (-HI_i, +GI_i)."""
+        out = []
+        for j in range(2, min(len(self.H), n + 1) + 1):
+            out += [(("x", j), m, c) for m, c in self._terms(n, j)]
+        if self.plan is not None:
+            coef = self._interp_coef(n)
+            if coef is not None:
+                ms, ii = np.nonzero(coef)
+                out += [(("i", int(i)), int(m), float(coef[m, i])) for m, i in zip(ms, ii)]
+        return out
+
+    def _mats_of(self, key):
+        """(the Mat applied to u, the Mat applied to p) of a history key (None: empty)."""
+        kind, j = key
+        if kind == "x":
+            return self.H[j - 1], (self.G[j - 1] if j - 1 < len(self.G) else None)
+        return self.HI[j], (self.GI[j] if self.GI else None)
+
+    def _panel_mats(self):
+        PETSc = self.PETSc
+        if getattr(self, "_pan", None) is None:
+            b = self.block
+            self._pan = {}
+            for side, tmpl in (("u", self.u_tmpl), ("p", self.p_tmpl)):
+                nl, ng = tmpl.getLocalSize(), tmpl.getSize()
+                M = PETSc.Mat().createDense(size=((nl, ng), (PETSc.DECIDE, b)), comm=self.comm)
+                M.setUp()
+                M.assemble()
+                self._pan[side] = M
+            self._prod = {}
+            self._R = np.zeros((self.u_tmpl.getLocalSize(), b), order="F")
+        return self._pan
+
+    def _new_block(self, n0):
+        """Collective: the known-state part of the history sums of steps n0+1 .. n0+b into
+        ``self._R`` (local rows x b); the in-block terms of each step kept for ``_blocked_history``."""
+        b = self.block
+        pan = self._panel_mats()
+        known, rest = {}, [dict() for _ in range(b)]
+        for k in range(b):
+            for key, m, c in self._step_terms(n0 + 1 + k):
+                if m <= n0:
+                    known.setdefault(key, []).append((k, m, c))
+                else:
+                    rest[k].setdefault(key, []).append((m, c))
+        R = self._R
+        R[...] = 0.0
+        bufs = {"u": [v.getArray(readonly=True) for v in self.ubuf],
+                "p": [v.getArray(readonly=True) for v in self.pbuf]}
+        for key in sorted(known):
+            for M, side, sign in zip(self._mats_of(key), ("u", "p"), (-1.0, 1.0)):
+                if M is None:
+                    continue
+                P = pan[side]
+                a = P.getDenseArray()
+                a[...] = 0.0
+                buf = bufs[side]
+                for k, m, c in known[key]:
+                    a[:, k] += c * buf[self._slot(m)]
+                if hasattr(P, "restoreDenseArray"):
+                    P.restoreDenseArray()
+                C = self._prod.get((key, side))
+                if C is None:
+                    C = self._prod[(key, side)] = M.matMult(P)
+                else:
+                    M.matMult(P, C)
+                R += sign * C.getDenseArray(readonly=True)
+        self._blk = (n0, rest)
+
+    def _blocked_history(self, n, out_u):
+        blk = getattr(self, "_blk", None)
+        if blk is None or not blk[0] < n <= blk[0] + self.block:
+            self._new_block(n - 1)
+        n0, rest = self._blk
+        out_u.getArray()[:] = self._R[:, n - n0 - 1]
+        for key in sorted(rest[n - n0 - 1]):
+            terms = rest[n - n0 - 1][key]
+            MH, MG = self._mats_of(key)
+            if MH is not None:
+                self._combine(self.wu, self.ubuf, terms)
+                MH.mult(self.wu, self.rhs)
+                out_u.axpy(-1.0, self.rhs)
+            if MG is not None:
+                self._combine(self.wp, self.pbuf, terms)
+                MG.multAdd(self.wp, out_u, out_u)
 
     def _combine(self, w, buf, terms):
         w.set(0.0)
@@ -361,6 +478,7 @@ class Marcher:
     def restore(self, reader, n):
         """Collective: the states of a checkpoint after step n (``checkpoint_vecs``)."""
         self.n = int(n)
+        self._blk = None
         for m in self._kept_steps():
             reader.load(f"bem_u_{m:06d}", self.ubuf[self._slot(m)])
             if self.p_tmpl.getSize():

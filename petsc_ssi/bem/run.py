@@ -3,6 +3,7 @@
 Order of work: every input check (collective, one-line errors) and the memory
 estimate come before any assembly.
 """
+import math
 import os
 import time
 
@@ -324,6 +325,25 @@ def run_bem(cfg, comm=None):
     return BEMTransient(cfg, comm).run()
 
 
+def history_block(cfg, plan):
+    """The steps per block of the time-blocked history sum (-ssi_history_block; 0: about
+    sqrt(2 L) for L stored lags, which balances the L/b panel products per step against the
+    about b/2 in-block products)."""
+    b = int(cfg.get("history_block") or 0)
+    if b:
+        return b
+    L = plan.Lx + (plan.k if plan.active else 0)
+    return max(1, min(32, int(round(math.sqrt(2 * L))))) if L >= 8 else 1
+
+
+def _say_block(march):
+    if march.block > 1:
+        printf(f"[ssi] history sum: time-blocked, {march.block} steps per block (-ssi_history_block; 1: step "
+               "by step)")
+    else:
+        printf("[ssi] history sum: step by step (-ssi_history_block 1)")
+
+
 def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     """Collective: assemble the lag matrices (exact and interpolating), factorise
     the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
@@ -375,7 +395,8 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
-    march.set_lags(H, G, plan, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=history_block(cfg, plan))
+    _say_block(march)
     ls.H = ls.G = None   # the triplets are in the Mats now
     if cfg.get("lags_save"):
         from . import lagstore
@@ -416,7 +437,8 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            f"lags ({ndense} dense, {nbaij} block-sparse)"
            + (f", {plan.k} interpolating matrices" if plan.active else "")
            + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
-    march.set_lags(H, G, plan, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=history_block(cfg, plan))
+    _say_block(march)
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
                    "nbaij": nbaij, "fill": float("nan"), "mem": mem_exact + mem_interp}

@@ -1,0 +1,110 @@
+"""The time-blocked history sum (issue 13, item 1; bem/march.py): the known part of the next b steps'
+history sums formed at once, one matrix-panel product per stored matrix, the in-block terms step by
+step. It sums the same terms as the per-step reference (-ssi_history_block 1) in another order, so
+every run must give the reference's solution to round-off: relative 1e-12 of the field's maximum,
+on every recorded displacement and traction, for the plain and stabilised schemes, with and without
+the interpolation of the far lags, with symmetry planes, with a prescribed-displacement region
+(traction unknowns: the G panels), in a coupled run with unilateral contact, and at -n 2."""
+import h5py
+import numpy as np
+import pytest
+
+from helpers import cli
+
+BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "10,10", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
+       "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025", "-ssi_t_end", "0.15",
+       "-ssi_receivers", "3,0,0;0,0,0", "-ssi_output_stride", "7", "-ssi_warn_beta", "0"]
+INTERP = ["-ssi_interp", "linear", "-ssi_interp_tl", "0.01", "-ssi_interp_k", "3"]
+DISP = ["-ssi_problem", "bem", "-ssi_mesh_size", "6,6", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "1,1",
+        "-ssi_disp_group", "load", "-ssi_disp_value", "0,0,1e-6", "-ssi_disp_rotation", "0,1e-6,0",
+        "-ssi_disp_history", "smoothstep", "-ssi_disp_t0", "0.005", "-ssi_dt", "0.0015", "-ssi_t_end", "0.06",
+        "-ssi_output_stride", "5", "-ssi_warn_beta", "0"]
+SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
+       "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",
+       "1,1,0.25", "-ssi_fem_box_origin", "-0.5,-0.5,0", "-ssi_fem_E", "3e8", "-ssi_fem_rho", "2000",
+       "-ssi_dt", "0.0125", "-ssi_t_end", "0.5", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000",
+       "-ssi_fem_load_history", "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral",
+       "-ssi_receivers", "1,0,0", "-ssi_output_stride", "5", "-ssi_warn_beta", "0"]
+
+
+def fields(path):
+    """Every recorded array of the run (displacements, tractions, receivers, resultants, interface)."""
+    out = {}
+    with h5py.File(path) as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f" and any(
+                    s in name for s in ("displacement", "traction", "receivers/u", "resultants/", "interface/")) \
+                    and "residual" not in name:              # round-off diagnostics, not the solution
+                out[name] = obj[...]
+        f.visititems(visit)
+    return out
+
+
+def same(a, b, rtol=1e-12):
+    A, B = fields(a), fields(b)
+    assert set(A) == set(B) and any("displacement" in k for k in A)
+    moving = 0
+    for k in A:
+        scale = np.abs(A[k]).max()
+        moving += scale > 0
+        assert np.abs(A[k] - B[k]).max() <= rtol * scale, (k, np.abs(A[k] - B[k]).max() / scale)
+    assert moving >= 3                 # the comparison is of fields that move, not of zeros
+    return A
+
+
+def log_line(out, text):
+    return [ln for ln in out.splitlines() if text in ln]
+
+
+CASES = {
+    "stabilised": BEM,
+    "plain": BEM + ["-ssi_scheme", "plain"],
+    "interpolated": BEM + INTERP,
+    "symmetry+interp": BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"],
+    "prescribed motion": DISP,
+    "prescribed motion, plain, anti": DISP + ["-ssi_scheme", "plain", "-ssi_disp_value", "1e-6,0,0",
+                                              "-ssi_symmetry", "x=anti,y=sym"],
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_blocked_equals_per_step(tmp_path, case):
+    """Blocks of 5 steps (and the automatic size) against step by step, one rank."""
+    args = CASES[case]
+    ref, blk, auto = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "auto"))
+    assert "history sum: step by step" in cli(args + ["-ssi_output", ref, "-ssi_history_block", "1"]).stdout
+    assert "time-blocked, 5 steps per block" in cli(args + ["-ssi_output", blk, "-ssi_history_block", "5"]).stdout
+    assert "history sum:" in cli(args + ["-ssi_output", auto]).stdout
+    same(ref, blk)
+    same(ref, auto)
+
+
+def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
+    """The block on the half-space with unilateral contact (uplift: the contact iterations change the
+    current step's state only): blocks of 6 against step by step at -n 1, and blocks of 6 at -n 2
+    (MUMPS on 2 ranks is not bitwise reproducible: -ssi_reproducible)."""
+    ref, blk, two = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "two"))
+    cli(SSI + ["-ssi_output", ref, "-ssi_history_block", "1"])
+    cli(SSI + ["-ssi_output", blk, "-ssi_history_block", "6"])
+    A = same(ref, blk)
+    assert any(k.startswith("interface/") for k in A)
+    with h5py.File(ref) as f:
+        closed = f["interface/closed"][...]
+    assert closed.any() and not closed.all()         # the block lifts off: contact is active
+    two1 = str(tmp_path / "two1.h5")
+    cli(SSI + ["-ssi_output", two1, "-ssi_history_block", "1", "-ssi_reproducible"], nranks=2)
+    cli(SSI + ["-ssi_output", two, "-ssi_history_block", "6", "-ssi_reproducible"], nranks=2)
+    same(two1, two)
+
+
+def test_blocked_two_ranks_and_a_block_longer_than_the_lags(tmp_path):
+    """-n 2: blocks of 4 against step by step (both -ssi_reproducible); one rank: a block longer
+    than the run (every term past the first step is then an in-block term) against step by step."""
+    args = BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"]
+    ref, ref2, two, long_ = (str(tmp_path / f"{k}.h5") for k in ("ref", "ref2", "two", "long"))
+    cli(args + ["-ssi_output", ref, "-ssi_history_block", "1"])
+    cli(args + ["-ssi_output", ref2, "-ssi_history_block", "1", "-ssi_reproducible"], nranks=2)
+    cli(args + ["-ssi_output", two, "-ssi_history_block", "4", "-ssi_reproducible"], nranks=2)
+    cli(args + ["-ssi_output", long_, "-ssi_history_block", "200"])
+    same(ref2, two)
+    same(ref, long_)
