@@ -125,7 +125,10 @@ class Marcher:
         self.plan = plan if (plan is not None and plan.active) else None
         self.HI, self.GI = list(HI), list(GI)
         self.p_tmpl = self._p_vec()
-        self.depth = self.L + 2
+        self.block = max(1, int(block))
+        # the ring buffer: the L + 2 states the history sum reads, and with blocks b - 1 more (a
+        # block starts at a multiple of b, also after a restart: the same sums as an uninterrupted run)
+        self.depth = self.L + 2 + (self.block - 1)
         self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
         self.pbuf = [self.p_tmpl.duplicate() for _ in range(self.depth)]
         self._setup_index_maps()
@@ -133,8 +136,7 @@ class Marcher:
         self.x = self.u_tmpl.duplicate()
         self.wu = self.u_tmpl.duplicate()
         self.wp = self.p_tmpl.duplicate()
-        self.block = max(1, int(block))
-        self._blk = self._pan = None
+        self._blk = self._rep = self._R = None
 
     def _p_vec(self):
         PETSc = self.PETSc
@@ -297,13 +299,17 @@ class Marcher:
     # ------------------------------------------------------------ the time-blocked history sum
     # The history sum is a discrete convolution with stationary matrices: the part of the history
     # sums of the next b steps n0+1 .. n0+b that involves only states already known (m <= n0) is
-    # formed at the block's first step, per matrix one product with a panel of b combined states
-    # (MatMatMult; each stored matrix is read once per b steps instead of b times). The terms of
-    # states inside the block (m > n0; low lags only, j <= b + 1) are added step by step. The
-    # same terms as ``history_step``, summed in another order: equal to round-off
-    # (tests/bem/test_history_block.py). A block is recomputed whenever a step falls outside it
-    # (a restart from a checkpoint included); a contact iteration changes only the current step's
-    # state, which no block reads before the step is final.
+    # formed at the block's first step. For each dense matrix (MATDENSE: each rank holds its rows
+    # and every column) it is one BLAS-3 product of the local rows with a panel of b combined
+    # states, taken from copies of the known states that every rank keeps (one all-gather per
+    # state, the data a dense MatMult gathers anyway): each stored matrix is read once per b steps
+    # instead of b times. Sparse (block) matrices, the terms of states inside the block (m > n0;
+    # low lags only, j <= b + 1) and any other Mat type go step by step as in ``history_step``.
+    # The same terms in another order: equal to round-off (tests/bem/test_history_block.py).
+    # Blocks start at multiples of b (n0 = 0, b, 2b, ...), also when a restart resumes inside one
+    # (its known states are in the ring buffer and the checkpoint), so a restart is bitwise the
+    # uninterrupted run; a contact iteration changes only the current step's state, which no block
+    # reads before the step is final.
     def _step_terms(self, n):
         """[(key, state m, coefficient)] of step n's history sum: key ('x', j) the exact lag j
         (-H_j on u, +G_j on p), ('i', i) the i-th interpolating matrix (-HI_i, +GI_i)."""
@@ -317,80 +323,94 @@ class Marcher:
                 out += [(("i", int(i)), int(m), float(coef[m, i])) for m, i in zip(ms, ii)]
         return out
 
-    def _mats_of(self, key):
-        """(the Mat applied to u, the Mat applied to p) of a history key (None: empty)."""
+    def _mat(self, key, side):
+        """The Mat of a history key on side 'u' (applied to u, sign -1) or 'p' (to p, +1); None: empty."""
         kind, j = key
         if kind == "x":
-            return self.H[j - 1], (self.G[j - 1] if j - 1 < len(self.G) else None)
-        return self.HI[j], (self.GI[j] if self.GI else None)
+            if side == "u":
+                return self.H[j - 1]
+            return self.G[j - 1] if j - 1 < len(self.G) else None
+        if side == "u":
+            return self.HI[j]
+        return self.GI[j] if self.GI else None
 
-    def _panel_mats(self):
-        PETSc = self.PETSc
-        if getattr(self, "_pan", None) is None:
-            b = self.block
-            self._pan = {}
+    def _replicate(self, n0):
+        """Collective: every rank's copies of the states m <= n0 the block reads (all-gathered once
+        per state: the copies of earlier blocks stay valid, their states being final)."""
+        if getattr(self, "_rep", None) is None:
+            PETSc = self.PETSc
+            self._rep = {}
             for side, tmpl in (("u", self.u_tmpl), ("p", self.p_tmpl)):
-                nl, ng = tmpl.getLocalSize(), tmpl.getSize()
-                M = PETSc.Mat().createDense(size=((nl, ng), (PETSc.DECIDE, b)), comm=self.comm)
-                M.setUp()
-                M.assemble()
-                self._pan[side] = M
-            self._prod = {}
-            self._R = np.zeros((self.u_tmpl.getLocalSize(), b), order="F")
-        return self._pan
+                sc, seq = PETSc.Scatter.toAll(tmpl)
+                self._rep[side] = (sc, seq, np.zeros((self.depth, tmpl.getSize())))
+            self._rep_upto = 0
+        lo = max(self._rep_upto + 1, n0 - self.depth + 1, 1)
+        for m in range(lo, n0 + 1):
+            for side, bufs in (("u", self.ubuf), ("p", self.pbuf)):
+                sc, seq, arr = self._rep[side]
+                if arr.shape[1] == 0:
+                    continue
+                sc.scatter(bufs[self._slot(m)], seq, addv=self.PETSc.InsertMode.INSERT_VALUES)
+                arr[self._slot(m)] = seq.getArray(readonly=True)
+        self._rep_upto = max(self._rep_upto, n0)
 
     def _new_block(self, n0):
-        """Collective: the known-state part of the history sums of steps n0+1 .. n0+b into
-        ``self._R`` (local rows x b); the in-block terms of each step kept for ``_blocked_history``."""
+        """Collective: the known-state part of the dense matrices' history sums of steps
+        n0+1 .. n0+b into ``self._R`` (b x local rows); every other term kept per step for
+        ``_blocked_history``."""
         b = self.block
-        pan = self._panel_mats()
-        known, rest = {}, [dict() for _ in range(b)]
+        panel, rest = {}, [dict() for _ in range(b)]
         for k in range(b):
             for key, m, c in self._step_terms(n0 + 1 + k):
-                if m <= n0:
-                    known.setdefault(key, []).append((k, m, c))
-                else:
-                    rest[k].setdefault(key, []).append((m, c))
+                for side in ("u", "p"):
+                    M = self._mat(key, side)
+                    if M is None:
+                        continue
+                    if m <= n0 and self._is_dense(M):
+                        panel.setdefault((key, side), []).append((k, m, c))
+                    else:
+                        rest[k].setdefault((key, side), []).append((m, c))
+        if getattr(self, "_R", None) is None or self._R.shape[0] != b:
+            self._R = np.zeros((b, self.u_tmpl.getLocalSize()))        # row k: step n0 + 1 + k
         R = self._R
         R[...] = 0.0
-        bufs = {"u": [v.getArray(readonly=True) for v in self.ubuf],
-                "p": [v.getArray(readonly=True) for v in self.pbuf]}
-        for key in sorted(known):
-            for M, side, sign in zip(self._mats_of(key), ("u", "p"), (-1.0, 1.0)):
-                if M is None:
-                    continue
-                P = pan[side]
-                a = P.getDenseArray()
-                a[...] = 0.0
-                buf = bufs[side]
-                for k, m, c in known[key]:
-                    a[:, k] += c * buf[self._slot(m)]
-                if hasattr(P, "restoreDenseArray"):
-                    P.restoreDenseArray()
-                C = self._prod.get((key, side))
-                if C is None:
-                    C = self._prod[(key, side)] = M.matMult(P)
+        if panel:
+            self._replicate(n0)
+            X = {side: np.zeros((b, self._rep[side][2].shape[1])) for side in ("u", "p")}
+            for (key, side) in sorted(panel):
+                M = self._mat(key, side)
+                rep, x = self._rep[side][2], X[side]
+                x[...] = 0.0
+                for k, m, c in panel[(key, side)]:
+                    x[k] += c * rep[self._slot(m)]
+                At = M.getDenseArray(readonly=True).T         # all columns x local rows, C order
+                self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
+                if side == "u":                               # (x @ At: OpenBLAS's fast layout
+                    R -= x @ At                               # for a skinny panel, twice A @ x.T)
                 else:
-                    M.matMult(P, C)
-                R += sign * C.getDenseArray(readonly=True)
+                    R += x @ At
         self._blk = (n0, rest)
+
+    @staticmethod
+    def _is_dense(M):
+        return "dense" in M.getType()
 
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)
         if blk is None or not blk[0] < n <= blk[0] + self.block:
-            self._new_block(n - 1)
+            self._new_block(self.block * ((n - 1) // self.block))
         n0, rest = self._blk
-        out_u.getArray()[:] = self._R[:, n - n0 - 1]
-        for key in sorted(rest[n - n0 - 1]):
-            terms = rest[n - n0 - 1][key]
-            MH, MG = self._mats_of(key)
-            if MH is not None:
+        out_u.getArray()[:] = self._R[n - n0 - 1]
+        for (key, side) in sorted(rest[n - n0 - 1]):
+            terms = rest[n - n0 - 1][(key, side)]
+            M = self._mat(key, side)
+            if side == "u":
                 self._combine(self.wu, self.ubuf, terms)
-                MH.mult(self.wu, self.rhs)
+                M.mult(self.wu, self.rhs)
                 out_u.axpy(-1.0, self.rhs)
-            if MG is not None:
+            else:
                 self._combine(self.wp, self.pbuf, terms)
-                MG.multAdd(self.wp, out_u, out_u)
+                M.multAdd(self.wp, out_u, out_u)
 
     def _combine(self, w, buf, terms):
         w.set(0.0)
@@ -478,7 +498,7 @@ class Marcher:
     def restore(self, reader, n):
         """Collective: the states of a checkpoint after step n (``checkpoint_vecs``)."""
         self.n = int(n)
-        self._blk = None
+        self._blk = self._rep = None
         for m in self._kept_steps():
             reader.load(f"bem_u_{m:06d}", self.ubuf[self._slot(m)])
             if self.p_tmpl.getSize():
