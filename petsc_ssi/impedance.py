@@ -22,7 +22,10 @@ planes each allows (a footing symmetric about x = 0 and y = 0, x_ref = the origi
 <stem>-<mode>.h5 (each run), <stem>-impedance.csv (a0, K, k, c per mode), <stem>-impedance.png
 (k and c against a0, with each mode's high-frequency dashpot limit: rho c_p A, rho c_s A,
 rho c_p I_y, rho c_s J). The trusted band: a0 >= 4 pi B / (c_s T) (two frequency bins of the
-record T), a0 <= pi B / (2 h) (four elements per shear wavelength) and omega dt <= 0.3, i.e.
+record T) and a0 >= 2 pi B c_R / (c_s L) (one Rayleigh wavelength across the meshed surface, L its
+smaller extent with the symmetry images: below it k and c of a 4 m surface around a 2 m square
+differ from an 8 m surface's by up to 0.13, above it by under 0.02; runs/impedance/extent_study.py),
+a0 <= pi B / (2 h) (four elements per shear wavelength) and omega dt <= 0.3, i.e.
 a0 <= 0.3 B / (c_s dt): the time discretisation's error grows with omega dt (on the square footing
 of runs/impedance/dt_study.py, k at a0 = 2.5 is 1.23, 0.83, 0.73 with dt = 1.6, 0.8, 0.4 ms, and
 converges as dt falls); the command prints the band.
@@ -139,6 +142,25 @@ def _region_geometry(prob):
     return dict(hx=hx, hy=hy, A=A, Ix=Ix, Iy=Iy, J=Ix + Iy, shape=shape)
 
 
+def surface_extent(prob):
+    """The smaller extent (x or y) of the meshed surface, its symmetry images included."""
+    X = np.asarray(prob.mesh.nodes, dtype=float)
+    ext = []
+    for ax in (0, 1):
+        v = X[:, ax]
+        mirrored = any(a == ax for a, _ in prob.planes)
+        ext.append(float(2 * np.abs(v).max() if mirrored else np.ptp(v)))
+    return min(ext)
+
+
+def extent_limit(prob, B, cs, cp):
+    """The lowest a0 the meshed surface is trusted for: one Rayleigh wavelength across it,
+    2 pi c_R / omega <= L, i.e. a0 >= 2 pi B c_R / (c_s L) (module docstring)."""
+    from .analytic.pekeris import arrivals, poisson_ratio
+    gamma = arrivals(poisson_ratio(cs, cp))[2]          # c_s / c_R
+    return 2 * np.pi * B / (gamma * surface_extent(prob))
+
+
 def _reference(geom, mode, a0, nu, name):
     """(label, k(a0), c(a0)) of the published curve for this footing and mode in our
     normalisation (a0 = omega B / c_s with our B), or None where there is none."""
@@ -218,7 +240,9 @@ def main():
         rho, cp, cs = cfg.rho, cfg.cp, cfg.cs
         h_el = p.prob.h                     # the mesh's element size (a gmsh mesh's too)
         n_steps = len(r["h"])
-        band = (4 * np.pi * B / (cs * n_steps * cfg.dt), min(np.pi * B / (2 * h_el), 0.3 * B / (cs * cfg.dt)))
+        a0_record = 4 * np.pi * B / (cs * n_steps * cfg.dt)
+        a0_extent = extent_limit(p.prob, B, cs, cp)
+        band = (max(a0_record, a0_extent), min(np.pi * B / (2 * h_el), 0.3 * B / (cs * cfg.dt)))
         Dh = np.abs(step_spectrum(r["h"], cfg.dt)[1])
         low = np.nonzero(Dh < 1e-3 * Dh[0])[0]   # K is a ratio of spectra: up to where the pulse fades
         keep = slice(0, int(low[0]) if low.size else len(Dh))
@@ -250,11 +274,17 @@ def main():
             if settle > 1e-2:
                 warn(f"impedance {mode}: the response has not settled by t_end (last fifth varies {settle:.2g}): K0 "
                      "and the low frequencies are not converged; raise -ssi_t_end", None)
-            if want and (want[0] < band[0] or want[1] > band[1]):
+            if band[0] >= band[1]:
+                warn(f"impedance {mode}: this mesh and record trust no a0: the lower limit {band[0]:.3g} (the "
+                     f"record, {a0_record:.3g}; one Rayleigh wavelength across the meshed surface, "
+                     f"{a0_extent:.3g}) is above the upper {band[1]:.3g} (omega dt <= 0.3, four elements per "
+                     "shear wavelength): widen the mesh, refine dt and h or lengthen t_end", None)
+            elif want and (want[0] < band[0] or want[1] > band[1]):
                 warn(f"impedance {mode}: the requested a0 in [{want[0]:g}, {want[1]:g}] leaves the band this mesh "
-                     f"and record trust, [{band[0]:.3g}, {band[1]:.3g}] (lower: the record length t_end; upper: "
-                     "omega dt <= 0.3 and four elements per shear wavelength): refine dt and h or lengthen t_end",
-                     None)
+                     f"and record trust, [{band[0]:.3g}, {band[1]:.3g}] (lower: the record length t_end, "
+                     f"a0 >= {a0_record:.3g}, and one Rayleigh wavelength across the meshed surface, "
+                     f"a0 >= {a0_extent:.3g}; upper: omega dt <= 0.3 and four elements per shear wavelength): "
+                     "refine dt and h, lengthen t_end or widen the mesh", None)
     if comm.getRank() == 0:
         if "horizontal" in K0s and "rocking" in K0s:
             for name, K0 in cross.items():
