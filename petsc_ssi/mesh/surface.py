@@ -49,10 +49,13 @@ class SurfaceMesh:
         return self.groups[spec]
 
     def element_sizes(self):
-        """Distance between neighbouring nodes along each element side (E, 2)."""
+        """Distance between neighbouring nodes in each element direction (E, 2): the largest of the
+        six node-to-node segments along xi (both sides and the midline), and along eta, so that a
+        distorted element (an O-grid's) is measured by its longest segment, whatever its node 0."""
         X = self.cell_coords()
-        s1 = np.linalg.norm(X[:, 4] - X[:, 0], axis=1)
-        s2 = np.linalg.norm(X[:, 7] - X[:, 0], axis=1)
+        seg = lambda pairs: np.max([np.linalg.norm(X[:, a] - X[:, b], axis=1) for a, b in pairs], axis=0)
+        s1 = seg(((0, 4), (4, 1), (3, 6), (6, 2), (7, 8), (8, 5)))
+        s2 = seg(((0, 7), (7, 3), (1, 5), (5, 2), (4, 8), (8, 6)))
         return np.stack([s1, s2], 1)
 
     def check(self):

@@ -169,3 +169,18 @@ def test_rigid_disk_quarter_model_runs(tmp_path):
     assert abs(fz[0] / (-2000.0 * 548.0 * np.pi * 1e-6 / 8e-4) - 1) <= 0.1, fz[0]
     assert np.abs(F[:, :2]).max() <= 1e-12 * np.abs(fz).max()
     assert np.abs(M).max() <= 1e-12 * np.abs(fz).max()
+
+
+def test_element_sizes_do_not_depend_on_node_order():
+    """SurfaceMesh.element_sizes (the h of the beta check and the impedance band): the O-grid's
+    distorted elements measured by their longest node-to-node segment, the same when every
+    element's nodes are renumbered to start at another corner (a quarter turn: corners 1 2 3 0,
+    midsides 5 6 7 4, centre 8); for a uniform grid it is the grid's node spacing h/2."""
+    from petsc_ssi.mesh.surface import SurfaceMesh, grid
+    m = problem(**CASE).mesh
+    turned = SurfaceMesh(m.nodes, m.cells[:, [1, 2, 3, 0, 5, 6, 7, 4, 8]], getattr(m, "groups", {}))
+    a, b = m.element_sizes(), turned.element_sizes()
+    assert np.allclose(np.sort(a, axis=1), np.sort(b, axis=1), rtol=1e-12)
+    assert a.max() == pytest.approx(b.max(), rel=1e-12)
+    g = grid(4.0, 4.0, 0.5)
+    assert np.allclose(g.element_sizes(), 0.25, rtol=1e-12)
