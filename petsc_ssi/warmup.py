@@ -1,6 +1,6 @@
 """``python -m petsc_ssi.warmup``: compile the numba kernels into the cache ahead of the first run.
 
-The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``) are compiled by numba
+The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.py``) are compiled by numba
 the first time a version of the sources runs on a machine (about a minute) and cached under
 ``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
 case on one process so that they are compiled now, says so, and exits at once when the cache is
@@ -28,8 +28,9 @@ def main():
     from .bem.run import run_bem
     with tempfile.TemporaryDirectory() as tmp:
         opts = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
-                "load_p0": 1000, "dt": 0.005, "t_end": 0.01, "output": os.path.join(tmp, "w.h5"),
-                "output_stride": 0, "warn_beta": 0}
+                "load_p0": 1000, "dt": 0.005, "t_end": 0.02, "output": os.path.join(tmp, "w.h5"),
+                "output_stride": 0, "warn_beta": 0,
+                "lag_storage": "sparse", "history_block": 2}    # the block-sparse kernels (bem/bsr.py) too
         db = PETSc.Options()
         for k, v in opts.items():
             db.setValue("ssi_" + k, str(v))

@@ -1,5 +1,6 @@
-"""Lag matrices as PETSc Mats: MATMPIDENSE for dense lags, MATMPIBAIJ (3x3
-node blocks) for shell-sparse ones, chosen per lag by global block fill
+"""Lag matrices as PETSc Mats: MATMPIDENSE for dense lags, block-sparse ones (3x3 node
+blocks; ``bsr``: the package's block CSR behind a python Mat) for shell-sparse ones, chosen
+per lag by global block fill
 (``-ssi_lag_storage auto|dense|sparse``, threshold ``-ssi_lag_fill``).
 
 Triplets (row node, lag, column node, 3x3 block) come from ``assemble``;
@@ -18,15 +19,13 @@ def _csr(rows_local, cols, vals, nloc):
 
 
 def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
-    """MPIBAIJ (bs 3) from sorted node-block triplets of local rows."""
-    PETSc = init()
+    """Block-sparse (3x3 node blocks, ``bsr``: the package's block CSR behind a python Mat) from
+    node-block triplets of local rows."""
+    from . import bsr
     o = np.lexsort((cols, rows))               # CSR: columns sorted within a row
     rows, cols, vals = rows[o], cols[o], vals[o]
     ip, ix, v = _csr(rows - r0, cols, vals, nrow_loc)
-    A = PETSc.Mat().createBAIJ(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
-                               bsize=3, csr=(ip, ix, np.ascontiguousarray(v).reshape(-1)), comm=comm)
-    A.assemble()
-    return A
+    return bsr.from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, ip, ix, v)
 
 
 def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
@@ -90,6 +89,9 @@ def mat_bytes(A):
     """Bytes a Mat stores (values and indices), from MatGetInfo."""
     if A is None:
         return 0
+    from . import bsr
+    if bsr.context(A) is not None:
+        return bsr.context(A).nbytes
     PETSc = init()
     inf = A.getInfo(PETSc.Mat.InfoType.LOCAL)   # the caller sums over ranks
     return int(inf.get("memory", 0)) or int(inf.get("nz_allocated", 0) * 8)

@@ -8,7 +8,7 @@ the assembly by loading the matrices a first run saved.
 
 ``FILE`` is a PETSc binary file with the step matrix (after the symmetry rows and columns are
 set), the exact lags H_l and G_l and the interpolating matrices HI_j, GI_j, in that order, each
-in the storage it had (dense or 3x3 block-sparse; an empty lag is not written). ``FILE.json``
+in the storage it had (dense, or 3x3 block-sparse as MPIBAIJ; an empty lag is not written). ``FILE.json``
 lists them and holds the key (``lag_key``: the values above, SHA-256 of the mesh and of the
 traction nodes), written last, so a save that was cut short has no ``.json`` and is refused.
 Loading checks the key before any heavy work and names the first entry that differs; the
@@ -110,8 +110,11 @@ def _mats(march):
 
 
 def _kind(M):
+    from . import bsr
     if M is None:
         return "empty"
+    if bsr.context(M) is not None:
+        return "baij"
     t = M.getType()
     return "dense" if "dense" in t else ("baij" if "baij" in t else "aij")
 
@@ -125,9 +128,17 @@ def save(path, comm, march, key):
     viewer = PETSc.Viewer().createBinary(tmp, mode="w", comm=comm)
 
     def write():
+        from . import bsr
         for _, M in mats:
-            if M is not None:
+            if M is None:
+                continue
+            ctx = bsr.context(M)
+            if ctx is None:
                 M.view(viewer)
+            else:                                 # written as MPIBAIJ, one lag at a time
+                A = ctx.to_baij()
+                A.view(viewer)
+                A.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     size = 0
@@ -170,6 +181,9 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
             M.setSizes(((3 * nloc, 3 * n_nodes), cols), bsize=3)
             M.setType(types[kind])
             M.load(viewer)
+            if kind == "baij":
+                from . import bsr
+                M = bsr.from_mat(M)
             out[group].append(M)
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
     viewer.destroy()

@@ -27,6 +27,7 @@ import scipy.sparse as sp
 
 from ..petsc import init, set_default_options, direct_solver_defaults, printf
 from ..monitor import event
+from . import bsr
 
 
 def _expand(trip, r0, coef, colmap=None):
@@ -302,9 +303,10 @@ class Marcher:
     # formed at the block's first step. For each dense matrix (MATDENSE: each rank holds its rows
     # and every column) it is one BLAS-3 product of the local rows with a panel of b combined
     # states, taken from copies of the known states that every rank keeps (one all-gather per
-    # state, the data a dense MatMult gathers anyway): each stored matrix is read once per b steps
-    # instead of b times. Sparse (block) matrices, the terms of states inside the block (m > n0;
-    # low lags only, j <= b + 1) and any other Mat type go step by step as in ``history_step``.
+    # state, the data a dense MatMult gathers anyway); for each block-sparse one (``bsr``) one
+    # compiled pass over its 3x3 blocks: each stored matrix is read once per b steps instead of b
+    # times. The terms of states inside the block (m > n0; low lags only, j <= b + 1) and any
+    # other Mat type go step by step as in ``history_step``.
     # The same terms in another order: equal to round-off (tests/bem/test_history_block.py).
     # Blocks start at multiples of b (n0 = 0, b, 2b, ...), also when a restart resumes inside one
     # (its known states are in the ring buffer and the checkpoint), so a restart is bitwise the
@@ -366,7 +368,7 @@ class Marcher:
                     M = self._mat(key, side)
                     if M is None:
                         continue
-                    if m <= n0 and self._is_dense(M):
+                    if m <= n0 and self._panel_kind(M):
                         panel.setdefault((key, side), []).append((k, m, c))
                     else:
                         rest[k].setdefault((key, side), []).append((m, c))
@@ -377,23 +379,37 @@ class Marcher:
         if panel:
             self._replicate(n0)
             X = {side: np.zeros((b, self._rep[side][2].shape[1])) for side in ("u", "p")}
+            RT = None
             for (key, side) in sorted(panel):
                 M = self._mat(key, side)
                 rep, x = self._rep[side][2], X[side]
                 x[...] = 0.0
                 for k, m, c in panel[(key, side)]:
                     x[k] += c * rep[self._slot(m)]
-                At = M.getDenseArray(readonly=True).T         # all columns x local rows, C order
-                self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
-                if side == "u":                               # (x @ At: OpenBLAS's fast layout
-                    R -= x @ At                               # for a skinny panel, twice A @ x.T)
-                else:
-                    R += x @ At
+                sign = -1.0 if side == "u" else 1.0
+                if self._panel_kind(M) == "dense":
+                    At = M.getDenseArray(readonly=True).T     # all columns x local rows, C order
+                    self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
+                    if side == "u":                           # (x @ At: OpenBLAS's fast layout
+                        R -= x @ At                           # for a skinny panel, twice A @ x.T)
+                    else:
+                        R += x @ At
+                else:                                         # block-sparse: one pass over its blocks
+                    ctx = bsr.context(M)
+                    if RT is None:
+                        RT = np.zeros((R.shape[1], b))
+                    ctx.panel(np.ascontiguousarray(x.T), RT, sign)
+                    self.PETSc.Log.logFlops(18.0 * b * ctx.indices.size)
+            if RT is not None:
+                R += RT.T
         self._blk = (n0, rest)
 
     @staticmethod
-    def _is_dense(M):
-        return "dense" in M.getType()
+    def _panel_kind(M):
+        """'dense', 'bsr' (a matrix the block forms a panel product with) or None (step by step)."""
+        if "dense" in M.getType():
+            return "dense"
+        return "bsr" if bsr.context(M) is not None else None
 
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)

@@ -1,0 +1,153 @@
+"""Block-sparse (3x3 node blocks) lag matrices in the package's own arrays, as PETSc Mats of type
+python (issue 13, item 1).
+
+PETSc's MPIBAIJ keeps its values out of reach of petsc4py, and its MatMatMult with a dense panel
+(3.18) is one MatMult per column: a time-blocked history sum would read a block-sparse lag b
+times per block of b steps, as the per-step sum does. Here each rank keeps its rows of a lag as a
+block CSR (``indptr`` over local node rows, ``indices`` global column nodes, ``data`` (nnzb, 3, 3)),
+the same bytes as MPIBAIJ (9 doubles and one int per block), and two compiled kernels work on it:
+
+    matvec     y = A x                  (x all-gathered: every column of the local rows)
+    panel      R^T += s A X^T           (X: b combined states, each rank's copy; one pass over A)
+
+The Mat (``BSRMat.mat``, type python) answers MatMult and MatMultAdd, so the per-step path, the
+step's known-value terms and every other caller are unchanged; ``march`` finds the context with
+``context(M)`` and uses the panel kernel. ``-ssi_lags_save`` writes it as MPIBAIJ (``to_baij``,
+one lag at a time) and a loaded MPIBAIJ becomes one again (``from_mat``).
+"""
+import numpy as np
+from numba import njit
+
+from ..petsc import init
+
+
+@njit(cache=True)
+def _matvec(indptr, indices, data, x, y):
+    for i in range(indptr.size - 1):
+        y0 = 0.0
+        y1 = 0.0
+        y2 = 0.0
+        for k in range(indptr[i], indptr[i + 1]):
+            c = 3 * indices[k]
+            x0, x1, x2 = x[c], x[c + 1], x[c + 2]
+            y0 += data[k, 0, 0] * x0 + data[k, 0, 1] * x1 + data[k, 0, 2] * x2
+            y1 += data[k, 1, 0] * x0 + data[k, 1, 1] * x1 + data[k, 1, 2] * x2
+            y2 += data[k, 2, 0] * x0 + data[k, 2, 1] * x1 + data[k, 2, 2] * x2
+        y[3 * i] = y0
+        y[3 * i + 1] = y1
+        y[3 * i + 2] = y2
+
+
+@njit(cache=True)
+def _panel(indptr, indices, data, XT, RT, sign):
+    """RT[3i+p, t] += sign * sum_k data[k, p, q] XT[3 col_k + q, t] (XT: columns x b, C order)."""
+    b = XT.shape[1]
+    acc = np.empty((3, b))
+    for i in range(indptr.size - 1):
+        acc[:, :] = 0.0
+        for k in range(indptr[i], indptr[i + 1]):
+            c = 3 * indices[k]
+            for p in range(3):
+                a0, a1, a2 = data[k, p, 0], data[k, p, 1], data[k, p, 2]
+                for t in range(b):
+                    acc[p, t] += a0 * XT[c, t] + a1 * XT[c + 1, t] + a2 * XT[c + 2, t]
+        for p in range(3):
+            for t in range(b):
+                RT[3 * i + p, t] += sign * acc[p, t]
+
+
+class _Shell:
+    """The python Mat's context: MatMult and MatMultAdd through ``_matvec``."""
+
+    def __init__(self, bsr):
+        self.bsr = bsr
+        self.scatter = None
+
+    def _gather(self, x):
+        PETSc = init()
+        if self.scatter is None:
+            self.scatter, self.xall = PETSc.Scatter.toAll(x)
+        self.scatter.scatter(x, self.xall, addv=PETSc.InsertMode.INSERT_VALUES)
+        return self.xall.getArray(readonly=True)
+
+    def mult(self, mat, x, y):
+        b = self.bsr
+        _matvec(b.indptr, b.indices, b.data, self._gather(x), y.getArray())
+
+    def multAdd(self, mat, x, v, y):
+        b = self.bsr
+        xa = self._gather(x)
+        tmp = np.empty(3 * (b.indptr.size - 1))
+        _matvec(b.indptr, b.indices, b.data, xa, tmp)
+        if v.handle != y.handle:
+            v.copy(y)
+        y.getArray()[:] += tmp
+
+
+class BSRMat:
+    """This rank's rows of a block-sparse lag and its python Mat (``mat``)."""
+
+    def __init__(self, comm, indptr, indices, data, nrow_loc, ncol_loc, nrow_glob, ncol_glob):
+        PETSc = init()
+        self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
+        self.indices = np.ascontiguousarray(indices, dtype=np.int32)
+        self.data = np.ascontiguousarray(np.asarray(data, dtype=float).reshape(-1, 3, 3))
+        self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
+        self.comm = comm
+        self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
+        self.mat.setUp()
+
+    @property
+    def nbytes(self):
+        """Bytes this rank stores (values and indices)."""
+        return self.data.nbytes + self.indices.nbytes + self.indptr.nbytes
+
+    def panel(self, XT, RT, sign):
+        """RT += sign * (local rows) @ XT: XT (all columns x b), RT (local rows x b), C order."""
+        _panel(self.indptr, self.indices, self.data, XT, RT, float(sign))
+
+    def to_baij(self):
+        """Collective: the same rows as a PETSc MPIBAIJ (bs 3), for -ssi_lags_save."""
+        PETSc = init()
+        A = PETSc.Mat().createBAIJ(size=self.sizes, bsize=3,
+                                   csr=(self.indptr.astype(np.int32), self.indices, self.data.reshape(-1)),
+                                   comm=self.comm)
+        A.assemble()
+        return A
+
+
+def context(M):
+    """The BSRMat behind a python Mat, or None (any other Mat)."""
+    if M is None or M.getType() != "python":
+        return None
+    ctx = M.getPythonContext()
+    return ctx.bsr if isinstance(ctx, _Shell) else None
+
+
+def from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, indices, values):
+    """The python Mat of node-block CSR arrays of the local rows (columns sorted or not)."""
+    return BSRMat(comm, indptr, indices, values, nrow_loc, ncol_loc, nrow_glob, ncol_glob).mat
+
+
+def from_mat(M):
+    """Collective: a loaded MPIBAIJ (bs 3) as a python Mat of the same rows (M destroyed)."""
+    (m, mg), (n, ng) = M.getSizes()
+    r0, r1 = M.getOwnershipRange()
+    ai, aj, av = M.getValuesCSR()           # scalar CSR of the local rows: each 3x3 block spans
+    nloc = (r1 - r0) // 3                   # three rows with the same column pattern
+    indptr = np.zeros(nloc + 1, np.int64)
+    cols, vals = [], []
+    for i in range(nloc):
+        rows = [aj[ai[3 * i + p]:ai[3 * i + p + 1]] for p in range(3)]
+        if not (len(rows[0]) == len(rows[1]) == len(rows[2])) or len(rows[0]) % 3:
+            raise ValueError("from_mat: not a 3x3 block matrix")
+        c = rows[0][::3] // 3
+        v = np.stack([av[ai[3 * i + p]:ai[3 * i + p + 1]].reshape(-1, 3) for p in range(3)], axis=1)
+        cols.append(c)
+        vals.append(v)
+        indptr[i + 1] = indptr[i] + len(c)
+    comm = M.getComm()
+    M.destroy()
+    return from_csr(comm, nloc, n // 3, mg // 3, ng // 3, indptr,
+                    np.concatenate(cols) if cols else np.zeros(0, np.int32),
+                    np.concatenate(vals) if vals else np.zeros((0, 3, 3)))
