@@ -18,13 +18,17 @@ WT=$(mktemp -d /tmp/petsc_ssi-before.XXXX)
 git worktree add --detach "$WT" "$BEFORE" > /dev/null
 trap 'git worktree remove --force "$WT"' EXIT
 ROOT=$PWD
-(cd "$WT" && "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
+# the old code's numba kernels are cached apart (the worktree's files are new to numba's index:
+# without its own cache the first timed run would compile them)
+export BEFORE_CACHE="$WT/.numba_cache"
+(cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
 run() {  # version ranks case extra...
   local version=$1 n=$2 case=$3; shift 3
-  local dir=$ROOT; [ "$version" = before ] && dir=$WT
+  local dir=$ROOT cache=$NUMBA_CACHE_DIR
+  [ "$version" = before ] && dir=$WT && cache=$BEFORE_CACHE
   local log="$ROOT/$OUT/$version-$case-n$n.log"
   echo "[bench] $version $case on $n rank(s) -> $log"
-  (cd "$dir" && /usr/bin/time -v mpirun --allow-run-as-root --oversubscribe -n "$n" "$ROOT/$PY" -m petsc_ssi \
+  (cd "$dir" && NUMBA_CACHE_DIR="$cache" /usr/bin/time -v mpirun --allow-run-as-root --oversubscribe -n "$n" "$ROOT/$PY" -m petsc_ssi \
      -options_file "$ROOT/runs/pekeris/$case.opts" -ssi_output "$ROOT/$OUT/$version-$case-n$n.h5" \
      -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view "$@") > "$log" 2>&1
 }

@@ -40,20 +40,33 @@ def _matvec(indptr, indices, data, x, y):
 
 @njit(cache=True)
 def _panel(indptr, indices, data, XT, RT, sign):
-    """RT[3i+p, t] += sign * sum_k data[k, p, q] XT[3 col_k + q, t] (XT: columns x b, C order)."""
+    """RT[3i+p, t] += sign * sum_k data[k, p, q] XT[3 col_k + q, t] (XT: columns x b, C order): per
+    block its nine values in registers and the three rows of XT it meets read once."""
     b = XT.shape[1]
-    acc = np.empty((3, b))
+    acc0 = np.empty(b)
+    acc1 = np.empty(b)
+    acc2 = np.empty(b)
     for i in range(indptr.size - 1):
-        acc[:, :] = 0.0
+        acc0[:] = 0.0
+        acc1[:] = 0.0
+        acc2[:] = 0.0
         for k in range(indptr[i], indptr[i + 1]):
             c = 3 * indices[k]
-            for p in range(3):
-                a0, a1, a2 = data[k, p, 0], data[k, p, 1], data[k, p, 2]
-                for t in range(b):
-                    acc[p, t] += a0 * XT[c, t] + a1 * XT[c + 1, t] + a2 * XT[c + 2, t]
-        for p in range(3):
+            a00, a01, a02 = data[k, 0, 0], data[k, 0, 1], data[k, 0, 2]
+            a10, a11, a12 = data[k, 1, 0], data[k, 1, 1], data[k, 1, 2]
+            a20, a21, a22 = data[k, 2, 0], data[k, 2, 1], data[k, 2, 2]
+            x0 = XT[c]
+            x1 = XT[c + 1]
+            x2 = XT[c + 2]
             for t in range(b):
-                RT[3 * i + p, t] += sign * acc[p, t]
+                u0, u1, u2 = x0[t], x1[t], x2[t]
+                acc0[t] += a00 * u0 + a01 * u1 + a02 * u2
+                acc1[t] += a10 * u0 + a11 * u1 + a12 * u2
+                acc2[t] += a20 * u0 + a21 * u1 + a22 * u2
+        for t in range(b):
+            RT[3 * i, t] += sign * acc0[t]
+            RT[3 * i + 1, t] += sign * acc1[t]
+            RT[3 * i + 2, t] += sign * acc2[t]
 
 
 class _Shell:

@@ -414,7 +414,18 @@ class Marcher:
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)
         if blk is None or not blk[0] < n <= blk[0] + self.block:
+            ev = event("SSI_BEM_HistPanel")
+            ev.begin()
             self._new_block(self.block * ((n - 1) // self.block))
+            ev.end()
+        ev = event("SSI_BEM_HistStep")
+        ev.begin()
+        self._step_rest(n, out_u)
+        ev.end()
+
+    def _step_rest(self, n, out_u):
+        """The block's row of step n and the terms it left to the step (in-block states, and
+        matrices without a panel product)."""
         n0, rest = self._blk
         out_u.getArray()[:] = self._R[n - n0 - 1]
         for (key, side) in sorted(rest[n - n0 - 1]):
