@@ -32,6 +32,9 @@ run() {  # version ranks case extra...
      -options_file "$ROOT/runs/pekeris/$case.opts" -ssi_output "$ROOT/$OUT/$version-$case-n$n.h5" \
      -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view "$@") > "$log" 2>&1
 }
+# one untimed run of each version first: numba compiles what the warm-up case did not need
+run before 2 medium -ssi_t_end 0.003 && run after 2 medium -ssi_t_end 0.003
+rm -f "$OUT"/*-medium-n2.*
 for case in $CASES; do
   run before 2 "$case"
   run after 2 "$case"

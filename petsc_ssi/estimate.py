@@ -17,6 +17,11 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
   history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
              * (1 + sigma (m - 1))                     the run (a dense lag: 72 N n_r B,
              + (c_op + c_op_mpi [p > 1]) * P_r
+             + FD_r / r_panel_dense                    time-blocked sum (-ssi_history_block b):
+             + FS_r / r_panel_sparse                   flops of the blocks' panel products
+                                                       (2 b per entry and panel), dense and
+                                                       block-sparse; HD, HS, P then count only
+                                                       the per-step products
                                                        sparse: 76 B per block), m ranks per
                                                        node sharing the memory bus; P_r
                                                        matrix-vector products
@@ -69,7 +74,7 @@ DEFAULT_CONSTANTS = os.path.join(HERE, "estimate_constants.json")
 FALLBACK = {"a0": 0.5, "a_blk": 6e-7, "a_int": 0.0, "a_lag": 0.0, "c_cache": 1.0, "rho_trip": 1.0, "a_dense": 1.0e-9, "a_sparse": 5e-7, "c_fac": 1e-6, "b_dense": 16e9,
             "b_sparse": 9e9, "sigma": 0.4, "c_op": 2e-5, "c_op_mpi": 0.0, "c_sol": 2.5e-8, "kappa": 0.3, "s0": 0.2,
             "s1": 3e-7, "c_step": 1e-3, "c_main": 0.7, "c_plot": 1.8, "m0": 0.15e9, "m_asm": 0.15e9,
-            "gamma": 1.0}
+            "gamma": 1.0, "r_panel_dense": 25e9, "r_panel_sparse": 15e9}
 
 
 def load_constants(path=""):
@@ -234,6 +239,12 @@ class Counts:
         self.limit = limit
         used = np.r_[total[:self.Lx], [total[l - 1] for l in self.interp_lags]]
         self.storage, self.fill = self._storage(cfg, used, limit)
+        # the time-blocked history sum's block: the run's choice from these matrices' bytes
+        from .bem.run import history_block
+        tot = self.nb_total_used()
+        hb = np.where(self.storage, 72.0 * N * N, 0.0) * (tot > 0)
+        g = 72.0 * N * self.nt * (tot > 0)
+        self.block = history_block(cfg, hb + g, np.where(self.storage, 0.0, 76.0 * tot))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(partition(N, p))] for p in ranks}
 
@@ -284,15 +295,50 @@ class Counts:
         if self.k:
             reach = n + 1 if self.stabilized else n
             uses[Lx:] = np.count_nonzero((reach > Lx) & (n >= 2))
+        fd = fs = 0.0
+        if self.block > 1:
+            # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
+            # one of the block's steps reads a state known at its start; the rest are per-step products
+            uses, panels = self._blocked_uses(n, used)
+            entries = np.where(dense, mat_bytes / 8.0, 9.0 * used) * nonempty
+            fd = float(np.sum(panels * 2.0 * self.block * (entries * dense + g_bytes / 8.0)))
+            fs = float(np.sum(panels * 2.0 * self.block * entries * ~dense))
         hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
         hs = float(np.sum(uses * mat_bytes * ~dense) + np.sum(uses * g_bytes * ~dense))
         prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
         # integrated pair-lags: with the cache its misses; without, every pair (~ blocks / 4)
         integ, pool = cache if cache is not None else (float(used.sum()) / 4.0, 0.0)
         return {"B": float(used.sum()), "I": integ, "C": 16.0 * pool, "D": float(np.sum(mat_bytes * dense)),
-                "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods,
+                "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods, "FD": fd, "FS": fs,
                 "mats": float(mat_bytes.sum() + g_bytes.sum()), "trip": float(trip.sum()),
                 "build": float(build.max() + g_bytes.sum()), "rows": nrows}
+
+    def _blocked_uses(self, n, used):
+        """(per-step uses, panel products) of each stored matrix with blocks of ``self.block`` steps:
+        step n (block start n0 = b floor((n-1)/b)) reads states n - l + o (o in 2, 1, 0 stabilised,
+        1 plain; 1 <= state <= n - 1) of lag l; those <= n0 are in the block's panel product, the
+        others a product of step n."""
+        b, Lx = self.block, self.Lx
+        n0 = b * ((n - 1) // b)
+        offs = (2, 1, 0) if self.stabilized else (1,)
+        steps_in, panel = np.zeros(len(used)), np.zeros(len(used))
+
+        def count(lags):
+            known = np.zeros(len(n), bool)
+            inblk = np.zeros(len(n), bool)
+            for lag in lags:
+                for o in offs:
+                    m = n - lag + o
+                    ok = (m >= 1) & (m <= n - 1)
+                    known |= ok & (m <= n0)
+                    inblk |= ok & (m > n0)
+            return np.count_nonzero(inblk), len(np.unique(n0[known]))
+        for j in range(2, Lx + 1):
+            steps_in[j - 1], panel[j - 1] = count([j])
+        if self.k:
+            s, q = count(range(Lx + 1, self.L + 1))
+            steps_in[Lx:], panel[Lx:] = s, q
+        return steps_in, panel
 
     def nb_total_used(self):
         t = self.nb_total
@@ -306,7 +352,7 @@ def features(cnt, p, q, cores):
     """Model terms for p ranks, q per node, ``cores`` per node: the maxima over
     ranks of each count, the oversubscription factor and the concurrency m."""
     rk = cnt.per_rank[p]
-    mx = {key: max(r[key] for r in rk) for key in ("B", "I", "D", "S", "HD", "HS", "P")}
+    mx = {key: max(r[key] for r in rk) for key in ("B", "I", "D", "S", "HD", "HS", "P", "FD", "FS")}
     qn = min(q, p)
     over = max(1.0, qn / float(cores))
     m = min(qn, cores)
@@ -323,7 +369,8 @@ def predict(cnt, c, p, q, cores):
                                       + c["a_sparse"] * mx["S"] + c["a_lag"] * (cnt.Lx + cnt.k))
     t["factor"] = c["c_fac"] * N15
     t["history"] = over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
-                           + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"])
+                           + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
+                           + mx["FD"] / c["r_panel_dense"] + mx["FS"] / c["r_panel_sparse"])
     t["solve"] = c["c_sol"] * cnt.steps * N15 * (1 + c["kappa"] * (p - 1))
     t["loop"] = t["history"] + t["solve"] + c["c_step"] * cnt.steps
     t["total"] = t["setup"] + t["assembly"] + t["factor"] + t["loop"] + c["c_main"] + (c["c_plot"] if cnt.plot else 0)

@@ -78,7 +78,7 @@ def test_counts_match_a_run(tmp_path):
     p = cli(["-options_file", SMALL, *REDUCED, "-ssi_history_block", "1", "-ssi_output", out, "-log_view",
              "-memory_view"])
     text = p.stdout
-    m = _model(SMALL, [1], REDUCED)
+    m = _model(SMALL, [1], REDUCED + ["-ssi_history_block", "1"])
     rk = m["rank0"]
     # one VecMAXPY (weighted history) per matrix-vector product of the history sum
     assert rk["P"] == _stage_count(text, "SSI BEM time loop", "VecMAXPY")

@@ -325,15 +325,66 @@ def run_bem(cfg, comm=None):
     return BEMTransient(cfg, comm).run()
 
 
-def history_block(cfg, plan):
-    """The steps per block of the time-blocked history sum (-ssi_history_block; 0: about
-    sqrt(2 L) for L stored lags, which balances the L/b panel products per step against the
-    about b/2 in-block products)."""
+# One core's rates on the development machine (jobscripts/dgemm_rate.py): the dense panel product
+# x @ A^T and the block-sparse panel kernel (bem/bsr.py) in GF/s at b = 8, 16, 32 states, and the
+# matrix streaming rate of a per-step product in GB/s. Only the automatic block size uses them.
+PANEL_B = (8, 16, 32)
+PANEL_DENSE_GFPS = (19.7, 27.7, 38.1)
+PANEL_SPARSE_GFPS = (8.2, 18.8, 32.2)
+STREAM_GBPS = 22.0
+
+
+def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32)):
+    """The steps per block that minimise the modelled time per step of the history sum, from the
+    bytes of each stored matrix (index 0: lag 1, ..., then the interpolating ones; dense and
+    block-sparse apart): the panel products, 2 flops per stored value at the rates above, and the
+    per-step products of the in-block terms, lag j in a fraction (b - j + 2) / b of the steps
+    (stabilised; plain b - j + 1), streamed. b = 1 streams every matrix every step."""
+    d = np.asarray(dense_bytes, float)
+    s = np.asarray(sparse_bytes, float)
+    every = d + s
+    Lx = len(every)
+    best, best_t = 1, float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
+    for b in candidates:
+        if b < 2:
+            continue
+        rd = np.interp(b, PANEL_B, PANEL_DENSE_GFPS) * 1e9
+        rs = np.interp(b, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
+        t = float(np.sum(d[1:])) * 2 / 8 / rd + float(np.sum(s[1:])) * 18 / 76 / rs
+        j = np.arange(2, min(b + 2, Lx) + 1)
+        frac = np.clip((b - j + (2 if stabilized else 1)) / b, 0.0, 1.0)
+        t += float(np.sum(frac * every[j - 1])) / (STREAM_GBPS * 1e9)
+        if t < best_t:
+            best, best_t = b, t
+    return best
+
+
+def history_block(cfg, dense_bytes=None, sparse_bytes=None):
+    """The steps per block of the time-blocked history sum: -ssi_history_block, or with 0 the
+    ``choose_block`` of the stored matrices' bytes (1 without them)."""
     b = int(cfg.get("history_block") or 0)
     if b:
         return b
-    L = plan.Lx + (plan.k if plan.active else 0)
-    return max(1, min(32, int(round(math.sqrt(2 * L))))) if L >= 8 else 1
+    if dense_bytes is None:
+        return 1
+    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"))
+
+
+def _block_of(cfg, comm, H, G, HI, GI):
+    """history_block from this run's Mats (None: empty): per stored matrix the bytes of its H,
+    dense or block-sparse, and of its G (dense; read by the same panel products), summed over
+    the ranks."""
+    from . import bsr
+    Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
+    d = np.zeros((2, len(Hs)))
+    for i, (Hm, Gm) in enumerate(zip(Hs, Gs)):
+        if Hm is not None:
+            d[1 if bsr.context(Hm) is not None else 0, i] += lagmats.mat_bytes(Hm)
+        if Gm is not None:
+            d[0, i] += lagmats.mat_bytes(Gm)
+    tot = np.zeros_like(d)
+    comm.tompi4py().Allreduce(d, tot)
+    return history_block(cfg, tot[0], tot[1])
 
 
 def _say_block(march):
@@ -395,7 +446,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
-    march.set_lags(H, G, plan, HI, GI, block=history_block(cfg, plan))
+    march.set_lags(H, G, plan, HI, GI, block=_block_of(cfg, comm, H, G, HI, GI))
     _say_block(march)
     ls.H = ls.G = None   # the triplets are in the Mats now
     if cfg.get("lags_save"):
@@ -437,7 +488,7 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            f"lags ({ndense} dense, {nbaij} block-sparse)"
            + (f", {plan.k} interpolating matrices" if plan.active else "")
            + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
-    march.set_lags(H, G, plan, HI, GI, block=history_block(cfg, plan))
+    march.set_lags(H, G, plan, HI, GI, block=_block_of(cfg, comm, H, G, HI, GI))
     _say_block(march)
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
