@@ -425,11 +425,41 @@ class Marcher:
 
     def _step_rest(self, n, out_u):
         """The block's row of step n and the terms it left to the step (in-block states, and
-        matrices without a panel product)."""
+        matrices without a panel product). Dense and block-sparse matrices take them from every
+        rank's copies of the states (one all-gather per new state, not one per product)."""
         n0, rest = self._blk
-        out_u.getArray()[:] = self._R[n - n0 - 1]
-        for (key, side) in sorted(rest[n - n0 - 1]):
-            terms = rest[n - n0 - 1][(key, side)]
+        todo = rest[n - n0 - 1]
+        acc = self._R[n - n0 - 1].copy()
+        if any(self._panel_kind(self._mat(key, side)) for key, side in todo):
+            self._replicate(n - 1)                         # the states before step n are final
+        other = []
+        for (key, side) in sorted(todo):
+            terms = todo[(key, side)]
+            M = self._mat(key, side)
+            kind = self._panel_kind(M)
+            if kind is None:
+                other.append((key, side))
+                continue
+            rep = self._rep[side][2]
+            x = np.zeros(rep.shape[1])
+            for m, c in terms:
+                x += c * rep[self._slot(m)]
+            if kind == "dense":
+                A = M.getDenseArray(readonly=True)
+                y = A @ x
+                self.PETSc.Log.logFlops(2.0 * A.size)
+            else:
+                ctx = bsr.context(M)
+                y = np.empty(acc.size)
+                bsr._matvec(ctx.indptr, ctx.indices, ctx.data, x, y)
+                self.PETSc.Log.logFlops(18.0 * ctx.indices.size)
+            if side == "u":
+                acc -= y
+            else:
+                acc += y
+        out_u.setArray(acc)
+        for (key, side) in other:                          # any other Mat type: PETSc products
+            terms = todo[(key, side)]
             M = self._mat(key, side)
             if side == "u":
                 self._combine(self.wu, self.ubuf, terms)
