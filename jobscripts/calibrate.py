@@ -75,7 +75,8 @@ def measured(text):
     tot = lv["total_s"]
     return {"ranks": lv["ranks"], "total": tot, "setup": setup, "assembly": asm - e("SSI_BEM_Factor"),
             "assembly_stage": asm, "kernels": e("SSI_BEM_Assembly"), "factor": e("SSI_BEM_Factor"),
-            "history": e("SSI_BEM_History"), "solve": e("SSI_BEM_Solve"), "loop": loop,
+            "history": e("SSI_BEM_History"), "hist_panel": e("SSI_BEM_HistPanel"), "solve": e("SSI_BEM_Solve"),
+            "loop": loop,
             "rest": tot - setup - asm - loop if tot else float("nan"),
             "loop_rest": loop - e("SSI_BEM_History") - e("SSI_BEM_Solve"),
             "peak": lv["peak_rss_bytes"], "peak_rank": lv.get("peak_rss_max_rank_bytes")}
@@ -160,8 +161,18 @@ def fit(runs):
                   arr(lambda me, ms, cn, p, *r: cn.steps * cn.N ** 1.5 * (p - 1))], 1)
     s, sk = _nnls(A, arr(lambda me, ms, *r: ms["solve"]))
     c["c_sol"], c["kappa"] = float(s), float(sk / s) if s > 0 else 0.0
+    # time-blocked history sum: the panel products (event SSI_BEM_HistPanel) against their flops,
+    # dense and block-sparse; the rest of the history sum as the per-step sum below
+    from petsc_ssi.estimate import FALLBACK
+    A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FD"]),
+                  arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FS"])], 1)
+    panel = arr(lambda me, ms, *r: ms.get("hist_panel", 0.0))
+    has = A.sum(1) > 0
+    ird, irs = _nnls(A[has], panel[has]) if has.sum() >= 2 else (0.0, 0.0)
+    c["r_panel_dense"] = 1.0 / ird if ird > 0 and A[has, 0].any() else FALLBACK["r_panel_dense"]
+    c["r_panel_sparse"] = 1.0 / irs if irs > 0 and A[has, 1].any() else FALLBACK["r_panel_sparse"]
     # history: bytes over bandwidth with contention sigma (grid), products
-    hist = arr(lambda me, ms, *r: ms["history"])
+    hist = arr(lambda me, ms, *r: ms["history"] - ms.get("hist_panel", 0.0))
     best = None
     for sigma in np.linspace(0.0, 1.5, 61):
         A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["HD"] * (1 + sigma * (m - 1))),
