@@ -68,7 +68,8 @@ register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), spa
          choices=("auto", "dense", "sparse"))
 register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "
          "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
-         "automatic, about sqrt(2 x lags))", "bem", validator=lambda v: None if v >= 0 else "must be >= 0")
+         "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes)", "bem",
+         validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
 register("lag_fill", "real", 0.35, "", "auto storage: lags with block fill above this are dense", "bem",
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
 register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this per node (0: 80% of this machine's memory); the run's estimated peak is shared by its ranks", "bem",

@@ -29,6 +29,8 @@ from ..petsc import init, set_default_options, direct_solver_defaults, printf
 from ..monitor import event
 from . import bsr
 
+BLOCK_MAX = 32          # the largest -ssi_history_block (the ring buffer's extra depth)
+
 
 def _expand(trip, r0, coef, colmap=None):
     """Scalar COO entries of node-block triplets (local rows)."""
@@ -127,9 +129,11 @@ class Marcher:
         self.HI, self.GI = list(HI), list(GI)
         self.p_tmpl = self._p_vec()
         self.block = max(1, int(block))
-        # the ring buffer: the L + 2 states the history sum reads, and with blocks b - 1 more (a
-        # block starts at a multiple of b, also after a restart: the same sums as an uninterrupted run)
-        self.depth = self.L + 2 + (self.block - 1)
+        # the ring buffer: the L + 2 states the history sum reads and BLOCK_MAX - 1 more, whatever b
+        # is: a block starts at a multiple of b, also after a restart (the same sums as an
+        # uninterrupted run), and a checkpoint holds what any b <= BLOCK_MAX needs, so a restart
+        # on another rank count, whose automatic b may differ, has every state it reads
+        self.depth = self.L + 2 + (BLOCK_MAX - 1)
         self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
         self.pbuf = [self.p_tmpl.duplicate() for _ in range(self.depth)]
         self._setup_index_maps()
