@@ -35,8 +35,26 @@ def main():
         for k, v in opts.items():
             db.setValue("ssi_" + k, str(v))
         run_bem(options.resolve(("common", "bem")))
+        _shared_cache_kernels(PETSc)
     print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
     return 0
+
+
+def _shared_cache_kernels(PETSc):
+    """The element-cache kernels a run on more than one rank uses (model.LagSet._share_cache, on
+    one process here): without this, the first parallel run compiled them in its assembly."""
+    import numpy as np
+    from .mesh.surface import grid
+    from .bem.model import Material, Regions, LagSet
+    from .bem.assemble import new_cache
+    mesh = grid(2.0, 2.0, 1.0, (1.0, 1.0))
+    opts = {"gauss": 2, "singular_order": 12, "subdivisions": 4, "near_factor": 2.0, "max_subdivisions": 32,
+            "cache": True}
+    ls = LagSet(PETSc.COMM_SELF, mesh, Material(548.0, 316.0, 2000.0), 0.005, 3,
+                Regions(mesh, load_elems=mesh.groups["load"]), [], opts)
+    gq, gw = np.polynomial.legendre.leggauss(2)
+    gr, gwr = np.polynomial.legendre.leggauss(12)
+    ls._share_cache(*new_cache(), 1, 3, 0.0, 1.0 / (1e-9 * float(ls.Vh.min())), gq, gw, gr, gwr)
 
 
 if __name__ == "__main__":

@@ -107,24 +107,6 @@ def _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi):
     return c
 
 
-@njit(cache=True)
-def lag_order(lag, L):
-    """Stable counting sort by lag (1..L): the permutation and the bucket
-    bounds. Triplets come out row-major, so within a lag rows stay sorted."""
-    cnt = np.zeros(L + 2, np.int64)
-    for x in lag:
-        cnt[x + 1] += 1
-    for l in range(1, L + 2):
-        cnt[l] += cnt[l - 1]
-    bounds = cnt.copy()
-    order = np.empty(lag.shape[0], np.int64)
-    pos = cnt[:-1].copy()
-    for i in range(lag.shape[0]):
-        order[pos[lag[i]]] = i
-        pos[lag[i]] += 1
-    return order, bounds[1:]
-
-
 def new_cache():
     """An element-integral cache (kept across calls of ``assemble_rows``)."""
     return (Dict.empty(key_type=types.int64, value_type=types.int64),
@@ -133,32 +115,127 @@ def new_cache():
 
 
 @njit(cache=True)
-def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alpha, beta,
-                  rho, nu, ns_base, near_factor, ns_max, gq, gw, gr, gwr, n_nodes, n_tcols,
-                  free_term, tol, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  lag_lo=1, toff=0.0, h_ref=1.0, cache_max=1 << 62):
+def _pool_end(cmeta, ncache):
+    """First free position of the cache pools (entry k holds (hi - lo + 1) * 81 doubles from cmeta[k, 2])."""
+    pool_n = 0
+    for k in range(ncache):
+        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
+        if e > pool_n:
+            pool_n = e
+    return pool_n
+
+
+@njit(cache=True)
+def _add_pair(src, nl, lo, cols, sign, i, slot, trow, tlag, tcol, tval, n, skip_zero):
+    """Add one pair's blocks src[li, a] * diag(sign) (lag lo + li, column cols[a]; cols[a] < 0: no
+    column) to row i's entries: slot[lag, col] is the entry of a block already met in this row
+    (-1: none yet), else a new one is made. With ``skip_zero`` an all-zero block makes no entry
+    (H: only non-zero blocks are stored; G keeps every traction column). Returns the entry count.
+    The triplet arrays have room for nl * 9 more entries (the caller grows them once per pair)."""
+    for li in range(nl):
+        lag = lo + li
+        for a in range(9):
+            col = cols[a]
+            if col < 0:
+                continue
+            if skip_zero:
+                nz = False
+                for p in range(3):
+                    for q in range(3):
+                        if src[li, a, p, q] != 0.0:
+                            nz = True
+                if not nz:
+                    continue
+            s = slot[lag, col]
+            if s < 0:
+                s = n
+                slot[lag, col] = s
+                trow[s] = i
+                tlag[s] = lag
+                tcol[s] = col
+                for p in range(3):
+                    for q in range(3):
+                        tval[s, p, q] = 0.0
+                n += 1
+            for p in range(3):
+                for q in range(3):
+                    tval[s, p, q] += src[li, a, p, q] * sign[q]
+    return n
+
+
+@njit(cache=True)
+def _sort_row(slot, lag_lo, L, e0, n, tlag, tcol, tval, tmp):
+    """Put row entries e0..n in (lag, column) order by one pass over the slot map, which is cleared on
+    the way (ready for the next row); ``tmp`` (at least n - e0 blocks) is scratch. Rows of a chunk
+    then come out sorted as block CSR needs them, lag by lag, with no sort afterwards."""
+    tmp[:n - e0] = tval[e0:n]
+    k = e0
+    for lag in range(lag_lo, L + 1):
+        for col in range(slot.shape[1]):
+            s = slot[lag, col]
+            if s >= 0:
+                tval[k] = tmp[s - e0]
+                tlag[k] = lag
+                tcol[k] = col
+                slot[lag, col] = -1
+                k += 1
+
+
+@njit(cache=True)
+def _cached(use_cache, cidx, ckeys, cmeta, VXv, xc, qinv, key, lo, hi, want_u):
+    """(found, fill_u, hsh) for a pair: the cache entry holding all it needs (found >= 0), or one
+    holding its P blocks but not the U blocks it wants (fill_u >= 0)."""
+    if not use_cache:
+        return -1, -1, np.int64(0)
+    hsh = _geom_key(VXv, xc, qinv, key)
+    c = _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi)
+    if c >= 0:
+        if cmeta[c, 3] == 1 or not want_u:
+            return c, -1, hsh
+        return -1, c, hsh
+    return -1, -1, hsh
+
+
+def new_work(L, n_nodes, n_tcols, blocks=1 << 16):
+    """Work arrays of ``assemble_rows``, kept from one call to the next (a call's triplets are used
+    before the next): triplets of H (row, lag, column, block) and of G, scratch blocks, and the slot
+    maps (-1) of lags 0..L by column. Reusing them spares each call its page faults (made anew, the
+    paper case's 3 GB per rank of triplet buffers cost more in the kernel than the assembly itself)."""
+    g = max(blocks // 64, 256)
+    return (np.zeros(blocks, np.int64), np.zeros(blocks, np.int64), np.zeros(blocks, np.int64),
+            np.zeros((blocks, 3, 3)), np.zeros(g, np.int64), np.zeros(g, np.int64), np.zeros(g, np.int64),
+            np.zeros((g, 3, 3)), np.zeros((1024, 3, 3)), np.full((L + 1, n_nodes), -1, np.int64),
+            np.full((L + 1, max(n_tcols, 1)), -1, np.int64))
+
+
+@njit(cache=True)
+def assemble_rows(rows, mesh, wave, quad, free_term, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
+                  work, cache_max=1 << 62):
     """Collective-free numba kernel: triplets of H and G for ``rows``.
 
-    Returns (hrow, hlag, hcol, hval, grow, glag, gcol, gval, nev, hits, cache
-    arrays) with lags 1-based, ``nev`` the number of (point, lag) kernel
-    evaluations and ``hits`` the pairs taken from the cache. With
-    ``use_cache`` the element integrals of a pair are reused for every later
-    pair with the same relative geometry (quantised to 1/qinv): translated
-    copies of an element on a structured mesh are integrated once. The key
-    includes the node order, so images and singular pairs are keyed correctly;
-    the integrals depend on nothing else (material, dt and lags are fixed).
-    Only lags lag_lo..L are computed, at kernel times l dt + toff (a cache
-    must not be shared between calls with different lag_lo, L or toff).
-    The cache stops growing at ``cache_max`` bytes per pool (reuse goes on).
+    mesh = (xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh): collocation points and the virtual elements
+    (nodes, global columns, image signs, traction columns, bounding spheres, sizes);
+    wave = (L, dt, alpha, beta, rho, nu, lag_lo, toff); quad = (ns_base, near_factor, ns_max, gq, gw,
+    gr, gwr, tol, h_ref); work: ``new_work`` (its slot maps size the columns).
+
+    Returns (work, nh, ng, nev, hits, cache arrays): the triplets are work[0:4][:nh] (H) and
+    work[4:8][:ng] (G), lags 1-based, row by row and within a row by (lag, column): split by lag,
+    each lag is block CSR with sorted columns. ``nev`` counts (point, lag) kernel evaluations,
+    ``hits`` the pairs taken from the cache. With ``use_cache`` the element integrals of a pair are
+    reused for every later pair with the same relative geometry (quantised to 1/qinv): translated
+    copies of an element on a structured mesh are integrated once. The key includes the node order,
+    so images and singular pairs are keyed correctly; the integrals depend on nothing else
+    (material, dt and lags are fixed). Only lags lag_lo..L are computed, at kernel times l dt + toff
+    (a cache must not be shared between calls with different lag_lo, L or toff). The cache stops
+    growing at ``cache_max`` bytes per pool (reuse goes on). Each block sums its pairs in element
+    order, then the free term.
     """
+    xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh = mesh
+    L, dt, alpha, beta, rho, nu, lag_lo, toff = wave
+    ns_base, near_factor, ns_max, gq, gw, gr, gwr, tol, h_ref = quad
+    hrow, hlag, hcol, hval, grw, glag, gcol, gval, tmp, slotH, slotG = work
     mu = rho * beta * beta
     nv = VX.shape[0]
-    slotH = np.full((L + 1, n_nodes), -1, np.int64)
-    slotG = np.full((L + 1, max(n_tcols, 1)), -1, np.int64)
-    hrow = np.zeros(1024, np.int64); hlag = np.zeros(1024, np.int64); hcol = np.zeros(1024, np.int64)
-    hval = np.zeros((1024, 3, 3))
-    grw = np.zeros(256, np.int64); glag = np.zeros(256, np.int64); gcol = np.zeros(256, np.int64)
-    gval = np.zeros((256, 3, 3))
     nh = 0
     ng_ = 0
     Ub = np.zeros((L, 9, 3, 3))
@@ -167,12 +244,10 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
     nev = 0
     hits = 0
     ncache = len(cidx)
-    pool_n = 0
-    for k in range(ncache):
-        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
-        if e > pool_n:
-            pool_n = e
+    pool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
+    fcol = np.full(9, -1, np.int64)         # the free term: one block at (lag 1, column i)
+    ones = np.ones(3)
     reach = alpha * (dt * L + toff)
     for ii in range(rows.shape[0]):
         i = rows[ii]
@@ -189,16 +264,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                 if Vtcol[v, a] >= 0:
                     want_u = True
             nl = hi - lo + 1
-            found = -1
-            fill_u = -1
-            if use_cache:
-                hsh = _geom_key(VX[v], xc, qinv, key)
-                c = _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi)
-                if c >= 0:
-                    if cmeta[c, 3] == 1 or not want_u:
-                        found = c
-                    else:
-                        fill_u = c      # stored without U blocks: integrate and complete the entry
+            found, fill_u, hsh = _cached(use_cache, cidx, ckeys, cmeta, VX[v], xc, qinv, key, lo, hi, want_u)
             if found >= 0:
                 off = cmeta[found, 2]
                 Psrc = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
@@ -207,7 +273,7 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
             else:
                 nev += _integrate(xc, VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu,
                                   want_u, toff, h_ref, Ub, Pb, Us, Ps)
-                if fill_u >= 0:
+                if fill_u >= 0:                 # complete the entry with its U blocks
                     off = cmeta[fill_u, 2]
                     cpoolU[off:off + nl * 81] = Ub[:nl].ravel()
                     cmeta[fill_u, 3] = 1
@@ -229,71 +295,50 @@ def assemble_rows(rows, xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh, L, dt, alph
                     ncache += 1
                 Psrc = Pb[:nl]
                 Usrc = Ub[:nl]
-            # capacity for every block this pair can add, checked once per pair
+            # room for every block this pair can add, made once per pair
             # (array views or calls per block cost ~200 ns each in numba)
             need = nh + nl * 9
             hrow = _grow(hrow, need); hlag = _grow(hlag, need); hcol = _grow(hcol, need)
             hval = _grow(hval, need)
-            needg = ng_ + nl * 9
-            grw = _grow(grw, needg); glag = _grow(glag, needg); gcol = _grow(gcol, needg)
-            gval = _grow(gval, needg)
-            for li in range(nl):
-                lag = lo + li
-                for a in range(9):
-                    nz = False
-                    for p in range(3):
-                        for q in range(3):
-                            if Psrc[li, a, p, q] != 0.0:
-                                nz = True
-                    if nz:
-                        col = Vnode[v, a]
-                        s = slotH[lag, col]
-                        if s < 0:
-                            s = nh
-                            slotH[lag, col] = s
-                            hrow[s] = i; hlag[s] = lag; hcol[s] = col
-                            for p in range(3):
-                                for q in range(3):
-                                    hval[s, p, q] = 0.0
-                            nh += 1
-                        for p in range(3):
-                            for q in range(3):
-                                hval[s, p, q] += Psrc[li, a, p, q] * Vsign[v, q]
-                    tc = Vtcol[v, a]
-                    if tc >= 0:
-                        s = slotG[lag, tc]
-                        if s < 0:
-                            s = ng_
-                            slotG[lag, tc] = s
-                            grw[s] = i; glag[s] = lag; gcol[s] = tc
-                            for p in range(3):
-                                for q in range(3):
-                                    gval[s, p, q] = 0.0
-                            ng_ += 1
-                        for p in range(3):
-                            for q in range(3):
-                                gval[s, p, q] += Usrc[li, a, p, q] * Vsign[v, q]
+            nh = _add_pair(Psrc, nl, lo, Vnode[v], Vsign[v], i, slotH, hrow, hlag, hcol, hval, nh, True)
+            if want_u:
+                needg = ng_ + nl * 9
+                grw = _grow(grw, needg); glag = _grow(glag, needg); gcol = _grow(gcol, needg)
+                gval = _grow(gval, needg)
+                ng_ = _add_pair(Usrc, nl, lo, Vtcol[v], Vsign[v], i, slotG, grw, glag, gcol, gval, ng_, False)
         # free term c_lk (I/2 at smooth points; freeterm module at edges/corners)
         if lag_lo == 1:
-            s = slotH[1, i]
-            if s < 0:
-                hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
-                hval = _grow(hval, nh)
-                s = nh
-                hrow[s] = i; hlag[s] = 1; hcol[s] = i
-                for p in range(3):
-                    for q in range(3):
-                        hval[s, p, q] = 0.0
-                nh += 1
-            for p in range(3):
-                for q in range(3):
-                    hval[s, p, q] += free_term[i, p, q]
-        for k in range(h0, nh):
-            slotH[hlag[k], hcol[k]] = -1
-        for k in range(g0, ng_):
-            slotG[glag[k], gcol[k]] = -1
-    return (hrow[:nh], hlag[:nh], hcol[:nh], hval[:nh], grw[:ng_], glag[:ng_], gcol[:ng_],
-            gval[:ng_], nev, hits, ckeys, cmeta, cpoolP, cpoolU)
+            hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
+            hval = _grow(hval, nh)
+            fcol[0] = i
+            nh = _add_pair(free_term[i:i + 1].reshape((1, 1, 3, 3)), 1, 1, fcol, ones, i, slotH, hrow, hlag,
+                           hcol, hval, nh, False)
+        tmp = _grow(tmp, max(nh - h0, ng_ - g0))
+        _sort_row(slotH, lag_lo, L, h0, nh, hlag, hcol, hval, tmp)
+        _sort_row(slotG, lag_lo, L, g0, ng_, glag, gcol, gval, tmp)
+    return ((hrow, hlag, hcol, hval, grw, glag, gcol, gval, tmp, slotH, slotG), nh, ng_, nev, hits,
+            ckeys, cmeta, cpoolP, cpoolU)
+
+
+@njit(cache=True)
+def lag_sort(row, lag, col, val, L, loc, counts, scol, sval):
+    """Stable counting sort of a chunk's triplets by lag into ``scol``, ``sval`` (reused buffers at
+    least as long); ``counts[lag, loc[row]]`` += blocks of that row and lag (loc: position of a row
+    among the rank's rows). Returns the bounds:
+    lag l (1..L) is scol[b[l]:b[l + 1]], rows ascending (and columns within a row, as emitted)."""
+    b = np.zeros(L + 2, np.int64)
+    for k in range(lag.shape[0]):
+        b[lag[k] + 1] += 1
+        counts[lag[k], loc[row[k]]] += 1
+    for l in range(1, L + 2):
+        b[l] += b[l - 1]
+    pos = b.copy()
+    for k in range(lag.shape[0]):
+        j = pos[lag[k]]
+        scol[j] = col[k]
+        sval[j] = val[k]
+        pos[lag[k]] = j + 1
+    return b
 
 
 # ---------------------------------------------------------------------------

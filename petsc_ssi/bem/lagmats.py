@@ -3,33 +3,35 @@ blocks; ``bsr``: the package's block CSR behind a python Mat) for shell-sparse o
 per lag by global block fill
 (``-ssi_lag_storage auto|dense|sparse``, threshold ``-ssi_lag_fill``).
 
-Triplets (row node, lag, column node, 3x3 block) come from ``assemble``;
+The block CSR of the local rows, lag by lag, comes from ``model.Buckets`` (``assemble``);
 rows are the locally owned nodes, columns global node (or traction) ids.
 """
 import numpy as np
+from numba import njit
 
 from ..petsc import init, release_memory
 
 
-def _csr(rows_local, cols, vals, nloc):
-    counts = np.bincount(rows_local, minlength=nloc)
-    indptr = np.zeros(nloc + 1, np.int32)
-    np.cumsum(counts, out=indptr[1:])
-    return indptr, cols.astype(np.int32), vals
+@njit(cache=True)
+def _scatter_dense(arr, rl, cols, vals):
+    """arr[3 rl + p, 3 col + q] = block[p, q] for each triplet (arr: local rows x all columns)."""
+    for k in range(rl.shape[0]):
+        r = 3 * rl[k]
+        c = 3 * cols[k]
+        for p in range(3):
+            for q in range(3):
+                arr[r + p, c + q] = vals[k, p, q]
 
 
-def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
-    """Block-sparse (3x3 node blocks, ``bsr``: the package's block CSR behind a python Mat) from
-    node-block triplets of local rows."""
+def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
+    """Block-sparse (3x3 node blocks, ``bsr``: the package's block CSR behind a python Mat) from the
+    block CSR of the local rows (``Buckets.take_csr``: columns sorted within a row)."""
     from . import bsr
-    o = np.lexsort((cols, rows))               # CSR: columns sorted within a row
-    rows, cols, vals = rows[o], cols[o], vals[o]
-    ip, ix, v = _csr(rows - r0, cols, vals, nrow_loc)
-    return bsr.from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, ip, ix, v)
+    return bsr.from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals)
 
 
-def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
-    """MPIDENSE from node-block triplets of local rows."""
+def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
+    """MPIDENSE from the block CSR of the local rows."""
     PETSc = init()
     A = PETSc.Mat().createDense(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
                                 bsize=3, comm=comm)          # bs 3 as BAIJ and loaded Mats: the traction
@@ -37,10 +39,7 @@ def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, r0, rows, cols, vals):
     A.setUp()
     arr = A.getDenseArray()
     arr[...] = 0.0
-    rl = rows - r0
-    for p in range(3):
-        for q in range(3):
-            arr[3 * rl + p, 3 * cols + q] = vals[:, p, q]
+    _scatter_dense(arr, np.repeat(np.arange(nrow_loc, dtype=np.int64), np.diff(indptr)), cols, vals)
     A.restoreDenseArray() if hasattr(A, "restoreDenseArray") else None
     A.assemble()
     return A
@@ -58,31 +57,30 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     mpi.Allreduce(counts, gcounts)
     mats, info = [], []
     for li in range(L):
-        row, col, val = buckets.take(li + 1)
-        A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val,
-                        storage, fill)
+        csr = buckets.take_csr(li + 1)
+        A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill)
         mats.append(A)
         info.append((li + 1, kind, int(gcounts[li])))
-        del row, col, val
+        del csr
         release_memory()
     return mats, info
 
 
-def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val, storage, fill):
+def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill):
     if nb == 0:
         return None, "empty"
     f = nb / float(n_rows_glob * n_cols_glob)
     use_dense = storage == "dense" or (storage == "auto" and f > fill)
     mk = dense if use_dense else baij
-    return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val), ("dense" if use_dense else "baij")
+    return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr), ("dense" if use_dense else "baij")
 
 
 def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
     """Collective: the Mat of one lag of ``buckets`` (an interpolating matrix)."""
     r0, r1 = node_range
-    row, col, val = buckets.take(lag)
-    nb = comm.tompi4py().allreduce(len(row))
-    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, r0, row, col, val, storage, fill)
+    csr = buckets.take_csr(lag)
+    nb = comm.tompi4py().allreduce(len(csr[1]))
+    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill)
 
 
 def mat_bytes(A):

@@ -13,7 +13,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import (assemble_rows, new_cache, lag_order, enumerate_pairs, integrate_records, cache_insert,
+from .assemble import (assemble_rows, new_cache, new_work, lag_sort, enumerate_pairs, integrate_records, cache_insert,
                        gather_into, SING_TOL)
 
 
@@ -178,41 +178,79 @@ def process_rss():
     return proc_status_bytes("VmRSS") or 0.0
 
 
-def _by_lag(trip, L):
-    """Split the triplets of one chunk of rows by lag: [(rows, cols, vals)] * L,
-    rows ascending within a lag (a stable O(n) counting sort), so the
-    per-chunk row/lag index arrays are dropped at once and every lag can be
-    freed after use. Columns are sorted later, only where BAIJ needs them."""
-    row, lag, col, val = trip
-    order, b = lag_order(lag, L)
-    # one independent copy per lag (not views of one sorted array), so taking
-    # a lag really frees its memory
-    return ([(row[order[b[l]:b[l + 1]]], col[order[b[l]:b[l + 1]]].astype(np.int32),
-              val[order[b[l]:b[l + 1]]]) for l in range(L)],)
-
-
 class Buckets:
-    """Node-block triplets of the local rows, by lag (1-based): ``take(l)``
-    returns (rows, cols, vals) and frees them; ``peek(l)`` keeps them."""
+    """Node-block triplets of the local rows (``rows``, of ``n_nodes``), by lag (1-based), as block CSR
+    being built: per lag one growing array of columns (int32) and one of blocks, and the blocks per
+    (lag, row). ``add`` appends a chunk of rows (``assemble_rows``' output: rows ascending, by lag
+    and column within a row), so each lag is CSR with sorted columns as it stands and no sort or
+    concatenation follows. ``csr(l)`` gives (indptr, cols, vals), ``peek(l)`` (rows, cols, vals);
+    ``take(l)`` and ``take_csr(l)`` free the lag. The arrays start at ``capacity[l - 1]`` blocks
+    (the memory estimate's count) and grow by half when needed; allocated in large pieces by numpy,
+    they are backed by huge pages where the kernel offers them (numpy advises it): a page fault per
+    4 kB of small per-chunk pieces cost the paper case more time than its assembly."""
 
-    def __init__(self, L, chunks):
-        self.L = L
-        self._b = [[c[0][l] for c in chunks] for l in range(L)]
+    GROW = 1.5
+    TRIM = 0.9            # a lag using less of its array is copied to its size when taken
+
+    def __init__(self, L, rows, n_nodes, capacity=None):
+        self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
+        self.loc = np.full(n_nodes, -1, np.int64)
+        self.loc[self.rows] = np.arange(self.nloc)
+        self.counts = np.zeros((L + 1, max(self.nloc, 1)), np.int64)
+        self.n = np.zeros(L + 1, np.int64)
+        self.cap = np.zeros(L + 1, np.int64)
+        if capacity is not None:
+            self.cap[1:] = np.asarray(capacity, np.int64)[:L]
+        self._c = [None] * (L + 1)
+        self._v = [None] * (L + 1)
+
+    def add(self, row, lag, col, val, scol, sval):
+        """Append a chunk's triplets (``scol``, ``sval``: reused scratch at least as long)."""
+        b = lag_sort(row, lag, col, val, self.L, self.loc, self.counts, scol, sval)
+        for l in np.nonzero(b[2:] > b[1:-1])[0] + 1:
+            lo, hi = int(b[l]), int(b[l + 1])
+            m, n = hi - lo, int(self.n[l])
+            if self._c[l] is None or n + m > len(self._c[l]):
+                cap = max(int(self.cap[l]) if self._c[l] is None else 0, int(self.GROW * (n + m)), 1024)
+                c2, v2 = np.empty(cap, np.int32), np.empty((cap, 3, 3))
+                if n:
+                    c2[:n] = self._c[l][:n]
+                    v2[:n] = self._v[l][:n]
+                self._c[l], self._v[l] = c2, v2
+            self._c[l][n:n + m] = scol[lo:hi]
+            self._v[l][n:n + m] = sval[lo:hi]
+            self.n[l] = n + m
+
+    def csr(self, lag):
+        """(indptr over the rows in their order, columns int32, blocks) of one lag (views)."""
+        n = int(self.n[lag])
+        indptr = np.zeros(self.nloc + 1, np.int64)
+        np.cumsum(self.counts[lag, :self.nloc], out=indptr[1:])
+        if self._c[lag] is None:
+            return indptr, np.zeros(0, np.int32), np.zeros((0, 3, 3))
+        return indptr, self._c[lag][:n], self._v[lag][:n]
 
     def peek(self, lag):
-        parts = self._b[lag - 1]
-        if not parts:
-            return np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros((0, 3, 3))
-        return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-                np.concatenate([p[2] for p in parts]))
+        indptr, c, v = self.csr(lag)
+        rows = np.repeat(self.rows, np.diff(indptr))
+        return rows, c, v
+
+    def take_csr(self, lag):
+        """``csr(lag)``; the lag is no longer held here (its arrays copied to size when mostly unused)."""
+        indptr, c, v = self.csr(lag)
+        if self._c[lag] is not None and len(c) < self.TRIM * len(self._c[lag]):
+            c, v = c.copy(), v.copy()
+        self._c[lag] = self._v[lag] = None
+        self.n[lag] = 0
+        self.counts[lag] = 0
+        return indptr, c, v
 
     def take(self, lag):
-        out = self.peek(lag)
-        self._b[lag - 1] = []
-        return out
+        rows = self.peek(lag)[0]
+        return (rows,) + self.take_csr(lag)[1:]
 
     def count(self, lag):
-        return sum(len(p[0]) for p in self._b[lag - 1])
+        return int(self.n[lag])
 
 
 def _first_occurrences(h, meta, full_keys):
@@ -277,9 +315,11 @@ class LagSet:
 
         ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
         for interpolating matrices. Each lag is stored dense (N^2 x 72 B) or
-        block-sparse (76 B per block) by the same rule as the build; triplets
-        (84 B per block) are freed lag by lag as the Mats are built, so the
-        peak is max_k [Mats of lags <= k + triplets of lags > k]. Per rank on top:
+        block-sparse (76 B per block) by the same rule as the build; the assembled
+        blocks (``Buckets``: 76 B per block in arrays sized from this count with 15 %
+        headroom, about 84 B per block as counted here) become the block-sparse Mats
+        as they are, or are freed lag by lag as dense Mats are built, so the
+        peak is max_k [Mats of lags <= k + blocks of lags > k]. Per rank on top:
         the element cache (at most 324 B per block of its rows, 162 B per pool: the
         (node, element) pairs are about a quarter of the node blocks and hold 81 doubles per
         lag; each pool capped at CACHE_MAX), one chunk of raw triplets (``chunk_rows``, up
@@ -400,34 +440,44 @@ class LagSet:
         rows = self.rows
         chunk = chunk or self.chunk_rows(lag_hi - lag_lo + 1)
         prog = Progress(what, max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
-        parts = []
+        nimg = len(self.Vc) // self.mesh.n_cells
+        cap = 1.15 * estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg)
+        cap[:lag_lo - 1] = 0
+        H, G = Buckets(lag_hi, rows, self.mesh.n_nodes, cap), Buckets(lag_hi, rows, self.mesh.n_nodes)
         nev = 0
         ev = event("SSI_BEM_Assembly")
         ev.begin()
         cidx, ckeys, cmeta, cpP, cpU = new_cache()
         qinv = 1.0 / (1e-9 * float(self.Vh.min()))
         hits = 0
+        mesh = (self.mesh.nodes, self.VX, self.VN, self.VS, self.VT, self.Vc, self.VR, self.Vh)
+        wave = (int(lag_hi), float(self.dt), float(self.mat.cp), float(self.mat.cs), float(self.mat.rho),
+                float(self.mat.nu), int(lag_lo), float(toff))
+        quad = (int(o["subdivisions"]), float(o["near_factor"]), int(o["max_subdivisions"]), gq, gw, gr, gwr,
+                SING_TOL, float(self.Vh.min()))
         if o.get("cache", True) and o.get("cache_share", True) and self.comm.getSize() > 1:
-            ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
-                                                            qinv, gq, gw, gr, gwr)
+            with event("SSI_BEM_Integrate"):
+                ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
+                                                                qinv, gq, gw, gr, gwr)
+        work = new_work(lag_hi, self.mesh.n_nodes, self.regions.n_t)
+        scol, sval = np.empty(0, np.int32), np.empty((0, 3, 3))
         for s in range(0, len(rows), chunk):
-            res = assemble_rows(rows[s:s + chunk], self.mesh.nodes, self.VX, self.VN, self.VS, self.VT,
-                                self.Vc, self.VR, self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
-                                self.mat.rho, self.mat.nu, o["subdivisions"], o["near_factor"],
-                                o["max_subdivisions"], gq, gw, gr, gwr, self.mesh.n_nodes,
-                                self.regions.n_t, self.cfree, SING_TOL, o.get("cache", True), cidx, ckeys, cmeta,
-                                cpP, cpU, qinv, lag_lo, toff, float(self.Vh.min()), self.CACHE_MAX)
-            parts.append(_by_lag(res[:4], lag_hi) + _by_lag(res[4:8], lag_hi))
-            nev += res[8]
-            hits += res[9]
-            ckeys, cmeta, cpP, cpU = res[10:14]
+            work, nh, ng, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
+                rows[s:s + chunk], mesh, wave, quad, self.cfree, bool(o.get("cache", True)), cidx, ckeys, cmeta,
+                cpP, cpU, qinv, work, self.CACHE_MAX)
+            if len(scol) < max(nh, ng):                        # the sorted copy of a chunk, reused
+                m = max(len(work[3]), len(work[7]))
+                scol, sval = np.empty(m, np.int32), np.empty((m, 3, 3))
+            H.add(*[a[:nh] for a in work[0:4]], scol, sval)
+            G.add(*[a[:ng] for a in work[4:8]], scol, sval)
+            nev += n_ev
+            hits += n_hit
             prog.update(min(s + chunk, len(rows)))
+        work = scol = sval = None
         ev.end()
         self.cache_entries = len(cidx)
         self.cache_hits = self.comm.tompi4py().allreduce(hits)
         self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)
-        self.H = Buckets(lag_hi, [p[0:1] for p in parts])
-        self.G = Buckets(lag_hi, [p[1:2] for p in parts])
-        parts = None
+        self.H, self.G = H, G
         self.kernel_evaluations = self.comm.tompi4py().allreduce(nev)
         return self.H, self.G

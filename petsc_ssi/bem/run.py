@@ -412,15 +412,17 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     r0, r1 = ls.node_range
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
-    H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
-    nt = prob.regions.n_t
-    if nt:
-        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-        tcol_loc = pl.getLocalSize() // 3
-        pl.destroy()
-        G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
-    else:
-        G = [None] * plan.Lx
+    with event("SSI_BEM_LagMats"):
+        H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
+                                 prob.lag_fill)
+        nt = prob.regions.n_t
+        if nt:
+            pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+            tcol_loc = pl.getLocalSize() // 3
+            pl.destroy()
+            G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
+        else:
+            G = [None] * plan.Lx
     nev = ls.kernel_evaluations
     HI, GI = [], []
     for j in range(plan.k if plan.active else 0):
