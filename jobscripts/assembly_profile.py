@@ -1,0 +1,45 @@
+"""Where one rank's BEM assembly spends its time (issue 13, item 2): runs LagSet.assemble and the
+Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing assemble_rows,
+Buckets.add, lag_sort and the Mat constructors, and prints per rank those times, the kernel (sys)
+time and minor page faults (getrusage), resident and huge-page memory, and per-chunk ms/row.
+
+  mpirun -n 2 python jobscripts/assembly_profile.py [-rows R]   (R > 0: only R rows from row 1000)
+"""
+import sys, time
+import numpy as np
+sys.argv = [sys.argv[0]] + (["-options_file", "runs/pekeris/paper.opts"] if "-options_file" not in sys.argv else []) + sys.argv[1:]
+from petsc_ssi.petsc import init
+PETSc = init(sys.argv)
+from petsc_ssi import options
+from petsc_ssi.bem.run import BEMProblem
+from petsc_ssi.bem import model, lagmats
+cfg = options.resolve(("common", "bem"))
+prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
+ls = prob.lagset()
+R = int(PETSc.Options().getInt("rows", 64))
+if R: ls.rows = ls.rows[1000:1000 + R]
+if R: ls.node_range = (1000, 1000 + R)
+R = len(ls.rows)
+T = {}
+TS = []
+def wrap(mod, name):
+    f = getattr(mod, name)
+    def g(*a, **k):
+        t = time.perf_counter(); r = f(*a, **k); d = time.perf_counter() - t; T[name] = T.get(name, 0) + d
+        if name == "assemble_rows": TS.append((d, r[1], a[0][0]))
+        return r
+    setattr(mod, name, g)
+for n in ("assemble_rows",):
+    wrap(model, n)
+wrap(model.Buckets, "add"); wrap(model, "lag_sort")
+for n in ("baij", "dense"):
+    wrap(lagmats, n)
+t = time.perf_counter(); ls.assemble(); ta = time.perf_counter() - t
+print(PETSc.COMM_WORLD.rank, "chunk", ls.chunk_rows(ls.L), f"assemble {ta:.2f}", {k: round(v, 2) for k, v in T.items()})
+import resource
+ru = resource.getrusage(resource.RUSAGE_SELF); print("rss", open("/proc/self/status").read().split("VmRSS:")[1].split("\n")[0], "AnonHuge", [l for l in open("/proc/self/smaps_rollup") if "AnonHuge" in l])
+print(PETSc.COMM_WORLD.rank, "per chunk ms/row, ns/block:", [(int(r), round(1e3*d/ls.chunk_rows(ls.L), 1), round(1e9*d/max(n,1))) for d, n, r in TS[::7]], "sys", ru.ru_stime, "minflt", ru.ru_minflt, flush=True)
+N = prob.mesh.n_nodes
+t = time.perf_counter()
+H, info = lagmats.build(PETSc.COMM_WORLD, ls.H, ls.L, ls.node_range, N, N, R, "sparse", 0.35)
+print(PETSc.COMM_WORLD.rank, f"build {time.perf_counter() - t:.2f}", {k: round(v, 2) for k, v in T.items()})
