@@ -36,7 +36,8 @@ are the maximum over ranks; with more ranks per node than cores
 Memory (peak of the processes, summed over ranks as -memory_view reports):
   p * m0 + gamma * max(rho_trip * (T + c_cache * C + p * m_asm),
                        max_k [Mats of lags <= k + T of lags > k] + G)
-with T = 84 B per block the triplets of the assembly, C the bytes of the
+with T = 84 B per block (44 B single precision, -ssi_lag_single_from: its Mats
+40 B per block) the blocks of the assembly, C the bytes of the
 element caches (pair_table: the distinct pair geometries each rank meets,
 capped as the assembly caps them) and m_asm a per-rank transient. With the
 cache shared between ranks (-ssi_cache_share, the default) I_r is 1/p of the
@@ -103,20 +104,23 @@ def parse_ranks(text):
     return r
 
 
-def pair_table(prob, ls, L, chunk=64):
+def pair_table(prob, ls, L, chunk=64, rows=None):
     """Every (collocation node, element) pair that the assembly integrates for
     lags 1..L: (row, geometry key, first and last lag of its wave window). The
     key is the element's node coordinates relative to the collocation point,
     quantised as the assembly's element cache keys them, so equal keys are the
-    pairs the cache integrates once (translated copies on a structured mesh)."""
+    pairs the cache integrates once (translated copies on a structured mesh).
+    ``prob``: anything with mesh, mat and dt (a BEMProblem or a LagSet); ``rows``: the
+    node rows looked at (default every node; ids in the table stay global)."""
     x = prob.mesh.nodes
+    ids = np.arange(len(x)) if rows is None else np.asarray(rows, np.int64)
     VX, Vc, VR, Vh = ls.VX, ls.Vc, ls.VR, ls.Vh
     cp, cs, dt = prob.mat.cp, prob.mat.cs, prob.dt
     qinv = 1.0 / (1e-9 * float(Vh.min()))
     mult = np.random.default_rng(12345).integers(1, 2 ** 62, size=27, dtype=np.int64) | 1
     rows, keys, los, his = [], [], [], []
-    for s in range(0, len(x), chunk):
-        xc = x[s:s + chunk]
+    for s in range(0, len(ids), chunk):
+        xc = x[ids[s:s + chunk]]
         d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
         dmin = np.maximum(d - VR, 0.0)
         lo = np.maximum(1, np.floor(dmin / cp / dt).astype(np.int64) + 1)
@@ -125,9 +129,11 @@ def pair_table(prob, ls, L, chunk=64):
         rel = np.rint((VX[v] - xc[r][:, None, :]) * qinv).astype(np.int64).reshape(len(v), 27)
         with np.errstate(over="ignore"):
             keys.append((rel * mult).sum(axis=1))
-        rows.append((r + s).astype(np.int32))
+        rows.append(ids[s:s + chunk][r].astype(np.int32))
         los.append(lo[r, v].astype(np.int32))
         his.append(hi[r, v].astype(np.int32))
+    if not rows:
+        return np.zeros(0, np.int32), np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros(0, np.int32)
     return np.concatenate(rows), np.concatenate(keys), np.concatenate(los), np.concatenate(his)
 
 
@@ -238,13 +244,16 @@ class Counts:
         # storage rule of lagmats (and the all-sparse fallback of check_memory)
         self.limit = limit
         used = np.r_[total[:self.Lx], [total[l - 1] for l in self.interp_lags]]
+        from .bem.model import single_lags, lag_bytes
+        self.single = single_lags(np.r_[np.arange(1, self.Lx + 1), self.interp_lags], int(cfg.lag_single_from))
         self.storage, self.fill = self._storage(cfg, used, limit)
         # the time-blocked history sum's block: the run's choice from these matrices' bytes
         from .bem.run import history_block
         tot = self.nb_total_used()
-        hb = np.where(self.storage, 72.0 * N * N, 0.0) * (tot > 0)
-        g = 72.0 * N * self.nt * (tot > 0)
-        self.block = history_block(cfg, hb + g, np.where(self.storage, 0.0, 76.0 * tot))
+        mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt)
+        g = g * (tot > 0) * (self.nt > 0)
+        self.block = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
+                                   np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(partition(N, p))] for p in ranks}
 
@@ -253,36 +262,35 @@ class Counts:
         f = used / float(N * N)
         fill = cfg.lag_fill
         if cfg.lag_storage == "auto":
-            dense = f > fill
+            dense = (f > fill) & ~self.single
             if self._peak_rule(used, dense) > limit:
                 dense_sp = np.zeros_like(dense)
                 if self._peak_rule(used, dense_sp) <= limit:
                     return dense_sp, 1.01
             return dense, fill
-        return np.full(len(used), cfg.lag_storage == "dense"), fill
+        return np.full(len(used), cfg.lag_storage == "dense") & ~self.single, fill
 
     def _peak_rule(self, used, dense, p=1):
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
-        from .bem.model import transient_bytes
+        from .bem.model import transient_bytes, lag_bytes
         N = self.N
-        mats = np.where(dense, 72.0 * N * N, 76.0 * used)
-        trip = 84.0 * used
-        g = 9.0 * N * max(self.nt, 1) * 8
+        mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt)
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
         transient = transient_bytes(used.sum() / p, N, len(used), N / p)
-        return 1.1 * max(trip.sum(), build.max()) + g * len(used) + transient * p
+        return 1.1 * max(trip.sum(), build.max()) + g.sum() + transient * p
 
     def _rank(self, nb, nrows, p, cache=None):
         """Counts of one rank (``nb``: its blocks per lag, ``nrows``: its nodes,
         ``cache``: its integrated pair-lags and cache floats, None: no cache)."""
         N, Lx = self.N, self.Lx
         used = np.r_[nb[:Lx], [nb[l - 1] for l in self.interp_lags]]
+        from .bem.model import lag_bytes
         dense = self.storage
         nonempty = self.nb_total_used() > 0
-        mat_bytes = np.where(dense, 72.0 * N * nrows, 76.0 * used) * nonempty
-        g_bytes = 72.0 * nrows * self.nt * nonempty if self.nt else np.zeros(len(used))
-        trip = 84.0 * used
+        mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt)
+        mat_bytes = mat_bytes * nonempty
+        g_bytes = g_bytes * nonempty if self.nt else np.zeros(len(used))
         build = np.cumsum(mat_bytes) + (trip.sum() - np.cumsum(trip))
         # history: at step n the exact lags 2..min(Lx, n+1) (plain: n) and, once
         # lags beyond Lx are reached, the k interpolating matrices
@@ -301,8 +309,9 @@ class Counts:
             # one of the block's steps reads a state known at its start; the rest are per-step products
             uses, panels = self._blocked_uses(n, used)
             entries = np.where(dense, mat_bytes / 8.0, 9.0 * used) * nonempty
-            fd = float(np.sum(panels * 2.0 * self.block * (entries * dense + g_bytes / 8.0)))
-            fs = float(np.sum(panels * 2.0 * self.block * entries * ~dense))
+            g_entries = 9.0 * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
+            fd = float(np.sum(panels * 2.0 * self.block * (entries * dense + g_entries * ~self.single)))
+            fs = float(np.sum(panels * 2.0 * self.block * (entries * ~dense + g_entries * self.single)))
         hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
         hs = float(np.sum(uses * mat_bytes * ~dense) + np.sum(uses * g_bytes * ~dense))
         prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
@@ -409,11 +418,13 @@ def report(cfg, comm, out=None):
     c, source = load_constants(cfg.estimate_constants)
     prob, plan, cnt = setup(cfg, comm, ranks, node_mem)
     nd = int(cnt.storage.sum())
-    ns = len(cnt.storage) - nd
+    n1 = int(cnt.single.sum())
+    ns = len(cnt.storage) - nd - n1
     lines = [f"[ssi] estimate of this BEM run (model petsc_ssi/estimate.py; constants {source})",
              f"[ssi]   {3 * cnt.N} DOFs ({cnt.N} nodes), {cnt.Ev} elements with images, {cnt.steps} steps, "
              f"{cnt.nt} traction nodes; lags stored {cnt.Lx + cnt.k} ({cnt.Lx} exact + {cnt.k} interpolating, "
              f"of {cnt.L} the run reaches): {nd} dense, {ns} block-sparse"
+             + (f", {n1} single-precision block-sparse" if n1 else "")
              + (" (all block-sparse: the dense choice would not fit the limit)" if cnt.fill > 1 else ""),
              f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
              f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",

@@ -36,6 +36,7 @@ def main():
             db.setValue("ssi_" + k, str(v))
         run_bem(options.resolve(("common", "bem")))
         _shared_cache_kernels(PETSc)
+        _single_kernels()
     print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
     return 0
 
@@ -55,6 +56,17 @@ def _shared_cache_kernels(PETSc):
     gq, gw = np.polynomial.legendre.leggauss(2)
     gr, gwr = np.polynomial.legendre.leggauss(12)
     ls._share_cache(*new_cache(), 1, 3, 0.0, 1.0 / (1e-9 * float(ls.Vh.min())), gq, gw, gr, gwr)
+
+
+def _single_kernels():
+    """The block-sparse kernels on float32 values (-ssi_lag_single_from; numba compiles one version
+    per value type)."""
+    import numpy as np
+    from .bem import bsr
+    indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
+    data = np.ones((1, 3, 3), np.float32)
+    bsr._matvec(indptr, cols, data, np.ones(3), np.zeros(3))
+    bsr._panel(indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
 
 
 if __name__ == "__main__":

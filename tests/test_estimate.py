@@ -88,7 +88,7 @@ def test_counts_match_a_run(tmp_path):
     assert lags == m["Lx"]
     blocks = fill / 100 * lags * m["N"] ** 2
     assert abs(m["blocks"] / blocks - 1) < 0.10
-    assert abs(rk["mats"] / 1e9 / gb - 1) < 0.05
+    assert abs(rk["mats"] / 1e9 / gb - 1) < 0.10          # block-sparse lags: as close as the block count
     # integrated pair-lags against the kernel evaluations (tens of quadrature points per pair-lag)
     kev = float(re.search(r"(\S+) kernel evaluations", text).group(1))
     assert 30 < kev / rk["I"] < 100

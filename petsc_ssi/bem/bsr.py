@@ -5,7 +5,9 @@ PETSc's MPIBAIJ keeps its values out of reach of petsc4py, and its MatMatMult wi
 (3.18) is one MatMult per column: a time-blocked history sum would read a block-sparse lag b
 times per block of b steps, as the per-step sum does. Here each rank keeps its rows of a lag as a
 block CSR (``indptr`` over local node rows, ``indices`` global column nodes, ``data`` (nnzb, 3, 3)),
-the same bytes as MPIBAIJ (9 doubles and one int per block), and two compiled kernels work on it:
+the same bytes as MPIBAIJ (9 doubles and one int per block; 9 floats and one int, 40 B, for a lag
+kept in single precision, ``-ssi_lag_single_from``, whose products still accumulate in double), and
+two compiled kernels work on it:
 
     matvec     y = A x                  (x all-gathered: every column of the local rows)
     panel      R^T += s A X^T           (X: b combined states, each rank's copy; one pass over A)
@@ -104,7 +106,8 @@ class BSRMat:
         PETSc = init()
         self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
         self.indices = np.ascontiguousarray(indices, dtype=np.int32)
-        self.data = np.ascontiguousarray(np.asarray(data, dtype=float).reshape(-1, 3, 3))
+        dt = np.float32 if np.asarray(data).dtype == np.float32 else np.float64    # single: -ssi_lag_single_from
+        self.data = np.ascontiguousarray(np.asarray(data, dtype=dt).reshape(-1, 3, 3))
         self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
         self.comm = comm
         self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
@@ -115,6 +118,11 @@ class BSRMat:
         """Bytes this rank stores (values and indices)."""
         return self.data.nbytes + self.indices.nbytes + self.indptr.nbytes
 
+    def to_single(self):
+        """Keep the values in float32 (a loaded lag of a -ssi_lag_single_from run); returns self."""
+        self.data = np.ascontiguousarray(self.data, dtype=np.float32)
+        return self
+
     def panel(self, XT, RT, sign):
         """RT += sign * (local rows) @ XT: XT (all columns x b), RT (local rows x b), C order."""
         _panel(self.indptr, self.indices, self.data, XT, RT, float(sign))
@@ -123,7 +131,8 @@ class BSRMat:
         """Collective: the same rows as a PETSc MPIBAIJ (bs 3), for -ssi_lags_save."""
         PETSc = init()
         A = PETSc.Mat().createBAIJ(size=self.sizes, bsize=3,
-                                   csr=(self.indptr.astype(np.int32), self.indices, self.data.reshape(-1)),
+                                   csr=(self.indptr.astype(np.int32), self.indices,
+                                        np.asarray(self.data.reshape(-1), dtype=PETSc.ScalarType)),
                                    comm=self.comm)
         A.assemble()
         return A

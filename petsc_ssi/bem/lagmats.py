@@ -1,7 +1,9 @@
 """Lag matrices as PETSc Mats: MATMPIDENSE for dense lags, block-sparse ones (3x3 node
 blocks; ``bsr``: the package's block CSR behind a python Mat) for shell-sparse ones, chosen
 per lag by global block fill
-(``-ssi_lag_storage auto|dense|sparse``, threshold ``-ssi_lag_fill``).
+(``-ssi_lag_storage auto|dense|sparse``, threshold ``-ssi_lag_fill``). Lags kept in single
+precision (``-ssi_lag_single_from``: the buckets hold them as float32) are block-sparse whatever
+their fill: 40 B per block against 72 B per block of a dense double lag.
 
 The block CSR of the local rows, lag by lag, comes from ``model.Buckets`` (``assemble``);
 rows are the locally owned nodes, columns global node (or traction) ids.
@@ -45,10 +47,11 @@ def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
     return A
 
 
-def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
+def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.95):
     """Collective: one Mat per lag 1..L (None where the lag is empty
     everywhere), freeing each lag's triplets once its Mat is built.
-    Returns (mats, info) with info rows (lag, type, blocks)."""
+    Returns (mats, info) with info rows (lag, type, blocks), type 'dense', 'baij', 'single'
+    (float32 block-sparse) or 'empty'."""
     r0, r1 = node_range
     nloc = r1 - r0
     mpi = comm.tompi4py()
@@ -69,13 +72,15 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
 def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill):
     if nb == 0:
         return None, "empty"
+    if csr[2].dtype == np.float32:       # -ssi_lag_single_from: block-sparse whatever the fill (a dense
+        return baij(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr), "single"    # lag: every block)
     f = nb / float(n_rows_glob * n_cols_glob)
     use_dense = storage == "dense" or (storage == "auto" and f > fill)
     mk = dense if use_dense else baij
     return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr), ("dense" if use_dense else "baij")
 
 
-def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.35):
+def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.95):
     """Collective: the Mat of one lag of ``buckets`` (an interpolating matrix)."""
     r0, r1 = node_range
     csr = buckets.take_csr(lag)

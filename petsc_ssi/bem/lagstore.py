@@ -1,8 +1,9 @@
 """Reusable lag matrices: ``-ssi_lags_save FILE`` and ``-ssi_lags_load FILE``.
 
 The lag matrices depend on the soil mesh, its material, dt, the scheme, the symmetry planes, the
-interpolation plan, the quadrature options and which soil nodes carry traction unknowns (the load
-and prescribed-displacement regions, or a structure's interface): not on the loads' size or
+interpolation plan, the quadrature options, the lags kept in single precision (-ssi_lag_single_from)
+and which soil nodes carry traction unknowns (the load and prescribed-displacement regions, or a
+structure's interface): not on the loads' size or
 history, the structure, or the receivers. A parameter study over those, or a restart, can skip
 the assembly by loading the matrices a first run saved.
 
@@ -39,6 +40,8 @@ def lag_key(cfg, prob, plan):
            "scheme": str(cfg.scheme), "symmetry": str(cfg.symmetry), "lags": str(prob.L), "exact_lags": str(plan.Lx),
            "traction_nodes": _h(np.asarray(reg.tnode, np.int64)), "load_nodes": str(reg.n_load),
            "disp_nodes": _h(np.asarray(reg.disp_nodes, np.int64))}
+    if int(cfg.get("lag_single_from") or 0):        # (absent when off: files of double runs keep their key)
+        key["single_from"] = str(int(cfg.lag_single_from))
     for k, v in sorted(prob.quad_options().items()):
         if k != "cache_share":
             key["quadrature_" + k] = str(v)

@@ -152,13 +152,56 @@ def _chunk_rows(n_nodes, lag_hi, n_rows):
     return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
 
 
-def transient_bytes(blocks, n_nodes, lags, n_rows):
-    """Bytes a rank holds during the assembly beside the triplets and Mats: the element cache (at
-    most 324 B per block of its rows, each of its two pools capped at CACHE_MAX), one chunk of raw
-    triplets and the process as it stands (resident size now, measured)."""
-    cache = min(2.0 * CACHE_MAX, 324.0 * blocks)
+def lag_bytes(used, dense, single, n_cols, n_rows, n_t):
+    """Per stored matrix (arrays over them): (bytes of its Mat, of its assembly buckets, of its G),
+    for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns: dense 72 B per block of the
+    whole row block, block-sparse 76 B per stored block (9 doubles, an int32 column), single
+    precision (``single``: -ssi_lag_single_from) 40 B (9 floats, a column) whatever the fill; the
+    buckets take the same bytes (their 15 % headroom is allocated but never touched, so not
+    resident); G (the ``n_t`` traction columns) dense, or at most 40 B per block single."""
+    single = np.asarray(single, bool)
+    dense = np.asarray(dense, bool) & ~single
+    mats = np.where(single, 40.0 * used, np.where(dense, 72.0 * n_cols * n_rows, 76.0 * used))
+    trip = np.where(single, 40.0, 76.0) * used
+    g = np.where(single, 40.0, 72.0) * n_rows * max(n_t, 1)
+    return mats, trip, g
+
+
+def single_lags(lags, single_from):
+    """Mask over ``lags`` (lag indices of the stored matrices): kept in single precision."""
+    lags = np.asarray(lags)
+    return (lags >= single_from) if single_from > 0 else np.zeros(lags.shape, bool)
+
+
+def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
+    """Bytes a rank holds beside the triplets and Mats: while it assembles, the element cache
+    (``cache`` bytes as counted from the pair geometries, ``LagSet.cache_estimate``, or without it
+    the bound of 324 B per block of its rows; each of its two pools capped at CACHE_MAX) and one
+    chunk of raw triplets with its sorted copy; throughout, the process as it stands (resident size
+    now, measured). ``parts``: (assembly-only bytes, process bytes), else their sum."""
+    cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
     chunk = 2.0 * _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
-    return cache + chunk + process_rss()
+    return (cache + chunk, process_rss()) if parts else cache + chunk + process_rss()
+
+
+_KERNELS_LOADED = []
+
+
+def load_kernels():
+    """Load the assembly's compiled kernels into this process (once; from the numba cache, or
+    compiled): a tiny assembly on one process. The memory check measures the process after it, so
+    that the code the kernels bring (about 50 MB) is counted."""
+    if _KERNELS_LOADED:
+        return
+    from ..petsc import init
+    from ..mesh.surface import grid
+    PETSc = init()
+    mesh = grid(2.0, 2.0, 1.0, (1.0, 1.0))
+    opts = {"gauss": 2, "singular_order": 4, "subdivisions": 1, "near_factor": 0.0, "max_subdivisions": 1,
+            "cache": True}
+    LagSet(PETSc.COMM_SELF, mesh, Material(548.0, 316.0, 2000.0), 0.005, 2,
+           Regions(mesh, load_elems=mesh.groups["load"]), [], opts).assemble()
+    _KERNELS_LOADED.append(True)
 
 
 def proc_status_bytes(field):
@@ -192,8 +235,9 @@ class Buckets:
     GROW = 1.5
     TRIM = 0.9            # a lag using less of its array is copied to its size when taken
 
-    def __init__(self, L, rows, n_nodes, capacity=None):
+    def __init__(self, L, rows, n_nodes, capacity=None, single_from=0):
         self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
+        self.single_from = int(single_from)     # lags >= this (> 0) keep their blocks in float32
         self.loc = np.full(n_nodes, -1, np.int64)
         self.loc[self.rows] = np.arange(self.nloc)
         self.counts = np.zeros((L + 1, max(self.nloc, 1)), np.int64)
@@ -212,14 +256,18 @@ class Buckets:
             m, n = hi - lo, int(self.n[l])
             if self._c[l] is None or n + m > len(self._c[l]):
                 cap = max(int(self.cap[l]) if self._c[l] is None else 0, int(self.GROW * (n + m)), 1024)
-                c2, v2 = np.empty(cap, np.int32), np.empty((cap, 3, 3))
+                c2, v2 = np.empty(cap, np.int32), np.empty((cap, 3, 3), self.dtype(l))
                 if n:
                     c2[:n] = self._c[l][:n]
                     v2[:n] = self._v[l][:n]
                 self._c[l], self._v[l] = c2, v2
             self._c[l][n:n + m] = scol[lo:hi]
-            self._v[l][n:n + m] = sval[lo:hi]
+            self._v[l][n:n + m] = sval[lo:hi]            # (rounded to float32 for a single lag)
             self.n[l] = n + m
+
+    def dtype(self, lag):
+        """The value type lag ``lag`` is kept in: float32 from ``single_from`` on (-ssi_lag_single_from)."""
+        return np.float32 if 0 < self.single_from <= lag else np.float64
 
     def csr(self, lag):
         """(indptr over the rows in their order, columns int32, blocks) of one lag (views)."""
@@ -227,7 +275,7 @@ class Buckets:
         indptr = np.zeros(self.nloc + 1, np.int64)
         np.cumsum(self.counts[lag, :self.nloc], out=indptr[1:])
         if self._c[lag] is None:
-            return indptr, np.zeros(0, np.int32), np.zeros((0, 3, 3))
+            return indptr, np.zeros(0, np.int32), np.zeros((0, 3, 3), self.dtype(lag))
         return indptr, self._c[lag][:n], self._v[lag][:n]
 
     def peek(self, lag):
@@ -310,25 +358,28 @@ class LagSet:
         self.n_nonsmooth = self.comm.tompi4py().allreduce(
             int(np.sum(np.abs(self.cfree[self.rows] - 0.5 * np.eye(3)).max(axis=(1, 2)) > 1e-14)))
 
-    def estimate_memory(self, lags, storage="auto", fill=0.35, extra_lags=(), sample=0):
+    def estimate_memory(self, lags, storage="auto", fill=0.95, extra_lags=(), sample=0, single_from=0):
         """Collective: estimated bytes of the stored Mats and the assembly peak (all ranks).
 
         ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
         for interpolating matrices. Each lag is stored dense (N^2 x 72 B) or
-        block-sparse (76 B per block) by the same rule as the build; the assembled
-        blocks (``Buckets``: 76 B per block in arrays sized from this count with 15 %
-        headroom, about 84 B per block as counted here) become the block-sparse Mats
+        block-sparse (76 B per block) by the same rule as the build (``lag_bytes``); the assembled
+        blocks (``Buckets``: 76 B per block, 40 B single, in arrays sized from this count with 15 %
+        headroom that is never touched, so not resident) become the block-sparse Mats
         as they are, or are freed lag by lag as dense Mats are built, so the
-        peak is max_k [Mats of lags <= k + blocks of lags > k]. Per rank on top:
-        the element cache (at most 324 B per block of its rows, 162 B per pool: the
-        (node, element) pairs are about a quarter of the node blocks and hold 81 doubles per
-        lag; each pool capped at CACHE_MAX), one chunk of raw triplets (``chunk_rows``, up
+        peak is max_k [Mats of lags <= k + blocks of lags > k], times 1.1. Per rank on top:
+        the element cache (``cache_estimate``: 81 doubles per distinct pair geometry and lag
+        in each of two pools, which grow by doubling: twice that; each pool capped at
+        CACHE_MAX) and one chunk of raw triplets while the blocks are assembled (``chunk_rows``, up
         to twice over-allocated) and the process as it stands now (its resident size,
         measured). ``sample`` > 0: the blocks counted on every k-th local row only (at most
-        ``sample`` rows per rank) and scaled up, a fast estimate."""
+        ``sample`` rows per rank) and scaled up, a fast estimate. ``single_from`` > 0: lags from it on
+        (exact or interpolating) kept in single precision (``lag_bytes``)."""
         nimg = len(self.Vc) // self.mesh.n_cells
         L = max([lags] + list(extra_lags))
         rows = self.rows
+        if not sample:
+            load_kernels()          # the process measured with the compiled kernels it will hold
         if sample and len(rows) > sample:
             rows = rows[::int(np.ceil(len(rows) / sample))]
         nb = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
@@ -339,16 +390,33 @@ class LagSet:
         use = np.r_[nb[:lags], [nb[l - 1] for l in extra_lags]] if len(extra_lags) else nb[:lags]
         N = self.mesh.n_nodes
         f = use / float(N * N)
-        dense = (f > fill) if storage == "auto" else np.full(len(use), storage == "dense")
-        mats = np.where(dense, 72.0 * N * N, 76.0 * use)
-        trip = 84.0 * use
-        g = 9.0 * N * max(self.regions.n_t, 1) * 8
+        single = single_lags(np.r_[np.arange(1, lags + 1), list(extra_lags)], single_from)
+        dense = ((f > fill) if storage == "auto" else np.full(len(use), storage == "dense")) & ~single
+        mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t)
         build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        transient = mpi.allreduce(transient_bytes(local_blocks, N, L, len(self.rows)))
-        peak = 1.1 * max(trip.sum(), build.max()) + g * len(use) + transient
-        return float(mats.sum() + g * len(use)), float(peak), int(dense.sum())
+        cache = None if sample else self.cache_estimate(lags, extra_lags)    # (sample: the bound per block)
+        asm, rss = (mpi.allreduce(v) for v in transient_bytes(local_blocks, N, L, len(self.rows), cache, parts=True))
+        # the cache and the chunk live while the blocks are assembled, not while the Mats are built
+        peak = 1.1 * (max(trip.sum() + asm, build.max()) + g.sum() + rss)
+        return float(mats.sum() + g.sum()), float(peak), int(dense.sum())
 
     CACHE_MAX = CACHE_MAX        # bytes per cache pool (P and U): 1 GiB per rank at most
+
+    def cache_estimate(self, lags, extra_lags=()):
+        """Bytes of this rank's element cache in the assembly of the exact lags 1..``lags`` (both
+        pools, 81 doubles per pair geometry and lag each, each pool capped at CACHE_MAX), counted
+        from the distinct pair geometries of its rows as ``petsc-ssi estimate`` counts them
+        (``estimate.pair_table``); 0 without the cache (-ssi_cache 0)."""
+        if not self.opts.get("cache", True):
+            return 0.0
+        key = (int(lags), tuple(extra_lags))
+        if getattr(self, "_cache_est", (None,))[0] != key:
+            from ..estimate import pair_table, cache_counts
+            table = pair_table(self, self, max([lags] + list(extra_lags)), rows=self.rows)
+            r0, r1 = self.node_range
+            pool = cache_counts(table, r0, r1, self.CACHE_MAX / 8, lags, extra_lags)[1]
+            self._cache_est = (key, 16.0 * pool)
+        return self._cache_est[1]
 
     def _per_row(self, lag_hi):
         return _per_row(self.mesh.n_nodes, lag_hi)
@@ -430,9 +498,11 @@ class LagSet:
         ckeys, cmeta, cpP, cpU = cache_insert(cidx, ckeys, cmeta, cpP, cpU, keys, hs, meta, rbuf, poffs, uoffs)
         return ckeys, cmeta, cpP, cpU, int(nev)
 
-    def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly"):
+    def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly",
+                 single_from=0):
         """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
-        each rank its rows; sets and returns (H, G) Buckets."""
+        each rank its rows; sets and returns (H, G) Buckets (lags >= ``single_from`` > 0 kept in
+        float32: -ssi_lag_single_from)."""
         o = self.opts
         lag_hi = self.L if lag_hi is None else lag_hi
         gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
@@ -443,7 +513,8 @@ class LagSet:
         nimg = len(self.Vc) // self.mesh.n_cells
         cap = 1.15 * estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg)
         cap[:lag_lo - 1] = 0
-        H, G = Buckets(lag_hi, rows, self.mesh.n_nodes, cap), Buckets(lag_hi, rows, self.mesh.n_nodes)
+        H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from)
+        G = Buckets(lag_hi, rows, self.mesh.n_nodes, single_from=single_from)
         nev = 0
         ev = event("SSI_BEM_Assembly")
         ev.begin()

@@ -260,19 +260,20 @@ class BEMProblem:
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
+        sf = int(c.lag_single_from)
         # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
         # block-sparse is refused now, before the full O(N E) count
-        est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64)
+        est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
         peak0 = max(peak0, est0 + extra_bytes)
         if share * peak0 > 1.5 * limit:
             raise SSIError(f"the lag matrices need about {share * peak0 / 1e9:.3g} GB at assembly (estimated from a "
                            f"sample of rows, every lag block-sparse) on {'the most loaded node' if n_nodes > 1 else 'this node'}, "
                            f"more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry "
                            "planes, -ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
-        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra)
+        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra, single_from=sf)
         peak = max(peak, est + extra_bytes)
         if share * peak > limit and c.lag_storage == "auto":
-            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra)
+            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, single_from=sf)
             peak2 = max(peak2, est2 + extra_bytes)
             if share * peak2 <= limit:
                 self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
@@ -371,9 +372,8 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None):
 
 
 def _block_of(cfg, comm, H, G, HI, GI):
-    """history_block from this run's Mats (None: empty): per stored matrix the bytes of its H,
-    dense or block-sparse, and of its G (dense; read by the same panel products), summed over
-    the ranks."""
+    """history_block from this run's Mats (None: empty): per stored matrix the bytes of its H and
+    of its G (read by the same panel products), dense or block-sparse, summed over the ranks."""
     from . import bsr
     Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
     d = np.zeros((2, len(Hs)))
@@ -381,7 +381,7 @@ def _block_of(cfg, comm, H, G, HI, GI):
         if Hm is not None:
             d[1 if bsr.context(Hm) is not None else 0, i] += lagmats.mat_bytes(Hm)
         if Gm is not None:
-            d[0, i] += lagmats.mat_bytes(Gm)
+            d[1 if bsr.context(Gm) is not None else 0, i] += lagmats.mat_bytes(Gm)
     tot = np.zeros_like(d)
     comm.tompi4py().Allreduce(d, tot)
     return history_block(cfg, tot[0], tot[1])
@@ -407,7 +407,8 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     t0 = time.perf_counter()
     if cfg.get("lags_load"):
         return _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
-    ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx)
+    single = int(cfg.lag_single_from)
+    ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx, single_from=single)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
@@ -427,7 +428,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     HI, GI = [], []
     for j in range(plan.k if plan.active else 0):
         lag, toff = plan.kernel_time(j)
-        hb, gb = ls.assemble(monitor=False, lag_lo=lag, lag_hi=lag, toff=toff)
+        hb, gb = ls.assemble(monitor=False, lag_lo=lag, lag_hi=lag, toff=toff, single_from=single)
         nev += ls.kernel_evaluations
         HI.append(lagmats.build_one(comm, hb, lag, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
                                     prob.lag_fill)[0])
@@ -439,12 +440,15 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     mem = mem_exact + mem_interp
     ndense = sum(1 for i in hinfo if i[1] == "dense")
     nbaij = sum(1 for i in hinfo if i[1] == "baij")
+    nsingle = sum(1 for i in hinfo if i[1] == "single")
     blocks = sum(i[2] for i in hinfo)
     fill = blocks / float(plan.Lx * N * N)
     if plan.active:
         printf(f"[ssi] memory: {plan.Lx} exact lags {mem_exact / 1e9:.3g} GB, {plan.k} interpolating "
                f"matrices {mem_interp / 1e9:.3g} GB (T_N = {plan.TN:.4g} s, T_L = {plan.TL:.4g} s)")
-    printf(f"[ssi] assembly {fmt_time(t_asm)}: {plan.Lx} exact lags ({ndense} dense, {nbaij} block-sparse), "
+    single_txt = f", {nsingle} single-precision block-sparse" if single else ""
+    printf(f"[ssi] assembly {fmt_time(t_asm)}: {plan.Lx} exact lags ({ndense} dense, {nbaij} block-sparse"
+           f"{single_txt}), "
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
@@ -458,7 +462,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
         printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
                f"{fmt_time(time.perf_counter() - t1)}; -ssi_lags_load {cfg.lags_save} reuses them)")
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
-                   "nbaij": nbaij, "fill": fill, "mem": mem}
+                   "nbaij": nbaij, "nsingle": nsingle, "fill": fill, "mem": mem}
 
 
 def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
@@ -473,6 +477,14 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         tcol_loc = pl.getLocalSize() // 3
         pl.destroy()
     A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
+    single = int(cfg.lag_single_from)
+    if single:          # the file holds the float32 values in double (PETSc's scalar): float32 again
+        from . import bsr
+        interp_lags = [plan.kernel_time(j)[0] for j in range(len(HI))]
+        for lag, M in list(enumerate(H, 1)) + list(enumerate(G, 1)) + list(zip(interp_lags, HI)) \
+                + list(zip(interp_lags, GI)):
+            if lag >= single and bsr.context(M) is not None:
+                bsr.context(M).to_single()
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
     if not nt:

@@ -28,7 +28,7 @@ def test_cgroup_limits_are_read(tmp_path):
 
 
 def test_the_estimate_bounds_the_measured_peak(tmp_path):
-    """runs/pekeris/small.opts (the quarter model, 49 dense lags): the estimated assembly peak is
+    """runs/pekeris/small.opts (the quarter model): the estimated assembly peak is
     above the measured peak resident memory of the ranks (summed) and within 3x of it, on 1 and 2
     ranks; the issue's case, -ssi_memory_limit 4 on 2 ranks, runs (it was refused at 4.2 GB)."""
     for n in (1, 2):
