@@ -9,7 +9,6 @@ matrices are the same (OUT/matrices.txt, from jobscripts/compare_lags.py).
 
 Writes jobscripts/results/assembly.csv and the table between <!-- assembly:begin --> and
 <!-- assembly:end --> in jobscripts/README.md and runs/pekeris/README.md."""
-import csv
 import glob
 import os
 import re
@@ -20,11 +19,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from logview import parse  # noqa: E402
+from logview import parse, write_csv, put_block  # noqa: E402
 from history_table import receivers  # noqa: E402
-
-BEGIN, END = "<!-- assembly:begin -->", "<!-- assembly:end -->"
-
 
 def row_of(log):
     text = open(log).read()
@@ -48,12 +44,7 @@ def main(out):
             if os.path.exists(ref) and os.path.exists(mine):
                 a, b = receivers(mine), receivers(ref)
                 r["receivers_vs_before"] = f"{np.abs(a - b).max() / np.abs(b).max():.1e}"
-    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    keys = list(dict.fromkeys(k for r in rows for k in r))
-    with open(os.path.join(HERE, "results", "assembly.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, keys)
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(os.path.join(HERE, "results", "assembly.csv"), rows)
     order = {"before": 0, "after": 1}
     rows.sort(key=lambda r: (r["case"], order[r["version"]], -r["ranks"]))
     s = lambda v: f"{v} s" if v != "" else "-"
@@ -79,11 +70,7 @@ def main(out):
         notes += ["", "Lag matrices of both versions (jobscripts/compare_lags.py):"]
         notes += [f"- {line.strip()}" for line in open(mt) if line.strip()]
     block = "\n".join(lines + [""] + notes) + "\n"
-    for path in (os.path.join(HERE, "README.md"), os.path.join(ROOT, "runs", "pekeris", "README.md")):
-        text = open(path).read()
-        if BEGIN in text:
-            text = text[:text.index(BEGIN) + len(BEGIN)] + "\n" + block + text[text.index(END):]
-            open(path, "w").write(text)
+    put_block("assembly", block, (os.path.join(HERE, "README.md"), os.path.join(ROOT, "runs", "pekeris", "README.md")))
     print(block)
 
 

@@ -7,7 +7,6 @@ and this one at 2 ranks, and this one at 1 rank; from the runs' -log_view and -m
 Reads OUT/{before,after}-<case>-n<ranks>.log, the HDF5 outputs beside them and OUT/dgemm_rate.txt;
 writes jobscripts/results/history_block.csv and the table between <!-- history:begin --> and
 <!-- history:end --> in jobscripts/README.md and runs/pekeris/README.md."""
-import csv
 import glob
 import os
 import re
@@ -18,10 +17,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from logview import parse  # noqa: E402
-
-BEGIN, END = "<!-- history:begin -->", "<!-- history:end -->"
-
+from logview import parse, write_csv, put_block  # noqa: E402
 
 def row_of(log):
     text = open(log).read()
@@ -60,12 +56,7 @@ def main(out):
             if os.path.exists(ref) and os.path.exists(mine):
                 a, b = receivers(mine), receivers(ref)
                 r["max_rel_diff_vs_before"] = f"{np.abs(a - b).max() / np.abs(b).max():.1e}"
-    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    keys = list(dict.fromkeys(k for r in rows for k in r))
-    with open(os.path.join(HERE, "results", "history_block.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, keys)
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(os.path.join(HERE, "results", "history_block.csv"), rows)
     order = {"before": 0, "after": 1}
     rows.sort(key=lambda r: (r["case"], order[r["version"]], -r["ranks"]))
     lines = ["| case | code | ranks | block b | total | assembly | time loop | history sum | history GF/s | "
@@ -95,11 +86,7 @@ def main(out):
                 notes.append(f"- {r['case']}: the history sum at {r['history_GFps']} GF/s on 2 ranks is "
                              f"{r['history_GFps'] / peak:.0%} of 2 x square dgemm ({peak:g} GF/s)")
     block = "\n".join(lines + [""] + notes) + "\n"
-    for path in (os.path.join(HERE, "README.md"), os.path.join(ROOT, "runs", "pekeris", "README.md")):
-        text = open(path).read()
-        if BEGIN in text:
-            text = text[:text.index(BEGIN) + len(BEGIN)] + "\n" + block + text[text.index(END):]
-            open(path, "w").write(text)
+    put_block("history", block, (os.path.join(HERE, "README.md"), os.path.join(ROOT, "runs", "pekeris", "README.md")))
     print(block)
 
 

@@ -45,3 +45,25 @@ def parse(text):
 if __name__ == "__main__":
     import json
     print(json.dumps(parse(open(sys.argv[1]).read()), indent=1))
+
+
+def write_csv(path, rows):
+    """Rows (dicts) to a CSV whose columns are every key in first-seen order."""
+    import csv
+    import os
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, keys)
+        w.writeheader()
+        w.writerows(rows)
+
+
+def put_block(tag, block, paths):
+    """Replace the text between <!-- tag:begin --> and <!-- tag:end --> in each file that has them."""
+    begin, end = f"<!-- {tag}:begin -->", f"<!-- {tag}:end -->"
+    for path in paths:
+        text = open(path).read()
+        if begin in text and end in text:
+            text = text[:text.index(begin) + len(begin)] + "\n" + block + text[text.index(end):]
+            open(path, "w").write(text)
