@@ -74,8 +74,9 @@ register("lag_fill", "real", 0.95, "", "auto storage: lags with block fill above
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
 register("lag_single_from", "int", 0, "lag", "store the lags from this one on in single precision: float32 "
          "block-sparse (40 B per 3x3 block, against 76 B block-sparse or 72 B per block dense), also the "
-         "interpolating matrices that stand for them; the products accumulate in double. 0: every lag in double; "
-         "lags 1 and 2 (the step matrix) stay double", "bem",
+         "interpolating matrices that stand for them (an interpolating matrix counts as the lag of its kernel time, "
+         "rounded down: the first one is usually the last exact lag); the products accumulate in double. 0: every "
+         "lag in double; lags 1 and 2 (the step matrix) stay double", "bem",
          validator=lambda v: None if v == 0 or v >= 3 else "must be 0 (off) or a lag >= 3 (lags 1 and 2 form the "
          "step matrix and stay double)")
 register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this per node (0: 80% of this machine's memory); the run's estimated peak is shared by its ranks", "bem",

@@ -36,8 +36,8 @@ are the maximum over ranks; with more ranks per node than cores
 Memory (peak of the processes, summed over ranks as -memory_view reports):
   p * m0 + gamma * max(rho_trip * (T + c_cache * C + p * m_asm),
                        max_k [Mats of lags <= k + T of lags > k] + G)
-with T = 84 B per block (44 B single precision, -ssi_lag_single_from: its Mats
-40 B per block) the blocks of the assembly, C the bytes of the
+with T = 76 B per block (40 B single precision, -ssi_lag_single_from, as its Mats;
+model.lag_bytes) the blocks of the assembly, C the bytes of the
 element caches (pair_table: the distinct pair geometries each rank meets,
 capped as the assembly caps them) and m_asm a per-rank transient. With the
 cache shared between ranks (-ssi_cache_share, the default) I_r is 1/p of the
@@ -253,7 +253,8 @@ class Counts:
         mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt)
         g = g * (tot > 0) * (self.nt > 0)
         self.block = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
-                                   np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0))
+                                   np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0),
+                                   np.where(self.storage, 0.0, tot) + np.where(self.single, g / 40.0, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(partition(N, p))] for p in ranks}
 
@@ -273,12 +274,12 @@ class Counts:
     def _peak_rule(self, used, dense, p=1):
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
-        from .bem.model import transient_bytes, lag_bytes
+        from .bem.model import transient_bytes, lag_bytes, peak_bytes
         N = self.N
         mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt)
-        build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
-        transient = transient_bytes(used.sum() / p, N, len(used), N / p)
-        return 1.1 * max(trip.sum(), build.max()) + g.sum() + transient * p
+        asm, rss = transient_bytes(used[:self.Lx].sum() / p, N, self.Lx, N / p, parts=True)
+        asm_i = transient_bytes(max(list(used[self.Lx:]) + [0.0]) / p, N, 1, N / p, parts=True)[0] if self.k else 0.0
+        return peak_bytes(mats, trip, g, asm * p, rss * p, n_exact=self.Lx, asm_interp=asm_i * p)
 
     def _rank(self, nb, nrows, p, cache=None):
         """Counts of one rank (``nb``: its blocks per lag, ``nrows``: its nodes,

@@ -66,6 +66,9 @@ def _single_kernels():
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
     data = np.ones((1, 3, 3), np.float32)
     bsr._matvec(indptr, cols, data, np.ones(3), np.zeros(3))
+    x = np.ones(3)
+    x.flags.writeable = False                # the python Mat's products read a read-only gathered x
+    bsr._matvec(indptr, cols, data, x, np.zeros(3))
     bsr._panel(indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
 
 

@@ -40,8 +40,10 @@ def lag_key(cfg, prob, plan):
            "scheme": str(cfg.scheme), "symmetry": str(cfg.symmetry), "lags": str(prob.L), "exact_lags": str(plan.Lx),
            "traction_nodes": _h(np.asarray(reg.tnode, np.int64)), "load_nodes": str(reg.n_load),
            "disp_nodes": _h(np.asarray(reg.disp_nodes, np.int64))}
-    if int(cfg.get("lag_single_from") or 0):        # (absent when off: files of double runs keep their key)
-        key["single_from"] = str(int(cfg.lag_single_from))
+    sf = int(cfg.get("lag_single_from") or 0)
+    top = max([plan.Lx] + ([plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []))
+    if 0 < sf <= top:         # (absent when no stored matrix is single: such files are of double runs)
+        key["single_from"] = str(sf)
     for k, v in sorted(prob.quad_options().items()):
         if k != "cache_share":
             key["quadrature_" + k] = str(v)
@@ -164,9 +166,12 @@ def save(path, comm, march, key):
     return comm.tompi4py().bcast(size, root=0)
 
 
-def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
+def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0, interp_lags=()):
     """Collective: (A, H, G, HI, GI) from ``path`` in this run's layout (rows: the nodes
-    ``node_range`` of ``n_nodes``; G's columns the ``n_t`` traction nodes, ``tcol_loc`` here)."""
+    ``node_range`` of ``n_nodes``; G's columns the ``n_t`` traction nodes, ``tcol_loc`` here).
+    ``single_from`` > 0: block-sparse lags from it on (``interp_lags``: the lag index of each
+    interpolating matrix) back to float32 as each is read, so that no more than one of them is
+    held in double at a time."""
     PETSc = init()
     nloc = node_range[1] - node_range[0]
     types = {"dense": PETSc.Mat.Type.DENSE, "baij": PETSc.Mat.Type.BAIJ, "aij": PETSc.Mat.Type.AIJ}
@@ -187,6 +192,10 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc):
             if kind == "baij":
                 from . import bsr
                 M = bsr.from_mat(M)
+                idx = int(name[len(group):])
+                lag = interp_lags[idx - 1] if group in ("HI", "GI") else idx
+                if 0 < single_from <= lag:
+                    bsr.context(M).to_single()
             out[group].append(M)
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
     viewer.destroy()

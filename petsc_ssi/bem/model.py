@@ -180,8 +180,29 @@ def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
     chunk of raw triplets with its sorted copy; throughout, the process as it stands (resident size
     now, measured). ``parts``: (assembly-only bytes, process bytes), else their sum."""
     cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
-    chunk = 2.0 * _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
+    # a chunk's triplet arrays are allocated for twice the blocks they get (``_per_row``): the half
+    # touched and the sorted copy of it
+    chunk = _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
     return (cache + chunk, process_rss()) if parts else cache + chunk + process_rss()
+
+
+def peak_bytes(mats, trip, g, asm, rss, n_exact=None, asm_interp=0.0):
+    """The memory check's peak (bytes, all ranks; ``LagSet.estimate_memory`` and ``petsc-ssi
+    estimate``'s storage rule): 1.1 x the largest of the phases, with G (``g``) and the process
+    (``rss``) throughout: assembling the exact lags (their blocks ``trip`` of the first ``n_exact``
+    matrices, with the element cache and a chunk, ``asm``); building their Mats (``mats`` of lags
+    <= k and blocks of lags > k); assembling each interpolating matrix after them (the exact Mats,
+    the interpolating ones before it, its blocks, its own cache and chunk, ``asm_interp``)."""
+    mats, trip = np.asarray(mats, float), np.asarray(trip, float)
+    n = len(mats) if n_exact is None else int(n_exact)
+    me, te = mats[:n], trip[:n]
+    phases = [te.sum() + asm]
+    if n:
+        phases.append(float((np.cumsum(me) + (te.sum() - np.cumsum(te))).max()))
+    mi, ti = mats[n:], trip[n:]
+    for j in range(len(mi)):
+        phases.append(me.sum() + mi[:j].sum() + ti[j] + asm_interp)
+    return 1.1 * (max(phases) + float(np.sum(g)) + rss)
 
 
 _KERNELS_LOADED = []
@@ -199,9 +220,32 @@ def load_kernels():
     mesh = grid(2.0, 2.0, 1.0, (1.0, 1.0))
     opts = {"gauss": 2, "singular_order": 4, "subdivisions": 1, "near_factor": 0.0, "max_subdivisions": 1,
             "cache": True}
+    from .. import numba_cache_warm
+    if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
+        announce_compile()
     LagSet(PETSc.COMM_SELF, mesh, Material(548.0, 316.0, 2000.0), 0.005, 2,
-           Regions(mesh, load_elems=mesh.groups["load"]), [], opts).assemble()
+           Regions(mesh, load_elems=mesh.groups["load"]), [], opts).assemble(quiet=True)
     _KERNELS_LOADED.append(True)
+
+
+_ANNOUNCED = []
+
+
+def announce_compile():
+    """Say once per process that the kernels compile now (a cold numba cache)."""
+    if not _ANNOUNCED:
+        _ANNOUNCED.append(True)
+        printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
+               f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
+               "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
+
+
+class _NoEvent:
+    def begin(self):
+        pass
+
+    def end(self):
+        pass
 
 
 def proc_status_bytes(field):
@@ -238,6 +282,8 @@ class Buckets:
     def __init__(self, L, rows, n_nodes, capacity=None, single_from=0):
         self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
         self.single_from = int(single_from)     # lags >= this (> 0) keep their blocks in float32
+        if self.single_from in (1, 2):
+            raise ValueError("Buckets: lags 1 and 2 (the step matrix) stay double (single_from 0 or >= 3)")
         self.loc = np.full(n_nodes, -1, np.int64)
         self.loc[self.rows] = np.arange(self.nloc)
         self.counts = np.zeros((L + 1, max(self.nloc, 1)), np.int64)
@@ -358,7 +404,8 @@ class LagSet:
         self.n_nonsmooth = self.comm.tompi4py().allreduce(
             int(np.sum(np.abs(self.cfree[self.rows] - 0.5 * np.eye(3)).max(axis=(1, 2)) > 1e-14)))
 
-    def estimate_memory(self, lags, storage="auto", fill=0.95, extra_lags=(), sample=0, single_from=0):
+    def estimate_memory(self, lags, storage="auto", fill=0.95, extra_lags=(), sample=0, single_from=0,
+                        load=True):
         """Collective: estimated bytes of the stored Mats and the assembly peak (all ranks).
 
         ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
@@ -367,18 +414,20 @@ class LagSet:
         blocks (``Buckets``: 76 B per block, 40 B single, in arrays sized from this count with 15 %
         headroom that is never touched, so not resident) become the block-sparse Mats
         as they are, or are freed lag by lag as dense Mats are built, so the
-        peak is max_k [Mats of lags <= k + blocks of lags > k], times 1.1. Per rank on top:
+        peak is max_k [Mats of lags <= k + blocks of lags > k] (``peak_bytes``, also the
+        interpolating matrices' assemblies after them), times 1.1. Per rank on top:
         the element cache (``cache_estimate``: 81 doubles per distinct pair geometry and lag
         in each of two pools, which grow by doubling: twice that; each pool capped at
         CACHE_MAX) and one chunk of raw triplets while the blocks are assembled (``chunk_rows``, up
-        to twice over-allocated) and the process as it stands now (its resident size,
-        measured). ``sample`` > 0: the blocks counted on every k-th local row only (at most
-        ``sample`` rows per rank) and scaled up, a fast estimate. ``single_from`` > 0: lags from it on
-        (exact or interpolating) kept in single precision (``lag_bytes``)."""
+        to twice over-allocated) and the process as it stands now (its resident size, measured after
+        loading the kernels unless ``load`` is False). ``sample`` > 0: the blocks counted on every
+        k-th local row only (at most ``sample`` rows per rank) and scaled up, a fast estimate.
+        ``single_from`` > 0: lags from it on (exact or interpolating) kept in single precision
+        (``lag_bytes``)."""
         nimg = len(self.Vc) // self.mesh.n_cells
         L = max([lags] + list(extra_lags))
         rows = self.rows
-        if not sample:
+        if not sample and load:
             load_kernels()          # the process measured with the compiled kernels it will hold
         if sample and len(rows) > sample:
             rows = rows[::int(np.ceil(len(rows) / sample))]
@@ -386,6 +435,7 @@ class LagSet:
         nb = nb * (len(self.rows) / max(len(rows), 1))
         mpi = self.comm.tompi4py()
         local_blocks = float(nb[:lags].sum())
+        local_interp = max([float(nb[l - 1]) for l in extra_lags] + [0.0])
         nb = mpi.allreduce(nb)
         use = np.r_[nb[:lags], [nb[l - 1] for l in extra_lags]] if len(extra_lags) else nb[:lags]
         N = self.mesh.n_nodes
@@ -393,11 +443,10 @@ class LagSet:
         single = single_lags(np.r_[np.arange(1, lags + 1), list(extra_lags)], single_from)
         dense = ((f > fill) if storage == "auto" else np.full(len(use), storage == "dense")) & ~single
         mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t)
-        build = np.cumsum(mats) + (trip.sum() - np.cumsum(trip))
         cache = None if sample else self.cache_estimate(lags, extra_lags)    # (sample: the bound per block)
         asm, rss = (mpi.allreduce(v) for v in transient_bytes(local_blocks, N, L, len(self.rows), cache, parts=True))
-        # the cache and the chunk live while the blocks are assembled, not while the Mats are built
-        peak = 1.1 * (max(trip.sum() + asm, build.max()) + g.sum() + rss)
+        asm_i = mpi.allreduce(transient_bytes(local_interp, N, 1, len(self.rows), parts=True)[0]) if len(extra_lags) else 0.0
+        peak = peak_bytes(mats, trip, g, asm, rss, n_exact=lags, asm_interp=asm_i)
         return float(mats.sum() + g.sum()), float(peak), int(dense.sum())
 
     CACHE_MAX = CACHE_MAX        # bytes per cache pool (P and U): 1 GiB per rank at most
@@ -499,10 +548,10 @@ class LagSet:
         return ckeys, cmeta, cpP, cpU, int(nev)
 
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly",
-                 single_from=0):
+                 single_from=0, quiet=False):
         """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
         each rank its rows; sets and returns (H, G) Buckets (lags >= ``single_from`` > 0 kept in
-        float32: -ssi_lag_single_from)."""
+        float32: -ssi_lag_single_from). ``quiet``: no -log_view event (``load_kernels``)."""
         o = self.opts
         lag_hi = self.L if lag_hi is None else lag_hi
         gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
@@ -516,7 +565,7 @@ class LagSet:
         H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from)
         G = Buckets(lag_hi, rows, self.mesh.n_nodes, single_from=single_from)
         nev = 0
-        ev = event("SSI_BEM_Assembly")
+        ev = _NoEvent() if quiet else event("SSI_BEM_Assembly")
         ev.begin()
         cidx, ckeys, cmeta, cpP, cpU = new_cache()
         qinv = 1.0 / (1e-9 * float(self.Vh.min()))

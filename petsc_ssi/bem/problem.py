@@ -93,6 +93,7 @@ class BEMTransient(TransientProblem):
             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
             "T_L": plan.TL if plan.active else None, "lag_bytes_exact": info["mem_exact"],
             "lag_bytes_interp": info["mem_interp"], "dense_lags": info["ndense"], "baij_lags": info["nbaij"],
+            "single_lags": info.get("nsingle", 0),
             "mean_fill": info["fill"], "lag_bytes": info["mem"], "mem_estimate": prob.mem_estimate,
             "T_N": prob.T_N, "r_max": prob.r_max, "kernel_evaluations": ls.kernel_evaluations,
             "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1],

@@ -261,6 +261,7 @@ class BEMProblem:
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
         sf = int(c.lag_single_from)
+        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
         # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
         # block-sparse is refused now, before the full O(N E) count
         est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
@@ -270,10 +271,10 @@ class BEMProblem:
                            f"sample of rows, every lag block-sparse) on {'the most loaded node' if n_nodes > 1 else 'this node'}, "
                            f"more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry "
                            "planes, -ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
-        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra, single_from=sf)
+        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra, single_from=sf, load=load)
         peak = max(peak, est + extra_bytes)
         if share * peak > limit and c.lag_storage == "auto":
-            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, single_from=sf)
+            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, single_from=sf, load=load)
             peak2 = max(peak2, est2 + extra_bytes)
             if share * peak2 <= limit:
                 self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
@@ -335,14 +336,18 @@ PANEL_SPARSE_GFPS = (8.2, 18.8, 32.2)
 STREAM_GBPS = 22.0
 
 
-def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32)):
+def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
+                 sparse_blocks=None):
     """The steps per block that minimise the modelled time per step of the history sum, from the
     bytes of each stored matrix (index 0: lag 1, ..., then the interpolating ones; dense and
     block-sparse apart): the panel products, 2 flops per stored value at the rates above, and the
     per-step products of the in-block terms, lag j in a fraction (b - j + 2) / b of the steps
-    (stabilised; plain b - j + 1), streamed. b = 1 streams every matrix every step."""
+    (stabilised; plain b - j + 1), streamed. b = 1 streams every matrix every step.
+    ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices (18 flops each per state;
+    default their bytes / 76, the double blocks; single-precision ones store 40 B a block)."""
     d = np.asarray(dense_bytes, float)
     s = np.asarray(sparse_bytes, float)
+    sb = s / 76.0 if sparse_blocks is None else np.asarray(sparse_blocks, float)
     every = d + s
     Lx = len(every)
     best, best_t = 1, float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
@@ -351,7 +356,7 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
             continue
         rd = np.interp(b, PANEL_B, PANEL_DENSE_GFPS) * 1e9
         rs = np.interp(b, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
-        t = float(np.sum(d[1:])) * 2 / 8 / rd + float(np.sum(s[1:])) * 18 / 76 / rs
+        t = float(np.sum(d[1:])) * 2 / 8 / rd + float(np.sum(sb[1:])) * 18 / rs
         j = np.arange(2, min(b + 2, Lx) + 1)
         frac = np.clip((b - j + (2 if stabilized else 1)) / b, 0.0, 1.0)
         t += float(np.sum(frac * every[j - 1])) / (STREAM_GBPS * 1e9)
@@ -360,7 +365,7 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
     return best
 
 
-def history_block(cfg, dense_bytes=None, sparse_bytes=None):
+def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
     """The steps per block of the time-blocked history sum: -ssi_history_block, or with 0 the
     ``choose_block`` of the stored matrices' bytes (1 without them)."""
     b = int(cfg.get("history_block") or 0)
@@ -368,7 +373,7 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None):
         return b
     if dense_bytes is None:
         return 1
-    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"))
+    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"), sparse_blocks=sparse_blocks)
 
 
 def _block_of(cfg, comm, H, G, HI, GI):
@@ -376,15 +381,18 @@ def _block_of(cfg, comm, H, G, HI, GI):
     of its G (read by the same panel products), dense or block-sparse, summed over the ranks."""
     from . import bsr
     Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
-    d = np.zeros((2, len(Hs)))
+    d = np.zeros((3, len(Hs)))              # dense bytes, block-sparse bytes, block-sparse blocks
     for i, (Hm, Gm) in enumerate(zip(Hs, Gs)):
-        if Hm is not None:
-            d[1 if bsr.context(Hm) is not None else 0, i] += lagmats.mat_bytes(Hm)
-        if Gm is not None:
-            d[1 if bsr.context(Gm) is not None else 0, i] += lagmats.mat_bytes(Gm)
+        for M in (Hm, Gm):
+            if M is None:
+                continue
+            ctx = bsr.context(M)
+            d[1 if ctx is not None else 0, i] += lagmats.mat_bytes(M)
+            if ctx is not None:
+                d[2, i] += ctx.indices.size
     tot = np.zeros_like(d)
     comm.tompi4py().Allreduce(d, tot)
-    return history_block(cfg, tot[0], tot[1])
+    return history_block(cfg, tot[0], tot[1], tot[2])
 
 
 def _say_block(march):
@@ -401,9 +409,8 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     PETSc = init()
     from .. import numba_cache_warm
     if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
-        printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
-               f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
-               "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
+        from .model import announce_compile
+        announce_compile()
     t0 = time.perf_counter()
     if cfg.get("lags_load"):
         return _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
@@ -476,15 +483,10 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
         tcol_loc = pl.getLocalSize() // 3
         pl.destroy()
-    A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
-    single = int(cfg.lag_single_from)
-    if single:          # the file holds the float32 values in double (PETSc's scalar): float32 again
-        from . import bsr
-        interp_lags = [plan.kernel_time(j)[0] for j in range(len(HI))]
-        for lag, M in list(enumerate(H, 1)) + list(enumerate(G, 1)) + list(zip(interp_lags, HI)) \
-                + list(zip(interp_lags, GI)):
-            if lag >= single and bsr.context(M) is not None:
-                bsr.context(M).to_single()
+    # (the file holds float32 values as doubles, PETSc's scalar: float32 again as each is read)
+    A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc,
+                                    single_from=int(cfg.lag_single_from),
+                                    interp_lags=[plan.kernel_time(j)[0] for j in range(plan.k if plan.active else 0)])
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
     if not nt:
@@ -495,18 +497,21 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     mem_interp = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in HI + GI))
     kinds = dict(prob.lags_manifest["mats"])
     ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "dense")
-    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "baij")
+    from . import bsr
+    nsingle = sum(1 for M in H if bsr.context(M) is not None and bsr.context(M).data.dtype == np.float32)
+    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "baij") - nsingle
     ls.kernel_evaluations = ls.cache_hits = 0
     ls.cache_bytes = 0.0
     printf(f"[ssi] lag matrices loaded from {cfg.lags_load} in {fmt_time(t_asm)} (no assembly): {plan.Lx} exact "
-           f"lags ({ndense} dense, {nbaij} block-sparse)"
+           f"lags ({ndense} dense, {nbaij} block-sparse" + (f", {nsingle} single-precision block-sparse" if nsingle
+                                                               else "") + ")"
            + (f", {plan.k} interpolating matrices" if plan.active else "")
            + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
     march.set_lags(H, G, plan, HI, GI, block=_block_of(cfg, comm, H, G, HI, GI))
     _say_block(march)
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
-                   "nbaij": nbaij, "fill": float("nan"), "mem": mem_exact + mem_interp}
+                   "nbaij": nbaij, "nsingle": nsingle, "fill": float("nan"), "mem": mem_exact + mem_interp}
 
 
 def _guard(cfg, prob, march, unorm, n):

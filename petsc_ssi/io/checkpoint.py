@@ -67,9 +67,14 @@ def run_key(cfg, exclude=RUN_CONTROL):
 
 
 def key_difference(saved, now):
-    """The first option that differs between two keys, as a phrase, or None."""
+    """The first option that differs between two keys, as a phrase, or None. An option the
+    checkpoint's version did not have counts as its default there (an option added since)."""
+    from ..options import _REGISTRY
     for name in sorted(set(saved) | set(now)):
         a, b = saved.get(name), now.get(name)
+        if a is None and name in _REGISTRY and not name.startswith("file:"):
+            d = _REGISTRY[name].default
+            a = repr(d) if isinstance(d, float) else str(d)
         if a == b:
             continue
         if name.startswith("file:"):

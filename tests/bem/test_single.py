@@ -121,3 +121,38 @@ def test_low_lags_stay_double(value):
 
 BEM_OPTS = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1, "mesh_patch": "1,1", "load_group": "load",
             "load_p0": 1000, "dt": 0.005, "t_end": 0.02}
+
+
+def test_buckets_refuse_single_step_matrix_lags():
+    from petsc_ssi.bem.model import Buckets
+    for sf in (1, 2):
+        with pytest.raises(ValueError, match="lags 1 and 2"):
+            Buckets(4, np.arange(2), 3, single_from=sf)
+
+
+def test_peak_counts_the_interpolating_assemblies():
+    """The memory check's peak: the largest phase, including the assembly of each interpolating
+    matrix after the exact Mats are built (its blocks and its own cache and chunk)."""
+    from petsc_ssi.bem.model import peak_bytes
+    mats, trip = np.array([10.0, 10.0, 4.0, 4.0]), np.array([10.0, 10.0, 4.0, 4.0])   # 2 exact + 2 interpolating
+    assert peak_bytes(mats, trip, [0.0], 5.0, 0.0, n_exact=2) == pytest.approx(1.1 * 28.0)     # last: 20 + 4 + 4
+    assert peak_bytes(mats, trip, [0.0], 5.0, 0.0, n_exact=2, asm_interp=3.0) == pytest.approx(1.1 * 31.0)
+    assert peak_bytes(mats[:2], trip[:2], [1.0], 5.0, 2.0) == pytest.approx(1.1 * (25.0 + 1.0 + 2.0))
+
+
+def test_block_choice_counts_blocks_not_bytes():
+    """A float32 block-sparse matrix has the flops of a double one with the same blocks in 40/76 of
+    its bytes: the block choice takes the blocks when given."""
+    from petsc_ssi.bem.run import choose_block
+    d = np.zeros(40)
+    blocks = np.full(40, 2.0e6)
+    assert choose_block(d, 76.0 * blocks) == choose_block(d, 76.0 * blocks, sparse_blocks=blocks)
+    b40 = choose_block(d, 40.0 * blocks, sparse_blocks=blocks)
+    assert b40 >= 2
+
+
+def test_an_option_added_since_a_checkpoint_counts_as_its_default():
+    from petsc_ssi.io.checkpoint import key_difference
+    assert key_difference({"dt": "0.001"}, {"dt": "0.001", "lag_single_from": "0"}) is None
+    msg = key_difference({"dt": "0.001"}, {"dt": "0.001", "lag_single_from": "3"})
+    assert msg and "-ssi_lag_single_from is 3 here and was 0" in msg
