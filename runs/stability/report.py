@@ -204,6 +204,40 @@ def history_plot(rows, outdir, png):
     plt.close(fig)
 
 
+def precision_table(prec, mp):
+    """Per scheme: h x beta cells 'double class -> single class' of the map's runs and their single-precision
+    repeats (-ssi_lag_single_from), and the single run's final norm relative to the double one's."""
+    out = []
+    for scheme in ("plain", "stabilized"):
+        sel = [r for r in prec if r["scheme"] == scheme]
+        if not sel:
+            continue
+        betas = sorted({r["beta"] for r in sel})
+        out += [f"**{scheme}**: class double -> single (final |u| single / double - 1, where both ran to the end)", "",
+                "| h \\ beta | " + " | ".join(f"{b:g}" for b in betas) + " |", "|---|" + "---|" * len(betas)]
+        for h in sorted({r["h"] for r in sel}):
+            cells = []
+            for b in betas:
+                s1 = [r for r in sel if r["h"] == h and r["beta"] == b]
+                d1 = [r for r in mp if r["scheme"] == scheme and r["h"] == h and r["beta"] == b]
+                if not s1 or not d1:
+                    cells.append("not run")
+                    continue
+                s1, d1 = s1[0], d1[0]
+                c = f"{SYMBOL[d1['class']]} -> {SYMBOL[s1['class']]}"
+                if not s1["cut"] and not d1["cut"] and d1["norm_late"] > 0:
+                    c += f" ({s1['norm_late'] / d1['norm_late'] - 1:.1e})"
+                elif s1["cut"] or d1["cut"]:
+                    c += f" (blow-up step {d1['steps_run'] if d1['cut'] else '-'} / {s1['steps_run'] if s1['cut'] else '-'})"
+                cells.append(c)
+            out.append(f"| {h:g} | " + " | ".join(cells) + " |")
+        out.append("")
+    same = sum(1 for r in prec for d in mp if d["scheme"] == r["scheme"] and d["h"] == r["h"]
+               and d["beta"] == r["beta"] and d["class"] == r["class"])
+    out.append(f"Same class in {same} of {len(prec)} cases.")
+    return out
+
+
 def replace_block(text, name, lines):
     b, e = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
     block = b + "\n" + "\n".join(lines) + "\n" + e
@@ -227,6 +261,9 @@ def report(here, outdir):
         text = replace_block(text, "map-table", tab)
         text = replace_block(text, "map-summary", summary(mp))
         text = replace_block(text, "guard-summary", guard_summary(mp + ip))
+    pp = read(os.path.join(here, "stability_precision.csv"))
+    if pp and mp:
+        text = replace_block(text, "precision-table", precision_table(pp, mp))
     if ip:
         ipi = [r for r in ip if r["interp"] != "none"]
         interp_plot(ipi, os.path.join(here, "stability_interp.png"))

@@ -17,6 +17,11 @@ tau_L = c_s T_L / r with r = 3 m (the receiver), below and above the Rayleigh
 arrival tau_R = 1.0877; k = 2..16; 1000 steps. Also the largest deviation of
 the receiver's vertical displacement from the run with exact lags.
 
+Part "precision": the map's cases with h = 1 and 1.5 m again, lags from the third on stored in single
+precision (-ssi_lag_single_from 3): does the float32 rounding of the far lags (a perturbation of
+about 1e-8 instead of 1e-16 of the recurrence) move the stability boundary or seed an instability?
+Compared with the map's double runs, class by class, and by their final norms.
+
 Classification (petsc_ssi.bem.stability.classify): the late growth rate r =
 slope of ln|u^n| per step fitted by least squares over the last third of the
 run; stable r < 1e-4, slowly growing 1e-4 <= r < 2e-3, unstable r >= 2e-3 or
@@ -65,6 +70,9 @@ KS = (2, 4, 8, 16)
 TAU_R = 1.0877
 MAP_CSV = os.path.join(HERE, "stability_map.csv")
 INTERP_CSV = os.path.join(HERE, "stability_interp.csv")
+PREC_CSV = os.path.join(HERE, "stability_precision.csv")
+PREC_HS = (1.0, 1.5)
+SINGLE_FROM = 3
 FIELDS = ["case", "part", "scheme", "h", "size", "beta", "beta_p_min", "dt", "interp", "tau_L", "k",
           "steps_planned", "steps_run", "lags", "rate", "class", "cut", "guard100_step", "onset_step",
           "norm_late", "norm_plateau", "dev_pct", "wall_s"]
@@ -82,6 +90,12 @@ def cases():
             for b in BETAS:
                 dt = b * (h / 2) / CS
                 out.append({"case": f"map-{scheme}-h{h:g}-b{b:g}", "part": "map", "scheme": scheme, "h": h,
+                            "size": SIZE, "beta": b, "dt": dt, "interp": "none", "tau_L": "", "k": ""})
+    for scheme in SCHEMES:
+        for h in PREC_HS:
+            for b in BETAS:
+                dt = b * (h / 2) / CS
+                out.append({"case": f"prec-{scheme}-h{h:g}-b{b:g}", "part": "precision", "scheme": scheme, "h": h,
                             "size": SIZE, "beta": b, "dt": dt, "interp": "none", "tau_L": "", "k": ""})
     out.append({"case": "interp-exact", "part": "interp", "scheme": "stabilized", "h": I_H, "size": I_SIZE,
                 "beta": CS * I_DT / (I_H / 2), "dt": I_DT, "interp": "none", "tau_L": "", "k": ""})
@@ -112,6 +126,8 @@ def options(c):
          "symmetry": "x=sym,y=sym", "load_group": "load", "load_p0": 1000, "cs": CS, "cp": CP, "rho": 2000,
          "dt": repr(c["dt"]), "t_end": repr(n * c["dt"]), "scheme": c["scheme"], "output_stride": 0,
          "warn_beta": 0, "guard": 1, "guard_factor": CUT_FACTOR, "interp": c["interp"]}
+    if c["part"] == "precision":
+        o["lag_single_from"] = SINGLE_FROM
     if c["part"] == "interp":
         o["receivers"] = f"{I_R:g},0,0"
         if c["interp"] != "none":
@@ -204,7 +220,7 @@ def run_case(c, outdir, lock):
         print(f"[stability] {c['case']} FAILED:\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}", flush=True)
         return None
     row = json.loads(p.stdout.strip().splitlines()[-1])
-    csvp = MAP_CSV if c["part"] == "map" else INTERP_CSV
+    csvp = {"map": MAP_CSV, "interp": INTERP_CSV, "precision": PREC_CSV}[c["part"]]
     append_row(csvp, row)
     print(f"[stability] {c['case']:34s} {row['class']:15s} rate {row['rate']:.3g}/step "
           f"{row['steps_run']}/{row['steps_planned']} steps, {time.time() - t0:.1f}s", flush=True)
@@ -213,7 +229,7 @@ def run_case(c, outdir, lock):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--part", choices=("map", "interp", "all"), default="all")
+    ap.add_argument("--part", choices=("map", "interp", "precision", "all"), default="all")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "stability"))
     ap.add_argument("--lock", default="/tmp/ssi_cpu.lock")
     ap.add_argument("--minutes", type=float, default=0.0, help="stop starting new cases after this long (0: no limit)")
@@ -241,7 +257,7 @@ def main():
             todo = [allc[int(a.case)]] if a.case.isdigit() else [c for c in allc if c["case"] == a.case]
         elif a.part != "all":
             todo = [c for c in allc if c["part"] == a.part]
-        done = done_cases(MAP_CSV) | done_cases(INTERP_CSV)
+        done = done_cases(MAP_CSV) | done_cases(INTERP_CSV) | done_cases(PREC_CSV)
         t0 = time.time()
         for c in todo:
             if c["case"] in done:
