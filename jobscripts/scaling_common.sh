@@ -16,7 +16,8 @@ if [ -z "${MPIEXEC:-}" ]; then
 fi
 MPIFLAGS=${MPIFLAGS:-}
 OUT=${OUT:-out/scaling}
-CORES=${CORES:-${SLURM_CPUS_ON_NODE:-${NCPUS:-$(nproc)}}}
+# (nproc without OMP_NUM_THREADS/OMP_THREAD_LIMIT: GNU nproc reports those instead of the cores)
+CORES=${CORES:-${SLURM_CPUS_ON_NODE:-${NCPUS:-$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)}}}
 LOCK=${LOCK:-}
 mkdir -p "$OUT"
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
