@@ -2,7 +2,8 @@
 (issue 13): square dgemm, the skinny products of the time-blocked history sum (a rank's rows of a
 dense lag, 2054 x 4107 as in the paper case on 2 ranks, times a panel of b states, both layouts),
 the matrix-vector product of the per-step sum (memory bound: its GB/s) and the block-sparse panel
-kernel of bem/bsr.py on a fully dense 3x3-block pattern of the same size.
+kernel of bem/bsr.py on a fully dense 3x3-block pattern of the same size, with double and with
+single-precision (float32) blocks.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python jobscripts/dgemm_rate.py
 
@@ -51,6 +52,12 @@ def main():
         RT = np.zeros((3 * nb_r, b))
         t = best(lambda: bsr._panel(indptr, indices, data, XT, RT, 1.0), reps=3)
         print(f"bsr_panel_b{b} {18 * b * indices.size / t / 1e9:.1f} GF/s")
+    data32 = data.astype(np.float32)              # lags in single precision (-ssi_lag_single_from)
+    for b in (8, 16, 32):
+        XT = rng.random((3 * nb_c, b))
+        RT = np.zeros((3 * nb_r, b))
+        t = best(lambda: bsr._panel(indptr, indices, data32, XT, RT, 1.0), reps=3)
+        print(f"bsr_panel_single_b{b} {18 * b * indices.size / t / 1e9:.1f} GF/s")
 
 
 if __name__ == "__main__":
