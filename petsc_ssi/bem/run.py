@@ -262,6 +262,9 @@ class BEMProblem:
         self.lag_fill = c.lag_fill
         sf = int(c.lag_single_from)
         load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
+        if sf > max([lags] + list(extra)):
+            warn(f"-ssi_lag_single_from {sf}: beyond the {max([lags] + list(extra))} stored lags, every lag "
+                 "stays in double precision")
         # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
         # block-sparse is refused now, before the full O(N E) count
         est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
@@ -453,7 +456,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     if plan.active:
         printf(f"[ssi] memory: {plan.Lx} exact lags {mem_exact / 1e9:.3g} GB, {plan.k} interpolating "
                f"matrices {mem_interp / 1e9:.3g} GB (T_N = {plan.TN:.4g} s, T_L = {plan.TL:.4g} s)")
-    single_txt = f", {nsingle} single-precision block-sparse" if single else ""
+    single_txt = f", {nsingle} single-precision block-sparse" if nsingle else ""
     printf(f"[ssi] assembly {fmt_time(t_asm)}: {plan.Lx} exact lags ({ndense} dense, {nbaij} block-sparse"
            f"{single_txt}), "
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "

@@ -156,3 +156,11 @@ def test_an_option_added_since_a_checkpoint_counts_as_its_default():
     assert key_difference({"dt": "0.001"}, {"dt": "0.001", "lag_single_from": "0"}) is None
     msg = key_difference({"dt": "0.001"}, {"dt": "0.001", "lag_single_from": "3"})
     assert msg and "-ssi_lag_single_from is 3 here and was 0" in msg
+
+
+def test_a_threshold_beyond_the_lags_is_said(tmp_path):
+    """-ssi_lag_single_from beyond every stored lag: one warning line, the run all-double."""
+    r = cli(BEM + ["-ssi_t_end", "0.02", "-ssi_output", str(tmp_path / "w.h5"), "-ssi_lag_single_from", "500"])
+    warns = [ln for ln in r.stdout.splitlines() if "-ssi_lag_single_from 500" in ln]
+    assert len(warns) == 1 and "every lag stays in double precision" in warns[0], r.stdout[-2000:]
+    assert "single-precision" not in log_line(r.stdout, "] assembly")[0]
