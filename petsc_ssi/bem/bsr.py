@@ -157,19 +157,18 @@ def from_mat(M):
     r0, r1 = M.getOwnershipRange()
     ai, aj, av = M.getValuesCSR()           # scalar CSR of the local rows: each 3x3 block spans
     nloc = (r1 - r0) // 3                   # three rows with the same column pattern
+    ai = np.asarray(ai, np.int64)
+    rl = np.diff(ai).reshape(nloc, 3)
+    if np.any(rl != rl[:, :1]) or np.any(rl[:, 0] % 3):
+        raise ValueError("from_mat: not a 3x3 block matrix")
+    nbr = rl[:, 0] // 3                     # blocks per node row
     indptr = np.zeros(nloc + 1, np.int64)
-    cols, vals = [], []
-    for i in range(nloc):
-        rows = [aj[ai[3 * i + p]:ai[3 * i + p + 1]] for p in range(3)]
-        if not (len(rows[0]) == len(rows[1]) == len(rows[2])) or len(rows[0]) % 3:
-            raise ValueError("from_mat: not a 3x3 block matrix")
-        c = rows[0][::3] // 3
-        v = np.stack([av[ai[3 * i + p]:ai[3 * i + p + 1]].reshape(-1, 3) for p in range(3)], axis=1)
-        cols.append(c)
-        vals.append(v)
-        indptr[i + 1] = indptr[i] + len(c)
+    np.cumsum(nbr, out=indptr[1:])
+    row = np.repeat(np.arange(nloc), nbr)
+    off = 3 * (np.arange(indptr[-1]) - indptr[row])          # a block's place in its scalar rows
+    start = ai[3 * row[:, None] + np.arange(3)] + off[:, None]    # (blocks, p): its first entry in row p
+    cols = (np.asarray(aj)[start[:, 0]] // 3).astype(np.int32)
+    vals = np.asarray(av)[start[:, :, None] + np.arange(3)]       # (blocks, p, q)
     comm = M.getComm()
     M.destroy()
-    return from_csr(comm, nloc, n // 3, mg // 3, ng // 3, indptr,
-                    np.concatenate(cols) if cols else np.zeros(0, np.int32),
-                    np.concatenate(vals) if vals else np.zeros((0, 3, 3)))
+    return from_csr(comm, nloc, n // 3, mg // 3, ng // 3, indptr, cols, vals)
