@@ -85,18 +85,13 @@ def steps_for(size, dt):
 
 def cases():
     out = []
-    for scheme in SCHEMES:
-        for h in HS:
-            for b in BETAS:
-                dt = b * (h / 2) / CS
-                out.append({"case": f"map-{scheme}-h{h:g}-b{b:g}", "part": "map", "scheme": scheme, "h": h,
-                            "size": SIZE, "beta": b, "dt": dt, "interp": "none", "tau_L": "", "k": ""})
-    for scheme in SCHEMES:
-        for h in PREC_HS:
-            for b in BETAS:
-                dt = b * (h / 2) / CS
-                out.append({"case": f"prec-{scheme}-h{h:g}-b{b:g}", "part": "precision", "scheme": scheme, "h": h,
-                            "size": SIZE, "beta": b, "dt": dt, "interp": "none", "tau_L": "", "k": ""})
+    for part, prefix, hs in (("map", "map", HS), ("precision", "prec", PREC_HS)):
+        for scheme in SCHEMES:
+            for h in hs:
+                for b in BETAS:
+                    dt = b * (h / 2) / CS
+                    out.append({"case": f"{prefix}-{scheme}-h{h:g}-b{b:g}", "part": part, "scheme": scheme, "h": h,
+                                "size": SIZE, "beta": b, "dt": dt, "interp": "none", "tau_L": "", "k": ""})
     out.append({"case": "interp-exact", "part": "interp", "scheme": "stabilized", "h": I_H, "size": I_SIZE,
                 "beta": CS * I_DT / (I_H / 2), "dt": I_DT, "interp": "none", "tau_L": "", "k": ""})
     for meth in ("chebyshev", "linear"):
