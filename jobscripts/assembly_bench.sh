@@ -19,12 +19,7 @@ BEFORE=${BEFORE:-9be1e80}
 CASES=${*:-"medium paper paper-interp"}
 OUT=out/bench/assembly
 mkdir -p "$OUT"
-WT=$(mktemp -d /tmp/petsc_ssi-before.XXXX)
-git worktree add --detach "$WT" "$BEFORE" > /dev/null
-trap 'git worktree remove --force "$WT"; rm -f "$ROOT/$OUT"/*.lags*' EXIT
-ROOT=$PWD
-export BEFORE_CACHE="$WT/.numba_cache"
-(cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
+before_worktree "$BEFORE" "rm -f '$PWD/$OUT'/*.lags*"
 run() {  # version ranks name opts-case extra...
   local version=$1 n=$2 name=$3 case=$4; shift 4
   local dir=$ROOT cache=$NUMBA_CACHE_DIR

@@ -14,14 +14,7 @@ BEFORE=${BEFORE:-e52d7a2}
 CASES=${*:-"medium paper paper-interp"}
 OUT=out/bench/history
 mkdir -p "$OUT"
-WT=$(mktemp -d /tmp/petsc_ssi-before.XXXX)
-git worktree add --detach "$WT" "$BEFORE" > /dev/null
-trap 'git worktree remove --force "$WT"' EXIT
-ROOT=$PWD
-# the old code's numba kernels are cached apart (the worktree's files are new to numba's index:
-# without its own cache the first timed run would compile them)
-export BEFORE_CACHE="$WT/.numba_cache"
-(cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
+before_worktree "$BEFORE"
 run() {  # version ranks case extra...
   local version=$1 n=$2 case=$3; shift 3
   local dir=$ROOT cache=$NUMBA_CACHE_DIR
