@@ -211,7 +211,7 @@ _KERNELS_LOADED = []
 def load_kernels():
     """Load the assembly's compiled kernels into this process (once; from the numba cache, or
     compiled): a tiny assembly on one process. The memory check measures the process after it, so
-    that the code the kernels bring (about 50 MB) is counted."""
+    that the code the kernels bring is counted."""
     if _KERNELS_LOADED:
         return
     from ..petsc import init
