@@ -70,6 +70,10 @@ register("history_block", "int", 0, "steps", "time-blocked history sum: the know
          "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
          "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes)", "bem",
          validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
+register("history_sub", "int", 0, "steps", "sub-blocks of the time-blocked history sum: at each sub-block's "
+         "start the terms of the block's states known by then are formed as panel products too, so only lags up to "
+         "about s + 2 stay in per-step products (s >= -ssi_history_block: one level; 0: automatic, with the block "
+         "size)", "bem", validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
 register("lag_fill", "real", 0.95, "", "auto storage: lags with block fill above this are dense (0.95: dense where it stores fewer bytes, 72 B per block of the whole lag against 76 B per stored block)", "bem",
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
 register("lag_single_from", "int", 0, "lag", "store the lags from this one on in single precision: float32 "

@@ -252,7 +252,7 @@ class Counts:
         tot = self.nb_total_used()
         mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt)
         g = g * (tot > 0) * (self.nt > 0)
-        self.block = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
+        self.block, self.sub = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
                                    np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0),
                                    np.where(self.storage, 0.0, tot) + np.where(self.single, g / 40.0, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
@@ -308,11 +308,11 @@ class Counts:
         if self.block > 1:
             # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
             # one of the block's steps reads a state known at its start; the rest are per-step products
-            uses, panels = self._blocked_uses(n, used)
+            uses, width = self._blocked_uses(n, used)
             entries = np.where(dense, mat_bytes / 8.0, 9.0 * used) * nonempty
             g_entries = 9.0 * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
-            fd = float(np.sum(panels * 2.0 * self.block * (entries * dense + g_entries * ~self.single)))
-            fs = float(np.sum(panels * 2.0 * self.block * (entries * ~dense + g_entries * self.single)))
+            fd = float(np.sum(width * 2.0 * (entries * dense + g_entries * ~self.single)))
+            fs = float(np.sum(width * 2.0 * (entries * ~dense + g_entries * self.single)))
         hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
         hs = float(np.sum(uses * mat_bytes * ~dense) + np.sum(uses * g_bytes * ~dense))
         prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
@@ -324,31 +324,19 @@ class Counts:
                 "build": float(build.max() + g_bytes.sum()), "rows": nrows}
 
     def _blocked_uses(self, n, used):
-        """(per-step uses, panel products) of each stored matrix with blocks of ``self.block`` steps:
-        step n (block start n0 = b floor((n-1)/b)) reads states n - l + o (o in 2, 1, 0 stabilised,
-        1 plain; 1 <= state <= n - 1) of lag l; those <= n0 are in the block's panel product, the
-        others a product of step n."""
-        b, Lx = self.block, self.Lx
-        n0 = b * ((n - 1) // b)
-        offs = (2, 1, 0) if self.stabilized else (1,)
-        steps_in, panel = np.zeros(len(used)), np.zeros(len(used))
-
-        def count(lags):
-            known = np.zeros(len(n), bool)
-            inblk = np.zeros(len(n), bool)
-            for lag in lags:
-                for o in offs:
-                    m = n - lag + o
-                    ok = (m >= 1) & (m <= n - 1)
-                    known |= ok & (m <= n0)
-                    inblk |= ok & (m > n0)
-            return np.count_nonzero(inblk), len(np.unique(n0[known]))
+        """(per-step uses, summed panel width) of each stored matrix with blocks of ``self.block``
+        steps and sub-blocks of ``self.sub`` (``march.block_terms``: the states a block's or a
+        sub-block's start knows go into its panel product, the others into a product of the step)."""
+        from .bem.march import block_terms
+        b, s, Lx = self.block, self.sub, self.Lx
+        steps_in, width = np.zeros(len(used)), np.zeros(len(used))
         for j in range(2, Lx + 1):
-            steps_in[j - 1], panel[j - 1] = count([j])
+            st, wb, ws = block_terms(n, [j], b, s, self.stabilized)
+            steps_in[j - 1], width[j - 1] = st, wb + ws
         if self.k:
-            s, q = count(range(Lx + 1, self.L + 1))
-            steps_in[Lx:], panel[Lx:] = s, q
-        return steps_in, panel
+            st, wb, ws = block_terms(n, range(Lx + 1, self.L + 1), b, s, self.stabilized)
+            steps_in[Lx:], width[Lx:] = st, wb + ws
+        return steps_in, width
 
     def nb_total_used(self):
         t = self.nb_total

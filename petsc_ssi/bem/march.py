@@ -32,6 +32,33 @@ from . import bsr
 BLOCK_MAX = 32          # the largest -ssi_history_block (the ring buffer's extra depth)
 
 
+def block_terms(n, lags, b, s, stabilized=True):
+    """How the time-blocked history sum (``Marcher``, blocks of b steps, sub-blocks of s) takes a
+    stored matrix that stands for ``lags`` (one lag, or the far lags of one interpolating matrix) over
+    the steps ``n`` (array): (steps with a per-step product, summed width of its block panel products,
+    summed width of its sub-block panel products). Step n (block start n0 = b floor((n-1)/b), sub-block
+    start n1 = n0 + s floor((n-n0-1)/s)) reads states m = n - l + o (o in 2, 1, 0 stabilised, 1 plain;
+    1 <= m <= n - 1) of lag l: those <= n0 in the block's panel product (width b), those in
+    n0 < m <= n1 in the sub-block's (width min(s, n0 + b - n1)), the others in a product of step n."""
+    n = np.asarray(n)
+    n0 = b * ((n - 1) // b)
+    n1 = n0 + s * ((n - n0 - 1) // s)
+    offs = (2, 1, 0) if stabilized else (1,)
+    known = np.zeros(n.size, bool)
+    sub = np.zeros(n.size, bool)
+    step = np.zeros(n.size, bool)
+    for lag in lags:
+        for o in offs:
+            m = n - lag + o
+            ok = (m >= 1) & (m <= n - 1)
+            known |= ok & (m <= n0)
+            sub |= ok & (m > n0) & (m <= n1)
+            step |= ok & (m > n1)
+    starts = np.unique(n1[sub])
+    wsub = int(np.sum(np.minimum(s, b * ((starts - 1) // b + 1) - starts))) if starts.size else 0
+    return int(np.count_nonzero(step)), b * len(np.unique(n0[known])), wsub
+
+
 def _expand(trip, r0, coef, colmap=None):
     """Scalar COO entries of node-block triplets (local rows)."""
     row, _, col, val = trip
@@ -119,16 +146,18 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
 
-    def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1):
+    def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
         empty) and, with an active interpolation ``plan``, the interpolating
         Mats HI[j] = H(T_j), GI[j] = G(T_j) that stand for lags plan.Lx+1..L; ``block``: the
-        steps of the time-blocked history sum (1: step by step)."""
+        steps of the time-blocked history sum (1: step by step); ``sub``: the steps of its
+        sub-blocks (None or >= block: one level)."""
         self.H, self.G = H, G
         self.plan = plan if (plan is not None and plan.active) else None
         self.HI, self.GI = list(HI), list(GI)
         self.p_tmpl = self._p_vec()
         self.block = max(1, int(block))
+        self.sub = self.block if not sub or sub >= self.block else max(1, int(sub))
         # the ring buffer: the L + 2 states the history sum reads and BLOCK_MAX - 1 more, whatever b
         # is: a block starts at a multiple of b, also after a restart (the same sums as an
         # uninterrupted run), and a checkpoint holds what any b <= BLOCK_MAX needs, so a restart
@@ -309,8 +338,12 @@ class Marcher:
     # states, taken from copies of the known states that every rank keeps (one all-gather per
     # state, the data a dense MatMult gathers anyway); for each block-sparse one (``bsr``) one
     # compiled pass over its 3x3 blocks: each stored matrix is read once per b steps instead of b
-    # times. The terms of states inside the block (m > n0; low lags only, j <= b + 1) and any
-    # other Mat type go step by step as in ``history_step``.
+    # times. The terms of states inside the block (m > n0; low lags only, j <= b + 1) go the same
+    # way one level down: the block is cut into sub-blocks of s steps (``sub``, -ssi_history_sub), and
+    # at the start n1 of each the terms of the block's states n0 < m <= n1 onto the sub-block's steps
+    # are one more panel product (width s); only the terms of states inside the sub-block (m > n1,
+    # lags j <= s + 1) and any other Mat type go step by step as in ``history_step``. Which terms go
+    # where is counted by ``block_terms`` (the cost model and the automatic choice of b and s).
     # The same terms in another order: equal to round-off (tests/bem/test_history_block.py).
     # Blocks start at multiples of b (n0 = 0, b, 2b, ...), also when a restart resumes inside one
     # (its known states are in the ring buffer and the checkpoint), so a restart is bitwise the
@@ -361,52 +394,64 @@ class Marcher:
         self._rep_upto = max(self._rep_upto, n0)
 
     def _new_block(self, n0):
-        """Collective: the known-state part of the dense matrices' history sums of steps
-        n0+1 .. n0+b into ``self._R`` (b x local rows); every other term kept per step for
-        ``_blocked_history``."""
-        b = self.block
-        panel, rest = {}, [dict() for _ in range(b)]
+        """Collective: the known-state part of the panel matrices' history sums of steps
+        n0+1 .. n0+b into ``self._R`` (b x local rows); the terms of states inside the block kept for
+        the sub-block panels (``self.sub`` steps each) and for ``_blocked_history`` step by step."""
+        b, s = self.block, self.sub
+        nsub = -(-b // s)
+        panel, subs, rest = {}, [dict() for _ in range(nsub)], [dict() for _ in range(b)]
         for k in range(b):
+            i = k // s
+            n1 = n0 + i * s                                   # the sub-block's start: states <= n1 final
             for key, m, c in self._step_terms(n0 + 1 + k):
                 for side in ("u", "p"):
                     M = self._mat(key, side)
                     if M is None:
                         continue
-                    if m <= n0 and self._panel_kind(M):
+                    if not self._panel_kind(M):
+                        rest[k].setdefault((key, side), []).append((m, c))
+                    elif m <= n0:
                         panel.setdefault((key, side), []).append((k, m, c))
+                    elif m <= n1:
+                        subs[i].setdefault((key, side), []).append((k - i * s, m, c))
                     else:
                         rest[k].setdefault((key, side), []).append((m, c))
         if getattr(self, "_R", None) is None or self._R.shape[0] != b:
             self._R = np.zeros((b, self.u_tmpl.getLocalSize()))        # row k: step n0 + 1 + k
-        R = self._R
-        R[...] = 0.0
+        self._R[...] = 0.0
         if panel:
-            self._replicate(n0)
-            X = {side: np.zeros((b, self._rep[side][2].shape[1])) for side in ("u", "p")}
-            RT = None
-            for (key, side) in sorted(panel):
-                M = self._mat(key, side)
-                rep, x = self._rep[side][2], X[side]
-                x[...] = 0.0
-                for k, m, c in panel[(key, side)]:
-                    x[k] += c * rep[self._slot(m)]
-                sign = -1.0 if side == "u" else 1.0
-                if self._panel_kind(M) == "dense":
-                    At = M.getDenseArray(readonly=True).T     # all columns x local rows, C order
-                    self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
-                    if side == "u":                           # (x @ At: OpenBLAS's fast layout
-                        R -= x @ At                           # for a skinny panel, twice A @ x.T)
-                    else:
-                        R += x @ At
-                else:                                         # block-sparse: one pass over its blocks
-                    ctx = bsr.context(M)
-                    if RT is None:
-                        RT = np.zeros((R.shape[1], b))
-                    ctx.panel(np.ascontiguousarray(x.T), RT, sign)
-                    self.PETSc.Log.logFlops(18.0 * b * ctx.indices.size)
-            if RT is not None:
-                R += RT.T
-        self._blk = (n0, rest)
+            self._panel_products(panel, self._R, n0)
+        self._blk = (n0, rest, subs)
+
+    def _panel_products(self, panel, R, upto):
+        """Collective: R (w x local rows) += the panel products of ``panel`` {(key, side): [(row k
+        of R, state m, coefficient)]}, states m <= ``upto`` (final) from every rank's copies."""
+        w = R.shape[0]
+        self._replicate(upto)
+        X = {side: np.zeros((w, self._rep[side][2].shape[1])) for side in ("u", "p")}
+        RT = None
+        for (key, side) in sorted(panel):
+            M = self._mat(key, side)
+            rep, x = self._rep[side][2], X[side]
+            x[...] = 0.0
+            for k, m, c in panel[(key, side)]:
+                x[k] += c * rep[self._slot(m)]
+            sign = -1.0 if side == "u" else 1.0
+            if self._panel_kind(M) == "dense":
+                At = M.getDenseArray(readonly=True).T     # all columns x local rows, C order
+                self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
+                if side == "u":                           # (x @ At: OpenBLAS's fast layout
+                    R -= x @ At                           # for a skinny panel, twice A @ x.T)
+                else:
+                    R += x @ At
+            else:                                         # block-sparse: one pass over its blocks
+                ctx = bsr.context(M)
+                if RT is None:
+                    RT = np.zeros((R.shape[1], w))
+                ctx.panel(np.ascontiguousarray(x.T), RT, sign)
+                self.PETSc.Log.logFlops(18.0 * w * ctx.indices.size)
+        if RT is not None:
+            R += RT.T
 
     @staticmethod
     def _panel_kind(M):
@@ -417,10 +462,19 @@ class Marcher:
 
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)
-        if blk is None or not blk[0] < n <= blk[0] + self.block:
+        new = blk is None or not blk[0] < n <= blk[0] + self.block
+        if new:
             ev = event("SSI_BEM_HistPanel")
             ev.begin()
             self._new_block(self.block * ((n - 1) // self.block))
+            ev.end()
+        n0, _, subs = self._blk
+        k = n - n0 - 1
+        i = k // self.sub
+        if i and (k % self.sub == 0 or new) and subs[i]:   # sub-block i starts (or a restart resumes in
+            ev = event("SSI_BEM_HistPanel")                 # it): its panel of the block's states before it
+            ev.begin()
+            self._panel_products(subs[i], self._R[i * self.sub:(i + 1) * self.sub], n0 + i * self.sub)
             ev.end()
         ev = event("SSI_BEM_HistStep")
         ev.begin()
@@ -431,7 +485,7 @@ class Marcher:
         """The block's row of step n and the terms it left to the step (in-block states, and
         matrices without a panel product). Dense and block-sparse matrices take them from every
         rank's copies of the states (one all-gather per new state, not one per product)."""
-        n0, rest = self._blk
+        n0, rest, _ = self._blk
         todo = rest[n - n0 - 1]
         acc = self._R[n - n0 - 1].copy()
         if any(self._panel_kind(self._mat(key, side)) for key, side in todo):

@@ -339,44 +339,66 @@ PANEL_SPARSE_GFPS = (8.2, 18.8, 32.2)
 STREAM_GBPS = 22.0
 
 
+def _sub_candidates(b, sub=0):
+    """The sub-block sizes tried with blocks of b steps: ``sub`` if set, else b (one level) and
+    b/2, b/4 down to 8 steps (narrower panels run below the streaming rate of a product)."""
+    if sub:
+        return (min(sub, b),)
+    return tuple(sorted({b} | {b // q for q in (2, 4) if b // q >= 8}, reverse=True))
+
+
 def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
-                 sparse_blocks=None):
-    """The steps per block that minimise the modelled time per step of the history sum, from the
-    bytes of each stored matrix (index 0: lag 1, ..., then the interpolating ones; dense and
-    block-sparse apart): the panel products, 2 flops per stored value at the rates above, and the
-    per-step products of the in-block terms, lag j in a fraction (b - j + 2) / b of the steps
-    (stabilised; plain b - j + 1), streamed. b = 1 streams every matrix every step.
-    ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices (18 flops each per state;
-    default their bytes / 76, the double blocks; single-precision ones store 40 B a block)."""
+                 sparse_blocks=None, sub=0):
+    """(b, s): the steps per block and per sub-block that minimise the modelled time per step of the
+    history sum, from the bytes of each stored matrix (index 0: lag 1, ..., then the interpolating
+    ones, taken as the lags that follow; dense and block-sparse apart): in a block of a run long
+    enough to reach every lag (``march.block_terms``), its panel products at the rates above for
+    their widths (2 flops per stored value and state) and the per-step products, streamed. b = 1
+    streams every matrix every step. ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices
+    (18 flops each per state; default their bytes / 76, the double blocks; single-precision ones
+    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too)."""
+    from .march import block_terms
     d = np.asarray(dense_bytes, float)
     s = np.asarray(sparse_bytes, float)
     sb = s / 76.0 if sparse_blocks is None else np.asarray(sparse_blocks, float)
     every = d + s
-    Lx = len(every)
-    best, best_t = 1, float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
+    nmat = len(every)
+    best, best_t = (1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
     for b in candidates:
         if b < 2:
             continue
-        rd = np.interp(b, PANEL_B, PANEL_DENSE_GFPS) * 1e9
-        rs = np.interp(b, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
-        t = float(np.sum(d[1:])) * 2 / 8 / rd + float(np.sum(sb[1:])) * 18 / rs
-        j = np.arange(2, min(b + 2, Lx) + 1)
-        frac = np.clip((b - j + (2 if stabilized else 1)) / b, 0.0, 1.0)
-        t += float(np.sum(frac * every[j - 1])) / (STREAM_GBPS * 1e9)
-        if t < best_t:
-            best, best_t = b, t
+        n = b * (-(-(nmat + 3) // b)) + 1 + np.arange(b)      # one block past every lag's start
+        for sub_b in _sub_candidates(b, sub):
+            t = 0.0
+            for i in range(1, nmat):
+                if every[i] == 0.0:
+                    continue
+                steps, wb, ws = block_terms(n, [i + 1], b, sub_b, stabilized)
+                for w, cnt in ((b, wb / b), (sub_b, ws / sub_b)):
+                    if cnt:
+                        rd = np.interp(w, PANEL_B, PANEL_DENSE_GFPS) * 1e9
+                        rs = np.interp(w, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
+                        t += cnt * w * (d[i] * 2 / 8 / rd + sb[i] * 18 / rs)
+                t += steps * every[i] / (STREAM_GBPS * 1e9)
+            t /= b
+            if t < best_t:
+                best, best_t = (b, sub_b), t
     return best
 
 
 def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
-    """The steps per block of the time-blocked history sum: -ssi_history_block, or with 0 the
-    ``choose_block`` of the stored matrices' bytes (1 without them)."""
+    """(b, s): the steps per block of the time-blocked history sum and per sub-block:
+    -ssi_history_block and -ssi_history_sub, or with 0 the ``choose_block`` of the stored
+    matrices' bytes (b = 1 without them)."""
     b = int(cfg.get("history_block") or 0)
-    if b:
-        return b
+    sub = int(cfg.get("history_sub") or 0)
+    if b and (sub or b == 1 or dense_bytes is None):
+        return b, min(sub, b) if sub else b
     if dense_bytes is None:
-        return 1
-    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"), sparse_blocks=sparse_blocks)
+        return 1, 1
+    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
+                        candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
+                        sub=sub)
 
 
 def _block_of(cfg, comm, H, G, HI, GI):
@@ -400,7 +422,8 @@ def _block_of(cfg, comm, H, G, HI, GI):
 
 def _say_block(march):
     if march.block > 1:
-        printf(f"[ssi] history sum: time-blocked, {march.block} steps per block (-ssi_history_block; 1: step "
+        subs = (f" in sub-blocks of {march.sub} (-ssi_history_sub)" if march.sub < march.block else "")
+        printf(f"[ssi] history sum: time-blocked, {march.block} steps per block{subs} (-ssi_history_block; 1: step "
                "by step)")
     else:
         printf("[ssi] history sum: step by step (-ssi_history_block 1)")
@@ -462,7 +485,8 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
-    march.set_lags(H, G, plan, HI, GI, block=_block_of(cfg, comm, H, G, HI, GI))
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
     _say_block(march)
     ls.H = ls.G = None   # the triplets are in the Mats now
     if cfg.get("lags_save"):
@@ -510,7 +534,8 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
                                                                else "") + ")"
            + (f", {plan.k} interpolating matrices" if plan.active else "")
            + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
-    march.set_lags(H, G, plan, HI, GI, block=_block_of(cfg, comm, H, G, HI, GI))
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
     _say_block(march)
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,

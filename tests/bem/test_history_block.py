@@ -71,20 +71,25 @@ CASES = {
 
 @pytest.mark.parametrize("case", list(CASES))
 def test_blocked_equals_per_step(tmp_path, case):
-    """Blocks of 5 steps (and the automatic size) against step by step, one rank."""
+    """Blocks of 5 steps, blocks of 7 in sub-blocks of 3 (3, 3 and 1 steps: the last one cut by the
+    block's end) and the automatic sizes against step by step, one rank."""
     args = CASES[case]
-    ref, blk, auto = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "auto"))
+    ref, blk, sub, auto = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "sub", "auto"))
     assert "history sum: step by step" in cli(args + ["-ssi_output", ref, "-ssi_history_block", "1"]).stdout
-    assert "time-blocked, 5 steps per block" in cli(args + ["-ssi_output", blk, "-ssi_history_block", "5"]).stdout
+    out = cli(args + ["-ssi_output", blk, "-ssi_history_block", "5", "-ssi_history_sub", "5"]).stdout
+    assert "time-blocked, 5 steps per block (" in out
+    out = cli(args + ["-ssi_output", sub, "-ssi_history_block", "7", "-ssi_history_sub", "3"]).stdout
+    assert "time-blocked, 7 steps per block in sub-blocks of 3" in out
     assert "history sum:" in cli(args + ["-ssi_output", auto]).stdout
     same(ref, blk)
+    same(ref, sub)
     same(ref, auto)
 
 
 def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
     """The block on the half-space with unilateral contact (uplift: the contact iterations change the
-    current step's state only): blocks of 6 against step by step at -n 1, and blocks of 6
-    against step by step at -n 2 (MUMPS on 2 ranks is not bitwise reproducible: -ssi_reproducible for
+    current step's state only): blocks of 6 against step by step at -n 1, and blocks of 6 in
+    sub-blocks of 4 against step by step at -n 2 (MUMPS on 2 ranks is not bitwise reproducible: -ssi_reproducible for
     both), to 1e-11 there: the contact gap, a difference of displacements, differs by 1.0e-12 of its
     largest value."""
     ref, blk, two = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "two"))
@@ -97,34 +102,39 @@ def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
     assert closed.any() and not closed.all()         # the block lifts off: contact is active
     two1 = str(tmp_path / "two1.h5")
     cli(SSI + ["-ssi_output", two1, "-ssi_history_block", "1", "-ssi_reproducible"], nranks=2)
-    cli(SSI + ["-ssi_output", two, "-ssi_history_block", "6", "-ssi_reproducible"], nranks=2)
+    cli(SSI + ["-ssi_output", two, "-ssi_history_block", "6", "-ssi_history_sub", "4", "-ssi_reproducible"],
+        nranks=2)
     same(two1, two, rtol=1e-11)     # observed 1.0e-12 (the gap, a difference of displacements)
 
 
 def test_blocked_two_ranks_and_a_block_longer_than_the_lags(tmp_path):
-    """-n 2: blocks of 4 against step by step (both -ssi_reproducible); one rank: a block longer
+    """-n 2: blocks of 8 in sub-blocks of 3 against step by step (both -ssi_reproducible); one rank: a block longer
     than the run (32 steps, the largest, for 30: every term past the first step is then an in-block
     term) against step by step."""
     args = BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"]
     ref, ref2, two, long_ = (str(tmp_path / f"{k}.h5") for k in ("ref", "ref2", "two", "long"))
     cli(args + ["-ssi_output", ref, "-ssi_history_block", "1"])
     cli(args + ["-ssi_output", ref2, "-ssi_history_block", "1", "-ssi_reproducible"], nranks=2)
-    cli(args + ["-ssi_output", two, "-ssi_history_block", "4", "-ssi_reproducible"], nranks=2)
-    cli(args + ["-ssi_output", long_, "-ssi_history_block", "32", "-ssi_t_end", "0.075"])
+    cli(args + ["-ssi_output", two, "-ssi_history_block", "8", "-ssi_history_sub", "3", "-ssi_reproducible"],
+        nranks=2)
+    cli(args + ["-ssi_output", long_, "-ssi_history_block", "32", "-ssi_history_sub", "32", "-ssi_t_end", "0.075"])
     same(ref2, two)
     cli(args + ["-ssi_output", ref, "-ssi_history_block", "1", "-ssi_t_end", "0.075", "-ssi_output_overwrite"])
     same(ref, long_)                                   # 30 steps in one block of 32
 
 
-def test_a_restart_inside_a_block_is_bitwise(tmp_path):
+@pytest.mark.parametrize("sub", ["7", "2"])
+def test_a_restart_inside_a_block_is_bitwise(tmp_path, sub):
     """Blocks of 7 steps (they start at steps 1, 8, 15, ...); a checkpoint after step 10 resumes
     inside the second block: the restart forms that block's panel from the restored states, as
-    the uninterrupted run did, and every dataset is bit for bit the uninterrupted run's (one rank)."""
+    the uninterrupted run did, and every dataset is bit for bit the uninterrupted run's (one rank).
+    With sub-blocks of 2 (steps 8-9, 10-11, ...) it resumes inside the second sub-block too, whose
+    panel the restart forms from the same states as the uninterrupted run."""
     import sys
     import os
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     from test_checkpoint import run_and_restart, assert_same_files
-    args = BEM + ["-ssi_history_block", "7"]
+    args = BEM + ["-ssi_history_block", "7", "-ssi_history_sub", sub]
     (ref, rs), = run_and_restart(args, tmp_path, 1, 5, 10)
     assert_same_files(ref, rs)
 
@@ -149,3 +159,58 @@ def test_a_restart_with_another_block_size(tmp_path):
             check=False)
     assert r.returncode == 0 and "restarted from" in r.stdout, r.stdout[-2000:]
     assert_same_files(ref, rs, rtol=1e-10)
+
+
+@pytest.mark.parametrize("scheme,b,s", [("stabilized", 8, 3), ("stabilized", 7, 7), ("plain", 6, 4),
+                                        ("stabilized", 32, 8)])
+def test_block_terms_counts_what_the_marcher_does(scheme, b, s):
+    """``march.block_terms`` (the cost model's and the automatic block choice's count of per-step
+    products and panel widths) against the Marcher's own split of the terms, block by block, for
+    every lag of a run of 6 blocks with 20 lags (the Mats stand-ins: dense, so every term with a
+    known state goes into a panel)."""
+    from petsc_ssi.bem.march import Marcher, block_terms
+
+    class Dense:
+        def getType(self):
+            return "seqdense"
+
+    class Vec:
+        def getLocalSize(self):
+            return 3
+
+    L, nsteps = 20, 6 * b
+    m = Marcher.__new__(Marcher)
+    m.block, m.sub, m.scheme, m.plan = b, s, scheme, None
+    m.H, m.G, m.u_tmpl, m._R = [Dense()] * L, [], Vec(), None
+    widths = {}
+    m._panel_products = lambda panel, R, upto: [widths.setdefault(key, []).append(R.shape[0]) for key in panel]
+    steps, sub = np.zeros(L + 1), np.zeros(L + 1)
+    for n0 in range(0, nsteps, b):
+        m._new_block(n0)
+        _, rest, subs = m._blk
+        for k in range(b):
+            for (kind, j), side in rest[k]:
+                steps[j] += 1
+        for i in range(1, len(subs)):
+            for (kind, j), side in subs[i]:
+                sub[j] += min(s, b - i * s)
+    n = np.arange(1, nsteps + 1)
+    for j in range(2, L + 1):
+        st, wb, ws = block_terms(n, [j], b, s, scheme == "stabilized")
+        assert (st, wb, ws) == (steps[j], sum(widths.get((("x", j), "u"), [])), sub[j]), j
+    assert sub.sum() > 0 or s == b                          # the sub-blocks take terms
+
+
+def test_automatic_sub_blocks_where_low_lags_carry_weight():
+    """The automatic choice (``run.choose_block``) splits a block into sub-blocks when the low lags,
+    which the in-block terms stream step by step, hold many blocks (a lag's blocks grow with the
+    square of its radius until the surface is covered, as on a half-space mesh), and keeps one level
+    when only far lags are stored (the sub-blocks would only add narrower panels)."""
+    from petsc_ssi.bem.run import choose_block
+    j = np.arange(1, 161)
+    blocks = np.minimum(2000.0 * j ** 2, 2.0e6)
+    b, s = choose_block(np.zeros(j.size), 76.0 * blocks)
+    assert b >= 16 and s < b
+    far = np.where(j > 40, 2.0e6, 0.0)
+    b, s = choose_block(np.zeros(j.size), 76.0 * far)
+    assert b >= 16 and s == b

@@ -147,8 +147,8 @@ def test_block_choice_counts_blocks_not_bytes():
     d = np.zeros(40)
     blocks = np.full(40, 2.0e6)
     assert choose_block(d, 76.0 * blocks) == choose_block(d, 76.0 * blocks, sparse_blocks=blocks)
-    b40 = choose_block(d, 40.0 * blocks, sparse_blocks=blocks)
-    assert b40 >= 2
+    b40, s40 = choose_block(d, 40.0 * blocks, sparse_blocks=blocks)
+    assert b40 >= 2 and 1 <= s40 <= b40
 
 
 def test_an_option_added_since_a_checkpoint_counts_as_its_default():
