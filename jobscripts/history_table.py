@@ -26,9 +26,11 @@ def row_of(log):
     st, ev = lv["stages"], lv["events"]
     hist = re.search(r"^SSI_BEM_History\s.*\s(\d+)\s*$", text, re.M)       # last column: total Mflop/s
     blk = re.search(r"time-blocked, (\d+) steps per block", text)
+    sub = re.search(r"in sub-blocks of (\d+)", text)
     lags = re.search(r"lags stored (\d+)", text)
     return {"version": m.group(1), "case": m.group(2), "ranks": int(m.group(3)),
-            "block": int(blk.group(1)) if blk else 1, "lags": int(lags.group(1)) if lags else "",
+            "block": int(blk.group(1)) if blk else 1,
+            "sub": int(sub.group(1)) if sub else (int(blk.group(1)) if blk else 1), "lags": int(lags.group(1)) if lags else "",
             "total_s": round(lv["total_s"], 1), "assembly_s": round(st.get("SSI BEM assembly", np.nan), 1),
             "time_loop_s": round(st.get("SSI BEM time loop", np.nan), 1),
             "history_s": round(ev.get("SSI_BEM_History", (0, np.nan))[1], 1),
@@ -59,10 +61,10 @@ def main(out):
     write_csv(os.path.join(HERE, "results", "history_block.csv"), rows)
     order = {"before": 0, "after": 1}
     rows.sort(key=lambda r: (r["case"], order[r["version"]], -r["ranks"]))
-    lines = ["| case | code | ranks | block b | total | assembly | time loop | history sum | history GF/s | "
+    lines = ["| case | code | ranks | block b / sub-block s | total | assembly | time loop | history sum | history GF/s | "
              "peak GB/rank | receivers vs before |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['case']} | {r['version']} | {r['ranks']} | {r['block']} | {r['total_s']} s | "
+        lines.append(f"| {r['case']} | {r['version']} | {r['ranks']} | {r['block']} / {r['sub']} | {r['total_s']} s | "
                      f"{r['assembly_s']} s | {r['time_loop_s']} s | {r['history_s']} s | {r['history_GFps']} | "
                      f"{r['peak_GB_per_rank']} | {r.get('max_rel_diff_vs_before', '-')} |")
     by = {(r["case"], r["version"], r["ranks"]): r for r in rows}

@@ -17,9 +17,10 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
   history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
              * (1 + sigma (m - 1))                     the run (a dense lag: 72 N n_r B,
              + (c_op + c_op_mpi [p > 1]) * P_r
-             + FD_r / r_panel_dense                    time-blocked sum (-ssi_history_block b):
-             + FS_r / r_panel_sparse                   flops of the blocks' panel products
-                                                       (2 b per entry and panel), dense and
+             + FD_r / r_panel_dense                    time-blocked sum (-ssi_history_block b,
+             + FS_r / r_panel_sparse                   -ssi_history_sub s): flops of the block and
+                                                       sub-block panel products (2 per entry and
+                                                       column: width b or s; march.block_terms), dense and
                                                        block-sparse; HD, HS, P then count only
                                                        the per-step products
                                                        sparse: 76 B per block), m ranks per

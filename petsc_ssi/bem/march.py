@@ -422,6 +422,7 @@ class Marcher:
         if panel:
             self._panel_products(panel, self._R, n0)
         self._blk = (n0, rest, subs)
+        self._sub_done = 0                                  # the sub-block whose panel R has last taken
 
     def _panel_products(self, panel, R, upto):
         """Collective: R (w x local rows) += the panel products of ``panel`` {(key, side): [(row k
@@ -462,19 +463,18 @@ class Marcher:
 
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)
-        new = blk is None or not blk[0] < n <= blk[0] + self.block
-        if new:
+        if blk is None or not blk[0] < n <= blk[0] + self.block:
             ev = event("SSI_BEM_HistPanel")
             ev.begin()
             self._new_block(self.block * ((n - 1) // self.block))
             ev.end()
         n0, _, subs = self._blk
-        k = n - n0 - 1
-        i = k // self.sub
-        if i and (k % self.sub == 0 or new) and subs[i]:   # sub-block i starts (or a restart resumes in
-            ev = event("SSI_BEM_HistPanel")                 # it): its panel of the block's states before it
-            ev.begin()
+        i = (n - n0 - 1) // self.sub
+        if i and subs[i] and self._sub_done != i:         # the first step in sub-block i (its start, or
+            ev = event("SSI_BEM_HistPanel")                # where a restart resumes): its panel of the
+            ev.begin()                                     # block's states before it, once
             self._panel_products(subs[i], self._R[i * self.sub:(i + 1) * self.sub], n0 + i * self.sub)
+            self._sub_done = i
             ev.end()
         ev = event("SSI_BEM_HistStep")
         ev.begin()

@@ -348,7 +348,7 @@ def _sub_candidates(b, sub=0):
 
 
 def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
-                 sparse_blocks=None, sub=0):
+                 sparse_blocks=None, sub=0, fixed=False):
     """(b, s): the steps per block and per sub-block that minimise the modelled time per step of the
     history sum, from the bytes of each stored matrix (index 0: lag 1, ..., then the interpolating
     ones, taken as the lags that follow; dense and block-sparse apart): in a block of a run long
@@ -356,7 +356,8 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
     their widths (2 flops per stored value and state) and the per-step products, streamed. b = 1
     streams every matrix every step. ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices
     (18 flops each per state; default their bytes / 76, the double blocks; single-precision ones
-    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too)."""
+    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too); ``fixed``: b is the one
+    candidate (a user's -ssi_history_block), kept even where the model prefers step by step."""
     from .march import block_terms
     d = np.asarray(dense_bytes, float)
     s = np.asarray(sparse_bytes, float)
@@ -364,6 +365,8 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
     every = d + s
     nmat = len(every)
     best, best_t = (1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
+    if fixed:
+        best, best_t = (candidates[0], candidates[0]), np.inf
     for b in candidates:
         if b < 2:
             continue
@@ -373,7 +376,8 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
             for i in range(1, nmat):
                 if every[i] == 0.0:
                     continue
-                steps, wb, ws = block_terms(n, [i + 1], b, sub_b, stabilized)
+                # a lag from b + 2 on reads only states known at the block's start
+                steps, wb, ws = block_terms(n, [i + 1], b, sub_b, stabilized) if i + 1 < b + 2 else (0, b, 0)
                 for w, cnt in ((b, wb / b), (sub_b, ws / sub_b)):
                     if cnt:
                         rd = np.interp(w, PANEL_B, PANEL_DENSE_GFPS) * 1e9
@@ -398,7 +402,7 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
         return 1, 1
     return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
                         candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
-                        sub=sub)
+                        sub=sub, fixed=bool(b))
 
 
 def _block_of(cfg, comm, H, G, HI, GI):
