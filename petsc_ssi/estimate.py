@@ -328,6 +328,9 @@ class Counts:
         """(per-step uses, summed panel width) of each stored matrix with blocks of ``self.block``
         steps and sub-blocks of ``self.sub`` (``march.block_terms``: the states a block's or a
         sub-block's start knows go into its panel product, the others into a product of the step)."""
+        key = (len(n), len(used))
+        if getattr(self, "_uses", (None,))[0] == key:      # the same for every rank and rank count
+            return self._uses[1]
         from .bem.march import block_terms
         b, s, Lx = self.block, self.sub, self.Lx
         steps_in, width = np.zeros(len(used)), np.zeros(len(used))
@@ -337,6 +340,7 @@ class Counts:
         if self.k:
             st, wb, ws = block_terms(n, range(Lx + 1, self.L + 1), b, s, self.stabilized)
             steps_in[Lx:], width[Lx:] = st, wb + ws
+        self._uses = (key, (steps_in, width))
         return steps_in, width
 
     def nb_total_used(self):

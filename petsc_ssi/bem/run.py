@@ -348,7 +348,7 @@ def _sub_candidates(b, sub=0):
 
 
 def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
-                 sparse_blocks=None, sub=0, fixed=False):
+                 sparse_blocks=None, sub=0):
     """(b, s): the steps per block and per sub-block that minimise the modelled time per step of the
     history sum, from the bytes of each stored matrix (index 0: lag 1, ..., then the interpolating
     ones, taken as the lags that follow; dense and block-sparse apart): in a block of a run long
@@ -356,22 +356,24 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
     their widths (2 flops per stored value and state) and the per-step products, streamed. b = 1
     streams every matrix every step. ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices
     (18 flops each per state; default their bytes / 76, the double blocks; single-precision ones
-    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too); ``fixed``: b is the one
-    candidate (a user's -ssi_history_block), kept even where the model prefers step by step."""
+    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too). Step by step is an
+    outcome only when 1 is a candidate: a user's -ssi_history_block b (candidates (b,)) is kept."""
     from .march import block_terms
     d = np.asarray(dense_bytes, float)
     s = np.asarray(sparse_bytes, float)
     sb = s / 76.0 if sparse_blocks is None else np.asarray(sparse_blocks, float)
     every = d + s
     nmat = len(every)
-    best, best_t = (1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)
-    if fixed:
-        best, best_t = (candidates[0], candidates[0]), np.inf
+    best, best_t = ((1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)) if 1 in candidates else (None, np.inf)
+
+    def rates(w):                                         # the panel rates at width w, flop/s
+        return np.interp(w, PANEL_B, PANEL_DENSE_GFPS) * 1e9, np.interp(w, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
     for b in candidates:
         if b < 2:
             continue
         n = b * (-(-(nmat + 3) // b)) + 1 + np.arange(b)      # one block past every lag's start
         for sub_b in _sub_candidates(b, sub):
+            rate = {w: rates(w) for w in (b, sub_b)}
             t = 0.0
             for i in range(1, nmat):
                 if every[i] == 0.0:
@@ -380,12 +382,11 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
                 steps, wb, ws = block_terms(n, [i + 1], b, sub_b, stabilized) if i + 1 < b + 2 else (0, b, 0)
                 for w, cnt in ((b, wb / b), (sub_b, ws / sub_b)):
                     if cnt:
-                        rd = np.interp(w, PANEL_B, PANEL_DENSE_GFPS) * 1e9
-                        rs = np.interp(w, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
+                        rd, rs = rate[w]
                         t += cnt * w * (d[i] * 2 / 8 / rd + sb[i] * 18 / rs)
                 t += steps * every[i] / (STREAM_GBPS * 1e9)
             t /= b
-            if t < best_t:
+            if t < best_t or best is None:
                 best, best_t = (b, sub_b), t
     return best
 
@@ -402,7 +403,7 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
         return 1, 1
     return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
                         candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
-                        sub=sub, fixed=bool(b))
+                        sub=sub)
 
 
 def _block_of(cfg, comm, H, G, HI, GI):

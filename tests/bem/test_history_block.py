@@ -215,3 +215,17 @@ def test_automatic_sub_blocks_where_low_lags_carry_weight():
     far = np.where(j > 40, 2.0e6, 0.0)
     b, s = choose_block(np.zeros(j.size), 76.0 * far)
     assert b >= 16 and s == b
+
+
+def test_an_explicit_block_size_is_kept():
+    """-ssi_history_block b is the user's: the model picks only the sub-block size for it, even where
+    it would rather go step by step (three small lags), and b = 1 stays step by step."""
+    from petsc_ssi.bem.run import history_block
+
+    class Cfg(dict):
+        scheme = "stabilized"
+    d = np.full(3, 1e6)
+    assert history_block(Cfg(), np.zeros(3), d, d / 76) == (1, 1)           # the model: step by step
+    assert history_block(Cfg(history_block=2), np.zeros(3), d, d / 76) == (2, 2)
+    assert history_block(Cfg(history_block=1), np.zeros(3), d, d / 76) == (1, 1)
+    assert history_block(Cfg(history_block=16, history_sub=4), np.zeros(3), d, d / 76) == (16, 4)
