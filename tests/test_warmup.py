@@ -26,3 +26,31 @@ def test_cold_cache_is_announced_then_warm(tmp_path):
     assert w.returncode == 0 and "[warmup] numba cache is warm" in w.stdout, w.stdout + w.stderr
     r = py(RUN + ["-ssi_output", str(tmp_path / "b.h5")])
     assert r.returncode == 0 and "compiling" not in r.stdout, r.stdout
+
+
+PROBE = """
+import numba.core.compiler as c
+calls = []
+orig = c.compile_extra
+def counted(*a, **k):
+    calls.append(getattr(a[2], '__qualname__', repr(a[2])) if len(a) > 2 else '?')
+    return orig(*a, **k)
+c.compile_extra = counted
+from petsc_ssi.bem.model import load_kernels
+load_kernels()
+print('COMPILED', len(calls), calls)
+"""
+
+
+def test_warm_run_compiles_nothing():
+    """With a warm cache, loading the BEM kernels (a tiny assembly: the element cache's typed Dict,
+    every assembly kernel) compiles nothing in a new process: numba.typed.Dict made or measured from
+    Python compiles its helpers in every process, uncached (0.3-0.5 s per rank per run), so the
+    assembly makes and measures it in compiled code. The first process warms the cache if needed."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    for _ in range(2):
+        r = subprocess.run([sys.executable, "-c", PROBE], cwd=ROOT, env=env, capture_output=True, text=True,
+                           timeout=600)
+        assert r.returncode == 0, r.stdout + r.stderr
+    line = [ln for ln in r.stdout.splitlines() if ln.startswith("COMPILED")]
+    assert line and line[0].startswith("COMPILED 0 "), r.stdout

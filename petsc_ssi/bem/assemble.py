@@ -107,10 +107,23 @@ def _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi):
     return c
 
 
+@njit(cache=True)
+def _new_index():
+    """The cache's hash -> entry map. Made in compiled code: ``numba.typed.Dict.empty`` called from
+    Python compiles its constructor in every process (about 0.3 s, not cached), and ``len`` of it
+    from Python another 0.1 s (``index_len``)."""
+    return Dict.empty(key_type=types.int64, value_type=types.int64)
+
+
+@njit(cache=True)
+def index_len(cidx):
+    """Entries of the cache's hash map (compiled and cached: see ``_new_index``)."""
+    return len(cidx)
+
+
 def new_cache():
     """An element-integral cache (kept across calls of ``assemble_rows``)."""
-    return (Dict.empty(key_type=types.int64, value_type=types.int64),
-            np.zeros((16, 27), np.int64), np.zeros((16, 4), np.int64),
+    return (_new_index(), np.zeros((16, 27), np.int64), np.zeros((16, 4), np.int64),
             np.zeros(1024), np.zeros(1024))
 
 

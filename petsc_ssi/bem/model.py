@@ -13,7 +13,7 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import (assemble_rows, new_cache, new_work, lag_sort, enumerate_pairs, integrate_records, cache_insert,
+from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records, cache_insert,
                        gather_into, SING_TOL)
 
 
@@ -595,7 +595,7 @@ class LagSet:
             prog.update(min(s + chunk, len(rows)))
         work = scol = sval = None
         ev.end()
-        self.cache_entries = len(cidx)
+        self.cache_entries = int(index_len(cidx))
         self.cache_hits = self.comm.tompi4py().allreduce(hits)
         self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)
         self.H, self.G = H, G
