@@ -60,7 +60,8 @@ def _shared_cache_kernels(PETSc):
 
 def _single_kernels():
     """The block-sparse kernels on float32 values (-ssi_lag_single_from; numba compiles one version
-    per value type)."""
+    per value type) and on a read-only x (the python Mat's products; without this the first coupled
+    run compiled one)."""
     import numpy as np
     from .bem import bsr
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
@@ -69,6 +70,7 @@ def _single_kernels():
     x = np.ones(3)
     x.flags.writeable = False                # the python Mat's products read a read-only gathered x
     bsr._matvec(indptr, cols, data, x, np.zeros(3))
+    bsr._matvec(indptr, cols, data.astype(np.float64), x, np.zeros(3))   # (double lags: the coupled runs)
     bsr._panel(indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
 
 

@@ -29,6 +29,7 @@ def test_cold_cache_is_announced_then_warm(tmp_path):
 
 
 PROBE = """
+import petsc_ssi  # first: it points NUMBA_CACHE_DIR at the cache of these sources
 import numba.core.compiler as c
 calls = []
 orig = c.compile_extra
