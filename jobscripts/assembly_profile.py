@@ -15,7 +15,7 @@ from petsc_ssi.bem.run import BEMProblem
 from petsc_ssi.bem import model, lagmats
 cfg = options.resolve(("common", "bem"))
 prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
-ls = prob.lagset()
+ls = prob.lagset(prob.interp_plan())
 R = int(PETSc.Options().getInt("rows", 64))
 if R: ls.rows = ls.rows[1000:1000 + R]
 if R: ls.node_range = (1000, 1000 + R)

@@ -54,6 +54,9 @@ def log_options(text):
         if re.match(r"ssi_(bem|fem|coupling|modes)_(ksp|pc|mat)", key):
             continue
         opts[key[len("ssi_"):]] = val.strip()
+    if "partition" not in opts:      # the run's own line (-ssi_partition's default); none before it existed: equal
+        m = re.search(r"-ssi_partition (\w+) \(estimated work", text)
+        opts["partition"] = m.group(1) if m else "equal"
     return opts
 
 

@@ -63,6 +63,9 @@ register("singular_order", "int", 12, "", "Gauss order of the polar (radial and 
 register("cache", "bool", True, "", "integrate each distinct (collocation point, element) geometry once and reuse it for translated copies (exact)", "bem")
 register("cache_share", "bool", True, "", "with -ssi_cache on several ranks: integrate each distinct geometry once over all "
          "ranks (its owner rank integrates it and sends it to the ranks that meet it) instead of once per rank", "bem")
+register("partition", "enum", "balanced", "", "soil nodes per rank: contiguous ranges of equal estimated history "
+         "products (bem/partition.py) or PETSc's equal node counts", "bem",
+         choices=("balanced", "equal"))
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))

@@ -185,13 +185,6 @@ def global_distinct(table, Lx, interp_lags=()):
     return g_exact, g_interp
 
 
-def partition(N, p):
-    """Node ranges of PETSc's split of a block-3 Vec of 3N entries over p ranks."""
-    n = [N // p + (1 if r < N % p else 0) for r in range(p)]
-    s = np.r_[0, np.cumsum(n)]
-    return [(int(s[r]), int(s[r + 1])) for r in range(p)]
-
-
 class Counts:
     """The work of one run, counted from the set-up (no assembly).
 
@@ -215,8 +208,17 @@ class Counts:
         nimg = len(ls.Vc) // prob.mesh.n_cells
         Lmax = max([self.Lx] + self.interp_lags)
         mpi = comm.tompi4py()
+        # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
+        from .bem import partition
+        w = None
+        if cfg.partition == "balanced" and max(ranks) > 1:
+            w = partition.all_weights(comm, prob.mesh.nodes, ls.Vc, ls.VR, prob.mat, prob.dt, nimg,
+                                      partition.lag_weights(self.Lx, self.steps, self.stabilized, self.interp_lags),
+                                      self.Lx, self.nt)
+        self.ranges = {p: partition.balanced_ranges(w, p) if w is not None else partition.equal_ranges(N, p)
+                       for p in ranks}
         # blocks per lag of every rank of every rank count (spread over the ranks of this process)
-        jobs = [(p, r, a, b) for p in ranks for r, (a, b) in enumerate(partition(N, p))]
+        jobs = [(p, r, a, b) for p in ranks for r, (a, b) in enumerate(self.ranges[p])]
         nb = {}
         for i, (p, r, a, b) in enumerate(jobs):
             if i % comm.getSize() == comm.getRank():
@@ -257,7 +259,7 @@ class Counts:
                                    np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0),
                                    np.where(self.storage, 0.0, tot) + np.where(self.single, g / 40.0, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
-                             in enumerate(partition(N, p))] for p in ranks}
+                             in enumerate(self.ranges[p])] for p in ranks}
 
     def _storage(self, cfg, used, limit):
         N = self.N
@@ -297,14 +299,8 @@ class Counts:
         # history: at step n the exact lags 2..min(Lx, n+1) (plain: n) and, once
         # lags beyond Lx are reached, the k interpolating matrices
         n = np.arange(1, self.steps + 1)
-        jmax = np.minimum(Lx, n + 1) if self.stabilized else np.minimum(Lx, n)
-        jmax = np.where(n >= 2, jmax, 1)
-        uses = np.zeros(len(used))                  # steps in which each stored matrix is used
-        for j in range(2, Lx + 1):
-            uses[j - 1] = np.count_nonzero(jmax >= j)
-        if self.k:
-            reach = n + 1 if self.stabilized else n
-            uses[Lx:] = np.count_nonzero((reach > Lx) & (n >= 2))
+        from .bem.partition import lag_uses
+        uses = lag_uses(Lx, self.steps, self.stabilized, self.k)     # steps in which each stored matrix is used
         fd = fs = 0.0
         if self.block > 1:
             # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
@@ -393,7 +389,7 @@ def setup(cfg, comm, ranks, node_mem):
     t0 = time.perf_counter()
     prob = BEMProblem(cfg, comm, log=quiet)
     plan = prob.interp_plan()
-    ls = prob.lagset()
+    ls = prob.lagset(plan)
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
     cnt = Counts(prob, plan, ls, ranks, limit, comm)
     cnt.setup_s = time.perf_counter() - t0

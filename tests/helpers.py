@@ -44,7 +44,7 @@ def resolve_error(groups=("common", "bem"), **opts):
     try:
         cfg = options.resolve(groups)
         prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
-        prob.check_memory(prob.lagset())
+        prob.check_memory(prob.lagset(prob.interp_plan()))
         return None
     except SSIError as exc:
         return str(exc)

@@ -13,8 +13,8 @@ import numpy as np
 from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
-from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records, cache_insert,
-                       gather_into, SING_TOL)
+from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records,
+                       cache_insert, gather_into, SING_TOL)
 
 
 class Material:
@@ -389,16 +389,21 @@ class LagSet:
         self.comm = comm
         self.mesh, self.mat, self.dt, self.L = mesh, mat, dt, L
         self.regions, self.planes, self.opts = regions, planes, opts
-        PETSc = init()
-        N = mesh.n_nodes
-        v = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * N), bsize=3, comm=comm)
-        r0, r1 = v.getOwnershipRange()
-        v.destroy()
-        self.node_range = (r0 // 3, r1 // 3)
-        self.rows = np.arange(r0 // 3, r1 // 3, dtype=np.int64)
         VX, VN, VS, VT = symmetry.virtual_elements(mesh.cell_coords(), mesh.cells, regions.tcols, planes)
         self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
+        from .partition import node_ranges, lag_weights
+        # the nodes (rows) of each rank: contiguous ranges of equal estimated work (-ssi_partition);
+        # opts "lag_weights": uses of the matrices by lag (partition.lag_weights), "work_lags": the
+        # exact lags (default: a stabilised run of L steps storing every lag)
+        Lx = int(opts.get("work_lags") or L)
+        lw = opts.get("lag_weights")
+        self.ranges, self.balance = node_ranges(comm, opts.get("partition", "balanced"), mesh.nodes, self.Vc,
+                                                self.VR, mat, dt, len(self.Vc) // mesh.n_cells,
+                                                np.asarray(lw, float) if lw is not None else lag_weights(Lx, L, True),
+                                                Lx, regions.n_t)
+        self.node_range = self.ranges[comm.getRank()]
+        self.rows = np.arange(*self.node_range, dtype=np.int64)
         from .freeterm import free_terms
         self.cfree = free_terms(VX, VN, mesh.n_nodes, mat.nu, nodes=self.rows)
         self.n_nonsmooth = self.comm.tompi4py().allreduce(

@@ -219,7 +219,12 @@ class BEMProblem:
             printf(line)
         plan = self.interp_plan()
         printf("[ssi] " + plan.describe())
-        ls = self.lagset()
+        ls = self.lagset(plan)
+        if ls.balance is not None:
+            n = [b - a for a, b in ls.ranges]
+            printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, -ssi_partition "
+                   f"{self.cfg.partition} (estimated work max/mean {ls.balance[0]:.3f}; equal node counts "
+                   f"{ls.balance[1]:.3f})")
         self.check_memory(ls, plan, extra_bytes, extra_what)
         from . import lagstore
         err = None
@@ -236,9 +241,15 @@ class BEMProblem:
                 "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions, "cache": c.cache,
                 "cache_share": c.cache_share}
 
-    def lagset(self):
-        return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes,
-                      self.quad_options())
+    def lagset(self, plan=None):
+        """The LagSet of this run; ``plan``: the interpolation plan (made here if not given), whose
+        matrices and their uses weigh in the partition of the nodes over the ranks."""
+        from .partition import lag_weights
+        plan = plan if plan is not None else self.interp_plan()
+        interp = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []
+        opts = dict(self.quad_options(), partition=self.cfg.partition, work_lags=plan.Lx,
+                    lag_weights=lag_weights(plan.Lx, self.n_steps, self.cfg.scheme.startswith("stabili"), interp))
+        return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes, opts)
 
     def check_memory(self, ls, plan=None, extra_bytes=0.0, extra_what=""):
         """Collective: refuse runs whose lag matrices would not fit; if the

@@ -41,7 +41,7 @@ FORMAT = 1
 RUN_CONTROL = frozenset((
     "output", "output_overwrite", "output_flush", "output_stride", "monitor", "monitor_every", "plot",
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
-    "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "fem_solver", "modes_n",
+    "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load"))
 
 
