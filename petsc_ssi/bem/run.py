@@ -502,7 +502,7 @@ def build_bem(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
     b, sub = _block_of(cfg, comm, H, G, HI, GI)
-    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub, n_steps=prob.n_steps)
     _say_block(march)
     ls.H = ls.G = None   # the triplets are in the Mats now
     if cfg.get("lags_save"):
@@ -551,7 +551,7 @@ def _load_bem(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            + (f", {plan.k} interpolating matrices" if plan.active else "")
            + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
     b, sub = _block_of(cfg, comm, H, G, HI, GI)
-    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub, n_steps=prob.n_steps)
     _say_block(march)
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
