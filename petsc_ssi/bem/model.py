@@ -72,22 +72,28 @@ def bounding_spheres(VX):
     return c, R, h
 
 
+def pair_windows(xc, Vc, VR, L, mat, dt, n_images=1):
+    """The lags 1..L each (point, element) pair reaches: (lo, hi, ok) of shape (points, elements
+    without images), from the bounding spheres (the P wave's arrival to the S wave's passing, plus
+    2), as the union over the element's symmetry images (they fold onto the same columns)."""
+    E = len(Vc) // n_images
+    d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
+    lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
+    hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
+    n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
+    lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
+    hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
+    return lo, hi, np.isfinite(lo) & (hi >= lo)
+
+
 def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
     """Estimated number of non-zero 3x3 blocks of each H lag (array, index
     l-1) in ``rows``: for each (row, element) the lags its wave window touches
     (union over the element's symmetry images, which fold onto the same
     columns), times four nodes per element (a node is shared by about four)."""
     diff = np.zeros(L + 2)
-    E = len(Vc) // n_images
     for s in range(0, len(rows), chunk):
-        xc = xnodes[rows[s:s + chunk]]
-        d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
-        lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
-        hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
-        n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
-        lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
-        hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
-        ok = np.isfinite(lo) & (hi >= lo)
+        lo, hi, ok = pair_windows(xnodes[rows[s:s + chunk]], Vc, VR, L, mat, dt, n_images)
         np.add.at(diff, lo[ok].astype(np.int64), 4.0)
         np.add.at(diff, hi[ok].astype(np.int64) + 1, -4.0)
     return np.cumsum(diff)[1:L + 1]

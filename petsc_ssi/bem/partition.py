@@ -62,20 +62,14 @@ def node_work(xnodes, rows, Vc, VR, mat, dt, n_images, lag_w, Lx, n_t=0, chunk=2
     symmetry images, four nodes per element); products: each block of lag index l (1..len(lag_w))
     times ``lag_w[l - 1]`` (``lag_weights``), and the node's row of G (``n_t`` traction nodes,
     stored dense: the same for every node) in every used matrix."""
+    from .model import pair_windows
     L = len(lag_w)
     cum = np.r_[0.0, np.cumsum(lag_w)]              # cum[l] = weight of lags 1..l
-    E = len(Vc) // n_images
     blocks = np.zeros(len(rows))
     prods = np.full(len(rows), float(n_t) * cum[-1])
     for s in range(0, len(rows), chunk):
         xc = xnodes[rows[s:s + chunk]]
-        d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
-        lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
-        hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
-        n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
-        lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
-        hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
-        ok = np.isfinite(lo) & (hi >= lo)
+        lo, hi, ok = pair_windows(xc, Vc, VR, L, mat, dt, n_images)
         lo_i = np.where(ok, lo, 1).astype(np.int64)
         hi_i = np.where(ok, hi, 0).astype(np.int64)
         blocks[s:s + len(xc)] = 4.0 * np.clip(np.minimum(hi_i, Lx) - lo_i + 1, 0, None).sum(1)
