@@ -441,16 +441,6 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
 
 
 @njit(cache=True)
-def gather_into(out, pos, src, starts, lengths):
-    """Copy the segments src[starts[i]:starts[i] + lengths[i]] one after the other into out from
-    position pos; returns the position after the last."""
-    for i in range(starts.shape[0]):
-        out[pos:pos + lengths[i]] = src[starts[i]:starts[i] + lengths[i]]
-        pos += lengths[i]
-    return pos
-
-
-@njit(cache=True)
 def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs, uoffs):
     """Add records (keys, hashes, meta as from enumerate_pairs) to an element cache, their P blocks at
     buf[poffs[r]:] and U blocks at buf[uoffs[r]:] (uoffs[r] < 0: no U); returns the cache arrays."""

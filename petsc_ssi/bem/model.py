@@ -14,7 +14,7 @@ from ..petsc import init, SSIError, collective_error, printf, warn
 from ..monitor import Progress, event
 from . import symmetry
 from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records,
-                       cache_insert, gather_into, SING_TOL)
+                       cache_insert, SING_TOL)
 
 
 class Material:
@@ -388,6 +388,47 @@ def _mix64(h):
     return x
 
 
+def _send_segments(mpi, jobs, rbuf, rcount, rd):
+    """Collective all-to-all of segments of doubles: to rank r the segments P[ps:ps + pl] then
+    U[us:us + ul] of ``jobs[r]`` = (P, ps, pl, U, us, ul), one after the other, without packing them
+    into a send buffer (an MPI datatype at the segments' addresses: no packed copy of the element
+    cache, which was as large as the cache itself, in fresh memory); from rank r ``rcount[r]``
+    doubles into rbuf[rd[r]:]."""
+    from mpi4py import MPI
+    p = mpi.Get_size()
+    made, stypes, scounts = [], [], []
+    for P, ps, pl, U, us, ul in jobs:
+        aP = MPI.Get_address(P) if P.size else 0            # (an empty pool: every length 0)
+        aU = MPI.Get_address(U) if U.size else 0
+        lens = np.r_[pl, ul].astype(np.int64)
+        addr = np.r_[aP + 8 * np.asarray(ps, np.int64), aU + 8 * np.asarray(us, np.int64)]
+        keep = lens > 0
+        if keep.any():
+            t = MPI.DOUBLE.Create_hindexed(lens[keep].tolist(), addr[keep].tolist()).Commit()
+            made.append(t)
+            stypes.append(t)
+            scounts.append(1)
+        else:
+            stypes.append(MPI.DOUBLE)
+            scounts.append(0)
+    base = MPI.Get_address(rbuf) if len(rbuf) else 0
+    rtypes, rcounts = [], []
+    for r in range(p):
+        if rcount[r]:
+            t = MPI.DOUBLE.Create_hindexed([int(rcount[r])], [int(base + 8 * rd[r])]).Commit()
+            made.append(t)
+            rtypes.append(t)
+            rcounts.append(1)
+        else:
+            rtypes.append(MPI.DOUBLE)
+            rcounts.append(0)
+    try:
+        mpi.Alltoallw([MPI.BOTTOM, (scounts, [0] * p), stypes], [MPI.BOTTOM, (rcounts, [0] * p), rtypes])
+    finally:
+        for t in made:
+            t.Free()
+
+
 class LagSet:
     """The assembled H_l, G_l (l = 1..L) of one rank as triplets, then Mats."""
 
@@ -525,27 +566,19 @@ class LagSet:
         collective_error(err, self.comm)
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
         seg = np.cumsum([0] + [len(g[2]) for g in got])
-        jobs, scount = [], []
+        jobs = []
         for r in range(p):
             u = inv[seg[r]:seg[r + 1]]
             w = u[got[r][2][:, 4] == 1]
             jobs.append((off[u], off[u + 1] - off[u], uoff[w], uoff[w + 1] - uoff[w]))
-            scount.append(int(jobs[-1][1].sum() + jobs[-1][3].sum()))
         got = None
-        sbuf = np.empty(sum(scount))
-        pos = 0
-        for ps, pl, us, ul in jobs:
-            pos = gather_into(sbuf, pos, P, ps, pl)
-            pos = gather_into(sbuf, pos, U, us, ul)
-        P = U = jobs = None
         nl81 = (meta[:, 1] - meta[:, 0] + 1) * 81
         wu = meta[:, 4] == 1
         rcount = [int(nl81[i].sum() + nl81[i][wu[i]].sum()) for i in mine]
         rbuf = np.empty(sum(rcount))
-        sd = np.r_[0, np.cumsum(scount)[:-1]].astype(np.int64)
         rd = np.r_[0, np.cumsum(rcount)[:-1]].astype(np.int64)
-        mpi.Alltoallv([sbuf, (scount, sd), MPI.DOUBLE], [rbuf, (rcount, rd), MPI.DOUBLE])
-        sbuf = None
+        _send_segments(mpi, [(P, ps, pl, U, us, ul) for ps, pl, us, ul in jobs], rbuf, rcount, rd)
+        P = U = jobs = None
         # where each of this rank's records landed in rbuf
         poffs = np.zeros(len(keys), np.int64)
         uoffs = np.full(len(keys), -1, np.int64)
