@@ -34,7 +34,10 @@ def _numba_cache_dir():
                     h.update(f.encode() + src)
     base = _os.environ.get("NUMBA_CACHE_DIR") or _os.path.join(
         _os.path.expanduser("~"), ".cache", "petsc_ssi", "numba")
-    return _os.path.join(base, h.hexdigest()[:12])
+    key = h.hexdigest()[:12]
+    if _os.path.basename(_os.path.normpath(base)) == key:
+        return base             # already this version's (inherited from a parent process that set it)
+    return _os.path.join(base, key)
 
 
 if "numba" not in __import__("sys").modules:

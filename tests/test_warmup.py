@@ -55,3 +55,17 @@ def test_warm_run_compiles_nothing():
         assert r.returncode == 0, r.stdout + r.stderr
     line = [ln for ln in r.stdout.splitlines() if ln.startswith("COMPILED")]
     assert line and line[0].startswith("COMPILED 0 "), r.stdout
+
+
+def test_cache_dir_is_not_nested_in_child_processes(tmp_path):
+    """A process that imports petsc_ssi points NUMBA_CACHE_DIR at <base>/<hash of the sources>; its
+    child processes (mpirun, the tests' subprocesses) inherit that and must keep it, not nest a
+    second <hash> under it (they then compiled every kernel again into a cache of their own)."""
+    code = "import os, petsc_ssi; print('DIR', os.environ['NUMBA_CACHE_DIR'])"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "base"))
+    first = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
+    d1 = first.stdout.split("DIR ", 1)[1].strip()
+    assert os.path.dirname(d1) == str(tmp_path / "base"), d1
+    env["NUMBA_CACHE_DIR"] = d1
+    second = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
+    assert second.stdout.split("DIR ", 1)[1].strip() == d1, second.stdout
