@@ -40,7 +40,8 @@ def block_terms(n, lags, b, s, stabilized=True):
     start n1 = n0 + s floor((n-n0-1)/s)) reads states m = n - l + o (o in 2, 1, 0 stabilised, 1 plain;
     1 <= m <= n - 1) of lag l: those <= n0 in the block's panel product (width b, or up to the last
     step of ``n`` in the run's last block), those in n0 < m <= n1 in the sub-block's (width
-    min(s, n0 + b - n1), or up to the last step), the others in a product of step n."""
+    min(s, n0 + b - n1), or up to the last step), the others in a product of step n. ``n`` is the
+    run's whole range of steps (its last element the run's last step) or one whole block."""
     n = np.asarray(n)
     n0 = b * ((n - 1) // b)
     n1 = n0 + s * ((n - n0 - 1) // s)
@@ -405,7 +406,7 @@ class Marcher:
         (``self.sub`` steps each) and for ``_blocked_history`` step by step."""
         b, s = self.block, self.sub
         last = getattr(self, "n_steps_run", None)
-        w = b if last is None else max(1, min(b, max(last, need) - n0))
+        w = b if last is None or need > last else max(1, min(b, last - n0))
         nsub = -(-w // s)
         panel, subs, rest = {}, [dict() for _ in range(nsub)], [dict() for _ in range(w)]
         for k in range(w):

@@ -123,20 +123,21 @@ def test_blocked_two_ranks_and_a_block_longer_than_the_lags(tmp_path):
     same(ref, long_)                                   # 30 steps in one block of 32
 
 
-@pytest.mark.parametrize("sub", ["7", "2", "3"])
-def test_a_restart_inside_a_block_is_bitwise(tmp_path, sub):
+@pytest.mark.parametrize("sub,every,step", [("7", 5, 10), ("2", 5, 10), ("3", 5, 10), ("3", 29, 58)])
+def test_a_restart_inside_a_block_is_bitwise(tmp_path, sub, every, step):
     """Blocks of 7 steps (they start at steps 1, 8, 15, ...); a checkpoint after step 10 resumes
     inside the second block: the restart forms that block's panel from the restored states, as
     the uninterrupted run did, and every dataset is bit for bit the uninterrupted run's (one rank).
     With sub-blocks of 2 (steps 8-9, 10-11, ...) it resumes inside the second sub-block too, whose
     panel the restart forms from the same states as the uninterrupted run; with sub-blocks of 3
-    (steps 8-10, 11-13, 14) it resumes at the second sub-block's first step."""
+    (steps 8-10, 11-13, 14) it resumes at the second sub-block's first step. After step 58 of the
+    60 it resumes inside the run's last block (steps 57-60), whose panels end at step 60."""
     import sys
     import os
     sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     from test_checkpoint import run_and_restart, assert_same_files
     args = BEM + ["-ssi_history_block", "7", "-ssi_history_sub", sub]
-    (ref, rs), = run_and_restart(args, tmp_path, 1, 5, 10)
+    (ref, rs), = run_and_restart(args, tmp_path, 1, every, step)
     assert_same_files(ref, rs)
 
 
