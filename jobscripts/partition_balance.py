@@ -45,7 +45,8 @@ def counts(case):
     N, Lx = prob.mesh.n_nodes, plan.Lx
     nimg = len(ls.Vc) // prob.mesh.n_cells
     # the weights a run computes (bem/run.py BEMProblem.lagset, bem/partition.py)
-    lag_w = partition.lag_weights(Lx, prob.n_steps, cfg.scheme.startswith("stabili"))
+    stab = cfg.scheme.startswith("stabili")
+    lag_w = partition.lag_weights(Lx, prob.L, stab)                   # (uses of a run of L steps)
     b, q = partition.node_work(prob.mesh.nodes, np.arange(N), ls.Vc, ls.VR, prob.mat, prob.dt, nimg, lag_w, Lx,
                                prob.regions.n_t)
     w = partition.weights(b, q)
@@ -55,7 +56,8 @@ def counts(case):
     H, G = ls.assemble(lag_hi=Lx)
     blocks = H.counts[1:Lx + 1, :N].astype(float)
     tb = blocks.sum(0)
-    tq = (blocks * lag_w[:, None]).sum(0) + prob.regions.n_t * lag_w.sum()
+    uses = partition.lag_weights(Lx, prob.n_steps, stab)             # this run's own uses
+    tq = (blocks * uses[:, None]).sum(0) + prob.regions.n_t * uses.sum()
     rows = []
     for p in RANKS:
         r = {"case": case, "ranks": p}

@@ -213,7 +213,7 @@ class Counts:
         w = None
         if cfg.partition == "balanced" and max(ranks) > 1:
             w = partition.all_weights(comm, prob.mesh.nodes, ls.Vc, ls.VR, prob.mat, prob.dt, nimg,
-                                      partition.lag_weights(self.Lx, self.steps, self.stabilized, self.interp_lags),
+                                      partition.lag_weights(self.Lx, self.L, self.stabilized, self.interp_lags),
                                       self.Lx, self.nt)
         self.ranges = {p: partition.balanced_ranges(w, p) if w is not None else partition.equal_ranges(N, p)
                        for p in ranks}

@@ -38,10 +38,12 @@ def block_terms(n, lags, b, s, stabilized=True):
     the steps ``n`` (array): (steps with a per-step product, summed width of its block panel products,
     summed width of its sub-block panel products). Step n (block start n0 = b floor((n-1)/b), sub-block
     start n1 = n0 + s floor((n-n0-1)/s)) reads states m = n - l + o (o in 2, 1, 0 stabilised, 1 plain;
-    1 <= m <= n - 1) of lag l: those <= n0 in the block's panel product (width b, or up to the last
-    step of ``n`` in the run's last block), those in n0 < m <= n1 in the sub-block's (width
-    min(s, n0 + b - n1), or up to the last step), the others in a product of step n. ``n`` is the
-    run's whole range of steps (its last element the run's last step) or one whole block."""
+    1 <= m <= n - 1) of lag l: those <= n0 in the block's panel product (width b), those in
+    n0 < m <= n1 in the sub-block's (width min(s, n0 + b - n1)), the others in a product of step n.
+    The run's last block is b wide too, past the run's end: a narrower panel rounds differently
+    (BLAS and the block-sparse kernel treat a panel's columns by its width), and a step's numbers
+    must not depend on how many steps the run takes (a stopped run equals a shorter one bit for
+    bit: tests/test_output_survives.py)."""
     n = np.asarray(n)
     n0 = b * ((n - 1) // b)
     n1 = n0 + s * ((n - n0 - 1) // s)
@@ -56,11 +58,9 @@ def block_terms(n, lags, b, s, stabilized=True):
             known |= ok & (m <= n0)
             sub |= ok & (m > n0) & (m <= n1)
             step |= ok & (m > n1)
-    last = int(n.max()) if n.size else 0
     starts = np.unique(n1[sub])
-    wsub = int(np.sum(np.minimum(s, np.minimum(b * ((starts - 1) // b + 1), last) - starts))) if starts.size else 0
-    wblock = int(np.sum(np.minimum(b, last - np.unique(n0[known]))))
-    return int(np.count_nonzero(step)), wblock, wsub
+    wsub = int(np.sum(np.minimum(s, b * ((starts - 1) // b + 1) - starts))) if starts.size else 0
+    return int(np.count_nonzero(step)), b * len(np.unique(n0[known])), wsub
 
 
 def _expand(trip, r0, coef, colmap=None):
@@ -150,14 +150,12 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
 
-    def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None, n_steps=None):
+    def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
         empty) and, with an active interpolation ``plan``, the interpolating
         Mats HI[j] = H(T_j), GI[j] = G(T_j) that stand for lags plan.Lx+1..L; ``block``: the
         steps of the time-blocked history sum (1: step by step); ``sub``: the steps of its
-        sub-blocks (None or >= block: one level); ``n_steps``: the run's last step (its last block
-        forms no panel columns beyond it; None: whole blocks)."""
-        self.n_steps_run = n_steps
+        sub-blocks (None or >= block: one level)."""
         self.H, self.G = H, G
         self.plan = plan if (plan is not None and plan.active) else None
         self.HI, self.GI = list(HI), list(GI)
@@ -399,17 +397,14 @@ class Marcher:
                 arr[self._slot(m)] = seq.getArray(readonly=True)
         self._rep_upto = max(self._rep_upto, n0)
 
-    def _new_block(self, n0, need=0):
+    def _new_block(self, n0):
         """Collective: the known-state part of the panel matrices' history sums of steps
-        n0+1 .. n0+w into ``self._R`` (w x local rows; w = b, or in the run's last block up to its last
-        step, ``need`` at least); the terms of states inside the block kept for the sub-block panels
-        (``self.sub`` steps each) and for ``_blocked_history`` step by step."""
+        n0+1 .. n0+b into ``self._R`` (b x local rows); the terms of states inside the block kept for
+        the sub-block panels (``self.sub`` steps each) and for ``_blocked_history`` step by step."""
         b, s = self.block, self.sub
-        last = getattr(self, "n_steps_run", None)
-        w = b if last is None or need > last else max(1, min(b, last - n0))
-        nsub = -(-w // s)
-        panel, subs, rest = {}, [dict() for _ in range(nsub)], [dict() for _ in range(w)]
-        for k in range(w):
+        nsub = -(-b // s)
+        panel, subs, rest = {}, [dict() for _ in range(nsub)], [dict() for _ in range(b)]
+        for k in range(b):
             i = k // s
             n1 = n0 + i * s                                   # the sub-block's start: states <= n1 final
             for key, m, c in self._step_terms(n0 + 1 + k):
@@ -425,8 +420,8 @@ class Marcher:
                         subs[i].setdefault((key, side), []).append((k - i * s, m, c))
                     else:
                         rest[k].setdefault((key, side), []).append((m, c))
-        if getattr(self, "_R", None) is None or self._R.shape[0] != w:
-            self._R = np.zeros((w, self.u_tmpl.getLocalSize()))        # row k: step n0 + 1 + k
+        if getattr(self, "_R", None) is None or self._R.shape[0] != b:
+            self._R = np.zeros((b, self.u_tmpl.getLocalSize()))        # row k: step n0 + 1 + k
         self._R[...] = 0.0
         if panel:
             self._panel_products(panel, self._R, n0)
@@ -472,10 +467,10 @@ class Marcher:
 
     def _blocked_history(self, n, out_u):
         blk = getattr(self, "_blk", None)
-        if blk is None or not blk[0] < n <= blk[0] + len(blk[1]):
+        if blk is None or not blk[0] < n <= blk[0] + self.block:
             ev = event("SSI_BEM_HistPanel")
             ev.begin()
-            self._new_block(self.block * ((n - 1) // self.block), need=n)
+            self._new_block(self.block * ((n - 1) // self.block))
             ev.end()
         n0, _, subs = self._blk
         i = (n - n0 - 1) // self.sub

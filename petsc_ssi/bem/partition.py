@@ -10,10 +10,12 @@ assembled lags: jobscripts/partition_balance.py).
 ``balanced`` (the default) cuts the node numbering into contiguous ranges of equal estimated work:
 per node, its history products, counted from its blocks as ``model.estimate_blocks`` counts them
 (the wave window of every node-element pair, folded over symmetry images, four nodes per element),
-each block of lag l once per step that uses lag l (``weights`` says why products alone). Every
+each block of lag l once per step that uses lag l in a run of L steps, L the lags the run reaches
+(``weights`` says why products alone; not the run's own steps: the cut then depends on the
+stored lags only, and a run stopped after n steps equals a run of n steps bit for bit). Every
 rank computes the weights of an equal share of the nodes; all ranks gather them and cut
 identically. Ranges stay contiguous, so the matrices' layout is PETSc's usual one with other
-local sizes, and every result is independent of the cut (the -n 1 / -n p tests).
+local sizes, and results agree with any other cut to round-off (the -n 1 / -n p tests).
 """
 import numpy as np
 
@@ -80,11 +82,10 @@ def node_work(xnodes, rows, Vc, VR, mat, dt, n_images, lag_w, Lx, n_t=0, chunk=2
 def weights(blocks, prods):
     """The weight of each node: its estimated history products (``blocks``: the nodes' blocks, the
     weight where no step uses any lag). On the medium and paper Lamb cases at 2-16 ranks, cutting
-    by products alone leaves the busiest rank's products as close to even as the equal split or
-    closer (0.002 worse to 0.030 better) and takes a sixth to two thirds off the blocks' excess, as
-    a node's products grow with its blocks; an equal mix of the blocks' and the products' shares
-    evens the blocks further but leaves the products 1-4 points further from even than the equal
-    split: the estimate counts the blocks of nodes near the symmetry corner low and those far from
+    by products alone brings the busiest rank's products closer to even than the equal split
+    (by 0.004 to 0.026) and takes a quarter to two thirds off the blocks' excess, as a node's
+    products grow with its blocks; an equal mix of the blocks' and the products' shares evens the
+    blocks further but leaves the products 2-4 points further from even than the equal split: the estimate counts the blocks of nodes near the symmetry corner low and those far from
     it high (jobscripts/partition_balance.py)."""
     prods = np.asarray(prods, float)
     return prods if float(prods.sum()) > 0 else np.asarray(blocks, float)
