@@ -396,32 +396,25 @@ def _send_segments(mpi, jobs, rbuf, rcount, rd):
     doubles into rbuf[rd[r]:]."""
     from mpi4py import MPI
     p = mpi.Get_size()
-    made, stypes, scounts = [], [], []
+    made = []
+
+    def segments(lens, addr):
+        """(datatype, count) of the doubles at absolute addresses ``addr``, ``lens`` each."""
+        keep = lens > 0
+        if not keep.any():
+            return MPI.DOUBLE, 0
+        made.append(MPI.DOUBLE.Create_hindexed(lens[keep].tolist(), addr[keep].tolist()).Commit())
+        return made[-1], 1
+    send = []
     for P, ps, pl, U, us, ul in jobs:
         aP = MPI.Get_address(P) if P.size else 0            # (an empty pool: every length 0)
         aU = MPI.Get_address(U) if U.size else 0
-        lens = np.r_[pl, ul].astype(np.int64)
-        addr = np.r_[aP + 8 * np.asarray(ps, np.int64), aU + 8 * np.asarray(us, np.int64)]
-        keep = lens > 0
-        if keep.any():
-            t = MPI.DOUBLE.Create_hindexed(lens[keep].tolist(), addr[keep].tolist()).Commit()
-            made.append(t)
-            stypes.append(t)
-            scounts.append(1)
-        else:
-            stypes.append(MPI.DOUBLE)
-            scounts.append(0)
+        send.append(segments(np.r_[pl, ul].astype(np.int64),
+                             np.r_[aP + 8 * np.asarray(ps, np.int64), aU + 8 * np.asarray(us, np.int64)]))
     base = MPI.Get_address(rbuf) if len(rbuf) else 0
-    rtypes, rcounts = [], []
-    for r in range(p):
-        if rcount[r]:
-            t = MPI.DOUBLE.Create_hindexed([int(rcount[r])], [int(base + 8 * rd[r])]).Commit()
-            made.append(t)
-            rtypes.append(t)
-            rcounts.append(1)
-        else:
-            rtypes.append(MPI.DOUBLE)
-            rcounts.append(0)
+    recv = [segments(np.array([rcount[r]], np.int64), np.array([base + 8 * rd[r]], np.int64)) for r in range(p)]
+    stypes, scounts = [t for t, _ in send], [c for _, c in send]
+    rtypes, rcounts = [t for t, _ in recv], [c for _, c in recv]
     try:
         mpi.Alltoallw([MPI.BOTTOM, (scounts, [0] * p), stypes], [MPI.BOTTOM, (rcounts, [0] * p), rtypes])
     finally:
