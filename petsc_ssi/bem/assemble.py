@@ -110,8 +110,9 @@ def _lookup(cidx, ckeys, cmeta, hsh, key, lo, hi):
 @njit(cache=True)
 def _new_index():
     """The cache's hash -> entry map. Made in compiled code: ``numba.typed.Dict.empty`` called from
-    Python compiles its constructor in every process (about 0.3 s, not cached), and ``len`` of it
-    from Python another 0.1 s (``index_len``)."""
+    Python compiles its constructor in every process (numba does not cache it), and ``len`` of it
+    from Python another helper (``index_len``); tests/test_warmup.py counts what a warm process
+    compiles."""
     return Dict.empty(key_type=types.int64, value_type=types.int64)
 
 
