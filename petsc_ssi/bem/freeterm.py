@@ -81,6 +81,10 @@ def free_term_from_cone(area, M, nu):
     return ((1 - 2 * nu) * area * np.eye(3) + 3 * M) / (8 * np.pi * (1 - nu))
 
 
+# shape-function derivatives at the nine nodes: _D1[a, k] = dN_k/dxi at node a
+_D1, _D2 = quad9.shape_grad(quad9.NODE_XI[:, 0], quad9.NODE_XI[:, 1])
+
+
 def _sectors(X, a):
     """Unit arc directions (start, [mid,] end) of element X's sector at node a,
     and the unit outward normal there."""
@@ -97,28 +101,50 @@ def _sectors(X, a):
     return [v / np.linalg.norm(v) for v in dirs], n
 
 
+def node_normals(VX):
+    """Unit outward normals (n_elem, 9, 3) of every element of ``VX`` (n_elem, 9, 3) at each of its
+    nine nodes, vectorised (the normal ``_sectors`` computes for one element and node)."""
+    t1 = np.einsum("ak,vkd->vad", _D1, VX)
+    t2 = np.einsum("ak,vkd->vad", _D2, VX)
+    n = np.cross(t1, t2)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
 def free_terms(VX, VN, n_nodes, nu, tol=1e-8, smooth_deg=1e-6, nodes=None):
     """c (n_nodes, 3, 3) from the virtual elements (mesh + symmetry images),
     for ``nodes`` (default all; the others stay 0).
 
     Nodes where the elements' normals agree to ``smooth_deg`` get I/2
-    exactly; the others get the cone formula, and must close their fan."""
+    exactly (found for all nodes at once, vectorised); the others get the cone formula, and must
+    close their fan."""
     c = np.zeros((n_nodes, 3, 3))
-    per = [[] for _ in range(n_nodes)]
-    for v in range(VX.shape[0]):
-        for a in range(9):
-            per[VN[v, a]].append((v, a))
-    for i in (range(n_nodes) if nodes is None else nodes):
+    sel = np.arange(n_nodes) if nodes is None else np.asarray(nodes, dtype=np.int64).ravel()
+    if sel.size == 0:
+        return c
+    flat = np.asarray(VN, dtype=np.int64).ravel()
+    order = np.argsort(flat, kind="stable")          # each node's incidences, in (element, local node) order
+    counts = np.bincount(flat, minlength=n_nodes)[:n_nodes]
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    lonely = sel[counts[sel] == 0]
+    if lonely.size:
+        raise SSIError(f"node {int(lonely[0])} belongs to no element: no free term can be defined")
+    nrm = node_normals(np.asarray(VX, float)).reshape(-1, 3)
+    ref = nrm[order[np.minimum(start, max(len(order) - 1, 0))]]     # each node's first normal
+    dots = np.einsum("id,id->i", nrm[order], np.repeat(ref, counts, axis=0))
+    has = counts > 0
+    mind = np.full(n_nodes, np.inf)
+    mind[has] = np.minimum.reduceat(dots, start[has])
+    smooth = mind >= min(np.cos(np.radians(smooth_deg)), 1 - 1e-12)
+    c[sel[smooth[sel]]] = 0.5 * np.eye(3)
+    for i in sel[~smooth[sel]]:
+        inc = order[start[i]:start[i] + counts[i]]
         arcs, normals = [], []
-        for v, a in per[i]:
+        for v, a in zip(inc // 9, inc % 9):
             dirs, n = _sectors(VX[v], a)
             normals.append(n)
             if dirs is not None:
                 arcs.append(dirs)
         N = np.array(normals)
-        if np.all(N @ N[0] >= min(np.cos(np.radians(smooth_deg)), 1 - 1e-12)):
-            c[i] = 0.5 * np.eye(3)
-            continue
         loop = _chain(arcs, tol)
         if loop is None:
             raise SSIError(f"node {i}: the surface is not smooth there and its elements do not close "

@@ -135,3 +135,30 @@ def test_rigid_body_rows_vanish_on_a_closed_cube():
     sums = [np.abs(v[r == i].sum(0)).max() for i in ids]
     # measured 2e-7 .. 8e-7 (1e-8 .. 5e-8 with subdivisions 8, near_factor 8)
     assert max(sums) < 2e-6, sums
+
+
+def test_free_terms_of_a_node_do_not_depend_on_the_others_asked_for():
+    """The vectorised smooth-point pass groups every node's elements at once: on the cube (face,
+    edge and corner nodes) each node's c asked alone equals its c among all nodes, bit for bit, and
+    the faces' smooth nodes get I/2 exactly."""
+    m = _cube(2)
+    VX, VN = m.cell_coords(), m.cells
+    c_all = free_terms(VX, VN, m.n_nodes, NU)
+    for i in range(m.n_nodes):
+        assert np.array_equal(free_terms(VX, VN, m.n_nodes, NU, nodes=[i])[i], c_all[i])
+    on_faces = np.sum(np.isclose(m.nodes, 0.0) | np.isclose(m.nodes, 1.0), axis=1)
+    assert np.all(c_all[on_faces == 1] == 0.5 * np.eye(3))
+    # corners: an octant, c_ii = 1/8 and |c_ij| = 3 int d_i d_j / (8 pi (1-nu)) = 1 / (8 pi (1-nu))
+    corners = c_all[on_faces == 3]
+    assert len(corners) == 8
+    assert np.abs(np.diagonal(corners, axis1=1, axis2=2) - 1 / 8).max() < 1e-9
+    off = corners[:, ~np.eye(3, dtype=bool)]
+    assert np.abs(np.abs(off) - 1 / (8 * np.pi * (1 - NU))).max() < 1e-9
+    assert not np.allclose(c_all[on_faces == 2], 0.5 * np.eye(3))
+
+
+def test_a_node_in_no_element_is_refused():
+    from petsc_ssi.petsc import SSIError
+    m = grid(2.0, 2.0, 1.0)
+    with pytest.raises(SSIError, match="belongs to no element"):
+        free_terms(m.cell_coords(), m.cells, m.n_nodes + 1, NU, nodes=[m.n_nodes])
