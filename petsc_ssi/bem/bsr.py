@@ -12,6 +12,8 @@ two compiled kernels work on it:
     matvec     y = A x                  (x all-gathered: every column of the local rows)
     panel      R^T += s A X^T           (X: b combined states, each rank's copy; one pass over A)
 
+and ``panel_states`` forms X (or X^T) from the states, one call per matrix.
+
 The Mat (``BSRMat.mat``, type python) answers MatMult and MatMultAdd, so the per-step path, the
 step's known-value terms and every other caller are unchanged; ``march`` finds the context with
 ``context(M)`` and uses the panel kernel. ``-ssi_lags_save`` writes it as MPIBAIJ (``to_baij``,
@@ -69,6 +71,26 @@ def _panel(indptr, indices, data, XT, RT, sign):
             RT[3 * i, t] += sign * acc0[t]
             RT[3 * i + 1, t] += sign * acc1[t]
             RT[3 * i + 2, t] += sign * acc2[t]
+
+
+@njit(cache=True)
+def panel_states(rep, rows, slots, coefs, out, transposed):
+    """The panel of combined states: out[rows[t]] += coefs[t] * rep[slots[t]] for t in order
+    (``transposed``: out is columns x b, out[:, rows[t]] instead). The same operations, in the
+    same order, as the numpy loop it replaces (a product rounded, then a sum rounded; numba
+    contracts no multiply-add without fastmath), so the bits are those of that loop; one call per
+    matrix instead of one numpy call per term."""
+    n = rep.shape[1]
+    for t in range(rows.size):
+        k = rows[t]
+        s = slots[t]
+        c = coefs[t]
+        if transposed:
+            for i in range(n):
+                out[i, k] += c * rep[s, i]
+        else:
+            for i in range(n):
+                out[k, i] += c * rep[s, i]
 
 
 class _Shell:

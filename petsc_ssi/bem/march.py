@@ -434,15 +434,20 @@ class Marcher:
         w = R.shape[0]
         self._replicate(upto)
         X = {side: np.zeros((w, self._rep[side][2].shape[1])) for side in ("u", "p")}
+        XT = {side: np.zeros((self._rep[side][2].shape[1], w)) for side in ("u", "p")}
         RT = None
         for (key, side) in sorted(panel):
             M = self._mat(key, side)
-            rep, x = self._rep[side][2], X[side]
+            rep = self._rep[side][2]
+            kind = self._panel_kind(M)
+            x = X[side] if kind == "dense" else XT[side]   # (a block-sparse lag reads X^T)
             x[...] = 0.0
-            for k, m, c in panel[(key, side)]:
-                x[k] += c * rep[self._slot(m)]
+            terms = panel[(key, side)]
+            bsr.panel_states(rep, np.array([k for k, _, _ in terms], np.int64),
+                             np.array([self._slot(m) for _, m, _ in terms], np.int64),
+                             np.array([c for _, _, c in terms], float), x, kind != "dense")
             sign = -1.0 if side == "u" else 1.0
-            if self._panel_kind(M) == "dense":
+            if kind == "dense":
                 At = M.getDenseArray(readonly=True).T     # all columns x local rows, C order
                 self.PETSc.Log.logFlops(2.0 * x.size * At.shape[1])
                 if side == "u":                           # (x @ At: OpenBLAS's fast layout
@@ -453,7 +458,7 @@ class Marcher:
                 ctx = bsr.context(M)
                 if RT is None:
                     RT = np.zeros((R.shape[1], w))
-                ctx.panel(np.ascontiguousarray(x.T), RT, sign)
+                ctx.panel(x, RT, sign)
                 self.PETSc.Log.logFlops(18.0 * w * ctx.indices.size)
         if RT is not None:
             R += RT.T
@@ -504,8 +509,8 @@ class Marcher:
                 continue
             rep = self._rep[side][2]
             x = np.zeros(rep.shape[1])
-            for m, c in terms:
-                x += c * rep[self._slot(m)]
+            bsr.panel_states(rep, np.zeros(len(terms), np.int64), np.array([self._slot(m) for m, _ in terms], np.int64),
+                             np.array([c for _, c in terms], float), x[None, :], False)
             if kind == "dense":
                 A = M.getDenseArray(readonly=True)
                 y = A @ x
