@@ -114,30 +114,40 @@ def free_terms(VX, VN, n_nodes, nu, tol=1e-8, smooth_deg=1e-6, nodes=None):
     """c (n_nodes, 3, 3) from the virtual elements (mesh + symmetry images),
     for ``nodes`` (default all; the others stay 0).
 
-    Nodes where the elements' normals agree to ``smooth_deg`` get I/2
-    exactly (found for all nodes at once, vectorised); the others get the cone formula, and must
-    close their fan."""
+    A node's elements are those that list it and meet it: an image element lists the node's number
+    at the node's mirror image, which is the node itself only on the symmetry plane. The node's place
+    is that of the first element listing it (``symmetry.virtual_elements`` puts the mesh's own
+    elements first). Nodes where their elements' normals agree to ``smooth_deg`` get I/2 exactly
+    (found for all nodes at once, vectorised); the others get the cone formula, and must close their
+    fan."""
     c = np.zeros((n_nodes, 3, 3))
     sel = np.arange(n_nodes) if nodes is None else np.asarray(nodes, dtype=np.int64).ravel()
     if sel.size == 0:
         return c
     flat = np.asarray(VN, dtype=np.int64).ravel()
+    if flat.size and (flat.min() < 0 or flat.max() >= n_nodes):
+        raise ValueError(f"free_terms: element node indices in [{flat.min()}, {flat.max()}], outside [0, {n_nodes})")
     order = np.argsort(flat, kind="stable")          # each node's incidences, in (element, local node) order
     counts = np.bincount(flat, minlength=n_nodes)[:n_nodes]
     start = np.concatenate([[0], np.cumsum(counts)[:-1]])
     lonely = sel[counts[sel] == 0]
     if lonely.size:
         raise SSIError(f"node {int(lonely[0])} belongs to no element: no free term can be defined")
-    nrm = node_normals(np.asarray(VX, float)).reshape(-1, 3)
-    ref = nrm[order[np.minimum(start, max(len(order) - 1, 0))]]     # each node's first normal
-    dots = np.einsum("id,id->i", nrm[order], np.repeat(ref, counts, axis=0))
+    VX = np.asarray(VX, float)
+    first = np.minimum(start, max(len(order) - 1, 0))             # each node's first incidence
+    pos = VX.reshape(-1, 3)[order]
+    scale = max(float(np.ptp(pos, axis=0).max()), 1e-300) if len(pos) else 1.0
+    meets = np.linalg.norm(pos - np.repeat(pos[first], counts, axis=0), axis=1) <= 1e-9 * scale
+    nrm = node_normals(VX).reshape(-1, 3)
+    dots = np.einsum("id,id->i", nrm[order], np.repeat(nrm[order[first]], counts, axis=0))
+    dots[~meets] = np.inf                            # an image element elsewhere: not this node's
     has = counts > 0
     mind = np.full(n_nodes, np.inf)
     mind[has] = np.minimum.reduceat(dots, start[has])
     smooth = mind >= min(np.cos(np.radians(smooth_deg)), 1 - 1e-12)
     c[sel[smooth[sel]]] = 0.5 * np.eye(3)
     for i in sel[~smooth[sel]]:
-        inc = order[start[i]:start[i] + counts[i]]
+        inc = order[start[i]:start[i] + counts[i]][meets[start[i]:start[i] + counts[i]]]
         arcs, normals = [], []
         for v, a in zip(inc // 9, inc % 9):
             dirs, n = _sectors(VX[v], a)

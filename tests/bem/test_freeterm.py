@@ -137,24 +137,85 @@ def test_rigid_body_rows_vanish_on_a_closed_cube():
     assert max(sums) < 2e-6, sums
 
 
-def test_free_terms_of_a_node_do_not_depend_on_the_others_asked_for():
-    """The vectorised smooth-point pass groups every node's elements at once: on the cube (face,
-    edge and corner nodes) each node's c asked alone equals its c among all nodes, bit for bit, and
-    the faces' smooth nodes get I/2 exactly."""
+def per_node_reference(VX, VN, n_nodes, nu, nodes, smooth_deg=1e-6, tol=1e-8):
+    """The free terms node by node, the plain loop free_terms replaced (each node's (element, local
+    node) pairs in that order, its first normal the reference): the independent reference."""
+    from petsc_ssi.bem.freeterm import _sectors, _chain
+    c = np.zeros((n_nodes, 3, 3))
+    for i in nodes:
+        arcs, normals = [], []
+        for v in range(VN.shape[0]):
+            for a in range(9):
+                if VN[v, a] == i:
+                    dirs, n = _sectors(VX[v], a)
+                    normals.append(n)
+                    if dirs is not None:
+                        arcs.append(dirs)
+        N = np.array(normals)
+        if np.all(N @ N[0] >= min(np.cos(np.radians(smooth_deg)), 1 - 1e-12)):
+            c[i] = 0.5 * np.eye(3)
+            continue
+        area, M = cone_moments(np.array(_chain(arcs, tol)), -N.mean(0))
+        if area < 0:
+            area, M = -area, -M
+        c[i] = free_term_from_cone(area, M, nu)
+    return c
+
+
+def test_free_terms_equal_the_per_node_loop_bit_for_bit():
+    """The vectorised smooth-point pass against the plain per-node loop, bit for bit: a cube (face,
+    edge and corner nodes) and a ridge mesh (a fold inside), every node or a scattered selection
+    given as a list and as an array; each node asked alone gives its value among all. On the cube:
+    faces I/2 exactly, edges (a right-angle wedge) a diagonal of 1/4, corners (an octant) 1/8 and
+    |c_ij| = 1 / (8 pi (1-nu))."""
     m = _cube(2)
-    VX, VN = m.cell_coords(), m.cells
-    c_all = free_terms(VX, VN, m.n_nodes, NU)
-    for i in range(m.n_nodes):
-        assert np.array_equal(free_terms(VX, VN, m.n_nodes, NU, nodes=[i])[i], c_all[i])
+    cases = [(m.cell_coords(), m.cells, m.n_nodes, None)]
+    r = grid(4.0, 4.0, 1.0)
+    r.nodes[:, 2] = -0.5 * np.abs(r.nodes[:, 0])
+    inner = np.nonzero(np.abs(r.nodes[:, 1]) < 1.5)[0]              # off the kinked ends
+    cases.append((r.cell_coords(), r.cells, r.n_nodes, inner))
+    for VX, VN, n, nodes in cases:
+        ask = np.arange(n) if nodes is None else nodes
+        ref = per_node_reference(VX, VN, n, NU, ask)
+        for sel in (nodes, list(ask[::3]), np.asarray(ask[1::2])):
+            got = free_terms(VX, VN, n, NU, nodes=sel)
+            want = ref if sel is None else np.where(np.isin(np.arange(n), sel)[:, None, None], ref, 0.0)
+            assert np.array_equal(got, want)
+        for i in ask[::5]:
+            assert np.array_equal(free_terms(VX, VN, n, NU, nodes=[i])[i], ref[i])
+    c_all = free_terms(m.cell_coords(), m.cells, m.n_nodes, NU)
     on_faces = np.sum(np.isclose(m.nodes, 0.0) | np.isclose(m.nodes, 1.0), axis=1)
     assert np.all(c_all[on_faces == 1] == 0.5 * np.eye(3))
-    # corners: an octant, c_ii = 1/8 and |c_ij| = 3 int d_i d_j / (8 pi (1-nu)) = 1 / (8 pi (1-nu))
+    diag = np.diagonal(c_all, axis1=1, axis2=2)
+    assert (on_faces == 2).sum() == 12 * 3 and np.abs(diag[on_faces == 2] - 0.25).max() < 1e-9
     corners = c_all[on_faces == 3]
-    assert len(corners) == 8
-    assert np.abs(np.diagonal(corners, axis1=1, axis2=2) - 1 / 8).max() < 1e-9
+    assert len(corners) == 8 and np.abs(diag[on_faces == 3] - 1 / 8).max() < 1e-9
     off = corners[:, ~np.eye(3, dtype=bool)]
     assert np.abs(np.abs(off) - 1 / (8 * np.pi * (1 - NU))).max() < 1e-9
-    assert not np.allclose(c_all[on_faces == 2], 0.5 * np.eye(3))
+
+
+@pytest.mark.parametrize("s", [0.5, -0.5])
+def test_a_symmetric_fold_equals_the_whole_mesh(s):
+    """Half of a ridge (s > 0; a valley, s < 0) meshed on x >= 0 with its image in the plane x = 0
+    gives every node the free term of the whole mesh (1e-12): the fold on the plane closes with the
+    image's elements, and a node off the plane takes no part of the image, whose elements list its
+    number at its mirror image (a tilted plane there: I/2)."""
+    from petsc_ssi.bem import symmetry
+    whole = grid(4.0, 4.0, 1.0)
+    whole.nodes[:, 2] = -s * np.abs(whole.nodes[:, 0])
+    half = grid(4.0, 4.0, 1.0, xmin=0.0)
+    half.nodes[:, 2] = -s * half.nodes[:, 0]
+    VX, VN, _, _ = symmetry.virtual_elements(half.cell_coords(), half.cells, half.cells, [(0, 1)])
+    inner = np.nonzero(np.abs(half.nodes[:, 1]) < 1.5)[0]
+    inner = inner[half.nodes[inner, 0] < 1.5]                      # off the mesh's kinked ends
+    ch = free_terms(VX, VN, half.n_nodes, NU, nodes=inner)
+    match = [int(np.argmin(np.linalg.norm(whole.nodes - half.nodes[i], axis=1))) for i in inner]
+    cw = free_terms(whole.cell_coords(), whole.cells, whole.n_nodes, NU, nodes=match)
+    assert np.abs(ch[inner] - cw[match]).max() < 1e-12
+    on_plane = half.nodes[inner, 0] == 0.0
+    theta = np.pi - 2 * np.arctan(s)
+    assert on_plane.sum() == 5 and np.abs(ch[inner[on_plane], 1, 1] - theta / (2 * np.pi)).max() < 1e-10
+    assert np.all(ch[inner[~on_plane]] == 0.5 * np.eye(3))
 
 
 def test_a_node_in_no_element_is_refused():
@@ -162,3 +223,9 @@ def test_a_node_in_no_element_is_refused():
     m = grid(2.0, 2.0, 1.0)
     with pytest.raises(SSIError, match="belongs to no element"):
         free_terms(m.cell_coords(), m.cells, m.n_nodes + 1, NU, nodes=[m.n_nodes])
+
+
+def test_element_nodes_outside_the_mesh_are_refused():
+    m = grid(2.0, 2.0, 1.0)
+    with pytest.raises(ValueError, match="outside"):
+        free_terms(m.cell_coords(), m.cells, m.n_nodes - 1, NU)
