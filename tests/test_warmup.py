@@ -5,6 +5,8 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from helpers import ROOT
 
 RUN = ["-m", "petsc_ssi", "-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch",
@@ -55,6 +57,48 @@ def test_warm_run_compiles_nothing():
         assert r.returncode == 0, r.stdout + r.stderr
     line = [ln for ln in r.stdout.splitlines() if ln.startswith("COMPILED")]
     assert line and line[0].startswith("COMPILED 0 "), r.stdout
+
+
+PROBE_RUN = """
+import sys
+import petsc_ssi
+import numba.core.compiler as c
+calls = []
+orig = c.compile_extra
+def counted(*a, **k):
+    calls.append(getattr(a[2], '__qualname__', repr(a[2])) if len(a) > 2 else '?')
+    return orig(*a, **k)
+c.compile_extra = counted
+from petsc_ssi.cli import main
+rc = main(['petsc-ssi'] + sys.argv[1:])
+print('COMPILED', len(calls), calls)
+sys.exit(rc)
+"""
+
+SSI_RUN = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
+           "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",
+           "1,1,0.25", "-ssi_fem_box_origin", "-0.5,-0.5,0", "-ssi_fem_E", "3e8", "-ssi_fem_rho", "2000",
+           "-ssi_dt", "0.0125", "-ssi_t_end", "0.1", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000",
+           "-ssi_fem_load_history", "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral",
+           "-ssi_warn_beta", "0", "-ssi_output_overwrite"]
+
+
+@pytest.mark.parametrize("what", ["bem-blocked", "bem-single", "ssi-contact"])
+def test_warm_runs_compile_nothing(tmp_path, what):
+    """Whole runs, not only the assembly: with the cache warm (the first process warms it if
+    needed), a new process running the time-blocked BEM march (block-sparse lags, panels and the
+    per-step rest), the same with single-precision far lags, or a coupled run with contact compiles
+    nothing: every kernel signature these runs meet is in the warm-up."""
+    args = {"bem-blocked": RUN[2:] + ["-ssi_lag_storage", "sparse", "-ssi_history_block", "2"],
+            "bem-single": RUN[2:] + ["-ssi_lag_single_from", "3", "-ssi_t_end", "0.03", "-ssi_history_block", "3"],
+            "ssi-contact": SSI_RUN}[what]
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    for k in range(2):
+        r = subprocess.run([sys.executable, "-c", PROBE_RUN] + args + ["-ssi_output", str(tmp_path / f"{k}.h5")],
+                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    line = [ln for ln in r.stdout.splitlines() if ln.startswith("COMPILED")]
+    assert line and line[0].startswith("COMPILED 0 "), line or r.stdout[-3000:]
 
 
 def test_cache_dir_is_not_nested_in_child_processes(tmp_path):
