@@ -4,6 +4,7 @@
 that command-line options reach the PETSc options database (petsc4py demos,
 PyLith). Nothing here captures MPI state at import time.
 """
+import importlib
 import sys
 
 _INITIALISED = False
@@ -45,6 +46,31 @@ def _pin_mmap_threshold(nbytes=256 << 10):
         libc.mallopt(M_TRIM_THRESHOLD, int(nbytes))
     except (OSError, AttributeError):
         pass
+
+
+def set_huge_pages(mode):
+    """numpy's transparent-huge-page advice for the arrays it allocates from now on (-ssi_huge_pages):
+    'off', 'on', or 'numpy' (left as numpy set it: on, unless NUMPY_MADVISE_HUGEPAGE=0). numpy (1.18
+    on, Linux) asks the kernel with madvise(MADV_HUGEPAGE) to back every array of 4 MB and more by
+    2 MB pages; where the kernel then compacts memory on the spot (transparent_hugepage/defrag
+    'madvise'), first writes stall erratically (jobscripts/first_touch.py). Returns the advice in
+    effect (True/False), or None where this numpy has no such switch (then nothing changes)."""
+    if mode not in ("off", "on", "numpy"):
+        raise SSIError(f"-ssi_huge_pages {mode}: expected off, on or numpy")
+    ma = None
+    for name in ("numpy._core.multiarray", "numpy.core.multiarray"):
+        try:
+            ma = importlib.import_module(name)
+        except ImportError:
+            continue
+        if hasattr(ma, "_set_madvise_hugepage"):
+            break
+        ma = None
+    if ma is None:
+        return None
+    if mode != "numpy":
+        ma._set_madvise_hugepage(mode == "on")
+    return bool(ma._get_madvise_hugepage())
 
 
 def release_memory():

@@ -84,6 +84,8 @@ class TransientProblem:
         self._state = "created"
         self.restart = None             # the header of -ssi_restart's checkpoint (check_output)
         self._key = None
+        from .petsc import set_huge_pages
+        self.huge_pages = set_huge_pages(cfg.get("huge_pages", "off"))   # before the large arrays
 
     _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
 

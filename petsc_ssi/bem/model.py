@@ -278,9 +278,11 @@ class Buckets:
     and column within a row), so each lag is CSR with sorted columns as it stands and no sort or
     concatenation follows. ``csr(l)`` gives (indptr, cols, vals), ``peek(l)`` (rows, cols, vals);
     ``take(l)`` and ``take_csr(l)`` free the lag. The arrays start at ``capacity[l - 1]`` blocks
-    (the memory estimate's count) and grow by half when needed; allocated in large pieces by numpy,
-    they are backed by huge pages where the kernel offers them (numpy advises it): a page fault per
-    4 kB of small per-chunk pieces cost the paper case more time than its assembly."""
+    (the memory estimate's count) and grow by half when needed: large arrays allocated once, each
+    page faulted in once (small per-chunk pieces, mapped and unmapped chunk after chunk, cost the
+    paper case more time in page faults than its assembly). Whether numpy backs them by huge pages
+    is ``-ssi_huge_pages`` (default off: on this machine a first write with the advice stalled
+    erratically, jobscripts/first_touch.py)."""
 
     GROW = 1.5
     TRIM = 0.9            # a lag using less of its array is copied to its size when taken
