@@ -28,6 +28,7 @@ import numpy as np
 
 from ..petsc import SSIError
 from ..mesh import quad9
+from ..mesh.surface import segment_sizes
 
 # parameter-plane sector of each local node: (start, end, middle or None)
 _SECTORS = {0: ((1, 0), (0, 1), None), 1: ((0, 1), (-1, 0), None), 2: ((-1, 0), (0, -1), None),
@@ -117,7 +118,9 @@ def free_terms(VX, VN, n_nodes, nu, tol=1e-8, smooth_deg=1e-6, nodes=None):
     A node's elements are those that list it and meet it: an image element lists the node's number
     at the node's mirror image, which is the node itself only on the symmetry plane. The node's place
     is that of the first element listing it (``symmetry.virtual_elements`` puts the mesh's own
-    elements first). Nodes where their elements' normals agree to ``smooth_deg`` get I/2 exactly
+    elements first); an element meets it within twice the on-plane tolerance of
+    ``symmetry.zero_dofs`` (a node within 1e-9 max(h, 1) of a plane is on it, h the mesh's
+    ``element_sizes``), so the free term and the zeroed DOFs see the same nodes on the planes. Nodes where their elements' normals agree to ``smooth_deg`` get I/2 exactly
     (found for all nodes at once, vectorised); the others get the cone formula, and must close their
     fan."""
     c = np.zeros((n_nodes, 3, 3))
@@ -136,8 +139,8 @@ def free_terms(VX, VN, n_nodes, nu, tol=1e-8, smooth_deg=1e-6, nodes=None):
     VX = np.asarray(VX, float)
     first = np.minimum(start, max(len(order) - 1, 0))             # each node's first incidence
     pos = VX.reshape(-1, 3)[order]
-    scale = max(float(np.ptp(pos, axis=0).max()), 1e-300) if len(pos) else 1.0
-    meets = np.linalg.norm(pos - np.repeat(pos[first], counts, axis=0), axis=1) <= 1e-9 * scale
+    h = float(segment_sizes(VX).max()) if len(VX) else 1.0
+    meets = np.linalg.norm(pos - np.repeat(pos[first], counts, axis=0), axis=1) <= 2e-9 * max(h, 1.0)
     nrm = node_normals(VX).reshape(-1, 3)
     dots = np.einsum("id,id->i", nrm[order], np.repeat(nrm[order[first]], counts, axis=0))
     dots[~meets] = np.inf                            # an image element elsewhere: not this node's

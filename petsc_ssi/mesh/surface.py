@@ -10,6 +10,15 @@ from ..petsc import SSIError
 from . import quad9
 
 
+def segment_sizes(X):
+    """``SurfaceMesh.element_sizes`` of the nine-node elements' coordinates X (E, 9, 3)."""
+    X = np.asarray(X, float)
+    seg = lambda pairs: np.max([np.linalg.norm(X[:, a] - X[:, b], axis=1) for a, b in pairs], axis=0)  # noqa: E731
+    s1 = seg(((0, 4), (4, 1), (3, 6), (6, 2), (7, 8), (8, 5)))
+    s2 = seg(((0, 7), (7, 3), (1, 5), (5, 2), (4, 8), (8, 6)))
+    return np.stack([s1, s2], 1)
+
+
 class SurfaceMesh:
     def __init__(self, nodes, cells, groups=None, name=""):
         self.nodes = np.ascontiguousarray(nodes, dtype=float)
@@ -52,11 +61,7 @@ class SurfaceMesh:
         """Distance between neighbouring nodes in each element direction (E, 2): the largest of the
         six node-to-node segments along xi (both sides and the midline), and along eta, so that a
         distorted element (an O-grid's) is measured by its longest segment, whatever its node 0."""
-        X = self.cell_coords()
-        seg = lambda pairs: np.max([np.linalg.norm(X[:, a] - X[:, b], axis=1) for a, b in pairs], axis=0)
-        s1 = seg(((0, 4), (4, 1), (3, 6), (6, 2), (7, 8), (8, 5)))
-        s2 = seg(((0, 7), (7, 3), (1, 5), (5, 2), (4, 8), (8, 6)))
-        return np.stack([s1, s2], 1)
+        return segment_sizes(self.cell_coords())
 
     def check(self):
         """Validate a nine-node surface: conforming ids, positive orientation."""
