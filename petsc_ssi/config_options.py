@@ -30,13 +30,12 @@ register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed
          "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
          "(-ssi_bem_pc_type redundant); the finished HDF5 files are rewritten without modification times, so "
          "identical results give identical files", "common")
-register("huge_pages", "enum", "off", "", "numpy's request (madvise) that the large arrays it allocates, the stored "
-         "lag blocks among them, be backed by transparent huge pages: off, on, or numpy (as numpy has it: on unless "
-         "NUMPY_MADVISE_HUGEPAGE=0). Where the kernel compacts memory for such a request "
-         "(/sys/kernel/mm/transparent_hugepage/defrag 'madvise'), a first write may stall: on the development machine "
-         "0.11-2.1 s/GB against a steady 0.38-0.49 s/GB without the request, 4 kB pages there (jobscripts/first_touch.py; "
-         "with THP 'always' the kernel may still give huge pages, without compacting); results do not depend on it",
-         "common",
+register("huge_pages", "enum", "numpy", "", "numpy's request (madvise) that the large arrays it allocates, the stored "
+         "lag blocks among them, be backed by transparent huge pages: numpy (as numpy has it: on unless "
+         "NUMPY_MADVISE_HUGEPAGE=0), on, or off. Where the kernel compacts memory for such a request "
+         "(/sys/kernel/mm/transparent_hugepage/defrag 'madvise'), a first write may stall (jobscripts/first_touch.py), "
+         "yet whole runs on the development machine were faster with huge pages, the paper case by far "
+         "(jobscripts/huge_pages_bench.sh); results do not depend on it", "common",
          choices=("off", "on", "numpy"))
 register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
          "becomes the step, to keep every checkpoint", "common")

@@ -85,7 +85,7 @@ class TransientProblem:
         self.restart = None             # the header of -ssi_restart's checkpoint (check_output)
         self._key = None
         from .petsc import set_huge_pages
-        self.huge_pages = set_huge_pages(cfg.get("huge_pages", "off"))   # before the large arrays
+        self.huge_pages = set_huge_pages(cfg.get("huge_pages", "numpy"))   # before the large arrays
 
     _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
 

@@ -4,7 +4,8 @@ The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.p
 the first time a version of the sources runs on a machine (about a minute) and cached under
 ``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
 case on one process so that they are compiled now, says so, and exits at once when the cache is
-already warm. ``make deps`` calls it.
+already warm: when the warm-up itself has finished in it (the file ``WARM_MARK`` in the cache), not
+merely when some run compiled some kernels there. ``make deps`` calls it.
 """
 import os
 import sys
@@ -12,14 +13,21 @@ import tempfile
 import time
 
 
+WARM_MARK = "warmup-done"
+
+
 def main():
     import petsc_ssi
     d = os.environ.get("NUMBA_CACHE_DIR", "")
-    if petsc_ssi.numba_cache_warm():
+    mark = os.path.join(d, WARM_MARK)
+    if os.path.exists(mark):
         print(f"[warmup] numba cache is warm ({d})")
         return 0
-    print(f"[warmup] compiling the BEM kernels with numba into {d} (about half a minute, once per version)",
-          flush=True)
+    if petsc_ssi.numba_cache_warm():
+        print(f"[warmup] numba cache partly warm ({d}): loading the kernels, compiling what a run has not", flush=True)
+    else:
+        print(f"[warmup] compiling the BEM kernels with numba into {d} (about half a minute, once per version)",
+              flush=True)
     os.environ["PETSC_SSI_WARMUP"] = "1"       # the run below does not announce the compile again
     t0 = time.perf_counter()
     from .petsc import init
@@ -37,6 +45,9 @@ def main():
         run_bem(options.resolve(("common", "bem")))
         _shared_cache_kernels(PETSc)
         _single_kernels()
+    os.makedirs(d, exist_ok=True)
+    with open(mark, "w") as fh:
+        fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache\n")
     print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
     return 0
 

@@ -1,6 +1,6 @@
 """-ssi_huge_pages: numpy's transparent-huge-page advice for large arrays is a memory setting only
-(jobscripts/first_touch.py measures why it is off by default): the switch takes effect, a bad value
-is refused, and a run gives the same bits with it on and off."""
+(jobscripts/first_touch.py and huge_pages_bench.sh measure what it costs): the switch takes effect,
+a bad value is refused, and a run gives the same bits with it on and off."""
 import json
 
 import numpy as np

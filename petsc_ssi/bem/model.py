@@ -280,9 +280,8 @@ class Buckets:
     ``take(l)`` and ``take_csr(l)`` free the lag. The arrays start at ``capacity[l - 1]`` blocks
     (the memory estimate's count) and grow by half when needed: large arrays allocated once, each
     page faulted in once (small per-chunk pieces, mapped and unmapped chunk after chunk, cost the
-    paper case more time in page faults than its assembly). Whether numpy backs them by huge pages
-    is ``-ssi_huge_pages`` (default off: on this machine a first write with the advice stalled
-    erratically, jobscripts/first_touch.py)."""
+    paper case more time in page faults than its assembly). numpy backs them by huge pages unless
+    ``-ssi_huge_pages off`` (jobscripts/huge_pages_bench.sh: the paper case assembles much faster with them)."""
 
     GROW = 1.5
     TRIM = 0.9            # a lag using less of its array is copied to its size when taken
