@@ -42,7 +42,8 @@ def test_cold_cache_is_announced_then_the_warm_up_covers_every_run(tmp_path):
     assert r.returncode == 0 and "compiling" not in r.stdout, r.stdout
 
 
-PROBE = """
+COUNT = """
+import sys
 import petsc_ssi  # first: it points NUMBA_CACHE_DIR at the cache of these sources
 import numba.core.compiler as c
 calls = []
@@ -51,6 +52,8 @@ def counted(*a, **k):
     calls.append(getattr(a[2], '__qualname__', repr(a[2])) if len(a) > 2 else '?')
     return orig(*a, **k)
 c.compile_extra = counted
+"""
+PROBE = COUNT + """
 from petsc_ssi.bem.model import load_kernels
 load_kernels()
 print('COMPILED', len(calls), calls)
@@ -71,16 +74,7 @@ def test_warm_run_compiles_nothing():
     assert line and line[0].startswith("COMPILED 0 "), r.stdout
 
 
-PROBE_RUN = """
-import sys
-import petsc_ssi
-import numba.core.compiler as c
-calls = []
-orig = c.compile_extra
-def counted(*a, **k):
-    calls.append(getattr(a[2], '__qualname__', repr(a[2])) if len(a) > 2 else '?')
-    return orig(*a, **k)
-c.compile_extra = counted
+PROBE_RUN = COUNT + """
 from petsc_ssi.cli import main
 rc = main(['petsc-ssi'] + sys.argv[1:])
 print('COMPILED', len(calls), calls)
