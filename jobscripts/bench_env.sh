@@ -22,3 +22,31 @@ before_worktree() {
   export BEFORE_CACHE="$WT/.numba_cache"
   (cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
 }
+
+# repeat_runs OUT REPEAT "CASES" VARIANT...: each case (runs/pekeris/CASE.opts) REPEAT times at 1 and at
+# 2 ranks under each VARIANT ("TAG=OPTIONS"; "=" the case as it stands), variants and rank counts
+# alternating within a repeat so that a slow spell of the machine hits them all, with -log_view:
+# OUT/CASE[-TAG]-nN-rI.log (jobscripts/scaling_repeat_table.py reads them). Warms the numba cache first.
+repeat_runs() {
+  local out=$1 repeat=$2 cases=$3
+  shift 3
+  mkdir -p "$out"
+  "$PY" -m petsc_ssi.warmup
+  local case i v n tag opts name log
+  for case in $cases; do
+    for i in $(seq 1 "$repeat"); do
+      for v in "$@"; do
+        tag=${v%%=*}
+        opts=${v#*=}
+        name=$case${tag:+-$tag}
+        for n in 1 2; do
+          log="$out/$name-n$n-r$i.log"
+          echo "[bench] $name${opts:+ ($opts)} on $n rank(s), run $i -> $log"
+          # shellcheck disable=SC2086
+          mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi -options_file "runs/pekeris/$case.opts" \
+            $opts -ssi_output "$out/$name-n$n-r$i.h5" -ssi_output_overwrite -ssi_output_stride 0 -log_view > "$log" 2>&1
+        done
+      done
+    done
+  done
+}

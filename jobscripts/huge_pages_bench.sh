@@ -11,20 +11,5 @@ set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 CASES=${*:-"medium"}
 REPEAT=${REPEAT:-3}
-OUT=out/bench/huge_pages
-mkdir -p "$OUT"
-"$PY" -m petsc_ssi.warmup
-for case in $CASES; do
-  for i in $(seq 1 "$REPEAT"); do
-    for hp in on off; do
-      for n in 1 2; do
-        log="$OUT/$case-hp$hp-n$n-r$i.log"
-        echo "[bench] $case, -ssi_huge_pages $hp, $n rank(s), run $i -> $log"
-        mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi -options_file "runs/pekeris/$case.opts" \
-          -ssi_huge_pages "$hp" -ssi_output "$OUT/$case-hp$hp-n$n-r$i.h5" -ssi_output_overwrite -ssi_output_stride 0 \
-          -log_view > "$log" 2>&1
-      done
-    done
-  done
-done
-"$PY" jobscripts/scaling_repeat_table.py "$OUT" huge_pages
+repeat_runs out/bench/huge_pages "$REPEAT" "$CASES" "hpon=-ssi_huge_pages on" "hpoff=-ssi_huge_pages off"
+"$PY" jobscripts/scaling_repeat_table.py out/bench/huge_pages huge_pages

@@ -11,17 +11,5 @@ set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 CASES=${*:-"medium paper"}
 REPEAT=${REPEAT:-3}
-OUT=out/bench/scaling_repeat
-mkdir -p "$OUT"
-"$PY" -m petsc_ssi.warmup
-for case in $CASES; do
-  for i in $(seq 1 "$REPEAT"); do
-    for n in 1 2; do
-      log="$OUT/$case-n$n-r$i.log"
-      echo "[bench] $case on $n rank(s), run $i -> $log"
-      mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi -options_file "runs/pekeris/$case.opts" \
-        -ssi_output "$OUT/$case-n$n-r$i.h5" -ssi_output_overwrite -ssi_output_stride 0 -log_view > "$log" 2>&1
-    done
-  done
-done
-"$PY" jobscripts/scaling_repeat_table.py "$OUT"
+repeat_runs out/bench/scaling_repeat "$REPEAT" "$CASES" "="
+"$PY" jobscripts/scaling_repeat_table.py out/bench/scaling_repeat

@@ -53,7 +53,8 @@ def set_huge_pages(mode):
     'off', 'on', or 'numpy' (left as it is: numpy's default, on unless NUMPY_MADVISE_HUGEPAGE=0, where
     nothing in the process changed it). numpy (1.18 on, Linux) asks the kernel with
     madvise(MADV_HUGEPAGE) to back every array of 4 MB and more by 2 MB pages (arrays numba allocates
-    inside compiled code are not numpy's: the element cache's pools keep the kernel's default); where the kernel then compacts memory on the spot (transparent_hugepage/defrag
+    inside compiled code are not numpy's: the element cache's pools keep the kernel's default);
+    where the kernel then compacts memory on the spot (transparent_hugepage/defrag
     'madvise'), first writes stall erratically (jobscripts/first_touch.py). Returns the advice in
     effect (True/False), or None where this numpy has no such switch (then nothing changes)."""
     if mode not in ("off", "on", "numpy"):

@@ -120,9 +120,9 @@ def free_terms(VX, VN, n_nodes, nu, tol=1e-8, smooth_deg=1e-6, nodes=None):
     is that of the first element listing it (``symmetry.virtual_elements`` puts the mesh's own
     elements first); an element meets it within twice the on-plane tolerance of
     ``symmetry.zero_dofs`` (a node within 1e-9 max(h, 1) of a plane is on it, h the mesh's
-    ``element_sizes``), so the free term and the zeroed DOFs see the same nodes on the planes. Nodes where their elements' normals agree to ``smooth_deg`` get I/2 exactly
-    (found for all nodes at once, vectorised); the others get the cone formula, and must close their
-    fan."""
+    ``element_sizes``), so the free term and the zeroed DOFs see the same nodes on the planes. Nodes
+    where their elements' normals agree to ``smooth_deg`` get I/2 exactly (found for all nodes at
+    once, vectorised); the others get the cone formula, and must close their fan."""
     c = np.zeros((n_nodes, 3, 3))
     sel = np.arange(n_nodes) if nodes is None else np.asarray(nodes, dtype=np.int64).ravel()
     if sel.size == 0:

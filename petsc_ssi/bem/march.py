@@ -433,14 +433,16 @@ class Marcher:
         of R, state m, coefficient)]}, states m <= ``upto`` (final) from every rank's copies."""
         w = R.shape[0]
         self._replicate(upto)
-        X = {side: np.zeros((w, self._rep[side][2].shape[1])) for side in ("u", "p")}
-        XT = {side: np.zeros((self._rep[side][2].shape[1], w)) for side in ("u", "p")}
+        bufs = {}                                         # the panel per side and layout, made once
         RT = None
         for (key, side) in sorted(panel):
             M = self._mat(key, side)
             rep = self._rep[side][2]
             kind = self._panel_kind(M)
-            x = X[side] if kind == "dense" else XT[side]   # (a block-sparse lag reads X^T)
+            shape = (w, rep.shape[1]) if kind == "dense" else (rep.shape[1], w)    # (block-sparse: X^T)
+            x = bufs.get((side, shape))
+            if x is None:
+                x = bufs[(side, shape)] = np.empty(shape)
             x[...] = 0.0
             terms = panel[(key, side)]
             bsr.panel_states(rep, np.array([k for k, _, _ in terms], np.int64),
