@@ -12,13 +12,13 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
 # numba's cache: ~/.cache/petsc_ssi/numba/<hash of the sources> (petsc_ssi/__init__.py), the same
-# for make and for direct calls; `make deps` fills it (petsc_ssi/warmup.py)
+# for make and for direct calls; `make deps` fills it (petsc_ssi/app/warmup.py)
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
 PIP_PKGS := numba gmsh matplotlib pytest pytest-timeout
 
-.PHONY: all deps demo test bench clean help-options
+.PHONY: all deps demo test test-unit test-mpi test-slow test-all bench clean help-options
 
 all: test
 
@@ -42,12 +42,26 @@ $(VENV)/.stamp: .deps/apt.stamp setup.py
 	@touch $@
 
 deps: $(VENV)/.stamp
-	@$(PY) -m petsc_ssi.warmup
+	@$(PY) -m petsc_ssi.app.warmup
 
 demo: deps
-	$(PY) -m petsc_ssi.demo
+	$(PY) -m petsc_ssi.app.demo
 
+# Tiers (pytest.ini, tests/conftest.py): `make test` is every tier but slow (what CI runs);
+# the slow tier holds the heavy cases and runs before a release.
 test: deps
+	$(PY) -m pytest -q -m "not slow" tests
+
+test-unit: deps
+	$(PY) -m pytest -q -m "unit and not slow" tests
+
+test-mpi: deps
+	$(PY) -m pytest -q -m "mpi and not slow" tests
+
+test-slow: deps
+	$(PY) -m pytest -q -m slow tests
+
+test-all: deps
 	$(PY) -m pytest -q tests
 
 bench: deps

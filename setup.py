@@ -14,5 +14,5 @@ setup(
     python_requires=">=3.9",
     install_requires=["numpy", "numba", "matplotlib"],
     extras_require={"mesh": ["gmsh"], "test": ["pytest"]},
-    entry_points={"console_scripts": ["petsc-ssi = petsc_ssi.cli:main"]},
+    entry_points={"console_scripts": ["petsc-ssi = petsc_ssi.app.cli:main"]},
 )

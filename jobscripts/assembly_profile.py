@@ -11,10 +11,11 @@ sys.argv = [sys.argv[0]] + (["-options_file", "runs/pekeris/paper.opts"] if "-op
 from petsc_ssi.petsc import init
 PETSc = init(sys.argv)
 from petsc_ssi import options
-from petsc_ssi.bem.run import BEMProblem
-from petsc_ssi.bem import model, lagmats
+import petsc_ssi.app.kinds  # noqa: F401  (every option declared)
+from petsc_ssi.bem.halfspace import HalfSpace
+from petsc_ssi.bem import lagset as model, lagmats
 cfg = options.resolve(("common", "bem"))
-prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
+prob = HalfSpace(cfg, PETSc.COMM_WORLD, log=lambda m: None)
 ls = prob.lagset(prob.interp_plan())
 R = int(PETSc.Options().getInt("rows", 64))
 if R: ls.rows = ls.rows[1000:1000 + R]

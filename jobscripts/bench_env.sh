@@ -20,7 +20,7 @@ before_worktree() {
   # shellcheck disable=SC2064
   trap "git worktree remove --force '$WT'; ${2:-:}" EXIT
   export BEFORE_CACHE="$WT/.numba_cache"
-  (cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.warmup) && "$PY" -m petsc_ssi.warmup
+  (cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.app.warmup) && "$PY" -m petsc_ssi.app.warmup
 }
 
 # repeat_runs OUT REPEAT "CASES" VARIANT...: each case (runs/pekeris/CASE.opts) REPEAT times at 1 and at
@@ -31,7 +31,7 @@ repeat_runs() {
   local out=$1 repeat=$2 cases=$3
   shift 3
   mkdir -p "$out"
-  "$PY" -m petsc_ssi.warmup
+  "$PY" -m petsc_ssi.app.warmup
   local case i v n tag opts name log
   for case in $cases; do
     for i in $(seq 1 "$repeat"); do

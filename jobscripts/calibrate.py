@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fit the machine constants of the cost model (petsc_ssi/estimate.py) to
+"""Fit the machine constants of the cost model (petsc_ssi/bem/cost.py) to
 -log_view/-memory_view logs of BEM runs.
 
   python jobscripts/calibrate.py [--out petsc_ssi/estimate_constants.json]
@@ -93,7 +93,7 @@ def counts(opts, ranks):
     from petsc_ssi.petsc import init
     PETSc = init([sys.argv[0]])
     from petsc_ssi import options
-    from petsc_ssi import estimate
+    from petsc_ssi.app import estimate
     db = PETSc.Options()
     for k in list(db.getAll()):
         if k.startswith("ssi_"):
@@ -127,7 +127,7 @@ def load(logs, cores_default):
 
 def terms(meta, meas, cnt):
     """Model terms of one run (estimate.features), with the run's placement."""
-    from petsc_ssi.estimate import features
+    from petsc_ssi.bem.cost import features
     p = meas["ranks"]
     q = int(np.ceil(p / float(meta["nodes"])))
     mx, over, m = features(cnt, p, q, meta["cores"])
@@ -143,7 +143,7 @@ def _nnls(A, b):
 
 def fit(runs):
     """Constants of estimate.py fitted to ``runs`` (see the module docstring)."""
-    from petsc_ssi.estimate import FALLBACK
+    from petsc_ssi.bem.cost import FALLBACK
     c = dict(FALLBACK)
     rows = [(meta, meas, cnt) + terms(meta, meas, cnt) for _, meta, meas, cnt in runs]
     arr = lambda f: np.array([f(*r) for r in rows], float)
@@ -166,7 +166,7 @@ def fit(runs):
     c["c_sol"], c["kappa"] = float(s), float(sk / s) if s > 0 else 0.0
     # time-blocked history sum: the panel products (event SSI_BEM_HistPanel) against their flops,
     # dense and block-sparse; the rest of the history sum as the per-step sum below
-    from petsc_ssi.estimate import FALLBACK
+    from petsc_ssi.bem.cost import FALLBACK
     A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FD"]),
                   arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FS"])], 1)
     panel = arr(lambda me, ms, *r: ms.get("hist_panel", 0.0))
@@ -216,7 +216,7 @@ def fit(runs):
 
 def compare(runs, c):
     """Rows of predicted vs measured per run (dict per run)."""
-    from petsc_ssi.estimate import predict
+    from petsc_ssi.bem.cost import predict
     out = []
     for path, meta, meas, cnt in runs:
         p, q, *_ = terms(meta, meas, cnt)

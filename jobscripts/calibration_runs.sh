@@ -15,7 +15,7 @@ set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 MACHINE=${MACHINE:-"dev-vm-2core (2 cores, 24 GB)"}
 if [ "${1:-}" != "--fit-only" ]; then
-  "$PY" -m petsc_ssi.warmup
+  "$PY" -m petsc_ssi.app.warmup
   RANKS="1 2" bash jobscripts/pekeris_bench.sh small medium paper paper-interp
   mkdir -p out/bench/perstep
   for case in small medium; do

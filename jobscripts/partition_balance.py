@@ -34,17 +34,18 @@ def counts(case):
     from petsc_ssi.petsc import init
     PETSc = init([sys.argv[0], "-options_file", os.path.join(ROOT, "runs", "pekeris", case + ".opts")])
     from petsc_ssi import options
-    from petsc_ssi.bem.run import BEMProblem
+    import petsc_ssi.app.kinds  # noqa: F401  (every option declared)
+    from petsc_ssi.bem.halfspace import HalfSpace
     from petsc_ssi.bem import partition
     cfg = options.resolve(("common", "bem"))
-    prob = BEMProblem(cfg, PETSc.COMM_SELF, log=lambda m: None)
+    prob = HalfSpace(cfg, PETSc.COMM_SELF, log=lambda m: None)
     plan = prob.interp_plan()
     ls = prob.lagset(plan)
     if plan.active:
         raise SystemExit(f"{case}: lag interpolation; this script counts the exact lags only")
     N, Lx = prob.mesh.n_nodes, plan.Lx
     nimg = len(ls.Vc) // prob.mesh.n_cells
-    # the weights a run computes (bem/run.py BEMProblem.lagset, bem/partition.py)
+    # the weights a run computes (bem/halfspace.py HalfSpace.lagset, bem/partition.py)
     stab = cfg.scheme.startswith("stabili")
     lag_w = partition.lag_weights(Lx, prob.L, stab)                   # (uses of a run of L steps)
     b, q = partition.node_work(prob.mesh.nodes, np.arange(N), ls.Vc, ls.VR, prob.mat, prob.dt, nimg, lag_w, Lx,

@@ -19,7 +19,7 @@ SINGLE_FROM=${SINGLE_FROM:-3}
 SMALL_LONG_T=${SMALL_LONG_T:-0.3}
 OUT=out/bench/precision
 mkdir -p "$OUT"
-"$PY" -m petsc_ssi.warmup
+"$PY" -m petsc_ssi.app.warmup
 run() {  # precision name case extra...
   local prec=$1 name=$2 case=$3; shift 3
   local sf=0

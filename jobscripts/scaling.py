@@ -21,7 +21,7 @@ stage 'SSI BEM assembly' without SSI_BEM_Factor: the lag Mats), factorisation
 Efficiency: strong, E_p = T_1 / (p T_p). Weak (the problem grows with p, but
 its work grows faster than p: N^2 x lags), per unit of work: E_p =
 [W_p / (p T_p)] / [W_1 / T_1] with W the cost model's 1-rank time of each
-case (petsc_ssi/estimate.py, same for every stage), i.e. the time the run
+case (petsc_ssi/bem/cost.py, same for every stage), i.e. the time the run
 would take at perfect scaling of its own work. Oversubscribed runs (more ranks
 than cores) are flagged in the table and drawn with open markers.
 """
@@ -72,7 +72,7 @@ def model_work(row):
     """The cost model's 1-rank times of the case of a log (for weak efficiency)."""
     try:
         from calibrate import log_options, counts
-        from petsc_ssi.estimate import predict, load_constants
+        from petsc_ssi.bem.cost import predict, load_constants
         c, _ = load_constants(os.environ.get("SSI_ESTIMATE_CONSTANTS", ""))
         cnt = counts(log_options(row["_text"]), [1])
         t = predict(cnt, c, 1, 1, 1)

@@ -16,7 +16,7 @@ BLOCK=${BLOCK:-32}
 SUBS=${SUBS:-"32 16 8"}
 OUT=out/bench/subblock
 mkdir -p "$OUT"
-"$PY" -m petsc_ssi.warmup
+"$PY" -m petsc_ssi.app.warmup
 LAGS="$OUT/$CASE-lags.h5"
 trap 'rm -f "$LAGS"' EXIT
 run() {  # name extra...

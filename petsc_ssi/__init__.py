@@ -46,7 +46,7 @@ if "numba" not in __import__("sys").modules:
 
 def numba_cache_warm():
     """Whether numba's cache for this version of the sources holds compiled kernels (else the
-    first BEM assembly compiles them: about a minute; ``python -m petsc_ssi.warmup`` does it
+    first BEM assembly compiles them: about a minute; ``python -m petsc_ssi.app.warmup`` does it
     ahead, and ``make deps`` runs that)."""
     d = _os.environ.get("NUMBA_CACHE_DIR", "")
     for _, _, files in _os.walk(d):

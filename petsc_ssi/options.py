@@ -15,7 +15,7 @@ import difflib
 import math
 from dataclasses import dataclass, field
 
-from .petsc import init, SSIError, collective_error
+from .petsc import init, SSIError, collective_error, warn, _APPLIED_DEFAULTS
 
 PREFIX = "ssi_"
 PART_PREFIX = "fem_part_"     # -ssi_fem_part_<NAME>_<property>: checked by fem/parts.py
@@ -122,9 +122,15 @@ def _convert(opt, text):
     return str(text)
 
 
-def _load_modules():
-    # Modules that declare options; imported here so -help sees them all.
-    from . import config_options  # noqa: F401
+_HELP_SECTIONS = []
+
+
+def register_help_section(fn):
+    """Add ``fn()`` (a block of text) to ``-help`` after the option table: options whose names are
+    not fixed (e.g. the per-part ``-ssi_fem_part_<NAME>_<property>``). The registry imports no
+    domain module: each declares its options, and its help, when it is imported."""
+    if fn not in _HELP_SECTIONS:
+        _HELP_SECTIONS.append(fn)
 
 
 def resolve(groups=None, comm=None):
@@ -135,7 +141,6 @@ def resolve(groups=None, comm=None):
     """
     PETSc = init()
     comm = comm or PETSc.COMM_WORLD
-    _load_modules()
     db = PETSc.Options()
     allopts = db.getAll()
     err = None
@@ -219,7 +224,6 @@ def _is_petsc_object_option(name):
 
 
 def help_text():
-    _load_modules()
     lines = ["petsc_ssi options (prefix -ssi_); PETSc's own options follow with -help", ""]
     bygroup = {}
     for opt in _REGISTRY.values():
@@ -231,15 +235,14 @@ def help_text():
             unit = f" [{opt.unit}]" if opt.unit else ""
             lines.append(f"  -ssi_{opt.name} <{opt.default}> ({kind}){unit}: {opt.help}")
         lines.append("")
-    from .fem.parts import help_text as parts_help
-    lines.append(parts_help())
-    lines.append("")
+    for fn in _HELP_SECTIONS:
+        lines.append(fn())
+        lines.append("")
     return "\n".join(lines)
 
 
 def markdown_table(groups=None):
     """The README's option table, generated from the registry."""
-    _load_modules()
     rows = ["| option | default | unit | meaning |", "|---|---|---|---|"]
     for opt in sorted(_REGISTRY.values(), key=lambda o: (o.group, o.name)):
         if groups is not None and opt.group not in groups:
@@ -251,3 +254,48 @@ def markdown_table(groups=None):
 
 __all__ = ["register", "register_check", "resolve", "help_text", "markdown_table",
            "Config", "SSIError", "positive", "nonnegative", "at_least"]
+
+
+def _options_used():
+    """A function name -> whether PETSc queried the option, or None where it cannot be known:
+    petsc4py's ``Options.used`` where it exists, else PETSc's ``PetscOptionsUsed`` through ctypes
+    (petsc4py 3.18 does not wrap it) from the libpetsc this process loaded (Linux)."""
+    PETSc = init()
+    db = PETSc.Options()
+    if hasattr(db, "used"):
+        return lambda name: bool(db.used(name))
+    try:
+        import ctypes
+        with open("/proc/self/maps") as fh:
+            path = next((ln.split()[-1] for ln in fh if "/libpetsc" in ln and ".so" in ln), None)
+        if path is None:
+            return None
+        fn = ctypes.CDLL(path).PetscOptionsUsed
+        fn.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+        fn.restype = ctypes.c_int
+
+        def used(name):
+            flag = ctypes.c_int(0)
+            return fn(None, name.encode(), ctypes.byref(flag)) == 0 and bool(flag.value)
+        return used
+    except (OSError, AttributeError):
+        return None
+
+
+def unused_petsc_options():
+    """The PETSc object options under our prefixes (-ssi_bem_ksp_..., -ssi_fem_pc_..., ...) that
+    nothing read, e.g. misspelt ones (-ssi_bem_ksp_tpye); None where it cannot be known."""
+    used = _options_used()
+    if used is None:
+        return None
+    keys = [k for k in init().Options().getAll() if k.startswith(PREFIX) and _is_petsc_object_option(k[len(PREFIX):])
+            and k not in _APPLIED_DEFAULTS]           # our own defaults: not the user's to worry about
+    return sorted(k for k in keys if not used(k))
+
+
+def warn_unused_options(comm=None):
+    """Collective (same options on every rank): one warning line naming the unused ones."""
+    left = unused_petsc_options()
+    if left:
+        warn("options set but never used (misspelt, or for a solver this run does not have): "
+             + " ".join("-" + k for k in left), comm)

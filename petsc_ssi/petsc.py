@@ -4,8 +4,10 @@
 that command-line options reach the PETSc options database (petsc4py demos,
 PyLith). Nothing here captures MPI state at import time.
 """
+import contextlib
 import importlib
 import sys
+import traceback
 
 _INITIALISED = False
 
@@ -176,6 +178,39 @@ def collective_error(message, comm=None):
             raise SSIError(m)
 
 
+def one_line(exc):
+    """``Type: first line of the message`` of an exception (an OSError: its strerror)."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror
+    lines = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+
+
+@contextlib.contextmanager
+def collective(comm, what, template="{what} failed on rank {rank}: {error}"):
+    """Collective: run the block on every rank (work for one rank only goes under an ``if`` inside
+    it) and raise the same SSIError on every rank if it failed on any (``collective_error``: the lowest
+    failing rank's message; the allgather is also the barrier). An SSIError passes its message
+    unchanged; any other exception (a bug, an unreadable file, MemoryError) is told as
+    ``template`` (``what``, the failing ``rank``, ``error`` = ``one_line(exc)``) after its
+    traceback is printed on that rank's stderr, so nothing is lost and mpirun never hangs:
+
+        with collective(comm, "reading the mesh"):
+            mesh = read(path)          # may fail on some ranks only
+    """
+    comm = comm or comm_world()
+    err = None
+    try:
+        yield
+    except SSIError as exc:
+        err = str(exc)
+    except Exception as exc:  # noqa: BLE001 -- reaches every rank, with the traceback on stderr
+        traceback.print_exc(file=sys.stderr)
+        sys.stderr.flush()
+        err = template.format(what=what, rank=comm.getRank(), error=one_line(exc))
+    collective_error(err, comm)
+
+
 def check(condition, message, comm=None):
     """Collective assert: ``condition`` may differ between ranks."""
     collective_error(None if condition else message, comm)
@@ -201,52 +236,6 @@ def warn(msg, comm=None):
 
 
 _APPLIED_DEFAULTS = set()
-
-
-def _options_used():
-    """A function name -> whether PETSc queried the option, or None where it cannot be known:
-    petsc4py's ``Options.used`` where it exists, else PETSc's ``PetscOptionsUsed`` through ctypes
-    (petsc4py 3.18 does not wrap it) from the libpetsc this process loaded (Linux)."""
-    PETSc = init()
-    db = PETSc.Options()
-    if hasattr(db, "used"):
-        return lambda name: bool(db.used(name))
-    try:
-        import ctypes
-        with open("/proc/self/maps") as fh:
-            path = next((ln.split()[-1] for ln in fh if "/libpetsc" in ln and ".so" in ln), None)
-        if path is None:
-            return None
-        fn = ctypes.CDLL(path).PetscOptionsUsed
-        fn.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
-        fn.restype = ctypes.c_int
-
-        def used(name):
-            flag = ctypes.c_int(0)
-            return fn(None, name.encode(), ctypes.byref(flag)) == 0 and bool(flag.value)
-        return used
-    except (OSError, AttributeError):
-        return None
-
-
-def unused_petsc_options():
-    """The PETSc object options under our prefixes (-ssi_bem_ksp_..., -ssi_fem_pc_..., ...) that
-    nothing read, e.g. misspelt ones (-ssi_bem_ksp_tpye); None where it cannot be known."""
-    from .options import PREFIX, _is_petsc_object_option
-    used = _options_used()
-    if used is None:
-        return None
-    keys = [k for k in init().Options().getAll() if k.startswith(PREFIX) and _is_petsc_object_option(k[len(PREFIX):])
-            and k not in _APPLIED_DEFAULTS]           # our own defaults: not the user's to worry about
-    return sorted(k for k in keys if not used(k))
-
-
-def warn_unused_options(comm=None):
-    """Collective (same options on every rank): one warning line naming the unused ones."""
-    left = unused_petsc_options()
-    if left:
-        warn("options set but never used (misspelt, or for a solver this run does not have): "
-             + " ".join("-" + k for k in left), comm)
 
 
 def set_default_options(prefix, defaults, log=None):

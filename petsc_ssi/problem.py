@@ -1,6 +1,7 @@
 """The life cycle every problem kind shares (PyLith's Problem: initialise, solve, finalise).
 
-``TransientProblem`` is the base of the three importable problems:
+``TransientProblem`` is the base of the problem kinds; it knows none of them (the table of kinds,
+``-ssi_problem`` -> class, is the application's: ``app/kinds.py``). The three kinds:
 
   petsc_ssi.bem.problem.BEMTransient        the half-space alone (-ssi_problem bem)
   petsc_ssi.fem.problem.FEMTransient        the structure alone (-ssi_problem fem)
@@ -22,7 +23,7 @@ the step after it. A script can step by itself:
 
     from petsc_ssi.petsc import init
     init()                                # PETSc from sys.argv: -options_file ... -ssi_...
-    from petsc_ssi.problem import from_options
+    from petsc_ssi.app.kinds import from_options
     p = from_options()                    # -ssi_problem and the rest from the options database
     p.setup(); p.start()
     for n in range(1, p.n_steps + 1):
@@ -269,48 +270,3 @@ class TransientProblem:
                     self._state = "stopped"
                 raise
             return self.finish()
-
-
-def _hwm():
-    """This process's peak resident memory, bytes: VmHWM of /proc/self/status (the peak of this
-    program alone; getrusage's ru_maxrss also keeps the RSS of the process it was forked from, e.g.
-    a large pytest), else ru_maxrss."""
-    from .bem.model import proc_status_bytes
-    hwm = proc_status_bytes("VmHWM")
-    if hwm is not None:
-        return hwm
-    import resource
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
-
-
-def peak_rss(comm):
-    """Collective: (largest, summed) peak resident memory of the ranks so far, bytes (Linux)."""
-    from mpi4py import MPI
-    hwm = _hwm()
-    mpi = comm.tompi4py()
-    return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
-
-
-KINDS = ("bem", "fem", "ssi")
-
-
-def problem_class(kind):
-    if kind == "bem":
-        from .bem.problem import BEMTransient
-        return BEMTransient
-    if kind == "fem":
-        from .fem.problem import FEMTransient
-        return FEMTransient
-    if kind == "ssi":
-        from .coupling.problem import SSITransient
-        return SSITransient
-    raise SSIError(f"-ssi_problem {kind}: must be one of {'|'.join(KINDS)}")
-
-
-def from_options(comm=None):
-    """Collective: the problem the options database describes (-ssi_problem and its options,
-    resolved and checked), constructed but not set up."""
-    from . import driver, options
-    kind = driver.problem_kind()
-    cfg = options.resolve(driver.GROUPS[kind])
-    return problem_class(kind)(cfg, comm)

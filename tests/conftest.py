@@ -9,3 +9,41 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
+
+
+# ---------------------------------------------------------------- test tiers (pytest.ini)
+import re as _re
+
+import pytest as _pytest
+
+# Heavy cases, measured with `pytest --durations=0` on an idle 2-core machine: each over a
+# minute, and each covered at a smaller size by a test that stays in `make test`.
+SLOW = {
+}
+_MPI = _re.compile(r"nranks\s*=\s*[2-9]|mpirun|mpiexec|\"-n\", \"?[2-9]|-n 2")
+_RUNS = _re.compile(r"\bcli\(|run_bem\(|run_ssi\(|run_fem\(|subprocess|from helpers import")
+_SRC = {}
+
+
+def _source(path):
+    if path not in _SRC:
+        try:
+            _SRC[path] = open(path, encoding="utf-8").read()
+        except OSError:
+            _SRC[path] = ""
+    return _SRC[path]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark every test with its tier: slow (the SLOW table), mpi (its module starts mpirun with
+    more than one rank), unit (its module makes no run and starts no process); a test may also
+    carry a marker of its own."""
+    for item in items:
+        name = item.nodeid.split("[")[0]
+        src = _source(str(item.fspath))
+        if name in SLOW or item.nodeid in SLOW:
+            item.add_marker(_pytest.mark.slow)
+        if _MPI.search(src):
+            item.add_marker(_pytest.mark.mpi)
+        elif not _RUNS.search(src) and not item.get_closest_marker("slow"):
+            item.add_marker(_pytest.mark.unit)

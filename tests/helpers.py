@@ -18,7 +18,8 @@ def run_bem(**opts):
     """Run a BEM case in this process with -ssi_<key> <value> options."""
     PETSc = petsc()
     from petsc_ssi import options
-    from petsc_ssi.bem.run import run_bem as _run
+    import petsc_ssi.app.kinds  # noqa: F401  (every problem kind's options declared)
+    from petsc_ssi.app.kinds import run_bem as _run
     db = PETSc.Options()
     opts = dict(opts)
     opts.setdefault("output_overwrite", 1)     # tests rerun cases into the same scratch file
@@ -36,14 +37,15 @@ def resolve_error(groups=("common", "bem"), **opts):
     """The SSIError message options.resolve + BEM set-up raise, or None."""
     PETSc = petsc()
     from petsc_ssi import options
+    import petsc_ssi.app.kinds  # noqa: F401  (every problem kind's options declared)
     from petsc_ssi.petsc import SSIError
-    from petsc_ssi.bem.run import BEMProblem
+    from petsc_ssi.bem.halfspace import HalfSpace
     db = PETSc.Options()
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
         cfg = options.resolve(groups)
-        prob = BEMProblem(cfg, PETSc.COMM_WORLD, log=lambda m: None)
+        prob = HalfSpace(cfg, PETSc.COMM_WORLD, log=lambda m: None)
         prob.check_memory(prob.lagset(prob.interp_plan()))
         return None
     except SSIError as exc:
@@ -86,7 +88,8 @@ def run_ssi(**opts):
     """Run a coupled FEM-BEM case in this process with -ssi_<key> <value> options."""
     PETSc = petsc()
     from petsc_ssi import options
-    from petsc_ssi.coupling.run import run_ssi as _run
+    import petsc_ssi.app.kinds  # noqa: F401  (every problem kind's options declared)
+    from petsc_ssi.app.kinds import run_ssi as _run
     db = PETSc.Options()
     opts = dict(opts)
     opts.setdefault("problem", "ssi")

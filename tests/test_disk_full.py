@@ -19,7 +19,7 @@ BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-s
 NO_CHECK = """import sys
 import petsc_ssi.io.output as O
 O.ensure_space = lambda *a, **k: None          # as if the shortage were a quota statvfs cannot see
-from petsc_ssi.cli import main
+from petsc_ssi.app.cli import main
 sys.exit(main(["petsc-ssi"] + sys.argv[1:]))
 """
 

@@ -5,7 +5,7 @@ from helpers import ROOT
 
 
 def test_readme_option_table_is_current():
-    from petsc_ssi.docs import table, BEGIN, END
+    from petsc_ssi.app.docs import table, BEGIN, END
     text = open(os.path.join(ROOT, "README.md")).read()
     i, j = text.index(BEGIN) + len(BEGIN), text.index(END)
-    assert text[i:j].strip() == table().strip(), "run: python -m petsc_ssi.docs"
+    assert text[i:j].strip() == table().strip(), "run: python -m petsc_ssi.app.docs"

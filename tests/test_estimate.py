@@ -1,4 +1,4 @@
-"""The cost model (petsc_ssi/estimate.py, ``petsc-ssi estimate``; issue 6).
+"""The cost model (petsc_ssi/bem/cost.py, ``petsc-ssi estimate``; issue 6).
 
 What is checked without timing anything on a loaded machine:
 - the model counts the work a run does: the matrix-vector products of the
@@ -26,7 +26,8 @@ _MODEL = r"""
 import json, sys
 from petsc_ssi.petsc import init
 PETSc = init([sys.argv[0], "-options_file", sys.argv[1]] + sys.argv[4:])
-from petsc_ssi import options, estimate
+from petsc_ssi import options
+from petsc_ssi.app import estimate
 cfg = options.resolve(("common", "bem", "estimate"))
 ranks = [int(r) for r in sys.argv[2].split(",")]
 _, _, cnt = estimate.setup(cfg, PETSc.COMM_WORLD, ranks, 0.0)

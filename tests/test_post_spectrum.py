@@ -11,7 +11,7 @@ import pytest
 from helpers import ROOT, PY, cli
 
 from petsc_ssi import spectrum as sp
-from petsc_ssi.post import main as post_main
+from petsc_ssi.app.post import main as post_main
 
 # two sines with an integer number of periods in T = N dt = 2 s: 5 Hz (10 periods) and 12.5 Hz (25)
 N, DT = 200, 0.01

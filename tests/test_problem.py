@@ -38,7 +38,7 @@ class opts:
 def test_stepping_by_hand_equals_run(case, tmp_path):
     """from_options + setup/start/step/finish gives the receivers of run(), bit for bit; the state
     between steps is the problem's own (its norm is the one the recorder keeps)."""
-    from petsc_ssi.problem import from_options
+    from petsc_ssi.app.kinds import from_options
     from petsc_ssi.petsc import init
     kw = {"bem": BEM, "fem": FEM, "ssi": SSI}[case]
     with opts(**kw, output=tmp_path / "a.h5"):
@@ -70,7 +70,7 @@ def test_acting_between_steps_changes_the_run(tmp_path):
     """A script may change the load between steps (here: the FEM load doubled after step 3 by
     scaling the spatial load Vec): the receiver equals the plain run's up to step 3 and differs
     by more than 0.1% from step 5 on."""
-    from petsc_ssi.problem import from_options
+    from petsc_ssi.app.kinds import from_options
     with opts(**{**FEM, "output": tmp_path / "a.h5", "fem_load_history": "heaviside", "output_overwrite": 1}):
         a = from_options().run()
         p = from_options()
@@ -87,7 +87,7 @@ def test_acting_between_steps_changes_the_run(tmp_path):
 
 
 def test_stages_out_of_order_are_refused(tmp_path):
-    from petsc_ssi.problem import from_options
+    from petsc_ssi.app.kinds import from_options
     from petsc_ssi.petsc import SSIError
     with opts(**FEM, output=tmp_path / "a.h5"):
         p = from_options()

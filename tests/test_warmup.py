@@ -1,5 +1,5 @@
 """No silent minute on the first run (issue 13, item 4): with an empty numba cache a run says in
-one line that it is compiling; `python -m petsc_ssi.warmup` compiles ahead (make deps runs it), and
+one line that it is compiling; `python -m petsc_ssi.app.warmup` compiles ahead (make deps runs it), and
 afterwards a run does not compile again."""
 import os
 import subprocess
@@ -25,10 +25,10 @@ def test_cold_cache_is_announced_then_the_warm_up_covers_every_run(tmp_path):
     r = py(RUN + ["-ssi_output", str(tmp_path / "a.h5")])
     lines = [ln for ln in r.stdout.splitlines() if "compiling the BEM kernels" in ln]
     assert r.returncode == 0 and len(lines) == 1, r.stdout
-    w = py(["-m", "petsc_ssi.warmup"])
+    w = py(["-m", "petsc_ssi.app.warmup"])
     assert w.returncode == 0 and "[warmup] numba cache partly warm" in w.stdout and "[warmup] done" in w.stdout, \
         w.stdout + w.stderr
-    w = py(["-m", "petsc_ssi.warmup"])
+    w = py(["-m", "petsc_ssi.app.warmup"])
     assert w.returncode == 0 and "[warmup] numba cache is warm" in w.stdout, w.stdout + w.stderr
     runs = {"bem-blocked": RUN[2:] + ["-ssi_lag_storage", "sparse", "-ssi_history_block", "2"],
             "bem-single": RUN[2:] + ["-ssi_lag_single_from", "3", "-ssi_t_end", "0.03", "-ssi_history_block", "3"],
@@ -54,7 +54,7 @@ def counted(*a, **k):
 c.compile_extra = counted
 """
 PROBE = COUNT + """
-from petsc_ssi.bem.model import load_kernels
+from petsc_ssi.bem.lagset import load_kernels
 load_kernels()
 print('COMPILED', len(calls), calls)
 """
@@ -75,7 +75,7 @@ def test_warm_run_compiles_nothing():
 
 
 PROBE_RUN = COUNT + """
-from petsc_ssi.cli import main
+from petsc_ssi.app.cli import main
 rc = main(['petsc-ssi'] + sys.argv[1:])
 print('COMPILED', len(calls), calls)
 sys.exit(rc)

@@ -7,7 +7,7 @@ fits, not exact solutions: a few percent for the statics and roughly 5-10 % for 
 coefficients at a0 <= 1.5-2 according to the secondary sources (not re-verified here; the small
 rotational damping at low a0 is the least accurate part).
 
-Convention (the project's, ``petsc_ssi/impedance.py``)
+Convention (the project's, ``petsc_ssi/app/impedance.py``)
 ------------------------------------------------------
     K(omega) = K0 [k(a0) + i a0 c(a0)],      a0 = omega B / c_s,
 

@@ -23,7 +23,7 @@ import os
 
 import numpy as np
 
-from ..petsc import init, collective_error, collective_io, SSIError
+from ..petsc import init, collective, collective_error, collective_io, SSIError
 
 FORMAT = 1
 
@@ -64,9 +64,9 @@ def _difference(saved, now):
 
 
 def _read_json(path, comm, what):
-    err, data = None, None
-    if comm.getRank() == 0:
-        try:
+    data = None
+    with collective(comm, f"{what} {path}", "{what}: cannot read " + f"{path}.json" + " ({error})"):
+        if comm.getRank() == 0:
             if not os.path.isfile(path) or not os.path.isfile(path + ".json"):
                 raise SSIError(f"{what} {path}: no such file, or its {os.path.basename(path)}.json is missing "
                                "(a save that did not finish)")
@@ -77,11 +77,6 @@ def _read_json(path, comm, what):
             if os.path.getsize(path) != data.get("bytes"):
                 raise SSIError(f"{what} {path}: {os.path.getsize(path)} bytes, {path}.json says {data.get('bytes')} "
                                "(a truncated or replaced file)")
-        except SSIError as exc:
-            err = str(exc)
-        except (OSError, ValueError) as exc:
-            err = f"{what} {path}: cannot read {path}.json ({type(exc).__name__})"
-    collective_error(err, comm)
     return comm.tompi4py().bcast(data, root=0)
 
 
@@ -147,8 +142,8 @@ def save(path, comm, march, key):
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     size = 0
-    if comm.getRank() == 0:
-        try:
+    with collective(comm, f"-ssi_lags_save {path}", "{what}: {error}"):
+        if comm.getRank() == 0:
             if os.path.exists(tmp + ".info"):
                 os.remove(tmp + ".info")
             if os.path.exists(path + ".json"):
@@ -160,9 +155,6 @@ def save(path, comm, march, key):
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
-        except OSError as exc:
-            err = f"-ssi_lags_save {path}: {exc.strerror or exc}"
-    collective_error(err, comm)
     return comm.tompi4py().bcast(size, root=0)
 
 

@@ -64,7 +64,7 @@ def node_work(xnodes, rows, Vc, VR, mat, dt, n_images, lag_w, Lx, n_t=0, chunk=2
     symmetry images, four nodes per element); products: each block of lag index l (1..len(lag_w))
     times ``lag_w[l - 1]`` (``lag_weights``), and the node's row of G (``n_t`` traction nodes,
     stored dense: the same for every node) in every used matrix."""
-    from .model import pair_windows
+    from .windows import pair_windows
     L = len(lag_w)
     cum = np.r_[0.0, np.cumsum(lag_w)]              # cum[l] = weight of lags 1..l
     blocks = np.zeros(len(rows))

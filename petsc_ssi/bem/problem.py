@@ -1,8 +1,8 @@
 """``BEMTransient``: the half-space alone (-ssi_problem bem) as an importable problem.
 
 The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads the mesh, checks
-every input and estimates the memory (``run.BEMProblem.prepare``); ``setup`` assembles the lag
-matrices and factorises the step matrix (``run.build_bem``); ``step`` advances the Marcher one
+every input and estimates the memory (``halfspace.HalfSpace.prepare``); ``setup`` assembles the lag
+matrices and factorises the step matrix (``build.build_marcher``); ``step`` advances the Marcher one
 step, records (``io.recorder``) and applies the divergence guard; ``finish`` writes receivers,
 sidecars and the run record. ``state`` between steps: (u, p), the soil's displacement and
 traction Vecs of the last step (owned layout).
@@ -12,10 +12,13 @@ import time
 import numpy as np
 
 from ..petsc import printf
-from ..monitor import staged, fmt_time
-from ..io.output import Output
+from ..monitor import staged, fmt_time, event
+from ..io.output import Output, provenance
 from ..problem import TransientProblem
-from .run import BEMProblem, build_bem, _guard, _finish
+from .halfspace import HalfSpace
+from .build import build_marcher
+from .stability import guard
+from . import options as _options  # noqa: F401  (declares the -ssi_ options of the half-space)
 
 
 class BEMTransient(TransientProblem):
@@ -26,7 +29,7 @@ class BEMTransient(TransientProblem):
         self.check_output()
         self.log = printf if cfg.monitor else (lambda m: None)
         with staged("SSI BEM setup"):
-            self.prob = BEMProblem(cfg, self.comm, log=printf)
+            self.prob = HalfSpace(cfg, self.comm, log=printf)
             self.plan, self.ls = self.prob.prepare()
         self.n_steps = self.prob.n_steps
         self.march = self.rec = self.out = None
@@ -36,7 +39,7 @@ class BEMTransient(TransientProblem):
         self._advance("created", "set up")
         p = self.prob
         with staged("SSI BEM assembly"):
-            self.march, self.info = build_bem(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
+            self.march, self.info = build_marcher(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
                                               p.known_p(), self.log)
 
     def start(self):
@@ -72,7 +75,7 @@ class BEMTransient(TransientProblem):
             self.n = n                        # the step is taken; its records follow
             rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
             if self.cfg.guard:
-                _guard(self.cfg, self.prob, self.march, rec.unorm, n)
+                guard(self.cfg, self.prob, self.march, rec.unorm, n)
         self.state = (u, p)
         return self.state
 
@@ -80,7 +83,7 @@ class BEMTransient(TransientProblem):
         rec = self.rec
         res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
                "resultants": rec.soil.resultants(rec.times)}
-        _finish(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
+        write_results(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
@@ -98,8 +101,31 @@ class BEMTransient(TransientProblem):
             "T_N": prob.T_N, "r_max": prob.r_max, "kernel_evaluations": ls.kernel_evaluations,
             "cache_hits": ls.cache_hits, "beta_min": prob.beta[0], "beta_max": prob.beta[1],
             "mem_peak_estimate": prob.mem_peak_estimate}
-        from ..problem import peak_rss
+        from ..sysmem import peak_rss
         res["stats"]["peak_rss_max_rank_bytes"], res["stats"]["peak_rss_sum_bytes"] = peak_rss(self.comm)
-        _finish(cfg, self.comm, prob, self.out, res, status=self.final_status())
+        write_results(cfg, self.comm, prob, self.out, res, status=self.final_status())
         printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
         return res
+
+
+def write_results(cfg, comm, prob, out, res, status="completed", final=True):
+    """Collective: write the receivers, attributes and run record; ``final``: close the output
+    (else flush it: readable, still open)."""
+    ev = event("SSI_IO")
+    ev.begin()
+    recd = None
+    if res["u"] is not None:
+        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+    attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
+             "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
+    groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
+    if cfg.mesh_patch and cfg.load_group == "load":
+        attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
+    rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
+    (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status, groups=groups)
+    ev.end()
+    if not final:
+        return
+    if cfg.plot and comm.getRank() == 0 and recd is not None:
+        from ..plot import receiver_plot
+        receiver_plot(cfg.output, cfg)

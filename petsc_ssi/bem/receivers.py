@@ -58,3 +58,21 @@ def operator(comm, mesh, points, planes, ncol_loc):
             M.setValue(r, c, v, addv=True)
     M.assemble()
     return M, where
+
+
+def traction_to_nodes(comm, prob, march):
+    """AIJ mapping traction columns to a nodal traction field (for output)."""
+    PETSc = init()
+    reg = prob.regions
+    if not reg.n_t:
+        return None
+    T = PETSc.Mat().createAIJ(size=((march.u_tmpl.getLocalSize(), 3 * prob.mesh.n_nodes),
+                                    (march.p_tmpl.getLocalSize(), 3 * reg.n_t)), nnz=(3, 3), comm=comm)
+    T.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    r0, r1 = T.getOwnershipRange()
+    for k, node in enumerate(reg.tnode):
+        for c in range(3):
+            if r0 <= 3 * node + c < r1:
+                T.setValue(3 * node + c, 3 * k + c, 1.0)
+    T.assemble()
+    return T

@@ -137,8 +137,8 @@ def check_stability(cfg, comm, run):
     largest element gives the smallest beta = c_s dt / l (the side where the
     plain scheme fails); a non-uniform mesh (smallest element < 0.75 x the
     largest) is checked at its smallest element too. Returns a dict."""
-    from .run import BEMProblem
-    prob = BEMProblem(cfg, comm, log=lambda m: None)
+    from .halfspace import HalfSpace
+    prob = HalfSpace(cfg, comm, log=lambda m: None)
     sizes = prob.mesh.element_sizes()
     hs = [2.0 * float(sizes.max())]
     if sizes.min() < 0.75 * sizes.max():
@@ -191,3 +191,35 @@ def _cleanup(path, comm):
                 os.remove(base + ext)
             except OSError:
                 pass
+
+
+def guard(cfg, prob, march, unorm, n):
+    """Stop a clearly diverging run (same decision on every rank: the norm is
+    a global reduction). Diverging: a non-finite norm, or after 20 steps a
+    norm above guard_factor times the largest norm of the first half of the
+    run so far. A loaded, damped (radiating) half-space cannot do that."""
+    nrm = unorm[-1]
+    pm = march.__dict__.setdefault("_prefix_max", [])      # running max of |u|: O(1) per step
+    pm.append(max(pm[-1], nrm) if pm else nrm)
+    ref = guard_reference(pm, n)
+    if not guard_trips(nrm, ref, n, cfg.guard_factor):
+        return
+    rate = (np.log(nrm / ref) / (n - n // 2)) if (np.isfinite(nrm) and ref > 0) else float("inf")
+    causes = []
+    if march.scheme == "plain":
+        causes.append(f"the plain scheme (eq. 6) is unstable for small beta = c_s dt / l (here {prob.beta[0]:.3g}; "
+                      "runs/stability/README.md maps where): use -ssi_scheme stabilized")
+    if prob.beta[0] < 0.3 or prob.beta[1] > 1.3:
+        causes.append(f"beta = c dt / l spans [{prob.beta[0]:.2f}, {prob.beta[1]:.2f}], outside [0.3, 1.3]: "
+                      "change -ssi_dt or the mesh")
+    plan = getattr(march, "plan", None)
+    if plan is not None:
+        causes.append(f"lag interpolation from T_L = {plan.TL:.4g} s: a threshold below the Rayleigh "
+                      "arrival (tau_L < 1.09) is inaccurate; raise -ssi_interp_tl")
+    if not causes:
+        causes.append("unknown (check the mesh and dt; -ssi_guard 0 disables this check)")
+    exc = SSIError(f"the solution is diverging at step {n} (t = {n * prob.dt:.4g} s): |u| = {nrm:.3e}, "
+                   f"{nrm / ref if ref > 0 else float('inf'):.3g} x the largest norm of the first half, growth "
+                   f"rate {rate:.3g} per step; likely cause: {'; '.join(causes)}")
+    exc.unorm = np.array(unorm)      # the history so far (-ssi_check_stability, runs/stability)
+    raise exc

@@ -4,6 +4,8 @@ The soil is the BEM half-space (``-ssi_cp/_cs/_rho/_mesh...``), the structure
 the FEM model (``-ssi_fem_*``); these options say how they meet.
 """
 from ..options import register, register_check, positive
+from ..bem import options as _bem_options  # noqa: F401  (the coupled problem reads the soil's options
+from ..fem import options as _fem_options  # noqa: F401   and the structure's)
 
 G = "ssi"
 

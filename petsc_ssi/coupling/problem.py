@@ -1,14 +1,15 @@
 """``SSITransient``: structure and half-space coupled (-ssi_problem ssi) as an importable problem.
 
 The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads both meshes and the
-interface and checks every input, then the memory (``run.setup``, ``BEMProblem.prepare`` with the
+interface and checks every input, then the memory (``model.build_coupled``, ``HalfSpace.prepare`` with the
 interface matrices counted); ``setup`` assembles K and M and factorises D, assembles the BEM lag
-matrices and factorises the step matrix, then builds the interface matrices (``run.Coupler``,
+matrices and factorises the step matrix, then builds the interface matrices (``step.Coupler``,
 with the staggered or implicit strategy); ``step`` is one coupled step with the contact
 iteration (``Coupler.step``); ``finish`` writes both outputs, the interface series and the run
 record. ``state`` between steps: (u_soil, p_soil, u_structure, res) with ``res`` the step's
 interface record (u_f, u_b, p, gap, p_N, status, iterations, resultants).
 """
+import os
 import time
 
 import numpy as np
@@ -17,9 +18,15 @@ from ..petsc import printf, warn, SSIError
 from ..monitor import staged, fmt_time
 from ..io.output import Output
 from ..problem import TransientProblem
-from ..bem.run import build_bem
-from ..fem.run import make_model_integrator, load_history
-from .run import setup, interface_bytes, Coupler, structure_output_path, _finish
+from ..io.output import provenance
+from ..io.structure import receiver_record
+from ..monitor import event
+from ..bem.build import build_marcher
+from ..fem.integrators import make_model_integrator
+from ..fem.loads import load_history
+from . import options as _options  # noqa: F401  (declares the coupling's options, and the soil's and structure's)
+from .model import build_coupled, interface_bytes
+from .step import Coupler
 
 INTERFACE_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
                   "moment_fe", "moment_be", "bem_residual", "force_map_error")
@@ -35,7 +42,7 @@ class SSITransient(TransientProblem):
         comm = self.comm
         with staged("SSI setup"):
             self.hist = load_history(cfg, comm)
-            self.prob, self.model, self.iface, self.fe_cfg = setup(cfg, comm)
+            self.prob, self.model, self.iface, self.fe_cfg = build_coupled(cfg, comm)
             iface = self.iface
             self.plan, self.ls = self.prob.prepare([
                 f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
@@ -54,7 +61,7 @@ class SSITransient(TransientProblem):
             self.model.assemble()
             _, self.integ, self.am = make_model_integrator(self.fe_cfg, comm, self.model)
         with staged("SSI BEM assembly"):
-            self.march, self.info = build_bem(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
+            self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
             self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
             printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
                    f"{self.fe_cfg.fem_integrator}): {3 * self.iface.n} BEM"
@@ -159,7 +166,7 @@ class SSITransient(TransientProblem):
         res = self.results()
         res["_outputs"] = (self.out, self.sout)
         res["stats"] = {"steps_done": self.n}
-        _finish(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False)
+        write_results(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
@@ -176,7 +183,7 @@ class SSITransient(TransientProblem):
                  "cycled_steps": law.cycled_steps, "interface_nodes": self.iface.n, "lags": prob.L,
                  "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
                  "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am}
-        from ..problem import peak_rss
+        from ..sysmem import peak_rss
         stats["peak_rss_max_rank_bytes"], stats["peak_rss_sum_bytes"] = peak_rss(comm)
         res["stats"] = stats
         if cfg.contact == "unilateral":
@@ -186,7 +193,34 @@ class SSITransient(TransientProblem):
                    f"({fmt_time(coupler.solver_cap().t_factor)}), active-set algebra {fmt_time(law.t_algebra)} in "
                    f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
                    "factorisation of the BEM step matrix")
-        _finish(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
+        write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
         self.integ.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
         return res
+
+
+def structure_output_path(path):
+    stem, ext = os.path.splitext(path)
+    return stem + "_structure" + (ext or ".h5")
+
+
+def write_results(cfg, comm, prob, model, iface, res, am, status="completed", final=True):
+    """Collective: both outputs (soil with the interface series, structure) with receivers,
+    attributes and the run record; ``final``: close them (else flush: readable, still open)."""
+    out, sout = res.pop("_outputs")
+    attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
+             "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
+             "structure_output": os.path.basename(structure_output_path(cfg.output))}
+    rec_ = provenance(cfg, comm, {"stats": res["stats"]})
+    recd = None
+    if res["u"] is not None:
+        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+    with event("SSI_IO"):
+        inter = res["interface"] if comm.getRank() == 0 else None
+        (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
+                                            groups={"interface": inter} if inter is not None else None)
+        srecd = None
+        if comm.getRank() == 0 and len(model.receiver_nodes):
+            srecd = receiver_record(model, res["structure"])
+        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
+                                                                      "dt": cfg.dt}, record=None, status=status)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error
+from ..petsc import init, SSIError, collective, collective_error
 from ..monitor import event
 from .mesh import one_line
 
@@ -175,16 +175,10 @@ def assemble(mesh, mat, layout):
     (a hex8 mesh built without parts), else None. An error on any rank (SSIError or
     not) is raised on every rank as a one-line SSIError."""
     with event("FEM_assembly"):
-        err = None
         A = m = None
-        try:                                   # local numpy work only: nothing collective in here
+        with collective(layout.comm, "assembling K and M"):      # local numpy work only in the block
             A = local_stiffness_csr(mesh, mat, layout)
             m = local_lumped_mass(mesh, mat, layout)
-        except SSIError as exc:
-            err = str(exc)
-        except Exception as exc:  # noqa: BLE001 -- a failure on one rank must reach the others
-            err = f"assembling K and M failed on rank {layout.comm.getRank()}: {one_line(exc)}"
-        collective_error(err, layout.comm)
         return csr_to_petsc(A, layout), lumped_mass_vec(mesh, mat, layout, m)
 
 

@@ -96,6 +96,7 @@ from ..petsc import init, SSIError, check, collective_error, set_default_options
     direct_solver_defaults, printf, warn
 from ..monitor import event
 from .assembly import check_mass, owned_dofs, eliminate_dofs
+from .options import alpha_m
 
 
 def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5):
@@ -539,3 +540,27 @@ class MidpointIntegrator(NewmarkIntegrator):
 def make_integrator(kind, *args, **kw):
     """'green', 'newmark' or 'midpoint'."""
     return {"green": GreenIntegrator, "newmark": NewmarkIntegrator, "midpoint": MidpointIntegrator}[kind](*args, **kw)
+
+
+def near_null_args(solver, model):
+    """(coords_vec, near_null) for make_solver: none for a direct solver; PETSc's rigid-body
+    modes of the coordinates for a brick-only model; the dof map's six modes otherwise."""
+    if solver != "iterative":
+        return None, None
+    if model.layout.uniform3:
+        return model.coords_vec(), None
+    return None, model.layout.near_null_space(model.mesh.coords)
+
+
+def make_model_integrator(cfg, comm, model=None):
+    """Collective: (model, integrator, alpha_m) for the options ``cfg``."""
+    if model is None:
+        from .model import build_model
+        model = build_model(cfg, comm)
+    am, note = alpha_m(cfg)
+    printf(f"[fem] {note}; integrator {cfg.fem_integrator}, solver {cfg.fem_solver}")
+    coords, near = near_null_args(cfg.fem_solver, model)
+    integ = make_integrator(cfg.fem_integrator, model.K, model.m, cfg.dt, am, model.fixed,
+                            cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
+                            coords_vec=coords, near_null=near)
+    return model, integ, am

@@ -27,7 +27,7 @@ accurate (see integrators.py for why, and tests/fem/test_fem_convergence.py).
 """
 import numpy as np
 
-from ..petsc import SSIError
+from ..petsc import SSIError, collective
 from ..histories import History  # noqa: F401  (the FEM's load histories)
 from .mesh import snap_points
 
@@ -274,3 +274,14 @@ def restrains_rigid_motion(coords, fixed):
     from .dofmap import DofMap
     c = np.asarray(coords, float)
     return DofMap(np.zeros(c.shape[0], bool)).restrains_rigid_motion(c, fixed)
+
+
+def load_history(cfg, comm):
+    """Collective: the load history (the option checks read it once already)."""
+    hist = None
+    with collective(comm, f"-ssi_fem_load_history {cfg.fem_load_history}", "{what}: {error}"):
+        try:
+            hist = history_from(cfg)
+        except SSIError as exc:
+            raise SSIError(f"-ssi_fem_load_history {cfg.fem_load_history}: {exc}") from None
+    return hist

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..petsc import SSIError, collective_error
+from ..petsc import SSIError, collective, collective_error
 from ..points import parse_triple
 from .elements import Props
 
@@ -516,17 +516,12 @@ def load_mesh(cfg, comm, specs=None):
     every rank as a one-line SSIError, so the other ranks never wait in bcast.
     """
     mpi = comm.tompi4py()
-    mesh, err = None, None
-    if mpi.rank == 0:
-        try:
+    mesh = None
+    with collective(comm, f"reading the mesh '{cfg.fem_mesh}'", "{what} failed: {error}"):
+        if mpi.rank == 0:
             mesh = build_mesh(cfg, specs)
             if cfg.fem_renumber:
                 mesh = renumber_rcm(mesh)
-        except SSIError as exc:
-            err = str(exc)
-        except Exception as exc:  # noqa: BLE001 -- any failure must reach the other ranks
-            err = f"reading the mesh '{cfg.fem_mesh}' failed: {one_line(exc)}"
-    collective_error(err, comm)
     return mpi.bcast(mesh, root=0)
 
 

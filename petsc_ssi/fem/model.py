@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error, printf
+from ..petsc import init, SSIError, collective, collective_error, printf
 from .assembly import Material, assemble, mass_report
 from .dofmap import DofMap
 from .loads import fixed_dofs, nodal_load, point_masses
@@ -99,20 +99,13 @@ def describe_parts(mesh, material=None, log=printf):
 def build_model(cfg, comm, assemble_matrices=True, log=printf):
     """Collective: parse the parts, read the mesh, check the inputs, then assemble K and M."""
     init()
-    err, specs = None, None
-    try:
+    specs = None
+    with collective(comm, "parsing -ssi_fem_parts"):
         specs = parse_parts(cfg)
-    except SSIError as exc:
-        err = str(exc)
-    collective_error(err, comm)
     mesh = load_mesh(cfg, comm, specs)
     dofmap = DofMap(mesh.has_rotation(), comm, mesh.released_nodes())
-    err = None
-    try:
+    with collective(comm, "checking the structure's inputs"):
         fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap)
-    except SSIError as exc:
-        err = str(exc)
-    collective_error(err, comm)
     dofmap.set_fixed(fixed)
     fixed = dofmap.fixed                  # the section's constraints are the record of the supports
     counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())

@@ -9,6 +9,8 @@ import os
 from ..options import register, register_check, positive, nonnegative, at_least
 from ..petsc import SSIError
 from ..points import parse_triple
+from .. import common_options  # noqa: F401  (the common options every problem reads)
+from . import parts as _parts  # noqa: F401  (-help lists the per-part options)
 
 G = "fem"
 

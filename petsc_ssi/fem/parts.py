@@ -243,3 +243,7 @@ def help_text():
         lines.append(f"  -ssi_fem_part_NAME_{p} <{kind}>{u}: {meaning} ({who}"
                      + (f"; required for {req}" if req else "") + ")")
     return "\n".join(lines)
+
+
+from ..options import register_help_section  # noqa: E402  (-help lists the per-part options)
+register_help_section(help_text)

@@ -1,19 +1,29 @@
-"""``FEMTransient``: the structure alone (-ssi_problem fem) as an importable problem.
+"""``FEMTransient``: the structure alone (-ssi_problem fem), time-stepped (paper Section 3).
+
+Collective. Steps: the load history (already read and checked with the options, before any heavy
+work), build the model (mesh, checks, K, M), alpha_m, the integrator (D factorised once), then for
+n = 1..N: u^n (eq. 13), the load sample f^n (mean of f over [t_n - dt/2, t_n + dt/2]) as a
+velocity impulse (eqs. 14, 16); displacement and velocity every -ssi_output_stride steps, the
+receiver series every step. PETSc log events: FEM_assembly, FEM_factor, FEM_timeloop, FEM_io.
 
 The stages of ``petsc_ssi.problem.TransientProblem``: the constructor reads the load history,
 the parts and the mesh and checks every input (``model.build_model`` without assembly);
-``setup`` assembles K and M and factorises D (``run.make_model_integrator``); ``start`` takes the
+``setup`` assembles K and M and factorises D (``integrators.make_model_integrator``); ``start`` takes the
 initial impulse of the load and records t = 0; ``step`` is one step of the integrator (paper eqs.
 13-16) with the load sample f^n; ``finish`` writes receivers and sidecars. ``state`` between
 steps: (u, v), displacement and velocity in the dof map's layout.
 """
+import os
+
 from ..petsc import printf
 from ..monitor import event, staged
-from ..io.output import Output
+from ..io.output import Output, provenance
 from ..problem import TransientProblem
 from .. import timegrid
+from . import options as _options  # noqa: F401  (declares the structure's -ssi_fem_ options)
 from .model import build_model
-from .run import load_history, make_model_integrator, _close_output
+from .loads import load_history
+from .integrators import make_model_integrator, green_constants
 
 
 class FEMTransient(TransientProblem):
@@ -95,3 +105,40 @@ class FEMTransient(TransientProblem):
                    f"{u[-1, 0, 2]:.6e}) m")
         self.integ.destroy()
         return {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}
+
+
+def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True):
+    """Collective: receivers, attributes and run record into the output; ``final``: close it
+    (else flush it: readable, still open)."""
+    if out is None:
+        return
+    t, u = srec.rec.arrays()
+    receivers = srec.receivers() if comm.getRank() == 0 else None
+    extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
+                     "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
+                     "elements": model.mesh.element_counts(),
+                     "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
+    if cfg.fem_integrator == "green":
+        extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
+    with event("FEM_io"):
+        (out.close if final else out.flush)(receivers=receivers, attrs={"problem": "fem", "alpha_m": am, "dt": cfg.dt},
+                                            record=provenance(cfg, comm, extra), status=status)
+    if not final:
+        return
+    if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
+        _plot(cfg.output, t, u)
+    printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
+
+
+def _plot(path, t, u):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(3, 1, sharex=True, figsize=(7, 7))
+    for i, ax in enumerate(axs):
+        ax.plot(t, u[:, :, i])
+        ax.set_ylabel(f"u_{'xyz'[i]} [m]")
+    axs[-1].set_xlabel("t [s]")
+    fig.tight_layout()
+    fig.savefig(os.path.splitext(path)[0] + ".png", dpi=120)
+    plt.close(fig)

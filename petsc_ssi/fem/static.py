@@ -7,8 +7,7 @@ receivers (displacement, rotation) and the JSON record.
 """
 import numpy as np
 
-from ..petsc import collective_error, warn, init, printf
-from ..monitor import event
+from ..petsc import collective_error, warn
 from .assembly import owned_dofs, eliminate_dofs
 from .integrators import make_solver, setup_or_fail, count_on_fixed, fixed_load_message
 from .loads import restrains_rigid_motion
@@ -59,44 +58,3 @@ def static_solve(K, f, fixed, coords, prefix="ssi_fem_", solver="direct", dofmap
     return u
 
 
-def main():
-    """Collective: the ``petsc-ssi static`` command (PETSc already initialised)."""
-    PETSc = init()
-    comm = PETSc.COMM_WORLD
-    from .. import options as ssi_options
-    from ..io.output import Output, provenance
-    from .model import build_model
-    from .run import ReceiverSeries, FieldWriter, receiver_record, near_null_args
-    cfg = ssi_options.resolve(("common", "fem"))
-    from ..io.output import check_output, command_output
-    cfg.set("output", command_output(cfg.output, "static"))       # never the transient run's file
-    if cfg.output:
-        check_output(cfg.output, comm, cfg.output_overwrite)
-    model = build_model(cfg, comm)
-    _, near = near_null_args(cfg.fem_solver, model)
-    coords = model.coords_vec() if (cfg.fem_solver == "iterative" and near is None) else None
-    with event("FEM_static"):
-        f = model.load_vec()
-        u = static_solve(model.K, f, model.fixed, model.mesh.coords, solver=cfg.fem_solver,
-                         dofmap=model.layout, near_null=near if coords is None else
-                         PETSc.NullSpace().createRigidBody(coords))
-    rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
-    rec.record(1.0, u)
-    umax = u.norm(PETSc.NormType.INFINITY)
-    printf(f"[static] solved K u = F ({model.layout.size} dofs): max |u_i| = {umax:.6e}")
-    if comm.getRank() == 0:
-        arr = rec.all_arrays()
-        for k, p in enumerate(model.receivers):
-            printf(f"[static] receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}): u = ({arr['u'][0, k, 0]:.6e}, "
-                   f"{arr['u'][0, k, 1]:.6e}, {arr['u'][0, k, 2]:.6e}) m, rotation = ({arr['rotation'][0, k, 0]:.6e}, "
-                   f"{arr['rotation'][0, k, 1]:.6e}, {arr['rotation'][0, k, 2]:.6e}) rad")
-    if cfg.output:
-        out = Output(cfg.output, comm)
-        fw = FieldWriter(out, model, comm)
-        fw.write(1.0, u)
-        receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
-        out.close(receivers=receivers, attrs={"problem": "static", "time_is": "load factor"},
-                  record=provenance(cfg, comm, {"static": {"n_dofs": model.layout.size,
-                                                           "max_abs_u": float(umax)}}))
-        printf(f"[static] wrote {cfg.output} (+ .xmf, .json)")
-    return u, model

@@ -32,7 +32,7 @@ import os
 
 import numpy as np
 
-from ..petsc import init, collective_error, collective_io, ensure_space, SSIError
+from ..petsc import init, collective, collective_error, collective_io, ensure_space, SSIError
 
 FORMAT = 1
 
@@ -107,9 +107,9 @@ def _h5(path, mode):
 def read_header(path, comm):
     """Collective: the attributes of a checkpoint (rank 0 reads, every rank gets them); SSIError in
     one line if it is missing or not a complete checkpoint."""
-    err, head = None, None
-    if comm.getRank() == 0:
-        try:
+    head = None
+    with collective(comm, f"-ssi_restart {path}", "{what}: cannot read it ({error})"):
+        if comm.getRank() == 0:
             if not os.path.isfile(path):
                 raise SSIError(f"-ssi_restart {path}: no such file")
             with _h5(path, "r") as f:
@@ -117,11 +117,6 @@ def read_header(path, comm):
                     raise SSIError(f"-ssi_restart {path}: not a petsc-ssi checkpoint (format {FORMAT})")
                 head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
                 head["key"] = json.loads(str(head["key"]))
-        except SSIError as exc:
-            err = str(exc)
-        except Exception as exc:  # noqa: BLE001 -- an unreadable file: one line on every rank
-            err = f"-ssi_restart {path}: cannot read it ({type(exc).__name__}: {str(exc).splitlines()[0]})"
-    collective_error(err, comm)
     return comm.tompi4py().bcast(head, root=0)
 
 
@@ -149,15 +144,11 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial):
     {name: Vec}, written by the PETSc HDF5 viewer; ``serial``: {name: array} of rank 0."""
     PETSc = init()
     tmp = path + ".tmp"
-    err = None
-    if comm.getRank() == 0:
-        try:
+    with collective(comm, f"checkpoint {path}", "{what}: {error}"):
+        if comm.getRank() == 0:
             os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
             if os.path.lexists(tmp):
                 os.remove(tmp)
-        except OSError as exc:
-            err = f"checkpoint {path}: {exc.strerror or exc}"
-    collective_error(err, comm)
     ensure_space(path, 8.0 * sum(v.getSize() for v in vecs.values()), comm, f"checkpoint after step {step}")
     viewer = PETSc.Viewer().createHDF5(tmp, mode="w", comm=comm)
 
@@ -171,8 +162,8 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial):
                 v.setName(old)
     collective_io(write_vecs, f"writing the checkpoint {tmp}", comm)
     collective_io(viewer.destroy, f"closing the checkpoint {tmp}", comm)
-    if comm.getRank() == 0:
-        try:
+    with collective(comm, f"checkpoint {path}", "{what}: {error}"):
+        if comm.getRank() == 0:
             from .. import __version__
             with _h5(tmp, "a") as f:
                 g = f.create_group("serial")
@@ -187,9 +178,6 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial):
             finally:
                 os.close(fd)
             os.replace(tmp, path)
-        except Exception as exc:  # noqa: BLE001 -- one line on every rank
-            err = f"checkpoint {path}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
-    collective_error(err, comm)
 
 
 class Reader:
@@ -199,15 +187,12 @@ class Reader:
     def __init__(self, path, comm):
         PETSc = init()
         self.path, self.comm = path, comm
-        err, data = None, None
-        if comm.getRank() == 0:
-            try:
+        data = None
+        with collective(comm, f"-ssi_restart {path}", "{what}: cannot read its data ({error})"):
+            if comm.getRank() == 0:
                 with _h5(path, "r") as f:
                     data = {k: f["serial"][k][()] for k in f["serial"]}
                 data = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in data.items()}
-            except Exception as exc:  # noqa: BLE001
-                err = f"-ssi_restart {path}: cannot read its data ({type(exc).__name__})"
-        collective_error(err, comm)
         self.serial = comm.tompi4py().bcast(data, root=0)
         self.viewer = PETSc.Viewer().createHDF5(path, mode="r", comm=comm)
 

@@ -27,7 +27,7 @@ import time as _time
 
 import numpy as np
 
-from ..petsc import init, collective_error, collective_io, ensure_space
+from ..petsc import init, collective, collective_error, collective_io, ensure_space
 
 XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
              "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
@@ -279,14 +279,9 @@ class Output:
     def _rank0(self, work, what):
         """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
         one-line SSIError (the allgather of collective_error is also the barrier)."""
-        err = None
-        if self.rank == 0:
-            try:
+        with collective(self.comm, what, "{what}: {error}"):
+            if self.rank == 0:
                 work()
-            except Exception as exc:  # noqa: BLE001 -- must reach the other ranks
-                lines = str(exc).strip().splitlines()
-                err = f"{what}: {type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
-        collective_error(err, self.comm)
 
     def _write_serial(self, receivers, attrs, record, groups=None, status="completed", final=True):
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an

@@ -6,9 +6,9 @@
                      traction) and the soil receiver series (a PETSc operator from
                      the nodal field to the receiver points; gathered to rank 0 once,
                      at the end)
-  StructureRecorder  the structure's mesh and fields (``fem.run.FieldWriter``:
+  StructureRecorder  the structure's mesh and fields (``io.structure.FieldWriter``:
                      displacement, rotation, velocity) and its receiver series
-                     (``fem.run.ReceiverSeries``: displacement, rotation, velocity,
+                     (``io.structure.ReceiverSeries``: displacement, rotation, velocity,
                      acceleration, on rank 0)
   interface series   per-step arrays of the coupling (a dict of lists, rank 0's copy)
 
@@ -24,11 +24,11 @@ from ..monitor import Progress, event
 
 class SoilRecorder:
     """Collective: the soil's fields and receiver series. ``out``: an Output (or None: receivers
-    only); ``prob``: the BEM problem (bem/run.py BEMProblem); ``march``: its Marcher."""
+    only); ``prob``: the BEM problem (bem/halfspace.py HalfSpace); ``march``: its Marcher."""
 
     def __init__(self, out, comm, prob, march):
         from ..bem import receivers as bem_rec
-        from ..bem.run import traction_to_nodes
+        from ..bem.receivers import traction_to_nodes
         self.out, self.comm, self.prob = out, comm, prob
         if out is not None:
             cvec = march.u_tmpl.duplicate()
@@ -118,7 +118,7 @@ class StructureRecorder:
     """Collective: the structure's fields (an Output, or None) and receiver series."""
 
     def __init__(self, out, model, comm, io_event="SSI_IO"):
-        from ..fem.run import FieldWriter, ReceiverSeries
+        from .structure import FieldWriter, ReceiverSeries
         self.out, self.model, self.comm, self.io_event = out, model, comm, io_event
         self.fw = FieldWriter(out, model, comm) if out is not None else None
         self.rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
@@ -157,7 +157,7 @@ class StructureRecorder:
 
     def receivers(self):
         """Rank 0: the output group of the structure receivers (points, nodes, t, u, rotation, ...)."""
-        from ..fem.run import receiver_record
+        from .structure import receiver_record
         return receiver_record(self.model, self.rec.all_arrays())
 
 

@@ -36,7 +36,7 @@ def entries(ls, node, tcol, lag):
 def main():
     PETSc = init(["matrix_history"])
     from petsc_ssi.mesh.surface import grid
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     from petsc_ssi.bem import interp
     comm = PETSc.COMM_SELF
     mat = Material(548.0, 316.0, 2000.0)

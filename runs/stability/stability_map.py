@@ -136,7 +136,8 @@ def worker(c, outdir):
     from petsc_ssi.petsc import init, SSIError
     PETSc = init([sys.argv[0]])
     from petsc_ssi import options as opt
-    from petsc_ssi.bem.run import run_bem
+    import petsc_ssi.app.kinds  # noqa: F401  (every option declared)
+    from petsc_ssi.app.kinds import run_bem
     from petsc_ssi.bem import stability as st
     o, n = options(c)
     o["output"] = os.path.join(outdir, c["case"] + ".h5")

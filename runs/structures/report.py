@@ -139,7 +139,7 @@ def parse_logs(directory):
 
 # ------------------------------------------------------------------ the profile
 PROFILE_ITEMS = [  # (label, file suffix or '', function name or substring)
-    ("whole run under cProfile", "petsc_ssi/cli.py", "main"),
+    ("whole run under cProfile", "petsc_ssi/app/cli.py", "main"),
     ("petsc4py initialise", "petsc4py/__init__.py", "init"),
     ("build_model: set-up + assembly", "fem/model.py", "build_model"),
     ("load_mesh: read on rank 0, renumber, broadcast", "fem/mesh.py", "load_mesh"),

@@ -16,7 +16,7 @@ from helpers import petsc
 def _lagset(planes, chunk_cache):
     PETSc = petsc()
     from petsc_ssi.mesh.surface import grid
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     from petsc_ssi.bem import symmetry
     mesh = grid(4.0, 4.0, 1.0, (1.0, 1.0), **({"xmin": 0.0, "ymin": 0.0} if planes else {}))
     reg = Regions(mesh, load_elems=mesh.groups["load"])

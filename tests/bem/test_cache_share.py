@@ -1,10 +1,10 @@
-"""The de-duplication of the shared element cache (bem/model.py): each distinct (key, lo, hi) request
+"""The de-duplication of the shared element cache (bem/lagset.py): each distinct (key, lo, hi) request
 is integrated once, from its first occurrence (the lowest rank's representative), also when two
 different keys share a hash."""
 import numpy as np
 import pytest
 
-from petsc_ssi.bem.model import _first_occurrences, _mix64
+from petsc_ssi.bem.lagset import _first_occurrences, _mix64
 
 
 @pytest.mark.parametrize("collide", [False, True])

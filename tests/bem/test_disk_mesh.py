@@ -1,5 +1,5 @@
 """meshes/disk_soil.geo, the soil surface with a circular footing of radius a (impedances of a
-rigid disk): read the way a run reads it (-ssi_mesh FILE.geo through BEMProblem: load_mesh with
+rigid disk): read the way a run reads it (-ssi_mesh FILE.geo through HalfSpace: load_mesh with
 the parameters from -ssi_mesh_size/_h/_patch/-ssi_symmetry, mesh.check, the symmetry-plane check,
 kinks), full, quarter and half models; then one short quarter-model run of a prescribed rigid
 translation of the disk."""
@@ -18,15 +18,16 @@ CASE = dict(mesh=GEO, mesh_size="6,6", mesh_h=0.25, mesh_patch=f"{A:g},{A:g}", d
 
 
 def problem(**opts):
-    """The BEMProblem a run sets up (mesh read, checked, regions, rigid motion), no assembly."""
+    """The HalfSpace a run sets up (mesh read, checked, regions, rigid motion), no assembly."""
     PETSc = petsc()
     from petsc_ssi import options
-    from petsc_ssi.bem.run import BEMProblem
+    import petsc_ssi.app.kinds  # noqa: F401
+    from petsc_ssi.bem.halfspace import HalfSpace
     db = PETSc.Options()
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
-        return BEMProblem(options.resolve(("common", "bem")), PETSc.COMM_WORLD, log=lambda m: None)
+        return HalfSpace(options.resolve(("common", "bem")), PETSc.COMM_WORLD, log=lambda m: None)
     finally:
         for k in opts:
             db.delValue("ssi_" + k)

@@ -113,7 +113,7 @@ def test_rigid_body_rows_vanish_on_a_closed_cube():
     with the singular and near-singular integration on folded surfaces."""
     from helpers import petsc
     PETSc = petsc()
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     mesh = _cube()
     from petsc_ssi.mesh.quad9 import geometry
     _, jn = geometry(mesh.cell_coords(), np.array([0.0]), np.array([0.0]))

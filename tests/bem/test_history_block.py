@@ -208,7 +208,7 @@ def test_automatic_sub_blocks_where_low_lags_carry_weight():
     which the in-block terms stream step by step, hold many blocks (a lag's blocks grow with the
     square of its radius until the surface is covered, as on a half-space mesh), and keeps one level
     when only far lags are stored (the sub-blocks would only add narrower panels)."""
-    from petsc_ssi.bem.run import choose_block
+    from petsc_ssi.bem.cost import choose_block
     j = np.arange(1, 161)
     blocks = np.minimum(2000.0 * j ** 2, 2.0e6)
     b, s = choose_block(np.zeros(j.size), 76.0 * blocks)
@@ -221,7 +221,7 @@ def test_automatic_sub_blocks_where_low_lags_carry_weight():
 def test_an_explicit_block_size_is_kept():
     """-ssi_history_block b is the user's: the model picks only the sub-block size for it, even where
     it would rather go step by step (three small lags), and b = 1 stays step by step."""
-    from petsc_ssi.bem.run import history_block
+    from petsc_ssi.bem.cost import history_block
 
     class Cfg(dict):
         scheme = "stabilized"

@@ -1,4 +1,4 @@
-"""petsc-ssi impedance (issue 12, item 2, a first version; petsc_ssi/impedance.py): K(omega) from
+"""petsc-ssi impedance (issue 12, item 2, a first version; petsc_ssi/app/impedance.py): K(omega) from
 the first differences of the resultant and of the smooth step, checked on a synthetic spring and
 dashpot, and on the square footing (B = 1 m, 0.5 m elements, 8 m surface) for what holds without
 published curves: K0 is the static stiffness of a held motion, k(a0 -> 0) = 1, rocking radiates
@@ -11,7 +11,7 @@ import pytest
 
 from helpers import cli
 from petsc_ssi.histories import History
-from petsc_ssi.impedance import spectrum
+from petsc_ssi.bem.impedance import spectrum
 
 CASE = ["-ssi_problem", "bem", "-ssi_mesh_size", "8,8", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "1,1",
         "-ssi_disp_group", "load", "-ssi_dt", "6e-4", "-ssi_t_end", "0.1", "-ssi_output_stride", "0",

@@ -12,7 +12,7 @@ from helpers import petsc, run_bem
 def _dense_lags(mesh_size, dt, L):
     PETSc = petsc()
     from petsc_ssi.mesh.surface import grid
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     mesh = grid(*mesh_size, 1.0, (1.0, 1.0))
     reg = Regions(mesh, load_elems=mesh.groups["load"])
     opts = {"gauss": 2, "singular_order": 12, "subdivisions": 4, "near_factor": 2.0,

@@ -10,7 +10,7 @@ from helpers import cli
 
 
 def test_cgroup_limits_are_read(tmp_path):
-    from petsc_ssi.bem.model import _cgroup_limit
+    from petsc_ssi.sysmem import _cgroup_limit
     v2 = tmp_path / "v2"
     (v2 / "job").mkdir(parents=True)
     (v2 / "job" / "memory.max").write_text("8589934592\n")

@@ -44,7 +44,7 @@ def test_balanced_ranges_cover_and_balance():
 
 
 def _small_lagset(PETSc, **extra):
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     from petsc_ssi.bem.symmetry import parse as parse_planes
     from petsc_ssi.mesh.surface import grid
     mesh = grid(8.0, 8.0, 1.0, (1.0, 1.0), xmin=0.0, ymin=0.0)
@@ -60,7 +60,7 @@ def test_node_work_is_the_memory_estimate_count():
     the march makes (estimate.Counts' count, checked there against a run's VecMAXPY count): lag 1
     never (it is in the step matrix), lag j >= 2 from step max(2, j - 1) on (stabilised) or from
     step j (plain)."""
-    from petsc_ssi.bem.model import estimate_blocks
+    from petsc_ssi.bem.windows import estimate_blocks
     PETSc = petsc()
     mesh, ls = _small_lagset(PETSc)
     nimg = len(ls.Vc) // mesh.n_cells
@@ -123,7 +123,7 @@ def test_two_ranks_balanced_and_equal_agree(tmp_path):
         assert relmax(r["u"], r1["u"]) <= 1e-12 and relmax(r["last"], r1["last"]) <= 1e-12
     # the cost model's ranges for 2 ranks, counted on one process: the sizes the run printed
     code = ("import json, sys\nfrom petsc_ssi.petsc import init\nPETSc = init(sys.argv)\n"
-            "from petsc_ssi import options, estimate\ncfg = options.resolve(('common', 'bem', 'estimate'))\n"
+            "from petsc_ssi import options\nfrom petsc_ssi.app import estimate\ncfg = options.resolve(('common', 'bem', 'estimate'))\n"
             "_, _, cnt = estimate.setup(cfg, PETSc.COMM_WORLD, [2], 0.0)\nprint('RANGES' + json.dumps(cnt.ranges[2]))")
     p = subprocess.run([PY, "-c", code] + ARGS, cwd=ROOT, capture_output=True, text=True, timeout=300,
                        env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))

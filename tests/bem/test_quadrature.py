@@ -116,7 +116,7 @@ def test_static_row_sum_equals_analytic_cpv_on_nonuniform_mesh():
     log term of the Guiggiani CPV at corner, edge and centre nodes."""
     from helpers import petsc
     PETSc = petsc()
-    from petsc_ssi.bem.model import Material, Regions, LagSet
+    from petsc_ssi.bem.lagset import Material, Regions, LagSet
     mesh = grid(6.0, 5.0, 0.7, patch=(1.1, 0.8))
     mat = Material(548.0, 316.0, 2000.0)
     reg = Regions(mesh)

@@ -42,7 +42,7 @@ def rel_diff(a, b):
 def test_buckets_round_the_far_lags_to_float32():
     """The buckets keep lags >= single_from in float32: the double buckets' values rounded, bit for
     bit, the columns and row pointers the same; lower lags stay double."""
-    from petsc_ssi.bem.model import Buckets
+    from petsc_ssi.bem.lagset import Buckets
     rng = np.random.default_rng(3)
     rows = np.arange(4)
     n = 40
@@ -124,7 +124,7 @@ BEM_OPTS = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1, "mesh_patch": "1,
 
 
 def test_buckets_refuse_single_step_matrix_lags():
-    from petsc_ssi.bem.model import Buckets
+    from petsc_ssi.bem.lagset import Buckets
     for sf in (1, 2):
         with pytest.raises(ValueError, match="lags 1 and 2"):
             Buckets(4, np.arange(2), 3, single_from=sf)
@@ -133,7 +133,7 @@ def test_buckets_refuse_single_step_matrix_lags():
 def test_peak_counts_the_interpolating_assemblies():
     """The memory check's peak: the largest phase, including the assembly of each interpolating
     matrix after the exact Mats are built (its blocks and its own cache and chunk)."""
-    from petsc_ssi.bem.model import peak_bytes
+    from petsc_ssi.bem.cost import peak_bytes
     mats, trip = np.array([10.0, 10.0, 4.0, 4.0]), np.array([10.0, 10.0, 4.0, 4.0])   # 2 exact + 2 interpolating
     assert peak_bytes(mats, trip, [0.0], 5.0, 0.0, n_exact=2) == pytest.approx(1.1 * 28.0)     # last: 20 + 4 + 4
     assert peak_bytes(mats, trip, [0.0], 5.0, 0.0, n_exact=2, asm_interp=3.0) == pytest.approx(1.1 * 31.0)
@@ -143,7 +143,7 @@ def test_peak_counts_the_interpolating_assemblies():
 def test_block_choice_counts_blocks_not_bytes():
     """A float32 block-sparse matrix has the flops of a double one with the same blocks in 40/76 of
     its bytes: the block choice takes the blocks when given."""
-    from petsc_ssi.bem.run import choose_block
+    from petsc_ssi.bem.cost import choose_block
     d = np.zeros(40)
     blocks = np.full(40, 2.0e6)
     assert choose_block(d, 76.0 * blocks) == choose_block(d, 76.0 * blocks, sparse_blocks=blocks)

@@ -14,7 +14,7 @@ Soil of the paper's foundation example (c_p 42, c_s 20 m/s, rho 1800 kg/m^3), a 
 import numpy as np
 
 from helpers import run_bem, run_ssi
-from petsc_ssi.impedance import rigid_fit, spectrum, step_spectrum
+from petsc_ssi.bem.impedance import rigid_fit, spectrum, step_spectrum
 
 CP, CS, RHO, B = 42.0, 20.0, 1800.0, 0.5
 DT, T_END, RISE, AMP = 0.0125, 1.0, 0.05, 1e-6

@@ -110,7 +110,7 @@ def test_hex8_coupled_run_equals_the_release_before_the_dof_map(before, tmp_path
     """runs/foundation/sym-bonded.opts (4 steps, coupled): soil and structure receivers and the
     interface tractions equal the code before the dof map to round-off. (The reference was made by
     commit 8e2fe32 with one change in the BEM, the node-order-independent element size of
-    bem/model.py:bounding_spheres, so that it isolates the structure's side.)"""
+    bem/windows.py:bounding_spheres, so that it isolates the structure's side.)"""
     out = str(tmp_path / "c.h5")
     ok(run_cli(["-options_file", "runs/foundation/sym-bonded.opts", "-ssi_t_end", "0.03", "-ssi_output", out,
                 "-ssi_structure_receivers", "0,0,0.5;0.5,0.5,0.5", "-ssi_output_stride", "0"], timeout=600))

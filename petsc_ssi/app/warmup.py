@@ -1,4 +1,4 @@
-"""``python -m petsc_ssi.warmup``: compile the numba kernels into the cache ahead of the first run.
+"""``python -m petsc_ssi.app.warmup``: compile the numba kernels into the cache ahead of the first run.
 
 The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.py``) are compiled by numba
 the first time a version of the sources runs on a machine (about a minute) and cached under
@@ -30,10 +30,10 @@ def main():
               flush=True)
     os.environ["PETSC_SSI_WARMUP"] = "1"       # the run below does not announce the compile again
     t0 = time.perf_counter()
-    from .petsc import init
+    from ..petsc import init
     PETSc = init([sys.argv[0]])
-    from . import options
-    from .bem.run import run_bem
+    from .. import options
+    from .kinds import run_bem
     with tempfile.TemporaryDirectory() as tmp:
         opts = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
                 "load_p0": 1000, "dt": 0.005, "t_end": 0.02, "output": os.path.join(tmp, "w.h5"),
@@ -56,9 +56,9 @@ def _shared_cache_kernels(PETSc):
     """The element-cache kernels a run on more than one rank uses (model.LagSet._share_cache, on
     one process here): without this, the first parallel run compiled them in its assembly."""
     import numpy as np
-    from .mesh.surface import grid
-    from .bem.model import Material, Regions, LagSet
-    from .bem.assemble import new_cache
+    from ..mesh.surface import grid
+    from ..bem.lagset import Material, Regions, LagSet
+    from ..bem.assemble import new_cache
     mesh = grid(2.0, 2.0, 1.0, (1.0, 1.0))
     opts = {"gauss": 2, "singular_order": 12, "subdivisions": 4, "near_factor": 2.0, "max_subdivisions": 32,
             "cache": True}
@@ -74,7 +74,7 @@ def _single_kernels():
     per value type) and on a read-only x (the python Mat's products; without this the first coupled
     run compiled one)."""
     import numpy as np
-    from .bem import bsr
+    from ..bem import bsr
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
     data = np.ones((1, 3, 3), np.float32)
     bsr._matvec(indptr, cols, data, np.ones(3), np.zeros(3))

@@ -33,7 +33,7 @@ def building_figures(out):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from .spectrum import amplitude_spectrum, peaks
+    from ..spectrum import amplitude_spectrum, peaks
     stem = out[:-3]
     with h5py.File(stem + "_structure.h5", "r") as f:
         t, acc = f["receivers/t"][:], f["receivers/acceleration"][:]
@@ -116,7 +116,7 @@ def lamb():
     rc = subprocess.call(cmd, cwd=ROOT)
     if rc:
         return rc
-    from .verify import lamb_errors
+    from ..verify import lamb_errors
     errs = lamb_errors(out)
     for r, ev, eh in errs:
         print(f"[demo] r = {r:g} m: relative L2 error of u~ over tau in [0, 2.5]: "

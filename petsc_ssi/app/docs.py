@@ -1,5 +1,5 @@
 """Regenerate the README's option table from the registry:
-``python -m petsc_ssi.docs [README.md]`` rewrites the text between the
+``python -m petsc_ssi.app.docs [README.md]`` rewrites the text between the
 markers ``<!-- options:begin -->`` and ``<!-- options:end -->``."""
 import sys
 
@@ -7,7 +7,8 @@ BEGIN, END = "<!-- options:begin -->", "<!-- options:end -->"
 
 
 def table():
-    from . import options
+    from .. import options
+    from . import kinds, estimate, impedance  # noqa: F401  (every option declared)
     return options.markdown_table()
 
 

@@ -214,7 +214,7 @@ def _mpl():
 
 def spectrum_command(a, out=None):
     out = sys.stdout if out is None else out
-    from .spectrum import amplitude_spectrum, peaks
+    from ..spectrum import amplitude_spectrum, peaks
     t, x, labels, desc = read_series(a.file, a.series, a.receiver, a.component)
     f, A, inf = amplitude_spectrum(t, x, pad=a.pad, window=a.window, tukey_alpha=a.tukey_alpha,
                                    detrend=a.detrend)
@@ -271,7 +271,7 @@ def spectrum_command(a, out=None):
 
 def transfer_command(a, out=None):
     out = sys.stdout if out is None else out
-    from .spectrum import transfer
+    from ..spectrum import transfer
     fa, sa, ra = _parse_ref(a.transfer[0], a.file, a.series)
     fb, sb, rb = _parse_ref(a.transfer[1], a.file, a.series)
     ta, xa, la, da = read_series(fa, sa, ra, a.component)
@@ -369,7 +369,7 @@ def main(argv=None):
     if a.file is None:
         ap.error("the following arguments are required: file")
     a.series = a.series or f"receivers/{a.quantity}"
-    from .spectrum import SpectrumError
+    from ..spectrum import SpectrumError
     try:
         if a.spectrum and a.transfer:
             raise PostError("give either --spectrum or --transfer, not both")
@@ -384,7 +384,7 @@ def main(argv=None):
         if a.receivers and a.csv:
             write_csv(a.file)
         if a.plot:
-            from .plot import receiver_plot
+            from ..plot import receiver_plot
             receiver_plot(a.file, png=a.plot)
         if not (a.info or (a.receivers and a.csv) or a.plot):
             ap.error("nothing to do: give --receivers --csv, --plot PNG, --info, --spectrum or --transfer A B")

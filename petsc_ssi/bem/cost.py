@@ -1,5 +1,8 @@
-"""Cost model of a BEM run: wall time per stage and peak memory before the run
-(``petsc-ssi estimate -options_file ...``; issue 6, part 4).
+"""The BEM cost model: wall time per stage and peak memory of a run before it runs
+(``petsc-ssi estimate -options_file ...``, ``app/estimate.py``; issue 6, part 4), the memory
+estimate of the lag matrices (``lag_bytes``, ``peak_bytes``; ``LagSet.estimate_memory`` and the
+memory check use them), the wave windows that bound the stored blocks (``pair_windows``), and the
+time model of the time-blocked history sum (``choose_block``, ``history_block``).
 
 The model counts the work of a run from the same set-up as the run itself
 (mesh, regions, lags, interpolation plan, the per-lag block estimate of
@@ -49,27 +52,15 @@ a 4.9 s assembly, medium case, 2 ranks).
 It covers the BEM half-space (-ssi_problem bem; for ssi the BEM part only).
 """
 import json
-import math
 import os
-import time
 
 import numpy as np
 
-from .options import register, SSIError
-from .monitor import fmt_time
+from ..petsc import SSIError
+from ..sysmem import process_rss
+from .windows import estimate_blocks
 
-G = "estimate"
-register("estimate_ranks", "str", "1,2,4", "", "estimate: rank counts to predict, e.g. '1,2,4,8,16'", G)
-register("estimate_ranks_per_node", "int", 0, "", "estimate: MPI ranks per node (0: the cores of this machine)", G,
-         validator=lambda v: None if v >= 0 else "must be >= 0")
-register("estimate_cores_per_node", "int", 0, "", "estimate: cores per node (0: this machine's); more ranks than "
-         "cores on a node are oversubscribed", G, validator=lambda v: None if v >= 0 else "must be >= 0")
-register("estimate_node_memory", "real", 0.0, "GB", "estimate: memory of one node (0: this machine's)", G,
-         validator=lambda v: None if v >= 0 else "must be >= 0")
-register("estimate_constants", "str", "", "", "estimate: JSON file of machine constants (default: "
-         "petsc_ssi/estimate_constants.json; jobscripts/calibrate.py writes one)", G)
-
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))      # the package: petsc_ssi/
 DEFAULT_CONSTANTS = os.path.join(HERE, "estimate_constants.json")
 
 # Starting values (this code's 2-core development machine) if no table is found.
@@ -95,23 +86,13 @@ def load_constants(path=""):
     return c, f"{os.path.relpath(path)} ({d.get('machine', '?')}, {d.get('fitted_from', '?')})"
 
 
-def parse_ranks(text):
-    try:
-        r = sorted({int(s) for s in str(text).split(",") if s.strip()})
-    except ValueError:
-        raise SSIError(f"-ssi_estimate_ranks '{text}': expected rank counts 'p1,p2,...'") from None
-    if not r or r[0] < 1:
-        raise SSIError(f"-ssi_estimate_ranks '{text}': expected positive rank counts")
-    return r
-
-
 def pair_table(prob, ls, L, chunk=64, rows=None):
     """Every (collocation node, element) pair that the assembly integrates for
     lags 1..L: (row, geometry key, first and last lag of its wave window). The
     key is the element's node coordinates relative to the collocation point,
     quantised as the assembly's element cache keys them, so equal keys are the
     pairs the cache integrates once (translated copies on a structured mesh).
-    ``prob``: anything with mesh, mat and dt (a BEMProblem or a LagSet); ``rows``: the
+    ``prob``: anything with mesh, mat and dt (a HalfSpace or a LagSet); ``rows``: the
     node rows looked at (default every node; ids in the table stay global)."""
     x = prob.mesh.nodes
     ids = np.arange(len(x)) if rows is None else np.asarray(rows, np.int64)
@@ -191,7 +172,6 @@ class Counts:
     ``per_rank[p]``: a list over ranks of dicts of counts for p ranks."""
 
     def __init__(self, prob, plan, ls, ranks, limit, comm):
-        from .bem.model import estimate_blocks
         cfg = prob.cfg
         self.N = N = prob.mesh.n_nodes
         self.Ev = len(ls.Vc)
@@ -209,7 +189,7 @@ class Counts:
         Lmax = max([self.Lx] + self.interp_lags)
         mpi = comm.tompi4py()
         # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
-        from .bem import partition
+        from . import partition
         w = None
         if cfg.partition == "balanced" and max(ranks) > 1:
             w = partition.all_weights(comm, prob.mesh.nodes, ls.Vc, ls.VR, prob.mat, prob.dt, nimg,
@@ -229,13 +209,12 @@ class Counts:
         # element cache of the assembly of the exact lags (one cache per rank and call)
         self.cache = {}
         if cfg.cache:
-            from .bem.model import LagSet
             table = pair_table(prob, ls, Lmax)
             g = global_distinct(table, self.Lx, self.interp_lags) if cfg.cache_share else None
             cc = {}
             for i, (p, r, a, b) in enumerate(jobs):
                 if i % comm.getSize() == comm.getRank():
-                    cc[(p, r)] = cache_counts(table, a, b, LagSet.CACHE_MAX / 8, self.Lx, self.interp_lags,
+                    cc[(p, r)] = cache_counts(table, a, b, CACHE_MAX / 8, self.Lx, self.interp_lags,
                                               (p,) + g if g and p > 1 else None)
             for part in mpi.allgather(cc):
                 self.cache.update(part)
@@ -247,11 +226,9 @@ class Counts:
         # storage rule of lagmats (and the all-sparse fallback of check_memory)
         self.limit = limit
         used = np.r_[total[:self.Lx], [total[l - 1] for l in self.interp_lags]]
-        from .bem.model import single_lags, lag_bytes
         self.single = single_lags(np.r_[np.arange(1, self.Lx + 1), self.interp_lags], int(cfg.lag_single_from))
         self.storage, self.fill = self._storage(cfg, used, limit)
         # the time-blocked history sum's block: the run's choice from these matrices' bytes
-        from .bem.run import history_block
         tot = self.nb_total_used()
         mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt)
         g = g * (tot > 0) * (self.nt > 0)
@@ -277,7 +254,6 @@ class Counts:
     def _peak_rule(self, used, dense, p=1):
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
-        from .bem.model import transient_bytes, lag_bytes, peak_bytes
         N = self.N
         mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt)
         asm, rss = transient_bytes(used[:self.Lx].sum() / p, N, self.Lx, N / p, parts=True)
@@ -289,7 +265,6 @@ class Counts:
         ``cache``: its integrated pair-lags and cache floats, None: no cache)."""
         N, Lx = self.N, self.Lx
         used = np.r_[nb[:Lx], [nb[l - 1] for l in self.interp_lags]]
-        from .bem.model import lag_bytes
         dense = self.storage
         nonempty = self.nb_total_used() > 0
         mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt)
@@ -299,7 +274,7 @@ class Counts:
         # history: at step n the exact lags 2..min(Lx, n+1) (plain: n) and, once
         # lags beyond Lx are reached, the k interpolating matrices
         n = np.arange(1, self.steps + 1)
-        from .bem.partition import lag_uses
+        from .partition import lag_uses
         uses = lag_uses(Lx, self.steps, self.stabilized, self.k)     # steps in which each stored matrix is used
         fd = fs = 0.0
         if self.block > 1:
@@ -327,7 +302,7 @@ class Counts:
         key = (len(n), len(used))
         if getattr(self, "_uses", (None,))[0] == key:      # the same for every rank and rank count
             return self._uses[1]
-        from .bem.march import block_terms
+        from .march import block_terms
         b, s, Lx = self.block, self.sub, self.Lx
         steps_in, width = np.zeros(len(used)), np.zeros(len(used))
         for j in range(2, Lx + 1):
@@ -381,80 +356,148 @@ def predict(cnt, c, p, q, cores):
     return t
 
 
-def setup(cfg, comm, ranks, node_mem):
-    """Collective: the BEM set-up of a run without assembly, and its counts."""
-    from .bem.run import BEMProblem
-    from .bem.model import machine_memory
-    quiet = lambda m: None
-    t0 = time.perf_counter()
-    prob = BEMProblem(cfg, comm, log=quiet)
-    plan = prob.interp_plan()
-    ls = prob.lagset(plan)
-    limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
-    cnt = Counts(prob, plan, ls, ranks, limit, comm)
-    cnt.setup_s = time.perf_counter() - t0
-    return prob, plan, cnt
+CACHE_MAX = 512 << 20
 
 
-def report(cfg, comm, out=None):
-    """Collective: print the estimate block (rank 0) and return its numbers."""
-    from .petsc import printf
-    from .bem.model import machine_memory
-    out = out or printf
-    ranks = parse_ranks(cfg.estimate_ranks)
-    cores = cfg.estimate_cores_per_node or (os.cpu_count() or 1)
-    q = cfg.estimate_ranks_per_node or cores
-    node_mem = cfg.estimate_node_memory * 1e9 if cfg.estimate_node_memory > 0 else machine_memory()
-    c, source = load_constants(cfg.estimate_constants)
-    prob, plan, cnt = setup(cfg, comm, ranks, node_mem)
-    nd = int(cnt.storage.sum())
-    n1 = int(cnt.single.sum())
-    ns = len(cnt.storage) - nd - n1
-    lines = [f"[ssi] estimate of this BEM run (model petsc_ssi/estimate.py; constants {source})",
-             f"[ssi]   {3 * cnt.N} DOFs ({cnt.N} nodes), {cnt.Ev} elements with images, {cnt.steps} steps, "
-             f"{cnt.nt} traction nodes; lags stored {cnt.Lx + cnt.k} ({cnt.Lx} exact + {cnt.k} interpolating, "
-             f"of {cnt.L} the run reaches): {nd} dense, {ns} block-sparse"
-             + (f", {n1} single-precision block-sparse" if n1 else "")
-             + (" (all block-sparse: the dense choice would not fit the limit)" if cnt.fill > 1 else ""),
-             f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
-             f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",
-             "[ssi]   ranks nodes | setup_s assembly_s factor_s history_s solve_s time_loop_s | total | "
-             "peak_GB GB/rank_max GB/node | fits"]
-    rows = []
-    for p in ranks:
-        t = predict(cnt, c, p, q, cores)
-        nodes = int(math.ceil(p / float(q)))
-        per_node = t["peak_bytes"] / p * min(q, p)
-        per_node = max(per_node, t["peak_rank_bytes"] * min(q, p) if p == 1 else per_node)
-        fits = per_node <= 0.9 * node_mem
-        refuse = _refuses(cnt, p, q)
-        flag = "yes" if fits else "NO"
-        if refuse:
-            flag += "; the run's memory check would refuse it (-ssi_memory_limit)"
-        if min(q, p) > cores:
-            flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
-        t.update({"ranks": p, "nodes": nodes, "node_bytes": per_node, "fits": fits})
-        rows.append(t)
-        lines.append(f"[ssi]   {p:5d} {nodes:5d} | {t['setup']:7.3g} {t['assembly']:10.4g} {t['factor']:8.3g} "
-                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
-                     f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
-    ok = [r for r in rows if r["fits"]]
-    if ok:
-        best = min(ok, key=lambda r: r["total"])
-        lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
-                     f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
-    else:
-        lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
-                     f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
-    lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
-                 f"-log_view times; the model's measured error: jobscripts/README.md)")
-    out("\n".join(lines))
-    return {"counts": cnt, "rows": rows}
+def _per_row(n_nodes, lag_hi):
+    """Bytes of raw triplets one row may need in a numba call (96 B per block, 2x over-allocated)."""
+    return 96.0 * 2 * n_nodes * max(lag_hi, 1) * 0.6
 
 
-def _refuses(cnt, p, q):
-    """Whether the run's own check (BEMProblem.check_memory: the estimated peak shared
-    by the ranks, the most loaded node's part against the per-node limit) refuses it."""
-    used = cnt.nb_total_used()
-    return cnt._peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
+def _chunk_rows(n_nodes, lag_hi, n_rows):
+    return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
 
+
+def lag_bytes(used, dense, single, n_cols, n_rows, n_t):
+    """Per stored matrix (arrays over them): (bytes of its Mat, of its assembly buckets, of its G),
+    for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns: dense 72 B per block of the
+    whole row block, block-sparse 76 B per stored block (9 doubles, an int32 column), single
+    precision (``single``: -ssi_lag_single_from) 40 B (9 floats, a column) whatever the fill; the
+    buckets take the same bytes (their 15 % headroom is allocated but never touched, so not
+    resident); G (the ``n_t`` traction columns) dense, or at most 40 B per block single."""
+    single = np.asarray(single, bool)
+    dense = np.asarray(dense, bool) & ~single
+    mats = np.where(single, 40.0 * used, np.where(dense, 72.0 * n_cols * n_rows, 76.0 * used))
+    trip = np.where(single, 40.0, 76.0) * used
+    g = np.where(single, 40.0, 72.0) * n_rows * max(n_t, 1)
+    return mats, trip, g
+
+
+def single_lags(lags, single_from):
+    """Mask over ``lags`` (lag indices of the stored matrices): kept in single precision."""
+    lags = np.asarray(lags)
+    return (lags >= single_from) if single_from > 0 else np.zeros(lags.shape, bool)
+
+
+def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
+    """Bytes a rank holds beside the triplets and Mats: while it assembles, the element cache
+    (``cache`` bytes as counted from the pair geometries, ``LagSet.cache_estimate``, or without it
+    the bound of 324 B per block of its rows; each of its two pools capped at CACHE_MAX) and one
+    chunk of raw triplets with its sorted copy; throughout, the process as it stands (resident size
+    now, measured). ``parts``: (assembly-only bytes, process bytes), else their sum."""
+    cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
+    # a chunk's triplet arrays are allocated for twice the blocks they get (``_per_row``): the half
+    # touched and the sorted copy of it
+    chunk = _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
+    return (cache + chunk, process_rss()) if parts else cache + chunk + process_rss()
+
+
+def peak_bytes(mats, trip, g, asm, rss, n_exact=None, asm_interp=0.0):
+    """The memory check's peak (bytes, all ranks; ``LagSet.estimate_memory`` and ``petsc-ssi
+    estimate``'s storage rule): 1.1 x the largest of the phases, with G (``g``) and the process
+    (``rss``) throughout: assembling the exact lags (their blocks ``trip`` of the first ``n_exact``
+    matrices, with the element cache and a chunk, ``asm``); building their Mats (``mats`` of lags
+    <= k and blocks of lags > k); assembling each interpolating matrix after them (the exact Mats,
+    the interpolating ones before it, its blocks, its own cache and chunk, ``asm_interp``)."""
+    mats, trip = np.asarray(mats, float), np.asarray(trip, float)
+    n = len(mats) if n_exact is None else int(n_exact)
+    me, te = mats[:n], trip[:n]
+    phases = [te.sum() + asm]
+    if n:
+        phases.append(float((np.cumsum(me) + (te.sum() - np.cumsum(te))).max()))
+    mi, ti = mats[n:], trip[n:]
+    for j in range(len(mi)):
+        phases.append(me.sum() + mi[:j].sum() + ti[j] + asm_interp)
+    return 1.1 * (max(phases) + float(np.sum(g)) + rss)
+
+
+# One core's rates on the development machine (jobscripts/dgemm_rate.py): the dense panel product
+# x @ A^T and the block-sparse panel kernel (bem/bsr.py) in GF/s at b = 8, 16, 32 states, and the
+# matrix streaming rate of a per-step product in GB/s. Only the automatic block size uses them.
+PANEL_B = (8, 16, 32)
+
+
+PANEL_DENSE_GFPS = (19.7, 27.7, 38.1)
+
+
+PANEL_SPARSE_GFPS = (8.2, 18.8, 32.2)
+
+
+STREAM_GBPS = 22.0
+
+
+def _sub_candidates(b, sub=0):
+    """The sub-block sizes tried with blocks of b steps: ``sub`` if set, else b (one level) and
+    b/2, b/4 down to 8 steps (narrower panels run below the streaming rate of a product)."""
+    if sub:
+        return (min(sub, b),)
+    return tuple(sorted({b} | {b // q for q in (2, 4) if b // q >= 8}, reverse=True))
+
+
+def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
+                 sparse_blocks=None, sub=0):
+    """(b, s): the steps per block and per sub-block that minimise the modelled time per step of the
+    history sum, from the bytes of each stored matrix (index 0: lag 1, ..., then the interpolating
+    ones, taken as the lags that follow; dense and block-sparse apart): in a block of a run long
+    enough to reach every lag (``march.block_terms``), its panel products at the rates above for
+    their widths (2 flops per stored value and state) and the per-step products, streamed. b = 1
+    streams every matrix every step. ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices
+    (18 flops each per state; default their bytes / 76, the double blocks; single-precision ones
+    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too). Step by step is an
+    outcome only when 1 is a candidate: a user's -ssi_history_block b (candidates (b,)) is kept."""
+    from .march import block_terms
+    d = np.asarray(dense_bytes, float)
+    s = np.asarray(sparse_bytes, float)
+    sb = s / 76.0 if sparse_blocks is None else np.asarray(sparse_blocks, float)
+    every = d + s
+    nmat = len(every)
+    best, best_t = ((1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)) if 1 in candidates else (None, np.inf)
+
+    def rates(w):                                         # the panel rates at width w, flop/s
+        return np.interp(w, PANEL_B, PANEL_DENSE_GFPS) * 1e9, np.interp(w, PANEL_B, PANEL_SPARSE_GFPS) * 1e9
+    for b in candidates:
+        if b < 2:
+            continue
+        n = b * (-(-(nmat + 3) // b)) + 1 + np.arange(b)      # one block past every lag's start
+        for sub_b in _sub_candidates(b, sub):
+            rate = {w: rates(w) for w in (b, sub_b)}
+            t = 0.0
+            for i in range(1, nmat):
+                if every[i] == 0.0:
+                    continue
+                # a lag from b + 2 on reads only states known at the block's start
+                steps, wb, ws = block_terms(n, [i + 1], b, sub_b, stabilized) if i + 1 < b + 2 else (0, b, 0)
+                for w, cnt in ((b, wb / b), (sub_b, ws / sub_b)):
+                    if cnt:
+                        rd, rs = rate[w]
+                        t += cnt * w * (d[i] * 2 / 8 / rd + sb[i] * 18 / rs)
+                t += steps * every[i] / (STREAM_GBPS * 1e9)
+            t /= b
+            if t < best_t or best is None:
+                best, best_t = (b, sub_b), t
+    return best
+
+
+def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
+    """(b, s): the steps per block of the time-blocked history sum and per sub-block:
+    -ssi_history_block and -ssi_history_sub, or with 0 the ``choose_block`` of the stored
+    matrices' bytes (b = 1 without them)."""
+    b = int(cfg.get("history_block") or 0)
+    sub = int(cfg.get("history_sub") or 0)
+    if b and (sub or b == 1 or dense_bytes is None):
+        return b, min(sub, b) if sub else b
+    if dense_bytes is None:
+        return 1, 1
+    return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
+                        candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
+                        sub=sub)

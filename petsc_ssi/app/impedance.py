@@ -38,8 +38,9 @@ import time
 
 import numpy as np
 
-from .options import register
-from .petsc import init, SSIError, printf, warn
+from ..options import register
+from ..petsc import init, SSIError, printf, warn
+from ..bem.impedance import step_spectrum, spectrum, rigid_fit
 
 G = "impedance"
 register("impedance_modes", "str", "vertical,horizontal,rocking,torsion", "", "petsc-ssi impedance: the modes to "
@@ -67,59 +68,13 @@ CROSS = {"horizontal": ("horizontal-rocking", "moment", 1),      # M_y per unit 
          "rocking": ("rocking-horizontal", "force", 0)}          # F_x per unit theta_y
 
 
-def step_spectrum(s, dt, traction=False, pad=8):
-    """(omega, S(omega)): the FFT of the first differences of a series s_n, n = 1..K, that starts
-    from rest and settles (s_0 = 0), zero-padded to ``pad`` times the next power of two. A traction
-    resultant (``traction``: the mean over (t_{n-1}, t_n]) is moved by half a step to t_n, where
-    displacements are sampled: times exp(i omega dt/2)."""
-    s = np.asarray(s, dtype=float)
-    n = pad * (1 << int(math.ceil(math.log2(max(len(s), 2)))))
-    om = 2 * np.pi * np.fft.rfftfreq(n, dt)
-    S = np.fft.rfft(np.diff(np.r_[0.0, s], axis=0), n, axis=0)
-    if traction:
-        S = S * np.exp(1j * om * dt / 2).reshape((-1,) + (1,) * (S.ndim - 1))
-    return om, S
-
-
-def spectrum(R, h, dt, pad=8):
-    """(omega, K(omega)) from the resultant R_n and the motion factor h_n, n = 1..K (module docstring)."""
-    om, SR = step_spectrum(R, dt, traction=True, pad=pad)
-    return om, SR / step_spectrum(h, dt, pad=pad)[1]
-
-
-def rigid_fit(x, u, x_ref=(0.0, 0.0, 0.0)):
-    """Least-squares rigid motion of nodal displacements: u_i ~ t + theta x (x_i - x_ref).
-
-    x (n, 3) node positions, u (..., n, 3) displacements (any leading axes, e.g. steps). Returns
-    (t (..., 3), theta (..., 3), residual): the translation, the small rotation about x_ref and
-    max |u - fit| / max |u| (how rigid the motion is). For a foundation that is not rigid (a
-    flexible block, a slab) this is the rigid-body part of its interface motion."""
-    r = np.asarray(x, dtype=float) - np.asarray(x_ref, dtype=float)
-    u = np.asarray(u, dtype=float)
-    n = len(r)
-    A = np.zeros((n, 3, 6))
-    A[:, :, :3] = np.eye(3)
-    A[:, 0, 4], A[:, 0, 5] = r[:, 2], -r[:, 1]      # theta x r = (th_y r_z - th_z r_y, ...)
-    A[:, 1, 3], A[:, 1, 5] = -r[:, 2], r[:, 0]
-    A[:, 2, 3], A[:, 2, 4] = r[:, 1], -r[:, 0]
-    A = A.reshape(3 * n, 6)
-    lead = u.shape[:-2]
-    b = u.reshape(-1, 3 * n).T
-    sol, *_ = np.linalg.lstsq(A, b, rcond=None)
-    fit = (A @ sol).T.reshape(u.shape)
-    scale = np.abs(u).max()
-    resid = float(np.abs(u - fit).max() / scale) if scale > 0 else 0.0
-    sol = sol.T.reshape(lead + (6,))
-    return sol[..., :3], sol[..., 3:], resid
-
-
 def _region_geometry(prob):
     """The prescribed region, whole (the modelled part times its symmetry images: x, x^2 and y^2
     are even under the reflections), by 6 x 6 Gauss points: {'hx', 'hy'} half-extents, 'A' area,
     'Ix' = int y^2, 'Iy' = int x^2, 'J' = Ix + Iy, and 'shape': 'rectangle' (A = 4 hx hy), 'disk'
     (hx = hy, A = pi hx^2, to 1e-3) or 'other'."""
-    from .bem import symmetry
-    from .mesh import quad9
+    from ..bem import symmetry
+    from ..mesh import quad9
     g, w = np.polynomial.legendre.leggauss(6)
     xi, eta = (v.ravel() for v in np.meshgrid(g, g, indexing="ij"))
     X = prob.mesh.cell_coords()[prob.regions.disp_elems]
@@ -156,7 +111,7 @@ def surface_extent(prob):
 def extent_limit(prob, B, cs, cp):
     """The lowest a0 the meshed surface is trusted for: one Rayleigh wavelength across it,
     2 pi c_R / omega <= L, i.e. a0 >= 2 pi B c_R / (c_s L) (module docstring)."""
-    from .analytic.pekeris import arrivals, poisson_ratio
+    from ..analytic.pekeris import arrivals, poisson_ratio
     gamma = arrivals(poisson_ratio(cs, cp))[2]          # c_s / c_R
     return 2 * np.pi * B / (gamma * surface_extent(prob))
 
@@ -167,7 +122,7 @@ def _reference(geom, mode, a0, nu, name):
     shape = geom["shape"]
     if name == "none" or shape == "other":
         return None
-    from .analytic import impedance_refs as refs
+    from ..analytic import impedance_refs as refs
     if name in ("auto", "pais-kausel") and shape == "rectangle":
         B, L = min(geom["hx"], geom["hy"]), max(geom["hx"], geom["hy"])
         if geom["hx"] < geom["hy"]:          # the long side along y: our x motions are P&K's y ones
@@ -199,8 +154,8 @@ def main():
     """Collective: the ``petsc-ssi impedance`` command (PETSc already initialised)."""
     PETSc = init()
     comm = PETSc.COMM_WORLD
-    from . import options
-    from .bem.problem import BEMTransient
+    from .. import options
+    from ..bem.problem import BEMTransient
     db = PETSc.Options()
     cfg0 = options.resolve(("common", "bem", G))
     modes = [m.strip() for m in cfg0.impedance_modes.split(",") if m.strip()]

@@ -1,17 +1,19 @@
-"""BEM model set-up: regions, lags, memory estimate, assembly into PETSc Mats.
+"""The lag set of a BEM run: material, regions, the node partition, the memory estimate and the
+assembly of the lag matrices (``LagSet``), and the per-lag block buckets it fills.
 
 Collective functions say so. Rows (collocation DOFs, 3 per node) are split by
 the ownership ranges of a PETSc Vec of size 3N with block size 3; each rank
 computes only the rows it owns, with no gather of matrices.
 """
-import math
 import os
-import time
 
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error, printf, warn
+from ..petsc import SSIError, collective, collective_error, printf
 from ..monitor import Progress, event
+from .cost import (CACHE_MAX, _per_row, _chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
+                   pair_table, cache_counts)
+from .windows import bounding_spheres, estimate_blocks
 from . import symmetry
 from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records,
                        cache_insert, SING_TOL)
@@ -55,162 +57,6 @@ class Regions:
         self.tnode = np.concatenate([self.load_nodes, self.disp_nodes])  # node of each traction column
 
 
-def causal_lags(r_max, mat, dt):
-    """Lags that can be non-zero: the P kernel vanishes once (l-2) dt > r/c_s."""
-    return int(math.floor(r_max / (mat.cs * dt))) + 2
-
-
-def bounding_spheres(VX):
-    c = VX[:, 8, :].copy()
-    R = 1.1 * np.linalg.norm(VX - c[:, None, :], axis=2).max(axis=1) + 1e-12
-    # element size: the longest of the four sides (corner to mid-side node, twice), independent of
-    # which corner is node 0 (an element and its mirror image get the same size, so the same
-    # near-field subdivisions: half and full models then integrate the same pairs alike)
-    sides = [np.linalg.norm(VX[:, m] - VX[:, a], axis=1) for a, m in ((0, 4), (1, 5), (2, 6), (3, 7),
-                                                                      (1, 4), (2, 5), (3, 6), (0, 7))]
-    h = np.max(sides, axis=0) * 2
-    return c, R, h
-
-
-def pair_windows(xc, Vc, VR, L, mat, dt, n_images=1):
-    """The lags 1..L each (point, element) pair reaches: (lo, hi, ok) of shape (points, elements
-    without images), from the bounding spheres (the P wave's arrival to the S wave's passing, plus
-    2), as the union over the element's symmetry images (they fold onto the same columns)."""
-    E = len(Vc) // n_images
-    d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
-    lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
-    hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
-    n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
-    lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
-    hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
-    return lo, hi, np.isfinite(lo) & (hi >= lo)
-
-
-def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
-    """Estimated number of non-zero 3x3 blocks of each H lag (array, index
-    l-1) in ``rows``: for each (row, element) the lags its wave window touches
-    (union over the element's symmetry images, which fold onto the same
-    columns), times four nodes per element (a node is shared by about four)."""
-    diff = np.zeros(L + 2)
-    for s in range(0, len(rows), chunk):
-        lo, hi, ok = pair_windows(xnodes[rows[s:s + chunk]], Vc, VR, L, mat, dt, n_images)
-        np.add.at(diff, lo[ok].astype(np.int64), 4.0)
-        np.add.at(diff, hi[ok].astype(np.int64) + 1, -4.0)
-    return np.cumsum(diff)[1:L + 1]
-
-
-def _cgroup_limit(proc="/proc/self/cgroup", root="/sys/fs/cgroup"):
-    """The memory limit of this process's cgroup (v2 memory.max, or v1 memory.limit_in_bytes), in
-    bytes, or inf: a batch job or container may have less than the machine."""
-    paths = []
-    try:
-        with open(proc) as fh:
-            for line in fh:
-                parts = line.strip().split(":", 2)
-                if len(parts) == 3 and (parts[1] == "" or "memory" in parts[1].split(",")):
-                    rel = parts[2].lstrip("/")
-                    if parts[1] == "":
-                        paths += [os.path.join(root, rel, "memory.max"), os.path.join(root, "memory.max")]
-                    else:
-                        paths += [os.path.join(root, "memory", rel, "memory.limit_in_bytes"),
-                                  os.path.join(root, "memory", "memory.limit_in_bytes")]
-    except OSError:
-        pass
-    best = float("inf")
-    for p in paths:
-        try:
-            with open(p) as fh:
-                v = fh.read().strip()
-        except OSError:
-            continue
-        if v and v != "max":
-            try:
-                best = min(best, float(v))
-            except ValueError:
-                pass
-    return best if best < 2 ** 60 else float("inf")      # cgroup v1 writes ~2^63 for "no limit"
-
-
-def machine_memory():
-    """Bytes of memory this process may use: the machine's (MemTotal), or its cgroup's limit when
-    that is lower (``_cgroup_limit``)."""
-    total = float("inf")
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemTotal"):
-                    total = float(line.split()[1]) * 1024
-                    break
-    except OSError:
-        pass
-    return min(total, _cgroup_limit())
-
-
-CACHE_MAX = 512 << 20
-
-
-def _per_row(n_nodes, lag_hi):
-    """Bytes of raw triplets one row may need in a numba call (96 B per block, 2x over-allocated)."""
-    return 96.0 * 2 * n_nodes * max(lag_hi, 1) * 0.6
-
-
-def _chunk_rows(n_nodes, lag_hi, n_rows):
-    return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
-
-
-def lag_bytes(used, dense, single, n_cols, n_rows, n_t):
-    """Per stored matrix (arrays over them): (bytes of its Mat, of its assembly buckets, of its G),
-    for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns: dense 72 B per block of the
-    whole row block, block-sparse 76 B per stored block (9 doubles, an int32 column), single
-    precision (``single``: -ssi_lag_single_from) 40 B (9 floats, a column) whatever the fill; the
-    buckets take the same bytes (their 15 % headroom is allocated but never touched, so not
-    resident); G (the ``n_t`` traction columns) dense, or at most 40 B per block single."""
-    single = np.asarray(single, bool)
-    dense = np.asarray(dense, bool) & ~single
-    mats = np.where(single, 40.0 * used, np.where(dense, 72.0 * n_cols * n_rows, 76.0 * used))
-    trip = np.where(single, 40.0, 76.0) * used
-    g = np.where(single, 40.0, 72.0) * n_rows * max(n_t, 1)
-    return mats, trip, g
-
-
-def single_lags(lags, single_from):
-    """Mask over ``lags`` (lag indices of the stored matrices): kept in single precision."""
-    lags = np.asarray(lags)
-    return (lags >= single_from) if single_from > 0 else np.zeros(lags.shape, bool)
-
-
-def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
-    """Bytes a rank holds beside the triplets and Mats: while it assembles, the element cache
-    (``cache`` bytes as counted from the pair geometries, ``LagSet.cache_estimate``, or without it
-    the bound of 324 B per block of its rows; each of its two pools capped at CACHE_MAX) and one
-    chunk of raw triplets with its sorted copy; throughout, the process as it stands (resident size
-    now, measured). ``parts``: (assembly-only bytes, process bytes), else their sum."""
-    cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
-    # a chunk's triplet arrays are allocated for twice the blocks they get (``_per_row``): the half
-    # touched and the sorted copy of it
-    chunk = _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
-    return (cache + chunk, process_rss()) if parts else cache + chunk + process_rss()
-
-
-def peak_bytes(mats, trip, g, asm, rss, n_exact=None, asm_interp=0.0):
-    """The memory check's peak (bytes, all ranks; ``LagSet.estimate_memory`` and ``petsc-ssi
-    estimate``'s storage rule): 1.1 x the largest of the phases, with G (``g``) and the process
-    (``rss``) throughout: assembling the exact lags (their blocks ``trip`` of the first ``n_exact``
-    matrices, with the element cache and a chunk, ``asm``); building their Mats (``mats`` of lags
-    <= k and blocks of lags > k); assembling each interpolating matrix after them (the exact Mats,
-    the interpolating ones before it, its blocks, its own cache and chunk, ``asm_interp``)."""
-    mats, trip = np.asarray(mats, float), np.asarray(trip, float)
-    n = len(mats) if n_exact is None else int(n_exact)
-    me, te = mats[:n], trip[:n]
-    phases = [te.sum() + asm]
-    if n:
-        phases.append(float((np.cumsum(me) + (te.sum() - np.cumsum(te))).max()))
-    mi, ti = mats[n:], trip[n:]
-    for j in range(len(mi)):
-        phases.append(me.sum() + mi[:j].sum() + ti[j] + asm_interp)
-    return 1.1 * (max(phases) + float(np.sum(g)) + rss)
-
-
 _KERNELS_LOADED = []
 
 
@@ -243,7 +89,7 @@ def announce_compile():
         _ANNOUNCED.append(True)
         printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
                f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
-               "'python -m petsc_ssi.warmup' or 'make deps' does it ahead)")
+               "'python -m petsc_ssi.app.warmup' or 'make deps' does it ahead)")
 
 
 class _NoEvent:
@@ -252,23 +98,6 @@ class _NoEvent:
 
     def end(self):
         pass
-
-
-def proc_status_bytes(field):
-    """A memory field of /proc/self/status ('VmRSS', 'VmHWM'), bytes; None where /proc is missing."""
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith(field + ":"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    return None
-
-
-def process_rss():
-    """This process's resident memory now (bytes; 0 where /proc is missing)."""
-    return proc_status_bytes("VmRSS") or 0.0
 
 
 class Buckets:
@@ -506,7 +335,6 @@ class LagSet:
             return 0.0
         key = (int(lags), tuple(extra_lags))
         if getattr(self, "_cache_est", (None,))[0] != key:
-            from ..estimate import pair_table, cache_counts
             table = pair_table(self, self, max([lags] + list(extra_lags)), rows=self.rows)
             r0, r1 = self.node_range
             pool = cache_counts(table, r0, r1, self.CACHE_MAX / 8, lags, extra_lags)[1]
@@ -531,15 +359,11 @@ class LagSet:
         mpi = self.comm.tompi4py()
         from mpi4py import MPI
         p = mpi.Get_size()
-        err = None
-        try:
+        with collective(self.comm, "listing the element-cache geometries"):     # e.g. MemoryError on one rank
             keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
                                                   self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
                                                   o["subdivisions"], o["near_factor"], o["max_subdivisions"],
                                                   SING_TOL, qinv, lag_lo, toff, self.CACHE_MAX)
-        except Exception as exc:         # e.g. MemoryError on one rank: every rank stops, none waits
-            err = f"listing the element-cache geometries failed on rank {mpi.Get_rank()}: {exc!r}"
-        collective_error(err, self.comm)
         owner = np.mod(_mix64(hs), p)
         mine = [np.nonzero(owner == r)[0] for r in range(p)]
         got = mpi.alltoall([(keys[i], hs[i], meta[i], pts[i]) for i in mine])
@@ -550,14 +374,10 @@ class LagSet:
         umeta = allm[first].copy()
         np.maximum.at(umeta[:, 4], inv, allm[:, 4])
         allh = None
-        try:
+        with collective(self.comm, "integrating the shared element-cache geometries"):
             off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
                                                      lag_hi, self.dt, self.mat.cp, self.mat.cs, self.mat.rho,
                                                      self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()))
-            err = None
-        except Exception as exc:
-            err = f"integrating the shared element-cache geometries failed on rank {mpi.Get_rank()}: {exc!r}"
-        collective_error(err, self.comm)
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
         seg = np.cumsum([0] + [len(g[2]) for g in got])
         jobs = []

@@ -36,67 +36,14 @@ Outputs: the soil fields in -ssi_output (quad9), the structure's in
 p_b, gap, p_N, status, open count, iterations, force resultants of both
 sides) in the group "interface" of -ssi_output.
 """
-import os
 import time
 
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error, printf
+from ..petsc import init
 from ..monitor import event
-from ..io.output import provenance
-from ..options import Config
-from ..bem.run import BEMProblem
-from ..bem.model import Regions
-from ..fem.model import build_model
-from ..fem.run import receiver_record
-from ..mesh import quad9
-from .interface import build_interface, fem_symmetry_dofs, force_matrix, InterfaceOperator, interface_offsets
+from .interface import force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
-
-
-def _view(cfg, **changes):
-    """A copy of the options with some values replaced."""
-    vals = cfg.as_dict()
-    vals.update(changes)
-    return Config(vals, cfg.sources())
-
-
-def setup(cfg, comm):
-    """Collective: the soil problem, the structure's model (not assembled) and the
-    interface, all checked. Returns (prob, model, iface, fe_cfg)."""
-    from .options import ignored_contact_options
-    from ..petsc import warn
-    ignored = ignored_contact_options(cfg)
-    if ignored:
-        warn(f"{' '.join(ignored)} act{'s' if len(ignored) == 1 else ''} only with -ssi_contact unilateral; "
-             f"ignored (the interface is {cfg.contact})", comm)
-    prob = BEMProblem(cfg, comm, log=printf)
-    fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
-    model = build_model(fe_cfg, comm, assemble_matrices=False)
-    err, iface, sym = None, None, None
-    try:
-        iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
-                                prob.planes, prob.h)
-        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.layout)
-        load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
-        both = np.intersect1d(load, iface.be_elems)
-        if both.size:
-            raise SSIError(f"-ssi_load_group {cfg.load_group}: {both.size} loaded soil elements lie under the "
-                           "structure (the interface); load the structure instead (-ssi_fem_load_*)")
-        prob.regions = Regions(prob.mesh, load, iface.be_elems)
-        if not np.array_equal(prob.regions.disp_nodes, iface.be_nodes):
-            raise SSIError("interface: internal error, node order of the soil regions differs")
-    except SSIError as exc:
-        err = str(exc)
-    collective_error(err, comm)
-    # a load on the soil away from the structure (an incident wave field, total field): the
-    # structure is a point of interest for the edge-diffraction warning and the interpolation rule
-    prob.sites = iface.x
-    prob.diffraction_warning(iface.x, "the structure (interface nodes)")
-    model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
-    model.layout.set_fixed(model.fixed)
-    return prob, model, iface, fe_cfg
-
 
 class StaggeredStep:
     """The paper's staggered step (Table 2): FEM predictor (Green's-function integrator), the BEM
@@ -379,51 +326,3 @@ def _area_weights(mesh, iface, order=6):
     elements (an independent quadrature of the traction resultants)."""
     from ..bem.resultants import area_moments
     return area_moments(mesh, iface.be_elems, iface.be_nodes, order)
-
-
-def run_ssi(cfg, comm=None):
-    """Collective: the coupled run (``problem.SSITransient``). Returns a dict of results (series on
-    rank 0)."""
-    from .problem import SSITransient
-    return SSITransient(cfg, comm).run()
-
-
-def interface_bytes(cfg, prob, model, iface, ranks):
-    """Estimated bytes of the coupling's dense interface matrices over all ranks: the local rows
-    of Z = A^-1 H_s E_I (soil dofs x 3 n_I) and, implicit, of D^-1 T^T (structure dofs x 3 n_I);
-    on every rank Z_II, M3, C (3 n_I)^2 each and the interface LUs (one bonded; a cache of at
-    most 512 MB with unilateral contact)."""
-    n = 3 * iface.n
-    b = 8.0 * 3 * prob.mesh.n_nodes * n + 3 * 8.0 * n * n * ranks
-    if cfg.coupling == "implicit":
-        b += 8.0 * model.layout.size * n + 8.0 * n * n * ranks
-    lu = 8.0 * n * n
-    b += ranks * (max(lu, 512e6) if cfg.contact == "unilateral" else lu)
-    return b
-
-
-def structure_output_path(path):
-    stem, ext = os.path.splitext(path)
-    return stem + "_structure" + (ext or ".h5")
-
-
-def _finish(cfg, comm, prob, model, iface, res, am, status="completed", final=True):
-    """Collective: both outputs (soil with the interface series, structure) with receivers,
-    attributes and the run record; ``final``: close them (else flush: readable, still open)."""
-    out, sout = res.pop("_outputs")
-    attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
-             "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
-             "structure_output": os.path.basename(structure_output_path(cfg.output))}
-    rec_ = provenance(cfg, comm, {"stats": res["stats"]})
-    recd = None
-    if res["u"] is not None:
-        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
-    with event("SSI_IO"):
-        inter = res["interface"] if comm.getRank() == 0 else None
-        (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
-                                            groups={"interface": inter} if inter is not None else None)
-        srecd = None
-        if comm.getRank() == 0 and len(model.receiver_nodes):
-            srecd = receiver_record(model, res["structure"])
-        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
-                                                                      "dt": cfg.dt}, record=None, status=status)

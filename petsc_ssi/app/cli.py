@@ -38,10 +38,10 @@ def _bad_command(argv):
 def versions():
     """One line per component: petsc-ssi, Python, PETSc, petsc4py, mpi4py, numpy."""
     import platform
-    from . import __version__
+    from .. import __version__
     lines = [f"petsc-ssi {__version__}", f"Python {platform.python_version()}"]
     try:
-        from .petsc import init
+        from ..petsc import init
         PETSc = init([sys.argv[0]])
         import petsc4py
         lines.append("PETSc {}.{}.{}".format(*PETSc.Sys.getVersion()) + f", petsc4py {petsc4py.__version__}")
@@ -84,7 +84,7 @@ def main(argv=None):
             print(bad, flush=True)
         return 2
     if any(a in ("--version", "-version") for a in argv[1:]):
-        from .petsc import init
+        from ..petsc import init
         init([argv[0]])
         from mpi4py import MPI
         if MPI.COMM_WORLD.Get_rank() == 0:
@@ -94,34 +94,29 @@ def main(argv=None):
     if cmd == "post":
         from .post import main as post_main
         return post_main(rest[1:])
-    from .petsc import init, SSIError
+    from ..petsc import init, SSIError
     PETSc = init(rest)
-    from . import options
-    if cmd == "estimate":
-        from . import estimate  # noqa: F401  (declares the -ssi_estimate_ options, also for -help)
+    from .. import options
+    from . import kinds, estimate, impedance  # noqa: F401  (every option declared, also for -help)
     if cmd == "help" or "-help" in rest or "--help" in rest:
         PETSc.Sys.Print(__doc__.split("Errors in the input")[0].rstrip() + "\n")
         PETSc.Sys.Print(options.help_text())
         return 0                # help prints and exits: it never starts a run
     try:
         if cmd == "run":
-            from .driver import run
-            run()
+            kinds.run()
         elif cmd == "static":
-            from .fem.static import main as static_main
+            from .static import main as static_main
             static_main()
         elif cmd == "modes":
-            from .fem.modes import main as modes_main
+            from .modes import main as modes_main
             modes_main()
         elif cmd == "estimate":
-            from .driver import estimate
-            estimate()
+            estimate.main()
         elif cmd == "impedance":
-            from .impedance import main as impedance_main
-            impedance_main()
+            impedance.main()
         if cmd != "estimate":
-            from .petsc import warn_unused_options
-            warn_unused_options()
+            options.warn_unused_options()
     except SSIError as exc:
         PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
         sys.stdout.flush()

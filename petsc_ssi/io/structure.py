@@ -1,24 +1,9 @@
-"""``-ssi_problem fem``: the structure alone, time-stepped (paper Section 3).
-
-Collective. Steps: the load history (already read and checked with the
-options, before any heavy work), build the model (mesh, checks, K, M), alpha_m, the
-integrator (D factorised once), then for n = 1..N: u^n (eq. 13), the load
-sample f^n (mean of f over [t_n - dt/2, t_n + dt/2]) as a velocity impulse
-(eqs. 14, 16); displacement and velocity every -ssi_output_stride steps, the
-receiver series every step. PETSc log events: FEM_assembly, FEM_factor,
-FEM_timeloop, FEM_io.
-"""
-import os
-
+"""The structure's writers: its mesh and nodal fields in an Output (``FieldWriter``), the series
+of its receivers (``ReceiverSeries``) and their output group (``receiver_record``). Collective
+unless said otherwise."""
 import numpy as np
 
-from ..petsc import init, SSIError, collective_error, printf
-from ..monitor import event
-from ..io.output import provenance
-from .integrators import make_integrator, green_constants
-from .loads import history_from
-from .model import build_model
-from .options import alpha_m
+from ..petsc import init
 
 
 class ReceiverSeries:
@@ -86,46 +71,6 @@ class ReceiverSeries:
         return out
 
 
-def load_history(cfg, comm):
-    """Collective: the load history (the option checks read it once already)."""
-    err, hist = None, None
-    try:
-        hist = history_from(cfg)
-    except SSIError as exc:
-        err = f"-ssi_fem_load_history {cfg.fem_load_history}: {exc}"
-    collective_error(err, comm)
-    return hist
-
-
-def near_null_args(solver, model):
-    """(coords_vec, near_null) for make_solver: none for a direct solver; PETSc's rigid-body
-    modes of the coordinates for a brick-only model; the dof map's six modes otherwise."""
-    if solver != "iterative":
-        return None, None
-    if model.layout.uniform3:
-        return model.coords_vec(), None
-    return None, model.layout.near_null_space(model.mesh.coords)
-
-
-def make_model_integrator(cfg, comm, model=None):
-    """Collective: (model, integrator, alpha_m) for the options ``cfg``."""
-    model = model or build_model(cfg, comm)
-    am, note = alpha_m(cfg)
-    printf(f"[fem] {note}; integrator {cfg.fem_integrator}, solver {cfg.fem_solver}")
-    coords, near = near_null_args(cfg.fem_solver, model)
-    integ = make_integrator(cfg.fem_integrator, model.K, model.m, cfg.dt, am, model.fixed,
-                            cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
-                            coords_vec=coords, near_null=near)
-    return model, integ, am
-
-
-def run_fem(cfg, comm=None):
-    """Collective: run the case (``problem.FEMTransient``); returns a summary dict (receiver series
-    on rank 0)."""
-    from .problem import FEMTransient
-    return FEMTransient(cfg, comm).run()
-
-
 def structure_topology(mesh):
     """(cell type, cells) for ``Output.write_mesh``: 'hex8' and the bricks for a brick-only
     mesh (as before parts existed), else 'mixed' and [(XDMF type, cells)] of every block."""
@@ -167,40 +112,3 @@ def receiver_record(model, rec_arrays):
          "snap_distance": model.receiver_dist}
     d.update(rec_arrays)
     return d
-
-
-def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True):
-    """Collective: receivers, attributes and run record into the output; ``final``: close it
-    (else flush it: readable, still open)."""
-    if out is None:
-        return
-    t, u = srec.rec.arrays()
-    receivers = srec.receivers() if comm.getRank() == 0 else None
-    extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
-                     "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
-                     "elements": model.mesh.element_counts(),
-                     "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
-    if cfg.fem_integrator == "green":
-        extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
-    with event("FEM_io"):
-        (out.close if final else out.flush)(receivers=receivers, attrs={"problem": "fem", "alpha_m": am, "dt": cfg.dt},
-                                            record=provenance(cfg, comm, extra), status=status)
-    if not final:
-        return
-    if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
-        _plot(cfg.output, t, u)
-    printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
-
-
-def _plot(path, t, u):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axs = plt.subplots(3, 1, sharex=True, figsize=(7, 7))
-    for i, ax in enumerate(axs):
-        ax.plot(t, u[:, :, i])
-        ax.set_ylabel(f"u_{'xyz'[i]} [m]")
-    axs[-1].set_xlabel("t [s]")
-    fig.tight_layout()
-    fig.savefig(os.path.splitext(path)[0] + ".png", dpi=120)
-    plt.close(fig)

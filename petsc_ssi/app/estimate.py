@@ -1,0 +1,123 @@
+"""``petsc-ssi estimate``: the predicted time per stage and memory of a BEM run, per rank count,
+and whether it fits the nodes, without assembling (the model: ``petsc_ssi.bem.cost``)."""
+import math
+import os
+import time
+
+from ..options import register, SSIError
+from ..monitor import fmt_time
+from ..bem.cost import Counts, load_constants, predict
+from .kinds import problem_kind, resolve
+
+G = "estimate"
+register("estimate_ranks", "str", "1,2,4", "", "estimate: rank counts to predict, e.g. '1,2,4,8,16'", G)
+register("estimate_ranks_per_node", "int", 0, "", "estimate: MPI ranks per node (0: the cores of this machine)", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_cores_per_node", "int", 0, "", "estimate: cores per node (0: this machine's); more ranks than "
+         "cores on a node are oversubscribed", G, validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_node_memory", "real", 0.0, "GB", "estimate: memory of one node (0: this machine's)", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("estimate_constants", "str", "", "", "estimate: JSON file of machine constants (default: "
+         "petsc_ssi/estimate_constants.json; jobscripts/calibrate.py writes one)", G)
+
+
+def parse_ranks(text):
+    try:
+        r = sorted({int(s) for s in str(text).split(",") if s.strip()})
+    except ValueError:
+        raise SSIError(f"-ssi_estimate_ranks '{text}': expected rank counts 'p1,p2,...'") from None
+    if not r or r[0] < 1:
+        raise SSIError(f"-ssi_estimate_ranks '{text}': expected positive rank counts")
+    return r
+
+
+def setup(cfg, comm, ranks, node_mem):
+    """Collective: the BEM set-up of a run without assembly, and its counts."""
+    from ..bem.halfspace import HalfSpace
+    from ..sysmem import machine_memory
+    quiet = lambda m: None
+    t0 = time.perf_counter()
+    prob = HalfSpace(cfg, comm, log=quiet)
+    plan = prob.interp_plan()
+    ls = prob.lagset(plan)
+    limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
+    cnt = Counts(prob, plan, ls, ranks, limit, comm)
+    cnt.setup_s = time.perf_counter() - t0
+    return prob, plan, cnt
+
+
+def report(cfg, comm, out=None):
+    """Collective: print the estimate block (rank 0) and return its numbers."""
+    from ..petsc import printf
+    from ..sysmem import machine_memory
+    out = out or printf
+    ranks = parse_ranks(cfg.estimate_ranks)
+    cores = cfg.estimate_cores_per_node or (os.cpu_count() or 1)
+    q = cfg.estimate_ranks_per_node or cores
+    node_mem = cfg.estimate_node_memory * 1e9 if cfg.estimate_node_memory > 0 else machine_memory()
+    c, source = load_constants(cfg.estimate_constants)
+    prob, plan, cnt = setup(cfg, comm, ranks, node_mem)
+    nd = int(cnt.storage.sum())
+    n1 = int(cnt.single.sum())
+    ns = len(cnt.storage) - nd - n1
+    lines = [f"[ssi] estimate of this BEM run (model petsc_ssi/bem/cost.py; constants {source})",
+             f"[ssi]   {3 * cnt.N} DOFs ({cnt.N} nodes), {cnt.Ev} elements with images, {cnt.steps} steps, "
+             f"{cnt.nt} traction nodes; lags stored {cnt.Lx + cnt.k} ({cnt.Lx} exact + {cnt.k} interpolating, "
+             f"of {cnt.L} the run reaches): {nd} dense, {ns} block-sparse"
+             + (f", {n1} single-precision block-sparse" if n1 else "")
+             + (" (all block-sparse: the dense choice would not fit the limit)" if cnt.fill > 1 else ""),
+             f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
+             f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",
+             "[ssi]   ranks nodes | setup_s assembly_s factor_s history_s solve_s time_loop_s | total | "
+             "peak_GB GB/rank_max GB/node | fits"]
+    rows = []
+    for p in ranks:
+        t = predict(cnt, c, p, q, cores)
+        nodes = int(math.ceil(p / float(q)))
+        per_node = t["peak_bytes"] / p * min(q, p)
+        per_node = max(per_node, t["peak_rank_bytes"] * min(q, p) if p == 1 else per_node)
+        fits = per_node <= 0.9 * node_mem
+        refuse = _refuses(cnt, p, q)
+        flag = "yes" if fits else "NO"
+        if refuse:
+            flag += "; the run's memory check would refuse it (-ssi_memory_limit)"
+        if min(q, p) > cores:
+            flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
+        t.update({"ranks": p, "nodes": nodes, "node_bytes": per_node, "fits": fits})
+        rows.append(t)
+        lines.append(f"[ssi]   {p:5d} {nodes:5d} | {t['setup']:7.3g} {t['assembly']:10.4g} {t['factor']:8.3g} "
+                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
+                     f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
+    ok = [r for r in rows if r["fits"]]
+    if ok:
+        best = min(ok, key=lambda r: r["total"])
+        lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
+                     f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
+    else:
+        lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
+                     f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
+                 f"-log_view times; the model's measured error: jobscripts/README.md)")
+    out("\n".join(lines))
+    return {"counts": cnt, "rows": rows}
+
+
+def _refuses(cnt, p, q):
+    """Whether the run's own check (HalfSpace.check_memory: the estimated peak shared
+    by the ranks, the most loaded node's part against the per-node limit) refuses it."""
+    used = cnt.nb_total_used()
+    return cnt._peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
+
+
+def main():
+    """Collective: print the predicted cost (time per stage, memory, whether it fits the nodes) of
+    the case the options describe, without assembling (``bem.cost``)."""
+    from ..petsc import init
+    kind = problem_kind()
+    if kind == "fem":
+        raise SSIError("petsc-ssi estimate models the BEM half-space (-ssi_problem bem, and the BEM part of "
+                       "-ssi_problem ssi); the FEM structure alone is cheap: run it with -log_view")
+    cfg = resolve(kind, ("estimate",))
+    if kind == "ssi":
+        init().Sys.Print("[ssi] estimate: -ssi_problem ssi: the BEM half-space part only (no FEM, no coupling)")
+    return report(cfg, init().COMM_WORLD)

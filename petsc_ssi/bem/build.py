@@ -1,0 +1,154 @@
+"""Assembly of a BEM run: the lag matrices (exact and interpolating) into PETSc Mats, the step
+matrix factorised once, all handed to a ``Marcher`` (``build_marcher``); or the matrices of
+-ssi_lags_load read back instead of assembled. Collective."""
+import os
+import time
+
+import numpy as np
+
+from ..petsc import init, printf
+from ..monitor import event, fmt_time
+from . import symmetry, lagmats
+from .march import Marcher
+from .cost import history_block
+
+
+def _block_of(cfg, comm, H, G, HI, GI):
+    """history_block from this run's Mats (None: empty): per stored matrix the bytes of its H and
+    of its G (read by the same panel products), dense or block-sparse, summed over the ranks."""
+    from . import bsr
+    Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
+    d = np.zeros((3, len(Hs)))              # dense bytes, block-sparse bytes, block-sparse blocks
+    for i, (Hm, Gm) in enumerate(zip(Hs, Gs)):
+        for M in (Hm, Gm):
+            if M is None:
+                continue
+            ctx = bsr.context(M)
+            d[1 if ctx is not None else 0, i] += lagmats.mat_bytes(M)
+            if ctx is not None:
+                d[2, i] += ctx.indices.size
+    tot = np.zeros_like(d)
+    comm.tompi4py().Allreduce(d, tot)
+    return history_block(cfg, tot[0], tot[1], tot[2])
+
+
+def _say_block(march):
+    if march.block > 1:
+        subs = (f" in sub-blocks of {march.sub} (-ssi_history_sub)" if march.sub < march.block else "")
+        printf(f"[ssi] history sum: time-blocked, {march.block} steps per block{subs} (-ssi_history_block; 1: step "
+               "by step)")
+    else:
+        printf("[ssi] history sum: step by step (-ssi_history_block 1)")
+
+
+def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
+    """Collective: assemble the lag matrices (exact and interpolating), factorise
+    the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
+    PETSc = init()
+    from .. import numba_cache_warm
+    if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
+        from .model import announce_compile
+        announce_compile()
+    t0 = time.perf_counter()
+    if cfg.get("lags_load"):
+        return _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
+    single = int(cfg.lag_single_from)
+    ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx, single_from=single)
+    N = prob.mesh.n_nodes
+    r0, r1 = ls.node_range
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
+    with event("SSI_BEM_LagMats"):
+        H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
+                                 prob.lag_fill)
+        nt = prob.regions.n_t
+        if nt:
+            pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+            tcol_loc = pl.getLocalSize() // 3
+            pl.destroy()
+            G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
+        else:
+            G = [None] * plan.Lx
+    nev = ls.kernel_evaluations
+    HI, GI = [], []
+    for j in range(plan.k if plan.active else 0):
+        lag, toff = plan.kernel_time(j)
+        hb, gb = ls.assemble(monitor=False, lag_lo=lag, lag_hi=lag, toff=toff, single_from=single)
+        nev += ls.kernel_evaluations
+        HI.append(lagmats.build_one(comm, hb, lag, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
+                                    prob.lag_fill)[0])
+        GI.append(lagmats.build_one(comm, gb, lag, ls.node_range, N, nt, tcol_loc, "dense")[0] if nt else None)
+    ls.kernel_evaluations = nev
+    t_asm = time.perf_counter() - t0
+    mem_exact = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
+    mem_interp = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in HI + GI))
+    mem = mem_exact + mem_interp
+    ndense = sum(1 for i in hinfo if i[1] == "dense")
+    nbaij = sum(1 for i in hinfo if i[1] == "baij")
+    nsingle = sum(1 for i in hinfo if i[1] == "single")
+    blocks = sum(i[2] for i in hinfo)
+    fill = blocks / float(plan.Lx * N * N)
+    if plan.active:
+        printf(f"[ssi] memory: {plan.Lx} exact lags {mem_exact / 1e9:.3g} GB, {plan.k} interpolating "
+               f"matrices {mem_interp / 1e9:.3g} GB (T_N = {plan.TN:.4g} s, T_L = {plan.TL:.4g} s)")
+    single_txt = f", {nsingle} single-precision block-sparse" if nsingle else ""
+    printf(f"[ssi] assembly {fmt_time(t_asm)}: {plan.Lx} exact lags ({ndense} dense, {nbaij} block-sparse"
+           f"{single_txt}), "
+           f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
+           f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
+           f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    _say_block(march)
+    ls.H = ls.G = None   # the triplets are in the Mats now
+    if cfg.get("lags_save"):
+        from . import lagstore
+        t1 = time.perf_counter()
+        size = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
+        printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
+               f"{fmt_time(time.perf_counter() - t1)}; -ssi_lags_load {cfg.lags_save} reuses them)")
+    return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
+                   "nbaij": nbaij, "nsingle": nsingle, "fill": fill, "mem": mem}
+
+
+def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
+    """Collective: build_marcher with the matrices of -ssi_lags_load (checked in ``prepare``)."""
+    PETSc = init()
+    from . import lagstore
+    N = prob.mesh.n_nodes
+    nt = prob.regions.n_t
+    tcol_loc = 0
+    if nt:
+        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+        tcol_loc = pl.getLocalSize() // 3
+        pl.destroy()
+    # (the file holds float32 values as doubles, PETSc's scalar: float32 again as each is read)
+    A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc,
+                                    single_from=int(cfg.lag_single_from),
+                                    interp_lags=[plan.kernel_time(j)[0] for j in range(plan.k if plan.active else 0)])
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
+    if not nt:
+        G = [None] * plan.Lx
+    t_asm = time.perf_counter() - t0
+    mpi = comm.tompi4py()
+    mem_exact = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in H + G))
+    mem_interp = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in HI + GI))
+    kinds = dict(prob.lags_manifest["mats"])
+    ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "dense")
+    from . import bsr
+    nsingle = sum(1 for M in H if bsr.context(M) is not None and bsr.context(M).data.dtype == np.float32)
+    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "baij") - nsingle
+    ls.kernel_evaluations = ls.cache_hits = 0
+    ls.cache_bytes = 0.0
+    printf(f"[ssi] lag matrices loaded from {cfg.lags_load} in {fmt_time(t_asm)} (no assembly): {plan.Lx} exact "
+           f"lags ({ndense} dense, {nbaij} block-sparse" + (f", {nsingle} single-precision block-sparse" if nsingle
+                                                               else "") + ")"
+           + (f", {plan.k} interpolating matrices" if plan.active else "")
+           + f", stored {(mem_exact + mem_interp) / 1e9:.3g} GB")
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    _say_block(march)
+    ls.H = ls.G = None
+    return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
+                   "nbaij": nbaij, "nsingle": nsingle, "fill": float("nan"), "mem": mem_exact + mem_interp}

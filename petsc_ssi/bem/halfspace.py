@@ -1,0 +1,319 @@
+"""The half-space of a run as meshed, loaded and checked (``HalfSpace``), before any assembly.
+
+Order of work: every input check (collective, one-line errors) and the memory estimate come
+before any assembly: the surface mesh (``read_surface_mesh``), the regions (loaded, prescribed),
+the receivers, the lags and the interpolation plan, the node partition (``lagset``) and the
+memory check (``check_memory``). ``bem.build.build_marcher`` then assembles.
+"""
+import numpy as np
+
+from ..petsc import SSIError, collective, printf, warn
+from ..mesh import surface
+from .. import timegrid
+from . import symmetry, receivers as rec, histories
+from .resultants import RigidMotion
+from .lagset import Material, Regions, LagSet
+from .windows import causal_lags
+from . import interp
+from ..sysmem import machine_memory
+
+
+def _pair(text, name):
+    try:
+        v = [float(s) for s in text.split(",")]
+    except ValueError:
+        raise SSIError(f"-ssi_{name} '{text}': expected 'a,b'") from None
+    if len(v) != 2 or min(v) <= 0:
+        raise SSIError(f"-ssi_{name} '{text}': expected two positive numbers 'a,b'")
+    return v
+
+
+def read_surface_mesh(cfg, comm, planes):
+    """Collective: the surface mesh (grid generator or gmsh; rank 0 reads, broadcast)."""
+    Lx, Ly = _pair(cfg.mesh_size, "mesh_size")
+    patch = _pair(cfg.mesh_patch, "mesh_patch") if cfg.mesh_patch else None
+    xmin = 0.0 if any(a == 0 for a, _ in planes) else None
+    ymin = 0.0 if any(a == 1 for a, _ in planes) else None
+    mpi = comm.tompi4py()
+    mesh = None
+    with collective(comm, f"-ssi_mesh {cfg.mesh}", "{what}: cannot read the mesh ({error})"):
+        if comm.getRank() == 0:
+            if cfg.mesh == "grid":
+                mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
+            else:
+                params = {"Lx": Lx, "Ly": Ly, "h": cfg.mesh_h,
+                          "xmin": -Lx / 2 if xmin is None else 0.0,
+                          "ymin": -Ly / 2 if ymin is None else 0.0}
+                if patch:
+                    params.update({"a": patch[0], "b": patch[1]})
+                from ..fem.mesh import parse_mesh_params
+                params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
+                mesh = surface.read_gmsh(cfg.mesh, params)
+            mesh.check()
+            z = np.abs(mesh.nodes[:, 2])
+            ext = float(np.ptp(mesh.nodes[:, :2], axis=0).max()) or 1.0
+            if z.max() > 1e-9 * ext:
+                k = int(z.argmax())
+                raise SSIError(f"-ssi_mesh {cfg.mesh}: the surface mesh must lie in the plane z = 0 (the free "
+                               f"surface of the half-space z < 0); node {k} is at z = {mesh.nodes[k, 2]:.6g} m")
+    return mpi.bcast(mesh)
+
+
+def _history(cfg, which):
+    """The -ssi_<which>_history as a callable, read and checked now."""
+    try:
+        return histories.make(cfg.get(which + "_history"), cfg.get(which + "_t0"), cfg.get(which + "_table"))
+    except SSIError as exc:
+        raise SSIError(f"-ssi_{which}_history {cfg.get(which + '_history')}: {exc}") from None
+
+
+class HalfSpace:
+    """Everything a BEM run needs, checked before heavy work (collective)."""
+
+    def __init__(self, cfg, comm, log=printf):
+        self.cfg, self.comm, self.log = cfg, comm, log
+        self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
+        self.planes = symmetry.parse(cfg.symmetry)
+        self.mesh = read_surface_mesh(cfg, comm, self.planes)
+        h = float(self.mesh.element_sizes().max())
+        self.h = h
+        symmetry.check_mesh(self.mesh.nodes, self.planes, h)
+        bad, ang = surface.kinks(self.mesh, self.planes)
+        if len(bad):
+            printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
+                   f"free term from the interior solid angle (Hartmann)")
+        self.dt = cfg.dt
+        # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
+        self.n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
+        load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
+        disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
+        if cfg.load_group and cfg.load_p0 == 0.0:
+            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
+        if cfg.user_set("load_p0") and not cfg.load_group:
+            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
+        if cfg.user_set("disp_value") and not cfg.disp_group:
+            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+        # histories are built (and tables read and checked) before any heavy work
+        self._load_f = _history(cfg, "load") if len(load) else None
+        self._disp_f = _history(cfg, "disp") if len(disp) else None
+        self.regions = Regions(self.mesh, load, disp)
+        for name in ("disp_rotation", "disp_ref"):
+            if cfg.user_set(name) and not cfg.disp_group:
+                warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
+        symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
+        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes) if len(disp) else None
+        self.receivers = rec.parse(cfg.receivers)
+        for p in self.receivers:
+            q, _ = symmetry.map_point(p, self.planes)
+            rec.locate(self.mesh, q)
+            if abs(p[2]) > 1e-6 * max(h, 1.0):
+                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        self._lags()
+        self._warnings(h)
+
+    def _lags(self):
+        VX = self.mesh.cell_coords()
+        ext = np.abs(VX).max(axis=(0, 1))
+        if self.planes:
+            lo = -ext
+        else:
+            lo = VX.min(axis=(0, 1))
+        hi = VX.max(axis=(0, 1))
+        self.r_max = float(np.linalg.norm(hi - lo))
+        self.T_N = self.r_max / self.mat.cs
+        causal = causal_lags(self.r_max, self.mat, self.dt)
+        self.L = max(2, min(causal, self.n_steps + 1))
+
+    def _warnings(self, h):
+        cfg = self.cfg
+        sizes = self.mesh.element_sizes()
+        lmin, lmax = sizes.min(), sizes.max()
+        self.beta = (self.mat.cs * self.dt / lmax, self.mat.cp * self.dt / lmin)
+        if cfg.warn_beta and (self.beta[0] < 0.3 or self.beta[1] > 1.3):
+            warn(f"beta = c dt / l spans [{self.beta[0]:.3f}, {self.beta[1]:.3f}] (c_s with the largest, "
+                 f"c_p with the smallest node spacing), outside [0.3, 1.3]: the time marching may be "
+                 f"inaccurate or unstable")
+        for p in self.receivers:
+            self.diffraction_warning(p[None], f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g})")
+
+    def diffraction_warning(self, points, what):
+        """Warn (rank 0) when waves from the load diffracted at the truncation edge reach any of
+        ``points`` (e.g. a receiver, or the structure's interface nodes) before t_end: the
+        earliest arrival over the points, path load -> edge -> point at c_p."""
+        if not self.regions.n_load or not len(points):
+            return None
+        src = self.mesh.nodes[self.regions.load_nodes]
+        edge = self._edge_points()
+        if not len(edge):
+            return None
+        d_se = np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0)
+        t_d = np.inf
+        for p in np.atleast_2d(points):
+            q, _ = symmetry.map_point(p, self.planes)
+            t_d = min(t_d, (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp)
+        if t_d < self.cfg.t_end:
+            warn(f"{what}: waves diffracted at the mesh edge arrive at t = {t_d:.4g} s < t_end = "
+                 f"{self.cfg.t_end:g} s")
+        return t_d
+
+    def _edge_points(self):
+        """Nodes on the truncation edge (not on a symmetry plane)."""
+        x = self.mesh.nodes
+        out = np.zeros(len(x), bool)
+        for ax in (0, 1):
+            lo, hi = x[:, ax].min(), x[:, ax].max()
+            tol = 1e-9 * max(abs(lo), abs(hi), 1.0)
+            on_plane = any(a == ax for a, _ in self.planes)
+            out |= np.abs(x[:, ax] - hi) < tol
+            if not on_plane:
+                out |= np.abs(x[:, ax] - lo) < tol
+        return x[out]
+
+    def summary(self):
+        mesh = self.mesh
+        nimg = len(symmetry.images(self.planes))
+        return (f"[ssi] BEM: {mesh.n_cells} nine-node elements ({mesh.n_cells * nimg} with symmetry images), "
+                f"{mesh.n_nodes} nodes, {3 * mesh.n_nodes} DOFs; {self.regions.n_t} traction nodes; "
+                f"dt {self.dt:g} s, {self.n_steps} steps, scheme {self.cfg.scheme}; "
+                f"r_max {self.r_max:.4g} m, T_N = r_max/c_s = {self.T_N:.4g} s; lags stored {self.L} "
+                f"(causal limit {causal_lags(self.r_max, self.mat, self.dt)}); "
+                f"beta in [{self.beta[0]:.3f}, {self.beta[1]:.3f}]")
+
+    def interp_plan(self):
+        """The lag interpolation plan from -ssi_interp* (auto: the paper's rule)."""
+        c = self.cfg
+        method, TL, k = c.interp, c.interp_tl, c.interp_k
+        if method == "auto":
+            src = (self.mesh.nodes[self.regions.load_nodes].mean(0) if self.regions.n_load
+                   else np.zeros(3))
+            for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
+                src[ax] = 0.0
+            sites = getattr(self, "sites", np.zeros((0, 3)))
+            pts = np.vstack([np.asarray(self.receivers).reshape(-1, 3), sites])
+            TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, pts, src)
+            if len(sites):
+                why += f" (points of interest: {len(self.receivers)} receivers and {len(sites)} interface nodes)"
+            method = "chebyshev"
+            printf(f"[ssi] -ssi_interp auto: {why}")
+        plan = interp.Plan(method, self.dt, self.L, TL if TL else None, k, c.interp_grading)
+        if c.interp != "none" and not plan.active:
+            printf("[ssi] lag interpolation falls back to exact lags (T_L >= T_N or no lag to replace)")
+        self.plan = plan
+        return plan
+
+    def prepare(self, extra=(), extra_bytes=0.0, extra_what=""):
+        """Collective: print the summary (and ``extra`` lines), choose the interpolation
+        plan, set up the LagSet and check the memory (with ``extra_bytes`` of the run's other
+        dense data); returns (plan, lagset)."""
+        printf(self.summary())
+        for line in extra:
+            printf(line)
+        plan = self.interp_plan()
+        printf("[ssi] " + plan.describe())
+        ls = self.lagset(plan)
+        if ls.balance is not None:
+            n = [b - a for a, b in ls.ranges]
+            printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, -ssi_partition "
+                   f"{self.cfg.partition} (estimated work max/mean {ls.balance[0]:.3f}; equal node counts "
+                   f"{ls.balance[1]:.3f})")
+        self.check_memory(ls, plan, extra_bytes, extra_what)
+        from . import lagstore
+        with collective(self.comm, "checking -ssi_lags_load"):
+            self.lags_manifest = lagstore.check(self.cfg, self.comm, self, plan)
+        return plan, ls
+
+    def quad_options(self):
+        c = self.cfg
+        return {"gauss": c.gauss, "singular_order": c.singular_order, "subdivisions": c.subdivisions,
+                "near_factor": c.near_factor, "max_subdivisions": c.max_subdivisions, "cache": c.cache,
+                "cache_share": c.cache_share}
+
+    def lagset(self, plan=None):
+        """The LagSet of this run; ``plan``: the interpolation plan (made here if not given), whose
+        matrices and their uses weigh in the partition of the nodes over the ranks. The uses are
+        those of a run of L steps (the lags it reaches), not of this run's steps: the partition, and
+        with it every rounding of a parallel run, depends on the stored lags only, so a run stopped
+        after n steps equals a run of n steps bit for bit (tests/test_output_survives.py)."""
+        from .partition import lag_weights
+        plan = plan if plan is not None else self.interp_plan()
+        interp = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []
+        opts = dict(self.quad_options(), partition=self.cfg.partition, work_lags=plan.Lx,
+                    lag_weights=lag_weights(plan.Lx, self.L, self.cfg.scheme.startswith("stabili"), interp))
+        return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes, opts)
+
+    def check_memory(self, ls, plan=None, extra_bytes=0.0, extra_what=""):
+        """Collective: refuse runs whose lag matrices would not fit; if the
+        dense lags of the automatic storage choice would not fit but block-
+        sparse storage would, store every lag block-sparse (and say so).
+        ``extra_bytes``: memory of the whole run (all ranks) that lives beside the
+        stored lags after assembly (the coupling's dense interface matrices)."""
+        c = self.cfg
+        limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
+        # the limit holds per node: the run's peak is shared by its ranks, of which
+        # ``share`` run on the most loaded node (all of them on one machine)
+        mpi = self.comm.tompi4py()
+        from mpi4py import MPI
+        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
+        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
+        n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
+        node.Free()
+        extra_bytes = float(extra_bytes)
+        lags = plan.Lx if plan is not None and plan.active else self.L
+        extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
+        self.lag_fill = c.lag_fill
+        sf = int(c.lag_single_from)
+        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
+        if sf > max([lags] + list(extra)):
+            warn(f"-ssi_lag_single_from {sf}: beyond the {max([lags] + list(extra))} stored lags, every lag "
+                 "stays in double precision")
+        # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
+        # block-sparse is refused now, before the full O(N E) count
+        est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
+        peak0 = max(peak0, est0 + extra_bytes)
+        if share * peak0 > 1.5 * limit:
+            raise SSIError(f"the lag matrices need about {share * peak0 / 1e9:.3g} GB at assembly (estimated from a "
+                           f"sample of rows, every lag block-sparse) on {'the most loaded node' if n_nodes > 1 else 'this node'}, "
+                           f"more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry "
+                           "planes, -ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+        est, peak, nd = ls.estimate_memory(lags, c.lag_storage, c.lag_fill, extra, single_from=sf, load=load)
+        peak = max(peak, est + extra_bytes)
+        if share * peak > limit and c.lag_storage == "auto":
+            est2, peak2, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, single_from=sf, load=load)
+            peak2 = max(peak2, est2 + extra_bytes)
+            if share * peak2 <= limit:
+                self.log(f"[ssi] memory: {nd} dense lags would need a {peak / 1e9:.3g} GB peak, over the "
+                         f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
+                self.lag_fill = 1.01
+                est, peak, nd = est2, peak2, 0
+        self.mem_estimate = est
+        self.mem_peak_estimate = peak
+        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
+        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
+                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
+        if share * peak > limit:
+            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
+                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
+                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+
+    def known_p(self):
+        c = self.cfg
+        f = self._load_f
+        tr = np.array([0.0, 0.0, -c.load_p0])   # p0 > 0 pushes the surface down (-z)
+        nl = self.regions.n_load
+
+        def kp(n):
+            return np.tile(tr * histories.step_mean(f, n, self.dt, c.load_history, c.load_t0), nl)
+        return kp
+
+    def disp_factor(self, n):
+        """h(t_n) of the prescribed motion."""
+        return float(self._disp_f(n * self.dt))
+
+    def known_u(self):
+        """callable(n) -> the prescribed displacements of step n at the region's nodes (3 n_disp,):
+        the rigid motion h(t_n) [u0 + theta0 x (x - x_ref)] (``resultants.RigidMotion``)."""
+        if not self.regions.n_disp:
+            return lambda n: np.zeros(0)
+        return lambda n: self.motion.values(self.disp_factor(n))

@@ -1,0 +1,55 @@
+"""The wave windows of a BEM run: which lags each (collocation node, element) pair reaches.
+
+An element's kernels are non-zero at a node only while a wave front from it sweeps the element:
+for bounding spheres of the elements, lags from the P arrival at the nearest point to the S
+departure from the farthest (``pair_windows``). The memory estimate, the partition's weights and
+the cost model count stored blocks with them (``estimate_blocks``); ``causal_lags`` is the number
+of lags after which no pair has a non-zero block.
+"""
+import math
+
+import numpy as np
+
+
+def causal_lags(r_max, mat, dt):
+    """Lags that can be non-zero: the P kernel vanishes once (l-2) dt > r/c_s."""
+    return int(math.floor(r_max / (mat.cs * dt))) + 2
+
+
+def bounding_spheres(VX):
+    c = VX[:, 8, :].copy()
+    R = 1.1 * np.linalg.norm(VX - c[:, None, :], axis=2).max(axis=1) + 1e-12
+    # element size: the longest of the four sides (corner to mid-side node, twice), independent of
+    # which corner is node 0 (an element and its mirror image get the same size, so the same
+    # near-field subdivisions: half and full models then integrate the same pairs alike)
+    sides = [np.linalg.norm(VX[:, m] - VX[:, a], axis=1) for a, m in ((0, 4), (1, 5), (2, 6), (3, 7),
+                                                                      (1, 4), (2, 5), (3, 6), (0, 7))]
+    h = np.max(sides, axis=0) * 2
+    return c, R, h
+
+
+def pair_windows(xc, Vc, VR, L, mat, dt, n_images=1):
+    """The lags 1..L each (point, element) pair reaches: (lo, hi, ok) of shape (points, elements
+    without images), from the bounding spheres (the P wave's arrival to the S wave's passing, plus
+    2), as the union over the element's symmetry images (they fold onto the same columns)."""
+    E = len(Vc) // n_images
+    d = np.linalg.norm(xc[:, None, :] - Vc[None, :, :], axis=2)
+    lo = np.maximum(1, np.floor(np.maximum(d - VR, 0) / (mat.cp * dt)) + 1)
+    hi = np.minimum(L, np.floor((d + VR) / (mat.cs * dt)) + 2)
+    n = np.clip(hi - lo + 1, 0, None).reshape(len(xc), n_images, E)
+    lo = np.where(n > 0, lo.reshape(n.shape), np.inf).min(1)
+    hi = np.where(n > 0, hi.reshape(n.shape), -np.inf).max(1)
+    return lo, hi, np.isfinite(lo) & (hi >= lo)
+
+
+def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
+    """Estimated number of non-zero 3x3 blocks of each H lag (array, index
+    l-1) in ``rows``: for each (row, element) the lags its wave window touches
+    (union over the element's symmetry images, which fold onto the same
+    columns), times four nodes per element (a node is shared by about four)."""
+    diff = np.zeros(L + 2)
+    for s in range(0, len(rows), chunk):
+        lo, hi, ok = pair_windows(xnodes[rows[s:s + chunk]], Vc, VR, L, mat, dt, n_images)
+        np.add.at(diff, lo[ok].astype(np.int64), 4.0)
+        np.add.at(diff, hi[ok].astype(np.int64) + 1, -4.0)
+    return np.cumsum(diff)[1:L + 1]

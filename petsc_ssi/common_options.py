@@ -1,0 +1,46 @@
+"""Declarations of the options every problem kind shares (group "common"); each package declares
+its own (``bem/options.py``, ``fem/options.py``, ``coupling/options.py``, the commands in ``app/``).
+
+Units are SI. Coordinates: the free surface is z = 0, soil in z < 0, z up.
+"""
+from .options import register, register_check, positive, at_least
+
+# ---------------------------------------------------------------- common
+register("problem", "enum", "bem", "", "what to run: bem (half-space alone), fem (structure alone), ssi (coupled)",
+         "common", choices=("bem", "fem", "ssi"))
+register("dt", "real", 7.5e-4, "s", "time step", "common", validator=positive)
+register("t_end", "real", 0.04, "s", "end time of the run", "common", validator=positive)
+register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it)", "common")
+register("output_stride", "int", 1, "steps", "write the fields every this many steps (0: receivers only)", "common",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE "
+         "node); for a structure also 'group:NAME' (every node of a physical group)", "common")
+register("monitor", "bool", False, "", "print progress: assembly, per-step time, elapsed, ETA (rank 0)", "common")
+register("monitor_every", "int", 0, "steps", "monitor line every this many steps (0: about 20 lines per run)", "common",
+         validator=lambda v: None if v >= 0 else "must be >= 0")
+register("output_overwrite", "bool", False, "", "replace an existing -ssi_output (and its sidecars); without it a run "
+         "refuses to start when the output exists", "common")
+register("output_flush", "real", 10.0, "s", "make the output file readable (time, receivers, sidecars, run "
+         "status) at least this often during the run, so a stopped run keeps its results; 0: only at the end",
+         "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed rank count: on more than one rank "
+         "the direct solves default to SuperLU_dist instead of MUMPS (MUMPS's parallel sums change order between "
+         "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
+         "(-ssi_bem_pc_type redundant); the finished HDF5 files are rewritten without modification times, so "
+         "identical results give identical files", "common")
+register("huge_pages", "enum", "numpy", "", "numpy's request (madvise) that the large arrays it allocates, the stored "
+         "lag blocks among them, be backed by transparent huge pages: numpy (as numpy has it: on unless "
+         "NUMPY_MADVISE_HUGEPAGE=0), on, or off. Where the kernel compacts memory for such a request "
+         "(/sys/kernel/mm/transparent_hugepage/defrag 'madvise'), a first write may stall (jobscripts/first_touch.py), "
+         "yet whole runs on the development machine were faster with huge pages, the paper case by far "
+         "(jobscripts/huge_pages_bench.sh); results do not depend on it", "common",
+         choices=("off", "on", "numpy"))
+register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
+         "becomes the step, to keep every checkpoint", "common")
+register("checkpoint_every", "int", 0, "steps", "write a checkpoint every this many steps (0: never; a signal "
+         "always writes one)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this much wall time has passed since "
+         "the last one (0: never)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("restart", "str", "", "", "resume the run from this checkpoint (same options, any rank count; the "
+         "output of the interrupted run is continued)", "common")
+register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")

@@ -1,0 +1,68 @@
+"""The coupled model before assembly: the soil (``bem.halfspace.HalfSpace``), the structure's
+model (``fem.model.build_model``, not assembled) and the interface that joins them, every input
+checked (``build_coupled``); and the bytes of the coupling's dense interface matrices for the
+memory check (``interface_bytes``). Collective."""
+import numpy as np
+
+from ..petsc import SSIError, collective, printf
+from ..options import Config
+from ..bem.halfspace import HalfSpace
+from ..bem.lagset import Regions
+from ..fem.model import build_model
+from .interface import build_interface, fem_symmetry_dofs
+from .step import STRATEGIES
+
+
+def _view(cfg, **changes):
+    """A copy of the options with some values replaced."""
+    vals = cfg.as_dict()
+    vals.update(changes)
+    return Config(vals, cfg.sources())
+
+
+def build_coupled(cfg, comm):
+    """Collective: the soil problem, the structure's model (not assembled) and the
+    interface, all checked. Returns (prob, model, iface, fe_cfg)."""
+    from .options import ignored_contact_options
+    from ..petsc import warn
+    ignored = ignored_contact_options(cfg)
+    if ignored:
+        warn(f"{' '.join(ignored)} act{'s' if len(ignored) == 1 else ''} only with -ssi_contact unilateral; "
+             f"ignored (the interface is {cfg.contact})", comm)
+    prob = HalfSpace(cfg, comm, log=printf)
+    fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
+    model = build_model(fe_cfg, comm, assemble_matrices=False)
+    iface = sym = None
+    with collective(comm, "matching the interface"):
+        iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
+                                prob.planes, prob.h)
+        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.layout)
+        load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
+        both = np.intersect1d(load, iface.be_elems)
+        if both.size:
+            raise SSIError(f"-ssi_load_group {cfg.load_group}: {both.size} loaded soil elements lie under the "
+                           "structure (the interface); load the structure instead (-ssi_fem_load_*)")
+        prob.regions = Regions(prob.mesh, load, iface.be_elems)
+        if not np.array_equal(prob.regions.disp_nodes, iface.be_nodes):
+            raise SSIError("interface: internal error, node order of the soil regions differs")
+    # a load on the soil away from the structure (an incident wave field, total field): the
+    # structure is a point of interest for the edge-diffraction warning and the interpolation rule
+    prob.sites = iface.x
+    prob.diffraction_warning(iface.x, "the structure (interface nodes)")
+    model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
+    model.layout.set_fixed(model.fixed)
+    return prob, model, iface, fe_cfg
+
+
+def interface_bytes(cfg, prob, model, iface, ranks):
+    """Estimated bytes of the coupling's dense interface matrices over all ranks: the local rows
+    of Z = A^-1 H_s E_I (soil dofs x 3 n_I) and, implicit, of D^-1 T^T (structure dofs x 3 n_I);
+    on every rank Z_II, M3, C (3 n_I)^2 each and the interface LUs (one bonded; a cache of at
+    most 512 MB with unilateral contact)."""
+    n = 3 * iface.n
+    b = 8.0 * 3 * prob.mesh.n_nodes * n + 3 * 8.0 * n * n * ranks
+    if cfg.coupling == "implicit":
+        b += 8.0 * model.layout.size * n + 8.0 * n * n * ranks
+    lu = 8.0 * n * n
+    b += ranks * (max(lu, 512e6) if cfg.contact == "unilateral" else lu)
+    return b

@@ -1,0 +1,90 @@
+"""Memory of the machine and of this process, from /proc and the cgroup (Linux; leaf module).
+
+``machine_memory``   bytes this process may use: MemTotal, or its cgroup's limit when lower
+``process_rss``      resident memory now; ``proc_status_bytes`` any field of /proc/self/status
+``peak_rss``         collective: (largest, summed) peak resident memory of the ranks so far
+"""
+import os
+
+
+def _cgroup_limit(proc="/proc/self/cgroup", root="/sys/fs/cgroup"):
+    """The memory limit of this process's cgroup (v2 memory.max, or v1 memory.limit_in_bytes), in
+    bytes, or inf: a batch job or container may have less than the machine."""
+    paths = []
+    try:
+        with open(proc) as fh:
+            for line in fh:
+                parts = line.strip().split(":", 2)
+                if len(parts) == 3 and (parts[1] == "" or "memory" in parts[1].split(",")):
+                    rel = parts[2].lstrip("/")
+                    if parts[1] == "":
+                        paths += [os.path.join(root, rel, "memory.max"), os.path.join(root, "memory.max")]
+                    else:
+                        paths += [os.path.join(root, "memory", rel, "memory.limit_in_bytes"),
+                                  os.path.join(root, "memory", "memory.limit_in_bytes")]
+    except OSError:
+        pass
+    best = float("inf")
+    for p in paths:
+        try:
+            with open(p) as fh:
+                v = fh.read().strip()
+        except OSError:
+            continue
+        if v and v != "max":
+            try:
+                best = min(best, float(v))
+            except ValueError:
+                pass
+    return best if best < 2 ** 60 else float("inf")      # cgroup v1 writes ~2^63 for "no limit"
+
+
+def machine_memory():
+    """Bytes of memory this process may use: the machine's (MemTotal), or its cgroup's limit when
+    that is lower (``_cgroup_limit``)."""
+    total = float("inf")
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemTotal"):
+                    total = float(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    return min(total, _cgroup_limit())
+
+
+def proc_status_bytes(field):
+    """A memory field of /proc/self/status ('VmRSS', 'VmHWM'), bytes; None where /proc is missing."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith(field + ":"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return None
+
+
+def process_rss():
+    """This process's resident memory now (bytes; 0 where /proc is missing)."""
+    return proc_status_bytes("VmRSS") or 0.0
+
+
+def _hwm():
+    """This process's peak resident memory, bytes: VmHWM of /proc/self/status (the peak of this
+    program alone; getrusage's ru_maxrss also keeps the RSS of the process it was forked from, e.g.
+    a large pytest), else ru_maxrss."""
+    hwm = proc_status_bytes("VmHWM")
+    if hwm is not None:
+        return hwm
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0      # Linux: kB
+
+
+def peak_rss(comm):
+    """Collective: (largest, summed) peak resident memory of the ranks so far, bytes (Linux)."""
+    from mpi4py import MPI
+    hwm = _hwm()
+    mpi = comm.tompi4py()
+    return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
