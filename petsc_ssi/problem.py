@@ -81,7 +81,7 @@ class TransientProblem:
         self.comm = comm if comm is not None else PETSc.COMM_WORLD
         self.t_start = time.perf_counter()
         self.n = 0                      # the last step taken
-        self.n_steps = 0
+        self.grid = None                # the time grid (timegrid.TimeGrid), made by the subclass
         self._state = "created"
         self.restart = None             # the header of -ssi_restart's checkpoint (check_output)
         self._key = None
@@ -176,7 +176,12 @@ class TransientProblem:
         self._state = new
 
     def time(self, n):
-        return n * self.cfg.dt
+        """t_n of the run's time grid, s."""
+        return self.grid.time(n)
+
+    @property
+    def n_steps(self):
+        return self.grid.n_steps if self.grid is not None else 0
 
     def setup(self):
         raise NotImplementedError

@@ -16,3 +16,29 @@ import math
 def n_steps(t_end, dt):
     """Number of steps of a run to ``t_end`` with step ``dt`` (see the module docstring)."""
     return max(int(math.ceil(t_end / dt - 1e-9)), 0)
+
+
+class TimeGrid:
+    """The time grid of a run, made once by its problem: step ``dt``, ``n_steps`` (the rule above),
+    times t_n = n dt, and which steps write fields (every ``stride`` steps; 0: none). Everything
+    that needs a step's time, or a time's step, asks the grid: no ``round(t / dt)``."""
+
+    def __init__(self, dt, t_end, stride=0):
+        self.dt, self.t_end, self.stride = float(dt), float(t_end), int(stride)
+        self.n_steps = n_steps(self.t_end, self.dt)
+
+    def time(self, n):
+        """t_n = n dt, s."""
+        return n * self.dt
+
+    def times(self, first=0, last=None):
+        """The times of steps first..last (default: to the last step), s."""
+        last = self.n_steps if last is None else last
+        return [self.time(n) for n in range(first, last + 1)]
+
+    def writes(self, n):
+        """Whether step n writes fields (-ssi_output_stride; 0: never)."""
+        return bool(self.stride) and n % self.stride == 0
+
+    def __repr__(self):
+        return f"TimeGrid(dt={self.dt:g} s, {self.n_steps} steps to {self.time(self.n_steps):g} s, stride {self.stride})"

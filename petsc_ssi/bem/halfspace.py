@@ -82,9 +82,9 @@ class HalfSpace:
         if len(bad):
             printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
                    f"free term from the interior solid angle (Hartmann)")
-        self.dt = cfg.dt
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
-        self.n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
+        self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
+        self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
         load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
         if cfg.load_group and cfg.load_p0 == 0.0:
@@ -309,7 +309,7 @@ class HalfSpace:
 
     def disp_factor(self, n):
         """h(t_n) of the prescribed motion."""
-        return float(self._disp_f(n * self.dt))
+        return float(self._disp_f(self.grid.time(n)))
 
     def known_u(self):
         """callable(n) -> the prescribed displacements of step n at the region's nodes (3 n_disp,):

@@ -17,7 +17,7 @@ from ..io.output import Output, provenance
 from ..problem import TransientProblem
 from .halfspace import HalfSpace
 from .build import build_marcher
-from .stability import guard
+from .stability import DivergenceGuard
 from . import options as _options  # noqa: F401  (declares the -ssi_ options of the half-space)
 
 
@@ -31,7 +31,7 @@ class BEMTransient(TransientProblem):
         with staged("SSI BEM setup"):
             self.prob = HalfSpace(cfg, self.comm, log=printf)
             self.plan, self.ls = self.prob.prepare()
-        self.n_steps = self.prob.n_steps
+        self.grid = self.prob.grid
         self.march = self.rec = self.out = None
         self.state = None
 
@@ -47,8 +47,10 @@ class BEMTransient(TransientProblem):
         from ..io.recorder import Recorder, SoilRecorder
         rd = self._open_restart()
         self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None)
-        self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.n_steps,
+        self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
+        if self.cfg.guard:
+            self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
         self._resume()
 
     def checkpoint_state(self):
@@ -73,16 +75,14 @@ class BEMTransient(TransientProblem):
             grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
             t = self.time(n)
             self.n = n                        # the step is taken; its records follow
-            rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")
-            if self.cfg.guard:
-                guard(self.cfg, self.prob, self.march, rec.unorm, n)
+            rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")   # and the guard
         self.state = (u, p)
         return self.state
 
     def write_partial(self, status):
         rec = self.rec
         res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
-               "resultants": rec.soil.resultants(rec.times)}
+               "resultants": rec.soil.resultants(rec.steps, rec.times)}
         write_results(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
 
     def finish(self):
@@ -90,7 +90,7 @@ class BEMTransient(TransientProblem):
         cfg, prob, plan, ls, info = self.cfg, self.prob, self.plan, self.ls, self.info
         rec = self.rec
         res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm),
-               "resultants": rec.soil.resultants(rec.times)}
+               "resultants": rec.soil.resultants(rec.steps, rec.times)}
         res["stats"] = {
             "assembly_s": info["t_asm"], "wall_s": time.perf_counter() - self.t_start, "lags": prob.L,
             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,

@@ -223,3 +223,14 @@ def guard(cfg, prob, march, unorm, n):
                    f"rate {rate:.3g} per step; likely cause: {'; '.join(causes)}")
     exc.unorm = np.array(unorm)      # the history so far (-ssi_check_stability, runs/stability)
     raise exc
+
+
+class DivergenceGuard:
+    """An observer of the recorder (``io.recorder`` protocol): after each step is recorded, stop
+    a clearly diverging run (``guard``) with the |u| history of ``norms`` (``NormHistory``)."""
+
+    def __init__(self, cfg, prob, march, norms):
+        self.cfg, self.prob, self.march, self.norms = cfg, prob, march, norms
+
+    def observe(self, n, t, step):
+        guard(self.cfg, self.prob, self.march, self.norms.values, n)

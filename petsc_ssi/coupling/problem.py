@@ -50,7 +50,7 @@ class SSITransient(TransientProblem):
                 + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
-        self.n_steps = self.prob.n_steps
+        self.grid = self.prob.grid
         self.coupler = self.rec = None
         self.state = None
 
@@ -76,9 +76,9 @@ class SSITransient(TransientProblem):
         over (t_{k-1}, t_k] (midpoint form, implicit)."""
         self.F.copy(self.fn)
         if self.cfg.coupling == "staggered" or k == 0:
-            self.fn.scale(self.hist.cell_mean(k, self.cfg.dt))
+            self.fn.scale(self.hist.cell_mean(k, self.grid.dt))
         else:
-            self.fn.scale(self.hist.step_mean(k, self.cfg.dt))
+            self.fn.scale(self.hist.step_mean(k, self.grid.dt))
         return self.fn
 
     def start(self):
@@ -89,12 +89,12 @@ class SSITransient(TransientProblem):
         rd = self._open_restart()
         self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None)
-        self.rec = Recorder(cfg, comm, "SSI time loop", self.n_steps,
+        self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
         self.integ.start(f0=self.load(0))
         if rd is None:
-            self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel))
+            self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
         self._resume()
 
     def checkpoint_state(self):

@@ -35,7 +35,7 @@ class FEMTransient(TransientProblem):
         with staged("FEM setup"):
             self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
             self.model = build_model(cfg, self.comm, assemble_matrices=False)
-        self.n_steps = timegrid.n_steps(cfg.t_end, cfg.dt)
+        self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
         self.integ = self.rec = self.out = None
         self.state = None
 
@@ -51,7 +51,7 @@ class FEMTransient(TransientProblem):
         """The load sample of step n: the spatial load times the mean of the history over the
         step's cell [t_n - dt/2, t_n + dt/2]."""
         self.F.copy(self.fn)
-        self.fn.scale(self.hist.cell_mean(n, self.cfg.dt))
+        self.fn.scale(self.hist.cell_mean(n, self.grid.dt))
         return self.fn
 
     def start(self):
@@ -62,11 +62,12 @@ class FEMTransient(TransientProblem):
         with event("FEM_io"):
             self.out = (Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
                         if cfg.output else None)
-            self.rec = Recorder(cfg, comm, "FEM time loop", self.n_steps,
+            self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
         self.integ.start(f0=self.load(0))
         if rd is None:
-            self.rec.structure.record(0.0, self.integ.u, self.integ.velocity(self.vel), write=self.rec.due(0))
+            self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),
+                                      write=self.grid.writes(0))
         self._resume()
         self.state = (self.integ.u, self.vel)
 

@@ -1,6 +1,5 @@
-"""What a run keeps, for the three problem kinds (BEM, FEM, coupled): one recorder.
-
-``Recorder`` holds up to three parts and the run's progress and |u| history:
+"""What a run keeps, for the three problem kinds (BEM, FEM, coupled): one recorder, a list of
+observers with one small protocol (``Recorder``; PyLith's observers):
 
   SoilRecorder       the soil's mesh and fields in an Output (displacement, nodal
                      traction) and the soil receiver series (a PETSc operator from
@@ -10,12 +9,12 @@
                      displacement, rotation, velocity) and its receiver series
                      (``io.structure.ReceiverSeries``: displacement, rotation, velocity,
                      acceleration, on rank 0)
-  interface series   per-step arrays of the coupling (a dict of lists, rank 0's copy)
+  InterfaceSeries    per-step arrays of the coupling (a dict of lists, rank 0's copy)
+  NormHistory        |u| of every step; ProgressLine the -ssi_monitor line
 
-Fields are written every -ssi_output_stride steps (``due``); receivers every step. The
-problems (bem/problem.py, fem/problem.py, coupling/problem.py) step and hand the
-results here; ``step`` also prints the -ssi_monitor progress line and keeps |u| for the
-divergence guard. Collective unless said otherwise.
+A problem hands each step to ``Recorder.step``; fields are written on the steps its time
+grid says (``TimeGrid.writes``: every -ssi_output_stride steps), receivers every step. A new
+output is a new observer. Collective unless said otherwise.
 """
 import numpy as np
 
@@ -47,6 +46,14 @@ class SoilRecorder:
             from ..bem.resultants import Resultants
             self.res = Resultants(comm, prob, march.p_tmpl)
 
+    def observe(self, n, t, step):
+        if step.get("soil") is not None:
+            self.record(*step["soil"], t)
+
+    def snapshot(self, n, t, step):
+        if step.get("soil") is not None:
+            self.write(t, *step["soil"])
+
     def record(self, u, p, t=None, write=False):
         if self.R is not None:
             self.R.mult(u, self.y)
@@ -77,7 +84,7 @@ class SoilRecorder:
                 out["soil_resultants"] = fm
         return out
 
-    def restore(self, s):
+    def restore(self, s, n=None):
         """The series of a checkpoint: each rank takes its rows of R (and of the resultants')."""
         if self.R is not None:
             full = np.asarray(s["soil_receivers"]).reshape(len(s["times"]), -1)
@@ -88,10 +95,10 @@ class SoilRecorder:
             r0, r1 = self.res.R.getOwnershipRange()
             self.res.series = [row[r0:r1].copy() for row in full]
 
-    def resultants(self, times):
+    def resultants(self, steps, times):
         """Collective: the output group 'resultants' (rank 0; None elsewhere or without a
-        prescribed region): t, force (K, 3), moment (K, 3) about x_ref, h (the motion's factor at
-        t_n), u0, theta0, x_ref."""
+        prescribed region) of the recorded ``steps`` at ``times``: t, force (K, 3), moment (K, 3)
+        about x_ref, h (the motion's factor at t_n), u0, theta0, x_ref."""
         if self.res is None:
             return None
         fm = self.res.arrays()
@@ -99,7 +106,7 @@ class SoilRecorder:
             return None
         m = self.prob.motion
         t = np.asarray(times, float)
-        h = np.array([self.prob.disp_factor(int(round(tk / self.prob.dt))) for tk in t])
+        h = np.array([self.prob.disp_factor(n) for n in steps])
         return {"t": t, "force": fm[:, :3], "moment": fm[:, 3:], "h": h, "u0": m.u0, "theta0": m.theta,
                 "x_ref": m.xref}
 
@@ -123,6 +130,14 @@ class StructureRecorder:
         self.fw = FieldWriter(out, model, comm) if out is not None else None
         self.rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
 
+    def observe(self, n, t, step):
+        if step.get("structure") is not None:
+            self.record(t, *step["structure"])
+
+    def snapshot(self, n, t, step):
+        if step.get("structure") is not None:
+            self.write(t, *step["structure"])
+
     def record(self, t, u, v=None, write=False):
         self.rec.record(t, u, v)
         if write:
@@ -134,7 +149,7 @@ class StructureRecorder:
             with event(self.io_event):
                 self.fw.write(t, u, v)
 
-    def state(self):
+    def state(self, n_times=None):
         """Rank 0: the receiver series, for a checkpoint."""
         r = self.rec
         if self.comm.getRank() != 0:
@@ -146,7 +161,7 @@ class StructureRecorder:
             s["structure_v"] = np.asarray(r.v).reshape(K, r.n, 3)
         return s
 
-    def restore(self, s):
+    def restore(self, s, n=None):
         r = self.rec
         if self.comm.getRank() != 0:
             return
@@ -161,68 +176,134 @@ class StructureRecorder:
         return receiver_record(self.model, self.rec.all_arrays())
 
 
-class Recorder:
-    """Collective: a run's soil and/or structure recorders, its interface series, progress line
-    and |u| history (see the module docstring)."""
+class InterfaceSeries:
+    """The coupling's per-step interface record (u_f, u_b, p, gap, status, ...): a dict of lists,
+    rank 0's copy (every rank holds the same)."""
 
-    def __init__(self, cfg, comm, what, n_steps, soil=None, structure=None, interface_keys=()):
-        self.cfg, self.comm = cfg, comm
-        self.soil, self.structure = soil, structure
-        self.interface = {k: [] for k in interface_keys}
-        self.times, self.unorm = [], []
+    def __init__(self, keys):
+        self.series = {k: [] for k in keys}
+
+    def observe(self, n, t, step):
+        res = step.get("interface")
+        if res is not None:
+            for k in self.series:
+                self.series[k].append(res[k])
+
+    def state(self, n_times):
+        return {"interface_" + k: np.asarray(v) for k, v in self.series.items()}
+
+    def restore(self, s, n):
+        for k in self.series:
+            self.series[k] = list(np.asarray(s["interface_" + k]))
+
+    def arrays(self):
+        return {k: np.asarray(v) for k, v in self.series.items()}
+
+
+class NormHistory:
+    """|u| of every step (the divergence guard and -ssi_monitor read it)."""
+
+    def __init__(self):
+        self.values = []
+
+    def observe(self, n, t, step):
+        if step.get("norm") is not None:
+            self.values.append(step["norm"])
+
+    def state(self, n_times):
+        return {"unorm": np.asarray(self.values, float)}
+
+    def restore(self, s, n):
+        self.values = [float(x) for x in s["unorm"]]
+
+
+class ProgressLine:
+    """The -ssi_monitor line (``monitor.Progress``): what, how far, how long to go."""
+
+    def __init__(self, cfg, comm, what, n_steps):
         self.progress = Progress(what, n_steps, enabled=cfg.monitor, every=cfg.monitor_every, comm=comm)
 
-    def due(self, n):
-        """Whether step n writes fields (-ssi_output_stride; 0: never)."""
-        s = self.cfg.output_stride
-        return bool(s) and n % s == 0
+    def observe(self, n, t, step):
+        self.progress.update(n, step.get("status", ""))
 
-    def step(self, n, t, soil=None, structure=None, interface=None, norm=None, status=""):
-        """Record step n at time t: ``soil`` (u, p) Vecs, ``structure`` (u, v) Vecs, ``interface``
-        a dict with the interface keys; ``norm`` the |u| kept for the guard; ``status`` the
-        progress line's tail."""
+    def restore(self, s, n):
+        self.progress.first = n
+
+
+class Recorder:
+    """Collective: what a run keeps, as a list of observers (PyLith's observers) with one protocol:
+
+      observe(n, t, step)    step n at time t; ``step`` holds what the problem gives: 'soil' (u, p)
+                             Vecs, 'structure' (u, v) Vecs, 'interface' (a dict), 'norm', 'status'
+      snapshot(n, t, step)   the fields of a step the time grid writes (``TimeGrid.writes``),
+                             after every observer saw the step (the series are whole before a
+                             snapshot can fail on a full disk)
+      state(n_times)         {name: array} for a checkpoint (rank 0's)
+      restore(s, n)          the same from a checkpoint after step n
+
+    each method optional. The recorder keeps the steps and times itself; ``soil``, ``structure``
+    and ``interface`` name the observers the problems read back, and ``add`` appends one (e.g. the
+    BEM's divergence guard, ``bem.stability.DivergenceGuard``), which sees every step after the
+    recorders and before the progress line."""
+
+    def __init__(self, cfg, comm, what, grid, soil=None, structure=None, interface_keys=()):
+        self.cfg, self.comm, self.grid = cfg, comm, grid
+        self.soil, self.structure = soil, structure
+        self.interface = InterfaceSeries(interface_keys) if interface_keys else None
+        self.norms = NormHistory()
+        self.progress = ProgressLine(cfg, comm, what, grid.n_steps)
+        self.steps, self.times = [], []
+        self.observers = [o for o in (soil, structure, self.interface, self.norms) if o is not None]
+        self.extra = []
+
+    def add(self, observer):
+        """Append an observer (it sees each step after the recorders, before the progress line)."""
+        self.extra.append(observer)
+        return observer
+
+    def _all(self):
+        return self.observers + self.extra + [self.progress]
+
+    @property
+    def unorm(self):
+        return self.norms.values
+
+    def due(self, n):
+        """Whether step n writes fields (the time grid's -ssi_output_stride; 0: never)."""
+        return self.grid.writes(n)
+
+    def step(self, n, t, **step):
+        """Record step n at time t (``step``: the keys of the protocol above)."""
+        self.steps.append(n)
         self.times.append(t)
-        if soil is not None and self.soil is not None:
-            self.soil.record(soil[0], soil[1], t)
-        if structure is not None and self.structure is not None:
-            self.structure.record(t, structure[0], structure[1])
-        if interface is not None:
-            for k in self.interface:
-                self.interface[k].append(interface[k])
-        if norm is not None:
-            self.unorm.append(norm)
-        if self.due(n):               # the series of step n are whole before a snapshot can fail (disk full)
-            if soil is not None and self.soil is not None:
-                self.soil.write(t, soil[0], soil[1])
-            if structure is not None and self.structure is not None:
-                self.structure.write(t, structure[0], structure[1])
-        self.progress.update(n, status)
+        for o in self.observers:
+            o.observe(n, t, step)
+        if self.grid.writes(n):
+            for o in self.observers:
+                if hasattr(o, "snapshot"):
+                    o.snapshot(n, t, step)
+        for o in self.extra + [self.progress]:
+            o.observe(n, t, step)
 
     def state(self):
         """Collective: the series so far, for a checkpoint ({name: array}, rank 0's)."""
-        s = {"times": np.asarray(self.times, float), "unorm": np.asarray(self.unorm, float)}
-        if self.soil is not None:
-            s.update(self.soil.state(len(self.times)))
-        if self.structure is not None:
-            s.update(self.structure.state())
-        for k, v in self.interface.items():
-            s["interface_" + k] = np.asarray(v)
+        s = {"times": np.asarray(self.times, float)}
+        for o in self._all():
+            if hasattr(o, "state"):
+                s.update(o.state(len(self.times)))
         return s
 
     def restore(self, s, n):
-        """The series of a checkpoint after step ``n`` (``state``)."""
+        """The series of a checkpoint after step ``n`` (``state``); the soil's series start at step
+        1, one value per step."""
         self.times = [float(t) for t in s["times"]]
-        self.unorm = [float(x) for x in s["unorm"]]
-        if self.soil is not None:
-            self.soil.restore(s)
-        if self.structure is not None:
-            self.structure.restore(s)
-        for k in self.interface:
-            self.interface[k] = list(np.asarray(s["interface_" + k]))
-        self.progress.first = n
+        self.steps = list(range(n - len(self.times) + 1, n + 1))
+        for o in self._all():
+            if hasattr(o, "restore"):
+                o.restore(s, n)
 
     def soil_receivers(self):
         return self.soil.receivers(len(self.times)) if self.soil is not None else None
 
     def interface_arrays(self):
-        return {k: np.asarray(v) for k, v in self.interface.items()}
+        return self.interface.arrays() if self.interface is not None else {}
