@@ -13,6 +13,6 @@ setup(
     packages=find_packages(include=["petsc_ssi", "petsc_ssi.*"]),
     python_requires=">=3.9",
     install_requires=["numpy", "numba", "matplotlib"],
-    extras_require={"mesh": ["gmsh"], "test": ["pytest"]},
+    extras_require={"mesh": ["gmsh"], "test": ["pytest"], "seismic": ["obspy"]},
     entry_points={"console_scripts": ["petsc-ssi = petsc_ssi.app.cli:main"]},
 )

@@ -1,0 +1,1 @@
+"""Earthquake input and response: records, response spectra."""

@@ -1,0 +1,627 @@
+"""Earthquake records for the seismic input: read, convert to SI, process, evaluate (numpy/scipy only).
+
+Pipeline (shared/notes/seismic-input.md, 5.2):
+    read_record(path) -> Record        values in SI (m/s^2, m/s or m), file SHA-256, metadata
+    process(record)   -> Motion        scale, window, Hann taper, acceleration, exact integration, baseline
+    motion(t, deriv)                   d (deriv 0), v (1), a (2) at any times, vectorised
+
+Formats (``fmt="auto"`` picks by extension, then by content)
+    PEER NGA ``.AT2``/``.VT2``/``.DT2``: 4 header lines.  Line 3 names the quantity and the units
+        ("ACCELERATION TIME SERIES IN UNITS OF G", "... UNITS OF CM/SEC/SEC", "VELOCITY ... CM/S", ...);
+        line 4 gives NPTS and DT as "NPTS=   7814, DT=   .0050 SEC," or (older) "7814  .0050  NPTS, DT".
+        Values are free-format floats, any number per line (".3654112E-03" is read).  The value count
+        must equal NPTS (truncation guard).  t = k DT, k = 0..NPTS-1.
+    Tables: rows "t a" or "t ax ay az", '#' starts a comment, whitespace or commas separate; t finite
+        and strictly increasing, non-uniform allowed.  A table states no units, so ``units`` must be
+        given, or the file carries a comment line "# units: cm/s2" (``units="auto"`` reads it).
+        ``component`` (x, y, z or 0, 1, 2) picks a column of a 4-column table; without it the
+        values are (n, 3).
+    Everything else through ObsPy (imported only then): miniSEED, SAC, K-NET/KiK-net, Kinemetrics
+        EVT, ... One trace is taken; with several, ``component`` selects it by channel code (exact,
+        or the last character, E/N/Z/1/2/3; E, N, Z also match K-NET's EW, NS, UD) or by position
+        (an int).  Calibration:
+          K-NET/KiK-net: ObsPy's reader does NOT apply the scale factor: the samples stay counts and
+            stats.calib = 0.01 x (scale factor "2000(gal)/8388608") converts them to m/s^2.  We apply it.
+          Kinemetrics EVT: read raw; stats.calib is ObsPy's m/s^2 per count (its apply_calib=True
+            gives the same numbers; ObsPy takes g = 9.81 m/s^2 there, 0.035 % above the standard g).
+          Any other format (SAC, miniSEED, ...) may hold counts: the samples are taken as they are and
+            ``units`` is mandatory (stats.calib is not applied; a warning says so when it is not 1).
+    ``units="auto"`` only where the file states its units (AT2 line 3, K-NET, EVT); given units must
+    then agree with the file's.  A requested ``quantity`` must agree with the file's.
+
+Units: g = 9.80665 m/s^2, m/s2, cm/s2 = gal, m/s, cm/s, m, cm, mm (aliases: cm/sec/sec, m/s^2, ...).
+
+Processing (``process``), in this order
+    1. scale (after the conversion to SI).
+    2. window: "all" | (t0, t1) record seconds (samples with t0 <= t <= t1) | ("arias", p0, p1): from
+       the last sample where the cumulative Arias intensity is <= p0 I_A to the first where it is
+       >= p1 I_A (so the part kept holds at least p1 - p0 of I_A, at most one sample interval more at
+       each end).  The Arias intensity that locates the window is the record's acceleration less its
+       mean (an offset must not decide where the motion is).
+    3. baseline "mean" and "poly6": subtract the pre-event mean (the arithmetic mean of the samples
+       before the window when there are at least 2, else of the window), in the record's quantity.
+    4. Hann taper of fraction p at EACH end, as ObsPy's Trace.taper(p, "hann") / gmprocess's width:
+       w = int(p n) sample intervals (n samples; the mean interval for non-uniform grids), weight
+       (1 - cos(pi s / w)) / 2 at distance s from the end.  The total tapered length is 2 p.
+    5. the record's quantity becomes acceleration (samples -> piecewise-linear a):
+         velocity:     the a whose exact integral passes through every sample v_k, of least
+                       int a^2 dt (the trapezoid recurrence leaves a free sawtooth c (-1)^k; c minimises).
+         displacement: the cubic spline through the d_k with v = 0 at the start and a = 0 at the end
+                       (the natural end: least int a^2 dt).  Its a is piecewise linear, so
+       exact re-integration returns the (windowed, tapered, scaled) record at its samples.
+    6. time axis: the first kept sample is at t_start = pad_start (motion(t) = 0 before it);
+       ``Motion.record_t0`` is its time in the record.
+    7. exact integration of the piecewise-linear a, from rest (acceleration record) or from the
+       record's first v (velocity) / d (displacement) sample:
+         v_{k+1} = v_k + h (a_k + a_{k+1}) / 2,  d_{k+1} = d_k + h v_k + h^2 (2 a_k + a_{k+1}) / 6.
+    8. baseline "poly6" (Ancheta et al. 2013, gmprocess baseline_sixth_order): least-squares fit of
+       d - d_0 by sum_{k=2..6} c_k tau^k (tau = t - t_start), subtract its second derivative from a at
+       the samples, and integrate again (so a, v, d stay exactly consistent; v and d then differ from
+       "d minus the polynomial" by the O(h^2) integration error of a smooth quartic).
+    Warnings (RecordWarning): the poly6 correction changes PGA by more than 5 %; |v_end| > 1 % PGV.
+
+Stats (``Motion.stats_raw``: the scaled record as read, integrated whole; ``Motion.stats``: processed):
+PGA, PGV, PGD (peaks over the samples), v_end, d_end, Arias intensity pi/(2 g) int a^2 dt (exact for
+piecewise-linear a), D5-95 (between the times where the cumulative Arias intensity, linear between
+samples, reaches 5 % and 95 %).  Per component (arrays) for 3-component motions.
+"""
+import dataclasses
+import hashlib
+import io
+import os
+import re
+import warnings
+
+import numpy as np
+
+G = 9.80665
+QUANTITIES = ("acceleration", "velocity", "displacement")
+SI_UNITS = {"acceleration": "m/s2", "velocity": "m/s", "displacement": "m"}
+UNITS = {"g": ("acceleration", G), "m/s2": ("acceleration", 1.0), "cm/s2": ("acceleration", 0.01),
+         "gal": ("acceleration", 0.01), "m/s": ("velocity", 1.0), "cm/s": ("velocity", 0.01),
+         "m": ("displacement", 1.0), "cm": ("displacement", 0.01), "mm": ("displacement", 0.001)}
+PEER_EXT = {".at2": "acceleration", ".vt2": "velocity", ".dt2": "displacement"}
+OBSPY_CALIBRATED = ("KNET", "KINEMETRICS_EVT")      # samples x stats.calib are m/s^2
+BASELINES = ("poly6", "mean", "none")
+STAT_UNITS = {"pga": "m/s2", "pgv": "m/s", "pgd": "m", "v_end": "m/s", "d_end": "m", "arias": "m/s",
+              "d5_95": "s"}
+_NPTS_NEW = re.compile(r"NPTS\s*=\s*([^,\s]+)\s*,?\s*DT\s*=\s*([^,\s]+)", re.I)
+_NPTS_OLD = re.compile(r"^\s*(\S+)\s+(\S+)\s+NPTS\s*,\s*DT", re.I)
+_COLUMNS = {"x": 0, "y": 1, "z": 2, "0": 0, "1": 1, "2": 2}
+_ALIASES = {"E": "EW", "N": "NS", "Z": "UD"}
+
+
+class RecordError(ValueError):
+    """A record that cannot be read or processed; the message is one line naming the file."""
+
+
+class RecordWarning(UserWarning):
+    """Processing that may have changed the motion more than intended."""
+
+
+@dataclasses.dataclass(eq=False)
+class Record:
+    """A record as read, in SI: ``values`` (n,) or (n, 3) at times ``t`` [s]."""
+    t: np.ndarray
+    values: np.ndarray
+    quantity: str
+    units_in: str
+    source: str
+    sha256: str
+    dt: float = None
+    metadata: dict = dataclasses.field(default_factory=dict)
+
+
+def _refuse(path, cause):
+    raise RecordError(f"record '{path}': {' '.join(str(cause).split())}")
+
+
+def canonical_units(text):
+    """The UNITS key for a unit spelling ('CM/SEC/SEC' -> 'cm/s2', 'G' -> 'g'), or None."""
+    u = re.sub(r"\s+", "", str(text)).lower().rstrip(".,;")
+    u = u.replace("sec", "s").replace("**2", "2").replace("^2", "2").replace("/s/s", "/s2")
+    return u if u in UNITS else None
+
+
+# ---------------------------------------------------------------------------------------------- reading
+
+def read_record(path, fmt="auto", quantity="auto", units="auto", component=None):
+    """Read a record file (module docstring) into a Record in SI; RecordError on any defect.
+
+    fmt: "auto" | "peer" | "table" | "obspy" (ObsPy's own detection) | an ObsPy format name ("KNET",
+    "MSEED", "SAC", "KINEMETRICS_EVT", ...).  quantity: "auto" or the quantity the caller expects (a
+    mismatch is refused).  units: "auto" (the file's) or a unit of UNITS.  component: a column of a
+    4-column table (x, y, z, 0, 1, 2) or a trace of a multi-trace ObsPy file (channel code or index).
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        _refuse(path, f"cannot read: {exc.strerror or exc}")
+    if not raw.strip():
+        _refuse(path, "empty file")
+    kind = _detect(path, raw, fmt)
+    reader = {"peer": _read_peer, "table": _read_table, "obspy": _read_obspy}[kind]
+    t, vals, file_units, meta = reader(path, raw, fmt, component)
+    unit, qty = _resolve(path, file_units, units, quantity)
+    if not np.all(np.isfinite(vals)):
+        _refuse(path, f"non-finite value (nan or inf) at sample {int(np.nonzero(~np.isfinite(vals))[0][0])}")
+    step = np.diff(t)
+    dt = float(step.mean()) if np.allclose(step, step[0], rtol=1e-6, atol=0) else None
+    return Record(t=t, values=vals * UNITS[unit][1], quantity=qty, units_in=unit, source=path,
+                  sha256=hashlib.sha256(raw).hexdigest(), dt=dt, metadata=dict(meta, format=kind))
+
+
+def _detect(path, raw, fmt):
+    f = str(fmt).lower()
+    if f != "auto":
+        return {"peer": "peer", "at2": "peer", "table": "table"}.get(f, "obspy")
+    if os.path.splitext(path)[1].lower() in PEER_EXT:
+        return "peer"
+    if b"\0" in raw[:4096]:
+        return "obspy"
+    lines = raw.decode("latin-1").splitlines()
+    if lines and "PEER" in lines[0].upper() or len(lines) > 3 and _npts_match(lines[3]):
+        return "peer"
+    first = next((ln for ln in (re.sub(r"#.*", "", x).strip() for x in lines) if ln), "")
+    return "table" if re.fullmatch(r"[-+0-9.eE,\s]+", first) else "obspy"
+
+
+def _npts_match(line):
+    return _NPTS_NEW.search(line) or _NPTS_OLD.search(line)
+
+
+def _read_peer(path, raw, fmt, component):
+    lines = raw.decode("latin-1").splitlines()
+    if component is not None:
+        _refuse(path, f"a PEER file holds one component (component={component!r} given)")
+    if len(lines) < 4:
+        _refuse(path, f"PEER header needs 4 lines, the file has {len(lines)}")
+    qty, unit = _peer_line3(path, lines[2])
+    ext_qty = PEER_EXT.get(os.path.splitext(path)[1].lower())
+    if ext_qty and ext_qty != qty:
+        _refuse(path, f"line 3 says {qty} but the extension means {ext_qty}")
+    npts, dt = _peer_line4(path, lines[3])
+    vals = _floats(path, " ".join(lines[4:]).split())
+    if vals.size != npts:
+        _refuse(path, f"{vals.size} values but NPTS = {npts}" + (" (truncated file?)" if vals.size < npts else ""))
+    return np.arange(npts) * dt, vals, unit, dict(_peer_line2(lines[1]), quantity_line=lines[2].strip())
+
+
+def _peer_line2(line):
+    parts = [p.strip() for p in line.split(",")]
+    meta = {"header": line.strip(), "event": parts[0], "station": "", "component": ""}
+    if len(parts) >= 3:
+        meta.update(station=parts[-2], component=parts[-1])
+    return meta
+
+
+def _peer_line3(path, line):
+    up = line.upper()
+    qty = next((q for q in QUANTITIES if q.upper() in up), None)
+    m = re.search(r"UNITS\s+OF\s+(\S+)", up)
+    if qty is None or m is None:
+        _refuse(path, f"line 3 must name the quantity and the units (got '{line.strip()}')")
+    unit = canonical_units(m.group(1))
+    if unit is None:
+        _refuse(path, f"unknown units '{m.group(1)}' on line 3 (known: {', '.join(UNITS)})")
+    if UNITS[unit][0] != qty:
+        _refuse(path, f"line 3: units '{m.group(1)}' are not units of {qty}")
+    return qty, unit
+
+
+def _peer_line4(path, line):
+    m = _npts_match(line)
+    if m is None:
+        _refuse(path, f"line 4 must give NPTS and DT (got '{line.strip()}')")
+    try:
+        npts, dt = int(m.group(1)), float(m.group(2).upper().replace("D", "E"))
+    except ValueError:
+        _refuse(path, f"line 4: NPTS '{m.group(1)}' or DT '{m.group(2)}' is not a number")
+    if not (np.isfinite(dt) and dt > 0):
+        _refuse(path, f"DT = {m.group(2)} on line 4 (must be finite and > 0)")
+    if npts < 2:
+        _refuse(path, f"NPTS = {npts} on line 4 (need at least 2 samples)")
+    return npts, dt
+
+
+def _floats(path, tokens):
+    try:
+        return np.array(tokens, dtype=float)
+    except ValueError:
+        bad = next(i for i, s in enumerate(tokens) if not _is_float(s))
+        _refuse(path, f"value {bad + 1} '{tokens[bad]}' is not a number")
+
+
+def _is_float(s):
+    try:
+        float(s)
+        return True
+    except ValueError:
+        return False
+
+
+def _read_table(path, raw, fmt, component):
+    text = raw.decode("latin-1")
+    body = re.sub(r"#.*", "", text).replace(",", " ")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(io.StringIO(body), ndmin=2)
+    except ValueError as exc:
+        _refuse(path, f"not a table of numbers ({str(exc).strip().splitlines()[-1]})")
+    if data.shape[0] < 2 or data.shape[1] not in (2, 4):
+        _refuse(path, f"need at least 2 rows of 't a' or 't ax ay az' (got shape {data.shape})")
+    if not np.all(np.isfinite(data)):
+        _refuse(path, f"non-finite value (nan or inf) in data row {int(np.nonzero(~np.isfinite(data))[0][0]) + 1}")
+    if np.any(np.diff(data[:, 0]) <= 0):
+        k = int(np.nonzero(np.diff(data[:, 0]) <= 0)[0][0])
+        _refuse(path, f"t must increase strictly (data row {k + 2}: t = {data[k + 1, 0]:g} after {data[k, 0]:g})")
+    vals, comp = _table_column(path, data, component)
+    m = re.search(r"^\s*#\s*units?\s*[:=]\s*(\S+)", text, re.M | re.I)
+    unit = canonical_units(m.group(1)) if m else None
+    if m and unit is None:
+        _refuse(path, f"unknown units '{m.group(1)}' in the '# units:' line (known: {', '.join(UNITS)})")
+    return data[:, 0].copy(), vals, unit, {"station": "", "event": "", "component": comp}
+
+
+def _table_column(path, data, component):
+    if data.shape[1] == 2:
+        if component is not None:
+            _refuse(path, f"a 't a' table holds one component (component={component!r} given)")
+        return data[:, 1].copy(), ""
+    if component is None:
+        return data[:, 1:].copy(), "x,y,z"
+    col = _COLUMNS.get(str(component).lower())
+    if col is None:
+        _refuse(path, f"component {component!r} (one of x, y, z or 0, 1, 2)")
+    return data[:, 1 + col].copy(), "xyz"[col]
+
+
+def _read_obspy(path, raw, fmt, component):
+    try:
+        import obspy
+    except ImportError:
+        _refuse(path, "not a PEER file or a table, and ObsPy (needed for seismological formats) is not installed")
+    f = None if str(fmt).lower() in ("auto", "obspy") else str(fmt).upper()
+    try:
+        st = obspy.read(io.BytesIO(raw), format=f)
+    except Exception as exc:                               # ObsPy raises many kinds
+        _refuse(path, f"not a PEER file, a table or a format ObsPy reads ({type(exc).__name__}: {exc})")
+    tr = _pick_trace(path, st, component)
+    form = tr.stats.get("_format", f or "")
+    vals = np.asarray(tr.data, dtype=float)
+    if form in OBSPY_CALIBRATED:
+        vals, unit = vals * float(tr.stats.calib), "m/s2"
+    else:
+        unit = None
+        if float(tr.stats.calib) != 1.0:
+            warnings.warn(f"record '{path}': {form} stats.calib = {tr.stats.calib:g} is not applied; "
+                          f"the samples are taken in the given units", RecordWarning, stacklevel=3)
+    return np.asarray(tr.times(), dtype=float), vals, unit, _obspy_meta(tr, form)
+
+
+def _pick_trace(path, st, component):
+    if component is None:
+        if len(st) != 1:
+            _refuse(path, f"{len(st)} traces ({', '.join(tr.id for tr in st)}): give component=")
+        return st[0]
+    if isinstance(component, (int, np.integer)):
+        if not 0 <= component < len(st):
+            _refuse(path, f"component {component} but the file has {len(st)} traces")
+        return st[int(component)]
+    c = str(component).upper()
+    hits = [tr for tr in st if tr.stats.channel.upper() == c] or \
+           [tr for tr in st if tr.stats.channel.upper().endswith(c)
+            or tr.stats.channel.upper().rstrip("0123456789") == _ALIASES.get(c)]
+    if len(hits) != 1:
+        _refuse(path, f"component {component!r} matches {len(hits)} of the traces ({', '.join(tr.id for tr in st)})")
+    return hits[0]
+
+
+def _obspy_meta(tr, form):
+    s = tr.stats
+    event = ""
+    if "knet" in s:
+        k = s.knet
+        event = f"origin {k.evot} lat {k.evla} lon {k.evlo} depth {k.evdp} km M{k.mag}"
+    return {"station": ".".join(x for x in (s.network, s.station, s.location) if x), "event": event,
+            "component": s.channel, "obspy_format": form, "starttime": str(s.starttime),
+            "calib": float(s.calib)}
+
+
+def _resolve(path, file_units, units, quantity):
+    if quantity not in QUANTITIES + ("auto",):
+        _refuse(path, f"unknown quantity '{quantity}' (one of auto, {', '.join(QUANTITIES)})")
+    given = None if units == "auto" else canonical_units(units)
+    if units != "auto" and given is None:
+        _refuse(path, f"unknown units '{units}' (one of auto, {', '.join(UNITS)})")
+    if file_units is None and given is None:
+        _refuse(path, f"the file does not state its units: give units= (one of {', '.join(UNITS)})")
+    if file_units and given and UNITS[file_units] != UNITS[given]:
+        _refuse(path, f"the file is in {file_units}, units='{units}' given")
+    unit = file_units or given
+    if quantity != "auto" and quantity != UNITS[unit][0]:
+        _refuse(path, f"quantity mismatch: the file holds {UNITS[unit][0]} ({unit}), {quantity} requested")
+    return unit, UNITS[unit][0]
+
+
+# ---------------------------------------------------------------------------------------------- kinematics
+
+def _as2d(x):
+    x = np.asarray(x, dtype=float)
+    return x[:, None] if x.ndim == 1 else x
+
+
+def integrate(t, a, v0=0.0, d0=0.0):
+    """(v, d) at the samples, exact for the piecewise-linear a through (t, a); a (n,) or (n, c)."""
+    t, a = np.asarray(t, float), np.asarray(a, float)
+    h = np.diff(t).reshape((-1,) + (1,) * (a.ndim - 1))
+    v = v0 + np.concatenate([np.zeros_like(a[:1]), np.cumsum(h * (a[:-1] + a[1:]) / 2, axis=0)])
+    d = d0 + np.concatenate([np.zeros_like(a[:1]),
+                             np.cumsum(h * v[:-1] + h * h * (2 * a[:-1] + a[1:]) / 6, axis=0)])
+    return v, d
+
+
+def _l2(x, y, t):
+    """int x y dt for piecewise-linear x, y (columns)."""
+    h = np.diff(t)[:, None]
+    return np.sum(h * (2 * x[:-1] * y[:-1] + x[:-1] * y[1:] + x[1:] * y[:-1] + 2 * x[1:] * y[1:]) / 6, axis=0)
+
+
+def to_acceleration(t, x, quantity):
+    """(a, v0, d0): the piecewise-linear a (module docstring, step 5) whose exact integral from
+    (v0, d0) passes through the samples x (n, c) of the given quantity."""
+    x = _as2d(x)
+    if quantity == "acceleration":
+        return x.copy(), 0.0, 0.0
+    if quantity == "velocity":
+        sign = (-1.0) ** np.arange(len(t))[:, None]
+        q = 2 * np.diff(x, axis=0) / np.diff(t)[:, None]
+        p = sign * np.concatenate([np.zeros_like(x[:1]), np.cumsum(-sign[:-1] * q, axis=0)])
+        c = -_l2(p, sign, t) / _l2(sign, sign, t)
+        return p + c * sign, x[0].copy(), 0.0
+    from scipy.interpolate import CubicSpline
+    zero = np.zeros(x.shape[1])
+    spline = CubicSpline(t, x, axis=0, bc_type=((1, zero), (2, zero)))
+    return spline(t, 2), 0.0, x[0].copy()
+
+
+def _kinematics(t, x, quantity):
+    a, v0, d0 = to_acceleration(t, x, quantity)
+    v, d = integrate(t, a, v0, d0)
+    return a, v, d
+
+
+def arias_cumulative(t, a):
+    """Cumulative Arias intensity pi/(2 g) int_0^t a^2 [m/s] at the samples, exact for piecewise-linear a."""
+    a = _as2d(a)
+    h = np.diff(t)[:, None]
+    seg = h * (a[:-1] ** 2 + a[:-1] * a[1:] + a[1:] ** 2) / 3
+    return np.pi / (2 * G) * np.concatenate([np.zeros_like(a[:1]), np.cumsum(seg, axis=0)])
+
+
+def _crossing(t, cum, frac):
+    """Time where cum (non-decreasing) first reaches frac * cum[-1], linear between samples."""
+    target = frac * cum[-1]
+    k = int(np.searchsorted(cum, target, side="left"))
+    if k == 0 or cum[-1] == 0:
+        return float(t[0])
+    return float(t[k - 1] + (target - cum[k - 1]) / (cum[k] - cum[k - 1]) * (t[k] - t[k - 1]))
+
+
+def motion_stats(t, a, v, d):
+    """Dict of PGA, PGV, PGD, v_end, d_end, Arias, D5-95 (units STAT_UNITS), per column."""
+    a, v, d = _as2d(a), _as2d(v), _as2d(d)
+    cum = arias_cumulative(t, a)
+    d595 = [_crossing(t, cum[:, j], 0.95) - _crossing(t, cum[:, j], 0.05) for j in range(a.shape[1])]
+    out = {"pga": np.abs(a).max(0), "pgv": np.abs(v).max(0), "pgd": np.abs(d).max(0), "v_end": v[-1],
+           "d_end": d[-1], "arias": cum[-1], "d5_95": np.array(d595)}
+    return {k: (float(x[0]) if x.size == 1 else np.array(x, float)) for k, x in out.items()}
+
+
+# ---------------------------------------------------------------------------------------------- processing
+
+def parse_window(text):
+    """'all' | 't0,t1' | 'arias:p0,p1' (the -ssi_seismic_window syntax) -> process()'s window."""
+    s = str(text).strip().lower()
+    if s == "all":
+        return "all"
+    body = s[len("arias:"):] if s.startswith("arias:") else s
+    try:
+        lo, hi = (float(x) for x in body.split(","))
+    except ValueError:
+        raise ValueError(f"window '{text}': expected all, t0,t1 or arias:p0,p1") from None
+    return ("arias", lo, hi) if s.startswith("arias:") else (lo, hi)
+
+
+def hann_taper(t, fraction):
+    """Weights of a Hann taper of ``fraction`` at each end (ObsPy's int(p n) samples; module docstring)."""
+    n = len(t)
+    wlen = int(fraction * n)
+    if wlen == 0:
+        return np.ones(n)
+    s = np.minimum(t - t[0], t[-1] - t) / (wlen * (t[-1] - t[0]) / (n - 1))
+    return np.where(s < 1, 0.5 * (1 - np.cos(np.pi * np.minimum(s, 1))), 1.0)
+
+
+def _window(path, t, a, window):
+    if isinstance(window, str) and window == "all":
+        return 0, len(t) - 1
+    if isinstance(window, (tuple, list)) and len(window) == 3 and window[0] == "arias":
+        p0, p1 = float(window[1]), float(window[2])
+        if not 0 <= p0 < p1 <= 1:
+            _refuse(path, f"Arias window fractions {p0:g}, {p1:g} (need 0 <= p0 < p1 <= 1)")
+        cum = arias_cumulative(t, a - a.mean(0)).sum(1)
+        if cum[-1] <= 0:
+            _refuse(path, "Arias window of a record with zero Arias intensity")
+        i0 = max(int(np.searchsorted(cum, p0 * cum[-1], side="right")) - 1, 0)
+        i1 = min(int(np.searchsorted(cum, p1 * cum[-1], side="left")), len(t) - 1)
+    elif isinstance(window, (tuple, list)) and len(window) == 2:
+        t0, t1 = float(window[0]), float(window[1])
+        i0, i1 = int(np.searchsorted(t, t0, side="left")), int(np.searchsorted(t, t1, side="right")) - 1
+    else:
+        _refuse(path, f"window {window!r} (all, (t0, t1) or ('arias', p0, p1))")
+    if i1 - i0 < 1:
+        _refuse(path, f"window {window!r} keeps {max(i1 - i0 + 1, 0)} sample(s) of the record "
+                      f"[{t[0]:g}, {t[-1]:g}] s (need 2)")
+    return i0, i1
+
+
+def _check_args(path, scale, taper, baseline, pad_start):
+    if not (np.isfinite(scale) and scale != 0):
+        _refuse(path, f"scale = {scale} (must be finite and non-zero)")
+    if not 0 <= taper <= 0.5:
+        _refuse(path, f"taper = {taper} (a fraction at each end, 0 <= taper <= 0.5)")
+    if baseline not in BASELINES:
+        _refuse(path, f"baseline '{baseline}' (one of {', '.join(BASELINES)})")
+    if not (np.isfinite(pad_start) and pad_start >= 0):
+        _refuse(path, f"pad_start = {pad_start} (must be finite and >= 0)")
+
+
+def _poly6_accel(t, d):
+    """Second derivative at the samples of the least-squares fit of d - d_0 by sum_{k=2..6} c_k tau^k."""
+    span = t[-1] - t[0]
+    x = ((t - t[0]) / span)[:, None]
+    k = np.arange(2, 7)
+    coef = np.linalg.lstsq(x ** k, d - d[0], rcond=None)[0]
+    return (k * (k - 1) * x ** (k - 2)) @ coef / span ** 2
+
+
+def _ratio(x, y):
+    return np.divide(x, y, out=np.zeros_like(np.asarray(x, float)), where=np.asarray(y) != 0)
+
+
+def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_start=0.0):
+    """Motion from a Record: scale, window, pre-event mean, Hann taper, acceleration, exact integration
+    and baseline (module docstring, steps 1-8).  RecordError on bad arguments, RecordWarning on a large
+    baseline change or final velocity.
+
+    scale: factor after the conversion to SI (finite, non-zero).  window: "all" | (t0, t1) | ("arias",
+    p0, p1) (``parse_window`` reads the option syntax).  taper: Hann fraction at each end, 0..0.5.
+    baseline: "poly6" | "mean" | "none".  pad_start: time of the first kept sample in the motion [s].
+    """
+    path = record.source
+    _check_args(path, scale, taper, baseline, pad_start)
+    t, x = np.asarray(record.t, float), _as2d(record.values) * scale
+    raw = _kinematics(t, x, record.quantity)
+    i0, i1 = _window(path, t, raw[0], window)
+    xw = x[i0:i1 + 1]
+    if baseline != "none":
+        xw = xw - (x[:i0] if i0 >= 2 else xw).mean(0)
+    tm = t[i0:i1 + 1] - t[i0] + pad_start
+    a, v0, d0 = to_acceleration(tm, xw * hann_taper(tm, taper)[:, None], record.quantity)
+    v, d = integrate(tm, a, v0, d0)
+    change = np.zeros(a.shape[1])
+    if baseline == "poly6":
+        a_new = a - _poly6_accel(tm, d)
+        change = _ratio(np.abs(a_new).max(0), np.abs(a).max(0)) - 1
+        a = a_new
+        v, d = integrate(tm, a, v0, d0)
+    proc = dict(scale=float(scale), window=window, taper=float(taper), baseline=baseline,
+                pad_start=float(pad_start), window_samples=(i0, i1))
+    motion = Motion(t=tm, a=a, v=v, d=d, stats_raw=motion_stats(t, *raw), stats=motion_stats(tm, a, v, d),
+                    baseline_pga_change=change, record_t0=float(t[i0]), source=path, sha256=record.sha256,
+                    record_info=_record_info(record), processing=proc, ndim=np.ndim(record.values))
+    motion.warn()
+    return motion
+
+
+def _record_info(record):
+    return dict(record.metadata, quantity=record.quantity, units_in=record.units_in, n=len(record.t),
+                dt=record.dt)
+
+
+# ---------------------------------------------------------------------------------------------- the motion
+
+def _fmt(x, spec=".4g"):
+    return "/".join(format(float(v), spec) for v in np.atleast_1d(x))
+
+
+@dataclasses.dataclass(eq=False)
+class Motion:
+    """Processed control motion: samples t, a, v, d (SI) and the time function motion(t, deriv).
+
+    Between samples a is linear, v quadratic, d cubic (exact integrals); 0 before t_start; after t_end
+    a = 0, v = v_end, d = d_end + v_end (t - t_end).  ``a``, ``v``, ``d`` are (n,) or (n, 3)."""
+    t: np.ndarray
+    a: np.ndarray
+    v: np.ndarray
+    d: np.ndarray
+    stats_raw: dict
+    stats: dict
+    baseline_pga_change: np.ndarray
+    record_t0: float
+    source: str
+    sha256: str
+    record_info: dict
+    processing: dict
+    ndim: int = 1
+
+    def __post_init__(self):
+        if self.ndim == 1:
+            self.a, self.v, self.d = (np.asarray(x, float).reshape(-1) for x in (self.a, self.v, self.d))
+            self.baseline_pga_change = float(np.asarray(self.baseline_pga_change).reshape(-1)[0])
+
+    t_start = property(lambda self: float(self.t[0]))
+    t_end = property(lambda self: float(self.t[-1]))
+    duration = property(lambda self: float(self.t[-1] - self.t[0]))
+
+    def __call__(self, t, deriv=0):
+        """d (deriv 0), v (1) or a (2) at times t (any shape; result t.shape [+ (3,)])."""
+        if deriv not in (0, 1, 2):
+            raise ValueError(f"deriv must be 0, 1 or 2 (got {deriv!r})")
+        tq = np.asarray(t, dtype=float)
+        s_all = tq.reshape(-1)
+        tk, a, v, d = self.t, _as2d(self.a), _as2d(self.v), _as2d(self.d)
+        k = np.clip(np.searchsorted(tk, s_all, side="right") - 1, 0, len(tk) - 2)
+        s = (s_all - tk[k])[:, None]
+        slope = (a[k + 1] - a[k]) / (tk[k + 1] - tk[k])[:, None]
+        out = [d[k] + s * (v[k] + s * (a[k] / 2 + s * slope / 6)),
+               v[k] + s * (a[k] + s * slope / 2), a[k] + s * slope][deriv]
+        out[s_all < tk[0]] = 0.0
+        after = s_all > tk[-1]
+        out[after] = [d[-1] + (s_all[after] - tk[-1])[:, None] * v[-1], v[-1], 0.0][deriv]
+        return out[:, 0].reshape(tq.shape)[()] if self.ndim == 1 else out.reshape(tq.shape + out.shape[1:])
+
+    def warn(self):
+        """RecordWarning if poly6 changed PGA by more than 5 % or |v_end| > 1 % PGV."""
+        s = self.stats
+        if np.any(np.abs(self.baseline_pga_change) > 0.05):
+            warnings.warn(f"record '{self.source}': the poly6 baseline changes PGA by "
+                          f"{_fmt(np.multiply(self.baseline_pga_change, 100), '+.1f')} % (> 5 %)",
+                          RecordWarning, stacklevel=3)
+        if np.any(np.abs(s["v_end"]) > 0.01 * np.asarray(s["pgv"])):
+            warnings.warn(f"record '{self.source}': final velocity {_fmt(s['v_end'])} m/s is more than "
+                          f"1 % of PGV {_fmt(s['pgv'])} m/s", RecordWarning, stacklevel=3)
+
+    def summary_lines(self):
+        """Human-readable report (units stated), one string per line."""
+        r, p = self.record_info, self.processing
+        dt = f"dt {r['dt']:g} s" if r.get("dt") else "non-uniform t"
+        form = r.get("obspy_format") or r.get("format", "")
+        lines = [f"record {self.source} (sha256 {self.sha256}): {form}, {r['quantity']} in {r['units_in']}, "
+                 f"{r['n']} samples, {dt}, station '{r.get('station', '')}', component '{r.get('component', '')}'",
+                 f"processing: scale {p['scale']:g}, window {p['window']!r} (record from {self.record_t0:g} s), "
+                 f"Hann taper {p['taper']:g} of the length at each end, baseline {p['baseline']}",
+                 f"motion: {len(self.t)} samples, t {self.t_start:g} .. {self.t_end:g} s "
+                 f"(duration {self.duration:g} s)",
+                 f"{'':16s}{'raw':>24s}{'processed':>24s}"]
+        names = {"pga": "PGA", "pgv": "PGV", "pgd": "PGD", "v_end": "final v", "d_end": "final d",
+                 "arias": "Arias", "d5_95": "D5-95"}
+        for key, name in names.items():
+            lines.append(f"{name + ' [' + STAT_UNITS[key] + ']':16s}{_fmt(self.stats_raw[key]):>24s}"
+                         f"{_fmt(self.stats[key]):>24s}")
+        lines.append(f"poly6 baseline PGA change: {_fmt(np.multiply(self.baseline_pga_change, 100), '+.2f')} %")
+        return lines
+
+    def as_arrays(self):
+        """name -> (array, unit): the samples and the raw/processed stats, for HDF5."""
+        out = {"t": (self.t, "s"), "acceleration": (self.a, "m/s2"), "velocity": (self.v, "m/s"),
+               "displacement": (self.d, "m"),
+               "baseline_pga_change": (np.asarray(self.baseline_pga_change), "1")}
+        for key, unit in STAT_UNITS.items():
+            out[f"raw_{key}"] = (np.asarray(self.stats_raw[key]), unit)
+            out[key] = (np.asarray(self.stats[key]), unit)
+        return out
