@@ -26,7 +26,8 @@ def run_bem(**opts):
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
-        cfg = options.resolve(("common", "bem"))
+        from petsc_ssi.app.kinds import resolve
+        cfg = resolve("bem")
         return _run(cfg)
     finally:
         for k in opts:
@@ -97,7 +98,8 @@ def run_ssi(**opts):
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
-        cfg = options.resolve(("common", "bem", "fem", "ssi"))
+        from petsc_ssi.app.kinds import resolve
+        cfg = resolve("ssi")
         return _run(cfg)
     finally:
         for k in opts:

@@ -11,9 +11,9 @@ from ..fem.problem import FEMTransient
 from ..coupling.problem import SSITransient
 
 # kind: (class, option groups of the registry it reads)
-KINDS = {"bem": (BEMTransient, ("common", "bem")),
-         "fem": (FEMTransient, ("common", "fem")),
-         "ssi": (SSITransient, ("common", "bem", "fem", "ssi"))}
+KINDS = {"bem": (BEMTransient, ("common", "bem", "seismic")),
+         "fem": (FEMTransient, ("common", "fem", "seismic")),
+         "ssi": (SSITransient, ("common", "bem", "fem", "ssi", "seismic"))}
 GROUPS = {k: g for k, (_, g) in KINDS.items()}
 
 

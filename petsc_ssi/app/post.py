@@ -13,6 +13,9 @@ Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
                       --window none and an integer number of periods; other
                       windows divide out their coherent gain).  Prints the
                       highest peaks (component,rank,f_hz,amplitude) on stdout.
+  --response-spectrum response spectra (SA, PSA, PSV, SD, SV; RotD50/RotD100, ratios of
+                      two spectra) of a receiver's acceleration: ``petsc-ssi post FILE.h5
+                      --response-spectrum --help`` (``app/response.py``)
   --transfer A B      transfer function H = B / A of two series on the same time
                       grid, magnitude and phase.  A and B are each
                         K                  receiver K of the selected series of FILE
@@ -335,6 +338,10 @@ def transfer_command(a, out=None):
 # ---------------------------------------------------------------- command line
 
 def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if "--response-spectrum" in argv:           # earthquake-engineering response spectra (app/response.py)
+        from .response import main as response_main
+        return response_main(argv)
     ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog="\n".join(__doc__.splitlines()[2:]))

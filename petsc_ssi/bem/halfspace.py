@@ -70,7 +70,7 @@ def _history(cfg, which):
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
-    def __init__(self, cfg, comm, log=printf):
+    def __init__(self, cfg, comm, log=printf, defer_seismic=False):
         self.cfg, self.comm, self.log = cfg, comm, log
         self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
         self.planes = symmetry.parse(cfg.symmetry)
@@ -110,6 +110,71 @@ class HalfSpace:
                 raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
         self._lags()
         self._warnings(h)
+        self.seismic = None
+        if cfg.get("seismic", "none") != "none" and len(disp):
+            self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
+        elif cfg.get("seismic", "none") != "none" and not defer_seismic:
+            self.attach_seismic(np.zeros(3))
+
+    def attach_seismic(self, ref):
+        """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with
+        ``ref`` the default control point (the centroid of the interface or the prescribed region).
+        Refuses a symmetry plane the wave breaks; without -ssi_t_end the run lasts the record."""
+        from ..seismic.input import SeismicInput
+        cfg = self.cfg
+        self.seismic = SeismicInput(cfg, self.comm, self.mat.cs, self.mat.cp, self.mat.rho, self.mesh.nodes,
+                                    ref, self.dt)
+        self._seismic_symmetry()
+        if not cfg.user_set("t_end"):
+            cfg.set("t_end", self.seismic.duration)
+            self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
+            self.n_steps = self.grid.n_steps
+            self._lags()
+        for line in self.seismic.summary_lines():
+            printf(line)
+        for note in self.seismic.notes:
+            warn(note, self.comm)
+        return self.seismic
+
+    def _seismic_symmetry(self):
+        """A symmetry plane must hold for the free field: a uniform (vertical) wave moving along
+        the plane's normal needs 'anti', along the plane 'sym'; an oblique or Rayleigh wave may not
+        travel across a plane (only along it)."""
+        if not self.planes:
+            return
+        s = self.seismic
+        for ax, kind in self.planes:
+            if s.kind != "vertical" and abs(s.waves[0].e_h[ax]) > 1e-12:
+                raise SSIError(f"-ssi_symmetry {'xy'[ax]}={'sym' if kind > 0 else 'anti'}: the {s.kind} wave "
+                               f"travels across this plane (azimuth {self.cfg.seismic_azimuth:g} deg): the free "
+                               "field is not symmetric about it; model the whole surface")
+        try:
+            symmetry.check_compatible(self.planes, s.direction(), None)
+        except SSIError as exc:
+            raise SSIError(f"{exc}; here the free field of -ssi_seismic {s.kind} moves along "
+                           f"{tuple(int(v) for v in s.direction())}") from None
+
+    def free_field_owned(self, t, r0, r1):
+        """The free-field displacement of the owned soil dofs [r0, r1) (3 per node) at time t [m]."""
+        if self.seismic is None:
+            return np.zeros(r1 - r0)
+        return self.seismic.u(self.mesh.nodes[r0 // 3:r1 // 3], t).ravel()
+
+    def total_field(self, u, t, out):
+        """The total soil displacement u_sc + u_ff at time t in ``out`` (owned rows; no communication),
+        or ``u`` itself without a wave [m]."""
+        if self.seismic is None:
+            return u
+        u.copy(out)
+        r0, r1 = out.getOwnershipRange()
+        out.getArray()[:] += self.free_field_owned(t, r0, r1)
+        return out
+
+    def free_field_at(self, nodes, t):
+        """The free-field displacement (3 n,) of soil ``nodes`` at time t [m] (0 without a wave)."""
+        if self.seismic is None:
+            return np.zeros(3 * len(nodes))
+        return self.seismic.u(self.mesh.nodes[nodes], t).ravel()
 
     def _lags(self):
         VX = self.mesh.cell_coords()
@@ -316,4 +381,7 @@ class HalfSpace:
         the rigid motion h(t_n) [u0 + theta0 x (x - x_ref)] (``resultants.RigidMotion``)."""
         if not self.regions.n_disp:
             return lambda n: np.zeros(0)
+        if self.seismic is not None:           # the BEM carries the scattered field: u_sc = u - u_ff
+            nodes = self.regions.disp_nodes
+            return lambda n: self.motion.values(self.disp_factor(n)) - self.free_field_at(nodes, self.grid.time(n))
         return lambda n: self.motion.values(self.disp_factor(n))

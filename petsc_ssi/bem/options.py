@@ -4,6 +4,7 @@ import os
 
 from ..options import register, register_check, positive, at_least
 from .. import common_options  # noqa: F401  (the common options every problem reads)
+from ..seismic import options as _seismic_options  # noqa: F401  (the soil takes an earthquake: -ssi_seismic*)
 
 # ---------------------------------------------------------------- BEM soil
 register("cp", "real", 548.0, "m/s", "P-wave speed of the half-space", "bem", validator=positive)

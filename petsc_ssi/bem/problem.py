@@ -51,6 +51,7 @@ class BEMTransient(TransientProblem):
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
         if self.cfg.guard:
             self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
+        self._ut = self.march.u_tmpl.duplicate()            # the total field (a seismic input's u_sc + u_ff)
         self._resume()
 
     def checkpoint_state(self):
@@ -75,8 +76,9 @@ class BEMTransient(TransientProblem):
             grow = f" growth x{nrm / prev:.3g}/{w} steps" if w and prev > 0 else ""
             t = self.time(n)
             self.n = n                        # the step is taken; its records follow
-            rec.step(n, t, soil=(u, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")   # and the guard
-        self.state = (u, p)
+            ut = self.prob.total_field(u, t, self._ut)
+            rec.step(n, t, soil=(ut, p), norm=nrm, status=f"t={t:.4g}s |u|={nrm:.3e}{grow}")   # and the guard
+        self.state = (ut, p)
         return self.state
 
     def write_partial(self, status):
@@ -119,6 +121,9 @@ def write_results(cfg, comm, prob, out, res, status="completed", final=True):
     attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
              "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
     groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
+    if getattr(prob, "seismic", None) is not None:
+        groups = dict(groups or {}, seismic=prob.seismic.arrays())
+        attrs["seismic"] = prob.seismic.kind
     if cfg.mesh_patch and cfg.load_group == "load":
         attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
     rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})

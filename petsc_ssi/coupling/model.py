@@ -29,7 +29,7 @@ def build_coupled(cfg, comm):
     if ignored:
         warn(f"{' '.join(ignored)} act{'s' if len(ignored) == 1 else ''} only with -ssi_contact unilateral; "
              f"ignored (the interface is {cfg.contact})", comm)
-    prob = HalfSpace(cfg, comm, log=printf)
+    prob = HalfSpace(cfg, comm, log=printf, defer_seismic=True)     # the wave's control point: the interface
     fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
     model = build_model(fe_cfg, comm, assemble_matrices=False)
     iface = sym = None
@@ -48,6 +48,8 @@ def build_coupled(cfg, comm):
     # a load on the soil away from the structure (an incident wave field, total field): the
     # structure is a point of interest for the edge-diffraction warning and the interpolation rule
     prob.sites = iface.x
+    if cfg.get("seismic", "none") != "none":
+        prob.attach_seismic(iface.x.mean(0))
     prob.diffraction_warning(iface.x, "the structure (interface nodes)")
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
     model.layout.set_fixed(model.fixed)

@@ -85,13 +85,15 @@ class SSITransient(TransientProblem):
         self._advance("set up", "started")
         from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
         cfg, comm = self.cfg, self.comm
-        keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ())
+        keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
+            (("uff",) if self.prob.seismic is not None else ())
         rd = self._open_restart()
         self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None)
         self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
+        self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
@@ -127,7 +129,8 @@ class SSITransient(TransientProblem):
         self._check_step(n)
         coupler, integ = self.coupler, self.integ
         with staged("SSI time loop"):
-            u, p, res = coupler.step(self.load(n))
+            uffI = self.prob.free_field_at(self.iface.be_nodes, self.time(n)) if self.prob.seismic is not None else None
+            u, p, res = coupler.step(self.load(n), uffI)
             t = self.time(n)
             if res["cycled"]:
                 coupler.law.cycled_steps.append(n)
@@ -136,13 +139,14 @@ class SSITransient(TransientProblem):
             nrm = u.norm()
             n_open = int((~res["closed"]).sum())
             self.n = n                        # the step is taken; its records follow
-            self.rec.step(n, t, soil=(u, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
+            ut = self.prob.total_field(u, t, self._ut)              # u_sc + u_ff with a seismic input
+            self.rec.step(n, t, soil=(ut, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
                           norm=nrm, status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} "
                                            f"it {res['iterations']}")
             if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
                 raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
                                "(beta = c dt / l) and -ssi_coupling_traction")
-        self.state = (u, p, integ.u, res)
+        self.state = (ut, p, integ.u, res)
         return self.state
 
     def results(self):
@@ -151,7 +155,7 @@ class SSITransient(TransientProblem):
         times = rec.times
         nI = self.coupler.nI
         inter = rec.interface_arrays()
-        for k in ("uf", "ub", "p") + (("uf_check",) if "uf_check" in inter else ()):
+        for k in ("uf", "ub", "p") + tuple(k for k in ("uf_check", "uff") if k in inter):
             inter[k] = inter[k].reshape(len(times), nI, 3)
         inter["n_open"] = (~inter["closed"]).sum(axis=1)
         inter["t"] = np.asarray(times)
@@ -211,6 +215,8 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
     attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
              "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
              "structure_output": os.path.basename(structure_output_path(cfg.output))}
+    if getattr(prob, "seismic", None) is not None:
+        attrs["seismic"] = prob.seismic.kind
     rec_ = provenance(cfg, comm, {"stats": res["stats"]})
     recd = None
     if res["u"] is not None:
@@ -218,9 +224,19 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
     with event("SSI_IO"):
         inter = res["interface"] if comm.getRank() == 0 else None
         (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
-                                            groups={"interface": inter} if inter is not None else None)
+                                            groups=_groups(prob, inter))
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
         (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
                                                                       "dt": cfg.dt}, record=None, status=status)
+
+
+def _groups(prob, inter):
+    """The serial groups of the soil output: the interface series (rank 0) and the seismic input."""
+    g = {}
+    if inter is not None:
+        g["interface"] = inter
+    if getattr(prob, "seismic", None) is not None:
+        g["seismic"] = prob.seismic.arrays()
+    return g or None

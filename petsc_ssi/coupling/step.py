@@ -59,7 +59,7 @@ class StaggeredStep:
         return self.cp.integ.predict()                              # B.1 (no load of step n)
 
     def known_interface_u(self, wI):
-        return wI                                                   # B.2: u_b = u_f (all closed)
+        return wI - self.cp.uffI                                    # B.2: u_b = u_f (all closed), scattered
 
     def interface(self, yI, wI):
         return self.cp.law.step(self.solver(yI, wI), wI)            # B.2-B.4 (active set)
@@ -96,13 +96,13 @@ class ImplicitStep:
         return self.cp.integ.predict(f_ext)
 
     def known_interface_u(self, wI):
-        return np.zeros_like(wI)                                    # q: the soil with u_I = 0
+        return np.zeros_like(wI)                                    # q: the soil with u_sc,I = 0
 
     def interface(self, yI, wI):
         return self.cp.law.step(self.solver(yI, wI, np.zeros_like(yI)), None)
 
     def correct_soil(self, x, res, wI):
-        x -= self.cp.Zloc @ res["ub"]                               # x = q - Z u_b
+        x -= self.cp.Zloc @ (res["ub"] - self.cp.uffI)              # x = q - Z (u_b - u_ff)
 
     def finish(self, f_ext, fI, res):
         cp = self.cp
@@ -174,6 +174,7 @@ class Coupler:
         # with the offset): moments of both sides are taken about the origin
         self.arm = iface.x + self.offsets
         self._kv_initial, self._r, self._dkv, self._t = (march.u_tmpl.duplicate() for _ in range(4))
+        self.uffI = np.zeros(3 * nI)
 
     def solver_cap(self):
         """The object that factorises per active set (n_factor, t_factor)."""
@@ -235,9 +236,13 @@ class Coupler:
         e.destroy(); z.destroy()
         return out, C
 
-    def step(self, f_ext):
-        """Collective: one coupled step. Returns (u_soil, p_soil, info)."""
+    def step(self, f_ext, uffI=None):
+        """Collective: one coupled step; ``uffI``: the free-field displacement of the interface
+        nodes at t_n (3 n_I, every rank; a seismic input in the scattered-field form: the BEM
+        carries u_sc = u - u_ff, the interface and contact work with total u_b). Returns
+        (u_soil scattered, p_soil, info)."""
         m, st = self.march, self.strategy
+        self.uffI = np.zeros(3 * self.nI) if uffI is None else np.asarray(uffI, float)
         with event("SSI_FEM_Step"):
             uf = st.predict(f_ext)                                 # B.1
         wI = self.Top.gather(uf)
@@ -249,13 +254,16 @@ class Coupler:
         m.solve(b, m.x)                                            # B.3: y (staggered) or q (u_I = 0)
         self.sc_be.scatter(m.x, self.seq_y)
         yI = self.seq_y.getArray(readonly=True).copy()
+        if self.mode == "implicit" and self.uffI.any():
+            yI += self.Z_II @ self.uffI                            # p = (q + Z u_ff) - Z u_b: the driving force
         ev = event("SSI_Contact")
         ev.begin()
         res = st.interface(yI, wI)
         x = m.x.getArray()
         st.correct_soil(x, res, wI)
         x[self.own_loc] = np.where(np.isin(self.own_k, res["O"]), res["p"][self.own_k], x[self.own_loc])
-        kv[self.own_loc] = res["ub"][self.own_k]
+        kv[self.own_loc] = (res["ub"] - self.uffI)[self.own_k]      # the BEM's history is scattered
+        res["uff"] = self.uffI
         ev.end()
         u, p = m.store(n, m.x)
         # the BEM equations of the step with the final interface values: A x - b = 0

@@ -15,7 +15,9 @@ steps: (u, v), displacement and velocity in the dof map's layout.
 """
 import os
 
-from ..petsc import printf
+import numpy as np
+
+from ..petsc import printf, warn
 from ..monitor import event, staged
 from ..io.output import Output, provenance
 from ..problem import TransientProblem
@@ -35,6 +37,16 @@ class FEMTransient(TransientProblem):
         with staged("FEM setup"):
             self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
             self.model = build_model(cfg, self.comm, assemble_matrices=False)
+            self.support = None
+            if cfg.get("seismic", "none") != "none":        # a fixed base moving with the record
+                from ..seismic.input import SupportMotion
+                self.support = SupportMotion(cfg, self.comm)
+                if not cfg.user_set("t_end"):
+                    cfg.set("t_end", self.support.duration)
+                for line in self.support.summary_lines():
+                    printf(line)
+                for note in self.support.notes:
+                    warn(note, self.comm)
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
         self.integ = self.rec = self.out = None
         self.state = None
@@ -46,13 +58,47 @@ class FEMTransient(TransientProblem):
             _, self.integ, self.am = make_model_integrator(self.cfg, self.comm, self.model)
         self.F, self.fn = self.model.load_vec(), self.model.load_vec()
         self.vel = self.integ.u.duplicate()
+        self.inertia = self._inertia() if self.support is not None else {}
+
+    def _inertia(self):
+        """{axis: -M iota_axis}: the effective earthquake load per unit ground acceleration along
+        each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]."""
+        dm, out = self.model.layout, {}
+        tdofs = dm.translation_dofs(np.arange(self.model.mesh.n_nodes))
+        r0, r1 = self.model.m.getOwnershipRange()
+        for k, axis in enumerate("xyz"):
+            if axis not in self.support.motions:
+                continue
+            iota = np.zeros(r1 - r0)
+            d = tdofs[:, k]
+            d = d[(d >= r0) & (d < r1)] - r0
+            iota[d] = 1.0
+            v = self.model.m.duplicate()
+            v.getArray()[:] = -self.model.m.getArray(readonly=True) * iota
+            out[axis] = v
+        return out
 
     def load(self, n):
         """The load sample of step n: the spatial load times the mean of the history over the
-        step's cell [t_n - dt/2, t_n + dt/2]."""
+        step's cell [t_n - dt/2, t_n + dt/2]; with a support motion also -M iota times the mean
+        ground acceleration over the same cell (exact for the piecewise-linear record)."""
         self.F.copy(self.fn)
         self.fn.scale(self.hist.cell_mean(n, self.grid.dt))
+        t, h = self.time(n), 0.5 * self.grid.dt
+        for axis, v in self.inertia.items():
+            self.fn.axpy(self.support.mean_acceleration(axis, t - h, t + h), v)
         return self.fn
+
+    def ground_acceleration(self, times):
+        """(K, 3) the ground's mean acceleration over the step that ends at each time (the recorded
+        relative acceleration's own convention, ``io.structure.ReceiverSeries``; 0 at t = 0)."""
+        t = np.asarray(times, float)
+        out = np.zeros((len(t), 3))
+        dt = self.grid.dt
+        for k, axis in enumerate("xyz"):
+            if axis in self.support.motions:
+                out[1:, k] = [self.support.mean_acceleration(axis, tk - dt, tk) for tk in t[1:]]
+        return out
 
     def start(self):
         self._advance("set up", "started")
@@ -91,16 +137,20 @@ class FEMTransient(TransientProblem):
         self.state = (self.integ.u, self.vel)
         return self.state
 
+    def _support_output(self):
+        """(ground acceleration of given times, the 'seismic' output group) with a support motion."""
+        return (self.ground_acceleration, self.support.arrays()) if self.support is not None else None
+
     def write_partial(self, status):
         _close_output(self.cfg, self.out, self.model, self.rec.structure, self.comm, self.am, self.n_steps,
-                      self.integ, status=status, final=False)
+                      self.integ, status=status, final=False, support=self._support_output())
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, model = self.cfg, self.comm, self.model
         t, u = self.rec.structure.rec.arrays()
         _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ,
-                      status=self.final_status())
+                      status=self.final_status(), support=self._support_output())
         if comm.getRank() == 0 and len(model.receiver_nodes):
             printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                    f"{u[-1, 0, 2]:.6e}) m")
@@ -108,13 +158,21 @@ class FEMTransient(TransientProblem):
         return {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}
 
 
-def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True):
+def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True, support=None):
     """Collective: receivers, attributes and run record into the output; ``final``: close it
     (else flush it: readable, still open)."""
     if out is None:
         return
     t, u = srec.rec.arrays()
     receivers = srec.receivers() if comm.getRank() == 0 else None
+    groups, attrs = None, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+    if support is not None:
+        ground, arrays = support
+        groups = {"seismic": arrays}
+        attrs["seismic"] = "support motion (relative-motion form: u, velocity, acceleration relative to the base)"
+        if receivers is not None and "acceleration" in receivers:
+            receivers["ground_acceleration"] = ground(receivers["t"])
+            receivers["absolute_acceleration"] = receivers["acceleration"] + receivers["ground_acceleration"][:, None, :]
     extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                      "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
                      "elements": model.mesh.element_counts(),
@@ -122,7 +180,7 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
     if cfg.fem_integrator == "green":
         extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
     with event("FEM_io"):
-        (out.close if final else out.flush)(receivers=receivers, attrs={"problem": "fem", "alpha_m": am, "dt": cfg.dt},
+        (out.close if final else out.flush)(receivers=receivers, attrs=attrs, groups=groups,
                                             record=provenance(cfg, comm, extra), status=status)
     if not final:
         return

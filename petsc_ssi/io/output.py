@@ -308,7 +308,12 @@ class Output:
             for gname, data in (groups or {}).items():
                 g = _group(f, gname)
                 for k, v in data.items():
-                    g.create_dataset(k, data=np.asarray(v), track_times=False)
+                    unit = None
+                    if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
+                        v, unit = v                     # (array, unit): the unit as an attribute
+                    d = g.create_dataset(k, data=np.asarray(v), track_times=False)
+                    if unit is not None:
+                        d.attrs["unit"] = unit
         if final and self.deterministic:
             rewrite_without_times(self.path)
         self._write_xdmf()

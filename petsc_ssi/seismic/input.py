@@ -1,0 +1,268 @@
+"""The earthquake of a run: records read and processed into control motions, the plane wave(s) they
+drive, and the free field u_ff(points, t) the scattered-field form needs (``SeismicInput``).
+
+The formulation (``/work/shared/notes/seismic-input.md`` sec. 1; Padron et al. 2008): the soil's
+total field is u = u_ff + u_sc, with u_ff the free field of the half-space (incident plus
+reflected waves, traction-free on z = 0, ``analytic.free_field``). The BEM carries the scattered
+field u_sc (it radiates and starts from rest; its history sum runs over scattered values); on the
+flat free surface t_ff = 0, so the BE matrices are those of an impedance run and the wave enters
+only through the known interface displacement u_sc = u_b - u_ff. Outputs are total fields.
+
+``-ssi_seismic vertical`` takes one record per component (x, y: vertically incident S polarised
+along x and y; z: vertically incident P) and the surface motion is uniform; ``sh``, ``sv``, ``p``
+take one record and an incidence angle and azimuth, ``rayleigh`` a record of the vertical surface
+motion. The record is the surface (outcrop) motion at the control point by default
+(``-ssi_seismic_control``). Rank 0 reads and processes the records; every rank gets the same
+motions (collective, one-line errors on every rank before any heavy work).
+"""
+import dataclasses
+import warnings
+
+import numpy as np
+
+from ..petsc import SSIError, collective
+from ..analytic.free_field import PlaneWave, FreeFieldError, critical_angle
+from .records import read_record, process, RecordError, RecordWarning
+
+AXES = "xyz"
+
+
+def _ref_point(text, default):
+    if str(text).strip().lower() == "auto":
+        return np.asarray(default, float)[:2]
+    try:
+        v = [float(s) for s in str(text).split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 2 or not np.all(np.isfinite(v)):
+        raise SSIError(f"-ssi_seismic_ref '{text}': expected 'auto' or 'x,y' in m")
+    return np.asarray(v)
+
+
+def _window(text):
+    t = str(text).strip().lower()
+    if t == "all":
+        return "all"
+    if t.startswith("arias:"):
+        try:
+            p0, p1 = (float(s) for s in t[6:].split(","))
+        except ValueError:
+            raise SSIError(f"-ssi_seismic_window '{text}': expected 'arias:p0,p1'") from None
+        return ("arias", p0, p1)
+    try:
+        t0, t1 = (float(s) for s in t.split(","))
+    except ValueError:
+        raise SSIError(f"-ssi_seismic_window '{text}': expected all, 't0,t1' or 'arias:p0,p1'") from None
+    return (t0, t1)
+
+
+def _records(cfg):
+    """{axis: Record} of -ssi_seismic_record* ('' for the one record of an oblique or Rayleigh wave)."""
+    c = cfg
+
+    def read(path, comp=None):
+        return read_record(path, fmt=c.seismic_format, quantity=c.seismic_quantity, units=c.seismic_units,
+                           component=comp)
+    if c.seismic != "vertical":
+        return {"": read(c.seismic_record, c.seismic_component or None)}
+    if not c.seismic_record:
+        return {a: read(c.get(f"seismic_record_{a}")) for a in AXES if c.get(f"seismic_record_{a}")}
+    rec = read(c.seismic_record)
+    if np.ndim(rec.values) == 2:                                   # a 't ax ay az' table
+        return {a: dataclasses.replace(rec, values=rec.values[:, k]) for k, a in enumerate(AXES)}
+    axis = (c.seismic_component or "x").strip().lower()[:1]
+    if axis not in AXES:
+        raise SSIError(f"-ssi_seismic_component {c.seismic_component}: with -ssi_seismic vertical and a "
+                       "one-component record, the component it drives: x, y or z")
+    return {axis: rec}
+
+
+def read_motions(cfg):
+    """{axis: Motion}: the records of ``cfg`` read and processed (``records.process``); one rank's
+    work (RecordError, SSIError on a defect)."""
+    c = cfg
+    out = {}
+    for axis, rec in _records(cfg).items():
+        m = process(rec, scale=c.seismic_scale, window=_window(c.seismic_window), taper=c.seismic_taper,
+                    baseline=c.seismic_baseline)
+        if m.duration < c.dt:
+            raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
+                           f"dt = {c.dt:g} s")
+        out[axis] = m
+    return out
+
+
+def collective_motions(cfg, comm):
+    """Collective: (motions, notes): ``read_motions`` on rank 0, broadcast; the processing's
+    warnings (``RecordWarning``) as one-line notes; one-line SSIError on every rank on a defect."""
+    motions, notes = None, []
+    with collective(comm, "-ssi_seismic", "{what}: {error}"):
+        if comm.getRank() == 0:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", RecordWarning)
+                try:
+                    motions = read_motions(cfg)
+                except RecordError as exc:
+                    raise SSIError(str(exc)) from None
+            notes = [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
+    return comm.tompi4py().bcast((motions, notes), root=0)
+
+
+class SupportMotion:
+    """Collective: the record of -ssi_seismic vertical as the uniform motion of a fixed base (the
+    structure alone, relative-motion form: M u_rel'' + C u_rel' + K u_rel = -M iota a_g(t)), shifted
+    like the coupled run's free field (-ssi_seismic_start; auto: one step) so that a structure and
+    its fixed-base twin see the same times. ``mean_acceleration(axis, t0, t1)``: the mean of a_g over
+    [t0, t1] (exact for the piecewise-linear record: the velocity difference over the length)."""
+
+    def __init__(self, cfg, comm):
+        if cfg.seismic != "vertical":
+            raise SSIError(f"-ssi_seismic {cfg.seismic}: a fixed base moves as one: the structure alone (-ssi_problem "
+                           "fem) takes -ssi_seismic vertical (one record per component)")
+        self.cfg, self.kind = cfg, cfg.seismic
+        self.motions, self.notes = collective_motions(cfg, comm)
+        text = str(cfg.seismic_start).strip().lower()
+        try:
+            self.t0 = cfg.dt if text == "auto" else float(text)
+        except ValueError:
+            raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+        self.duration = self.t0 + max(m.t[-1] for m in self.motions.values())
+
+    def velocity(self, axis, t):
+        m = self.motions.get(axis)
+        return 0.0 if m is None else float(m(np.asarray(t, float) - self.t0, 1))
+
+    def mean_acceleration(self, axis, t0, t1):
+        return (self.velocity(axis, t1) - self.velocity(axis, t0)) / (t1 - t0)
+
+    def summary_lines(self):
+        lines = [f"[fem] support motion (-ssi_seismic vertical, fixed base, relative-motion form): start t0 = "
+                 f"{self.t0:.6g} s, record until {self.duration:.6g} s"]
+        for axis, m in self.motions.items():
+            lines += [f"[fem]   record ({axis}): " + s for s in m.summary_lines()]
+        return lines
+
+    def arrays(self):
+        out = {}
+        for axis, m in self.motions.items():
+            for name, (arr, unit) in m.as_arrays().items():
+                out[f"{axis}_{name}"] = (arr, unit)
+            out[f"{axis}_sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
+        out["t0"] = (np.array(self.t0), "s (run time = record time + t0)")
+        return out
+
+
+class SeismicInput:
+    """Collective: the seismic input of ``cfg`` (group "seismic") on a soil of speeds ``cs``, ``cp``
+    and density ``rho``; ``points``: every soil node the run touches (the automatic start keeps the
+    free field zero there for t <= 0); ``ref``: the default control point (x, y); ``dt``: the step.
+
+    ``u(points, t)``: the free-field displacement (n, 3) [m] (sum of the waves); ``summary_lines``,
+    ``arrays`` (the output group 'seismic', units in ``units``), ``key`` (the records' SHA-256, for
+    checkpoints), ``duration`` (s, from t = 0 to the end of the shifted record)."""
+
+    def __init__(self, cfg, comm, cs, cp, rho, points, ref, dt):
+        self.cfg, self.kind = cfg, cfg.seismic
+        self.motions = None
+        self.motions, self.notes = collective_motions(cfg, comm)
+        with collective(comm, f"-ssi_seismic {self.kind}", "{what}: {error}"):
+            self.waves = self._waves(cs, cp, rho, _ref_point(cfg.seismic_ref, ref))
+            self._start(np.asarray(points, float), dt)
+        self.key = {a: m.sha256 for a, m in self.motions.items()}
+
+    # ------------------------------------------------------------ waves
+    def _waves(self, cs, cp, rho, x0):
+        c = self.cfg
+        try:
+            if self.kind == "vertical":
+                return [PlaneWave("vertical_p" if a == "z" else "vertical_s", cs, cp, m, x0=x0,
+                                  polarisation=90.0 if a == "y" else 0.0, control=c.seismic_control, rho=rho)
+                        for a, m in self.motions.items()]
+            m = self.motions[""]
+            wave = {"sh": "sh", "sv": "sv", "p": "p", "rayleigh": "rayleigh"}[self.kind]
+            grid = np.arange(-0.5 * m.duration, 2.0 * m.duration + m.t[-1], max(np.min(np.diff(m.t)), 1e-4))
+            return [PlaneWave(wave, cs, cp, m, angle=c.seismic_angle if wave != "rayleigh" else 0.0,
+                              azimuth=c.seismic_azimuth, x0=x0, control=c.seismic_control,
+                              component=c.seismic_direction, postcritical=c.seismic_postcritical, rho=rho,
+                              t_grid=grid)]
+        except FreeFieldError as exc:
+            msg = str(exc)
+            if self.kind == "sv" and "critical" in msg:
+                msg = (f"SV at {c.seismic_angle:g} degrees is beyond the critical angle "
+                       f"{critical_angle(cs, cp):.4f} degrees of this soil; add -ssi_seismic_postcritical")
+            raise SSIError(msg) from None
+
+    def _start(self, points, dt):
+        text = str(self.cfg.seismic_start).strip().lower()
+        if text == "auto":
+            t0 = max(w.auto_start(points, dt) for w in self.waves)
+        else:
+            try:
+                t0 = float(text)
+            except ValueError:
+                raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+            need = max(w.auto_start(points, dt) for w in self.waves) - dt
+            if t0 < need:
+                raise SSIError(f"-ssi_seismic_start {t0:g}: the free field would not be at rest at t = 0 at every "
+                               f"soil node (the wave needs t0 >= {need:.6g} s here); use auto")
+        for w in self.waves:
+            w.t0 = t0
+        self.t0 = t0
+        self.duration = t0 + max(m.t[-1] for m in self.motions.values())
+
+    # ------------------------------------------------------------ evaluation
+    def u(self, points, t):
+        """The free-field displacement at ``points`` (n, 3) at time t (scalar) [m]."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        out = np.zeros((len(pts), 3))
+        for w in self.waves:
+            out += w.displacement(pts, t)
+        return out
+
+    def acceleration(self, points, t):
+        """The free-field acceleration at ``points`` at time t [m/s^2]."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        out = np.zeros((len(pts), 3))
+        for w in self.waves:
+            out += w.acceleration(pts, t)
+        return out
+
+    def uniform(self):
+        """Whether the free field is the same at every point (vertical incidence)."""
+        return self.kind == "vertical"
+
+    def direction(self):
+        """The components the free field moves (for the symmetry check): (3,) of 0/1."""
+        v = np.zeros(3)
+        for w in self.waves:
+            amp = np.abs(np.asarray(w.surface_coefficients(), complex))
+            v += (amp[0] > 0) * np.abs(w.e_h) + (amp[1] > 0) * np.array([0.0, 0.0, 1.0]) + \
+                (amp[2] > 0) * np.abs(w.e_t)
+        return (v > 1e-12).astype(float)
+
+    def summary_lines(self):
+        c = self.cfg
+        head = (f"[ssi] seismic input: {self.kind}" +
+                (f", angle {c.seismic_angle:g} deg, azimuth {c.seismic_azimuth:g} deg" if self.kind in ("sh", "sv", "p")
+                 else "") + f", control {c.seismic_control}, start t0 = {self.t0:.6g} s, free field until "
+                f"{self.duration:.6g} s")
+        lines = [head]
+        for axis, m in self.motions.items():
+            tag = f" ({axis})" if axis else ""
+            lines += [f"[ssi]   record{tag}: " + s for s in m.summary_lines()]
+        return lines
+
+    def arrays(self):
+        """{name: (array, unit)} of the output group 'seismic': the processed motions (per component)
+        and the wave's parameters."""
+        out = {}
+        for axis, m in self.motions.items():
+            pre = f"{axis}_" if axis else ""
+            for name, (arr, unit) in m.as_arrays().items():
+                out[pre + name] = (arr, unit)
+            out[pre + "sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
+            out[pre + "source"] = (np.bytes_(str(m.source)), "path")
+        out["t0"] = (np.array(self.t0), "s (run time = record time + t0)")
+        out["angle"] = (np.array(float(self.cfg.seismic_angle)), "deg")
+        out["azimuth"] = (np.array(float(self.cfg.seismic_azimuth)), "deg")
+        return out

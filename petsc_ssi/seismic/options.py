@@ -1,0 +1,83 @@
+"""Options of the earthquake input (group "seismic", prefix ``-ssi_seismic``): the plane wave, the
+record and its processing. A problem that takes a seismic input (``bem``, ``ssi``; the ``fem``
+structure alone takes the same record as a support motion) reads them. Units SI, angles degrees."""
+from ..options import register, register_check
+from .. import common_options  # noqa: F401
+
+G = "seismic"
+WAVES = ("none", "vertical", "sh", "sv", "p", "rayleigh")
+
+register("seismic", "enum", "none", "", "plane-wave earthquake input in the scattered-field form: none, vertical "
+         "(vertically incident S in x and y, P in z, from one record per component), sh, sv, p (oblique, "
+         "-ssi_seismic_angle), rayleigh", G, choices=WAVES)
+register("seismic_record", "str", "", "", "the record: PEER .AT2/.VT2/.DT2, a table 't a' (or 't ax ay az' for "
+         "vertical), or a seismological format through ObsPy (miniSEED, SAC, K-NET, Kinemetrics EVT, ...)", G)
+register("seismic_record_x", "str", "", "", "vertical: the record of the x component (any subset of x, y, z)", G)
+register("seismic_record_y", "str", "", "", "vertical: the record of the y component", G)
+register("seismic_record_z", "str", "", "", "vertical: the record of the z component (vertical P)", G)
+register("seismic_format", "str", "auto", "", "record format: auto (by extension/header), peer, table, obspy or "
+         "an ObsPy format name", G)
+register("seismic_quantity", "enum", "auto", "", "what the record holds: auto (the file says; tables: "
+         "acceleration), acceleration, velocity, displacement", G,
+         choices=("auto", "acceleration", "velocity", "displacement"))
+register("seismic_units", "str", "auto", "", "record units: auto (the file's), g, m/s2, cm/s2, gal, m/s, cm/s, m, "
+         "cm, mm", G)
+register("seismic_component", "str", "", "", "the trace of a multi-trace ObsPy file (channel code suffix or "
+         "index) or the column of a 4-column table (x, y, z)", G)
+register("seismic_scale", "real", 1.0, "", "amplitude factor after unit conversion", G)
+register("seismic_control", "enum", "surface", "", "surface: the record is the free-field surface (outcrop) "
+         "motion at the control point; incident: the record is the incident wave (the surface motion is twice "
+         "it at vertical incidence)", G, choices=("surface", "incident"))
+register("seismic_direction", "enum", "auto", "", "the surface component the record controls: auto (SH "
+         "transverse, SV horizontal, P vertical, Rayleigh vertical), horizontal, vertical, transverse", G,
+         choices=("auto", "horizontal", "vertical", "transverse"))
+register("seismic_angle", "real", 0.0, "deg", "incidence angle from the vertical, 0 <= angle < 90 (sh, sv, p)", G)
+register("seismic_azimuth", "real", 0.0, "deg", "horizontal propagation direction, from +x toward +y", G)
+register("seismic_postcritical", "bool", False, "", "allow SV beyond the critical angle (Hilbert-transform "
+         "field, acausal tails tapered)", G)
+register("seismic_ref", "str", "auto", "m", "control point 'x,y' on the surface (auto: the centroid of the "
+         "interface, or of the prescribed region, else the origin)", G)
+register("seismic_start", "str", "auto", "s", "time shift t0 of the wave: auto (the smallest that keeps the free "
+         "field zero for t <= 0 at every soil node, plus one step) or seconds", G)
+register("seismic_window", "str", "all", "", "part of the record: all, 't0,t1' (s of the record) or "
+         "'arias:p0,p1' (fractions of the Arias intensity)", G)
+register("seismic_taper", "real", 0.05, "", "Hann taper fraction at both ends (0: none)", G,
+         validator=lambda v: None if 0.0 <= v <= 0.5 else "must lie in [0, 0.5]")
+register("seismic_baseline", "enum", "poly6", "", "baseline correction: poly6 (sixth-order displacement fit, "
+         "PEER/USGS), mean, none", G, choices=("poly6", "mean", "none"))
+register("seismic_combine", "enum", "refuse", "", "a soil load (-ssi_load_group) with a seismic input: refuse, "
+         "or superpose (the load acts on the scattered field, the wave is added)", G,
+         choices=("refuse", "superpose"))
+
+
+def _checks(cfg):
+    if cfg.get("seismic", "none") == "none":
+        used = [k for k in ("seismic_record", "seismic_record_x", "seismic_record_y", "seismic_record_z")
+                if cfg.user_set(k)]
+        return f"-ssi_{used[0]} is set but -ssi_seismic is none: say which wave (vertical, sh, sv, p, rayleigh)" \
+            if used else None
+    w = cfg.seismic
+    comps = [cfg.get(f"seismic_record_{c}") for c in "xyz"]
+    if w == "vertical":
+        if not cfg.seismic_record and not any(comps):
+            return "-ssi_seismic vertical: give -ssi_seismic_record (a table 't ax ay az' or one component) or " \
+                   "-ssi_seismic_record_x/_y/_z"
+        if cfg.seismic_record and any(comps):
+            return "-ssi_seismic vertical: give either -ssi_seismic_record or -ssi_seismic_record_x/_y/_z, not both"
+    else:
+        if any(comps):
+            return f"-ssi_seismic_record_x/_y/_z are for -ssi_seismic vertical; -ssi_seismic {w} takes " \
+                   "-ssi_seismic_record"
+        if not cfg.seismic_record:
+            return f"-ssi_seismic {w}: give the record (-ssi_seismic_record FILE)"
+    if w in ("sh", "sv", "p") and not 0.0 <= cfg.seismic_angle < 90.0:
+        return f"-ssi_seismic_angle {cfg.seismic_angle:g}: must lie in [0, 90) degrees"
+    if w in ("vertical", "rayleigh") and cfg.user_set("seismic_angle") and cfg.seismic_angle != 0.0:
+        return f"-ssi_seismic_angle {cfg.seismic_angle:g}: not used by -ssi_seismic {w}"
+    if cfg.get("load_group") and cfg.seismic_combine == "refuse":
+        return ("-ssi_load_group with -ssi_seismic: say how the soil load and the wave combine "
+                "(-ssi_seismic_combine superpose)")
+    return None
+
+
+register_check(("seismic",), _checks)
