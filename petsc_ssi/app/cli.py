@@ -92,6 +92,9 @@ def main(argv=None):
         return 0
     cmd, rest = _split(argv)
     if cmd == "post":
+        if "--response-spectrum" in rest:          # earthquake-engineering response spectra
+            from .response import main as response_main
+            return response_main(rest[1:])
         from .post import main as post_main
         return post_main(rest[1:])
     from ..petsc import init, SSIError

@@ -338,10 +338,6 @@ def transfer_command(a, out=None):
 # ---------------------------------------------------------------- command line
 
 def main(argv=None):
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if "--response-spectrum" in argv:           # earthquake-engineering response spectra (app/response.py)
-        from .response import main as response_main
-        return response_main(argv)
     ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog="\n".join(__doc__.splitlines()[2:]))
