@@ -19,6 +19,18 @@ import pytest as _pytest
 # Heavy cases, measured with `pytest --durations=0` on an idle 2-core machine: each over a
 # minute, and each covered at a smaller size by a test that stays in `make test`.
 SLOW = {
+    # the full building's option files (the half building's and the CI building stay in make test)
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-common.opts]",
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-half-common.opts]",
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-full-bonded-ny4.opts]",
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-full-bonded-released.opts]",
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-full-unilateral.opts]",
+    # the disk's impedance against Veletsos & Verbic (the square's against Pais & Kausel stays)
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/impedance/disk.opts]",
+    "tests/bem/test_impedance.py::test_disk_against_veletsos_and_verbic",
+    # the fixed-base limit's convergence in the soil's stiffness (three soils; the light-block,
+    # Newton and -n 2 checks of the seismic input stay)
+    "tests/coupling/test_seismic.py::test_fixed_base_limit_converges_in_the_soil_stiffness",
 }
 _MPI = _re.compile(r"nranks\s*=\s*[2-9]|mpirun|mpiexec|\"-n\", \"?[2-9]|-n 2")
 _RUNS = _re.compile(r"\bcli\(|run_bem\(|run_ssi\(|run_fem\(|subprocess|from helpers import")

@@ -39,6 +39,10 @@ def test_options_file_runs_reduced(path, tmp_path):
         args += ["-ssi_mesh_size", "8,8"]
         if _value(text, "receivers"):
             args += ["-ssi_receivers", "2,0,0"]
+    if _value(text, "seismic") and not _value(text, "seismic_record"):   # the record comes on the command line
+        obspy = pytest.importorskip("obspy")
+        args += ["-ssi_seismic_record", os.path.join(os.path.dirname(obspy.__file__), "io", "nied", "tests", "data",
+                                                     "test.knet")]
     if "petsc-ssi impedance" in text:          # an impedance case: the command, one mode, a few steps
         cli(["impedance"] + args + ["-ssi_t_end", repr(20 * dt), "-ssi_impedance_modes", "vertical",
                                     "-ssi_output_overwrite"])

@@ -152,6 +152,10 @@ def load_h5(path, receiver=0, components=("x",), source="auto", arg="--receiver"
         g = f.get("receivers")
         if not isinstance(g, h5py.Group) or "t" not in g:
             raise _error(f"{path} holds no receiver series (no receivers/t)")
+        # a fixed base moving with a record (relative-motion form) also holds the absolute
+        # acceleration (relative + ground): that is what the structure feels, and what the
+        # coupled run records
+        absolute = "absolute_acceleration" in g
         has_a, has_u = "acceleration" in g, "u" in g
         if source == "acceleration" and not has_a:
             raise _error(f"--source acceleration: {path} holds no receivers/acceleration (soil "
@@ -159,6 +163,8 @@ def load_h5(path, receiver=0, components=("x",), source="auto", arg="--receiver"
         if not (has_a or has_u) or (source == "displacement" and not has_u):
             raise _error(f"{path} holds no receivers/u" + ("" if has_a else " nor receivers/acceleration"))
         name = "acceleration" if (has_a and source != "displacement") else "u"
+        if name == "acceleration" and absolute:
+            name = "absolute_acceleration"
         shape = g[name].shape
         if len(shape) != 3 or shape[2] != 3:
             raise _error(f"{path}: receivers/{name} has shape {shape}, not (K, R, 3)")
@@ -169,10 +175,12 @@ def load_h5(path, receiver=0, components=("x",), source="auto", arg="--receiver"
         point = tuple(float(v) for v in g["points"][receiver]) if "points" in g else None
     t, x, _, _ = _post.read_series(path, f"receivers/{name}", int(receiver), "all")
     x = x[:, [COMPONENTS.index(c) for c in components]]
-    if name == "acceleration":
+    if name in ("acceleration", "absolute_acceleration"):
         return GroundSeries(t, x, tuple(components), path, "recorded",
-                            "recorded acceleration receivers/acceleration [m/s^2]: the mean over "
-                            "the step ending at t_n, (v_n - v_{n-1}) / dt", int(receiver), point)
+                            f"recorded acceleration receivers/{name} [m/s^2]: the mean over "
+                            "the step ending at t_n, (v_n - v_{n-1}) / dt"
+                            + (" (relative to the moving base + the ground's)" if absolute else ""),
+                            int(receiver), point)
     t, a = second_difference(t, x)
     return GroundSeries(t, a, tuple(components), path, "differentiated",
                         "differentiated displacement: second central difference of receivers/u "
