@@ -4,23 +4,14 @@ import math
 
 import numpy as np
 
-from ..petsc import init, printf
-from .. import options as ssi_options
+from ..petsc import printf
 from ..fem.modes import compute_modes, default_target
 
 
 def main():
     """Collective: the ``petsc-ssi modes`` command (PETSc already initialised)."""
-    PETSc = init()
-    comm = PETSc.COMM_WORLD
-    from ..fem import options as _fem_options  # noqa: F401
-    cfg = ssi_options.resolve(("common", "fem"))
-    from ..io.output import check_output, command_output
-    cfg.set("output", command_output(cfg.output, "modes"))       # never the transient run's file
-    if cfg.output:
-        check_output(cfg.output, comm, cfg.output_overwrite)
-    from ..fem.model import build_model
-    model = build_model(cfg, comm)
+    from .static import structure_command
+    PETSc, comm, cfg, model = structure_command("modes")
     target = PETSc.Options().getReal("ssi_modes_eps_target",
                                      default_target(model.material if model.material is not None else model,
                                                     model.mesh.coords))

@@ -5,33 +5,41 @@ from ..monitor import event
 from ..fem.static import static_solve
 
 
-def main():
-    """Collective: the ``petsc-ssi static`` command (PETSc already initialised)."""
+def structure_command(name):
+    """Collective: (PETSc, comm, cfg, model) of a command on the structure alone (``name``:
+    static, modes): the options of the structure resolved and checked, the output the command's
+    own (``io.output.command_output``: never the transient run's file) and checked, the model
+    built."""
     PETSc = init()
     comm = PETSc.COMM_WORLD
     from .. import options as ssi_options
     from ..fem import options as _fem_options  # noqa: F401
-    from ..io.output import Output, provenance
     from ..fem.model import build_model
-    from ..fem.integrators import near_null_args
-    from ..io.structure import ReceiverSeries, FieldWriter, receiver_record
-    cfg = ssi_options.resolve(("common", "fem"))
     from ..io.output import check_output, command_output
-    cfg.set("output", command_output(cfg.output, "static"))       # never the transient run's file
+    cfg = ssi_options.resolve(("common", "fem"))
+    cfg.set("output", command_output(cfg.output, name))
     if cfg.output:
         check_output(cfg.output, comm, cfg.output_overwrite)
-    model = build_model(cfg, comm)
+    return PETSc, comm, cfg, build_model(cfg, comm)
+
+
+def main():
+    """Collective: the ``petsc-ssi static`` command (PETSc already initialised)."""
+    from ..io.output import Output, provenance
+    from ..fem.integrators import near_null_args
+    from ..io.structure import ReceiverSeries, FieldWriter, receiver_record
+    PETSc, comm, cfg, model = structure_command("static")
     _, near = near_null_args(cfg.fem_solver, model)
     coords = model.coords_vec() if (cfg.fem_solver == "iterative" and near is None) else None
     with event("FEM_static"):
         f = model.load_vec()
         u = static_solve(model.K, f, model.fixed, model.mesh.coords, solver=cfg.fem_solver,
-                         dofmap=model.layout, near_null=near if coords is None else
+                         dofmap=model.dofmap, near_null=near if coords is None else
                          PETSc.NullSpace().createRigidBody(coords))
-    rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
+    rec = ReceiverSeries(model.dofmap, model.receiver_nodes, comm)
     rec.record(1.0, u)
     umax = u.norm(PETSc.NormType.INFINITY)
-    printf(f"[static] solved K u = F ({model.layout.size} dofs): max |u_i| = {umax:.6e}")
+    printf(f"[static] solved K u = F ({model.dofmap.size} dofs): max |u_i| = {umax:.6e}")
     if comm.getRank() == 0:
         arr = rec.all_arrays()
         for k, p in enumerate(model.receivers):
@@ -44,7 +52,7 @@ def main():
         fw.write(1.0, u)
         receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
         out.close(receivers=receivers, attrs={"problem": "static", "time_is": "load factor"},
-                  record=provenance(cfg, comm, {"static": {"n_dofs": model.layout.size,
+                  record=provenance(cfg, comm, {"static": {"n_dofs": model.dofmap.size,
                                                            "max_abs_u": float(umax)}}))
         printf(f"[static] wrote {cfg.output} (+ .xmf, .json)")
     return u, model

@@ -36,7 +36,7 @@ def build_coupled(cfg, comm):
     with collective(comm, "matching the interface"):
         iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
                                 prob.planes, prob.h)
-        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.layout)
+        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.dofmap)
         load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
         both = np.intersect1d(load, iface.be_elems)
         if both.size:
@@ -52,7 +52,7 @@ def build_coupled(cfg, comm):
         prob.attach_seismic(iface.x.mean(0))
     prob.diffraction_warning(iface.x, "the structure (interface nodes)")
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
-    model.layout.set_fixed(model.fixed)
+    model.dofmap.set_fixed(model.fixed)
     return prob, model, iface, fe_cfg
 
 
@@ -64,7 +64,7 @@ def interface_bytes(cfg, prob, model, iface, ranks):
     n = 3 * iface.n
     b = 8.0 * 3 * prob.mesh.n_nodes * n + 3 * 8.0 * n * n * ranks
     if cfg.coupling == "implicit":
-        b += 8.0 * model.layout.size * n + 8.0 * n * n * ranks
+        b += 8.0 * model.dofmap.size * n + 8.0 * n * n * ranks
     lu = 8.0 * n * n
     b += ranks * (max(lu, 512e6) if cfg.contact == "unilateral" else lu)
     return b

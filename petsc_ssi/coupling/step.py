@@ -132,7 +132,7 @@ class Coupler:
         nI = iface.n
         self.nI = nI
         self.dofs_be = (3 * iface.be_nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
-        self.dofs_fe = model.layout.translation_dofs(iface.fe_nodes).ravel().astype(PETSc.IntType)
+        self.dofs_fe = model.dofmap.translation_dofs(iface.fe_nodes).ravel().astype(PETSc.IntType)
         # the interface values on every rank (3 n_I numbers: the small replicated
         # interface system; the fields stay distributed): the soil's by a scatter,
         # the structure's through the interface operator T (translations, and the
@@ -142,7 +142,7 @@ class Coupler:
                                             self.seq_y, None)
         self.offsets = (interface_offsets(model.mesh, iface, cfg.fem_interface) if cfg.interface_offset
                         else np.zeros((nI, 3)))
-        self.Top = InterfaceOperator(comm, iface, model.layout, self.offsets if cfg.interface_offset else None,
+        self.Top = InterfaceOperator(comm, iface, model.dofmap, self.offsets if cfg.interface_offset else None,
                                      fe_mesh=model.mesh)
         self.own_k, self.own_loc = _owned(self.dofs_be, march.u_tmpl)
         self.fown_k, self.fown_loc = _owned(self.dofs_fe, integ.u)
@@ -164,7 +164,7 @@ class Coupler:
         ev.end()
         # forces: f_f = F p (FE layout); rows of FE DOFs a symmetry plane (or the
         # user) fixes are left out: their reaction is not a load on the structure
-        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, model.layout,
+        self.F = force_matrix(comm, iface, integ.u, prob.regions.n_load, march.p_tmpl, model.dofmap,
                               skip=model.fixed)
         self.pI_prev = np.zeros(3 * nI)
         self.closed_prev = self.law.closed.copy()

@@ -30,7 +30,7 @@ from .mesh import one_line
 from .elements.hex8 import (XI_NODES, gauss_hex, hex8_shape, hex8_geometry, lame,  # noqa: F401 (compat)
                              hex8_stiffness, hex8_lumped_mass, hex8_stiffness_reference)
 from .elements import Props
-from .dofmap import DofMap, Layout  # noqa: F401  (Layout: the dof map of a hex8-only model)
+from .dofmap import DofMap  # noqa: F401
 
 
 @dataclass

@@ -332,8 +332,8 @@ class DofMap:
         return PETSc.NullSpace().create(vectors=vecs, comm=self.comm)
 
 
-class Layout(DofMap):
-    """Compatibility: the dof map of N nodes with translations only (hex8 models)."""
+class BrickDofMap(DofMap):
+    """The dof map of N nodes with translations only (a model of bricks)."""
 
     def __init__(self, n_nodes, comm):
         super().__init__(np.zeros(int(n_nodes), bool), comm)

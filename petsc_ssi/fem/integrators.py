@@ -547,9 +547,9 @@ def near_null_args(solver, model):
     modes of the coordinates for a brick-only model; the dof map's six modes otherwise."""
     if solver != "iterative":
         return None, None
-    if model.layout.uniform3:
+    if model.dofmap.uniform3:
         return model.coords_vec(), None
-    return None, model.layout.near_null_space(model.mesh.coords)
+    return None, model.dofmap.near_null_space(model.mesh.coords)
 
 
 def make_model_integrator(cfg, comm, model=None):

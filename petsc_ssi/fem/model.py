@@ -24,7 +24,7 @@ from ..points import parse_points
 @dataclass
 class Model:
     mesh: object
-    layout: object               # the dof map (fem/dofmap.py)
+    dofmap: object               # the dof map (fem/dofmap.py)
     material: object             # legacy Material of a hex8 model without parts, else None
     fixed: np.ndarray            # replicated sorted global dofs
     F: np.ndarray                # replicated global dof array: spatial load [N, N m]
@@ -38,24 +38,20 @@ class Model:
 
     def assemble(self):
         """Collective: K and the lumped M (point masses added) of the model."""
-        self.K, self.m = assemble(self.mesh, self.material, self.layout)
+        self.K, self.m = assemble(self.mesh, self.material, self.dofmap)
         if self.point_mass is not None and np.any(self.point_mass):
-            self.m.getArray()[:] += self.point_mass[self.layout.r0:self.layout.r1]
+            self.m.getArray()[:] += self.point_mass[self.dofmap.r0:self.dofmap.r1]
         return self.K, self.m
-
-    @property
-    def dofmap(self):
-        return self.layout
 
     def coords_vec(self):
         """Collective: node coordinates in the dof layout (translation dofs; rotations 0)."""
-        return self.layout.nodal_vec(self.mesh.coords)
+        return self.dofmap.nodal_vec(self.mesh.coords)
 
     def load_vec(self):
-        return self.layout.vec_from_global(self.F)
+        return self.dofmap.vec_from_global(self.F)
 
     def constrained(self):
-        return self.layout.restrains_rigid_motion(self.mesh.coords, self.fixed)
+        return self.dofmap.restrains_rigid_motion(self.mesh.coords, self.fixed)
 
 
 def structure_receivers(mesh, text, what="-ssi_receivers"):

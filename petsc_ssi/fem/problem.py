@@ -63,7 +63,7 @@ class FEMTransient(TransientProblem):
     def _inertia(self):
         """{axis: -M iota_axis}: the effective earthquake load per unit ground acceleration along
         each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]."""
-        dm, out = self.model.layout, {}
+        dm, out = self.model.dofmap, {}
         tdofs = dm.translation_dofs(np.arange(self.model.mesh.n_nodes))
         r0, r1 = self.model.m.getOwnershipRange()
         for k, axis in enumerate("xyz"):
@@ -174,7 +174,7 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
             receivers["ground_acceleration"] = ground(receivers["t"])
             receivers["absolute_acceleration"] = receivers["acceleration"] + receivers["ground_acceleration"][:, None, :]
     extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
-                     "n_cells": model.mesh.n_cells, "n_dofs": model.layout.size, "mesh": model.mesh.source,
+                     "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
                      "elements": model.mesh.element_counts(),
                      "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
     if cfg.fem_integrator == "green":

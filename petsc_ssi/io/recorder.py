@@ -128,7 +128,7 @@ class StructureRecorder:
         from .structure import FieldWriter, ReceiverSeries
         self.out, self.model, self.comm, self.io_event = out, model, comm, io_event
         self.fw = FieldWriter(out, model, comm) if out is not None else None
-        self.rec = ReceiverSeries(model.layout, model.receiver_nodes, comm)
+        self.rec = ReceiverSeries(model.dofmap, model.receiver_nodes, comm)
 
     def observe(self, n, t, step):
         if step.get("structure") is not None:

@@ -85,7 +85,7 @@ class FieldWriter:
     brick-only model writes its dof-layout Vecs directly (dof = 3 * node + c)."""
 
     def __init__(self, out, model, comm):
-        self.out, self.dm = out, model.layout
+        self.out, self.dm = out, model.dofmap
         self.rot = bool(self.dm.has_rotation.any())
         ctype, cells = structure_topology(model.mesh)
         cvec = model.coords_vec() if not self.rot else self.dm.nodal_coords(model.mesh.coords)

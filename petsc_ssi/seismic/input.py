@@ -211,21 +211,17 @@ class SeismicInput:
         self.duration = t0 + max(m.t[-1] for m in self.motions.values())
 
     # ------------------------------------------------------------ evaluation
+    def _sum(self, what, points, t):
+        pts = np.asarray(points, float).reshape(-1, 3)
+        return sum((getattr(w, what)(pts, t) for w in self.waves), np.zeros((len(pts), 3)))
+
     def u(self, points, t):
         """The free-field displacement at ``points`` (n, 3) at time t (scalar) [m]."""
-        pts = np.asarray(points, float).reshape(-1, 3)
-        out = np.zeros((len(pts), 3))
-        for w in self.waves:
-            out += w.displacement(pts, t)
-        return out
+        return self._sum("displacement", points, t)
 
     def acceleration(self, points, t):
         """The free-field acceleration at ``points`` at time t [m/s^2]."""
-        pts = np.asarray(points, float).reshape(-1, 3)
-        out = np.zeros((len(pts), 3))
-        for w in self.waves:
-            out += w.acceleration(pts, t)
-        return out
+        return self._sum("acceleration", points, t)
 
     def uniform(self):
         """Whether the free field is the same at every point (vertical incidence)."""

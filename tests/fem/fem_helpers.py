@@ -15,7 +15,8 @@ _init([sys.argv[0]])   # before anything else imports PETSc: keep pytest's argum
 def small_system(mesh, E=1e6, nu=0.25, rho=1e3, comm=None):
     """(K Mat, m Vec, layout) of ``mesh`` on one process."""
     from petsc_ssi.petsc import init
-    from petsc_ssi.fem.assembly import Layout, Material, assemble
+    from petsc_ssi.fem.assembly import Material, assemble
+    from petsc_ssi.fem.dofmap import BrickDofMap as Layout
     PETSc = init()
     layout = Layout(mesh.n_nodes, comm or PETSc.COMM_SELF)
     K, m = assemble(mesh, Material(E, nu, rho), layout)

@@ -22,11 +22,12 @@ def main(workdir):
     comm = PETSc.COMM_WORLD
     rank = comm.getRank()
     from petsc_ssi.fem import mesh as fmesh, assembly
+    from petsc_ssi.fem.dofmap import BrickDofMap
     from petsc_ssi.io import output
     cfg = SimpleNamespace(fem_mesh="box", fem_box_cells="2,2,2", fem_box_size="1,1,0.5",
                           fem_box_origin="-0.5,-0.5,0", fem_renumber=True)
     mesh = fmesh.structured_box((2, 2, 2))
-    layout = assembly.Layout(mesh.n_nodes, comm)
+    layout = BrickDofMap(mesh.n_nodes, comm)
     mat = assembly.Material(1e6, 0.25, 1e3)
     blocker = os.path.join(workdir, "a_file")
     if rank == 0:

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from fem_helpers import ROOT, run_cli
-from petsc_ssi.fem.assembly import Layout, Material, assemble
+from petsc_ssi.fem.assembly import Material, assemble
+from petsc_ssi.fem.dofmap import BrickDofMap as Layout
 from petsc_ssi.fem.loads import fixed_dofs, nodal_load
 from petsc_ssi.fem.mesh import read_gmsh, snap_points
 from petsc_ssi.fem.static import static_solve

@@ -68,7 +68,8 @@ def test_hex8_K_and_M_equal_the_node_blocked_assembly(PETSc):
     """A hex8 mesh through the dof map: K and M equal, bit for bit, a plain scatter of the hex8
     kernels into dof 3 * node + c (the layout before the dof map)."""
     from petsc_ssi.fem.mesh import read_gmsh
-    from petsc_ssi.fem.assembly import Layout, Material, assemble
+    from petsc_ssi.fem.assembly import Material, assemble
+    from petsc_ssi.fem.dofmap import BrickDofMap as Layout
     from petsc_ssi.fem.elements.hex8 import hex8_stiffness, hex8_lumped_mass
     from fem_helpers import dense
     mesh = read_gmsh(os.path.join(ROOT, "meshes", "foundation.geo"))
