@@ -103,7 +103,7 @@ def counts(opts, ranks):
     db.setValue("ssi_warn_beta", "0")
     cfg = options.resolve(("common", "bem", "estimate"))
     with contextlib.redirect_stdout(io.StringIO()):
-        _, _, cnt = estimate.setup(cfg, PETSc.COMM_SELF, sorted(set(ranks)), 0.0)
+        _, _, cnt = estimate.count_run(cfg, PETSc.COMM_SELF, sorted(set(ranks)), 0.0)
     _CACHE[key] = cnt
     return cnt
 

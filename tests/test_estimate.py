@@ -30,7 +30,7 @@ from petsc_ssi import options
 from petsc_ssi.app import estimate
 cfg = options.resolve(("common", "bem", "estimate"))
 ranks = [int(r) for r in sys.argv[2].split(",")]
-_, _, cnt = estimate.setup(cfg, PETSc.COMM_WORLD, ranks, 0.0)
+_, _, cnt = estimate.count_run(cfg, PETSc.COMM_WORLD, ranks, 0.0)
 c, _ = estimate.load_constants()
 out = {"N": cnt.N, "Lx": cnt.Lx, "steps": cnt.steps, "blocks": float(cnt.nb_total_used().sum()),
        "rank0": cnt.per_rank[ranks[0]][0], "pred": {}}

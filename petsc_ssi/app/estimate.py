@@ -31,7 +31,7 @@ def parse_ranks(text):
     return r
 
 
-def setup(cfg, comm, ranks, node_mem):
+def count_run(cfg, comm, ranks, node_mem):
     """Collective: the BEM set-up of a run without assembly, and its counts."""
     from ..bem.halfspace import HalfSpace
     from ..sysmem import machine_memory
@@ -56,7 +56,7 @@ def report(cfg, comm, out=None):
     q = cfg.estimate_ranks_per_node or cores
     node_mem = cfg.estimate_node_memory * 1e9 if cfg.estimate_node_memory > 0 else machine_memory()
     c, source = load_constants(cfg.estimate_constants)
-    prob, plan, cnt = setup(cfg, comm, ranks, node_mem)
+    prob, plan, cnt = count_run(cfg, comm, ranks, node_mem)
     nd = int(cnt.storage.sum())
     n1 = int(cnt.single.sum())
     ns = len(cnt.storage) - nd - n1

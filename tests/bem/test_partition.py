@@ -124,7 +124,7 @@ def test_two_ranks_balanced_and_equal_agree(tmp_path):
     # the cost model's ranges for 2 ranks, counted on one process: the sizes the run printed
     code = ("import json, sys\nfrom petsc_ssi.petsc import init\nPETSc = init(sys.argv)\n"
             "from petsc_ssi import options\nfrom petsc_ssi.app import estimate\ncfg = options.resolve(('common', 'bem', 'estimate'))\n"
-            "_, _, cnt = estimate.setup(cfg, PETSc.COMM_WORLD, [2], 0.0)\nprint('RANGES' + json.dumps(cnt.ranges[2]))")
+            "_, _, cnt = estimate.count_run(cfg, PETSc.COMM_WORLD, [2], 0.0)\nprint('RANGES' + json.dumps(cnt.ranges[2]))")
     p = subprocess.run([PY, "-c", code] + ARGS, cwd=ROOT, capture_output=True, text=True, timeout=300,
                        env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     line = [x for x in p.stdout.splitlines() if x.startswith("RANGES")]
