@@ -22,7 +22,11 @@ def cost_rows(d):
     rows = []
     for path in sorted(glob.glob(os.path.join(d, "*-n*.log_view"))):
         case, ranks = os.path.basename(path)[:-9].rsplit("-n", 1)
-        lv = parse(open(path).read())
+        text = open(path).read()
+        log = path[:-len(".log_view")] + ".log"                 # -memory_view prints to standard output
+        if os.path.exists(log):
+            text += "\n" + open(log).read()
+        lv = parse(text)
         st = lv["stages"]
         rows.append({"case": case, "ranks": int(ranks), "wall [s]": lv["total_s"],
                      "set-up + assembly [s]": sum(v for k, v in st.items() if "setup" in k.lower() or "assembly" in k.lower()),
