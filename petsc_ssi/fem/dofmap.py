@@ -193,9 +193,6 @@ class DofMap:
             d = d + 3 * (self.released[cells][:, :, None] & (ks >= 3))
         return d.reshape(cells.shape[0], cells.shape[1] * len(ks))
 
-    def owner_of_dofs(self, dofs):
-        return np.searchsorted(self.dof_bounds, np.asarray(dofs, np.int64), side="right") - 1
-
     # ------------------------------------------------------------ constraints
     def set_fixed(self, dofs):
         """Record the fixed dofs (replicated, global) as constraint dofs of the section

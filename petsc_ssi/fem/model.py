@@ -50,9 +50,6 @@ class Model:
     def load_vec(self):
         return self.dofmap.vec_from_global(self.F)
 
-    def constrained(self):
-        return self.dofmap.restrains_rigid_motion(self.mesh.coords, self.fixed)
-
 
 def structure_receivers(mesh, text, what="-ssi_receivers"):
     """(points (R, 3), nodes (R,), snapping distances (R,)) of 'x,y,z;...' items (nearest node)

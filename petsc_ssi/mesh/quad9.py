@@ -55,20 +55,3 @@ def geometry(X, xi, eta):
 
 def gauss_legendre(n):
     return np.polynomial.legendre.leggauss(n)
-
-
-def subdivision_rule(ns, ng):
-    """Points and weights of ns x ns equal subdivisions of [-1,1]^2, ng x ng
-    Gauss points each. Returns xi, eta, w (ns*ns*ng*ng,) ordered by
-    subdivision, and the subdivisions' centres and half-size."""
-    g, w = gauss_legendre(ng)
-    h = 2.0 / ns
-    centres = -1.0 + h * (np.arange(ns) + 0.5)
-    cx, cy = np.meshgrid(centres, centres, indexing="ij")
-    cx = cx.ravel(); cy = cy.ravel()
-    gx, gy = np.meshgrid(g, g, indexing="ij")
-    wx, wy = np.meshgrid(w, w, indexing="ij")
-    xi = (cx[:, None] + 0.5 * h * gx.ravel()[None, :]).ravel()
-    eta = (cy[:, None] + 0.5 * h * gy.ravel()[None, :]).ravel()
-    ww = np.tile((wx * wy).ravel() * (0.5 * h) ** 2, ns * ns)
-    return xi, eta, ww, np.stack([cx, cy], 1), 0.5 * h

@@ -23,7 +23,3 @@ def get(name):
             raise KeyError(name)
         importlib.import_module(f".{name}", __package__)
     return REGISTRY[name]
-
-
-def all_types():
-    return {n: get(n) for n in NAMES}
