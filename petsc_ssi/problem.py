@@ -71,6 +71,34 @@ class _Signals:
         return False
 
 
+class CheckpointObserver:
+    """An observer of the recorder (``io.recorder`` protocol) that ``TransientProblem.run`` adds:
+    after each step but the last, one collective poll (``_poll``: a signal any rank caught;
+    -ssi_output_flush and -ssi_checkpoint_interval due by rank 0's clock), a checkpoint every
+    -ssi_checkpoint_every steps, when the interval is due and on a signal; on a signal the run
+    stops after that checkpoint (SSIError); a due flush makes the output readable. A script that
+    steps by itself gets none of this."""
+
+    def __init__(self, problem, sig):
+        self.p, self.sig = problem, sig
+        self.every = int(problem.cfg.get("checkpoint_every") or 0)
+
+    def observe(self, n, t, step):
+        p = self.p
+        if n == p.n_steps:
+            return                                   # the run is done: finish it, whatever arrived
+        name, due, ck_due = p._poll(self.sig)
+        path = None
+        if name or ck_due or (self.every and n % self.every == 0):
+            path = p.write_checkpoint()
+        if name:
+            raise SSIError(f"stopped by {name} after step {n} of {p.n_steps} (t = {p.time(n):.6g} s)"
+                           + (f"; the results up to that step are in {p.cfg.output}" if p.cfg.get("output") else "")
+                           + (f"; resume with -ssi_restart {path}" if path else ""))
+        if due:
+            p._flush()
+
+
 class TransientProblem:
     """Base class; see the module docstring."""
     kind = ""
@@ -251,27 +279,16 @@ class TransientProblem:
         nothing more. With -ssi_restart the steps start after the checkpoint's."""
         self.setup()
         self.start()
-        every = int(self.cfg.get("checkpoint_every") or 0)
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end
+            ck = self.rec.add(CheckpointObserver(self, sig))
             try:
                 for n in range(self.n + 1, self.n_steps + 1):
-                    self.step(n)
-                    if n == self.n_steps:
-                        break                        # the run is done: finish it, whatever arrived
-                    name, due, ck_due = self._poll(sig)
-                    path = None
-                    if name or ck_due or (every and n % every == 0):
-                        path = self.write_checkpoint()
-                    if name:
-                        raise SSIError(f"stopped by {name} after step {n} of {self.n_steps} (t = {self.time(n):.6g} s)"
-                                       + (f"; the results up to that step are in {self.cfg.output}"
-                                          if self.cfg.get("output") else "")
-                                       + (f"; resume with -ssi_restart {path}" if path else ""))
-                    if due:
-                        self._flush()
+                    self.step(n)                     # the recorder's observers checkpoint and flush
             except SSIError as exc:
                 if self._state in ("started", "stepping"):
                     self.write_partial(f"stopped after step {self.n} of {self.n_steps}: {exc}")
                     self._state = "stopped"
                 raise
+            finally:
+                self.rec.extra.remove(ck)
             return self.finish()

@@ -93,6 +93,7 @@ class SSITransient(TransientProblem):
         self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
+        self.rec.add(_FiniteCheck(self.integ))
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
@@ -143,9 +144,6 @@ class SSITransient(TransientProblem):
             self.rec.step(n, t, soil=(ut, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
                           norm=nrm, status=f"t={t:.4g}s |u_soil|={nrm:.3e} open {n_open}/{coupler.nI} "
                                            f"it {res['iterations']}")
-            if not np.isfinite(nrm) or not np.isfinite(integ.u.norm()):
-                raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
-                               "(beta = c dt / l) and -ssi_coupling_traction")
         self.state = (ut, p, integ.u, res)
         return self.state
 
@@ -240,3 +238,16 @@ def _groups(prob, inter):
     if getattr(prob, "seismic", None) is not None:
         g["seismic"] = prob.seismic.arrays()
     return g or None
+
+
+class _FiniteCheck:
+    """An observer of the recorder: stop the coupled run once a step's soil or structure solution is
+    not finite (after the step is recorded, before any checkpoint of it)."""
+
+    def __init__(self, integ):
+        self.integ = integ
+
+    def observe(self, n, t, step):
+        if not np.isfinite(step["norm"]) or not np.isfinite(self.integ.u.norm()):
+            raise SSIError(f"the coupled solution is not finite at step {n} (t = {t:.4g} s): check dt "
+                           "(beta = c dt / l) and -ssi_coupling_traction")
