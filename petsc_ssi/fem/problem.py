@@ -86,7 +86,7 @@ class FEMTransient(TransientProblem):
         self.fn.scale(self.hist.cell_mean(n, self.grid.dt))
         t, h = self.time(n), 0.5 * self.grid.dt
         for axis, v in self.inertia.items():
-            self.fn.axpy(self.support.mean_acceleration(axis, t - h, t + h), v)
+            self.fn.axpy(float(self.support.mean_acceleration(axis, t - h, t + h)), v)
         return self.fn
 
     def ground_acceleration(self, times):
@@ -94,10 +94,8 @@ class FEMTransient(TransientProblem):
         relative acceleration's own convention, ``io.structure.ReceiverSeries``; 0 at t = 0)."""
         t = np.asarray(times, float)
         out = np.zeros((len(t), 3))
-        dt = self.grid.dt
         for k, axis in enumerate("xyz"):
-            if axis in self.support.motions:
-                out[1:, k] = [self.support.mean_acceleration(axis, tk - dt, tk) for tk in t[1:]]
+            out[1:, k] = self.support.mean_acceleration(axis, t[1:] - self.grid.dt, t[1:])
         return out
 
     def start(self):

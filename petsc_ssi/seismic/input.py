@@ -22,7 +22,7 @@ import numpy as np
 
 from ..petsc import SSIError, collective
 from ..analytic.free_field import PlaneWave, FreeFieldError, critical_angle
-from .records import read_record, process, RecordError, RecordWarning
+from .records import read_record, process, parse_window, RecordError, RecordWarning
 
 AXES = "xyz"
 
@@ -40,20 +40,42 @@ def _ref_point(text, default):
 
 
 def _window(text):
-    t = str(text).strip().lower()
-    if t == "all":
-        return "all"
-    if t.startswith("arias:"):
-        try:
-            p0, p1 = (float(s) for s in t[6:].split(","))
-        except ValueError:
-            raise SSIError(f"-ssi_seismic_window '{text}': expected 'arias:p0,p1'") from None
-        return ("arias", p0, p1)
+    """-ssi_seismic_window as ``records.process`` takes it (``records.parse_window``)."""
     try:
-        t0, t1 = (float(s) for s in t.split(","))
+        return parse_window(text)
+    except ValueError as exc:
+        raise SSIError(f"-ssi_seismic_{exc}") from None
+
+
+def _start(cfg):
+    """-ssi_seismic_start: None for auto, else the time shift in seconds."""
+    text = str(cfg.seismic_start).strip().lower()
+    if text == "auto":
+        return None
+    try:
+        return float(text)
     except ValueError:
-        raise SSIError(f"-ssi_seismic_window '{text}': expected all, 't0,t1' or 'arias:p0,p1'") from None
-    return (t0, t1)
+        raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+
+
+def record_lines(motions, tag):
+    """The processing report of every motion (``Motion.summary_lines``), each line led by ``tag``."""
+    return [f"{tag}   record" + (f" ({axis})" if axis else "") + ": " + s
+            for axis, m in motions.items() for s in m.summary_lines()]
+
+
+def motion_arrays(motions, t0):
+    """{name: (array, unit)} of an output group 'seismic': every processed motion (names led by its
+    axis), the record files' SHA-256 and paths, and the time shift t0."""
+    out = {}
+    for axis, m in motions.items():
+        pre = f"{axis}_" if axis else ""
+        for name, (arr, unit) in m.as_arrays().items():
+            out[pre + name] = (arr, unit)
+        out[pre + "sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
+        out[pre + "source"] = (np.bytes_(str(m.source)), "path")
+    out["t0"] = (np.array(t0), "s (run time = record time + t0)")
+    return out
 
 
 def _records(cfg):
@@ -121,35 +143,27 @@ class SupportMotion:
                            "fem) takes -ssi_seismic vertical (one record per component)")
         self.cfg, self.kind = cfg, cfg.seismic
         self.motions, self.notes = collective_motions(cfg, comm)
-        text = str(cfg.seismic_start).strip().lower()
-        try:
-            self.t0 = cfg.dt if text == "auto" else float(text)
-        except ValueError:
-            raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+        t0 = _start(cfg)
+        self.t0 = cfg.dt if t0 is None else t0
         self.duration = self.t0 + max(m.t[-1] for m in self.motions.values())
 
     def velocity(self, axis, t):
+        """The ground's velocity along ``axis`` at times t (any shape) [m/s]."""
         m = self.motions.get(axis)
-        return 0.0 if m is None else float(m(np.asarray(t, float) - self.t0, 1))
+        t = np.asarray(t, float)
+        return np.zeros_like(t) if m is None else m(t - self.t0, 1)
 
     def mean_acceleration(self, axis, t0, t1):
-        return (self.velocity(axis, t1) - self.velocity(axis, t0)) / (t1 - t0)
+        """The mean ground acceleration along ``axis`` over [t0, t1] (arrays allowed) [m/s^2]."""
+        return (self.velocity(axis, t1) - self.velocity(axis, t0)) / (np.asarray(t1) - np.asarray(t0))
 
     def summary_lines(self):
         lines = [f"[fem] support motion (-ssi_seismic vertical, fixed base, relative-motion form): start t0 = "
                  f"{self.t0:.6g} s, record until {self.duration:.6g} s"]
-        for axis, m in self.motions.items():
-            lines += [f"[fem]   record ({axis}): " + s for s in m.summary_lines()]
-        return lines
+        return lines + record_lines(self.motions, "[fem]")
 
     def arrays(self):
-        out = {}
-        for axis, m in self.motions.items():
-            for name, (arr, unit) in m.as_arrays().items():
-                out[f"{axis}_{name}"] = (arr, unit)
-            out[f"{axis}_sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
-        out["t0"] = (np.array(self.t0), "s (run time = record time + t0)")
-        return out
+        return motion_arrays(self.motions, self.t0)
 
 
 class SeismicInput:
@@ -193,15 +207,12 @@ class SeismicInput:
             raise SSIError(msg) from None
 
     def _start(self, points, dt):
-        text = str(self.cfg.seismic_start).strip().lower()
-        if text == "auto":
-            t0 = max(w.auto_start(points, dt) for w in self.waves)
+        auto = max(w.auto_start(points, dt) for w in self.waves)
+        t0 = _start(self.cfg)
+        if t0 is None:
+            t0 = auto
         else:
-            try:
-                t0 = float(text)
-            except ValueError:
-                raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
-            need = max(w.auto_start(points, dt) for w in self.waves) - dt
+            need = auto - dt
             if t0 < need:
                 raise SSIError(f"-ssi_seismic_start {t0:g}: the free field would not be at rest at t = 0 at every "
                                f"soil node (the wave needs t0 >= {need:.6g} s here); use auto")
@@ -242,23 +253,12 @@ class SeismicInput:
                 (f", angle {c.seismic_angle:g} deg, azimuth {c.seismic_azimuth:g} deg" if self.kind in ("sh", "sv", "p")
                  else "") + f", control {c.seismic_control}, start t0 = {self.t0:.6g} s, free field until "
                 f"{self.duration:.6g} s")
-        lines = [head]
-        for axis, m in self.motions.items():
-            tag = f" ({axis})" if axis else ""
-            lines += [f"[ssi]   record{tag}: " + s for s in m.summary_lines()]
-        return lines
+        return [head] + record_lines(self.motions, "[ssi]")
 
     def arrays(self):
         """{name: (array, unit)} of the output group 'seismic': the processed motions (per component)
         and the wave's parameters."""
-        out = {}
-        for axis, m in self.motions.items():
-            pre = f"{axis}_" if axis else ""
-            for name, (arr, unit) in m.as_arrays().items():
-                out[pre + name] = (arr, unit)
-            out[pre + "sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
-            out[pre + "source"] = (np.bytes_(str(m.source)), "path")
-        out["t0"] = (np.array(self.t0), "s (run time = record time + t0)")
+        out = motion_arrays(self.motions, self.t0)
         out["angle"] = (np.array(float(self.cfg.seismic_angle)), "deg")
         out["azimuth"] = (np.array(float(self.cfg.seismic_azimuth)), "deg")
         return out
