@@ -31,13 +31,15 @@ def parse_ranks(text):
     return r
 
 
-def count_run(cfg, comm, ranks, node_mem):
-    """Collective: the BEM set-up of a run without assembly, and its counts."""
+def count_run(cfg, comm, ranks, node_mem, coupled=None):
+    """Collective: the BEM set-up of a run without assembly, and its counts. ``coupled``: the
+    (prob, model, iface, fe_cfg) of ``coupling.model.build_coupled`` for -ssi_problem ssi (the
+    soil with the interface as its traction region, as the coupled run assembles it)."""
     from ..bem.halfspace import HalfSpace
     from ..sysmem import machine_memory
     quiet = lambda m: None
     t0 = time.perf_counter()
-    prob = HalfSpace(cfg, comm, log=quiet)
+    prob = coupled[0] if coupled is not None else HalfSpace(cfg, comm, log=quiet)
     plan = prob.interp_plan()
     ls = prob.lagset(plan)
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
@@ -56,11 +58,19 @@ def report(cfg, comm, out=None):
     q = cfg.estimate_ranks_per_node or cores
     node_mem = cfg.estimate_node_memory * 1e9 if cfg.estimate_node_memory > 0 else machine_memory()
     c, source = load_constants(cfg.estimate_constants)
-    prob, plan, cnt = count_run(cfg, comm, ranks, node_mem)
+    coupled = cc = None
+    if problem_kind() == "ssi":
+        from ..coupling.model import build_coupled
+        from ..coupling.cost import CoupledCounts
+        coupled = build_coupled(cfg, comm)
+        cc = CoupledCounts(cfg, comm, *coupled)
+    prob, plan, cnt = count_run(cfg, comm, ranks, node_mem, coupled)
     nd = int(cnt.storage.sum())
     n1 = int(cnt.single.sum())
     ns = len(cnt.storage) - nd - n1
-    lines = [f"[ssi] estimate of this BEM run (model petsc_ssi/bem/cost.py; constants {source})",
+    what = ("coupled run (models petsc_ssi/bem/cost.py and petsc_ssi/coupling/cost.py" if cc is not None
+            else "BEM run (model petsc_ssi/bem/cost.py")
+    lines = [f"[ssi] estimate of this {what}; constants {source})",
              f"[ssi]   {3 * cnt.N} DOFs ({cnt.N} nodes), {cnt.Ev} elements with images, {cnt.steps} steps, "
              f"{cnt.nt} traction nodes; lags stored {cnt.Lx + cnt.k} ({cnt.Lx} exact + {cnt.k} interpolating, "
              f"of {cnt.L} the run reaches): {nd} dense, {ns} block-sparse"
@@ -68,11 +78,24 @@ def report(cfg, comm, out=None):
              + (" (all block-sparse: the dense choice would not fit the limit)" if cnt.fill > 1 else ""),
              f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
              f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",
-             "[ssi]   ranks nodes | setup_s assembly_s factor_s history_s solve_s time_loop_s | total | "
-             "peak_GB GB/rank_max GB/node | fits"]
+             ]
+    if cc is not None:
+        from ..coupling.cost import describe
+        lines.append(describe(cc))
+    lines.append("[ssi]   ranks nodes | setup_s assembly_s factor_s history_s solve_s "
+                 + ("coupling_setup_s coupling_loop_s " if cc is not None else "")
+                 + "time_loop_s | total | peak_GB GB/rank_max GB/node | fits")
     rows = []
     for p in ranks:
         t = predict(cnt, c, p, q, cores)
+        if cc is not None:            # the structure, the interface matrices and the coupled step
+            bem_solve = c["c_sol"] * cnt.N ** 1.5 * (1 + c["kappa"] * (p - 1))
+            add = cc.predict(c, p, bem_solve)
+            t.update(add)
+            t["loop"] += add["cpl_loop"]
+            t["total"] += add["cpl_setup"] + add["cpl_loop"]
+            t["peak_bytes"] += add["cpl_bytes"]
+            t["peak_rank_bytes"] += add["cpl_bytes"] / p
         nodes = int(math.ceil(p / float(q)))
         per_node = t["peak_bytes"] / p * min(q, p)
         per_node = max(per_node, t["peak_rank_bytes"] * min(q, p) if p == 1 else per_node)
@@ -86,7 +109,9 @@ def report(cfg, comm, out=None):
         t.update({"ranks": p, "nodes": nodes, "node_bytes": per_node, "fits": fits})
         rows.append(t)
         lines.append(f"[ssi]   {p:5d} {nodes:5d} | {t['setup']:7.3g} {t['assembly']:10.4g} {t['factor']:8.3g} "
-                     f"{t['history']:9.4g} {t['solve']:7.3g} {t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
+                     f"{t['history']:9.4g} {t['solve']:7.3g} "
+                     + (f"{t['cpl_setup']:16.4g} {t['cpl_loop']:15.4g} " if cc is not None else "")
+                     + f"{t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
                      f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
     ok = [r for r in rows if r["fits"]]
     if ok:
@@ -118,6 +143,4 @@ def main():
         raise SSIError("petsc-ssi estimate models the BEM half-space (-ssi_problem bem, and the BEM part of "
                        "-ssi_problem ssi); the FEM structure alone is cheap: run it with -log_view")
     cfg = resolve(kind, ("estimate",))
-    if kind == "ssi":
-        init().Sys.Print("[ssi] estimate: -ssi_problem ssi: the BEM half-space part only (no FEM, no coupling)")
     return report(cfg, init().COMM_WORLD)

@@ -19,6 +19,11 @@ register("interface_offset", "bool", False, "", "shell foundation slab: the soil
          "translations", G)
 register("interface_tol", "real", 1e-6, "", "FE and BE interface nodes match when closer than this times "
          "the smallest interface node spacing", G, validator=positive)
+register("interface_stride", "int", 1, "steps", "keep the interface's nodal series (u_f, u_b, p, gap, p_N, "
+         "status, u_ff) every this many steps (1: every step); the resultants, iterations and open-node "
+         "counts are kept every step. A long record's interface series grows by 3 n_I doubles per key and "
+         "step: e.g. -ssi_interface_stride 10 with -ssi_output_stride 10", G,
+         validator=lambda v: None if v >= 1 else "must be >= 1")
 register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f always; linear) or unilateral "
          "(Kuhn-Tucker contact with a cohesion limit: the structure may lift off, paper eq. 25)", G,
          choices=("bonded", "unilateral"))

@@ -29,7 +29,9 @@ from .model import build_coupled, interface_bytes
 from .step import Coupler
 
 INTERFACE_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
-                  "moment_fe", "moment_be", "bem_residual", "force_map_error")
+                  "moment_fe", "moment_be", "bem_residual", "force_map_error", "n_open")
+# the keys with a value per interface dof or node: kept every -ssi_interface_stride steps
+NODAL_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "uf_check", "uff")
 
 
 class SSITransient(TransientProblem):
@@ -83,7 +85,7 @@ class SSITransient(TransientProblem):
 
     def start(self):
         self._advance("set up", "started")
-        from ..io.recorder import Recorder, SoilRecorder, StructureRecorder
+        from ..io.recorder import Recorder, SoilRecorder, StructureRecorder, StepClock
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
             (("uff",) if self.prob.seismic is not None else ())
@@ -92,13 +94,16 @@ class SSITransient(TransientProblem):
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None)
         self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
-                            structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
+                            structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys,
+                            interface_nodal=NODAL_KEYS, interface_stride=cfg.interface_stride)
         self.rec.add(_FiniteCheck(self.integ))
+        self.clock = self.rec.add(StepClock())
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
         self._resume()
+        self.clock.start()
 
     def checkpoint_state(self):
         cp, law = self.coupler, self.coupler.law
@@ -139,6 +144,7 @@ class SSITransient(TransientProblem):
                      f"iterations (cycling); the step is accepted with the last status (-ssi_contact_max_iter)")
             nrm = u.norm()
             n_open = int((~res["closed"]).sum())
+            res["n_open"] = n_open
             self.n = n                        # the step is taken; its records follow
             ut = self.prob.total_field(u, t, self._ut)              # u_sc + u_ff with a seismic input
             self.rec.step(n, t, soil=(ut, p), structure=(integ.u, integ.velocity(self.vel)), interface=res,
@@ -153,10 +159,14 @@ class SSITransient(TransientProblem):
         times = rec.times
         nI = self.coupler.nI
         inter = rec.interface_arrays()
+        nodal = inter.pop("nodal_steps")
         for k in ("uf", "ub", "p") + tuple(k for k in ("uf_check", "uff") if k in inter):
-            inter[k] = inter[k].reshape(len(times), nI, 3)
-        inter["n_open"] = (~inter["closed"]).sum(axis=1)
+            inter[k] = inter[k].reshape(len(nodal), nI, 3)
+        inter["n_open"] = np.asarray(inter["n_open"], np.int64)
         inter["t"] = np.asarray(times)
+        if self.cfg.interface_stride > 1:       # the nodal series' own steps and times
+            inter["nodal_steps"] = nodal
+            inter["t_nodal"] = self.grid.time(nodal) if len(nodal) else np.zeros(0)
         inter["x"] = iface.x
         inter["normal"] = iface.n_b
         st, su = rec.structure.rec.arrays()
@@ -175,6 +185,7 @@ class SSITransient(TransientProblem):
         cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob
         res = self.results()
         res["_outputs"] = (self.out, self.sout)
+        res["timing"] = {"step_wall": (np.asarray(self.clock.values, float), "s")}
         law = coupler.law
         nch = law.total_changes
         stats = {"wall_s": time.perf_counter() - self.t_start, "assembly_s": self.info["t_asm"],
@@ -221,8 +232,11 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
         recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
     with event("SSI_IO"):
         inter = res["interface"] if comm.getRank() == 0 else None
+        groups = _groups(prob, inter)
+        if comm.getRank() == 0 and res.get("timing") is not None:
+            groups = dict(groups or {}, timing=res["timing"])
         (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
-                                            groups=_groups(prob, inter))
+                                            groups=groups)
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])

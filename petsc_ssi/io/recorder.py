@@ -177,27 +177,72 @@ class StructureRecorder:
 
 
 class InterfaceSeries:
-    """The coupling's per-step interface record (u_f, u_b, p, gap, status, ...): a dict of lists,
-    rank 0's copy (every rank holds the same)."""
+    """The coupling's interface record: a dict of lists, rank 0's copy (every rank holds the same).
+    The ``nodal`` keys (one value per interface dof or node: u_f, u_b, p, ...) are kept every
+    ``stride`` steps (steps n with n % stride == 0, listed in ``nodal_steps``), the others
+    (resultants, counts) every step."""
 
-    def __init__(self, keys):
+    def __init__(self, keys, nodal=(), stride=1):
         self.series = {k: [] for k in keys}
+        self.nodal = set(k for k in nodal if k in self.series)
+        self.stride = max(int(stride), 1)
+        self.nodal_steps = []
 
     def observe(self, n, t, step):
         res = step.get("interface")
-        if res is not None:
-            for k in self.series:
+        if res is None:
+            return
+        keep = n % self.stride == 0
+        if keep:
+            self.nodal_steps.append(n)
+        for k in self.series:
+            if keep or k not in self.nodal:
                 self.series[k].append(res[k])
 
     def state(self, n_times):
-        return {"interface_" + k: np.asarray(v) for k, v in self.series.items()}
+        s = {"interface_" + k: np.asarray(v) for k, v in self.series.items()}
+        s["interface_nodal_steps"] = np.asarray(self.nodal_steps, np.int64)
+        return s
 
     def restore(self, s, n):
         for k in self.series:
             self.series[k] = list(np.asarray(s["interface_" + k]))
+        steps = s.get("interface_nodal_steps")
+        self.nodal_steps = ([int(k) for k in steps] if steps is not None
+                            else list(range(n - len(self.series[next(iter(self.nodal))]) + 1, n + 1))
+                            if self.nodal else [])
 
     def arrays(self):
-        return {k: np.asarray(v) for k, v in self.series.items()}
+        a = {k: np.asarray(v) for k, v in self.series.items()}
+        a["nodal_steps"] = np.asarray(self.nodal_steps, np.int64)
+        return a
+
+
+class StepClock:
+    """The wall time of every step (seconds from the end of the previous step's records to the end of
+    this one's, on this rank): what a long record's per-step cost is, and whether it stays flat."""
+
+    def __init__(self):
+        import time
+        self._now = time.perf_counter
+        self.last = None
+        self.values = []
+
+    def observe(self, n, t, step):
+        now = self._now()
+        self.values.append(now - self.last if self.last is not None else np.nan)
+        self.last = now
+
+    def start(self):
+        """Call at the start of the time loop (the first step's time is then measured too)."""
+        self.last = self._now()
+
+    def state(self, n_times):
+        return {"step_wall": np.asarray(self.values, float)}
+
+    def restore(self, s, n):
+        self.values = [float(x) for x in s.get("step_wall", [])]
+        self.last = None
 
 
 class NormHistory:
@@ -246,10 +291,12 @@ class Recorder:
     BEM's divergence guard, ``bem.stability.DivergenceGuard``), which sees every step after the
     recorders and before the progress line."""
 
-    def __init__(self, cfg, comm, what, grid, soil=None, structure=None, interface_keys=()):
+    def __init__(self, cfg, comm, what, grid, soil=None, structure=None, interface_keys=(), interface_nodal=(),
+                 interface_stride=1):
         self.cfg, self.comm, self.grid = cfg, comm, grid
         self.soil, self.structure = soil, structure
-        self.interface = InterfaceSeries(interface_keys) if interface_keys else None
+        self.interface = (InterfaceSeries(interface_keys, interface_nodal, interface_stride)
+                          if interface_keys else None)
         self.norms = NormHistory()
         self.progress = ProgressLine(cfg, comm, what, grid.n_steps)
         self.steps, self.times = [], []

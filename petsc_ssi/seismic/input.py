@@ -106,7 +106,7 @@ def read_motions(cfg):
     out = {}
     for axis, rec in _records(cfg).items():
         m = process(rec, scale=c.seismic_scale, window=_window(c.seismic_window), taper=c.seismic_taper,
-                    baseline=c.seismic_baseline)
+                    baseline=c.seismic_baseline, highpass=c.seismic_highpass)
         if m.duration < c.dt:
             raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
                            f"dt = {c.dt:g} s")

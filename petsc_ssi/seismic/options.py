@@ -45,6 +45,11 @@ register("seismic_taper", "real", 0.05, "", "Hann taper fraction at both ends (0
          validator=lambda v: None if 0.0 <= v <= 0.5 else "must lie in [0, 0.5]")
 register("seismic_baseline", "enum", "poly6", "", "baseline correction: poly6 (sixth-order displacement fit, "
          "PEER/USGS), mean, none", G, choices=("poly6", "mean", "none"))
+register("seismic_highpass", "real", 0.0, "Hz", "corner frequency of an acausal (zero-phase) Butterworth "
+         "high-pass of order 4 applied to the tapered, zero-padded acceleration (pads of 1.5 n / f_c in all, "
+         "half at each end, kept: the motion lasts that much longer; PEER's processing; e.g. 0.1): removes the "
+         "drift that the baseline leaves (0: none)", G,
+         validator=lambda v: None if v >= 0 else "must be >= 0")
 register("seismic_combine", "enum", "refuse", "", "a soil load (-ssi_load_group) with a seismic input: refuse, "
          "or superpose (the load acts on the scattered field, the wave is added)", G,
          choices=("refuse", "superpose"))

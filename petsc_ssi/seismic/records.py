@@ -58,6 +58,15 @@ Processing (``process``), in this order
        d - d_0 by sum_{k=2..6} c_k tau^k (tau = t - t_start), subtract its second derivative from a at
        the samples, and integrate again (so a, v, d stay exactly consistent; v and d then differ from
        "d minus the polynomial" by the O(h^2) integration error of a smooth quartic).
+    4b. high-pass (``highpass`` f_c > 0 Hz; uniform sampling only): the tapered acceleration is padded
+       with zeros of total length T_pad = 1.5 n / f_c, half at each end (Boore 2005, "On pads and
+       filters": room for the acausal filter's transients, n = 4 the filter's order) and filtered by a zero-phase
+       (acausal) Butterworth of order 4 (order 2 forward and backward, scipy ``sosfiltfilt``; gain
+       |H|^2 = 1 / (1 + (f_c / f)^4): 0.5 at f_c, 0.99 at 3.4 f_c). The pads are kept (the filtered
+       motion starts T_pad / 2 before the record's first kept sample and ends T_pad / 2 after its last), so
+       the velocity and displacement of its exact integration return to about zero (what PEER's
+       processing does; a record's long-period content below f_c is lost). With a velocity or
+       displacement record the filter acts on the acceleration of step 5.
     Warnings (RecordWarning): the poly6 correction changes PGA by more than 5 %; |v_end| > 1 % PGV.
 
 Stats (``Motion.stats_raw``: the scaled record as read, integrated whole; ``Motion.stats``: processed):
@@ -469,6 +478,28 @@ def _window(path, t, a, window):
     return i0, i1
 
 
+HIGHPASS_ORDER = 4
+
+
+def _highpass(path, t, a, fc):
+    """(t, a) padded by T_pad / 2 = 0.75 n / f_c zeros at each end and high-pass filtered (zero-phase
+    Butterworth of order n = 4); t starts at the original t[0] - T_pad / 2."""
+    from scipy.signal import butter, sosfiltfilt
+    h = np.diff(t)
+    dt = float(h.mean())
+    if np.abs(h - dt).max() > 1e-6 * dt:
+        _refuse(path, "high-pass filter: the record's sampling is not uniform")
+    nyq = 0.5 / dt
+    if not fc < nyq:
+        _refuse(path, f"high-pass corner {fc:g} Hz is not below the Nyquist frequency {nyq:g} Hz")
+    npad = int(np.ceil(0.75 * HIGHPASS_ORDER / fc / dt))
+    ap = np.vstack([np.zeros((npad, a.shape[1])), a, np.zeros((npad, a.shape[1]))])
+    sos = butter(HIGHPASS_ORDER // 2, fc / nyq, btype="highpass", output="sos")
+    af = sosfiltfilt(sos, ap, axis=0, padtype=None)
+    tp = t[0] + dt * (np.arange(len(ap)) - npad)
+    return tp, af, npad
+
+
 def _check_args(path, scale, taper, baseline, pad_start):
     if not (np.isfinite(scale) and scale != 0):
         _refuse(path, f"scale = {scale} (must be finite and non-zero)")
@@ -493,7 +524,7 @@ def _ratio(x, y):
     return np.divide(x, y, out=np.zeros_like(np.asarray(x, float)), where=np.asarray(y) != 0)
 
 
-def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_start=0.0):
+def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_start=0.0, highpass=0.0):
     """Motion from a Record: scale, window, pre-event mean, Hann taper, acceleration, exact integration
     and baseline (module docstring, steps 1-8).  RecordError on bad arguments, RecordWarning on a large
     baseline change or final velocity.
@@ -501,9 +532,12 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
     scale: factor after the conversion to SI (finite, non-zero).  window: "all" | (t0, t1) | ("arias",
     p0, p1) (``parse_window`` reads the option syntax).  taper: Hann fraction at each end, 0..0.5.
     baseline: "poly6" | "mean" | "none".  pad_start: time of the first kept sample in the motion [s].
+    highpass: corner frequency f_c of the acausal Butterworth high-pass [Hz] (0: none; step 4b).
     """
     path = record.source
     _check_args(path, scale, taper, baseline, pad_start)
+    if not (np.isfinite(highpass) and highpass >= 0):
+        _refuse(path, f"highpass = {highpass} Hz (must be finite and >= 0)")
     t, x = np.asarray(record.t, float), _as2d(record.values) * scale
     raw = _kinematics(t, x, record.quantity)
     i0, i1 = _window(path, t, raw[0], window)
@@ -512,6 +546,11 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
         xw = xw - (x[:i0] if i0 >= 2 else xw).mean(0)
     tm = t[i0:i1 + 1] - t[i0] + pad_start
     a, v0, d0 = to_acceleration(tm, xw * hann_taper(tm, taper)[:, None], record.quantity)
+    npad = 0
+    if highpass > 0:
+        tm, a, npad = _highpass(path, tm, a, float(highpass))
+        tm = tm - tm[0] + pad_start                  # the first (padded) sample at pad_start
+        v0, d0 = 0.0 * v0, 0.0 * d0                  # the pads start from rest
     v, d = integrate(tm, a, v0, d0)
     change = np.zeros(a.shape[1])
     if baseline == "poly6":
@@ -520,9 +559,11 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
         a = a_new
         v, d = integrate(tm, a, v0, d0)
     proc = dict(scale=float(scale), window=window, taper=float(taper), baseline=baseline,
-                pad_start=float(pad_start), window_samples=(i0, i1))
+                pad_start=float(pad_start), window_samples=(i0, i1), highpass=float(highpass),
+                highpass_pad_s=float(npad * (tm[1] - tm[0])) if npad else 0.0)
+    t_rec0 = float(t[i0]) - proc["highpass_pad_s"]
     motion = Motion(t=tm, a=a, v=v, d=d, stats_raw=motion_stats(t, *raw), stats=motion_stats(tm, a, v, d),
-                    baseline_pga_change=change, record_t0=float(t[i0]), source=path, sha256=record.sha256,
+                    baseline_pga_change=change, record_t0=t_rec0, source=path, sha256=record.sha256,
                     record_info=_record_info(record), processing=proc, ndim=np.ndim(record.values))
     motion.warn()
     return motion
@@ -604,7 +645,9 @@ class Motion:
         lines = [f"record {self.source} (sha256 {self.sha256}): {form}, {r['quantity']} in {r['units_in']}, "
                  f"{r['n']} samples, {dt}, station '{r.get('station', '')}', component '{r.get('component', '')}'",
                  f"processing: scale {p['scale']:g}, window {p['window']!r} (record from {self.record_t0:g} s), "
-                 f"Hann taper {p['taper']:g} of the length at each end, baseline {p['baseline']}",
+                 f"Hann taper {p['taper']:g} of the length at each end, baseline {p['baseline']}"
+                 + (f", acausal Butterworth high-pass of order {HIGHPASS_ORDER} at {p['highpass']:g} Hz with "
+                    f"{p['highpass_pad_s']:.4g} s of zero pads kept at each end" if p.get("highpass") else ""),
                  f"motion: {len(self.t)} samples, t {self.t_start:g} .. {self.t_end:g} s "
                  f"(duration {self.duration:g} s)",
                  f"{'':16s}{'raw':>24s}{'processed':>24s}"]
