@@ -24,6 +24,8 @@ register("interface_stride", "int", 1, "steps", "keep the interface's nodal seri
          "counts are kept every step. A long record's interface series grows by 3 n_I doubles per key and "
          "step: e.g. -ssi_interface_stride 10 with -ssi_output_stride 10", G,
          validator=lambda v: None if v >= 1 else "must be >= 1")
+register("step_times", "bool", False, "", "write the wall time of every step into the output (timing/step_wall, "
+         "s): whether a long record's cost per step stays flat (benchmarks; it differs between reruns)", G)
 register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f always; linear) or unilateral "
          "(Kuhn-Tucker contact with a cohesion limit: the structure may lift off, paper eq. 25)", G,
          choices=("bonded", "unilateral"))

@@ -185,7 +185,8 @@ class SSITransient(TransientProblem):
         cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob
         res = self.results()
         res["_outputs"] = (self.out, self.sout)
-        res["timing"] = {"step_wall": (np.asarray(self.clock.values, float), "s")}
+        if cfg.step_times:
+            res["timing"] = {"step_wall": (np.asarray(self.clock.values, float), "s")}
         law = coupler.law
         nch = law.total_changes
         stats = {"wall_s": time.perf_counter() - self.t_start, "assembly_s": self.info["t_asm"],
