@@ -1,0 +1,220 @@
+"""Member forces (issue 28 item 2): frame end forces and shell stress resultants from the element
+kernels (``Frame.end_forces``, ``shell.resultants``) against closed forms, and the output of a run
+with -ssi_structure_forces (``io.forces.ForceRecorder``: per-snapshot datasets, envelopes, the
+XDMF cell fields) against the kernels applied to the run's own displacement snapshots.
+
+The static solves use the test's own scipy assembly (elements/np_assembly.py); the frame element
+is exact for nodal loads, and the shell patch fields are reproduced exactly, so the closed forms
+hold to round-off (tolerances 1e-9 relative unless said).
+"""
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+import pytest
+
+from fem_helpers import ROOT, run_cli
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "elements"))
+from np_assembly import assemble, solve_static  # noqa: E402
+
+from petsc_ssi.fem.elements import Props  # noqa: E402
+from petsc_ssi.fem.elements.frame import FRAME, rect_section, _geometry  # noqa: E402
+from petsc_ssi.fem.elements.shell import SHELL, resultants, local_frame  # noqa: E402
+from petsc_ssi.fem import obstacle as ob  # noqa: E402
+
+
+def element_dofs(cells):
+    return (6 * np.asarray(cells)[:, :, None] + np.arange(6)).reshape(len(cells), -1)
+
+
+# ------------------------------------------------------------------ frames
+def test_cantilever_end_forces_closed_form():
+    """A skew cantilever (4 Timoshenko elements) under a tip force (Px, Py, Pz) in its local axes
+    and a tip torque T: every element's end forces are the statics of the tip load, f[6:12] =
+    (Px, Py, Pz, T, -Pz a, Py a) at the node a from the tip and f[0:6] the opposite at the other
+    end: shear P and moment P L at the root, no moment at the tip."""
+    n, L = 4, 3.0
+    d = np.array([1.0, 0.4, 0.3])
+    d /= np.linalg.norm(d)
+    X = np.outer(np.linspace(0, L, n + 1), d) + np.array([0.5, -0.2, 1.0])
+    cells = np.column_stack([np.arange(n), np.arange(1, n + 1)])
+    props = Props(E=30e9, nu=0.25, rho=2500.0, **rect_section(0.2, 0.4), orientation=(0.0, 0.0, 1.0))
+    _, Lam = _geometry(X[cells[:1]], props)
+    ex, ey, ez = Lam[0]
+    Px, Py, Pz, T = 3e3, -2e3, 1e4, 2e3
+    K, _ = assemble(n + 1, [(FRAME, cells, X, props)])
+    f = np.zeros(6 * (n + 1))
+    f[6 * n:6 * n + 3] = Px * ex + Py * ey + Pz * ez
+    f[6 * n + 3:6 * n + 6] = T * ex
+    u = solve_static(K, f, np.arange(6))
+    fe = FRAME.end_forces(X[cells], props, u[element_dofs(cells)])
+    a = L - np.linspace(0, L, n + 1)                   # distance of each node from the tip
+    want = np.zeros((n, 12))
+    for e in range(n):
+        for k, s in ((0, -1.0), (1, 1.0)):
+            want[e, 6 * k:6 * k + 6] = s * np.array([Px, Py, Pz, T, -Pz * a[e + k], Py * a[e + k]])
+    scale = np.hypot(Py, Pz) * L
+    assert np.abs(fe - want).max() < 1e-9 * scale
+    assert abs(fe[0, 4] - Pz * L) < 1e-9 * scale and abs(fe[-1, 10]) < 1e-9 * scale   # root P L, tip 0
+    # the stress resultants (-f at node 0): My at the root -Pz L (the +z' fibre in compression)
+    assert abs(-fe[0, 4] + Pz * L) < 1e-9 * scale
+
+
+@pytest.mark.parametrize("k", [0.25, 1.0, 1e6])
+def test_portal_frame_column_moments_closed_form(k):
+    """Fixed-base portal (columns h, beam span L in the x-z plane, Euler-Bernoulli, axial
+    deformation negligible: A 1e6 times the section's) under a horizontal force H at the beam:
+    the classical sway solution with k = I_b h / (I_c L): column shear H/2, moments
+    M_base = H h/2 (3k+1)/(6k+1), M_top = H h/2 3k/(6k+1), beam end moments M_top, beam shear
+    and column axial force 2 M_top / L, no moment at mid-span (the beam is two elements). k = 1e6
+    is the infinitely stiff beam (M_base = M_top = H h/4)."""
+    h, L, H = 3.0, 5.0, 1e4
+    Ic = 1e-3
+    Ib = k * Ic * L / h
+    X = np.array([[0, 0, 0], [0, 0, h], [L / 2, 0, h], [L, 0, h], [L, 0, 0.0]])
+    col = Props(E=30e9, nu=0.2, rho=2500.0, area=1e3, Iy=Ic, Iz=Ic, J=Ic, shear_factor=0.0,
+                orientation=(1.0, 0.0, 0.0))
+    beam = Props(E=30e9, nu=0.2, rho=2500.0, area=1e3, Iy=Ib, Iz=Ic, J=Ic, shear_factor=0.0,
+                 orientation=(0.0, 0.0, 1.0))
+    cc, cb = np.array([[0, 1], [4, 3]]), np.array([[1, 2], [2, 3]])
+    K, _ = assemble(5, [(FRAME, cc, X, col), (FRAME, cb, X, beam)])
+    f = np.zeros(30)
+    f[6] = H
+    u = solve_static(K, f, np.r_[np.arange(6), 24 + np.arange(6)])
+    fc = FRAME.end_forces(X[cc], col, u[element_dofs(cc)])
+    fb = FRAME.end_forces(X[cb], beam, u[element_dofs(cb)])
+    Mb, Mt = H * h / 2 * (3 * k + 1) / (6 * k + 1), H * h / 2 * 3 * k / (6 * k + 1)
+    tol = 1e-6 * H * h
+    assert np.allclose(np.abs(fc[:, [4, 10]]), [[Mb, Mt], [Mb, Mt]], rtol=0, atol=tol)   # about y' (in plane)
+    assert np.allclose(np.abs(fc[:, [2, 8]]), H / 2, rtol=0, atol=1e-6 * H)              # shear along z' = x
+    assert np.allclose(np.abs(fc[:, [0, 6]]), 2 * Mt / L, rtol=0, atol=1e-6 * H)         # axial
+    assert np.allclose(np.abs(fb[:, [2, 8]]), 2 * Mt / L, rtol=0, atol=1e-6 * H)         # beam shear
+    assert abs(abs(fb[0, 4]) - Mt) < tol and abs(abs(fb[1, 10]) - Mt) < tol
+    assert abs(fb[0, 10]) < tol and abs(fb[1, 4]) < tol                                  # mid-span: 0
+    assert np.abs(np.r_[fc[:, [1, 3, 5, 7, 9, 11]].ravel(), fb[:, [1, 3, 5, 7, 9, 11]].ravel()]).max() < tol
+    # the two columns' base moments and shears balance the load: sum of base reactions = H
+    assert abs(fc[0, 2] + fc[1, 2] + H) < 1e-6 * H or abs(fc[0, 2] + fc[1, 2] - H) < 1e-6 * H
+
+
+# ------------------------------------------------------------------ shells
+PROPS = Props(E=30e9, nu=0.2, rho=2500.0, thickness=0.3)
+
+
+def _rotation(seed=6):
+    Q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    return Q * np.sign(np.linalg.det(Q))
+
+
+def _in_element_frames(T2, R, X):
+    """A plane symmetric tensor T2 (2x2, in the patch's axes R[:2]) in each cell's local frame."""
+    T3 = R[:2].T @ T2 @ R[:2]
+    Re, _, _, _ = local_frame(X)
+    return np.einsum("eai,ij,ebj->eab", Re[:, :2], T3, Re[:, :2])
+
+
+def _patch_solve(U, coords, cells, bnd, props):
+    import scipy.sparse.linalg as spla
+    K, _ = assemble(8, [(SHELL, cells, coords, props)])
+    pres = ob.fix(bnd, range(6))
+    u = np.zeros(48)
+    u[pres] = U[bnd].ravel()
+    free = np.setdiff1d(np.arange(48), pres)
+    u[free] = spla.spsolve(K[free][:, free].tocsc(), -(K[free][:, pres] @ u[pres]))
+    return u
+
+
+@pytest.mark.parametrize("rotated", [False, True], ids=["xy-plane", "rotated"])
+def test_membrane_patch_resultants(rotated):
+    """Uniform in-plane strain (and a rigid rotation, drilling dofs = the exact rotation) on the
+    boundary of the distorted 5-element patch: every element's N = E t/(1 - nu^2) [[1, nu, 0],
+    [nu, 1, 0], [0, 0, (1-nu)/2]] eps in its own local frame; M, Q = 0."""
+    R = _rotation() if rotated else np.eye(3)
+    coords, cells, xy, R, bnd, inner = ob.distorted_patch(R, origin=(3.0, -2.0, 1.0))
+    B = np.array([[1.0e-3, 0.4e-3], [0.4e-3, -0.6e-3]]) + np.array([[0, -2e-3], [2e-3, 0]])
+    uv = np.array([1e-4, -2e-4]) + xy @ B.T
+    U = np.zeros((8, 6))
+    U[:, :3] = np.c_[uv, np.zeros(8)] @ R
+    U[:, 3:] = np.array([0.0, 0.0, 0.5 * (B[1, 0] - B[0, 1])]) @ R
+    u = _patch_solve(U, coords, cells, bnd, PROPS)
+    s = resultants(coords[cells], PROPS, u[element_dofs(cells)])[:, 0]
+    E, nu, t = PROPS.E, PROPS.nu, PROPS.thickness
+    eps = 0.5 * (B + B.T)
+    sig = E / (1 - nu ** 2) * ((1 - nu) * eps + nu * np.trace(eps) * np.eye(2))
+    want = _in_element_frames(t * sig, R, coords[cells])
+    scale = np.abs(t * sig).max()
+    assert np.abs(s[:, [0, 1, 2]] - want[:, [0, 1, 0], [0, 1, 1]]).max() < 1e-9 * scale
+    assert np.abs(s[:, 3:]).max() < 1e-9 * scale * t
+
+
+@pytest.mark.parametrize("rotated", [False, True], ids=["xy-plane", "rotated"])
+def test_bending_patch_resultants(rotated):
+    """Constant curvature (quadratic w, Kirchhoff rotations) on the boundary of the distorted
+    patch: every element's M = E t^3/(12 (1 - nu^2)) [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]]
+    kappa with kappa = -grad grad w (M11 > 0 stretches the +e3 fibre) in its local frame, Q = 0
+    and N = 0 (to 1e-9 of M / t)."""
+    R = _rotation(3) if rotated else np.eye(3)
+    coords, cells, xy, R, bnd, inner = ob.distorted_patch(R, origin=(-1.0, 0.5, 2.0))
+    c0, c1, c2, a, b, c = 1e-4, 2e-3, -1e-3, 0.02, -0.013, 0.031
+    x, y = xy.T
+    w = c0 + c1 * x + c2 * y + 0.5 * a * x * x + b * x * y + 0.5 * c * y * y
+    U = np.zeros((8, 6))
+    U[:, :3] = np.c_[0 * w, 0 * w, w] @ R
+    U[:, 3:] = np.c_[c2 + b * x + c * y, -(c1 + a * x + b * y), 0 * w] @ R
+    u = _patch_solve(U, coords, cells, bnd, PROPS)
+    s = resultants(coords[cells], PROPS, u[element_dofs(cells)])[:, 0]
+    E, nu, t = PROPS.E, PROPS.nu, PROPS.thickness
+    kap = -np.array([[a, b], [b, c]])
+    Mt = E * t ** 3 / (12 * (1 - nu ** 2)) * ((1 - nu) * kap + nu * np.trace(kap) * np.eye(2))
+    want = _in_element_frames(Mt, R, coords[cells])
+    # the local frames' e3 equals the patch normal R[2] (the cells are counter-clockwise in (x, y))
+    assert np.allclose(local_frame(coords[cells])[0][:, 2], R[2])
+    scale = np.abs(Mt).max()
+    assert np.abs(s[:, [3, 4, 5]] - want[:, [0, 1, 0], [0, 1, 1]]).max() < 1e-9 * scale
+    assert np.abs(s[:, 6:]).max() < 1e-9 * scale and np.abs(s[:, :3]).max() < 1e-9 * scale / t
+
+
+def test_transverse_shear_resultant():
+    """A uniform shear strain (w linear, no rotation) on warped, distorted cells: the MITC4
+    assumed shear is exact for it, Q = k G t grad w in each cell's local frame; M = N = 0."""
+    rng = np.random.default_rng(4)
+    X = np.array([[[0, 0, 0], [1.1, 0.1, 0], [1.0, 0.9, 0], [-0.1, 1.2, 0.0]],
+                  [[0, 0, 0], [0.8, -0.2, 0], [1.2, 1.0, 0], [0.1, 0.7, 0.0]]])
+    g = np.array([2e-3, -1e-3])
+    ue = np.zeros((2, 4, 6))
+    ue[:, :, 2] = X[..., :2] @ g
+    Q = _rotation(9)
+    Xr = X @ Q.T + rng.normal(size=3)
+    uer = np.concatenate([ue[..., :3] @ Q.T, ue[..., 3:] @ Q.T], axis=2).reshape(2, 24)
+    s = resultants(Xr, PROPS, uer)[:, 0]
+    Re, _, _, _ = local_frame(Xr)
+    ks = 5.0 / 6.0 * PROPS.E / (2 * (1 + PROPS.nu)) * PROPS.thickness
+    # local normal e3 = +-Q z: gamma_a3 = dw'/dx_a with w' = u . e3
+    sgn = np.sign(Re[:, 2] @ (Q @ [0, 0, 1.0]))
+    want = ks * sgn[:, None] * np.einsum("eai,i->ea", Re[:, :2], Q @ np.r_[g, 0.0])
+    assert np.abs(s[:, 6:] - want).max() < 1e-9 * np.abs(want).max()
+    assert np.abs(s[:, :6]).max() < 1e-9 * np.abs(want).max()
+
+
+def test_cantilever_plate_strip_under_end_moment():
+    """A clamped 2 m x 0.5 m strip (8 x 2 elements, nu = 0) under an end moment m per unit width
+    about +y (consistent nodal moments): M11 = m in every element, M22 = M12 = 0, Q = 0, N = 0."""
+    props = Props(E=30e9, nu=0.0, rho=2500.0, thickness=0.2)
+    nx, ny, Lx, Ly, m = 8, 2, 2.0, 0.5, 3e3
+    x, y = np.meshgrid(np.linspace(0, Lx, nx + 1), np.linspace(0, Ly, ny + 1), indexing="ij")
+    coords = np.c_[x.ravel(), y.ravel(), np.zeros(x.size)]
+    nid = lambda i, j: i * (ny + 1) + j                      # noqa: E731
+    cells = np.array([[nid(i, j), nid(i + 1, j), nid(i + 1, j + 1), nid(i, j + 1)]
+                      for i in range(nx) for j in range(ny)])
+    K, _ = assemble(coords.shape[0], [(SHELL, cells, coords, props)])
+    f = np.zeros(6 * coords.shape[0])
+    tip = [nid(nx, j) for j in range(ny + 1)]
+    share = np.full(ny + 1, Ly / ny)
+    share[[0, -1]] *= 0.5
+    f[6 * np.array(tip) + 4] = m * share
+    u = solve_static(K, f, ob.fix([nid(0, j) for j in range(ny + 1)], range(6)))
+    s = resultants(coords[cells], props, u[element_dofs(cells)])[:, 0]
+    assert np.abs(s[:, 3] - m).max() < 1e-9 * m
+    assert np.abs(s[:, [4, 5, 6, 7]]).max() < 1e-9 * m and np.abs(s[:, :3]).max() < 1e-9 * m / 0.2
