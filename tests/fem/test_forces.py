@@ -218,3 +218,132 @@ def test_cantilever_plate_strip_under_end_moment():
     s = resultants(coords[cells], props, u[element_dofs(cells)])[:, 0]
     assert np.abs(s[:, 3] - m).max() < 1e-9 * m
     assert np.abs(s[:, [4, 5, 6, 7]]).max() < 1e-9 * m and np.abs(s[:, :3]).max() < 1e-9 * m / 0.2
+
+
+# ------------------------------------------------------------------ the output of a run
+SLAB = os.path.join("runs", "structures", "slab-on-columns.opts")
+
+
+def _run(path, nranks, stride, extra=()):
+    r = run_cli(["-options_file", SLAB, "-ssi_t_end", "0.02", "-ssi_output", path, "-ssi_output_stride",
+                 str(stride), "-ssi_structure_forces", "all", "-ssi_output_overwrite"] + list(extra), n=nranks)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+
+
+def _read(path):
+    with h5py.File(path, "r") as f:
+        out = {k: f["forces"][k][()] for k in f["forces"]}
+        out["attrs"] = {k: dict(f["forces"][k].attrs) for k in ("columns", "slab", "columns_envelope")}
+        out["u"] = [f[f"displacement_{k:06d}"][()] for k in out["snapshots"]]
+        out["r"] = [f[f"rotation_{k:06d}"][()] for k in out["snapshots"]]
+        out["coords"] = f["coordinates"][()]
+        out["time"] = f["time"][()]
+        out["cell"] = {k[len("cell_peak_"):]: f[k][()] for k in f if k.startswith("cell_peak_")}
+        out["cell_units"] = {k[len("cell_peak_"):]: f[k].attrs["unit"] for k in f if k.startswith("cell_peak_")}
+    return out
+
+
+def test_forces_output_of_a_run(tmp_path):
+    """The slab on columns (24 frames, 48 shells, 10 steps) with -ssi_structure_forces all, on 1 rank
+    writing every step (A) and on 2 ranks writing every 5th (B):
+      * the datasets forces/<part> (K, E, 12 | 8) carry units and component names;
+      * A's forces at every snapshot equal the element kernels (Frame.end_forces, shell
+        resultants) applied to A's own displacement and rotation snapshots (1e-9 of the peak);
+      * B's snapshots equal A's at the same times, and B's envelope (2 ranks, written every 5th
+        step) equals the max over ALL of A's steps of |value| (1e-9): the envelope sees every
+        step; it is >= every written |value|;
+      * the cell fields cell_peak_* are the envelopes on the parts' cells (frames: max over both
+        ends) and NaN elsewhere; the XDMF parses and has them as Center="Cell" attributes with the
+        topology's cell count."""
+    a, b = str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
+    _run(a, 1, 1)
+    _run(b, 2, 5)
+    A, B = _read(a), _read(b)
+    assert A["columns"].shape == (11, 24, 12) and A["slab"].shape == (11, 48, 8)
+    assert B["columns"].shape == (3, 24, 12) and list(B["snapshots"]) == [0, 1, 2]
+    assert A["attrs"]["columns"]["unit"].split(",")[4] == "N m" and A["attrs"]["slab"]["unit"].split(",")[3] == "N m/m"
+    assert A["attrs"]["columns"]["components"].split(",")[:6] == ["N_i", "V2_i", "V3_i", "T_i", "M2_i", "M3_i"]
+    assert A["attrs"]["slab"]["components"] == "N11,N22,N12,M11,M22,M12,Q1,Q2"
+    assert np.allclose(A["time"][A["snapshots"]], A["time"]) and np.allclose(B["time"], A["time"][::5])
+    # the kernels on A's own snapshots (columns: vertical members, default orientation x)
+    col = Props(E=30e9, nu=0.2, rho=2500.0, **rect_section(0.3, 0.3), orientation=(1.0, 0.0, 0.0))
+    slab = Props(E=30e9, nu=0.2, rho=2500.0, thickness=0.2, added_mass=100.0)
+    X = A["coords"]
+    for k in range(len(A["snapshots"])):
+        U = np.c_[A["u"][k], A["r"][k]]
+        fc = FRAME.end_forces(X[A["columns_nodes"]], col, U[A["columns_nodes"]].reshape(-1, 12))
+        fs = resultants(X[A["slab_nodes"]], slab, U[A["slab_nodes"]].reshape(-1, 24))[:, 0]
+        assert np.abs(A["columns"][k] - fc).max() <= 1e-9 * np.abs(A["columns"]).max()
+        assert np.abs(A["slab"][k] - fs).max() <= 1e-9 * np.abs(A["slab"]).max()
+    for part in ("columns", "slab"):
+        peak = np.abs(A[part]).max()
+        assert np.abs(B[part] - A[part][::5]).max() < 1e-9 * peak
+        assert np.abs(B[part + "_envelope"] - np.abs(A[part]).max(axis=0)).max() < 1e-9 * peak
+        assert np.all(B[part + "_envelope"] >= np.abs(B[part]).max(axis=0))
+        assert np.array_equal(A[part + "_cells"], B[part + "_cells"])
+    # B's envelope exceeds its written values somewhere: the steps between the snapshots count
+    assert np.any(B["columns_envelope"] > np.abs(B["columns"]).max(axis=0) * (1 + 1e-6))
+    env = B["columns_envelope"]
+    assert np.array_equal(B["cell"]["M3"][B["columns_cells"]], np.maximum(env[:, 5], env[:, 11]))
+    assert np.isnan(B["cell"]["M3"][B["slab_cells"]]).all() and np.isnan(B["cell"]["M11"][B["columns_cells"]]).all()
+    assert np.array_equal(B["cell"]["Q2"][B["slab_cells"]], B["slab_envelope"][:, 7])
+    assert B["cell_units"]["M3"] == "N m" and B["cell_units"]["M11"] == "N m/m"
+    root = ET.parse(b.replace(".h5", ".xmf")).getroot()
+    grids = root.findall(".//Grid[@GridType='Uniform']")
+    assert len(grids) == 3
+    for g in grids:
+        ne = int(g.find("Topology").get("NumberOfElements"))
+        cells = {a.get("Name"): a for a in g.findall("Attribute") if a.get("Center") == "Cell"}
+        assert {"peak_M3", "peak_M2", "peak_N", "peak_M11", "peak_Q1"} <= set(cells)
+        assert all(int(a.find("DataItem").get("Dimensions")) == ne for a in cells.values())
+        assert cells["peak_M3"].find("DataItem").text.endswith(":/cell_peak_M3")
+
+
+@pytest.mark.parametrize("value, message", [
+    ("slabb", "no part 'slabb' (parts: slab, columns); did you mean slab?"),
+    ("slab,slab", "a part is named twice"),
+])
+def test_forces_option_bad_input(value, message, tmp_path):
+    """A misspelt or repeated part: one line, before any mesh is read."""
+    r = run_cli(["-options_file", SLAB, "-ssi_output", str(tmp_path / "x.h5"), "-ssi_structure_forces", value])
+    assert r.returncode != 0 and message in (r.stdout + r.stderr), r.stdout + r.stderr
+    assert "[fem] mesh" not in r.stdout
+
+
+def test_forces_option_refuses_brick_parts():
+    from petsc_ssi.fem.parts import PartSpec
+    from petsc_ssi.io.forces import parse_force_parts
+    from petsc_ssi.petsc import SSIError
+    specs = [PartSpec("block", "hex8", None), PartSpec("beam", "frame", None)]
+    assert parse_force_parts("all", specs) == ["beam"] and parse_force_parts("none", specs) == []
+    with pytest.raises(SSIError, match="part 'block' is a hex8 part"):
+        parse_force_parts("beam,block", specs)
+    with pytest.raises(SSIError, match="no frame or shell part"):
+        parse_force_parts("all", specs[:1])
+
+
+def test_forces_xdmf_opens_in_paraview(tmp_path):
+    """ParaView reads the cell fields (skipped without pvpython)."""
+    import shutil
+    import subprocess
+    pv = shutil.which("pvpython")
+    if pv is None:
+        pytest.skip("ParaView (pvpython) is not installed")
+    s = str(tmp_path / "s.h5")
+    _run(s, 1, 5)
+    script = tmp_path / "read.py"
+    script.write_text(
+        "import sys, json\nfrom paraview.simple import XDMFReader\nfrom paraview import servermanager as sm\n"
+        "from vtk.numpy_interface import dataset_adapter as dsa\n"
+        "r = XDMFReader(FileNames=[sys.argv[1]])\nr.UpdatePipeline()\n"
+        "d = dsa.WrapDataObject(sm.Fetch(r))\n"
+        "import numpy as np\nm = np.asarray(d.CellData['peak_M3'])\n"
+        "print(json.dumps({'cells': int(d.GetNumberOfCells()), 'm': [None if v != v else v for v in m.tolist()]}))\n")
+    p = subprocess.run([pv, "--force-offscreen-rendering", str(script), s.replace(".h5", ".xmf")],
+                       capture_output=True, text=True, timeout=180, env=dict(os.environ, DISPLAY=""))
+    assert p.returncode == 0, p.stdout + p.stderr
+    got = __import__("json").loads([ln for ln in p.stdout.splitlines() if ln.startswith("{")][-1])
+    with h5py.File(s) as f:
+        want = f["cell_peak_M3"][()]
+    assert got["cells"] == want.size
+    assert np.array_equal(np.array([np.nan if v is None else v for v in got["m"]]), want, equal_nan=True)
