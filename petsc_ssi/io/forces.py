@@ -120,9 +120,8 @@ class _Part:
         self.G = np.concatenate(ops) if ops else np.zeros((0, self.c, nd))
         self.dofs = np.concatenate(dofs) if dofs else np.zeros((0, nd), np.int64)
         self.vec = PETSc.Vec().createMPI(((self.e1 - self.e0) * self.c, n * self.c), bsize=self.c, comm=comm)
-        self.env_vec = self.vec.duplicate()
-        self.env_vec.zeroEntries()
-        self.env = self.env_vec.getArray().reshape(-1, self.c)   # the envelope lives in its Vec
+        self.env_vec = self.vec.duplicate()          # the envelope's Vec, filled when written or saved
+        self.env = np.zeros((self.e1 - self.e0, self.c))
         self.value = np.zeros((self.e1 - self.e0, self.c))
 
     def attrs(self):
@@ -192,13 +191,21 @@ class ForceRecorder:
         self.snapshots = [int(k) for k in s["forces_snapshots"]]
         self.times = [float(t) for t in s["forces_times"]]
 
-    def checkpoint_vecs(self):
-        """{name: Vec}: the envelopes (the checkpoint keeps them in the run's own layout)."""
+    def _envelope_vecs(self):
+        """{name: Vec} of the envelopes, the Vecs filled (no view into a Vec's array is kept: a
+        load may replace it)."""
+        for p in self.parts:
+            p.env_vec.getArray()[:] = p.env.ravel()
         return {f"forces_envelope_{p.name}": p.env_vec for p in self.parts}
 
+    def checkpoint_vecs(self):
+        """{name: Vec}: the envelopes (saved by the checkpoint globally: any rank count restarts)."""
+        return self._envelope_vecs()
+
     def restore_vecs(self, reader):
-        for name, v in self.checkpoint_vecs().items():
-            reader.load(name, v)
+        for p in self.parts:
+            reader.load(f"forces_envelope_{p.name}", p.env_vec)
+            p.env[:] = p.env_vec.getArray(readonly=True).reshape(-1, p.c)
 
     # ------------------------------------------------------------ work
     def compute(self, u):
@@ -229,7 +236,7 @@ class ForceRecorder:
     # ------------------------------------------------------------ Output's call-backs
     def write_collective(self, out):
         """Collective, before the output closes its viewer: the envelopes."""
-        out.write_vecs({f"forces_envelope_{p.name}": p.env_vec for p in self.parts}, "member force envelopes")
+        out.write_vecs(self._envelope_vecs(), "member force envelopes")
 
     def write_serial(self, f):
         """Rank 0, the file open (h5py): the 'forces' group and the cell fields; returns the XDMF

@@ -15,7 +15,7 @@ import h5py
 import numpy as np
 import pytest
 
-from fem_helpers import ROOT, run_cli
+from fem_helpers import run_cli
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "elements"))
 from np_assembly import assemble, solve_static  # noqa: E402
@@ -347,3 +347,28 @@ def test_forces_xdmf_opens_in_paraview(tmp_path):
         want = f["cell_peak_M3"][()]
     assert got["cells"] == want.size
     assert np.array_equal(np.array([np.nan if v is None else v for v in got["m"]]), want, equal_nan=True)
+
+
+def test_forces_restart_and_flushes(tmp_path):
+    """A run with flushes at every step (-ssi_output_flush 1e-9: the envelopes and the 'forces'
+    group rewritten in place) and checkpoints every 4 steps, restarted after step 4 on 2 ranks
+    (the envelopes come back from the checkpoint's Vecs): every dataset of the restarted file,
+    forces and envelopes included, equals the uninterrupted run's (1e-9 relative: 1 vs 2 ranks)."""
+    sys.path.insert(0, os.path.dirname(os.path.dirname(__file__)))
+    from test_checkpoint import run_and_restart, datasets
+    args = ["-options_file", SLAB, "-ssi_t_end", "0.02", "-ssi_output_stride", "3", "-ssi_structure_forces",
+            "columns,slab", "-ssi_output_overwrite", "-ssi_output_flush", "1e-9"]
+    for ref, rs in run_and_restart(args, tmp_path, 1, 4, 4, nranks_restart=2):
+        A, B = datasets(rs), datasets(ref)
+        assert sorted(A) == sorted(B) and A["@run_status"] == "completed"
+        for k in A:
+            x, y = np.asarray(A[k]), np.asarray(B[k])
+            assert x.shape == y.shape, k
+            if x.dtype.kind == "f" and x.size:
+                assert np.array_equal(np.isnan(x), np.isnan(y)), k            # NaN: cells without the field
+                assert np.nanmax(np.abs(x - y)) <= 1e-9 * max(np.nanmax(np.abs(y)), 1e-300), k
+            else:
+                assert np.array_equal(x, y), k
+        assert "forces/columns" in A and "forces_envelope_slab" in A and "cell_peak_M3" in A
+        with h5py.File(ref) as f:
+            assert f["forces/columns"].shape == (4, 24, 12) and f["forces/columns"].is_virtual
