@@ -372,3 +372,38 @@ def test_forces_restart_and_flushes(tmp_path):
         assert "forces/columns" in A and "forces_envelope_slab" in A and "cell_peak_M3" in A
         with h5py.File(ref) as f:
             assert f["forces/columns"].shape == (4, 24, 12) and f["forces/columns"].is_virtual
+
+
+def test_forces_in_a_coupled_run(tmp_path):
+    """A coupled run (the one-storey half building of test_building_ci.py on the half-space, 8
+    steps, 2 ranks, -ssi_structure_forces all): the structure's file has the forces of its three
+    parts at every structure snapshot, equal to the kernels applied to that file's displacement
+    and rotation snapshots (1e-9 of the peak), and envelopes >= every written |value|."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    sys.path[:0] = [here, os.path.join(here, "coupling")]
+    from test_building_ci import building_msh, structure_opts, soil_opts, E, NU, RC
+    from helpers import cli
+    msh = building_msh(str(tmp_path / "half.msh"), half=True)
+    soil = soil_opts(t_end=0.02, sym=True)
+    soil[soil.index("-ssi_output_stride") + 1] = "4"
+    out = str(tmp_path / "c.h5")
+    cli(["-ssi_problem", "ssi", "-ssi_output", out, "-ssi_structure_forces", "all"] + soil + structure_opts(msh),
+        nranks=2, timeout=600)
+    props = {"foundation": Props(E=E, nu=NU, rho=RC, thickness=0.5), "roof": Props(E=E, nu=NU, rho=RC, thickness=0.2),
+             "columns": Props(E=E, nu=NU, rho=RC, **rect_section(0.3, 0.3), orientation=(1.0, 0.0, 0.0))}
+    with h5py.File(out.replace(".h5", "_structure.h5"), "r") as f:
+        X = f["coordinates"][()]
+        snaps = f["forces/snapshots"][()]
+        assert len(snaps) == len(f["time"]) == 2 and np.allclose(f["forces/time"][()], f["time"][()])
+        for part, p in props.items():
+            F, env, nodes = f[f"forces/{part}"][()], f[f"forces/{part}_envelope"][()], f[f"forces/{part}_nodes"][()]
+            assert F.shape == (2, nodes.shape[0], 12 if part == "columns" else 8)
+            assert f[f"forces/{part}"].attrs["unit"].split(",")[3] == ("N m" if part == "columns" else "N m/m")
+            peak = np.abs(F).max()
+            assert peak > 0 and np.all(env >= np.abs(F).max(axis=0))
+            for i, k in enumerate(snaps):
+                U = np.c_[f[f"displacement_{k:06d}"][()], f[f"rotation_{k:06d}"][()]][nodes]
+                want = (FRAME.end_forces(X[nodes], p, U.reshape(-1, 12)) if part == "columns" else
+                        resultants(X[nodes], p, U.reshape(-1, 24))[:, 0])
+                assert np.abs(F[i] - want).max() <= 1e-9 * peak, (part, k)
+        assert "cell_peak_M3" in f and "cell_peak_M11" in f
