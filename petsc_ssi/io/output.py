@@ -9,6 +9,9 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
   topology               (E, n)  cell connectivity (0-based)        [rank 0]
   time                   (K,)    time of snapshot k                 [rank 0]
   receivers/...          receiver series (see ``write_receivers``)  [rank 0]
+  (writers)              more data of ``Output.writers`` (e.g. io/forces.py's member forces:
+                         distributed Vecs through the viewer before it closes, then rank 0's
+                         h5py work, which may name cell fields: XDMF Center="Cell" attributes)
   attrs: cell_type, fields, n_snapshots, petsc_ssi_version
 
 Distributed fields are written collectively by the PETSc viewer; the small
