@@ -281,9 +281,10 @@ class ForceRecorder:
         return cells
 
 
-def add_force_recorder(cfg, out, model, comm, recorder):
-    """Collective: the ForceRecorder of ``-ssi_structure_forces`` added to ``recorder`` among its
-    recorders (``Recorder.add_recorder``), or None (no part named, or no output to write to)."""
+def add_force_recorder(cfg, out, model, comm, recorder=None):
+    """Collective: the ForceRecorder of ``-ssi_structure_forces`` added to ``recorder`` (when
+    given) among its recorders (``Recorder.add_recorder``), or None (no part named, or no output
+    to write to)."""
     parts = parse_force_parts(cfg.get("structure_forces", ""), model.specs or [])
     if not parts:
         return None
@@ -291,4 +292,5 @@ def add_force_recorder(cfg, out, model, comm, recorder):
         from ..petsc import warn
         warn("-ssi_structure_forces: the run writes no output (-ssi_output is empty): no member forces", comm)
         return None
-    return recorder.add_recorder(ForceRecorder(out, model, comm, parts))
+    fr = ForceRecorder(out, model, comm, parts)
+    return recorder.add_recorder(fr) if recorder is not None else fr

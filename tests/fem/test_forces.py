@@ -407,3 +407,43 @@ def test_forces_in_a_coupled_run(tmp_path):
                         resultants(X[nodes], p, U.reshape(-1, 24))[:, 0])
                 assert np.abs(F[i] - want).max() <= 1e-9 * peak, (part, k)
         assert "cell_peak_M3" in f and "cell_peak_M11" in f
+
+
+def test_static_cantilever_forces_through_the_cli(tmp_path):
+    """`petsc-ssi static` on a skew cantilever (6 frames, 2 ranks) with a tip force P normal to it
+    (along the local z') and a tip torque T, -ssi_structure_forces beam: every element's end
+    forces are the statics of the tip load (shear P, moment P a at the distance a from the tip:
+    P L at the root, 0 at the tip; torque T; no axial force), to 1e-9 of P L."""
+    from petsc_ssi.mesh.gmsh import write_msh
+    n, L = 6, 3.0
+    d = np.array([1.0, 2.0, 2.0]) / 3.0
+    X = np.outer(np.linspace(0, L, n + 1), d) + np.array([0.5, -0.2, 1.0])
+    msh = str(tmp_path / "cant.msh")
+    write_msh(msh, X, {"beam": ("line2", np.column_stack([np.arange(n), np.arange(1, n + 1)])),
+                       "root": ("point", [[0]]), "tip": ("point", [[n]])})
+    z = np.array([0.0, 0.0, 1.0]) - d[2] * d
+    z /= np.linalg.norm(z)
+    P, T = 1e4, 2e3
+    load = ",".join(repr(v) for v in np.r_[X[-1], P * z, T * d])
+    out = str(tmp_path / "cant.h5")
+    r = run_cli(["static", "-ssi_problem", "fem", "-ssi_fem_mesh", msh, "-ssi_fem_parts", "beam",
+                 "-ssi_fem_part_beam_element", "frame", "-ssi_fem_part_beam_E", "30e9", "-ssi_fem_part_beam_nu", "0.25",
+                 "-ssi_fem_part_beam_rho", "2500", "-ssi_fem_part_beam_section", "0.2,0.4",
+                 "-ssi_fem_part_beam_orientation", "0,0,1", "-ssi_fem_fixed", "root", "-ssi_fem_point_load", load,
+                 "-ssi_output", out, "-ssi_structure_forces", "beam"], n=2)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    with h5py.File(out, "r") as f:
+        F, nodes = f["forces/beam"][0], f["forces/beam_nodes"][()]
+        env = f["forces/beam_envelope"][()]
+        Y = f["coordinates"][()]                                  # the run's node numbering
+        assert f["forces/beam"].attrs["components"].split(",")[10] == "M2_j"
+    assert np.array_equal(env, np.abs(F))
+    a = np.linalg.norm(Y[nodes] - X[-1], axis=2)                  # distance of each end from the tip
+    want = np.zeros_like(F)
+    want[:, 2], want[:, 3], want[:, 4] = -P, -T, P * a[:, 0]
+    want[:, 8], want[:, 9], want[:, 10] = P, T, -P * a[:, 1]
+    assert np.abs(F - want).max() < 1e-9 * P * L
+    root = int(np.argmax(a[:, 0]))
+    tip = int(np.argmin(a[:, 1]))
+    assert abs(a[root, 0] - L) < 1e-12 and a[tip, 1] < 1e-12
+    assert abs(F[root, 4] - P * L) < 1e-9 * P * L and abs(F[tip, 10]) < 1e-9 * P * L
