@@ -240,7 +240,21 @@ def _read(path):
         out["time"] = f["time"][()]
         out["cell"] = {k[len("cell_peak_"):]: f[k][()] for k in f if k.startswith("cell_peak_")}
         out["cell_units"] = {k[len("cell_peak_"):]: f[k].attrs["unit"] for k in f if k.startswith("cell_peak_")}
+        out["topology"] = f["topology"][()]
     return out
+
+
+def _mixed_cells(flat):
+    """The node lists of an XDMF Mixed topology (type id, [node count of a Polyline], nodes)."""
+    cells, i, size = [], 0, {5: 4, 9: 8}
+    while i < flat.size:
+        if flat[i] == 2:
+            n, i = int(flat[i + 1]), i + 2
+        else:
+            n, i = size[int(flat[i])], i + 1
+        cells.append(flat[i:i + n].tolist())
+        i += n
+    return cells
 
 
 def test_forces_output_of_a_run(tmp_path):
@@ -283,6 +297,10 @@ def test_forces_output_of_a_run(tmp_path):
         assert np.array_equal(A[part + "_cells"], B[part + "_cells"])
     # B's envelope exceeds its written values somewhere: the steps between the snapshots count
     assert np.any(B["columns_envelope"] > np.abs(B["columns"]).max(axis=0) * (1 + 1e-6))
+    topo = _mixed_cells(B["topology"])                             # the XDMF's cell order
+    assert len(topo) == 72
+    for part in ("columns", "slab"):
+        assert [topo[c] for c in B[part + "_cells"]] == B[part + "_nodes"].tolist()
     env = B["columns_envelope"]
     assert np.array_equal(B["cell"]["M3"][B["columns_cells"]], np.maximum(env[:, 5], env[:, 11]))
     assert np.isnan(B["cell"]["M3"][B["slab_cells"]]).all() and np.isnan(B["cell"]["M11"][B["columns_cells"]]).all()
