@@ -22,8 +22,9 @@ Output (the structure's file: ``-ssi_output`` of a fem run, ``<stem>_structure.h
 ----------------------------------------------------------------------------------------------
   forces_<part>_<k:06d>     (E, c)       the forces at snapshot k (time[k]), written collectively
   forces_envelope_<part>    (E, c)       max over ALL steps (not only the written ones) of |value|
-  forces/<part>             (K, E, c)    the snapshots as one (virtual) dataset; attrs unit,
-                                         units, components, convention, element, part
+  forces/<part>             (K, E, c)    the snapshots as one (virtual) dataset; attrs unit (one
+                                         per component, comma-separated), components,
+                                         convention, element, part
   forces/<part>_envelope    (E, c)       the envelope, with the same attributes
   forces/<part>_cells       (E,)         each element's index in the XDMF topology
   forces/<part>_nodes       (E, n)       its nodes (0-based, the ``coordinates`` rows)
@@ -125,7 +126,7 @@ class _Part:
         self.value = np.zeros((self.e1 - self.e0, self.c))
 
     def attrs(self):
-        return {"unit": ",".join(self.units), "units": ",".join(self.units),
+        return {"unit": ",".join(self.units),
                 "components": ",".join(self.components), "element": self.kind, "part": self.name,
                 "convention": FRAME_CONVENTION if self.kind == "frame" else SHELL_CONVENTION}
 
