@@ -50,6 +50,10 @@ def main():
         out = Output(cfg.output, comm)
         fw = FieldWriter(out, model, comm)
         fw.write(1.0, u)
+        from ..io.forces import add_force_recorder
+        forces = add_force_recorder(cfg, out, model, comm)          # -ssi_structure_forces
+        if forces is not None:
+            forces.record(1.0, u, write=True)
         receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
         out.close(receivers=receivers, attrs={"problem": "static", "time_is": "load factor"},
                   record=provenance(cfg, comm, {"static": {"n_dofs": model.dofmap.size,

@@ -19,6 +19,7 @@ from ..monitor import staged, fmt_time
 from ..io.output import Output
 from ..problem import TransientProblem
 from ..io.output import provenance
+from ..io.forces import add_force_recorder
 from ..io.structure import receiver_record
 from ..monitor import event
 from ..bem.build import build_marcher
@@ -53,7 +54,7 @@ class SSITransient(TransientProblem):
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
         self.grid = self.prob.grid
-        self.coupler = self.rec = None
+        self.coupler = self.rec = self.forces = None
         self.state = None
 
     def setup(self):
@@ -96,12 +97,15 @@ class SSITransient(TransientProblem):
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys,
                             interface_nodal=NODAL_KEYS, interface_stride=cfg.interface_stride)
+        self.forces = add_force_recorder(cfg, self.sout, self.model, comm, self.rec)
         self.rec.add(_FiniteCheck(self.integ))
         self.clock = self.rec.add(StepClock())
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
+            if self.forces is not None:
+                self.forces.record(self.time(0), self.integ.u)
         self._resume()
         self.clock.start()
 
@@ -116,6 +120,8 @@ class SSITransient(TransientProblem):
                        "cp_closed_prev": cp.closed_prev})
         vecs = self.march.checkpoint_vecs()
         vecs.update(self.integ.checkpoint_vecs())
+        if self.forces is not None:
+            vecs.update(self.forces.checkpoint_vecs())
         return vecs, serial
 
     def restore_state(self, reader):
@@ -123,6 +129,8 @@ class SSITransient(TransientProblem):
         n = int(self.restart["step"])
         self.march.restore(reader, n)
         self.integ.restore(reader)
+        if self.forces is not None:
+            self.forces.restore_vecs(reader)
         self.rec.restore(s, n)
         law.closed = np.asarray(s["law_closed"], bool).copy()
         law.ub_prev = np.asarray(s["law_ub_prev"], float).copy()

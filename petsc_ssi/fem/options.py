@@ -80,6 +80,11 @@ register("fem_point_mass", "str", "", "m, kg, kg m^2", "added point masses 'x,y,
 register("fem_fixed", "str", "", "", "fixed dofs by node group 'group[:dofs],...': a bare group fixes all its dofs, "
          "dof names ux uy uz rx ry rz joined by '+' (e.g. 'base,symx:ux+ry+rz,pin:uz'), letters of xyz fix "
          "translations ('xmin:x')", G)
+register("structure_forces", "str", "", "", "member forces of frame and shell parts: 'PART,...' or 'all' (every "
+         "frame and shell part; '' or none: no forces): frame end forces (N, V2, V3, T, M2, M3 at both ends, local "
+         "axes) and shell stress resultants (N11, N22, N12, M11, M22, M12, Q1, Q2 at the centre, local frame) with "
+         "every structure snapshot, their peak over all steps, and the peaks as XDMF cell fields "
+         "(petsc_ssi/io/forces.py)", G)
 register("modes_n", "int", 6, "", "petsc-ssi modes: number of natural modes", G, validator=at_least(1))
 
 
@@ -112,6 +117,27 @@ def _fem_checks(cfg):
 
 
 register_check((G,), _fem_checks)
+
+
+def _forces_check(cfg):
+    """-ssi_structure_forces names frame and shell parts (checked before any mesh is read)."""
+    text = str(cfg.get("structure_forces", "") or "").strip()
+    if not text or text == "none":
+        return None
+    from .parts import parse_parts
+    from ..io.forces import parse_force_parts
+    try:
+        specs = parse_parts(cfg)
+    except SSIError:
+        return None                  # the parts' own error comes with the model
+    try:
+        parse_force_parts(text, specs)
+    except SSIError as exc:
+        return str(exc)
+    return None
+
+
+register_check((G,), _forces_check)
 
 
 def alpha_m(cfg):

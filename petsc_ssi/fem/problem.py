@@ -20,6 +20,7 @@ import numpy as np
 from ..petsc import printf, warn
 from ..monitor import event, staged
 from ..io.output import Output, provenance
+from ..io.forces import add_force_recorder
 from ..problem import TransientProblem
 from .. import timegrid
 from . import options as _options  # noqa: F401  (declares the structure's -ssi_fem_ options)
@@ -48,7 +49,7 @@ class FEMTransient(TransientProblem):
                 for note in self.support.notes:
                     warn(note, self.comm)
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
-        self.integ = self.rec = self.out = None
+        self.integ = self.rec = self.out = self.forces = None
         self.state = None
 
     def setup(self):
@@ -108,10 +109,13 @@ class FEMTransient(TransientProblem):
                         if cfg.output else None)
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
+            self.forces = add_force_recorder(cfg, self.out, self.model, comm, self.rec)
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),
                                       write=self.grid.writes(0))
+            if self.forces is not None:
+                self.forces.record(self.time(0), self.integ.u, write=self.grid.writes(0))
         self._resume()
         self.state = (self.integ.u, self.vel)
 
@@ -119,10 +123,15 @@ class FEMTransient(TransientProblem):
         serial = self.rec.state()
         serial.update(self._output_state("out", self.out))
         serial.update(self.integ.checkpoint_scalars())
-        return self.integ.checkpoint_vecs(), serial
+        vecs = self.integ.checkpoint_vecs()
+        if self.forces is not None:
+            vecs.update(self.forces.checkpoint_vecs())
+        return vecs, serial
 
     def restore_state(self, reader):
         self.integ.restore(reader)
+        if self.forces is not None:
+            self.forces.restore_vecs(reader)
         self.rec.restore(reader.serial, int(self.restart["step"]))
 
     def step(self, n):

@@ -9,6 +9,9 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
   topology               (E, n)  cell connectivity (0-based)        [rank 0]
   time                   (K,)    time of snapshot k                 [rank 0]
   receivers/...          receiver series (see ``write_receivers``)  [rank 0]
+  (writers)              more data of ``Output.writers`` (e.g. io/forces.py's member forces:
+                         distributed Vecs through the viewer before it closes, then rank 0's
+                         h5py work, which may name cell fields: XDMF Center="Cell" attributes)
   attrs: cell_type, fields, n_snapshots, petsc_ssi_version
 
 Distributed fields are written collectively by the PETSc viewer; the small
@@ -208,6 +211,10 @@ class Output:
         self.n_nodes = 0
         # -ssi_reproducible: the finished file is rewritten without HDF5 modification times
         self.deterministic = PETSc.Options().getBool("ssi_reproducible", False)
+        # writers of more data (e.g. io.forces.ForceRecorder): write_collective(out) before the
+        # viewer closes, write_serial(h5 file) on rank 0 -> XDMF cell attributes [(name, dataset, unit)]
+        self.writers = []
+        self.cell_attributes = []
 
     def state(self):
         """The snapshot list, for a checkpoint: {'times', 'fields'}."""
@@ -249,12 +256,29 @@ class Output:
                 self.fields.append(name)
         self.times.append(float(t))
 
+    def write_vecs(self, vecs, what):
+        """Collective: distributed Vecs {dataset name: Vec} through the viewer (a Vec of block
+        size c gives an (n / c, c) dataset; an existing dataset of that name is overwritten)."""
+        ensure_space(self.path, 8.0 * sum(v.getSize() for v in vecs.values()), self.comm, what)
+
+        def write():
+            for name, vec in vecs.items():
+                old = vec.getName()
+                vec.setName(name)
+                try:
+                    vec.view(self.viewer)
+                finally:
+                    vec.setName(old)
+        collective_io(write, f"writing {self.path} ({what})", self.comm)
+
     def close(self, receivers=None, attrs=None, record=None, groups=None, status="completed", final=True):
         """Collective: close the viewer, then rank 0 adds the serial data and
         writes the XDMF and JSON files. ``receivers``: dict with 'points'
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
         ``groups``: {group: {name: array}} more serial data (rank 0). ``status``: how the run
         ended (the file's attribute ``run_status`` and the record's)."""
+        for w in self.writers:
+            w.write_collective(self)
         viewer, self.viewer = self.viewer, None
         collective_io(viewer.destroy, f"closing {self.path}", self.comm)
         self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status, final), f"writing {self.path}")
@@ -314,6 +338,9 @@ class Output:
                     d = g.create_dataset(k, data=np.asarray(v), track_times=False)
                     if unit is not None:
                         d.attrs["unit"] = unit
+            self.cell_attributes = []
+            for w in self.writers:
+                self.cell_attributes += w.write_serial(f)
         if final and self.deterministic:
             rewrite_without_times(self.path)
         self._write_xdmf()
@@ -350,6 +377,10 @@ class Output:
             lines.append(topo)
             lines.append(f'<Geometry GeometryType="XYZ"><DataItem Dimensions="{nn} 3" NumberType="Float" '
                          f'Precision="8" Format="HDF">{base}:/coordinates</DataItem></Geometry>')
+            for name, dset, unit in self.cell_attributes:
+                lines.append(f'<Attribute Name="{escape(name)}" AttributeType="Scalar" Center="Cell">'
+                             f'<DataItem Dimensions="{ne}" NumberType="Float" Precision="8" Format="HDF">'
+                             f'{base}:/{escape(dset)}</DataItem></Attribute>')
             if k is not None:
                 for name in self.fields:
                     lines.append(f'<Attribute Name="{name}" AttributeType="Vector" Center="Node">'

@@ -308,6 +308,13 @@ class Recorder:
         self.extra.append(observer)
         return observer
 
+    def add_recorder(self, observer):
+        """Append an observer among the recorders: it sees each step with them (``observe``), and
+        the steps the time grid writes (``snapshot``) after the structure's and soil's fields;
+        its ``state``/``restore`` go into checkpoints."""
+        self.observers.append(observer)
+        return observer
+
     def _all(self):
         return self.observers + self.extra + [self.progress]
 

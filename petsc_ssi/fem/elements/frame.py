@@ -102,6 +102,8 @@ from ...petsc import SSIError
 
 # local dof order per node: u v w tx ty tz  (node-major, 6 a + k)
 _U, _V, _W, _TX, _TY, _TZ = range(6)
+END_FORCES = tuple(f"{c}_{e}" for e in "ij" for c in ("N", "V2", "V3", "T", "M2", "M3"))
+END_FORCE_UNITS = ("N", "N", "N", "N m", "N m", "N m") * 2
 
 # lambda(5) = sum over odd n of n^-5 = (1 - 2^-5) zeta(5)
 _LAMBDA5 = 31.0 / 32.0 * 1.0369277551433699263
@@ -280,6 +282,26 @@ class Frame(ElementType):
         T = _block_rotation(Lam)
         K = np.matmul(T.transpose(0, 2, 1), np.matmul(k, T))
         return 0.5 * (K + K.transpose(0, 2, 1))
+
+    # ----------------------------------------------------------- end forces
+    def end_force_operator(self, X, props):
+        """G (E, 12, 12) with the end forces f = G u_e = k_local (T u_e) of the global element
+        dofs u_e (node-major ux uy uz rx ry rz): the forces and moments the nodes exert ON the
+        element, in its local axes (x' along the member from node 0 to node 1, y', z' of the
+        orientation vector), order (N, V2, V3, T, M2, M3) at node 0 then at node 1, i.e. the
+        local dofs (u, v, w, tx, ty, tz); the member's inertia is not included (OpenSees'
+        ``localForce``). The stress resultants of the section in the vector convention (the
+        force and moment vectors on the face whose outward normal is +x', components along x',
+        y', z') are -f[0:6] at node 0 and +f[6:12] at node 1: the axial force (tension > 0) is
+        -f[0] = f[6]; the moment about y' (> 0 stretches the +z' fibre, sigma = M2 z' / Iy) is
+        -f[4] and f[10]; about z' (> 0 compresses the +y' fibre, sigma = -M3 y' / Iz) -f[5]
+        and f[11]; the torque -f[3] and f[9]."""
+        L, Lam = self._checked_geometry(X, props)
+        return np.matmul(self.local_stiffness(L, props), _block_rotation(Lam))
+
+    def end_forces(self, X, props, ue):
+        """End forces (E, 12) of the global element dofs ue (E, 12) (``end_force_operator``)."""
+        return np.einsum("eij,ej->ei", self.end_force_operator(X, props), np.asarray(ue, float))
 
     def local_lumped_mass(self, L, props):
         """HRZ-lumped local diagonal mass (E, 12), dofs (u v w tx ty tz) per node."""

@@ -210,14 +210,13 @@ def _product(B, D, wd):
                      (np.matmul(D, B) * wd[:, :, None, None]).reshape(ne, -1, n))
 
 
-def membrane_stiffness(xy, Dm, kd, rule=None):
-    """Allman / Hughes-Brezzi membrane (E, 12, 12) over (u, v, theta_z) per node."""
+def membrane_B(xy, P):
+    """Membrane strain rows at the points P (G, 2): B (E, G, 4, 12) over (u, v, theta_z) per node,
+    rows eps_xx, eps_yy, gamma_xy and skew u - theta (the drilling term), and det J (E, G)."""
     ne = xy.shape[0]
-    P, W = gauss2d(MEMBRANE_ORDER) if rule is None else rule
     N, dN = shape(P)
     M, dM = midside(P)
     J, det, inv = _jacobian(xy, dN)
-    wd = det * W
     dNx = _cartesian(inv, dN)                                    # (E, G, 4, 2)
     dMx = _cartesian(inv, dM)                                    # (E, G, 4 edges, 2)
     # edge vectors l n / 8 = (dy, -dx) / 8 and the derivatives of the Allman modes of node a:
@@ -234,24 +233,32 @@ def membrane_stiffness(xy, Dm, kd, rule=None):
                   np.stack([z, Ny, dPhi[..., 1, 1]], -1),
                   np.stack([Ny, Nx, dPhi[..., 0, 1] + dPhi[..., 1, 0]], -1),
                   np.stack([-0.5 * Ny, 0.5 * Nx, 0.5 * (dPhi[..., 1, 0] - dPhi[..., 0, 1]) - N[None]], -1)],
-                 axis=2).reshape(ne, len(W), 4, 12)
+                 axis=2).reshape(ne, P.shape[0], 4, 12)
+    return B, det
+
+
+def membrane_stiffness(xy, Dm, kd, rule=None):
+    """Allman / Hughes-Brezzi membrane (E, 12, 12) over (u, v, theta_z) per node."""
+    P, W = gauss2d(MEMBRANE_ORDER) if rule is None else rule
+    B, det = membrane_B(xy, P)
     D = np.zeros((4, 4))
     D[:3, :3], D[3, 3] = Dm, kd
-    return _product(B, D, wd)
+    return _product(B, D, det * W)
 
 
-def plate_stiffness(xy, Db, ks):
-    """MITC4 plate (E, 12, 12) over (w, theta_x, theta_y) per node, 2x2 Gauss."""
+def plate_B(xy, P):
+    """Plate strain rows at the points P (G, 2): B (E, G, 5, 12) over (w, theta_x, theta_y) per
+    node, rows kappa_xx, kappa_yy, 2 kappa_xy (bending) and gamma_xz, gamma_yz (the MITC4
+    assumed covariant shear, interpolated from the tying points), and det J (E, G)."""
     ne = xy.shape[0]
-    N, dN = shape(GAUSS)
+    N, dN = shape(P)
     J, det, inv = _jacobian(xy, dN)
-    wd = det                                                     # 2x2 weights are 1
     dNx = _cartesian(inv, dN)
     Nx, Ny = dNx[..., 0], dNx[..., 1]
     z = np.zeros_like(Nx)
     Bb = np.stack([np.stack([z, z, Nx], -1),
                    np.stack([z, -Ny, z], -1),
-                   np.stack([z, -Nx, Ny], -1)], axis=2).reshape(ne, -1, 3, 12)
+                   np.stack([z, -Nx, Ny], -1)], axis=2).reshape(ne, P.shape[0], 3, 12)
     # MITC4 shear: covariant strains at the tying points, rows over (w, theta_x, theta_y)
     Nt, dNt = shape(TYING)
     Jt = np.einsum("tak,eai->etki", dNt, xy)                      # (E, 4, 2, 2)
@@ -261,13 +268,57 @@ def plate_stiffness(xy, Db, ks):
                          -Jt[:, T, k, 1, None] * Nt[T], Jt[:, T, k, 0, None] * Nt[T]], -1).reshape(ne, 12)
 
     eA, eB, eC, eD = cov(0, 0), cov(1, 1), cov(2, 0), cov(3, 1)
-    xi, eta = GAUSS[:, 0], GAUSS[:, 1]
+    xi, eta = P[:, 0], P[:, 1]
     e_xi = 0.5 * ((1 - eta)[None, :, None] * eA[:, None] + (1 + eta)[None, :, None] * eC[:, None])
     e_eta = 0.5 * ((1 - xi)[None, :, None] * eD[:, None] + (1 + xi)[None, :, None] * eB[:, None])
     Bs = np.matmul(inv, np.stack([e_xi, e_eta], axis=2))         # (E, G, 2, 12)
+    return np.concatenate([Bb, Bs], axis=2), det
+
+
+def plate_stiffness(xy, Db, ks):
+    """MITC4 plate (E, 12, 12) over (w, theta_x, theta_y) per node, 2x2 Gauss."""
+    B, det = plate_B(xy, GAUSS)
     D = np.zeros((5, 5))
     D[:3, :3], D[3:, 3:] = Db, ks * np.eye(2)
-    return _product(np.concatenate([Bb, Bs], axis=2), D, wd)
+    return _product(B, D, det)                                   # 2x2 weights are 1
+
+
+RESULTANTS = ("N11", "N22", "N12", "M11", "M22", "M12", "Q1", "Q2")
+RESULTANT_UNITS = ("N/m", "N/m", "N/m", "N m/m", "N m/m", "N m/m", "N/m", "N/m")
+
+
+def resultant_operator(X, props, points=None):
+    """S (E, G, 8, 24) with the stress resultants s = S u_e at the points (G, 2) of the reference
+    square (default: the centre, G = 1) from the element's global dofs u_e (24, node-major
+    ux uy uz rx ry rz), in the element's local frame (``local_frame``: e1, e2 in the mean plane,
+    e3 the normal; z the distance along e3 from the mid-surface):
+
+      N11, N22, N12 = int (s11, s22, s12) dz      = D_m eps        [N/m]
+      M11, M22, M12 = int (s11, s22, s12) z dz    = D_b kappa      [N m/m]
+      Q1,  Q2       = int (s13, s23) dz           = k G t gamma    [N/m]
+
+    with eps (Allman field included), kappa and the MITC4 assumed shear gamma from the same
+    B matrices as the stiffness (``membrane_B``, ``plate_B``) on the projected nodes (the
+    warping links of ``transformation`` included). M11 > 0 stretches the fibres on the +e3 side
+    (the fibre displacement z (theta_y, -theta_x)); Q1 > 0 is the shear on the +e1 face along
+    +e3."""
+    X = np.asarray(X, float)
+    R, xy, h, _ = local_frame(X)
+    c = _props(props)
+    P = np.zeros((1, 2)) if points is None else np.atleast_2d(np.asarray(points, float))
+    Bm, _ = membrane_B(xy, P)
+    Bp, _ = plate_B(xy, P)
+    ne, ng = X.shape[0], P.shape[0]
+    S = np.zeros((ne, ng, 8, 4, 6))
+    S[..., 0:3, :, :][..., MEMBRANE] = np.matmul(c["Dm"], Bm[:, :, :3]).reshape(ne, ng, 3, 4, 3)
+    S[..., 3:6, :, :][..., PLATE] = np.matmul(c["Db"], Bp[:, :, :3]).reshape(ne, ng, 3, 4, 3)
+    S[..., 6:8, :, :][..., PLATE] = c["ks"] * Bp[:, :, 3:].reshape(ne, ng, 2, 4, 3)
+    return np.einsum("egrbi,ebij->egrbj", S, transformation(R, h)).reshape(ne, ng, 8, 24)
+
+
+def resultants(X, props, ue, points=None):
+    """Stress resultants (E, G, 8) of the global element dofs ue (E, 24) (``resultant_operator``)."""
+    return np.einsum("egri,ei->egr", resultant_operator(X, props, points), np.asarray(ue, float))
 
 
 def flat_stiffness(xy, props):
