@@ -88,5 +88,62 @@ def main(d):
     print(f"wrote {os.path.join(HERE, 'roof.png')}")
 
 
+def _accel(t, u):
+    """The acceleration of a displacement series by second differences (m/s^2)."""
+    dt = t[1] - t[0]
+    return np.gradient(np.gradient(u, dt, axis=0), dt, axis=0)
+
+
+def oblique(d):
+    """Vertical and oblique incidence side by side (building.h5 and building-oblique.h5): the soil
+    (soil receiver 0, 6 m from the centre on x: the total field, free + scattered), the foundation
+    (structure receiver 2, the slab's centre) and the roof (structure receiver 0): peak accelerations
+    along x and z, and the foundation's peak rocking (rotation about y); oblique.png: their time
+    histories."""
+    cases = [("vertical S", "building"), ("SV at 20 deg", "building-oblique")]
+    if not all(os.path.exists(os.path.join(d, f"{c}.h5")) for _, c in cases):
+        return
+    print()
+    print("| quantity | vertical S | SV at 20 deg |")
+    print("|---|---|---|")
+    data = {}
+    for name, c in cases:
+        tg, ug = series(os.path.join(d, f"{c}.h5"), "u")
+        ts, a = series(os.path.join(d, f"{c}_structure.h5"), "acceleration")
+        with h5py.File(os.path.join(d, f"{c}_structure.h5"), "r") as f:
+            rot = f["receivers/rotation"][()]
+        data[name] = (tg, _accel(tg, ug[:, 0]), ts, a, rot)
+    rows = [("soil at (6, 0, 0), total field: peak a_x [m/s^2]", lambda v: np.abs(v[1][:, 0]).max()),
+            ("soil at (6, 0, 0), total field: peak a_z [m/s^2]", lambda v: np.abs(v[1][:, 2]).max()),
+            ("foundation centre: peak a_x [m/s^2]", lambda v: np.abs(v[3][:, 2, 0]).max()),
+            ("foundation centre: peak a_z [m/s^2]", lambda v: np.abs(v[3][:, 2, 2]).max()),
+            ("foundation: peak rocking, rotation about y [rad]", lambda v: np.abs(v[4][:, 2, 1]).max()),
+            ("roof centre: peak a_x [m/s^2]", lambda v: np.abs(v[3][:, 0, 0]).max())]
+    for label, f in rows:
+        print(f"| {label} | {f(data[cases[0][0]]):.4g} | {f(data[cases[1][0]]):.4g} |")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    for name, _ in cases:
+        tg, ag, ts, a, rot = data[name]
+        axs[0].plot(tg, ag[:, 0], lw=0.8, label=f"{name}: a_x")
+        axs[0].plot(tg, ag[:, 2], lw=0.8, label=f"{name}: a_z")
+        axs[1].plot(ts, a[:, 2, 0], lw=0.8, label=f"{name}: a_x")
+        axs[1].plot(ts, a[:, 2, 2], lw=0.8, label=f"{name}: a_z")
+        axs[2].plot(ts, a[:, 0, 0], lw=0.8, label=f"{name}: a_x")
+    for ax, title in zip(axs, ("soil receiver (6, 0, 0): total field (free field + scattered)",
+                               "foundation centre (0, 0, 0)", "roof centre (0, 0, 6)")):
+        ax.set_title(title, fontsize=9)
+        ax.set_ylabel("acceleration [m/s^2]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+    axs[-1].set_xlabel("t [s]")
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "oblique.png"), dpi=120)
+    print(f"wrote {os.path.join(HERE, 'oblique.png')}")
+
+
 if __name__ == "__main__":
     main(sys.argv[1] if len(sys.argv) > 1 else "out/seismic")
+    oblique(sys.argv[1] if len(sys.argv) > 1 else "out/seismic")

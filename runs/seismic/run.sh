@@ -12,6 +12,9 @@ mkdir -p out/seismic
 mpirun --oversubscribe -n "$N" "$PY" -m petsc_ssi -options_file runs/seismic/building.opts -ssi_seismic_record "$REC" \
   -ssi_output_overwrite -ssi_monitor -log_view :out/seismic/building-n$N.log_view -memory_view "$@" \
   | tee out/seismic/building-n$N.log
+mpirun --oversubscribe -n "$N" "$PY" -m petsc_ssi -options_file runs/seismic/building-oblique.opts -ssi_seismic_record "$REC" \
+  -ssi_output_overwrite -ssi_monitor -log_view :out/seismic/building-oblique-n$N.log_view -memory_view "$@" \
+  | tee out/seismic/building-oblique-n$N.log
 mpirun --oversubscribe -n "$N" "$PY" -m petsc_ssi -options_file runs/seismic/fixed-base.opts -ssi_seismic_record "$REC" \
   -ssi_output_overwrite -log_view :out/seismic/fixed-base-n$N.log_view -memory_view "$@" \
   | tee out/seismic/fixed-base-n$N.log
