@@ -102,9 +102,8 @@ class HalfSpace:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
         symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
         self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and len(disp) > 0
-        if self.massless:
-            self._massless_reference()
-        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes) if len(disp) else None
+        xref = self._massless_reference() if self.massless else None
+        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if len(disp) else None
         self.receivers = rec.parse(cfg.receivers)
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
@@ -122,20 +121,22 @@ class HalfSpace:
             self.attach_seismic(np.zeros(3))
 
     def _massless_reference(self):
-        """-ssi_disp_rigid massless: the footing's reference point -ssi_disp_ref defaults to the whole
-        region's centroid; with symmetry planes it must lie on them (the rotations the planes allow
-        are about axes in them)."""
+        """-ssi_disp_rigid massless: the footing's reference point x_ref [m], -ssi_disp_ref or by
+        default the whole region's centroid (the options stay as given: a restart's key compares
+        them); with symmetry planes it must lie on them (the rotations the planes allow are about
+        axes in them)."""
         from .input_motion import region_centroid
-        cfg = self.cfg
-        if not cfg.user_set("disp_ref"):
-            c = region_centroid(self.mesh, self.regions, self.planes)
-            cfg.set("disp_ref", ",".join(repr(float(v)) for v in c))
         from .resultants import parse_vector
-        xr = parse_vector(cfg.disp_ref, "disp_ref")
+        cfg = self.cfg
+        if cfg.user_set("disp_ref"):
+            xr = parse_vector(cfg.disp_ref, "disp_ref")
+        else:
+            xr = region_centroid(self.mesh, self.regions, self.planes)
         for ax, _ in self.planes:
             if abs(xr[ax]) > 1e-9 * max(self.h, 1.0):
                 raise SSIError(f"-ssi_disp_ref {cfg.disp_ref}: with -ssi_symmetry {cfg.symmetry} the footing's "
                                f"reference point must lie on the plane {'xy'[ax]} = 0")
+        return xr
 
     def attach_seismic(self, ref):
         """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with

@@ -193,3 +193,21 @@ def test_free_surface_rotation_is_half_the_curl(wave, angle, azimuth, tmp_path):
     rot = s.rotation(pts, t)
     assert np.abs(rot).max() > 1e-4
     assert np.abs(rot - 0.5 * curl).max() < 1e-4 * np.abs(rot).max()
+
+
+def test_restart_keeps_the_motion(tmp_path):
+    """-ssi_problem bem -ssi_disp_rigid massless, checkpoint after step 12 of 25, restarted: the footing's
+    motion series (kept in the checkpoint) and its step states give the same output bit for bit."""
+    from test_checkpoint import run_and_restart
+    rec = pulse(tmp_path / "p.txt", 0.1)
+    args = ["-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2", "-ssi_mesh_h", "0.5",
+            "-ssi_mesh_patch", "0.5,0.5", "-ssi_disp_group", "box:-0.5,0.5,-0.5,0.5", "-ssi_dt", "0.006",
+            "-ssi_seismic", "sh", "-ssi_seismic_angle", "60", "-ssi_seismic_record", rec, "-ssi_seismic_units",
+            "m/s2", "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none", "-ssi_symmetry", "y=anti",
+            "-ssi_output_stride", "0", "-ssi_t_end", "0.15", "-ssi_disp_rigid", "massless"]
+    (tmp_path / "ck").mkdir()
+    (ref, rs), = run_and_restart(args, tmp_path / "ck", 1, 12, 12)
+    with h5py.File(ref, "r") as a, h5py.File(rs, "r") as b:
+        assert np.abs(a["input_motion/rotation"][()]).max() > 0
+        for k in a["input_motion"]:
+            assert np.array_equal(a["input_motion"][k][()], b["input_motion"][k][()]), k
