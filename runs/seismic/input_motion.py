@@ -11,7 +11,9 @@ records: a sin^4 acceleration pulse of length T then the reversed pulse (1 m/s^2
    T = 0.05 .. 0.8 s (a0 = 2 pi B / (c_app T), B = 0.5 m): peak translation u_y and torsion theta_z
    and their accelerations against the free field's at the centre, the largest differences to it, and
    the rocking theta_x the horizontal-rocking coupling adds.
-3. Haskind: the blocked footing's force against minus the impedance tractions convolved with the
+3. ``petsc-ssi input-motion`` under a Rayleigh wave along x (y=sym), T = 0.2 and 0.4 s: the
+   largest differences of u_x, u_z and the rocking theta_y to the free field at the centre.
+4. Haskind: the blocked footing's force against minus the impedance tractions convolved with the
    free field (tests/bem/test_haskind.py's ``haskind``), SH 60 degrees on 0.5 and 0.25 m elements
    and P 30 degrees on 0.5 m.
 
@@ -95,6 +97,17 @@ def main():
                 T, vals["a0"], vals["u_y"], vals["a_y"], vals["th_z"], vals["alpha_z"], vals["err_u_y"],
                 vals["err_th_z"], vals["th_x"], vals["resultant"]))
             rows += [(f"SH60: {k}", f"T={T}", v) for k, v in vals.items()]
+        print("\nRayleigh along x, y=sym: max |q - q_ff| / max |q_ff| at the centre")
+        for T in (0.2, 0.4):
+            rec = pulse(os.path.join(tmp, f"r{T}.txt"), T)
+            g = input_motion(tmp, f"ray{T}", ["-ssi_seismic", "rayleigh", "-ssi_seismic_record", rec,
+                                              "-ssi_symmetry", "y=sym"])
+            q = np.c_[g["translation"], g["rotation"]]
+            ff = np.c_[g["free_field_translation"], g["free_field_rotation"]]
+            errs = {n: np.abs(q[:, k] - ff[:, k]).max() / np.abs(ff[:, k]).max()
+                    for n, k in (("u_x", 0), ("u_z", 2), ("theta_y", 4))}
+            print(f"  T = {T}: " + ", ".join(f"{n} {e:.3g}" for n, e in errs.items()))
+            rows += [(f"Rayleigh: max diff {n}", f"T={T}", e) for n, e in errs.items()]
         sys.path.insert(0, os.path.join(ROOT, "tests"))
         sys.path.insert(0, os.path.join(ROOT, "tests", "bem"))
         from test_haskind import haskind
