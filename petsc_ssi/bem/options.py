@@ -90,7 +90,8 @@ register("interp_k", "int", 0, "", "number k of interpolating matrices (auto: on
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("interp_grading", "real", 1.0, "", "multi-linear node grading exponent p in T_j = T_L + (T_N-T_L)((j-1)/(k-1))^p", "bem",
          validator=lambda v: None if v > 0 else "must be > 0")
-register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause", "bem")
+register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause (with "
+         "-ssi_seismic only a non-finite norm: the scattered field grows as the wave arrives)", "bem")
 register("guard_factor", "real", 100.0, "", "guard: stop when |u| exceeds this times the largest |u| of the first half of the run so far", "bem",
          validator=lambda v: None if v > 1 else "must be > 1")
 register("check_stability", "bool", False, "", "only check stability: run a coarse surrogate (3x3-element quarter model, same "
