@@ -6,6 +6,8 @@ Commands:
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
   static          static solution K u = F of a FE structure (loads at h = 1), written like a run
   impedance       dynamic stiffness K(a0) of a surface footing (-ssi_disp_group), one run per mode
+  input-motion    foundation input motion of a rigid massless footing (-ssi_disp_group) under the
+                  seismic wave (-ssi_seismic): its translations and rotations, free field beside
   estimate        predicted time per stage and memory of the run, per rank count, and
                   whether it fits the nodes (no assembly; -ssi_estimate_* options)
   help            list every -ssi_ option with default, unit and meaning (also -help, --help)
@@ -16,7 +18,7 @@ and exit status 2 on every rank.
 """
 import sys
 
-COMMANDS = ("run", "post", "modes", "static", "help", "estimate", "impedance")
+COMMANDS = ("run", "post", "modes", "static", "help", "estimate", "impedance", "input-motion")
 
 
 def _split(argv):
@@ -118,6 +120,9 @@ def main(argv=None):
             estimate.main()
         elif cmd == "impedance":
             impedance.main()
+        elif cmd == "input-motion":
+            from .input_motion import main as input_motion_main
+            input_motion_main()
         if cmd != "estimate":
             options.warn_unused_options()
     except SSIError as exc:

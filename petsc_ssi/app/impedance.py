@@ -164,7 +164,7 @@ def main():
         raise SSIError(f"-ssi_impedance_modes {cfg0.impedance_modes}: modes are {', '.join(MODES)}")
     if not cfg0.disp_group:
         raise SSIError("petsc-ssi impedance needs the footing as -ssi_disp_group (a group or 'box:x0,x1,y0,y1')")
-    for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group"):
+    for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group", "disp_rigid"):
         if cfg0.user_set(name):
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
     want = _a0_range(cfg0.impedance_a0)

@@ -101,7 +101,9 @@ class HalfSpace:
             if cfg.user_set(name) and not cfg.disp_group:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
         symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
-        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes) if len(disp) else None
+        self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and len(disp) > 0
+        xref = self._massless_reference() if self.massless else None
+        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if len(disp) else None
         self.receivers = rec.parse(cfg.receivers)
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
@@ -111,10 +113,30 @@ class HalfSpace:
         self._lags()
         self._warnings(h)
         self.seismic = None
-        if cfg.get("seismic", "none") != "none" and len(disp):
+        if cfg.get("seismic", "none") != "none" and self.massless:     # the control point: x_ref by default
+            self.attach_seismic(self.motion.xref)
+        elif cfg.get("seismic", "none") != "none" and len(disp):
             self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
         elif cfg.get("seismic", "none") != "none" and not defer_seismic:
             self.attach_seismic(np.zeros(3))
+
+    def _massless_reference(self):
+        """-ssi_disp_rigid massless: the footing's reference point x_ref [m], -ssi_disp_ref or by
+        default the whole region's centroid (the options stay as given: a restart's key compares
+        them); with symmetry planes it must lie on them (the rotations the planes allow are about
+        axes in them)."""
+        from .input_motion import region_centroid
+        from .resultants import parse_vector
+        cfg = self.cfg
+        if cfg.user_set("disp_ref"):
+            xr = parse_vector(cfg.disp_ref, "disp_ref")
+        else:
+            xr = region_centroid(self.mesh, self.regions, self.planes)
+        for ax, _ in self.planes:
+            if abs(xr[ax]) > 1e-9 * max(self.h, 1.0):
+                raise SSIError(f"-ssi_disp_ref {cfg.disp_ref}: with -ssi_symmetry {cfg.symmetry} the footing's "
+                               f"reference point must lie on the plane {'xy'[ax]} = 0")
+        return xr
 
     def attach_seismic(self, ref):
         """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with

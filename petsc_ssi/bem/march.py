@@ -542,13 +542,39 @@ class Marcher:
         w.set(0.0)
         w.maxpy([c for _, c in terms], [buf[self._slot(m)] for m, _ in terms])
 
-    def step(self):
-        """Advance one step; returns (u^n, p^n) Vecs (views into the buffer)."""
+    def step(self, correct=None):
+        """Advance one step; returns (u^n, p^n) Vecs (views into the buffer). ``correct(n, x)``, if
+        given, may change the solution x of the step and the known values kv_u together before they
+        are stored (a linear combination with ``unit_response``s: ``bem.input_motion``)."""
         n = self.begin_step()
         self._set_known(n)
         b = self.add_known(self._b)
         self.solve(b, self.x)
+        if correct is not None:
+            correct(n, self.x)
         return self.store(n, self.x)
+
+    def unit_response(self, U, x):
+        """Collective: x = the unknowns of a step with zero history, zero known traction and the
+        known displacement ``U`` (a Vec of the u layout, nonzero at prescribed DOFs only): the part
+        of every step's solution that is linear in its known displacement. Leaves kv_u = U and
+        kv_p = 0 (call before stepping, or set them again)."""
+        U.copy(self.kv_u)
+        self.kv_p.set(0.0)
+        b = self.u_tmpl.duplicate()
+        b.set(0.0)
+        self.add_known(b)
+        self.solve(b, x)
+        b.destroy()
+        return x
+
+    def traction_of(self, x, p):
+        """Collective: p = the traction of unknowns x (x at the prescribed DOFs, scattered into the
+        traction layout; zero at load DOFs)."""
+        p.set(0.0)
+        if self.reg.n_disp:
+            self.sc_x2p.scatter(x, p, addv=self.PETSc.InsertMode.INSERT_VALUES)
+        return p
 
     # The pieces of a step, for callers that set the known values themselves
     # (the FEM-BEM coupling: u at interface nodes from the structure).

@@ -71,6 +71,12 @@ register("disp_history", "enum", "heaviside", "", "time history of the prescribe
          "smoothstep ((1 - cos(pi t/t0))/2 up to t0, then 1)", "bem", choices=("heaviside", "box", "table", "smoothstep"))
 register("disp_t0", "real", 0.025, "s", "duration of the box history, rise time of the smoothstep", "bem", validator=positive)
 register("disp_table", "str", "", "", "file of 't value' rows for the prescribed displacement", "bem")
+register("disp_rigid", "enum", "prescribed", "", "the -ssi_disp_group region's rigid motion: prescribed "
+         "(-ssi_disp_value/_rotation/_history), or massless: a rigid massless footing under the seismic input "
+         "(-ssi_seismic), its motion the unknown that makes the soil's resultant force and moment on it zero "
+         "every step (kinematic interaction; the foundation input motion about -ssi_disp_ref, default the "
+         "region's centroid, written to the output group input_motion; petsc-ssi input-motion)", "bem",
+         choices=("prescribed", "massless"))
 register("lags_save", "str", "", "", "save the assembled lag matrices (PETSc binary FILE and FILE.json with the "
          "key of what they depend on) for -ssi_lags_load", "bem")
 register("lags_load", "str", "", "", "load the lag matrices a run saved with -ssi_lags_save instead of assembling "
@@ -84,7 +90,8 @@ register("interp_k", "int", 0, "", "number k of interpolating matrices (auto: on
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("interp_grading", "real", 1.0, "", "multi-linear node grading exponent p in T_j = T_L + (T_N-T_L)((j-1)/(k-1))^p", "bem",
          validator=lambda v: None if v > 0 else "must be > 0")
-register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause", "bem")
+register("guard", "bool", True, "", "stop a run whose solution norm is clearly diverging, naming the likely cause (with "
+         "-ssi_seismic only a non-finite norm: the scattered field grows as the wave arrives)", "bem")
 register("guard_factor", "real", 100.0, "", "guard: stop when |u| exceeds this times the largest |u| of the first half of the run so far", "bem",
          validator=lambda v: None if v > 1 else "must be > 1")
 register("check_stability", "bool", False, "", "only check stability: run a coarse surrogate (3x3-element quarter model, same "
@@ -115,6 +122,15 @@ def _bem_checks(cfg):
         if a is not None and (a >= lx / 2 or b >= ly / 2):
             return (f"-ssi_mesh_patch {cfg.mesh_patch}: the patch (half-widths) reaches the edge of the mesh "
                     f"-ssi_mesh_size {cfg.mesh_size} (full extent); make the mesh larger or the patch smaller")
+    if cfg.get("disp_rigid", "prescribed") == "massless" and cfg.get("coupling") is None:   # (ssi: its own check)
+        if not cfg.disp_group:
+            return "-ssi_disp_rigid massless: give the footing as -ssi_disp_group (a group or 'box:x0,x1,y0,y1')"
+        if cfg.get("seismic", "none") == "none":
+            return ("-ssi_disp_rigid massless needs a seismic input (-ssi_seismic vertical|sh|sv|p|rayleigh): "
+                    "without a wave a massless footing stays at rest")
+        for name in ("disp_value", "disp_rotation", "disp_history", "disp_t0", "disp_table"):
+            if cfg.user_set(name):
+                return f"-ssi_disp_rigid massless: the footing's motion is the unknown; drop -ssi_{name}"
     if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
         return f"-ssi_load_table '{cfg.load_table}': no such file"
     return None

@@ -33,6 +33,7 @@ class BEMTransient(TransientProblem):
             self.plan, self.ls = self.prob.prepare()
         self.grid = self.prob.grid
         self.march = self.rec = self.out = None
+        self.footing = None                  # -ssi_disp_rigid massless (bem/input_motion.py)
         self.state = None
 
     def setup(self):
@@ -41,6 +42,9 @@ class BEMTransient(TransientProblem):
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
                                               p.known_p(), self.log)
+            if p.massless:
+                from .input_motion import MasslessFooting
+                self.footing = MasslessFooting(self.comm, p, self.march)
 
     def start(self):
         self._advance("set up", "started")
@@ -49,6 +53,8 @@ class BEMTransient(TransientProblem):
         self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None)
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
+        if self.footing is not None:
+            self.rec.add(self.footing)                      # its motion series in checkpoints
         if self.cfg.guard:
             self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
         self._ut = self.march.u_tmpl.duplicate()            # the total field (a seismic input's u_sc + u_ff)
@@ -68,7 +74,7 @@ class BEMTransient(TransientProblem):
     def step(self, n):
         self._check_step(n)
         with staged("SSI BEM time loop"):
-            u, p = self.march.step()
+            u, p = self.march.step(self.footing.correct if self.footing is not None else None)
             nrm = u.norm()
             rec = self.rec
             w = min(100, n - 1)       # growth of |u| over the last (up to) 100 steps, shown by -ssi_monitor
@@ -85,6 +91,8 @@ class BEMTransient(TransientProblem):
         rec = self.rec
         res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
                "resultants": rec.soil.resultants(rec.steps, rec.times)}
+        if self.footing is not None:
+            res["input_motion"] = self.footing.arrays(rec.times)
         write_results(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
 
     def finish(self):
@@ -93,6 +101,8 @@ class BEMTransient(TransientProblem):
         rec = self.rec
         res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "unorm": np.array(rec.unorm),
                "resultants": rec.soil.resultants(rec.steps, rec.times)}
+        if self.footing is not None:
+            res["input_motion"] = self.footing.arrays(rec.times)
         res["stats"] = {
             "assembly_s": info["t_asm"], "wall_s": time.perf_counter() - self.t_start, "lags": prob.L,
             "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0, "interp": plan.method,
@@ -124,6 +134,9 @@ def write_results(cfg, comm, prob, out, res, status="completed", final=True):
     if getattr(prob, "seismic", None) is not None:
         groups = dict(groups or {}, seismic=prob.seismic.arrays())
         attrs["seismic"] = prob.seismic.kind
+    if res.get("input_motion") is not None:
+        groups = dict(groups or {}, input_motion=res["input_motion"])
+        attrs["disp_rigid"] = "massless"
     if cfg.mesh_patch and cfg.load_group == "load":
         attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
     rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})

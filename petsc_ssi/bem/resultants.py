@@ -65,10 +65,12 @@ def _skew(v):
 class RigidMotion:
     """The prescribed rigid motion of the -ssi_disp_group region (``known_u``) and its checks."""
 
-    def __init__(self, cfg, mesh, regions, planes):
+    def __init__(self, cfg, mesh, regions, planes, xref=None):
+        """``xref``: the reference point [m] if not -ssi_disp_ref's (the massless footing's default,
+        ``halfspace.HalfSpace``)."""
         self.u0 = parse_vector(cfg.disp_value, "disp_value")
         self.theta = parse_vector(cfg.disp_rotation, "disp_rotation")
-        self.xref = parse_vector(cfg.disp_ref, "disp_ref")
+        self.xref = parse_vector(cfg.disp_ref, "disp_ref") if xref is None else np.asarray(xref, float)
         self.x = mesh.nodes[regions.disp_nodes]
         self.base = (self.u0 + np.cross(self.theta, self.x - self.xref)).ravel()     # (3 n_disp,)
         self._check_symmetry(planes)
@@ -103,7 +105,7 @@ class Resultants:
         PETSc = init()
         reg, mesh = prob.regions, prob.mesh
         self.comm = comm
-        self.xref = parse_vector(prob.cfg.disp_ref, "disp_ref")
+        self.xref = prob.motion.xref
         a, b = area_moments(mesh, reg.disp_elems, reg.disp_nodes)
         blocks = np.zeros((reg.n_disp, 6, 3))
         for axes, s in symmetry.images(prob.planes):

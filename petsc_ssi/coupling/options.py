@@ -55,6 +55,9 @@ register("structure_receivers", "str", "", "m", "structure receivers 'x,y,z;...'
 
 
 def _ssi_checks(cfg):
+    if cfg.get("disp_rigid", "prescribed") != "prescribed":
+        return ("-ssi_disp_rigid massless is for the half-space alone (-ssi_problem bem, petsc-ssi input-motion); "
+                "in a coupled run the structure moves the interface")
     if cfg.disp_group:
         return ("-ssi_disp_group prescribes soil displacements; with -ssi_problem ssi the interface "
                 "displacements come from the structure (-ssi_interface)")

@@ -234,6 +234,26 @@ class SeismicInput:
         """The free-field acceleration at ``points`` at time t [m/s^2]."""
         return self._sum("acceleration", points, t)
 
+    def rotation(self, points, t):
+        """The rotation of the free surface at surface ``points`` (n, 3) at time t (scalar or 1-D):
+        1/2 curl u_ff = (du_z/dy, -du_z/dx, (du_y/dx - du_x/dy)/2) [rad], (n, 3) or (nt, n, 3). Each
+        plane wave is a function of t - p e_h.(x - x0) along the surface, so du/dx_j = -p e_h[j]
+        du/dt; traction-free (sigma_xz = sigma_yz = 0) makes 1/2 curl's horizontal components the
+        surface's tilts."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        out = 0.0
+        for w in self.waves:
+            if w.p == 0.0:
+                continue
+            v = w.velocity(pts, t)
+            gx, gy = -w.p * w.e_h[0], -w.p * w.e_h[1]         # d/dx = gx d/dt, d/dy = gy d/dt
+            out = out + np.stack([gy * v[..., 2], -gx * v[..., 2],
+                                  0.5 * (gx * v[..., 1] - gy * v[..., 0])], axis=-1)
+        if np.isscalar(out):
+            shape = (len(pts), 3) if np.ndim(t) == 0 else (len(np.atleast_1d(t)), len(pts), 3)
+            return np.zeros(shape)
+        return out
+
     def uniform(self):
         """Whether the free field is the same at every point (vertical incidence)."""
         return self.kind == "vertical"
