@@ -83,7 +83,9 @@ class ImplicitStep:
     """The interface-implicit step: the structure's predictor w (trapezoidal rule in midpoint
     form, no interface force), the BEM solution q with zero interface displacement, then the
     interface system u_f = w + 2 C f, f = -M p, p = q - Z u_b with the active-set loop
-    (contact.ImplicitSolve), C = T D^-1 T^T."""
+    (contact.ImplicitSolve), C = T D^-1 T^T. Under a wave the interface unknowns are taken relative
+    to the free field (s - u_ff, w - u_ff), the soil's own scattered-field unknowns; the contact law
+    sees the same gap, and u_b, u_f come back as totals."""
     integrator = "midpoint"
 
     def __init__(self, cp):
