@@ -160,6 +160,7 @@ def test_preload_under_a_vertical_p_wave(tmp_path, p_wave):
     assert big["n_open"].max() == 0
     for k in ("uf", "ub", "p"):
         assert np.array_equal(big[k], bonded[k]), k
+    assert bonded["pN"].max() < 50.0                  # the hand bound: the largest dynamic tension
     # the closed block follows the TOTAL ground motion (the gap is on u_b = u_sc + u_ff)
     scale = np.abs(big["uff"]).max()
     assert scale > 0.5 and np.abs(big["ub"] - big["uff"]).max() < 1e-5 * scale
@@ -175,6 +176,11 @@ def test_preload_under_a_vertical_p_wave(tmp_path, p_wave):
     op = ~wt["closed"]
     assert np.abs(wt["pN"][op] - p_w).max() <= 1e-12 * p_w
     assert wt["gap"][op].min() >= -1e-6 * scale
+    # the gap written is (u_f - u_b) . n_b of the written totals (not of the scattered u_b = u - u_ff,
+    # which would put the free field's 0.7 m into it), and it opens in flight
+    g = np.einsum("kij,ij->ki", wt["uf"] - wt["ub"], wt["normal"])
+    assert np.abs(g - wt["gap"]).max() <= 1e-12 * scale
+    assert 1e-3 < wt["gap"].max() < 0.1 * scale
     assert wt["n_open"][-1] < 25                                                # it lands again
     # the BEM equations of every step with the final interface values (the light block's tractions
     # are ~1e-6 of Z u_ff: the relative residual carries the round-off of the totals; 2.6e-4 while
@@ -183,6 +189,26 @@ def test_preload_under_a_vertical_p_wave(tmp_path, p_wave):
     assert shaken(tmp_path, p_wave, 0.8, contact_preload="weight", **kw)["n_open"].max() < 25
     none = shaken(tmp_path, p_wave, 0.8, **kw)
     assert abs(int(np.argmax(none["n_open"] == 25)) - int(np.argmax(ground_acceleration(none) < 0))) <= 1
+
+
+def test_preload_under_a_vertical_p_wave_staggered(tmp_path, p_wave):
+    """(d), staggered coupling (a heavy block, m = 2000 kg, for its stability): a preload above the
+    bonded run's largest dynamic tension keeps it closed (== bonded bit for bit); the weight
+    (19620 N/m^2) does not at 1.2 g, and open nodes carry p_w n_b."""
+    kw = dict(coupling="staggered", fem_rho=8000.0)
+    bonded = shaken(tmp_path, p_wave, 1.2, **kw)
+    pmax = bonded["pN"].max()
+    big = shaken(tmp_path, p_wave, 1.2, contact="unilateral", contact_preload=f"{1.01 * pmax!r}", **kw)
+    assert big["n_open"].max() == 0
+    for k in ("uf", "ub", "p"):
+        assert np.array_equal(big[k], bonded[k]), k
+    wt = shaken(tmp_path, p_wave, 1.2, contact="unilateral", contact_preload="weight", **kw)
+    p_w = 8000.0 * 0.25 * G_N
+    assert wt["preload"] == pytest.approx(p_w, rel=1e-12) and p_w < pmax and wt["n_open"].max() == 25
+    op = ~wt["closed"]
+    assert np.abs(wt["pN"][op] - p_w).max() <= 1e-12 * p_w
+    assert np.allclose(wt["force_fe"][wt["n_open"] == 25, 2], -p_w, rtol=1e-12, atol=0)
+    assert wt["bem_residual"].max() <= 1e-10
 
 
 SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",

@@ -10,7 +10,8 @@ The half model must give the full model's soil receivers (total field, points wi
 interface displacements and tractions of the matching nodes, and half the full interface's force
 (x, z) and moment about y (the moment about x and the force along y vanish on the full interface
 and are not halved quantities), bonded and with unilateral contact under the weight preload.
-Tolerance 1e-8 relative (both runs solve the same equations). The contact case runs at half the
+Tolerance 1e-10 relative to each series' largest value (both runs solve the same equations;
+measured: displacements 3e-14, tractions 2.5e-12, resultants 2.3e-12, receivers 9e-15). The contact case runs at half the
 amplitude (2.5 m/s^2): at 5 m/s^2 some steps cycle, and the cycling rule (change only the worst
 node) then picks different nodes in the two models, so they part.
 """
@@ -55,7 +56,7 @@ def test_half_equals_full_under_a_vertical_s_wave(tmp_path, record, contact):
     # interface nodes of the half are those of the full with y >= 0, matched by position
     idx = [int(np.argmin(np.linalg.norm(fi["x"] - p, axis=1))) for p in hi["x"]]
     assert np.allclose(fi["x"][idx], hi["x"], atol=1e-12) and len(idx) == 15 and len(fi["x"]) == 25
-    tol = 1e-8
+    tol = 1e-10
     su = np.abs(fi["ub"]).max()
     assert su > 1e-2                                                  # the wave moves the block (cm)
     for k in ("ub", "uf"):
