@@ -238,9 +238,9 @@ def _groups(prob, inter):
     """The serial groups of the soil output: the interface series (rank 0) and the seismic input."""
     g = {}
     if inter is not None:
-        g["interface"] = dict(inter)
-        if "preload" in inter:      # the static contact pressure p_w (dynamic tractions are increments)
-            g["interface"]["preload"] = (np.float64(inter["preload"]), "N/m^2")
+        # time series only (readers slice every dataset of the group); the static contact pressure
+        # p_w is the file's attribute contact_preload [N/m^2]
+        g["interface"] = {k: v for k, v in inter.items() if k != "preload"}
     if getattr(prob, "seismic", None) is not None:
         g["seismic"] = prob.seismic.arrays()
     return g or None

@@ -335,12 +335,14 @@ class Coupler:
 
 def structure_mass(model):
     """Collective: the structure's total mass [kg] (the lumped masses of the x translations, point
-    masses included; the modelled part with a symmetry plane)."""
+    masses included; the modelled part with a symmetry plane), once at set-up: the nodal masses
+    gathered and summed exactly rounded (math.fsum), the same number on any rank count."""
+    import math
     d = model.dofmap.translation_dofs(np.arange(model.mesh.n_nodes))[:, 0]
     r0, r1 = model.m.getOwnershipRange()
     d = d[(d >= r0) & (d < r1)] - r0
-    local = float(model.m.getArray(readonly=True)[d].sum())
-    return model.m.getComm().tompi4py().allreduce(local)
+    parts = model.m.getComm().tompi4py().allgather(model.m.getArray(readonly=True)[d].copy())
+    return math.fsum(np.concatenate(parts))
 
 
 def contact_preload(cfg, comm, model, iface):
