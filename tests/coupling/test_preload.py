@@ -225,13 +225,20 @@ def series(path):
         return out
 
 
-def test_preload_restart_and_two_ranks(tmp_path):
+STAGGERED = ["-ssi_coupling", "staggered", "-ssi_fem_rho", "8000", "-ssi_fem_load_p0", "-32000"]
+
+
+@pytest.mark.parametrize("coupling, extra, mass, landed", [("implicit", [], 50.0, slice(18, 24)),
+                                                           ("staggered", STAGGERED, 2000.0, slice(12, 19))])
+def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
     """A box pull that lifts the block off and lets it land, with the weight preload: restarted
     from the checkpoint of step 10 (block in the air) on 2 ranks with -ssi_reproducible it is the
     uninterrupted run bit for bit; -n 2 == -n 1 with the same contact status every step, the
-    series to 1e-7 in flight and 1e-6 after the landing (relative to each series' largest value)."""
+    series to 1e-7 in flight and 1e-6 after the landing (relative to each series' largest value).
+    Staggered: a heavy block (m = 2000 kg) for the step's stability."""
     import shutil
-    args = SSI + ["-ssi_reproducible"]
+    case = SSI + extra
+    args = case + ["-ssi_reproducible"]
     ref = tmp_path / "ref"
     ref.mkdir()
     cli(args + ["-ssi_output", str(ref / "r.h5"), "-ssi_checkpoint", str(tmp_path / "ck-%d.h5"),
@@ -239,15 +246,15 @@ def test_preload_restart_and_two_ranks(tmp_path):
     rs = tmp_path / "rs"
     shutil.copytree(ref, rs)
     out = cli(args + ["-ssi_output", str(rs / "r.h5"), "-ssi_restart", str(tmp_path / "ck-10.h5")], nranks=2)
-    assert "restarted from" in out.stdout and "contact preload: the structure's weight 50 kg" in out.stdout
+    assert "restarted from" in out.stdout and f"contact preload: the structure's weight {mass:g} kg" in out.stdout
     a, b = series(ref / "r.h5"), series(rs / "r.h5")
-    assert not a["closed"][9].any() and a["closed"][-1].all()            # in the air at 10, landed at 24
+    assert not a["closed"][9].any() and a["closed"][landed].all()     # in the air at step 10, then landed
     for k in a:
         assert np.array_equal(a[k], b[k]), k
-    cli(SSI + ["-ssi_output", str(tmp_path / "n1.h5")], nranks=1)
+    cli(case + ["-ssi_output", str(tmp_path / "n1.h5")], nranks=1)
     c = series(tmp_path / "n1.h5")
     assert np.array_equal(c["closed"], a["closed"])
-    assert c["preload"] == a["preload"] == pytest.approx(50.0 * G_N, rel=1e-12)   # summed exactly (fsum)
+    assert c["preload"] == a["preload"] == pytest.approx(mass * G_N, rel=1e-12)   # summed exactly (fsum)
     for k in ("ub", "uf", "p"):        # the open set's capacitance solves (Z_OO) amplify the round-off
         sc = np.abs(a[k]).max()        # of the rank count: measured 4.4e-8 in flight, 1.7e-7 after landing
         assert np.abs(c[k][:11] - a[k][:11]).max() <= 1e-7 * sc, k
