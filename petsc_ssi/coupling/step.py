@@ -355,7 +355,8 @@ def contact_preload(cfg, comm, model, iface):
     if v == "weight":
         m, a = structure_mass(model), iface.area()
         p = m * G_N / a
-        printf(f"[ssi] contact preload: the structure's weight {m:.6g} kg x {G_N:g} m/s^2 = {m * G_N:.6g} N over "
+        part = f" (the part modelled with -ssi_symmetry {cfg.symmetry})" if str(cfg.symmetry).strip() else ""
+        printf(f"[ssi] contact preload: the structure's weight{part} {m:.6g} kg x {G_N:g} m/s^2 = {m * G_N:.6g} N over "
                f"the interface area {a:.6g} m^2: p_w = {p:.6g} N/m^2, uniform (a node opens when its dynamic "
                f"tension exceeds p_w + p_C = {p + cfg.contact_cohesion:.6g} N/m^2)")
         return p

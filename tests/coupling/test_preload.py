@@ -265,15 +265,26 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
         assert np.abs(c[k] - a[k]).max() <= 1e-6 * sc, k
 
 
-@pytest.mark.parametrize("extra,words", [
-    (["-ssi_contact_preload", "-100"], "must be a finite pressure >= 0"),
-    (["-ssi_contact_preload", "heavy"], "expected none, weight or a pressure"),
-    (["-ssi_contact", "bonded"], "needs -ssi_contact unilateral"),
+@pytest.mark.parametrize("kw,words", [
+    (dict(contact="unilateral", contact_preload="-100"), "must be a finite pressure >= 0"),
+    (dict(contact="unilateral", contact_preload="nan"), "must be a finite pressure >= 0"),
+    (dict(contact="unilateral", contact_preload="heavy"), "expected none, weight or a pressure"),
+    (dict(contact_preload="weight"), "needs -ssi_contact unilateral"),
+    (dict(contact_preload="1000"), "needs -ssi_contact unilateral"),
 ])
-def test_bad_preload_is_refused_in_one_line(tmp_path, extra, words):
-    """Each misuse ends the run before any assembly with one line on every rank (2 ranks)."""
-    p = cli(SSI + ["-ssi_output", str(tmp_path / "o.h5")] + extra, nranks=2, check=False, timeout=300)
+def test_bad_preload_is_refused(tmp_path, kw, words):
+    """Each misuse is an SSIError naming the option, before any assembly."""
+    from petsc_ssi.petsc import SSIError
+    with pytest.raises(SSIError, match="-ssi_contact_preload") as exc:
+        block(tmp_path, t_end=0.05, **kw)
+    assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_bad_preload_is_refused_in_one_line_at_two_ranks(tmp_path):
+    """Under mpirun -n 2: one line, every rank stops (no hang), before any assembly."""
+    p = cli(SSI + ["-ssi_output", str(tmp_path / "o.h5"), "-ssi_contact_preload", "-100"], nranks=2, check=False,
+            timeout=300)
     errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
-    assert words in errors[0], errors[0]
+    assert "must be a finite pressure >= 0" in errors[0], errors[0]
     assert "assembly" not in p.stdout
