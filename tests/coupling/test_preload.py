@@ -11,18 +11,23 @@ Checks:
     bit for bit, the cohesion p_C = p with -ssi_contact_open_traction cohesion (eq. 25 read
     literally: the same opening threshold and the same open-node traction; an independent
     reading of the sign conventions);
-(b) a block pulled up by a slowly ramped force F(t) on its top: without preload every node opens at
-    the first step; with the preload 'weight' (m g / A, reported and written) the run is the bonded
-    run until the first step at which the bonded run's largest nodal tension exceeds p_w + p_C
-    (exactly that step), and the block lifts off entirely between the steps at which F reaches
-    p_w A and (p_w + p_C) A (at exactly the first with p_C = 0), both couplings;
+(b) a block pulled up by a slowly ramped force F(t) on its top: without preload (and p_C = 0) it
+    opens at the first step; with the preload 'weight' (m g / A, reported and written) the run is
+    the bonded run until the first step at which the bonded run's largest nodal tension exceeds
+    p_w + p_C (exactly that step: the corners, where a stiff block's traction concentrates, open
+    first), and the block lifts off entirely between the steps at which F reaches p_w A and
+    (p_w + p_C) A (at exactly the first with p_C = 0), both couplings;
 (c) an open node's dynamic soil traction is p_w n_b (minus the preload's traction) to round-off,
     and once the block has lifted off the soil's force on it is -p_w A = -m g;
-(d) a vertical P wave on a light block: a large preload keeps the interface closed (== bonded,
-    bit for bit); with the preload 'weight' the block lifts off entirely within one step of the
-    step at which the ground's acceleration falls below -g (and never at 0.8 g), without preload
-    as soon as it falls below 0; in flight the soil's force on the block is -m g;
-checkpoint/restart and -n 2 == -n 1 with a preload; refusals in one line at -n 2.
+(d) a vertical P wave on a light block (implicit): a preload above the bonded run's largest tension
+    keeps the interface closed (== bonded, bit for bit) and the block on the TOTAL ground motion;
+    with the preload 'weight' it lifts off entirely within one step of the step at which the
+    ground's acceleration falls below -g (and never at 0.8 g), without preload as soon as it falls
+    below 0; in flight the soil's force on the block is -m g; the written gap is (u_f - u_b) . n_b of
+    the written totals; the implicit step's interface traction is the BEM's field to 1e-10;
+    the same under the staggered step (a heavy block);
+restart (bit for bit) and -n 2 == -n 1 with the weight preload, both couplings (SLOW set);
+refusals: SSIError naming the option, and one line on every rank at -n 2.
 """
 import h5py
 import numpy as np
