@@ -36,6 +36,16 @@ negative; then solve / check / update until nothing changes. If a status set
 repeats only the worst violation (relative to the traction and displacement
 scales) is changed per iteration; if violations remain after ``max_iter``
 iterations the step is accepted with a warning (cycling).
+
+Static preload (-ssi_contact_preload, p_w >= 0 [N/m^2], uniform): the BEM works
+on the dynamic increment from the static state, whose traction on the soil is
+the compression -p_w n_b. The law acts on the total normal traction
+p_N + (-p_w): a closed node opens when p_N > p_C + p_w, and an open node
+carries total traction zero (or p_C n_b with open_traction 'cohesion'), i.e.
+the dynamic traction (p_C + p_w) n_b or p_w n_b: the soil unloads by the
+preload, and the structure (f = -M p) loses the same support. The gap is the
+dynamic one (the static displacements of both sides are equal); p_w = 0 is
+today's law bit for bit.
 """
 import time
 
@@ -89,7 +99,7 @@ class ContactLaw:
     u_f^n depends on the interface force, there is no prediction)."""
 
     def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero",
-                 comm=None):
+                 comm=None, preload=0.0):
         self.comm = comm if comm is not None and comm.Get_size() > 1 else None   # mpi4py
         self.n_b = np.asarray(n_b, float)            # (n_I, 3)
         self.open_traction = open_traction
@@ -97,6 +107,7 @@ class ContactLaw:
         self.zero = np.asarray(zero, bool).reshape(self.nI, 3)
         self.law = law
         self.p_C = float(p_C)
+        self.preload = float(preload)                # p_w: the static compression [N/m^2], >= 0
         self.tol = float(tol)
         self.max_iter = int(max_iter)
         self.closed = np.ones(self.nI, bool)
@@ -110,12 +121,14 @@ class ContactLaw:
         return np.nonzero(m)[0]
 
     def target(self, closed):
-        """Traction prescribed at open DOFs (3n_I, zero elsewhere): 0, or with
-        open_traction 'cohesion' the normal tension p_C n_b (eq. 25 read
-        literally: an open node, g > 0, carries p_N = p_C)."""
+        """Dynamic traction prescribed at open DOFs (3n_I, zero elsewhere): the
+        total traction 0, or with open_traction 'cohesion' the normal tension p_C
+        n_b (eq. 25 read literally: an open node, g > 0, carries p_N = p_C),
+        minus the preload's -p_w n_b: (p_w [+ p_C]) n_b."""
         t = np.zeros(3 * self.nI)
-        if self.open_traction == "cohesion" and self.p_C > 0:
-            tt = (self.p_C * self.n_b) * (~closed)[:, None]
+        p_open = self.p_C if (self.open_traction == "cohesion" and self.p_C > 0) else 0.0
+        if p_open > 0 or self.preload > 0:
+            tt = ((p_open + self.preload) * self.n_b) * (~closed)[:, None]
             t[:] = tt.ravel()
             t[self.zero.ravel()] = 0.0
         return t
@@ -152,9 +165,10 @@ class ContactLaw:
                 pN = self._normal(p)
                 gap = -self._normal(ub - uf)
                 # violations relative to their own scales (tractions and displacements)
-                sp = max(np.abs(p).max(), self.p_C, 1e-300)
+                sp = max(np.abs(p).max(), self.p_C, self.preload, 1e-300)
                 su = max(scale_u, np.abs(uf).max(), np.abs(ub).max(), 1e-300)
-                v_open = np.where(closed, (pN - self.p_C) / sp - self.tol, -np.inf)     # > 0: must open
+                # total normal traction pN - p_w against p_C
+                v_open = np.where(closed, (pN - self.p_C - self.preload) / sp - self.tol, -np.inf)  # > 0: open
                 v_close = np.where(~closed, -gap / su - self.tol, -np.inf)              # > 0: must close
                 viol = np.maximum(v_open, v_close)
                 new = None

@@ -3,6 +3,8 @@
 The soil is the BEM half-space (``-ssi_cp/_cs/_rho/_mesh...``), the structure
 the FEM model (``-ssi_fem_*``); these options say how they meet.
 """
+import numpy as np
+
 from ..options import register, register_check, positive
 from ..bem import options as _bem_options  # noqa: F401  (the coupled problem reads the soil's options
 from ..fem import options as _fem_options  # noqa: F401   and the structure's)
@@ -32,11 +34,44 @@ register("contact", "enum", "bonded", "", "interface law: bonded (u_b = u_f alwa
 register("contact_cohesion", "real", 0.0, "N/m^2", "cohesion limit p_C: a closed node opens when its normal "
          "traction (tension positive) exceeds p_C", G,
          validator=lambda v: None if v >= 0 else "must be >= 0")
+G_N = 9.81                                   # m/s^2: the weight preload's gravity
+
+
+def parse_preload(text):
+    """-ssi_contact_preload: None ('none'), 'weight', or a pressure [N/m^2] >= 0; ValueError in words."""
+    t = str(text).strip().lower()
+    if t in ("none", ""):
+        return None
+    if t == "weight":
+        return "weight"
+    try:
+        v = float(t)
+    except ValueError:
+        raise ValueError("expected none, weight or a pressure in N/m^2") from None
+    if not np.isfinite(v) or v < 0:
+        raise ValueError("the preload is a compression: it must be a finite pressure >= 0 N/m^2")
+    return v
+
+
+def _preload_ok(text):
+    try:
+        parse_preload(text)
+    except ValueError as exc:
+        return str(exc)
+    return None
+
+
+register("contact_preload", "str", "none", "N/m^2", "static contact pressure under the dynamic increment "
+         "(unilateral contact): none (tractions are increments from rest: any tension beyond p_C opens), "
+         "weight (the structure's total mass x 9.81 m/s^2 spread uniformly over the interface area) or a "
+         "pressure in N/m^2; a node opens when its dynamic normal tension exceeds preload + p_C, and an open "
+         "node carries total traction zero (dynamic traction = the preload's relief)", G,
+         validator=_preload_ok)
 register("contact_open_traction", "enum", "zero", "", "traction an open node carries: zero (p_C is a "
          "strength lost on opening) or cohesion (the normal tension p_C, eq. 25 read literally: "
          "(p_C - p_N) g = 0 with g > 0)", G, choices=("zero", "cohesion"))
 register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact checks: gap < -tol max|u_f| "
-         "closes a node, p_N > p_C + tol max(|p|, p_C) opens one", G, validator=positive)
+         "closes a node, p_N > p_C + preload + tol max(|p|, p_C, preload) opens one", G, validator=positive)
 register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "
          "a warning (cycling)", G, validator=lambda v: None if v >= 1 else "must be >= 1")
 register("coupling", "enum", "implicit", "", "time coupling: implicit (the structure's interface "
@@ -72,6 +107,9 @@ def _ssi_checks(cfg):
                 f"{cfg.symmetry}): contact destroys the antisymmetry of the response (the side in "
                 "compression stays closed, the other may open), so an antisymmetric half model is "
                 "wrong; mesh the whole interface")
+    if cfg.contact != "unilateral" and parse_preload(cfg.contact_preload) is not None:
+        return (f"-ssi_contact_preload {cfg.contact_preload} needs -ssi_contact unilateral (a bonded interface "
+                f"is linear: the static pressure does not change its dynamic response)")
     if cfg.user_set("fem_integrator") and cfg.coupling == "staggered" and cfg.fem_integrator != "green":
         return ("-ssi_coupling staggered integrates the structure with green (u^n independent of the force "
                 f"of step n); drop -ssi_fem_integrator {cfg.fem_integrator}")

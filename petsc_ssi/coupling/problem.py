@@ -51,6 +51,8 @@ class SSITransient(TransientProblem):
                 f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
                 f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
                 + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
+                + (f", preload {cfg.contact_preload}" if cfg.contact == "unilateral" and
+                   str(cfg.contact_preload).strip().lower() != "none" else "")
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
         self.grid = self.prob.grid
@@ -179,6 +181,7 @@ class SSITransient(TransientProblem):
         inter["normal"] = iface.n_b
         st, su = rec.structure.rec.arrays()
         sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
+        inter["preload"] = self.coupler.preload            # p_w [N/m^2] (0: none)
         return {"t": np.asarray(times), "u": rec.soil_receivers(), "structure_t": st, "structure_u": su,
                 "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm)}
 
@@ -232,6 +235,7 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
     out, sout = res.pop("_outputs")
     attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
              "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
+             "contact_preload": float(res["interface"].get("preload", 0.0)),
              "structure_output": os.path.basename(structure_output_path(cfg.output))}
     if getattr(prob, "seismic", None) is not None:
         attrs["seismic"] = prob.seismic.kind
@@ -257,7 +261,9 @@ def _groups(prob, inter):
     """The serial groups of the soil output: the interface series (rank 0) and the seismic input."""
     g = {}
     if inter is not None:
-        g["interface"] = inter
+        # time series only (readers slice every dataset of the group); the static contact pressure
+        # p_w is the file's attribute contact_preload [N/m^2]
+        g["interface"] = {k: v for k, v in inter.items() if k != "preload"}
     if getattr(prob, "seismic", None) is not None:
         g["seismic"] = prob.seismic.arrays()
     return g or None

@@ -40,7 +40,7 @@ import time
 
 import numpy as np
 
-from ..petsc import init
+from ..petsc import init, printf
 from ..monitor import event
 from .interface import force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -83,7 +83,9 @@ class ImplicitStep:
     """The interface-implicit step: the structure's predictor w (trapezoidal rule in midpoint
     form, no interface force), the BEM solution q with zero interface displacement, then the
     interface system u_f = w + 2 C f, f = -M p, p = q - Z u_b with the active-set loop
-    (contact.ImplicitSolve), C = T D^-1 T^T."""
+    (contact.ImplicitSolve), C = T D^-1 T^T. Under a wave the interface unknowns are taken relative
+    to the free field (s - u_ff, w - u_ff), the soil's own scattered-field unknowns; the contact law
+    sees the same gap, and u_b, u_f come back as totals."""
     integrator = "midpoint"
 
     def __init__(self, cp):
@@ -99,7 +101,15 @@ class ImplicitStep:
         return np.zeros_like(wI)                                    # q: the soil with u_sc,I = 0
 
     def interface(self, yI, wI):
-        return self.cp.law.step(self.solver(yI, wI, np.zeros_like(yI)), None)
+        # relative to the free field (a seismic input): the unknown s - u_ff and w - u_ff, so that
+        # p = q - Z (s - u_ff) is formed from the small scattered part, not as the difference of
+        # totals (which loses the digits of p where the structure follows the free field); the
+        # gap (u_b - u_f) . n_f is the same; u_b and u_f are handed back as totals
+        uff = self.cp.uffI
+        res = self.cp.law.step(self.solver(yI, wI - uff, np.zeros_like(yI)), None)
+        if uff.any():
+            res["ub"], res["uf"] = res["ub"] + uff, res["uf"] + uff
+        return res
 
     def correct_soil(self, x, res, wI):
         x -= self.cp.Zloc @ (res["ub"] - self.cp.uffI)              # x = q - Z (u_b - u_ff)
@@ -154,8 +164,10 @@ class Coupler:
         t0 = time.perf_counter()
         self.Zloc = self._bem_columns()
         self.Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
+        self.preload = contact_preload(cfg, comm, model, iface)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
-                              cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py())
+                              cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py(),
+                              preload=self.preload)
         ex = cfg.coupling_traction == "extrapolated"
         self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
         self.M3 = np.kron(iface.M.toarray(), np.eye(3))
@@ -254,8 +266,6 @@ class Coupler:
         m.solve(b, m.x)                                            # B.3: y (staggered) or q (u_I = 0)
         self.sc_be.scatter(m.x, self.seq_y)
         yI = self.seq_y.getArray(readonly=True).copy()
-        if self.mode == "implicit" and self.uffI.any():
-            yI += self.Z_II @ self.uffI                            # p = (q + Z u_ff) - Z u_b: the driving force
         ev = event("SSI_Contact")
         ev.begin()
         res = st.interface(yI, wI)
@@ -321,6 +331,38 @@ class Coupler:
         err = np.abs(a - ref[self.fown_k]).max() if a.size else 0.0
         mpi = self.comm.tompi4py()
         return mpi.allreduce(float(err), op=__import__("mpi4py").MPI.MAX)
+
+
+def structure_mass(model):
+    """Collective: the structure's total mass [kg] (the lumped masses of the x translations, point
+    masses included; the modelled part with a symmetry plane), once at set-up: the nodal masses
+    gathered and summed exactly rounded (math.fsum), the same number on any rank count."""
+    import math
+    d = model.dofmap.translation_dofs(np.arange(model.mesh.n_nodes))[:, 0]
+    r0, r1 = model.m.getOwnershipRange()
+    d = d[(d >= r0) & (d < r1)] - r0
+    parts = model.m.getComm().tompi4py().allgather(model.m.getArray(readonly=True)[d].copy())
+    return math.fsum(np.concatenate(parts))
+
+
+def contact_preload(cfg, comm, model, iface):
+    """Collective: the static contact pressure p_w [N/m^2] of -ssi_contact_preload (0 for none), with
+    one report line: 'weight' spreads the structure's total mass x g over the interface area."""
+    from .options import parse_preload, G_N
+    v = parse_preload(cfg.contact_preload)
+    if v is None:
+        return 0.0
+    if v == "weight":
+        m, a = structure_mass(model), iface.area()
+        p = m * G_N / a
+        part = f" (the part modelled with -ssi_symmetry {cfg.symmetry})" if str(cfg.symmetry).strip() else ""
+        printf(f"[ssi] contact preload: the structure's weight{part} {m:.6g} kg x {G_N:g} m/s^2 = {m * G_N:.6g} N over "
+               f"the interface area {a:.6g} m^2: p_w = {p:.6g} N/m^2, uniform (a node opens when its dynamic "
+               f"tension exceeds p_w + p_C = {p + cfg.contact_cohesion:.6g} N/m^2)")
+        return p
+    printf(f"[ssi] contact preload: p_w = {v:.6g} N/m^2, uniform (a node opens when its dynamic tension exceeds "
+           f"p_w + p_C = {v + cfg.contact_cohesion:.6g} N/m^2)")
+    return float(v)
 
 
 def _owned(dofs, vec):
