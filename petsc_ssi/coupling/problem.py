@@ -50,8 +50,13 @@ class SSITransient(TransientProblem):
                 + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
+            from ..io.demands import DemandSpec
+            from ..petsc import collective
+            with collective(comm, "checking the storey demands' options"):
+                self.demand_spec = DemandSpec(cfg, self.model, "-ssi_structure_receivers", base="interface",
+                                              ref_auto=interface_centroid(self.prob, iface))
         self.grid = self.prob.grid
-        self.coupler = self.rec = None
+        self.coupler = self.rec = self.demands = None
         self.state = None
 
     def setup(self):
@@ -94,10 +99,13 @@ class SSITransient(TransientProblem):
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys)
         self.rec.add(_FiniteCheck(self.integ))
+        from ..io.demands import Demands       # base shear, overturning moment, drifts (io/demands.py)
+        self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"))
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
+            self.demands.record(self.time(0), self.integ.u)            # at rest: no interface force yet
         self._resume()
 
     def checkpoint_state(self):
@@ -161,8 +169,9 @@ class SSITransient(TransientProblem):
         inter["normal"] = iface.n_b
         st, su = rec.structure.rec.arrays()
         sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
+        dem = self.demands.group() if comm.getRank() == 0 else None
         return {"t": np.asarray(times), "u": rec.soil_receivers(), "structure_t": st, "structure_u": su,
-                "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm)}
+                "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm), "demands": dem}
 
     def write_partial(self, status):
         res = self.results()
@@ -197,6 +206,7 @@ class SSITransient(TransientProblem):
                    "factorisation of the BEM step matrix")
         write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
         self.integ.destroy()
+        self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
         return res
 
@@ -226,8 +236,22 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
+        sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
         (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
-                                                                      "dt": cfg.dt}, record=None, status=status)
+                                                                      "dt": cfg.dt}, record=None, status=status,
+                                              groups=sgroups)
+
+
+def interface_centroid(prob, iface):
+    """The interface's area centroid at z = 0 (the soil surface), moved onto the -ssi_symmetry
+    planes (the whole interface's centroid lies on them) [m]: the overturning moment's reference."""
+    from ..bem.resultants import area_moments
+    a, b = area_moments(prob.mesh, iface.be_elems, iface.be_nodes)
+    c = b.sum(axis=0) / a.sum()
+    c[2] = 0.0
+    for axis, _ in prob.planes:
+        c[axis] = 0.0
+    return c
 
 
 def _groups(prob, inter):
