@@ -227,7 +227,8 @@ class Demands:
                 e.destroy()
                 self.funcs.append(g)
         from scipy.sparse import csr_matrix            # the owned part of every functional, (n_func, n_local)
-        self.G = csr_matrix(np.array([g.getArray(readonly=True) for g in self.funcs]).reshape(len(self.funcs), -1))
+        rows = [g.getArray(readonly=True) for g in self.funcs]
+        self.G = csr_matrix(np.array(rows) if rows else np.zeros((0, dm.n_local)))
         for g in self.funcs:
             g.destroy()
         self.funcs = []
