@@ -66,9 +66,12 @@ class FEMTransient(TransientProblem):
 
     def _inertia(self):
         """{axis: -M iota_axis}: the effective earthquake load per unit ground acceleration along
-        each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]."""
+        each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]; none
+        on the fixed dofs (they move with the ground: their inertia goes to the supports, and the
+        integrator would drop it with a warning that a load acts on fixed dofs)."""
         dm, out = self.model.dofmap, {}
         tdofs = dm.translation_dofs(np.arange(self.model.mesh.n_nodes))
+        tdofs = np.where(np.isin(tdofs, np.asarray(self.model.fixed, np.int64)), -1, tdofs)
         r0, r1 = self.model.m.getOwnershipRange()
         for k, axis in enumerate("xyz"):
             if axis not in self.support.motions:

@@ -316,7 +316,7 @@ class Demands:
         t = a["t"]
         g = {"t": (t, "s", {"convention": "time of each step t_n"})}
         desc = {"base_shear": ("N", CONV_SHEAR), "overturning_moment": ("N m", CONV_MOMENT),
-                "drift_ratio": ("1", CONV_DRIFT)}
+                "drift_ratio": ("m/m", CONV_DRIFT)}
         for name, (unit, conv) in desc.items():
             if name not in a:
                 continue
