@@ -259,3 +259,25 @@ def test_a_level_without_nodes_is_refused_in_one_line_before_assembly(msh, tmp_p
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert "z = 4.2 m" in errors[0], errors[0]
     assert "integrator" not in p.stdout and "alpha_m" not in p.stdout       # make_model_integrator's line
+
+
+def test_two_ranks_equal_one(msh, record, tmp_path):
+    """The fixed-base run under the record on 2 ranks writes the demands of 1 rank (the functionals'
+    rows are split over the ranks and reduced every step) to 1e-10 relative."""
+    out = {}
+    for n in (1, 2):
+        args = ["-ssi_problem", "fem", "-ssi_seismic", "vertical", "-ssi_seismic_record", record,
+                "-ssi_seismic_units", "m/s2", "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none",
+                "-ssi_dt", "0.005", "-ssi_t_end", "0.2", "-ssi_output_stride", "0", "-ssi_fem_alpha_m", "1",
+                "-ssi_output", str(tmp_path / f"n{n}.h5"), "-ssi_receivers", "0,0,0;0,0,6",
+                "-ssi_structure_drift_pairs", "0:1"]
+        for k, v in frame_opts(msh).items():
+            args += ["-ssi_" + k, str(v)]
+        p = run_cli(args, n=n)
+        assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-2000:]
+        with h5py.File(tmp_path / f"n{n}.h5", "r") as f:
+            out[n] = {k: f["demands/" + k][()] for k in ("base_shear", "overturning_moment", "drift_ratio")}
+    assert out[1]["drift_ratio"].shape == (41, 3, 2)            # two level storeys and one receiver pair
+    for k in out[1]:
+        a, b = out[1][k], out[2][k]
+        assert np.abs(a).max() > 0 and np.abs(a - b).max() <= 1e-10 * np.abs(a).max(), k
