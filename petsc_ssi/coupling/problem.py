@@ -44,17 +44,17 @@ class SSITransient(TransientProblem):
             self.hist = load_history(cfg, comm)
             self.prob, self.model, self.iface, self.fe_cfg = build_coupled(cfg, comm)
             iface = self.iface
+            from ..io.demands import DemandSpec
+            from ..petsc import collective
+            with collective(comm, "checking the storey demands' options"):
+                self.demand_spec = DemandSpec(cfg, self.model, "-ssi_structure_receivers", base="interface",
+                                              ref_auto=interface_centroid(self.prob, iface))
             self.plan, self.ls = self.prob.prepare([
                 f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
                 f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
                 + (f", cohesion p_C = {cfg.contact_cohesion:g} N/m^2" if cfg.contact == "unilateral" else "")
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
-            from ..io.demands import DemandSpec
-            from ..petsc import collective
-            with collective(comm, "checking the storey demands' options"):
-                self.demand_spec = DemandSpec(cfg, self.model, "-ssi_structure_receivers", base="interface",
-                                              ref_auto=interface_centroid(self.prob, iface))
         self.grid = self.prob.grid
         self.coupler = self.rec = self.demands = None
         self.state = None
