@@ -277,6 +277,15 @@ class Demands:
         return {"demands_t": np.asarray(self.t, float), "demands_values": np.asarray(self.values, float)}
 
     def restore(self, s, n=None):
+        """The series of a checkpoint; one written before the demands existed leaves the steps up
+        to it unknown (NaN, with a warning)."""
+        if "demands_t" not in s:
+            from ..petsc import warn
+            warn("the checkpoint holds no storey demands (written by an older version): the demands of the "
+                 "steps up to it are NaN in the output", self.comm)
+            t = np.r_[0.0, np.asarray(s["times"], float)]
+            width = self.G.shape[0] + (4 if self.spec.base == "interface" else 0)
+            s = {"demands_t": t, "demands_values": np.full((len(t), width), np.nan)}
         if self.rank != 0:
             return
         self.t = [float(x) for x in s["demands_t"]]
@@ -338,9 +347,10 @@ class Demands:
 
 
 def peaks(t, x):
-    """(max over axis 0 of |x|, the first time of it) for a series x (K, ...)."""
+    """(max over axis 0 of |x|, the first time of it) for a series x (K, ...), NaN steps skipped."""
     x = np.asarray(x, float)
     if x.shape[0] == 0:
         return np.zeros(x.shape[1:]), np.zeros(x.shape[1:])
-    i = np.argmax(np.abs(x), axis=0)
-    return np.take_along_axis(np.abs(x), i[None], axis=0)[0], np.asarray(t, float)[i]
+    a = np.abs(x)
+    i = np.argmax(np.where(np.isnan(a), -1.0, a), axis=0)     # unknown (NaN) steps skipped
+    return np.take_along_axis(a, i[None], axis=0)[0], np.asarray(t, float)[i]

@@ -281,3 +281,36 @@ def test_two_ranks_equal_one(msh, record, tmp_path):
     for k in out[1]:
         a, b = out[1][k], out[2][k]
         assert np.abs(a).max() > 0 and np.abs(a - b).max() <= 1e-10 * np.abs(a).max(), k
+
+
+def test_restart_from_a_checkpoint_without_demands(msh, record, tmp_path):
+    """A checkpoint of a version before the demands (its serial group without them) restarts: the
+    steps up to it are NaN (with a warning), the later ones equal the uninterrupted run's bit for
+    bit, and the peaks skip the unknown steps. (A checkpoint with them restores them bit for bit:
+    tests/test_checkpoint.py.)"""
+    import shutil
+    args = ["-ssi_problem", "fem", "-ssi_seismic", "vertical", "-ssi_seismic_record", record,
+            "-ssi_seismic_units", "m/s2", "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none",
+            "-ssi_dt", "0.005", "-ssi_t_end", "0.1", "-ssi_output_stride", "0"]
+    for k, v in frame_opts(msh).items():
+        args += ["-ssi_" + k, str(v)]
+    ref = tmp_path / "ref.h5"
+    p = run_cli(args + ["-ssi_output", str(ref), "-ssi_checkpoint", str(tmp_path / "ck-%d.h5"),
+                        "-ssi_checkpoint_every", "10"])
+    assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-2000:]
+    ck = tmp_path / "ck-10.h5"
+    with h5py.File(ck, "a") as f:
+        assert "demands_values" in f["serial"]
+        del f["serial/demands_t"], f["serial/demands_values"]
+    rs = tmp_path / "rs.h5"
+    shutil.copy(ref, rs)
+    p = run_cli(args + ["-ssi_output", str(rs), "-ssi_restart", str(ck)])
+    assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-2000:]
+    assert "the checkpoint holds no storey demands" in p.stdout
+    with h5py.File(ref, "r") as f, h5py.File(rs, "r") as g:
+        a, b = f["demands/base_shear"][()], g["demands/base_shear"][()]
+        assert np.array_equal(f["demands/t"][()], g["demands/t"][()]) and len(a) == 21
+        assert np.isnan(b[:11]).all() and np.array_equal(a[11:], b[11:])
+        i = 11 + np.argmax(np.abs(a[11:, 0]))
+        assert g["demands/peak_base_shear"][0] == abs(a[i, 0])
+        assert g["demands/peak_base_shear_time"][0] == f["demands/t"][i]
