@@ -117,7 +117,9 @@ class FEMTransient(TransientProblem):
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
         if self.demand_spec.any:                  # base shear, overturning moment, drifts (io/demands.py)
             from ..io.demands import Demands
-            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]"))
+            sup = self.support                    # the base moves with the ground: its inertia m a_g
+            ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
+            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),

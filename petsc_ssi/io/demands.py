@@ -4,10 +4,14 @@ group ``demands`` of the structure's output file.
 
 Conventions (attributes of every dataset):
 
-  base_shear          (V_x, V_y) [N]: the horizontal force the STRUCTURE EXERTS ON ITS BASE (the
-                      ground, the foundation soil): positive along +x when the structure,
-                      displaced along +x, pushes the ground along +x; under static lateral loads
-                      it is their sum (the engineers' base shear, Chopra's V_b).
+  base_shear          (V_x, V_y) [N]: the horizontal force the STRUCTURE EXERTS ON THE GROUND
+                      through its base (the supports, the foundation soil), the foundation's own
+                      inertia included: positive along +x when the structure, displaced along +x,
+                      pushes the ground along +x; under static lateral loads it is their sum (the
+                      engineers' base shear, Chopra's V_b); dynamically minus the sum of the
+                      inertia forces m a of every node with its absolute acceleration (and of the
+                      mass-proportional dashpots, see below). The same quantity with and without
+                      SSI, so their peaks compare.
   overturning_moment  (M_x, M_y) [N m]: the moment vector (right-hand rule) of the same forces about
                       the reference point x_ref: M = sum (x - x_ref) x F (plus the nodal moments
                       of frame and shell supports); a lateral load F_x at height h above x_ref
@@ -25,26 +29,32 @@ Where the forces come from:
 
   fixed base (``-ssi_problem fem``)  the reactions at the base: the fixed dofs of the nodes at the
       lowest level of the fixed nodes (within the level tolerance); fixed dofs above it (symmetry
-      planes, lateral supports) are not the base and are left out. The reaction of a fixed dof is
-      (K u)_c (the supports' force on the structure; u = 0 there), so V = -sum_c (K u^n)_c over the
-      base's x (y) dofs and M = -R_c^T K u^n, R_c the rigid rotation about x_ref restricted to the
-      base's fixed dofs. With K symmetric each is one linear functional g . u^n, g = -K e (formed
-      once): exact at t_n for any integrator, and in a static solve it is the applied lateral
-      load's resultant exactly (K annihilates the rigid motions). Dynamically the structure's
-      equilibrium ties it to the inertia forces: the Green's-function scheme (trapezoidal free
+      planes, lateral supports) are not the base and are left out. The support's force on the
+      structure at a fixed dof c is (K u)_c + m_c a_g(t) (u = 0 there, and the node moves with the
+      ground: relative-motion form), so V = -sum_c [(K u^n)_c + m_c a_g(t_n)] over the base's x (y)
+      dofs and M = -R_c^T [K u^n + m a_g(t_n)], R_c the rigid rotation about x_ref restricted to
+      the base's fixed dofs, a_g(t_n) the record's acceleration at t_n. With K symmetric the
+      stiffness part is one linear functional g . u^n, g = -K e (formed once): exact at t_n for any
+      integrator, and in a static solve V, M are the applied loads' resultants exactly (K
+      annihilates the rigid motions). (A load put on a fixed dof goes into the support and is not
+      counted.) Without the base nodes' inertia, -sum_c (K u^n)_c is the shear of the members at
+      the base (columns): V minus the foundation's m a_g. Dynamically the structure's
+      equilibrium ties V to the inertia forces: the Green's-function scheme (trapezoidal free
       steps between velocity impulses, ``fem/integrators.py``) satisfies on the free dofs
           M (v^n - v^{n-1})/dt + C vbar + K ubar = fbar - alpha_m dt (f^{n-1} - f^n)/4,
       bars the means of steps n and n-1, f^n = -M iota ag^n the load of step n (ag^n the ground's
       mean acceleration over [t_n - dt/2, t_n + dt/2]); summed over the free x dofs (K's rows sum
       to zero over a rigid translation):
           (V^n + V^{n-1})/2 = -sum_free m [(v^n - v^{n-1})/dt + (ag^n + ag^{n-1})/2]
-                              - alpha_m sum_free m [vbar + dt (ag^n - ag^{n-1})/4],
+                              - alpha_m sum_free m [vbar + dt (ag^n - ag^{n-1})/4]
+                              - sum_base m (a_g(t_n) + a_g(t_{n-1}))/2,
       minus the sum of the inertia forces with the absolute acceleration, minus the mass-
       proportional dashpots' forces (C = alpha_m M on the relative velocity: dashpots from each
       node to the moving ground, whose forces reach the ground without passing through the base;
       they are not in base_shear). tests/fem/test_demands.py checks this to round-off.
   coupled (``-ssi_problem ssi``)  the interface force of the step (the interface series'
-      ``force_fe``, the soil's force on the structure, -M p; ``moment_fe`` about the origin):
+      ``force_fe``, the soil's force on the structure, -M p, the foundation's inertia included;
+      ``moment_fe`` about the origin):
       V = -force_fe[:2], M = -(moment_fe - x_ref x force_fe)[:2], with the force of step n as the
       coupling hands it over (implicit: the mean over (t_{n-1}, t_n]); zero at t = 0 (at rest).
       x_ref (auto): the interface's centroid at z = 0, moved onto the -ssi_symmetry planes.
@@ -72,9 +82,11 @@ register("structure_moment_ref", "str", "auto", "m", "reference point 'x,y,z' of
          "the interface's centroid at z = 0 (coupled runs, on the -ssi_symmetry planes), the centroid of the "
          "base's fixed nodes (fixed-base runs)", G)
 
-CONV_SHEAR = ("force the structure exerts on its base (the ground), x and y; = the sum of the lateral loads "
-              "in a static case; fixed base: minus the base's support reactions (K u at the base's fixed dofs) "
-              "at t_n; coupled: minus the interface force of the step (the soil's force on the structure)")
+CONV_SHEAR = ("force the structure exerts on the ground through its base (the foundation's inertia included), "
+              "x and y; = the sum of the lateral loads in a static case, minus the sum of the nodal inertia forces "
+              "(absolute accelerations) dynamically; fixed base: minus the base's support reactions (K u + m a_g "
+              "at the base's fixed dofs) at t_n; coupled: minus the interface force of the step (the soil's force "
+              "on the structure)")
 CONV_MOMENT = ("moment vector (right-hand rule) about x and y of the forces the structure exerts on its base, "
                "about the reference point x_ref: M = sum (x - x_ref) x F; a lateral load F_x at height h gives "
                "M_y = +h F_x")
@@ -196,8 +208,10 @@ class Demands:
     docstring). ``spec``: a DemandSpec; ``model``: the assembled model (K for the reactions);
     ``what``: '[fem]' or '[ssi]' for the start-up line."""
 
-    def __init__(self, spec, model, comm, what="[fem]"):
+    def __init__(self, spec, model, comm, what="[fem]", ground=None):
         self.spec, self.comm, self.rank = spec, comm, comm.getRank()
+        self.ground = ground                      # t -> (3,) the base's acceleration [m/s^2] (support motion)
+        self.Cg = np.zeros((4, 3))
         dm = model.dofmap
         coords = model.mesh.coords
         self.funcs = []                           # Vecs g: value = g . u
@@ -226,6 +240,19 @@ class Demands:
                 g.scale(-1.0)
                 e.destroy()
                 self.funcs.append(g)
+            # the base nodes' inertia m a_g (they move with the ground): -R_k^T (m iota_c) per axis c
+            r0, r1 = dm.r0, dm.r1
+            mloc = model.m.getArray(readonly=True)
+            tb = dm.translation_dofs(np.arange(model.mesh.n_nodes))
+            loc = np.zeros((4, 3))
+            for c in range(3):
+                iota = np.zeros(dm.size)
+                d = tb[:, c][np.isin(tb[:, c], spec.base_dofs)]
+                iota[d] = 1.0
+                w = iota[r0:r1] * mloc
+                loc[:, c] = -(R[r0:r1][:, [0, 1, 3, 4]] * w[:, None]).sum(axis=0)
+            from mpi4py import MPI
+            comm.tompi4py().Allreduce(loc, self.Cg, op=MPI.SUM)
         from scipy.sparse import csr_matrix            # the owned part of every functional, (n_func, n_local)
         rows = [g.getArray(readonly=True) for g in self.funcs]
         self.G = csr_matrix(np.array(rows) if rows else np.zeros((0, dm.n_local)))
@@ -262,6 +289,8 @@ class Demands:
         if vals.size:                             # one small reduction (no field is gathered)
             from mpi4py import MPI
             self.mpi.Allreduce(self.G @ u.getArray(readonly=True), vals, op=MPI.SUM)
+        if self.ground is not None and self.spec.base == "reactions" and self.spec.base_dofs.size:
+            vals[self.n_drift_funcs:] += self.Cg @ np.asarray(self.ground(t), float)
         if self.spec.base == "interface":
             F = np.zeros(3) if interface is None else np.asarray(interface["force_fe"], float)
             M0 = np.zeros(3) if interface is None else np.asarray(interface["moment_fe"], float)

@@ -63,7 +63,7 @@ def test_coupled_base_shear_is_the_interface_force_and_the_inertia(tmp_path, rec
         g = {k: f["demands/" + k][()] for k in f["demands"]}
         conv = f["demands/base_shear"].attrs["convention"]
         assert f["demands/overturning_moment"].attrs["unit"] == "N m"
-    assert "exerts on its base" in conv
+    assert "exerts on the ground through its base" in conv
     t, V, M = g["t"], g["base_shear"], g["overturning_moment"]
     K = len(t)
     assert K == 25 and np.array_equal(t, np.r_[0.0, it["t"]])
