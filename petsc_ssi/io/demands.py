@@ -359,7 +359,11 @@ class Demands:
             if name not in a:
                 continue
             x = a[name]
-            g[name] = (x, unit, {"convention": conv})
+            attrs = {"convention": conv}
+            if name != "drift_ratio":
+                attrs["source"] = ("support reactions at t_n (fixed base)" if sp.base == "reactions" else
+                                   "interface force of the step (coupled; implicit: the mean over (t_{n-1}, t_n])")
+            g[name] = (x, unit, attrs)
             pk, pt = peaks(t, x)
             g["peak_" + name] = (pk, unit, {"convention": "max over the steps of |" + name + "| per component"})
             g["peak_" + name + "_time"] = (pt, "s", {"convention": "the first time of each peak"})

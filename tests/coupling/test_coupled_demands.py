@@ -62,6 +62,7 @@ def test_coupled_base_shear_is_the_interface_force_and_the_inertia(tmp_path, rec
     with h5py.File(str(out).replace(".h5", "_structure.h5"), "r") as f:
         g = {k: f["demands/" + k][()] for k in f["demands"]}
         conv = f["demands/base_shear"].attrs["convention"]
+        assert f["demands/base_shear"].attrs["source"].startswith("interface force")
         assert f["demands/overturning_moment"].attrs["unit"] == "N m"
     assert "exerts on the ground through its base" in conv
     t, V, M = g["t"], g["base_shear"], g["overturning_moment"]
