@@ -24,6 +24,10 @@ Conventions (attributes of every dataset):
                       displacements are those the run computes: relative to the moving base in a
                       fixed-base run (relative-motion form), total in a coupled run (a rocking
                       foundation's rigid rotation is part of the drift there).
+  base_rotation       (theta_x, theta_y) [rad] of the lowest drift level (least-squares fit of its
+                      nodes' u_z), and drift_ratio_deformation = drift_ratio - (theta_y, -theta_x):
+                      the drift without the foundation's rocking (equal to drift_ratio on a fixed
+                      base). With levels only.
 
 Where the forces come from:
 
@@ -91,7 +95,13 @@ CONV_MOMENT = ("moment vector (right-hand rule) about x and y of the forces the 
                "about the reference point x_ref: M = sum (x - x_ref) x F; a lateral load F_x at height h gives "
                "M_y = +h F_x")
 CONV_DRIFT = ("inter-storey drift ratio (upper level's mean horizontal displacement minus the lower's) / "
-              "storey height, x and y; storeys of the levels first, then the receiver pairs")
+              "storey height, x and y; storeys of the levels first, then the receiver pairs; the displacements "
+              "of the run (fixed base: relative to the base; coupled: total, the foundation's rocking included)")
+CONV_ROT = ("rigid rotation (theta_x, theta_y) of the lowest drift level (right-hand rule), the least-squares fit "
+            "u_z = theta_x (y - y_c) - theta_y (x - x_c) of its nodes; NaN about an axis the level's nodes do not "
+            "span")
+CONV_DEF = ("drift_ratio minus the lowest level's rigid rotation (theta_y, -theta_x): the storeys' deformation "
+            "without the foundation's rocking")
 
 
 def parse_levels(text):
@@ -228,6 +238,18 @@ class Demands:
                 a[tb[c]] += 1.0 / h
                 a[ta[c]] -= 1.0 / h
                 self.funcs.append(dm.vec_from_global(a))
+        self.rot_ok = np.zeros(2, bool)
+        if len(spec.levels):                      # the lowest level's rigid rotation (theta_x, theta_y) from u_z
+            nodes = spec.level_nodes[0]
+            tz = dm.translation_dofs(nodes)[:, 2]
+            xy = coords[nodes, :2] - coords[nodes, :2].mean(axis=0)
+            for c, (col, sign) in enumerate(((1, 1.0), (0, -1.0))):     # u_z = theta_x y - theta_y x
+                den = float((xy[:, col] ** 2).sum())
+                a = np.zeros(dm.size)
+                if den > (1e-9 * max(np.abs(coords).max(), 1.0)) ** 2:
+                    a[tz] = sign * xy[:, col] / den
+                    self.rot_ok[c] = True
+                self.funcs.append(dm.vec_from_global(a))
         self.n_drift_funcs = len(self.funcs)
         if spec.base == "reactions" and spec.base_dofs.size:
             R = dm.rigid_body_modes(coords, centre=spec.ref)
@@ -339,9 +361,17 @@ class Demands:
             drift.append((means[:, 1:] - means[:, :-1]) / h[None, :, None])
             k = 2 * nl
         if len(sp.pairs):
-            drift.append(v[:, k:nd].reshape(len(t), len(sp.pairs), 2))
+            drift.append(v[:, k:k + 2 * len(sp.pairs)].reshape(len(t), len(sp.pairs), 2))
+            k += 2 * len(sp.pairs)
         if drift:
             out["drift_ratio"] = np.concatenate(drift, axis=1)
+        if len(sp.levels):
+            rot = v[:, k:k + 2].copy()
+            rot[:, ~self.rot_ok] = np.nan
+            out["base_rotation"] = rot
+            # a rigid rotation theta moves a node by theta x r: u_x = theta_y z, u_y = -theta_x z
+            rigid = np.stack([rot[:, 1], -rot[:, 0]], axis=-1)[:, None, :]
+            out["drift_ratio_deformation"] = out["drift_ratio"] - rigid
         if sp.has_base:
             out["base_shear"] = v[:, nd:nd + 2]
             out["overturning_moment"] = v[:, nd + 2:nd + 4]
@@ -354,13 +384,14 @@ class Demands:
         t = a["t"]
         g = {"t": (t, "s", {"convention": "time of each step t_n"})}
         desc = {"base_shear": ("N", CONV_SHEAR), "overturning_moment": ("N m", CONV_MOMENT),
-                "drift_ratio": ("m/m", CONV_DRIFT)}
+                "drift_ratio": ("m/m", CONV_DRIFT), "base_rotation": ("rad", CONV_ROT),
+                "drift_ratio_deformation": ("m/m", CONV_DEF)}
         for name, (unit, conv) in desc.items():
             if name not in a:
                 continue
             x = a[name]
             attrs = {"convention": conv}
-            if name != "drift_ratio":
+            if name in ("base_shear", "overturning_moment"):
                 attrs["source"] = ("support reactions at t_n (fixed base)" if sp.base == "reactions" else
                                    "interface force of the step (coupled; implicit: the mean over (t_{n-1}, t_n])")
             g[name] = (x, unit, attrs)

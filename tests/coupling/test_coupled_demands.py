@@ -14,7 +14,9 @@ Checks, every step:
   stiffness forces sum to zero) and the moment minus their moment about the reference, to 1e-9 of
   the peak (round-off);
 - the drift ratio of the one storey (levels 0, 0.25 m) is the mean x, y displacement of the top
-  nodes minus that of the base nodes over 0.25 m, from the structure receivers (every node);
+  nodes minus that of the base nodes over 0.25 m, from the structure receivers (every node); the
+  base's rotation is the least-squares plane through the base nodes' u_z, and the deformation drift
+  the drift minus that rigid rotation;
 - the peaks are max |series| and the time of it.
 """
 import h5py
@@ -95,8 +97,18 @@ def test_coupled_base_shear_is_the_interface_force_and_the_inertia(tmp_path, rec
     assert g["drift_ratio"].shape == (K, 1, 2)
     assert np.abs(g["drift_ratio"][:, 0] - ref_drift).max() <= 1e-12 * np.abs(ref_drift).max()
     assert np.abs(ref_drift[:, 0]).max() > 1e-6
+    # the base's rocking: a least-squares plane u_z = c + theta_x y - theta_y x through the base nodes
+    base = z < 0.05
+    xb = prob.model.mesh.coords[nodes[base]]
+    A = np.c_[np.ones(base.sum()), xb[:, 1], -xb[:, 0]]
+    fit = np.linalg.lstsq(A, u[:, base, 2].T, rcond=None)[0][1:].T                    # (K, 2)
+    rot = g["base_rotation"]
+    assert np.abs(rot).max() > 1e-7
+    assert np.abs(rot - fit).max() <= 1e-10 * np.abs(fit).max()
+    rigid = np.stack([rot[:, 1], -rot[:, 0]], axis=-1)
+    assert np.array_equal(g["drift_ratio_deformation"][:, 0], g["drift_ratio"][:, 0] - rigid)
     # the peak envelopes
-    for name in ("base_shear", "overturning_moment", "drift_ratio"):
+    for name in ("base_shear", "overturning_moment", "drift_ratio", "base_rotation"):
         x = g[name]
         i = np.argmax(np.abs(x), axis=0)
         assert np.array_equal(g["peak_" + name], np.take_along_axis(np.abs(x), i[None], 0)[0])

@@ -116,6 +116,8 @@ def test_static_shear_frame_drifts_shear_and_moment(msh, PETSc):
     err = np.abs(dr - hand).max() / np.abs(hand).max()
     print(f"static drift ratios {dr.ravel()} vs hand {hand.ravel()}: max rel. difference {err:.2e}")
     assert err < 3e-3, (dr, hand)
+    assert np.array_equal(a["base_rotation"][0], [0.0, 0.0])                # a fixed base does not rock
+    assert np.array_equal(a["drift_ratio_deformation"], a["drift_ratio"])
     assert np.allclose(a["base_shear"][0], [F1 + F2, F2y], rtol=1e-9, atol=0)
     ref = np.array([L / 2, L / 2, 0.0])                # auto: the base nodes' centroid at z = 0
     assert np.allclose(d.spec.ref, ref)
