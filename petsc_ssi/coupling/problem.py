@@ -47,6 +47,11 @@ class SSITransient(TransientProblem):
             self.hist = load_history(cfg, comm)
             self.prob, self.model, self.iface, self.fe_cfg = build_coupled(cfg, comm)
             iface = self.iface
+            from ..io.demands import DemandSpec
+            from ..petsc import collective
+            with collective(comm, "checking the storey demands' options"):
+                self.demand_spec = DemandSpec(cfg, self.model, "-ssi_structure_receivers", base="interface",
+                                              ref_auto=interface_centroid(self.prob, iface))
             self.plan, self.ls = self.prob.prepare([
                 f"[ssi] interface: {iface.n} nodes ({len(iface.be_elems)} soil elements, area {iface.area():.4g} m^2, "
                 f"node spacing {iface.spacing:.3g} m), contact {cfg.contact}"
@@ -56,7 +61,7 @@ class SSITransient(TransientProblem):
                 + f", {cfg.coupling} coupling"], interface_bytes(cfg, self.prob, self.model, iface, comm.getSize()),
                 "interface matrices")
         self.grid = self.prob.grid
-        self.coupler = self.rec = self.forces = None
+        self.coupler = self.rec = self.forces = self.demands = None
         self.state = None
 
     def setup(self):
@@ -102,12 +107,15 @@ class SSITransient(TransientProblem):
         self.forces = add_force_recorder(cfg, self.sout, self.model, comm, self.rec)
         self.rec.add(_FiniteCheck(self.integ))
         self.clock = self.rec.add(StepClock())
+        from ..io.demands import Demands       # base shear, overturning moment, drifts (io/demands.py)
+        self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"))
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
             if self.forces is not None:
                 self.forces.record(self.time(0), self.integ.u)
+            self.demands.record(self.time(0), self.integ.u)            # at rest: no interface force yet
         self._resume()
         self.clock.start()
 
@@ -182,8 +190,9 @@ class SSITransient(TransientProblem):
         st, su = rec.structure.rec.arrays()
         sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
         inter["preload"] = self.coupler.preload            # p_w [N/m^2] (0: none)
+        dem = self.demands.group() if comm.getRank() == 0 else None
         return {"t": np.asarray(times), "u": rec.soil_receivers(), "structure_t": st, "structure_u": su,
-                "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm)}
+                "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm), "demands": dem}
 
     def write_partial(self, status):
         res = self.results()
@@ -220,6 +229,7 @@ class SSITransient(TransientProblem):
                    "factorisation of the BEM step matrix")
         write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
         self.integ.destroy()
+        self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
         return res
 
@@ -253,8 +263,22 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
         srecd = None
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
+        sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
         (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
-                                                                      "dt": cfg.dt}, record=None, status=status)
+                                                                      "dt": cfg.dt}, record=None, status=status,
+                                              groups=sgroups)
+
+
+def interface_centroid(prob, iface):
+    """The interface's area centroid at z = 0 (the soil surface), moved onto the -ssi_symmetry
+    planes (the whole interface's centroid lies on them) [m]: the overturning moment's reference."""
+    from ..bem.resultants import area_moments
+    a, b = area_moments(prob.mesh, iface.be_elems, iface.be_nodes)
+    c = b.sum(axis=0) / a.sum()
+    c[2] = 0.0
+    for axis, _ in prob.planes:
+        c[axis] = 0.0
+    return c
 
 
 def _groups(prob, inter):

@@ -12,6 +12,7 @@ from ..points import parse_triple
 from .. import common_options  # noqa: F401  (the common options every problem reads)
 from . import parts as _parts  # noqa: F401  (-help lists the per-part options)
 from ..seismic import options as _seismic_options  # noqa: F401  (a fixed base moving with a record)
+from ..io import demands as _demands  # noqa: F401  (-ssi_structure_drift_*: the storey demands' options)
 
 G = "fem"
 

@@ -38,6 +38,10 @@ class FEMTransient(TransientProblem):
         with staged("FEM setup"):
             self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
             self.model = build_model(cfg, self.comm, assemble_matrices=False)
+            from ..io.demands import DemandSpec
+            from ..petsc import collective
+            with collective(self.comm, "checking the storey demands' options"):
+                self.demand_spec = DemandSpec(cfg, self.model, "-ssi_receivers", base="reactions")
             self.support = None
             if cfg.get("seismic", "none") != "none":        # a fixed base moving with the record
                 from ..seismic.input import SupportMotion
@@ -49,7 +53,7 @@ class FEMTransient(TransientProblem):
                 for note in self.support.notes:
                     warn(note, self.comm)
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
-        self.integ = self.rec = self.out = self.forces = None
+        self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None
 
     def setup(self):
@@ -63,9 +67,12 @@ class FEMTransient(TransientProblem):
 
     def _inertia(self):
         """{axis: -M iota_axis}: the effective earthquake load per unit ground acceleration along
-        each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]."""
+        each axis of the support motion (lumped masses of the translation dofs) [N / (m/s^2)]; none
+        on the fixed dofs (they move with the ground: their inertia goes to the supports, and the
+        integrator would drop it with a warning that a load acts on fixed dofs)."""
         dm, out = self.model.dofmap, {}
         tdofs = dm.translation_dofs(np.arange(self.model.mesh.n_nodes))
+        tdofs = np.where(np.isin(tdofs, np.asarray(self.model.fixed, np.int64)), -1, tdofs)
         r0, r1 = self.model.m.getOwnershipRange()
         for k, axis in enumerate("xyz"):
             if axis not in self.support.motions:
@@ -110,12 +117,19 @@ class FEMTransient(TransientProblem):
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
             self.forces = add_force_recorder(cfg, self.out, self.model, comm, self.rec)
+        if self.demand_spec.any:                  # base shear, overturning moment, drifts (io/demands.py)
+            from ..io.demands import Demands
+            sup = self.support                    # the base moves with the ground: its inertia m a_g
+            ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
+            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),
                                       write=self.grid.writes(0))
             if self.forces is not None:
                 self.forces.record(self.time(0), self.integ.u, write=self.grid.writes(0))
+            if self.demands is not None:
+                self.demands.record(self.time(0), self.integ.u)
         self._resume()
         self.state = (self.integ.u, self.vel)
 
@@ -150,32 +164,40 @@ class FEMTransient(TransientProblem):
 
     def write_partial(self, status):
         _close_output(self.cfg, self.out, self.model, self.rec.structure, self.comm, self.am, self.n_steps,
-                      self.integ, status=status, final=False, support=self._support_output())
+                      self.integ, status=status, final=False, support=self._support_output(), demands=self.demands)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, model = self.cfg, self.comm, self.model
         t, u = self.rec.structure.rec.arrays()
         _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ,
-                      status=self.final_status(), support=self._support_output())
+                      status=self.final_status(), support=self._support_output(), demands=self.demands)
         if comm.getRank() == 0 and len(model.receiver_nodes):
             printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                    f"{u[-1, 0, 2]:.6e}) m")
         self.integ.destroy()
-        return {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}
+        out = {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}
+        if self.demands is not None:
+            out["demands"] = self.demands.arrays() if comm.getRank() == 0 else None
+            self.demands.destroy()
+        return out
 
 
-def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True, support=None):
+def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True, support=None,
+                  demands=None):
     """Collective: receivers, attributes and run record into the output; ``final``: close it
-    (else flush it: readable, still open)."""
+    (else flush it: readable, still open). ``demands``: the storey demands' observer (the group
+    'demands', io/demands.py)."""
     if out is None:
         return
     t, u = srec.rec.arrays()
     receivers = srec.receivers() if comm.getRank() == 0 else None
-    groups, attrs = None, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+    groups, attrs = {}, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+    if demands is not None and comm.getRank() == 0:
+        groups["demands"] = demands.group()
     if support is not None:
         ground, arrays = support
-        groups = {"seismic": arrays}
+        groups["seismic"] = arrays
         attrs["seismic"] = "support motion (relative-motion form: u, velocity, acceleration relative to the base)"
         if receivers is not None and "acceleration" in receivers:
             receivers["ground_acceleration"] = ground(receivers["t"])
@@ -187,7 +209,7 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
     if cfg.fem_integrator == "green":
         extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
     with event("FEM_io"):
-        (out.close if final else out.flush)(receivers=receivers, attrs=attrs, groups=groups,
+        (out.close if final else out.flush)(receivers=receivers, attrs=attrs, groups=groups or None,
                                             record=provenance(cfg, comm, extra), status=status)
     if not final:
         return

@@ -275,7 +275,8 @@ class Output:
         """Collective: close the viewer, then rank 0 adds the serial data and
         writes the XDMF and JSON files. ``receivers``: dict with 'points'
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
-        ``groups``: {group: {name: array}} more serial data (rank 0). ``status``: how the run
+        ``groups``: {group: {name: array, (array, unit) or (array, unit, {attribute: value})}}
+        more serial data (rank 0). ``status``: how the run
         ended (the file's attribute ``run_status`` and the record's)."""
         for w in self.writers:
             w.write_collective(self)
@@ -332,12 +333,16 @@ class Output:
             for gname, data in (groups or {}).items():
                 g = _group(f, gname)
                 for k, v in data.items():
-                    unit = None
+                    unit, extra = None, {}
                     if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
                         v, unit = v                     # (array, unit): the unit as an attribute
+                    elif isinstance(v, tuple) and len(v) == 3 and isinstance(v[1], str):
+                        v, unit, extra = v              # (array, unit, {attribute: value})
                     d = g.create_dataset(k, data=np.asarray(v), track_times=False)
                     if unit is not None:
                         d.attrs["unit"] = unit
+                    for ak, av in extra.items():
+                        d.attrs[ak] = av
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)

@@ -157,6 +157,12 @@ class SupportMotion:
         """The mean ground acceleration along ``axis`` over [t0, t1] (arrays allowed) [m/s^2]."""
         return (self.velocity(axis, t1) - self.velocity(axis, t0)) / (np.asarray(t1) - np.asarray(t0))
 
+    def acceleration(self, axis, t):
+        """The ground's acceleration along ``axis`` at times t (any shape) [m/s^2]."""
+        m = self.motions.get(axis)
+        t = np.asarray(t, float)
+        return np.zeros_like(t) if m is None else m(t - self.t0, 2)
+
     def summary_lines(self):
         lines = [f"[fem] support motion (-ssi_seismic vertical, fixed base, relative-motion form): start t0 = "
                  f"{self.t0:.6g} s, record until {self.duration:.6g} s"]
