@@ -54,4 +54,11 @@ def test_options_file_runs_reduced(path, tmp_path):
     cli(args)
     d = read_h5(out)
     assert d["u"].shape[0] in (3, 4) and np.all(np.isfinite(d["u"]))
+    if _value(text, "seismic", "none") not in ("none", "vertical"):
+        # an oblique wave reaches the receivers later than these few steps (the automatic start keeps
+        # the free field zero at every soil node up to t = 0): the input itself must be there
+        import h5py
+        with h5py.File(out, "r") as f:
+            assert np.abs(f["seismic/acceleration"][()]).max() > 0
+        return
     assert np.abs(d["u"]).max() > 0
