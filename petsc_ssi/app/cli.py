@@ -2,7 +2,8 @@
 
 Commands:
   (none) | run    run the case the options describe (-ssi_problem bem|fem|ssi)
-  post FILE.h5    post-process an output file (--receivers --csv, --spectrum, --transfer A B)
+  post FILE.h5    post-process an output file (--receivers --csv, --spectrum, --transfer A B,
+                  --response-spectrum, SSI.h5 --glance FIXED.h5)
   modes           natural frequencies and mode shapes of a FE structure (SLEPc)
   static          static solution K u = F of a FE structure (loads at h = 1), written like a run
   impedance       dynamic stiffness K(a0) of a surface footing (-ssi_disp_group), one run per mode
@@ -97,6 +98,9 @@ def main(argv=None):
         if "--response-spectrum" in rest:          # earthquake-engineering response spectra
             from .response import main as response_main
             return response_main(rest[1:])
+        if "--glance" in rest:                     # SSI at a glance: coupled run vs fixed-base twin
+            from .glance import main as glance_main
+            return glance_main(rest[1:])
         from .post import main as post_main
         return post_main(rest[1:])
     from ..petsc import init, SSIError

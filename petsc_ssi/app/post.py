@@ -16,6 +16,11 @@ Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
   --response-spectrum response spectra (SA, PSA, PSV, SD, SV; RotD50/RotD100, ratios of
                       two spectra) of a receiver's acceleration: ``petsc-ssi post FILE.h5
                       --response-spectrum --help`` (``app/response.py``)
+  --glance FIXED.h5   SSI at a glance: FILE.h5 a coupled run with an earthquake, FIXED.h5
+                      its fixed-base twin; first frequency and damping of each (transfer
+                      function roof / ground), period lengthening, peak roof acceleration,
+                      drift and base shear: ``petsc-ssi post FILE.h5 --glance FIXED.h5
+                      --help`` (``app/glance.py``)
   --transfer A B      transfer function H = B / A of two series on the same time
                       grid, magnitude and phase.  A and B are each
                         K                  receiver K of the selected series of FILE

@@ -287,4 +287,6 @@ class SeismicInput:
         out = motion_arrays(self.motions, self.t0)
         out["angle"] = (np.array(float(self.cfg.seismic_angle)), "deg")
         out["azimuth"] = (np.array(float(self.cfg.seismic_azimuth)), "deg")
+        out["control"] = (np.bytes_(self.cfg.seismic_control), "-ssi_seismic_control: surface (the record is the "
+                          "free-field surface motion at the control point) or incident")
         return out

@@ -254,6 +254,32 @@ def sdof_history(t, acc, period, damping=0.05, oversample=1):
     return OscillatorHistory(nodes, y0 / omega[0], y1, -omega[0] * (y0 + 2 * zeta[0] * y1))
 
 
+def sdof_filter(frequency, damping, dt):
+    """(b, a): the recurrence above for the ABSOLUTE acceleration of one oscillator (natural
+    frequency [Hz] > 0, damping [-] in [0, 1)) on a uniform step dt [s], as the coefficients of
+    a second-order digital filter a_abs = lfilter(b, a, a_g) (numpy arrays of 3).  Exact for
+    the piecewise-linear a_g through the samples and the oscillator at rest at the first sample
+    when a_g[0] = 0 (lfilter takes the samples before the first as 0, i.e. a ramp from 0 over
+    the step before it otherwise).
+
+    With y = (omega u, u'), y_{i+1} = A y_i + b0 a_i + b1 a_{i+1} and a_abs = C y,
+    C = -omega (1, 2 zeta): a_abs = C (q I - A)^-1 (b0 + q b1) a_g, q the forward shift, so
+    b = (C b1, C b0 + C J b1, C J b0), J = adj(q I - A) - q I = [[-A11, A01], [A10, -A00]],
+    a = (1, -tr A, det A)."""
+    f, z, h = float(frequency), float(damping), float(dt)
+    if not (np.isfinite(f) and f > 0 and np.isfinite(h) and h > 0 and 0 <= z < 1):
+        raise SpectrumInputError(f"sdof_filter: needs frequency > 0 Hz, dt > 0 s and damping in [0, 1) "
+                                 f"(got {frequency!r}, {dt!r}, {damping!r})")
+    omega = 2 * np.pi * f
+    A, B = _step_matrices(h, np.array([omega]), np.array([z]))
+    A, b0, b1 = A[:, :, 0], B[:, 0, 0], B[:, 1, 0]
+    C = -omega * np.array([1.0, 2 * z])
+    J = np.array([[-A[1, 1], A[0, 1]], [A[1, 0], -A[0, 0]]])
+    b = np.array([C @ b1, C @ b0 + C @ J @ b1, C @ J @ b0])
+    a = np.array([1.0, -np.trace(A), np.linalg.det(A)])
+    return b, a
+
+
 def response_spectrum(t, acc, periods=None, damping=(0.05,), quantity="all", oversample=1):
     """Response spectra of the ground acceleration ``acc`` [m/s^2] sampled at ``t`` [s].
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The demo's building under an earthquake (runs/seismic/README.md): the coupled run, its fixed-base
-# twin, and the response spectra engineers read (roof and free field, SSI over fixed base).
+# twin, the response spectra engineers read (roof and free field, SSI over fixed base) and the
+# glance (petsc-ssi post --glance: what the soil changes).
 #   bash runs/seismic/run.sh [NRANKS] [extra PETSc/-ssi_ options, e.g. -ssi_t_end 1]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -28,4 +29,8 @@ post out/seismic/building_structure.h5 --response-spectrum --receiver 0 --compon
   --csv out/seismic/roof-ratio.csv --png out/seismic/roof-ratio.png
 post out/seismic/building.h5 --response-spectrum --receiver 0 --component x \
   --csv out/seismic/free-field.csv --png out/seismic/free-field.png
+# SSI at a glance: first frequency and damping with and without the soil (roof / ground transfer
+# functions), period lengthening, peak roof acceleration, drift and base shear (when recorded)
+post out/seismic/building.h5 --glance out/seismic/fixed-base.h5 --receiver 0 --component x \
+  --csv out/seismic/glance.csv --png out/seismic/glance.png | tee out/seismic/glance.txt
 "$PY" runs/seismic/report.py out/seismic
