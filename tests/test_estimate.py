@@ -144,3 +144,34 @@ def test_estimate_bad_input(args, msg):
     assert p.returncode == 2
     err = [line for line in p.stdout.splitlines() if line.startswith("petsc-ssi: error:")]
     assert len(err) == 1 and msg in err[0], p.stdout
+
+
+COUPLED = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800",
+           "-ssi_mesh_size", "2,2", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5",
+           "-ssi_fem_box_cells", "4,4,2", "-ssi_fem_box_size", "1,1,0.5", "-ssi_fem_load_group", "top",
+           "-ssi_fem_load_p0", "1000", "-ssi_dt", "0.0125", "-ssi_t_end", "0.5", "-ssi_warn_beta", "0",
+           "-ssi_estimate_ranks", "1,2"]
+
+
+def test_coupled_estimate_counts_the_interface_and_the_structure():
+    """-ssi_problem ssi (issue 28): the soil is counted with the interface as its traction region, as the
+    coupled run assembles it (the traction nodes are the interface's nodes, which the run reports), and
+    the coupling adds the structure (factorised and a solve timed), the interface matrices' 3 n_I
+    solves and the coupled steps: the coupling columns are positive and part of the time loop."""
+    import re as _re
+    p = cli(["estimate"] + COUPLED)
+    out = p.stdout
+    assert "estimate of this coupled run" in out, out
+    n_t = int(_re.search(r"(\d+) traction nodes", out).group(1))
+    n_i = int(_re.search(r"coupling: (\d+) interface nodes \((\d+) columns\), structure (\d+) dofs", out).group(1))
+    assert n_t == n_i == 25                          # a 1 m x 1 m block on 0.25 m nodes: 5 x 5
+    head = [l for l in out.splitlines() if "ranks nodes |" in l][0].split("|")[1].split()
+    rows = {}
+    for line in out.splitlines():
+        m = _re.match(r"\[ssi\]\s+(\d+)\s+\d+\s+\|(.*?)\|", line)
+        if m:
+            rows[int(m.group(1))] = dict(zip(head, map(float, m.group(2).split())))
+    assert set(rows) == {1, 2}
+    for r in rows.values():
+        assert r["coupling_setup_s"] > 0 and r["coupling_loop_s"] > 0
+        assert r["time_loop_s"] >= r["history_s"] + r["solve_s"] + r["coupling_loop_s"] - 1e-9
