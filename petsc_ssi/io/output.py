@@ -9,7 +9,8 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
   topology               (E, n)  cell connectivity (0-based)        [rank 0]
   time                   (K,)    time of snapshot k                 [rank 0]
   receivers/...          receiver series (see ``write_receivers``)  [rank 0]
-  attrs: cell_type, fields, n_snapshots, petsc_ssi_version
+  attrs: cell_type, fields, n_snapshots, petsc_ssi_version, run_status, run_id (shared with
+         the run's checkpoints: a restart continues only the output of its own run)
 
 Distributed fields are written collectively by the PETSc viewer; the small
 serial data (topology, time, receiver series) by rank 0 with h5py after the
@@ -171,8 +172,9 @@ def _h5(path, mode):
 class Output:
     """Collective writer of one run's fields and series."""
 
-    def __init__(self, path, comm, resume=None):
-        """``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
+    def __init__(self, path, comm, resume=None, run_id=""):
+        """``run_id``: the run's id (``TransientProblem.run_id``), the attribute ``run_id`` of the
+        file, which a restart compares with its checkpoint's. ``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
         its file is continued (opened to append; later snapshots overwrite those the interrupted run
         wrote after its checkpoint); a missing file is started anew, with a warning."""
         PETSc = init()
@@ -180,6 +182,7 @@ class Output:
         self.path = path
         self.comm = comm
         self.rank = comm.getRank()
+        self.run_id = run_id or ""
         d = os.path.dirname(os.path.abspath(path))
 
         def stale():
@@ -294,6 +297,7 @@ class Output:
                 f.create_dataset("topology", data=self.cells, track_times=False)
             f.create_dataset("time", data=np.asarray(self.times), track_times=False)
             f.attrs["run_status"] = status
+            f.attrs["run_id"] = self.run_id
             f.attrs["cell_type"] = self.cell_type or ""
             f.attrs["fields"] = ",".join(self.fields)
             f.attrs["n_snapshots"] = len(self.times)
