@@ -88,12 +88,17 @@ def _read_json(path, comm, what):
 def verify(path, comm, manifest, what="-ssi_lags_load"):
     """Collective: the CRC32 of every piece of ``path`` against its manifest's; SSIError in one line
     naming the file and the damaged piece's offset."""
+    import time
     from ..io.integrity import file_crcs, first_bad_piece
+    from ..petsc import printf
+    t0 = time.perf_counter()
     chunk = int(manifest.get("crc32_chunk", 0)) or 1
     off = first_bad_piece(manifest["crc32"], file_crcs(path, comm, chunk), chunk)
     if off is not None:
         raise SSIError(f"{what} {path}: the content differs from the checksum saved with it (CRC32 of the "
                        f"{chunk} bytes at offset {off}): a damaged file; save it again with -ssi_lags_save")
+    printf(f"[ssi] {what} {path}: content checked against its CRC32s ({manifest['bytes'] / 1e9:.3g} GB in "
+           f"{time.perf_counter() - t0:.2f} s)")
 
 
 def check(cfg, comm, prob, plan):
@@ -137,7 +142,8 @@ def _kind(M):
 
 
 def save(path, comm, march, key):
-    """Collective: the Marcher's matrices to ``path`` (PETSc binary) and ``path``.json; returns bytes."""
+    """Collective: the Marcher's matrices to ``path`` (PETSc binary) and ``path``.json; returns (bytes,
+    seconds of the checksums)."""
     PETSc = init()
     tmp = path + ".tmp"
     mats = _mats(march)
@@ -158,8 +164,11 @@ def save(path, comm, march, key):
                 A.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
+    import time
     from ..io.integrity import file_crcs, CHUNK
+    t0 = time.perf_counter()
     crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
+    t_crc = time.perf_counter() - t0
     size = 0
     with collective(comm, f"-ssi_lags_save {path}", "{what}: {error}"):
         if comm.getRank() == 0:
@@ -174,7 +183,7 @@ def save(path, comm, march, key):
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
-    return comm.tompi4py().bcast(size, root=0)
+    return comm.tompi4py().bcast(size, root=0), t_crc
 
 
 def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0, interp_lags=()):
