@@ -165,6 +165,10 @@ class TransientProblem:
         if cfg.get("restart"):
             self.restart = checkpoint.check_restart(cfg, self.comm, self.kind, outputs=outputs)
             self.run_id = str(self.restart.get("run_id") or "")
+        elif cfg.get("reproducible"):               # identical reruns give identical files: the id of the options
+            import hashlib
+            import json
+            self.run_id = hashlib.sha256(json.dumps(checkpoint.run_key(cfg), sort_keys=True).encode()).hexdigest()[:32]
         else:
             import uuid
             self.run_id = self.comm.tompi4py().bcast(uuid.uuid4().hex if self.comm.getRank() == 0 else None, root=0)
