@@ -36,7 +36,7 @@ register("huge_pages", "enum", "numpy", "", "numpy's request (madvise) that the 
          "(jobscripts/huge_pages_bench.sh); results do not depend on it", "common",
          choices=("off", "on", "numpy"))
 register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
-         "becomes the step, to keep every checkpoint", "common")
+         "becomes the step, to keep every checkpoint; never an output or sidecar of the run", "common")
 register("checkpoint_every", "int", 0, "steps", "write a checkpoint every this many steps (0: never; a signal "
          "always writes one)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
 register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this much wall time has passed since "

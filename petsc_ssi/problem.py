@@ -99,6 +99,36 @@ class CheckpointObserver:
             p._flush()
 
 
+def check_names(cfg, outputs):
+    """SSIError (the same on every rank: names only) if the checkpoint (-ssi_checkpoint, '%d' any
+    step) or -ssi_lags_save's files would replace an output of the run or its sidecars, or each
+    other: a file written by one part of the run must not be another's."""
+    import re
+    from .io.output import output_files
+    from .io import checkpoint
+    from .io.lock import lock_path
+    ab = os.path.abspath
+    owned = {}                                    # file -> what writes it
+    for o in outputs:
+        for f in output_files(o) + [lock_path(o)]:
+            owned[ab(f)] = f"the output {o}" if ab(f) == ab(o) else f"a sidecar of the output {o}"
+    lags = cfg.get("lags_save") or ""
+    if lags:
+        for f in (lags, lags + ".json", lags + ".tmp", lags + ".json.tmp", lock_path(lags)):
+            if ab(f) in owned:
+                raise SSIError(f"-ssi_lags_save {lags}: would replace {f}, {owned[ab(f)]}; give the lag file "
+                               "a name of its own")
+            owned[ab(f)] = f"-ssi_lags_save's {f}"
+    ck = cfg.get("checkpoint") or ""
+    if ck or outputs:
+        pattern = ab(checkpoint.checkpoint_path(cfg) or "")
+        rx = re.compile("^" + "[0-9]+".join(re.escape(part) for part in pattern.split("%d")) + r"(\.tmp)?$")
+        for f, who in owned.items():
+            if rx.match(f):
+                raise SSIError(f"-ssi_checkpoint {ck or pattern}: would replace {f}, {who}; a checkpoint needs "
+                               "a name of its own")
+
+
 class TransientProblem:
     """Base class; see the module docstring."""
     kind = ""
@@ -112,6 +142,8 @@ class TransientProblem:
         self.grid = None                # the time grid (timegrid.TimeGrid), made by the subclass
         self._state = "created"
         self.restart = None             # the header of -ssi_restart's checkpoint (check_output)
+        self.run_id = ""                # written into the outputs and checkpoints (check_output)
+        self._locks = []                # the lock files of the run's outputs (check_output)
         self._key = None
         from .petsc import set_huge_pages
         self.huge_pages = set_huge_pages(cfg.get("huge_pages", "numpy"))   # before the large arrays
@@ -121,13 +153,25 @@ class TransientProblem:
     def check_output(self, also=()):
         """Collective: the output can be written and replaces nothing unless asked
         (``io.output.check_output``), the checkpoint location too, and -ssi_restart's checkpoint
-        belongs to this run (``io.checkpoint.check_restart``); called first by every constructor.
-        A restart continues the output of the interrupted run, so that one may exist."""
+        belongs to this run (``io.checkpoint.check_restart``: its options, its checksums, and an
+        existing output of the same run id); no checkpoint or lag file named like an output or
+        sidecar of the run; then the run's files are locked (``io.lock``) for the run's duration.
+        Called first by every constructor. A restart continues the output of the interrupted run,
+        so that one may exist."""
         from .io.output import check_output
         from .io import checkpoint
         cfg = self.cfg
+        outputs = ([cfg.output] + list(also)) if cfg.get("output") else []
         if cfg.get("restart"):
-            self.restart = checkpoint.check_restart(cfg, self.comm, self.kind)
+            self.restart = checkpoint.check_restart(cfg, self.comm, self.kind, outputs=outputs)
+            self.run_id = str(self.restart.get("run_id") or "")
+        elif cfg.get("reproducible"):               # identical reruns give identical files: the id of the options
+            import hashlib
+            import json
+            self.run_id = hashlib.sha256(json.dumps(checkpoint.run_key(cfg), sort_keys=True).encode()).hexdigest()[:32]
+        else:
+            import uuid
+            self.run_id = self.comm.tompi4py().bcast(uuid.uuid4().hex if self.comm.getRank() == 0 else None, root=0)
         overwrite = bool(cfg.get("output_overwrite"))
         if cfg.get("output"):
             check_output(cfg.output, self.comm, overwrite or self.restart is not None, also=also)
@@ -136,6 +180,21 @@ class TransientProblem:
             same = self.restart is not None and os.path.abspath(ck) == os.path.abspath(cfg.restart)
             check_output(ck, self.comm, overwrite or same or "%d" in (cfg.get("checkpoint") or ""),
                          what="-ssi_checkpoint")
+        check_names(cfg, outputs)
+        from .io import lock
+        paths = list(outputs)
+        if cfg.get("checkpoint"):
+            paths.append(cfg.checkpoint)                 # the pattern itself: ck-%d.h5.lock
+        if cfg.get("lags_save"):
+            paths.append(cfg.lags_save)
+        self._locks = lock.acquire(paths, self.comm, self) if paths else []
+
+    def release_locks(self):
+        """The locks of the run's files given back (``io.lock``); ``run`` does it at its end and
+        on any error; a script that steps by itself may call it after finish() (else: at exit)."""
+        from .io import lock
+        lock.release(getattr(self, "_locks", ()), self.comm)
+        self._locks = []
 
     # ------------------------------------------------------------ checkpoint and restart
     def checkpoint_state(self):
@@ -161,7 +220,8 @@ class TransientProblem:
             if self.cfg.get("output"):
                 self._flush()              # the output holds every snapshot the checkpoint lists, even after SIGKILL
             vecs, serial = self.checkpoint_state()
-            checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial)
+            checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial,
+                             run_id=getattr(self, "run_id", ""))
         self._last_ckpt = time.perf_counter()
         if self.cfg.get("monitor"):
             printf(f"[ssi] checkpoint after step {self.n} of {self.n_steps}: {path}")
@@ -276,7 +336,14 @@ class TransientProblem:
         the run just finishes); a stop by a signal or by an SSIError (the divergence guard, a
         non-finite solution) writes the results up to the last step with ``run_status`` 'stopped
         ...' before the error is raised. Other exceptions (a bug, PETSc or MPI failures) write
-        nothing more. With -ssi_restart the steps start after the checkpoint's."""
+        nothing more. With -ssi_restart the steps start after the checkpoint's. The locks of
+        the run's files are given back at the end, whatever happened."""
+        try:
+            return self._run()
+        finally:
+            self.release_locks()
+
+    def _run(self):
         self.setup()
         self.start()
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end

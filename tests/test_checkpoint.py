@@ -6,6 +6,7 @@ interrupted run's output in place. Each test compares every dataset of the resta
 bit for bit at the rank count of the checkpoint (one rank, or two with -ssi_reproducible, whose
 solves are deterministic: tests/test_reproducible.py), to 1e-10 relative on another rank count.
 A restart whose options change the run is refused in one line naming the option."""
+import os
 import shutil
 import signal
 import subprocess
@@ -131,6 +132,7 @@ def test_a_signal_writes_a_checkpoint_that_restarts_a_coupled_contact_run(tmp_pa
     ck = str(tmp_path / "k-checkpoint.h5")
     errs = [ln for ln in text.splitlines() if ln.startswith("petsc-ssi: error: stopped by SIGTERM")]
     assert rc == 2 and len(errs) == 1 and f"resume with -ssi_restart {ck}" in errs[0], text[-2000:]
+    assert not os.path.exists(out + ".lock")                     # a stop by a signal gives the lock back
     with h5py.File(out) as f:
         n = len(f["receivers/t"])
         assert str(f.attrs["run_status"]).startswith(f"stopped after step {n} of 960")
@@ -153,6 +155,7 @@ def test_a_signal_writes_a_checkpoint_that_restarts_a_bem_run(tmp_path):
     out, log = str(tmp_path / "k.h5"), str(tmp_path / "k.log")
     rc, text = signal_midway(args + ["-ssi_output", out], log, 30, lambda p: p.send_signal(signal.SIGTERM))
     assert rc == 2, text[-2000:]
+    assert not os.path.exists(out + ".lock")
     with h5py.File(out) as f:
         n = len(f["receivers/t"])
     assert 30 <= n < 2000

@@ -370,6 +370,8 @@ REFUSALS = [
     (["A", "--png", "A"], ["--png", "input file"]),
     (["A", "--ratio", "S", "--png", "S", "--overwrite"], ["--png", "input file"]),
     (["A", "--csv", "EXISTING"], ["--csv", "exists", "--overwrite"]),
+    (["A", "--csv", "S", "--overwrite"], ["--csv", "existing HDF5 file"]),        # a result, not an input
+    (["A", "--png", "S", "--overwrite"], ["--png", "existing HDF5 file"]),
     (["A", "--png", "EXISTING"], ["--png", "exists"]),
     (["A", "--csv", "NODIR/out.csv"], ["--csv", "no directory"]),
     (["A", "--receiver", "2"], ["--receiver 2", "out of range", "2 receivers"]),

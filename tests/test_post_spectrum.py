@@ -215,7 +215,7 @@ def test_cli_transfer_b_is_2a(sines, tmp_path):
     u2 = np.zeros((N, 1, 3))
     u2[:, 0] = 2.0 * _two_sines(t)[:, None]
     other = _write(str(tmp_path / "other.h5"), t, u2)
-    rc, out, err = _run([sines, "--transfer", "0", f"{other}:0", "--component", "x", "--csv", csv])
+    rc, out, err = _run([sines, "--transfer", "0", f"{other}:0", "--component", "x", "--csv", csv, "--overwrite"])
     assert rc == 0, err
     _, names, data = _read_csv(csv)
     rel = data[:, 3] > 0
@@ -238,7 +238,7 @@ def test_cli_interface_force_series(tmp_path):
     (f, a), = _printed_peaks(out)["force_be_z"]
     assert f == pytest.approx(7.5) and a == pytest.approx(1e4, rel=1e-6)
     rc, out, err = _run([path, "--transfer", "interface/force_be", "interface/force_fe", "--component", "z",
-                         "--csv", csv])
+                         "--csv", csv, "--overwrite"])
     assert rc == 0, err
     _, names, data = _read_csv(csv)
     rel = data[:, 3] > 0
@@ -309,3 +309,46 @@ def test_cli_spectrum_of_a_runs_resultants(tmp_path):
     nfft = 64                                          # 20 samples, padded to the power of two >= 40
     assert data[0, 1] == pytest.approx(fz.sum() / len(fz), rel=1e-6)
     assert data[1, 0] == pytest.approx(1.0 / (nfft * 0.0125), rel=1e-9)
+
+
+def test_outputs_never_replace_an_input_or_a_result(sines, tmp_path):
+    """Issue 30: an output path (--csv of --spectrum/--transfer, --png, --plot) naming the input,
+    a sidecar of it or another HDF5 result is refused in one line (exit 2) even with --overwrite,
+    before anything is read or written; an existing CSV/PNG is refused without --overwrite (as a
+    run's -ssi_output without -ssi_output_overwrite) and replaced with it."""
+    other = _write(str(tmp_path / "other.h5"), _t(), np.zeros((N, 1, 3)))
+    side = str(tmp_path / "sines.json")
+    with open(side, "w") as fh:
+        fh.write("{}\n")
+    old = str(tmp_path / "old.csv")
+    with open(old, "w") as fh:
+        fh.write("keep\n")
+    keep = {p: open(p, "rb").read() for p in (sines, other, side, old)}
+    cases = [
+        (["--spectrum", "--csv", sines], "--csv", "is the input file"),
+        (["--spectrum", "--csv", sines, "--overwrite"], "--csv", "is the input file"),
+        (["--spectrum", "--png", sines], "--png", "is the input file"),
+        (["--plot", sines], "--plot", "is the input file"),
+        (["--transfer", "0", f"{other}:0", "--csv", other, "--overwrite"], "--csv", "is the input file"),
+        (["--spectrum", "--csv", side, "--overwrite"], "--csv", "a sidecar of the input file"),
+        (["--spectrum", "--png", other, "--overwrite"], "--png", "existing HDF5 file"),
+        (["--spectrum", "--csv", old], "--csv", "exists (give --overwrite"),
+        (["--spectrum", "--csv", str(tmp_path / "s.csv"), "--png", str(tmp_path / "s.csv")], "--png",
+         "the same file as --csv"),
+    ]
+    for extra, opt, words in cases:
+        rc, out, err = _run([sines] + extra)
+        lines = err.strip().splitlines()
+        assert rc == 2 and len(lines) == 1, (extra, err)
+        assert lines[0].startswith(f"petsc-ssi post: error: {opt} ") and words in lines[0], (extra, lines[0])
+        assert out == "" and "Traceback" not in err
+        assert {p: open(p, "rb").read() for p in keep} == keep, extra
+    assert not os.path.exists(tmp_path / "s.csv")
+    # the command line as the tester gave it (a subprocess: no traceback, the input intact)
+    p = subprocess.run([PY, "-m", "petsc_ssi", "post", sines, "--spectrum", "--csv", sines], cwd=ROOT,
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2 and "is the input file" in p.stderr and "Traceback" not in p.stderr, p.stderr
+    assert open(sines, "rb").read() == keep[sines]
+    rc, _, err = _run([sines, "--spectrum", "--component", "x", "--csv", old, "--overwrite"])
+    assert rc == 0, err
+    assert _read_csv(old)[1] == ["f_hz", "u_x"]

@@ -21,10 +21,12 @@ planes each allows (a footing symmetric about x = 0 and y = 0, x_ref = the origi
 (-ssi_impedance_symmetry 0 meshes the whole surface instead). Outputs, from -ssi_output's stem:
 <stem>-<mode>.h5 (each run), <stem>-impedance.csv (a0, K, k, c per mode), <stem>-impedance.png
 (k and c against a0, with each mode's high-frequency dashpot limit: rho c_p A, rho c_s A,
-rho c_p I_y, rho c_s J). The trusted band: a0 >= 4 pi B / (c_s T) (two frequency bins of the
-record T) and a0 >= 2 pi B c_R / (c_s L) (one Rayleigh wavelength across the meshed surface, L its
-smaller extent with the symmetry images: below it k and c of a 4 m surface around a 2 m square
-differ from an 8 m surface's by up to 0.13, above it by under 0.02; runs/impedance/extent_study.py),
+rho c_p I_y, rho c_s J); all of them are checked before the first mode's run, and an existing
+one is refused unless -ssi_output_overwrite (``check_outputs``). The trusted band:
+a0 >= 4 pi B / (c_s T) (two frequency bins of the record T) and a0 >= 2 pi B c_R / (c_s L) (one
+Rayleigh wavelength across the meshed surface, L its smaller extent with the symmetry images:
+below it k and c of a 4 m surface around a 2 m square differ from an 8 m surface's by up to 0.13,
+above it by under 0.02; runs/impedance/extent_study.py),
 a0 <= pi B / (2 h) (four elements per shear wavelength) and omega dt <= 0.3, i.e.
 a0 <= 0.3 B / (c_s dt): the time discretisation's error grows with omega dt (on the square footing
 of runs/impedance/dt_study.py, k at a0 = 2.5 is 1.23, 0.83, 0.73 with dt = 1.6, 0.8, 0.4 ms, and
@@ -150,6 +152,29 @@ def _a0_range(text):
     return lo, hi
 
 
+def check_outputs(stem, modes, comm, overwrite):
+    """Collective, before the first mode's run: every file the command writes (each mode's
+    ``<stem>-<mode>.h5`` with its sidecars, ``<stem>-impedance.csv`` and ``.png``) may be written
+    and replaces nothing unless -ssi_output_overwrite (``io.output.check_output``'s rule); SSIError
+    in one line on every rank otherwise."""
+    from ..io.output import check_output
+    from ..petsc import collective_error
+    for mode in modes:
+        check_output(f"{stem}-{mode}.h5", comm, overwrite)
+    err = None
+    for f in (stem + "-impedance.csv", stem + "-impedance.png"):
+        if os.path.isdir(f):
+            err = f"-ssi_output {stem}.h5: {f} is a directory"
+        elif os.path.lexists(f) and not os.path.isfile(f):
+            err = f"-ssi_output {stem}.h5: {f} exists and is not a regular file"
+        elif os.path.lexists(f) and not overwrite:
+            err = (f"-ssi_output {stem}.h5: {f} exists (a previous result); add -ssi_output_overwrite to replace "
+                   "it, or choose another -ssi_output")
+        if err:
+            break
+    collective_error(err, comm)
+
+
 def main():
     """Collective: the ``petsc-ssi impedance`` command (PETSc already initialised)."""
     PETSc = init()
@@ -169,6 +194,7 @@ def main():
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
     want = _a0_range(cfg0.impedance_a0)
     stem = os.path.splitext(cfg0.output or "out/impedance.h5")[0]
+    check_outputs(stem, modes, comm, bool(cfg0.get("output_overwrite")))
     rise = cfg0.impedance_rise or 4 * cfg0.dt
     nu = ((cfg0.cp / cfg0.cs) ** 2 - 2) / (2 * ((cfg0.cp / cfg0.cs) ** 2 - 1))
     table, curves, K0s, cross = [], {}, {}, {}

@@ -57,6 +57,11 @@ Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
                       (transfer: f_hz, then |H|, phase_deg, reliable per component)
   --png OUT.png       plot (matplotlib Agg) with the peaks marked in Hz; the
                       title states window, padding and df
+  --overwrite         replace an existing --csv/--png/--plot file of ours
+Output files (--csv OUT.csv, --png, --plot) are checked before anything is read or
+written: one naming an input file or its sidecars (.xmf, .json, .lock), or any
+existing HDF5 file, is refused even with --overwrite; another existing file is
+refused without --overwrite, as a run's -ssi_output is without -ssi_output_overwrite.
 Errors (missing series, non-uniform time grid, different grids) end with one
 line ``petsc-ssi post: error: ...`` on stderr and exit status 2.
 """
@@ -72,6 +77,60 @@ QUANTITIES = ("u", "velocity", "acceleration", "rotation")
 
 class PostError(Exception):
     """A one-line error of the post command (exit status 2)."""
+
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def is_hdf5(path):
+    """Whether ``path`` is an HDF5 file (its signature at byte 0, 512, 1024, ... as HDF5 places it)."""
+    try:
+        with open(path, "rb") as fh:
+            for off in (0, 512, 1024, 2048, 4096, 8192):
+                fh.seek(off)
+                if fh.read(8) == HDF5_SIGNATURE:
+                    return True
+    except OSError:
+        return False
+    return False
+
+
+def _same_file(a, b):
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_outputs(outputs, inputs, overwrite, flag="--overwrite"):
+    """Before anything is read or written: PostError (one line) unless every output file of
+    ``outputs`` [(option, path or None/True/'-' for none or standard output)] may be written: not
+    an input of ``inputs`` nor one of its sidecars (.xmf, .json, .lock), never an existing HDF5
+    file (a result), not a directory, not an existing file without ``overwrite``, in an existing
+    directory, and no two outputs the same file."""
+    named = [(opt, p) for opt, p in outputs if isinstance(p, str) and p and p != "-"]
+    for opt, path in named:
+        for src in inputs:
+            stem = os.path.splitext(src)[0]
+            for f in (src, stem + ".xmf", stem + ".json", src + ".lock"):
+                if _same_file(path, f):
+                    what = "the input file" if f == src else f"a sidecar of the input file {src}:"
+                    raise PostError(f"{opt} {path}: is {what} {f}; refusing to overwrite it")
+        if os.path.isdir(path):
+            raise PostError(f"{opt} {path}: is a directory")
+        if os.path.lexists(path) and is_hdf5(path):
+            raise PostError(f"{opt} {path}: is an existing HDF5 file (a result); post never writes over one")
+        if os.path.lexists(path) and not overwrite:
+            raise PostError(f"{opt} {path}: exists (give {flag} to replace it)")
+        d = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(d):
+            raise PostError(f"{opt} {path}: no directory {d}")
+    for i, (o1, p1) in enumerate(named):
+        for o2, p2 in named[i + 1:]:
+            if os.path.abspath(p1) == os.path.abspath(p2):
+                raise PostError(f"{o2} {p2}: the same file as {o1}")
 
 
 def receivers(path):
@@ -369,6 +428,8 @@ def main(argv=None):
     ap.add_argument("--fmin", type=float, default=None, metavar="HZ")
     ap.add_argument("--eps", type=float, default=1e-3)
     ap.add_argument("--png", metavar="OUT.png")
+    ap.add_argument("--overwrite", action="store_true", help="replace an existing --csv/--png/--plot file "
+                    "(never an input or an HDF5 file)")
     a = ap.parse_args(argv)
     # legacy order 'post --receivers --csv FILE.h5': the optional --csv value is the file
     if a.file is None and isinstance(a.csv, str) and a.csv.endswith((".h5", ".hdf5")) \
@@ -379,6 +440,9 @@ def main(argv=None):
     a.series = a.series or f"receivers/{a.quantity}"
     from ..spectrum import SpectrumError
     try:
+        inputs = [a.file] + [_parse_ref(r, a.file, a.series)[0] for r in (a.transfer or ())]
+        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer) else None), ("--png", a.png),
+                       ("--plot", a.plot)], inputs, a.overwrite)
         if a.spectrum and a.transfer:
             raise PostError("give either --spectrum or --transfer, not both")
         if a.spectrum:

@@ -50,7 +50,8 @@ Options
                         columns carry their label, e.g. 'RotD50 PSA [m/s^2]'; a ratio:
                         'PSA ratio [-]').  Standard output without a name.
   --png OUT.png         PSA (--plot-quantity Q) against period on a log axis
-  --overwrite           replace an existing --csv/--png file (never an input file)
+  --overwrite           replace an existing --csv/--png file (never an input file, its
+                        sidecars .xmf/.json/.lock, or any HDF5 file)
 Prints what was computed (input, receiver, component, acceleration source, dt, samples,
 PGA, periods, damping, sub-steps) and the peak of each spectrum.  Errors end with one line
 ``petsc-ssi post: error: ...`` on stderr naming the argument, and exit status 2.
@@ -435,30 +436,6 @@ def _parser():
     return ap
 
 
-def _same(a, b):
-    if os.path.realpath(a) == os.path.realpath(b):
-        return True
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
-def _check_output(opt, path, inputs, overwrite):
-    if path is None or path == "-":
-        return
-    for p in inputs:
-        if _same(path, p):
-            raise _error(f"{opt} {path}: is the input file {p}; refusing to overwrite it")
-    if os.path.isdir(path):
-        raise _error(f"{opt} {path}: is a directory")
-    if os.path.lexists(path) and not overwrite:
-        raise _error(f"{opt} {path}: exists (give --overwrite to replace it)")
-    d = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(d):
-        raise _error(f"{opt} {path}: no directory {d}")
-
-
 def _validate(a):
     """Argument combinations; the components to read."""
     if a.file and a.table:
@@ -502,10 +479,7 @@ def main(argv=None, out=None):
         comps = _validate(a)
         periods, ptext = a.periods if a.periods is not None else parse_periods("standard")
         inputs = [p for p in (a.file, a.table, a.ratio, a.ratio_table) if p]
-        _check_output("--csv", a.csv, inputs, a.overwrite)
-        _check_output("--png", a.png, inputs, a.overwrite)
-        if a.csv and a.png and a.csv != "-" and _same(a.csv, a.png):
-            raise _error(f"--png {a.png}: the same file as --csv")
+        _post.check_outputs([("--csv", a.csv), ("--png", a.png)], inputs, a.overwrite)
         A = _load(a.file, a.table, a.receiver, comps, a, "--table" if a.table else "--receiver")
         specs, k = spectra(A, periods, a.damping, a.rotd, a.geomean, a.oversample)
         B = None

@@ -104,9 +104,10 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     if cfg.get("lags_save"):
         from . import lagstore
         t1 = time.perf_counter()
-        size = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
+        size, t_crc = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
         printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
-               f"{fmt_time(time.perf_counter() - t1)}; -ssi_lags_load {cfg.lags_save} reuses them)")
+               f"{fmt_time(time.perf_counter() - t1)}, of which {t_crc:.2f} s the CRC32 checksums of its content; "
+               f"-ssi_lags_load {cfg.lags_save} reuses them)")
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
                    "nbaij": nbaij, "nsingle": nsingle, "fill": fill, "mem": mem}
 

@@ -11,8 +11,10 @@ the assembly by loading the matrices a first run saved.
 set), the exact lags H_l and G_l and the interpolating matrices HI_j, GI_j, in that order, each
 in the storage it had (dense, or 3x3 block-sparse as MPIBAIJ; an empty lag is not written). ``FILE.json``
 lists them and holds the key (``lag_key``: the values above, SHA-256 of the mesh and of the
-traction nodes), written last, so a save that was cut short has no ``.json`` and is refused.
-Loading checks the key before any heavy work and names the first entry that differs; the
+traction nodes) and the CRC32 of every 8 MiB piece of ``FILE``'s bytes (``io.integrity``: summed
+by the ranks in turn, no gather), written last, so a save that was cut short has no ``.json`` and
+is refused. Loading checks the key and the checksums before any heavy work (one line naming the
+first entry that differs, or the file and the byte offset of the damaged piece); the
 matrices load on any number of ranks (rows by the run's node ranges). A run with loaded matrices
 is bitwise the run that saved them when the solves are deterministic (one rank, or
 -ssi_reproducible; ``tests/bem/test_lagstore.py``).
@@ -25,7 +27,7 @@ import numpy as np
 
 from ..petsc import init, collective, collective_error, collective_io, SSIError
 
-FORMAT = 1
+FORMAT = 2          # 2: with the CRC32 of the file's content (format 1 had none: refused)
 
 
 def _h(a):
@@ -72,7 +74,10 @@ def _read_json(path, comm, what):
                                "(a save that did not finish)")
             with open(path + ".json") as fh:
                 data = json.load(fh)
-            if data.get("format") != FORMAT or "key" not in data:
+            if data.get("format") == 1:
+                raise SSIError(f"{what} {path}: a lag file of an older petsc-ssi without checksums of its content "
+                               "(format 1): save it again with -ssi_lags_save")
+            if data.get("format") != FORMAT or "key" not in data or "crc32" not in data:
                 raise SSIError(f"{what} {path}: not a petsc-ssi lag file (format {FORMAT})")
             if os.path.getsize(path) != data.get("bytes"):
                 raise SSIError(f"{what} {path}: {os.path.getsize(path)} bytes, {path}.json says {data.get('bytes')} "
@@ -80,9 +85,25 @@ def _read_json(path, comm, what):
     return comm.tompi4py().bcast(data, root=0)
 
 
+def verify(path, comm, manifest, what="-ssi_lags_load"):
+    """Collective: the CRC32 of every piece of ``path`` against its manifest's; SSIError in one line
+    naming the file and the damaged piece's offset."""
+    import time
+    from ..io.integrity import file_crcs, first_bad_piece
+    from ..petsc import printf
+    t0 = time.perf_counter()
+    chunk = int(manifest.get("crc32_chunk", 0)) or 1
+    off = first_bad_piece(manifest["crc32"], file_crcs(path, comm, chunk), chunk)
+    if off is not None:
+        raise SSIError(f"{what} {path}: the content differs from the checksum saved with it (CRC32 of the "
+                       f"{chunk} bytes at offset {off}): a damaged file; save it again with -ssi_lags_save")
+    printf(f"[ssi] {what} {path}: content checked against its CRC32s ({manifest['bytes'] / 1e9:.3g} GB in "
+           f"{time.perf_counter() - t0:.2f} s)")
+
+
 def check(cfg, comm, prob, plan):
     """Collective, before any heavy work: -ssi_lags_load's key against this run (SSIError naming
-    what differs; returns its manifest), and -ssi_lags_save's location (writable, not replacing a
+    what differs; returns its manifest) and content (``verify``), and -ssi_lags_save's location (writable, not replacing a
     file without -ssi_output_overwrite). Returns the manifest or None."""
     manifest = None
     if cfg.get("lags_load"):
@@ -91,6 +112,7 @@ def check(cfg, comm, prob, plan):
         if diff:
             raise SSIError(f"-ssi_lags_load {cfg.lags_load}: the saved lag matrices are of another soil problem: "
                            f"{diff}")
+        verify(cfg.lags_load, comm, manifest)
     if cfg.get("lags_save"):
         from ..io.output import check_output
         if cfg.get("lags_load"):
@@ -120,7 +142,8 @@ def _kind(M):
 
 
 def save(path, comm, march, key):
-    """Collective: the Marcher's matrices to ``path`` (PETSc binary) and ``path``.json; returns bytes."""
+    """Collective: the Marcher's matrices to ``path`` (PETSc binary) and ``path``.json; returns (bytes,
+    seconds of the checksums)."""
     PETSc = init()
     tmp = path + ".tmp"
     mats = _mats(march)
@@ -141,6 +164,11 @@ def save(path, comm, march, key):
                 A.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
+    import time
+    from ..io.integrity import file_crcs, CHUNK
+    t0 = time.perf_counter()
+    crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
+    t_crc = time.perf_counter() - t0
     size = 0
     with collective(comm, f"-ssi_lags_save {path}", "{what}: {error}"):
         if comm.getRank() == 0:
@@ -151,11 +179,11 @@ def save(path, comm, march, key):
             os.replace(tmp, path)
             size = os.path.getsize(path)
             manifest = {"format": FORMAT, "key": key, "mats": [[n, _kind(M)] for n, M in mats],
-                        "ranks": comm.getSize(), "bytes": size}
+                        "ranks": comm.getSize(), "bytes": size, "crc32_chunk": CHUNK, "crc32": crcs}
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
-    return comm.tompi4py().bcast(size, root=0)
+    return comm.tompi4py().bcast(size, root=0), t_crc
 
 
 def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0, interp_lags=()):

@@ -50,7 +50,7 @@ class BEMTransient(TransientProblem):
         self._advance("set up", "started")
         from ..io.recorder import Recorder, SoilRecorder
         rd = self._open_restart()
-        self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None)
+        self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
         if self.footing is not None:

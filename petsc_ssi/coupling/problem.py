@@ -98,8 +98,9 @@ class SSITransient(TransientProblem):
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
             (("uff",) if self.prob.seismic is not None else ())
         rd = self._open_restart()
-        self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
-        self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None)
+        self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
+        self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None,
+                           run_id=self.run_id)
         self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
                             structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys,

@@ -112,7 +112,7 @@ class FEMTransient(TransientProblem):
         cfg, comm = self.cfg, self.comm
         rd = self._open_restart()
         with event("FEM_io"):
-            self.out = (Output(cfg.output, comm, resume=rd.output_state("out") if rd else None)
+            self.out = (Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
                         if cfg.output else None)
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))

@@ -9,9 +9,13 @@ A checkpoint of a run after step n holds
       the recorded series (times, |u|, soil and structure receivers, interface series), the
       output's snapshot list, the contact state, integrator scalars
   attributes
-      ``step``, ``n_steps``, ``problem``, ``ranks``, ``format``, the package version and ``key``:
+      ``step``, ``n_steps``, ``problem``, ``ranks``, ``format``, the package version, ``key``:
       the options that define the run (``run_key``) as JSON, with a SHA-256 of every input file
-      they name (meshes, load tables)
+      they name (meshes, load tables), and ``run_id``: the id the run wrote into its output too
+      (a restart continues only an output of the same run)
+  on every dataset, attribute ``crc32``
+      the CRC32 of each 8 MiB piece of its data (``io.integrity``: the ranks sum the pieces in
+      turn, no gather); a restart verifies them before any heavy work and refuses a damaged file
 
 It is written to ``FILE.tmp`` and renamed over ``FILE`` only when complete, so a kill during the
 write leaves the previous checkpoint. ``-ssi_checkpoint FILE`` names it (default
@@ -34,7 +38,7 @@ import numpy as np
 
 from ..petsc import init, collective, collective_error, collective_io, ensure_space, SSIError
 
-FORMAT = 1
+FORMAT = 2          # 2: with run_id and the CRC32 of every dataset's data (1: refused)
 
 # Options that steer how a run is carried out, watched or written, not what it computes: a restart
 # may change them. Every other -ssi_ option defines the run and must be the same on restart.
@@ -112,19 +116,47 @@ def read_header(path, comm):
         if comm.getRank() == 0:
             if not os.path.isfile(path):
                 raise SSIError(f"-ssi_restart {path}: no such file")
+            import h5py
             with _h5(path, "r") as f:
+                if int(f.attrs.get("format", -1)) == 1:
+                    raise SSIError(f"-ssi_restart {path}: a checkpoint of an older petsc-ssi without checksums "
+                                   "of its content (format 1); run again from the start")
                 if int(f.attrs.get("format", -1)) != FORMAT or "key" not in f.attrs:
                     raise SSIError(f"-ssi_restart {path}: not a petsc-ssi checkpoint (format {FORMAT})")
                 head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
                 head["key"] = json.loads(str(head["key"]))
+                crc = {}
+                f.visititems(lambda name, obj: crc.__setitem__(name, [int(c) for c in obj.attrs["crc32"]])
+                             if isinstance(obj, h5py.Dataset) and "crc32" in obj.attrs else None)
+                head["crc32"] = crc
     return comm.tompi4py().bcast(head, root=0)
 
 
-def check_restart(cfg, comm, kind):
+def output_run_id(path, comm):
+    """Collective: the ``run_id`` attribute of an existing output ('' without one), None when the
+    file does not exist; rank 0 reads, every rank gets it."""
+    rid = None
+    with collective(comm, f"-ssi_output {path}", "{what}: cannot read it to check that it belongs to the "
+                                                 "checkpoint ({error})"):
+        if comm.getRank() == 0 and os.path.lexists(path):
+            with _h5(path, "r") as f:
+                v = f.attrs.get("run_id", "")
+                rid = v.decode() if isinstance(v, bytes) else str(v)
+    return comm.tompi4py().bcast(rid, root=0)
+
+
+def check_restart(cfg, comm, kind, outputs=()):
     """Collective, before any heavy work: the header of -ssi_restart, checked against this run
-    (problem kind, the options that define the run); SSIError naming what differs."""
+    (problem kind, the options that define the run), its content against its checksums, and each
+    existing file of ``outputs`` (the run's HDF5 outputs, which a restart continues) against its
+    run id; SSIError naming what differs."""
+    from .integrity import check_datasets
     path = cfg.restart
     head = read_header(path, comm)
+    bad = check_datasets(path, comm, head.pop("crc32"))
+    if bad:
+        raise SSIError(f"-ssi_restart {path}: {bad}: a damaged checkpoint; restart from an earlier one or "
+                       "run again from the start")
     err = None
     if head["problem"] != kind:
         err = f"-ssi_restart {path}: the checkpoint is of -ssi_problem {head['problem']}, this run is {kind}"
@@ -136,12 +168,20 @@ def check_restart(cfg, comm, kind):
     if err is None and not 0 < int(head["step"]) < int(head["n_steps"]):
         err = f"-ssi_restart {path}: the checkpoint is after step {head['step']} of {head['n_steps']}: nothing to do"
     collective_error(err, comm)
+    for out in outputs:
+        rid = output_run_id(out, comm)
+        if rid is not None and rid != head.get("run_id"):
+            raise SSIError(f"-ssi_output {out}: exists and is not the output of the run that wrote -ssi_restart "
+                           f"{path} (run id {rid or '(none)'} there, {head.get('run_id')} in the checkpoint); a "
+                           "restart continues its own run's output: give that one, or a name that does not exist")
     return head
 
 
-def write(path, comm, step, n_steps, kind, key, vecs, serial):
+def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
     """Collective: a checkpoint at ``path``, atomically (``path``.tmp, then renamed). ``vecs``:
-    {name: Vec}, written by the PETSc HDF5 viewer; ``serial``: {name: array} of rank 0."""
+    {name: Vec}, written by the PETSc HDF5 viewer; ``serial``: {name: array} of rank 0; every
+    dataset gets the CRC32s of its data (``io.integrity.dataset_crcs``)."""
+    from .integrity import dataset_crcs
     PETSc = init()
     tmp = path + ".tmp"
     with collective(comm, f"checkpoint {path}", "{what}: {error}"):
@@ -164,14 +204,20 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial):
     collective_io(viewer.destroy, f"closing the checkpoint {tmp}", comm)
     with collective(comm, f"checkpoint {path}", "{what}: {error}"):
         if comm.getRank() == 0:
-            from .. import __version__
             with _h5(tmp, "a") as f:
                 g = f.create_group("serial")
                 for name, val in serial.items():
                     g.create_dataset(name, data=np.bytes_(val.encode()) if isinstance(val, str) else np.asarray(val))
+    crcs = dataset_crcs(tmp, comm)
+    with collective(comm, f"checkpoint {path}", "{what}: {error}"):
+        if comm.getRank() == 0:
+            from .. import __version__
+            with _h5(tmp, "a") as f:
+                for name, c in crcs.items():
+                    f[name].attrs["crc32"] = np.asarray(c, np.uint32)
                 f.attrs.update({"format": FORMAT, "step": int(step), "n_steps": int(n_steps), "problem": kind,
                                 "ranks": comm.getSize(), "petsc_ssi_version": __version__,
-                                "key": json.dumps(key, sort_keys=True)})
+                                "key": json.dumps(key, sort_keys=True), "run_id": run_id})
             fd = os.open(tmp, os.O_RDONLY)
             try:
                 os.fsync(fd)

@@ -12,7 +12,8 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
   (writers)              more data of ``Output.writers`` (e.g. io/forces.py's member forces:
                          distributed Vecs through the viewer before it closes, then rank 0's
                          h5py work, which may name cell fields: XDMF Center="Cell" attributes)
-  attrs: cell_type, fields, n_snapshots, petsc_ssi_version
+  attrs: cell_type, fields, n_snapshots, petsc_ssi_version, run_status, run_id (shared with
+         the run's checkpoints: a restart continues only the output of its own run)
 
 Distributed fields are written collectively by the PETSc viewer; the small
 serial data (topology, time, receiver series) by rank 0 with h5py after the
@@ -174,8 +175,9 @@ def _h5(path, mode):
 class Output:
     """Collective writer of one run's fields and series."""
 
-    def __init__(self, path, comm, resume=None):
-        """``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
+    def __init__(self, path, comm, resume=None, run_id=""):
+        """``run_id``: the run's id (``TransientProblem.run_id``), the attribute ``run_id`` of the
+        file, which a restart compares with its checkpoint's. ``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
         its file is continued (opened to append; later snapshots overwrite those the interrupted run
         wrote after its checkpoint); a missing file is started anew, with a warning."""
         PETSc = init()
@@ -183,6 +185,7 @@ class Output:
         self.path = path
         self.comm = comm
         self.rank = comm.getRank()
+        self.run_id = run_id or ""
         d = os.path.dirname(os.path.abspath(path))
 
         def stale():
@@ -319,6 +322,7 @@ class Output:
                 f.create_dataset("topology", data=self.cells, track_times=False)
             f.create_dataset("time", data=np.asarray(self.times), track_times=False)
             f.attrs["run_status"] = status
+            f.attrs["run_id"] = self.run_id
             f.attrs["cell_type"] = self.cell_type or ""
             f.attrs["fields"] = ",".join(self.fields)
             f.attrs["n_snapshots"] = len(self.times)

@@ -214,3 +214,30 @@ def test_the_meshed_surface_limits_the_low_frequencies(tmp_path):
     below = (a0 > 0.2) & (a0 < lo)
     assert dev[inside].max() < 0.03, dev[inside].max()
     assert dev[below].max() > 0.06, dev[below].max()
+
+
+def test_existing_outputs_are_refused_before_the_first_run(tmp_path):
+    """Issue 30, item 2: an existing <stem>-impedance.csv (or .png, or a later mode's .h5) is a
+    previous result: refused in one line on every rank, exit 2, before the first mode runs (no
+    mode's file written, the CSV untouched), as a run's -ssi_output is; -ssi_output_overwrite
+    replaces it. (One mode of the 4 m surface: seconds.)"""
+    out = ["-ssi_output", str(tmp_path / "z.h5"), "-ssi_impedance_modes", "vertical,rocking"]
+    short = ["-ssi_t_end", "0.008"]
+    csv_path = tmp_path / "z-impedance.csv"
+    csv_path.write_text("an earlier table\n")
+    for n in (1, 2):
+        p = cli(["impedance"] + SMALL + short + out, nranks=n, check=False)
+        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        assert p.returncode == 2 and len(errs) == 1, p.stdout[-1500:]
+        assert f"{csv_path} exists (a previous result); add -ssi_output_overwrite" in errs[0], errs[0]
+        assert "[impedance] mode" not in p.stdout and not (tmp_path / "z-vertical.h5").exists()
+        assert csv_path.read_text() == "an earlier table\n"
+    csv_path.unlink()
+    (tmp_path / "z-rocking.h5").write_bytes(b"an earlier run")          # the second mode's result
+    p = cli(["impedance"] + SMALL + short + out, nranks=2, check=False)
+    assert p.returncode == 2 and "z-rocking.h5 exists (a previous result)" in p.stdout, p.stdout[-1500:]
+    assert not (tmp_path / "z-vertical.h5").exists()
+    (tmp_path / "z-rocking.h5").unlink()
+    csv_path.write_text("an earlier table\n")
+    cli(["impedance"] + SMALL + short + out[:2] + ["-ssi_impedance_modes", "vertical", "-ssi_output_overwrite"])
+    assert "an earlier table" not in csv_path.read_text() and set(_table(str(csv_path))) == {"vertical"}
