@@ -47,8 +47,9 @@ def read_surface_mesh(cfg, comm, planes):
                 if patch:
                     params.update({"a": patch[0], "b": patch[1]})
                 from ..fem.mesh import parse_mesh_params
-                params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
-                mesh = surface.read_gmsh(cfg.mesh, params)
+                user = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
+                params.update(user)
+                mesh = surface.read_gmsh(cfg.mesh, params, tuple(user))
             mesh.check()
             z = np.abs(mesh.nodes[:, 2])
             ext = float(np.ptp(mesh.nodes[:, :2], axis=0).max()) or 1.0
