@@ -34,6 +34,33 @@ import numpy as np
 
 from ..petsc import SSIError, printf
 
+# What the stability map of runs/stability (stability_map.csv, README "Results: stability map")
+# found, in beta_s = c_s dt / l (l: node spacing): per scheme, the smallest beta from which every
+# mapped run (h = 0.5, 1, 1.5 m) was stable, and the largest beta mapped (every run stable there).
+# tests/bem/test_beta_warning.py checks these against the CSV.
+MAP_STABLE_FROM = {"plain": 0.15, "stabilized": 0.07}
+MAP_BETA_MAX = 2.0
+
+
+def beta_warning(scheme, beta_lo, beta_hi):
+    """One line when beta_s = c_s dt / l over the mesh ([beta_lo, beta_hi]: the largest and the
+    smallest node spacing) leaves what the stability map found stable for ``scheme``, else None."""
+    lo = MAP_STABLE_FROM.get(scheme)
+    tips = []
+    if lo is not None and beta_lo < lo:
+        other = [f"-ssi_scheme {k} from {v:g}" for k, v in MAP_STABLE_FROM.items() if k != scheme and v < lo]
+        tips.append(f"below {lo:g}, from which every {scheme} run of the stability map was stable (the "
+                    "largest elements need a larger dt" + (f", or {other[0]}" if other else "") + ")")
+    if beta_hi > MAP_BETA_MAX * (1 + 1e-9):
+        tips.append(f"above {MAP_BETA_MAX:g}, the largest the stability map ran (the smallest elements are "
+                    "crossed in less than a step: a smaller dt or coarser elements there)")
+    if not tips:
+        return None
+    return (f"beta_s = c_s dt / l spans [{beta_lo:.3g}, {beta_hi:.3g}] (largest to smallest node spacing), "
+            + " and ".join(tips) + ": the marching may be unstable (runs/stability/README.md; "
+            "-ssi_check_stability tests this mesh's beta)")
+
+
 RATE_SLOW = 1e-4
 RATE_UNSTABLE = 2e-3
 FIT_FRACTION = 1.0 / 3.0
@@ -209,9 +236,9 @@ def guard(cfg, prob, march, unorm, n):
     if march.scheme == "plain":
         causes.append(f"the plain scheme (eq. 6) is unstable for small beta = c_s dt / l (here {prob.beta[0]:.3g}; "
                       "runs/stability/README.md maps where): use -ssi_scheme stabilized")
-    if prob.beta[0] < 0.3 or prob.beta[1] > 1.3:
-        causes.append(f"beta = c dt / l spans [{prob.beta[0]:.2f}, {prob.beta[1]:.2f}], outside [0.3, 1.3]: "
-                      "change -ssi_dt or the mesh")
+    beta = beta_warning(march.scheme, prob.beta[0], prob.beta[1] * prob.mat.cs / prob.mat.cp)
+    if beta:
+        causes.append(beta.split(": the marching")[0] + ": change -ssi_dt or the mesh")
     plan = getattr(march, "plan", None)
     if plan is not None:
         causes.append(f"lag interpolation from T_L = {plan.TL:.4g} s: a threshold below the Rayleigh "
@@ -244,5 +271,6 @@ class DivergenceGuard:
         nrm = self.norms.values[-1]
         if not np.isfinite(nrm):
             raise SSIError(f"the solution is not finite at step {n} (t = {t:.4g} s): |u| = {nrm}; likely cause: "
-                           f"beta = c dt / l spans [{self.prob.beta[0]:.2f}, {self.prob.beta[1]:.2f}] (keep it "
-                           "in [0.3, 1.3]) or the scheme")
+                           f"beta_s = c_s dt / l from {self.prob.beta[0]:.2f} (the stability map's stable range "
+                           f"for -ssi_scheme {self.cfg.scheme}: from {MAP_STABLE_FROM.get(self.cfg.scheme, 0):g} to "
+                           f"{MAP_BETA_MAX:g}) or the scheme")
