@@ -3,7 +3,9 @@
 Implements Romero, Galvin and Dominguez, "3D non-linear time domain FEM-BEM
 approach to soil-structure interaction problems": a time-domain BEM for the
 elastic half-space (nine-node quadrilaterals), a FEM structure integrated with
-implicit Green's functions, and their staggered coupling with contact.
+implicit Green's functions, and their coupling with unilateral contact: an
+interface-implicit step (the default, ``-ssi_coupling implicit``) or the paper's
+staggered step (``-ssi_coupling staggered``).
 
 Import order matters: ``petsc_ssi.petsc.init()`` must run (it calls
 ``petsc4py.init(sys.argv)``) before anything imports ``petsc4py.PETSc``, so
