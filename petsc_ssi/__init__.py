@@ -14,6 +14,12 @@ every command-line option reaches the options database. The command line
 """
 import hashlib as _hashlib
 import os as _os
+import warnings as _warnings
+
+# Debian's python3-matplotlib (pulled in by ParaView) puts its mpl_toolkits beside the venv's
+# matplotlib; matplotlib then warns on import that it cannot import Axes3D. petsc_ssi draws no 3D
+# axes: that warning says nothing about its plots.
+_warnings.filterwarnings("ignore", message="Unable to import Axes3D", category=UserWarning)
 
 __version__ = "0.1.0"
 
