@@ -217,7 +217,7 @@ class HalfSpace:
         sizes = self.mesh.element_sizes()
         lmin, lmax = sizes.min(), sizes.max()
         self.beta = (self.mat.cs * self.dt / lmax, self.mat.cp * self.dt / lmin)
-        from .stability import beta_warning
+        from .stability_map import beta_warning
         msg = beta_warning(cfg.scheme, self.mat.cs * self.dt / lmax, self.mat.cs * self.dt / lmin)
         if cfg.warn_beta and msg:
             warn(msg)
