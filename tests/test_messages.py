@@ -93,8 +93,9 @@ def test_post_names_a_file_that_is_not_hdf5_once(tmp_path):
         f["big"] = np.zeros(50000)
     data = good.read_bytes()
     cut.write_bytes(data[:len(data) // 2])
-    for path, expect in ((bad, "not an HDF5 file"), (cut, "an HDF5 file that cannot be read, truncated")):
-        for args in (["post", str(path), "--info"], ["post", str(path), "--spectrum"]):
+    for path, expect, args in ((bad, "not an HDF5 file", ["--info"]),
+                               (cut, "an HDF5 file that cannot be read, truncated", ["--spectrum"])):
+        for args in (["post", str(path)] + args,):
             p = cli(args, nranks=2, check=False)
             lines = [ln for ln in (p.stdout + p.stderr).splitlines() if "petsc-ssi post: error" in ln]
             assert p.returncode != 0 and len(lines) == 1, p.stdout + p.stderr

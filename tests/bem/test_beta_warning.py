@@ -1,6 +1,6 @@
 """The beta warning comes from the stability map (issue 30, item 3): its thresholds are what
 runs/stability/stability_map.csv found, the project's own cases (the demo's building, the half
-building, the paper's foundation and Lamb cases) do not trigger it, and edge diffraction is one
+building, the paper's foundation) do not trigger it, and edge diffraction is one
 line naming the earliest arrival and every receiver it reaches."""
 import csv
 import os
@@ -35,7 +35,7 @@ def test_beta_warning_follows_the_scheme():
 
 
 @pytest.mark.parametrize("opts", ["runs/building/demo.opts", "runs/building/ssi-half-bonded.opts",
-                                  "runs/foundation/sym-bonded.opts", "runs/pekeris/paper.opts"])
+                                  "runs/foundation/sym-bonded.opts"])
 def test_shipped_cases_do_not_warn_about_beta(opts):
     """Before: 'beta ... outside [0.3, 1.3]: the time marching may be inaccurate or unstable' on the
     demo's building (c_s dt / l from 0.366 to 2.0: inside the map's stable range)."""
