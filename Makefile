@@ -38,6 +38,9 @@ $(VENV)/.stamp: .deps/apt.stamp setup.py Makefile
 	@NPV=$$(/usr/bin/python3 -c "import numpy; print(numpy.__version__)"); \
 	  $(PY) -m pip install -q --disable-pip-version-check "numpy==$$NPV" $(PIP_PKGS)
 	@$(PY) -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+	@# gmsh's pip script starts '#!/usr/bin/env python' (the system python without the venv active):
+	@# point it at the venv's python, so .venv/bin/gmsh runs as it is
+	@[ ! -f $(VENV)/bin/gmsh ] || sed -i '1s|^#!.*python.*$$|#!$(abspath $(PY))|' $(VENV)/bin/gmsh
 	@$(PY) -c "import petsc4py, mpi4py, numba, gmsh, matplotlib; print('[deps] ok: petsc4py', petsc4py.__version__, 'numba', numba.__version__, 'gmsh', gmsh.__version__)"
 	@touch $@
 

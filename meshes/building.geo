@@ -38,10 +38,10 @@
 //   hc         column element size [m] (0.3)
 //   half       0: full building; 1: the half y >= 0 (symmetry about y = 0)
 DefineConstant[
-  nbx = {4, Name "Parameters/nbx"}, nby = {3, Name "Parameters/nby"},
-  sx = {3.6, Name "Parameters/sx"}, sy = {3.6, Name "Parameters/sy"},
-  ns = {3, Name "Parameters/ns"}, hs = {3.0, Name "Parameters/hs"},
-  h = {0.6, Name "Parameters/h"}, hc = {0.3, Name "Parameters/hc"},
+  nbx = {4, Min 1, Max 1000, Step 1, Name "Parameters/nbx"}, nby = {3, Min 1, Max 1000, Step 1, Name "Parameters/nby"},
+  sx = {3.6, Min 0.001, Name "Parameters/sx"}, sy = {3.6, Min 0.001, Name "Parameters/sy"},
+  ns = {3, Min 1, Max 1000, Step 1, Name "Parameters/ns"}, hs = {3.0, Min 0.001, Name "Parameters/hs"},
+  h = {0.6, Min 0.001, Name "Parameters/h"}, hc = {0.3, Min 0.001, Name "Parameters/hc"},
   half = {0, Name "Parameters/half", Choices {0, 1}} ];
 
 Lx = nbx * sx; Ly = nby * sy; tol = 1e-6 * (sx + sy);

@@ -3,7 +3,9 @@
 Implements Romero, Galvin and Dominguez, "3D non-linear time domain FEM-BEM
 approach to soil-structure interaction problems": a time-domain BEM for the
 elastic half-space (nine-node quadrilaterals), a FEM structure integrated with
-implicit Green's functions, and their staggered coupling with contact.
+implicit Green's functions, and their coupling with unilateral contact: an
+interface-implicit step (the default, ``-ssi_coupling implicit``) or the paper's
+staggered step (``-ssi_coupling staggered``).
 
 Import order matters: ``petsc_ssi.petsc.init()`` must run (it calls
 ``petsc4py.init(sys.argv)``) before anything imports ``petsc4py.PETSc``, so
@@ -12,6 +14,12 @@ every command-line option reaches the options database. The command line
 """
 import hashlib as _hashlib
 import os as _os
+import warnings as _warnings
+
+# Debian's python3-matplotlib (pulled in by ParaView) puts its mpl_toolkits beside the venv's
+# matplotlib; matplotlib then warns on import that it cannot import Axes3D. petsc_ssi draws no 3D
+# axes: that warning says nothing about its plots.
+_warnings.filterwarnings("ignore", message="Unable to import Axes3D", category=UserWarning)
 
 __version__ = "0.1.0"
 

@@ -44,3 +44,7 @@ register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this 
 register("restart", "str", "", "", "resume the run from this checkpoint (same options, any rank count; the "
          "output of the interrupted run is continued)", "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
+register("disk_check", "bool", True, "", "before the assembly, compare the free space of the output's file system "
+         "with the run's estimated output (fields x snapshots x nodes x 8 B, receiver and interface series) and "
+         "refuse a run that cannot fit (0: skip the check; the per-snapshot check still stops a run whose disk "
+         "fills)", "common")

@@ -2,7 +2,9 @@
 the snapshot that would not fit, in one line with exit status 2 and no traceback, and its file
 holds every step up to the stop (receivers whole, run_status saying why). When the check cannot
 see the shortage (a quota), the failed PETSc write ends the job in one line, exit 2, without a
-hang or a segfault. Needs permission to mount a tmpfs (root); skipped otherwise."""
+hang or a segfault. A run whose estimated output exceeds the free space is refused before the
+assembly, in one line with both numbers (-ssi_disk_check 0 skips that: the tests of the run that
+fills the disk use it). Needs permission to mount a tmpfs (root); skipped otherwise."""
 import os
 import subprocess
 import time
@@ -14,7 +16,8 @@ from helpers import ROOT, PY
 
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
-       "-ssi_t_end", "0.5", "-ssi_output_stride", "1", "-ssi_warn_beta", "0", "-ssi_receivers", "3,0,0"]
+       "-ssi_t_end", "0.5", "-ssi_output_stride", "1", "-ssi_warn_beta", "0", "-ssi_receivers", "3,0,0",
+       "-ssi_disk_check", "0"]
 
 NO_CHECK = """import sys
 import petsc_ssi.io.output as O
@@ -72,3 +75,20 @@ def test_a_failed_write_ends_the_job_in_one_line(small_disk, tmp_path, n):
     assert r.returncode == 2 and 1 <= len(errs) <= n, r.stdout[-2000:] + r.stderr[-2000:]
     assert "failed (PETSc error" in errs[0] and "Traceback" not in r.stderr
     assert "Segmentation" not in r.stderr + r.stdout
+
+
+def test_a_run_that_cannot_fit_is_refused_before_the_assembly(small_disk):
+    """The quarter model (169 nodes), 400 snapshots of displacement and traction at 169 x 3 x 8 B
+    + 4 kB each: 6.52 MB (x 1.1 + 1 MB: 8.18 MB) on a 2 MB disk: one line naming both, at -n 2,
+    nothing assembled or written. 10 snapshots (1.18 MB) pass the check, and the run completes."""
+    out = str(small_disk / "big.h5")
+    assert BEM[-2:] == ["-ssi_disk_check", "0"]
+    base = [PY, "-m", "petsc_ssi"] + BEM[:-2] + ["-ssi_output", out]
+    r = _run(base + ["-ssi_t_end", "1.0"], 2)
+    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    assert r.returncode == 2 and len(errs) == 1, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "the run needs about 8.18 MB of disk (soil fields 6.52 MB, soil receivers 0.0096 MB;" in errs[0], errs[0]
+    assert f"and {small_disk} has 2.1 MB free" in errs[0] and "-ssi_disk_check 0" in errs[0], errs[0]
+    assert "assembl" not in r.stdout.lower() and not os.path.exists(out)
+    r = _run(base + ["-ssi_t_end", "0.025"], 2)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]

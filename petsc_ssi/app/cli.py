@@ -78,6 +78,34 @@ def _bad_options_file(argv):
     return None
 
 
+SOLVERS = (("ssi_bem_", "the soil's step solve (BEM)"), ("ssi_fem_", "the structure's solve (FEM)"))
+
+
+def _solver_help(PETSc):
+    """-help: the PETSc solver options under petsc_ssi's prefixes, with the defaults a run inserts
+    where the user set nothing (a run makes these solvers only after the assembly, so without
+    this -help would never list them): PETSc prints each KSP's options with their current
+    values (its own -help output)."""
+    from ..petsc import direct_solver_defaults
+    comm = PETSc.COMM_WORLD
+    db = PETSc.Options()
+    for prefix, what in SOLVERS:
+        PETSc.Sys.Print(f"PETSc solver options of {what}: prefix -{prefix} (any KSP/PC option; "
+                        "petsc-ssi's defaults where you set none: " + " ".join(
+                            f"-{prefix}{k} {v}" for k, v in direct_solver_defaults(comm).items()) + ")")
+        inserted = []
+        for k, v in direct_solver_defaults(comm).items():
+            if not db.hasName(prefix + k):
+                db.setValue(prefix + k, v)
+                inserted.append(prefix + k)
+        ksp = PETSc.KSP().create(comm)
+        ksp.setOptionsPrefix(prefix)
+        ksp.setFromOptions()            # with -help in the database, PETSc prints the options here
+        ksp.destroy()
+        for k in inserted:
+            db.delValue(k)
+
+
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     bad = _bad_command(argv) or _bad_options_file(argv)
@@ -110,6 +138,7 @@ def main(argv=None):
     if cmd == "help" or "-help" in rest or "--help" in rest:
         PETSc.Sys.Print(__doc__.split("Errors in the input")[0].rstrip() + "\n")
         PETSc.Sys.Print(options.help_text())
+        _solver_help(PETSc)
         return 0                # help prints and exits: it never starts a run
     try:
         if cmd == "run":

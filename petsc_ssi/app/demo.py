@@ -15,7 +15,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+ROOT = os.path.dirname(os.path.dirname(HERE))      # the repository (this file: petsc_ssi/app/demo.py)
 
 
 def _mpi(cmd):
@@ -42,16 +42,17 @@ def building_figures(out):
     for i, (name, comp) in enumerate((("A (roof)", 0), ("A (roof)", 2), ("B (foundation)", 0),
                                       ("B (foundation)", 2))):
         k = 0 if name.startswith("A") else 1
-        lab = f"{name} {'x1' if comp == 0 else 'z'}"
-        axs[0, k].plot(t, acc[:, k, comp], label=lab.split(" ", 1)[1] if False else ("x1" if comp == 0 else "z"))
+        lab = f"{name} {'x' if comp == 0 else 'z'}"
+        axs[0, k].plot(t, acc[:, k, comp], label="x" if comp == 0 else "z")
         f, a, info = amplitude_spectrum(t, acc[:, k, comp], pad=8)
         fp, ap, _ = peaks(f, a, 3, min_separation=info["resolution"], fmin=info["resolution"])
-        axs[1, k].plot(f, a, label=("x1" if comp == 0 else "z"))
+        axs[1, k].plot(f, a, label="x" if comp == 0 else "z")
         axs[1, k].plot(fp, ap, "o", ms=4)
         found[lab] = fp
     for k, name in enumerate(("A (roof)", "B (foundation)")):
         axs[0, k].set(title=f"acceleration at {name}", xlabel="t [s]", ylabel="a [m/s^2]")
-        axs[1, k].set(title=f"spectrum at {name} (zero-padded x8)", xlabel="f [Hz]", xlim=(0, 40))
+        axs[1, k].set(title=f"spectrum at {name} (zero-padded x8)", xlabel="f [Hz]", xlim=(0, 40),
+                      ylabel="|A(f)| [m/s^2] (a sine of amplitude a peaks at a)")
         axs[0, k].legend(); axs[1, k].legend()
     fig.tight_layout()
     png1 = stem + "-accelerations.png"
@@ -67,12 +68,12 @@ def building_figures(out):
     UZ = np.r_[U[:, 2], U[:, 2]]
     c = axs[0].tricontourf(XX[:, 0], XX[:, 1], UZ, 30, cmap="RdBu_r")
     fig.colorbar(c, ax=axs[0], label="u_z [m]")
-    axs[0].set(title=f"soil surface u_z at t = {times[k]:.3g} s (half model mirrored)", xlabel="x1 [m]",
-               ylabel="x2 [m]", aspect="equal")
+    axs[0].set(title=f"soil surface u_z at t = {times[k]:.3g} s (half model mirrored)", xlabel="x [m]",
+               ylabel="y [m]", aspect="equal")
     s = 0.3 / max(np.abs(Us).max(), 1e-30)
     axs[1].plot(Xs[:, 0], Xs[:, 2], ".", color="0.7", ms=3, label="undeformed")
     axs[1].plot(Xs[:, 0] + s * Us[:, 0], Xs[:, 2] + s * Us[:, 2], ".", ms=3, label=f"deformed x {s:.3g}")
-    axs[1].set(title="structure, elevation (x1-z)", xlabel="x1 [m]", ylabel="z [m]", aspect="equal")
+    axs[1].set(title="structure, elevation (x-z)", xlabel="x [m]", ylabel="z [m]", aspect="equal")
     axs[1].legend()
     fig.tight_layout()
     png2 = stem + "-snapshot.png"

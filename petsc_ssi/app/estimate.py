@@ -40,6 +40,7 @@ def count_run(cfg, comm, ranks, node_mem, coupled=None):
     quiet = lambda m: None
     t0 = time.perf_counter()
     prob = coupled[0] if coupled is not None else HalfSpace(cfg, comm, log=quiet)
+    prob.warn_diffraction()             # the run says it at its set-up (HalfSpace.prepare), one line
     plan = prob.interp_plan()
     ls = prob.lagset(plan)
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())

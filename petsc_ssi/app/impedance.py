@@ -187,6 +187,10 @@ def main():
     bad = [m for m in modes if m not in MODES]
     if bad or not modes:
         raise SSIError(f"-ssi_impedance_modes {cfg0.impedance_modes}: modes are {', '.join(MODES)}")
+    dup = sorted({m for m in modes if modes.count(m) > 1})
+    if dup:                         # each mode writes its own file: the second would stop after the first's run
+        raise SSIError(f"-ssi_impedance_modes {cfg0.impedance_modes}: {', '.join(dup)} given twice; name each "
+                       "mode once")
     if not cfg0.disp_group:
         raise SSIError("petsc-ssi impedance needs the footing as -ssi_disp_group (a group or 'box:x0,x1,y0,y1')")
     for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group", "disp_rigid"):

@@ -133,9 +133,36 @@ def check_outputs(outputs, inputs, overwrite, flag="--overwrite"):
                 raise PostError(f"{o2} {p2}: the same file as {o1}")
 
 
-def receivers(path):
+def open_h5(path):
+    """h5py.File(path, "r"), or PostError naming ``path`` and why it cannot be read: missing,
+    a directory, not HDF5, or an HDF5 file that does not open (truncated: a run killed without
+    warning, a copy cut short)."""
     import h5py
-    with h5py.File(path, "r") as f:
+    if not os.path.exists(path):
+        raise PostError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise PostError(f"{path}: a directory, not an output file")
+    if not h5py.is_hdf5(path):
+        raise PostError(f"{path}: not an HDF5 file ({os.path.getsize(path)} bytes without HDF5's signature)")
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise PostError(f"{path}: an HDF5 file that cannot be read, truncated or damaged (a run killed "
+                        f"without warning, a copy cut short): {' '.join(str(exc).split())}") from None
+
+
+def world_rank():
+    """This process's rank under mpirun (0 outside it), from the launcher's environment: post is
+    serial, so under ``mpirun -n 2`` only rank 0 writes and reports (the others check the file and
+    exit with its status)."""
+    for k in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK", "MV2_COMM_WORLD_RANK"):
+        if os.environ.get(k, "").isdigit():
+            return int(os.environ[k])
+    return 0
+
+
+def receivers(path):
+    with open_h5(path) as f:
         if "receivers" not in f:
             raise SystemExit(f"petsc-ssi post: error: {path} holds no receiver series")
         g = f["receivers"]
@@ -154,8 +181,7 @@ def write_csv(path, out=None):
 
 def info(path, out=None):
     out = sys.stdout if out is None else out
-    import h5py
-    with h5py.File(path, "r") as f:
+    with open_h5(path) as f:
         for k, v in f.attrs.items():
             out.write(f"{k}: {v}\n")
         out.write("datasets: " + ", ".join(sorted(f.keys())[:12]) + (" ..." if len(f.keys()) > 12 else "") + "\n")
@@ -169,12 +195,9 @@ def read_series(path, series="receivers/u", receiver=0, component="all"):
     series: 'GROUP/NAME' with a sibling 'GROUP/t'; a (K, R, 3) dataset is taken at
     ``receiver``, (K, 3) and (K,) as they are.  component: x|y|z|all (3-component series).
     """
-    import h5py
-    if not os.path.exists(path):
-        raise PostError(f"{path}: no such file")
     series = series.strip("/")
     grp, _, name = series.rpartition("/")
-    with h5py.File(path, "r") as f:
+    with open_h5(path) as f:
         if series not in f:
             have = [k for k in (f[grp].keys() if grp in f else []) if k != "t"]
             hint = f" (the group {grp} holds: {', '.join(sorted(have))})" if have else \
@@ -439,6 +462,12 @@ def main(argv=None):
         ap.error("the following arguments are required: file")
     a.series = a.series or f"receivers/{a.quantity}"
     from ..spectrum import SpectrumError
+    if world_rank() > 0:            # serial: rank 0 does the work and reports; the others agree on the status
+        try:
+            open_h5(a.file).close()
+        except PostError:
+            return 2
+        return 0
     try:
         inputs = [a.file] + [_parse_ref(r, a.file, a.series)[0] for r in (a.transfer or ())]
         check_outputs([("--csv", a.csv if (a.spectrum or a.transfer) else None), ("--png", a.png),
@@ -451,6 +480,7 @@ def main(argv=None):
         if a.transfer:
             transfer_command(a)
             return 0
+        open_h5(a.file).close()
         if a.info:
             info(a.file)
         if a.receivers and a.csv:

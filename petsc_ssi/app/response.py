@@ -149,7 +149,7 @@ def load_h5(path, receiver=0, components=("x",), source="auto", arg="--receiver"
         raise _error(f"{path}: no such file")
     if os.path.isdir(path) or not h5py.is_hdf5(path):
         raise _error(f"{path}: not an HDF5 file (a table 't a' or 't ax ay az' goes with --table FILE)")
-    with h5py.File(path, "r") as f:
+    with _post.open_h5(path) as f:
         g = f.get("receivers")
         if not isinstance(g, h5py.Group) or "t" not in g:
             raise _error(f"{path} holds no receiver series (no receivers/t)")
@@ -471,6 +471,13 @@ def main(argv=None, out=None):
     """``petsc-ssi post ... --response-spectrum`` (argv: the arguments after ``post``): 0, or 2
     after one error line on stderr."""
     out = sys.stdout if out is None else out
+    if _post.world_rank() > 0:      # serial (post's rule): rank 0 works and reports; the others only
+        try:                        # check the file, for the same exit status
+            for p in (x for x in (argv or []) if x.endswith((".h5", ".hdf5"))):
+                _post.open_h5(p).close()
+        except _post.PostError:
+            return 2
+        return 0
     try:
         try:
             a = _parser().parse_args(argv)

@@ -47,8 +47,9 @@ def read_surface_mesh(cfg, comm, planes):
                 if patch:
                     params.update({"a": patch[0], "b": patch[1]})
                 from ..fem.mesh import parse_mesh_params
-                params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
-                mesh = surface.read_gmsh(cfg.mesh, params)
+                user = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
+                params.update(user)
+                mesh = surface.read_gmsh(cfg.mesh, params, tuple(user))
             mesh.check()
             z = np.abs(mesh.nodes[:, 2])
             ext = float(np.ptp(mesh.nodes[:, :2], axis=0).max()) or 1.0
@@ -216,17 +217,19 @@ class HalfSpace:
         sizes = self.mesh.element_sizes()
         lmin, lmax = sizes.min(), sizes.max()
         self.beta = (self.mat.cs * self.dt / lmax, self.mat.cp * self.dt / lmin)
-        if cfg.warn_beta and (self.beta[0] < 0.3 or self.beta[1] > 1.3):
-            warn(f"beta = c dt / l spans [{self.beta[0]:.3f}, {self.beta[1]:.3f}] (c_s with the largest, "
-                 f"c_p with the smallest node spacing), outside [0.3, 1.3]: the time marching may be "
-                 f"inaccurate or unstable")
-        for p in self.receivers:
-            self.diffraction_warning(p[None], f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g})")
+        from .stability_map import beta_warning
+        msg = beta_warning(cfg.scheme, self.mat.cs * self.dt / lmax, self.mat.cs * self.dt / lmin)
+        if cfg.warn_beta and msg:
+            warn(msg)
+        self._diffracted = []
+        for k, p in enumerate(self.receivers):
+            self.diffraction_warning(p[None], f"receiver {k} ({p[0]:g}, {p[1]:g}, {p[2]:g})")
 
     def diffraction_warning(self, points, what):
-        """Warn (rank 0) when waves from the load diffracted at the truncation edge reach any of
-        ``points`` (e.g. a receiver, or the structure's interface nodes) before t_end: the
-        earliest arrival over the points, path load -> edge -> point at c_p."""
+        """Note the earliest time at which waves from the load diffracted at the truncation edge
+        reach any of ``points`` (e.g. a receiver, or the structure's interface nodes), path load ->
+        edge -> point at c_p; ``warn_diffraction`` (from ``prepare``) says in one line which
+        arrive before t_end. Returns that time (None without a load or an edge)."""
         if not self.regions.n_load or not len(points):
             return None
         src = self.mesh.nodes[self.regions.load_nodes]
@@ -239,9 +242,18 @@ class HalfSpace:
             q, _ = symmetry.map_point(p, self.planes)
             t_d = min(t_d, (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp)
         if t_d < self.cfg.t_end:
-            warn(f"{what}: waves diffracted at the mesh edge arrive at t = {t_d:.4g} s < t_end = "
-                 f"{self.cfg.t_end:g} s")
+            self._diffracted.append((what, t_d))
         return t_d
+
+    def warn_diffraction(self):
+        """One warning line: the earliest edge-diffracted arrival and every receiver (and the
+        structure) it reaches before t_end."""
+        if self._diffracted:
+            t0 = min(t for _, t in self._diffracted)
+            warn(f"waves from the load diffracted at the mesh edge (path load -> edge -> point at c_p) arrive "
+                 f"before t_end = {self.cfg.t_end:g} s, the earliest at t = {t0:.4g} s, at "
+                 + ", ".join(f"{w} (t = {t:.4g} s)" for w, t in self._diffracted))
+        self._diffracted = []
 
     def _edge_points(self):
         """Nodes on the truncation edge (not on a symmetry plane)."""
@@ -295,6 +307,7 @@ class HalfSpace:
         printf(self.summary())
         for line in extra:
             printf(line)
+        self.warn_diffraction()
         plan = self.interp_plan()
         printf("[ssi] " + plan.describe())
         ls = self.lagset(plan)

@@ -98,7 +98,8 @@ register("check_stability", "bool", False, "", "only check stability: run a coar
          "element size, dt, scheme, interpolation) for a few hundred steps and print a verdict (runs/stability)", "bem")
 register("check_stability_steps", "int", 400, "steps", "-ssi_check_stability: at least this many steps (and at least "
          "3 x the surrogate's causal lags)", "bem", validator=at_least(100))
-register("warn_beta", "bool", True, "", "warn when beta = c dt / l leaves [0.3, 1.3]", "bem")
+register("warn_beta", "bool", True, "", "warn when beta_s = c_s dt / l leaves what the stability map (runs/stability) "
+         "found stable for the scheme in use", "bem")
 
 
 def _bem_checks(cfg):

@@ -35,6 +35,12 @@ class BEMTransient(TransientProblem):
         self.march = self.rec = self.out = None
         self.footing = None                  # -ssi_disp_rigid massless (bem/input_motion.py)
         self.state = None
+        self.check_disk()
+
+    def output_bytes(self):
+        g, p = self.grid, self.prob
+        return {"soil fields": self.field_bytes(p.mesh.n_nodes, 2, g),       # displacement, traction
+                "soil receivers": 8.0 * 3 * len(p.receivers) * g.n_steps}
 
     def setup(self):
         self._advance("created", "set up")

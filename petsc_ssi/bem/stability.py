@@ -34,6 +34,8 @@ import numpy as np
 
 from ..petsc import SSIError, printf
 
+from .stability_map import MAP_STABLE_FROM, MAP_BETA_MAX, beta_warning  # noqa: F401  (re-exported)
+
 RATE_SLOW = 1e-4
 RATE_UNSTABLE = 2e-3
 FIT_FRACTION = 1.0 / 3.0
@@ -209,9 +211,9 @@ def guard(cfg, prob, march, unorm, n):
     if march.scheme == "plain":
         causes.append(f"the plain scheme (eq. 6) is unstable for small beta = c_s dt / l (here {prob.beta[0]:.3g}; "
                       "runs/stability/README.md maps where): use -ssi_scheme stabilized")
-    if prob.beta[0] < 0.3 or prob.beta[1] > 1.3:
-        causes.append(f"beta = c dt / l spans [{prob.beta[0]:.2f}, {prob.beta[1]:.2f}], outside [0.3, 1.3]: "
-                      "change -ssi_dt or the mesh")
+    beta = beta_warning(march.scheme, prob.beta[0], prob.beta[1] * prob.mat.cs / prob.mat.cp)
+    if beta:
+        causes.append(beta.split(": the marching")[0] + ": change -ssi_dt or the mesh")
     plan = getattr(march, "plan", None)
     if plan is not None:
         causes.append(f"lag interpolation from T_L = {plan.TL:.4g} s: a threshold below the Rayleigh "
@@ -244,5 +246,6 @@ class DivergenceGuard:
         nrm = self.norms.values[-1]
         if not np.isfinite(nrm):
             raise SSIError(f"the solution is not finite at step {n} (t = {t:.4g} s): |u| = {nrm}; likely cause: "
-                           f"beta = c dt / l spans [{self.prob.beta[0]:.2f}, {self.prob.beta[1]:.2f}] (keep it "
-                           "in [0.3, 1.3]) or the scheme")
+                           f"beta_s = c_s dt / l from {self.prob.beta[0]:.2f} (the stability map's stable range "
+                           f"for -ssi_scheme {self.cfg.scheme}: from {MAP_STABLE_FROM.get(self.cfg.scheme, 0):g} to "
+                           f"{MAP_BETA_MAX:g}) or the scheme")

@@ -9,7 +9,7 @@ from ..options import Config
 from ..bem.halfspace import HalfSpace
 from ..bem.lagset import Regions
 from ..fem.model import build_model
-from .interface import build_interface, fem_symmetry_dofs
+from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces
 from .step import STRATEGIES
 
 
@@ -18,6 +18,18 @@ def _view(cfg, **changes):
     vals = cfg.as_dict()
     vals.update(changes)
     return Config(vals, cfg.sources())
+
+
+def check_on_surface(mesh, groups):
+    """SSIError when the structure's interface faces (-ssi_fem_interface) do not lie on the soil's
+    surface z = 0 (a structure placed above or below the soil), naming their heights."""
+    z = mesh.coords[np.unique(fe_interface_faces(mesh, groups)), 2]
+    ext = float(np.ptp(mesh.coords, axis=0).max()) or 1.0
+    if np.abs(z).max() > 1e-6 * ext:
+        where = "above" if z.min() > 0 else "below" if z.max() < 0 else "off"
+        raise SSIError(f"-ssi_fem_interface {groups}: the structure's interface faces lie at z = {z.min():.6g} .. "
+                       f"{z.max():.6g} m, {where} the soil's surface z = 0 (they must rest on it: move the "
+                       "structure, e.g. -ssi_fem_box_origin, or its mesh)")
 
 
 def build_coupled(cfg, comm):
@@ -31,7 +43,8 @@ def build_coupled(cfg, comm):
              f"ignored (the interface is {cfg.contact})", comm)
     prob = HalfSpace(cfg, comm, log=printf, defer_seismic=True)     # the wave's control point: the interface
     fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
-    model = build_model(fe_cfg, comm, assemble_matrices=False)
+    model = build_model(fe_cfg, comm, assemble_matrices=False, receivers_what="-ssi_structure_receivers",
+                        check_mesh=lambda mesh: check_on_surface(mesh, cfg.fem_interface))
     iface = sym = None
     with collective(comm, "matching the interface"):
         iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,

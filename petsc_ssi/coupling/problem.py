@@ -63,6 +63,19 @@ class SSITransient(TransientProblem):
         self.grid = self.prob.grid
         self.coupler = self.rec = self.forces = self.demands = None
         self.state = None
+        self.check_disk()
+
+    def output_bytes(self):
+        from ..fem.problem import structure_bytes
+        g, p = self.grid, self.prob
+        out = {"soil fields": self.field_bytes(p.mesh.n_nodes, 2, g),
+               "soil receivers": 8.0 * 3 * len(p.receivers) * g.n_steps}
+        out.update(structure_bytes(self.model, g))
+        # the interface's nodal series (u_f, u_b, p and u_f_check/u_ff: 3 per node; gap, p_N, closed: 1)
+        # every -ssi_interface_stride steps
+        kept = g.n_steps // max(1, int(self.cfg.interface_stride))
+        out["interface series"] = 8.0 * (5 * 3 + 3) * self.iface.n * kept
+        return out
 
     def setup(self):
         self._advance("created", "set up")

@@ -227,7 +227,7 @@ def parse_mesh_params(text, what="-ssi_fem_mesh_params"):
     return out
 
 
-def read_gmsh(path, specs=None, params=None):
+def read_gmsh(path, specs=None, params=None, user=None):
     """Serial: read a .msh, or mesh a .geo in 3D, with gmsh; return a StructureMesh.
 
     ``specs``: the parts ([parts.PartSpec]); None: one hex8 part of every brick
@@ -235,7 +235,7 @@ def read_gmsh(path, specs=None, params=None):
     existed). Raises SSIError on any check of the module docstring."""
     from ..mesh import gmsh as reader
     from .parts import parse_parts
-    model = reader.read(path, dim=3, params=params)
+    model = reader.read(path, dim=3, params=params, user=tuple(params or ()) if user is None else user)
     if specs is None:
         from types import SimpleNamespace
         specs = parse_parts(SimpleNamespace(get=lambda *a: "", fem_E=1.0, fem_nu=0.0, fem_rho=1.0), raw={})
@@ -497,9 +497,14 @@ def build_mesh(cfg, specs=None):
         if specs is not None and not all(s.legacy for s in specs):
             raise SSIError("-ssi_fem_parts needs a gmsh mesh (-ssi_fem_mesh FILE.geo|.msh); the box generator "
                            "makes one hex8 part")
-        mesh = structured_box(parse_triple(cfg.fem_box_cells, int, "-ssi_fem_box_cells"),
-                              parse_triple(cfg.fem_box_size, float, "-ssi_fem_box_size"),
-                              parse_triple(cfg.fem_box_origin, float, "-ssi_fem_box_origin"))
+        cells = parse_triple(cfg.fem_box_cells, int, "-ssi_fem_box_cells")
+        size = parse_triple(cfg.fem_box_size, float, "-ssi_fem_box_size")
+        if min(cells) < 1:
+            raise SSIError(f"-ssi_fem_box_cells {cfg.fem_box_cells}: need at least one brick per direction")
+        if not min(size) > 0:
+            raise SSIError(f"-ssi_fem_box_size {cfg.fem_box_size}: the box's lengths lx,ly,lz must be > 0 m "
+                           "(place the box with -ssi_fem_box_origin, its lowest corner)")
+        mesh = structured_box(cells, size, parse_triple(cfg.fem_box_origin, float, "-ssi_fem_box_origin"))
         if specs is not None:
             mesh.blocks[0].props = specs[0].props
         return mesh

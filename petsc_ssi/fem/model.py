@@ -70,11 +70,11 @@ def structure_receivers(mesh, text, what="-ssi_receivers"):
     return np.concatenate(pts), np.concatenate(nodes).astype(np.int64), np.concatenate(dist)
 
 
-def _inputs(mesh, cfg, dofmap):
+def _inputs(mesh, cfg, dofmap, receivers_what="-ssi_receivers"):
     fixed = fixed_dofs(mesh, cfg.fem_fixed, dofmap)
     F, pdist = nodal_load(mesh, cfg, dofmap)
     pm, mdist = point_masses(mesh, cfg.get("fem_point_mass", ""), dofmap)
-    pts, nodes, dist = structure_receivers(mesh, cfg.receivers)
+    pts, nodes, dist = structure_receivers(mesh, cfg.receivers, receivers_what)
     return fixed, F, pts, nodes, dist, np.r_[pdist, mdist], pm
 
 
@@ -89,8 +89,13 @@ def describe_parts(mesh, material=None, log=printf):
     return parts, total
 
 
-def build_model(cfg, comm, assemble_matrices=True, log=printf):
-    """Collective: parse the parts, read the mesh, check the inputs, then assemble K and M."""
+def build_model(cfg, comm, assemble_matrices=True, log=printf, receivers_what="-ssi_receivers", check_mesh=None):
+    """Collective: parse the parts, read the mesh, check the inputs, then assemble K and M.
+
+    ``receivers_what``: the option that named ``cfg.receivers`` (for its errors);
+    ``check_mesh(mesh)``: the caller's own check of the mesh (raises SSIError), run before
+    the inputs are checked against it (a structure placed wrong is then named as such, not
+    as a receiver outside it)."""
     init()
     specs = None
     with collective(comm, "parsing -ssi_fem_parts"):
@@ -98,7 +103,9 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf):
     mesh = load_mesh(cfg, comm, specs)
     dofmap = DofMap(mesh.has_rotation(), comm, mesh.released_nodes())
     with collective(comm, "checking the structure's inputs"):
-        fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap)
+        if check_mesh is not None:
+            check_mesh(mesh)
+        fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap, receivers_what)
     dofmap.set_fixed(fixed)
     fixed = dofmap.fixed                  # the section's constraints are the record of the supports
     counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())

@@ -55,6 +55,10 @@ class FEMTransient(TransientProblem):
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
         self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None
+        self.check_disk()
+
+    def output_bytes(self):
+        return structure_bytes(self.model, self.grid)
 
     def setup(self):
         self._advance("created", "set up")
@@ -230,3 +234,13 @@ def _plot(path, t, u):
     fig.tight_layout()
     fig.savefig(os.path.splitext(path)[0] + ".png", dpi=120)
     plt.close(fig)
+
+
+def structure_bytes(model, grid):
+    """{what: bytes} of the structure's output: displacement, velocity (and rotation where the
+    model has rotations) every snapshot; u, velocity, acceleration, rotation of every receiver
+    every step."""
+    from ..problem import TransientProblem
+    rot = bool(np.any(model.dofmap.has_rotation))
+    return {"structure fields": TransientProblem.field_bytes(model.mesh.n_nodes, 3 if rot else 2, grid),
+            "structure receivers": 8.0 * 3 * 4 * len(model.receivers) * grid.n_steps}

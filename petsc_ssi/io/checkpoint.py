@@ -46,7 +46,8 @@ RUN_CONTROL = frozenset((
     "output", "output_overwrite", "output_flush", "output_stride", "monitor", "monitor_every", "plot",
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
     "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
-    "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load"))
+    "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
+    "huge_pages", "disk_check"))
 
 
 def _file_digest(path):
@@ -72,7 +73,8 @@ def run_key(cfg, exclude=RUN_CONTROL):
 
 def key_difference(saved, now):
     """The first option that differs between two keys, as a phrase, or None. An option the
-    checkpoint's version did not have counts as its default there (an option added since)."""
+    checkpoint's version did not have counts as its default there (an option added since). An
+    option naming an input file compares by the file's SHA-256, not its path."""
     from ..options import _REGISTRY
     for name in sorted(set(saved) | set(now)):
         a, b = saved.get(name), now.get(name)
@@ -81,6 +83,11 @@ def key_difference(saved, now):
             a = repr(d) if isinstance(d, float) else str(d)
         if a == b:
             continue
+        fa, fb = saved.get("file:" + name), now.get("file:" + name)
+        if fa is not None and fa == fb:
+            continue            # the same input file at another path (moved, copied): the same run
+        if fa is not None and fb is not None:
+            name = "file:" + name
         if name.startswith("file:"):
             return f"the file of -ssi_{name[5:]} changed since the checkpoint (SHA-256 differs)"
         return f"-ssi_{name} is {b if b is not None else '(unset)'} here and was {a if a is not None else '(unset)'}"

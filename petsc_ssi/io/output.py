@@ -57,6 +57,26 @@ def mixed_topology(blocks):
 
 SIDECARS = (".xmf", ".json")
 
+# The ``unit`` attribute of the datasets whose names are fixed ("1": a count, index, flag or a
+# relative number): the snapshots' fields (``<field>_NNNNNN``), the receivers' group (soil and
+# structure) and the coupled run's interface group. A group written as (array, unit) tuples gives
+# its own; README "Output files" lists them all.
+UNITS = {
+    "displacement": "m", "traction": "N/m^2", "velocity": "m/s", "rotation": "rad", "acceleration": "m/s^2",
+    "mode_shape": "1 (the mode vector scaled to max |entry| = 1)",
+    "mode_shape_rotation": "1 (rotations of the same scaled vector)",
+    "receivers/points": "m", "receivers/t": "s", "receivers/u": "m", "receivers/velocity": "m/s",
+    "receivers/acceleration": "m/s^2", "receivers/rotation": "rad", "receivers/nodes": "1",
+    "receivers/node_points": "m", "receivers/snap_distance": "m", "receivers/has_rotation": "1",
+    "receivers/ground_acceleration": "m/s^2", "receivers/absolute_acceleration": "m/s^2",
+    "interface/t": "s", "interface/x": "m", "interface/normal": "1", "interface/uf": "m", "interface/ub": "m",
+    "interface/uf_check": "m", "interface/uff": "m", "interface/p": "N/m^2", "interface/gap": "m",
+    "interface/pN": "N/m^2", "interface/closed": "1", "interface/n_open": "1", "interface/iterations": "1",
+    "interface/changes": "1", "interface/force_fe": "N", "interface/force_be": "N", "interface/moment_fe": "N m",
+    "interface/moment_be": "N m", "interface/bem_residual": "1", "interface/force_map_error": "N",
+    "interface/nodal_steps": "1", "interface/t_nodal": "s",
+}
+
 
 def output_files(path):
     """The files a run with -ssi_output ``path`` writes: the HDF5 file and its sidecars."""
@@ -330,14 +350,11 @@ class Output:
             f.attrs["petsc_ssi_version"] = __version__
             for k, v in (attrs or {}).items():
                 f.attrs[k] = v
-            if receivers is not None:
-                g = _group(f, "receivers")
-                for k, v in receivers.items():
-                    g.create_dataset(k, data=np.asarray(v), track_times=False)
-            for gname, data in (groups or {}).items():
+            for gname, data in ((("receivers", receivers),) if receivers is not None else ()) + \
+                    tuple((groups or {}).items()):
                 g = _group(f, gname)
                 for k, v in data.items():
-                    unit, extra = None, {}
+                    unit, extra = UNITS.get(f"{gname}/{k}"), {}
                     if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
                         v, unit = v                     # (array, unit): the unit as an attribute
                     elif isinstance(v, tuple) and len(v) == 3 and isinstance(v[1], str):
@@ -347,6 +364,7 @@ class Output:
                         d.attrs["unit"] = unit
                     for ak, av in extra.items():
                         d.attrs[ak] = av
+            self._field_units(f, (attrs or {}).get("time_is"))
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
@@ -359,6 +377,21 @@ class Output:
             with open(tmp, "w") as fh:
                 json.dump(record, fh, indent=1, sort_keys=True, default=str)
             os.replace(tmp, os.path.splitext(self.path)[0] + ".json")
+
+    def _field_units(self, f, time_is=None):
+        """Rank 0: ``unit`` attributes of the datasets the PETSc viewer wrote (coordinates and the
+        snapshots' fields, UNITS), of time and topology; snapshots already done are skipped."""
+        for name, unit in (("coordinates", "m"), ("topology", "1"),
+                           ("time", "1 (" + time_is + ")" if time_is else "s")):
+            if name in f and f[name].attrs.get("unit") != unit:
+                f[name].attrs["unit"] = unit
+        done = getattr(self, "_units_done", 0)
+        for k in range(done, len(self.times)):
+            for name in self.fields:
+                d = f.get(f"{name}_{k:06d}")
+                if d is not None:
+                    d.attrs["unit"] = UNITS.get(name, "")
+        self._units_done = len(self.times)
 
     def _write_xdmf(self):
         if self.cells is None:

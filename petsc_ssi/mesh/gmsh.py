@@ -46,11 +46,15 @@ class GmshModel:
     source: str = ""
 
 
-def read(path, dim=3, order=1, params=None):
+def read(path, dim=3, order=1, params=None, user=(), what="-ssi_fem_mesh_params"):
     """Serial: read ``path`` (.msh, or .geo meshed up to ``dim``) with gmsh; see the module docstring.
 
     ``params``: {name: value} set as ONELAB 'Parameters/<name>' before a .geo is
-    opened (DefineConstant parameters). SSIError if gmsh cannot read or mesh it."""
+    opened (DefineConstant parameters). ``user``: the names among them the user gave
+    (option ``what``): each must be a parameter the .geo declares, inside the range it
+    declares (``Min``, ``Max``; ``Step 1`` with an integer ``Min``: an integer), checked
+    before gmsh sees the values, so a parameter that empties a group or breaks
+    the .geo is named as the cause. SSIError if gmsh cannot read or mesh it."""
     import gmsh
     own = not gmsh.isInitialized()
     if own:
@@ -58,6 +62,14 @@ def read(path, dim=3, order=1, params=None):
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         try:
+            if path.endswith(".geo") and user:
+                # the declarations (names, ranges) from the .geo with its defaults, checked before
+                # the user's values reach gmsh: a value that breaks the .geo is then named as the
+                # cause, and gmsh's parser is spared an error (after one, it fails the next file
+                # it opens in this process)
+                declared = _declared(gmsh, path)
+                if declared is not None:
+                    _check_params(declared, path, {k: params[k] for k in user}, what)
             if path.endswith(".geo"):
                 for k, v in (params or {}).items():
                     gmsh.onelab.setNumber(f"Parameters/{k}", [float(v)])
@@ -75,6 +87,44 @@ def read(path, dim=3, order=1, params=None):
     finally:
         if own:
             gmsh.finalize()
+
+
+def _declared(gmsh, path):
+    """{name: onelab record} of the parameters ``path`` declares (DefineConstant ... Name
+    "Parameters/<name>"), read by opening it with its defaults; None if that fails."""
+    import json
+    import re
+    try:
+        with open(path, errors="replace") as fh:     # onelab also lists names only set, never declared:
+            names = set(re.findall(r'Name\s*"Parameters/(\w+)"', fh.read()))   # the file says which
+        gmsh.open(path)
+        onelab = {p["name"].split("/", 1)[1]: p for p in json.loads(gmsh.onelab.get())["onelab"]["parameters"]
+                  if p.get("type") == "number" and p["name"].startswith("Parameters/")}
+    except Exception:
+        return None
+    finally:
+        gmsh.clear()
+        gmsh.onelab.clear()
+    return {k: onelab.get(k, {}) for k in names}
+
+
+def _check_params(declared, path, given, what):
+    """SSIError naming the first of ``given`` ({name: value}) that ``path`` does not declare or
+    that lies outside its declared range (``declared``: ``_declared``'s)."""
+    for name, v in given.items():
+        p = declared.get(name)
+        if p is None:
+            raise SSIError(f"{what} {name}={v:g}: '{path}' has no parameter '{name}' (its parameters: "
+                           f"{', '.join(sorted(declared)) or 'none'})")
+        lo, hi = p.get("min", -1e200), p.get("max", 1e200)
+        choices = p.get("choices")
+        if choices and not any(v == c for c in choices):
+            raise SSIError(f"{what} {name}={v:g}: '{path}' allows {name} in {{{', '.join(f'{c:g}' for c in choices)}}}")
+        if not lo <= v <= hi:
+            rng = f"[{lo:g}, {hi:g}]" if hi < 1e199 else f">= {lo:g}" if lo > -1e199 else f"<= {hi:g}"
+            raise SSIError(f"{what} {name}={v:g}: '{path}' declares {name} {rng}")
+        if p.get("step") == 1 and float(lo).is_integer() and not float(v).is_integer():
+            raise SSIError(f"{what} {name}={v:g}: '{path}' declares {name} an integer")
 
 
 def _model(gmsh, path):

@@ -154,17 +154,18 @@ def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
     return SurfaceMesh(nodes, cells, groups, name="grid")
 
 
-def read_gmsh(path, params=None):
+def read_gmsh(path, params=None, user=()):
     """Read nine-node quads (gmsh type 10) from a .msh, or mesh a .geo first
     (order 2), through the one gmsh reader (``mesh/gmsh.py``).
 
     ``params``: {name: value} set with gmsh.onelab/setNumber before meshing a
-    .geo (DefineConstant parameters). Physical surface groups become element
+    .geo (DefineConstant parameters); ``user``: those the user named (-ssi_mesh_params),
+    checked against the .geo's declarations. Physical surface groups become element
     groups. Collective callers should call this on every rank (it is cheap)
     or broadcast the result.
     """
     from . import gmsh as gmsh_reader
-    model = gmsh_reader.read(path, dim=2, order=2, params=params)
+    model = gmsh_reader.read(path, dim=2, order=2, params=params, user=user, what="-ssi_mesh_params")
     other2d = dict(gmsh_reader.unknown_of_dim(model, 2))
     if "quad4" in model.blocks:
         other2d["Quadrilateral 4"] = len(model.blocks["quad4"])

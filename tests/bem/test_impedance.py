@@ -125,6 +125,7 @@ def test_disk_against_veletsos_and_verbic(tmp_path):
 def test_bad_input(tmp_path):
     out = ["-ssi_output", str(tmp_path / "x.h5")]
     for extra, msg in ((["-ssi_impedance_modes", "swaying"], "modes are vertical"),
+                       (["-ssi_impedance_modes", "vertical,rocking,vertical"], "vertical given twice"),
                        (["-ssi_symmetry", "x=sym"], "sets -ssi_symmetry itself"),
                        (["-ssi_disp_group", ""], "needs the footing as -ssi_disp_group")):
         p = cli(["impedance"] + CASE + out + extra, nranks=2, check=False)
