@@ -62,3 +62,18 @@ def test_impedance_of_an_off_centre_footing_uses_only_its_planes(tmp_path):
     a, b = _K0(tmp_path / "sym-impedance.csv"), _K0(tmp_path / "whole-impedance.csv")
     for mode in ("vertical", "rocking"):
         assert abs(a[mode] / b[mode] - 1) < 1e-6, (mode, a[mode], b[mode])
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_impedance_needs_soil_around_the_footing(tmp_path, n):
+    """The whole meshed surface as the footing (-ssi_disp_group surface), or a footing reaching the
+    surface's edge, was run and compared with Pais & Kausel without a word; now refused in one line
+    before the runs."""
+    args = IMP + ["-ssi_output", str(tmp_path / "i.h5"), "-ssi_impedance_modes", "vertical"]
+    line = one_line_error(cli(args + ["-ssi_disp_group", "surface"], nranks=n, check=False))
+    assert line == ("petsc-ssi: error: -ssi_disp_group surface: the footing is the whole meshed surface; petsc-ssi "
+                    "impedance needs the footing as a part of the surface with soil around it (mesh a larger "
+                    "surface or name a smaller group)")
+    r = cli(args + ["-ssi_disp_group", "box:1,3,-1,1"], nranks=n, check=False)
+    assert "the footing reaches the edge of the meshed surface (at x = 3, y = " in one_line_error(r)
+    assert "[impedance] mode" not in r.stdout
