@@ -38,11 +38,12 @@
 //   hc         column element size [m] (0.3)
 //   half       0: full building; 1: the half y >= 0 (symmetry about y = 0)
 DefineConstant[
-  nbx = {4, Name "Parameters/nbx"}, nby = {3, Name "Parameters/nby"},
-  sx = {3.6, Name "Parameters/sx"}, sy = {3.6, Name "Parameters/sy"},
-  ns = {3, Name "Parameters/ns"}, hs = {3.0, Name "Parameters/hs"},
-  h = {0.6, Name "Parameters/h"}, hc = {0.3, Name "Parameters/hc"},
+  nbx = {4, Name "Parameters/nbx", Min 1, Step 1}, nby = {3, Name "Parameters/nby", Min 1, Step 1},
+  sx = {3.6, Name "Parameters/sx", Min 1e-6}, sy = {3.6, Name "Parameters/sy", Min 1e-6},
+  ns = {3, Name "Parameters/ns", Min 1, Step 1}, hs = {3.0, Name "Parameters/hs", Min 1e-6},
+  h = {0.6, Name "Parameters/h", Min 1e-6}, hc = {0.3, Name "Parameters/hc", Min 1e-6},
   half = {0, Name "Parameters/half", Choices {0, 1}} ];
+// (Min, Step, Choices: the values petsc-ssi accepts in -ssi_fem_mesh_params; gmsh itself does not check)
 
 Lx = nbx * sx; Ly = nby * sy; tol = 1e-6 * (sx + sy);
 

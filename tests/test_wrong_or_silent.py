@@ -77,3 +77,110 @@ def test_impedance_needs_soil_around_the_footing(tmp_path, n):
     r = cli(args + ["-ssi_disp_group", "box:1,3,-1,1"], nranks=n, check=False)
     assert "the footing reaches the edge of the meshed surface (at x = 3, y = " in one_line_error(r)
     assert "[impedance] mode" not in r.stdout
+
+
+# ------------------------------------------------------------ options that do nothing in the run given
+
+BEM = ["-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load",
+       "-ssi_load_p0", "1", "-ssi_dt", "0.005", "-ssi_t_end", "0.01", "-ssi_warn_beta", "0", "-ssi_output_overwrite"]
+FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_t_end", "0.01", "-ssi_dt", "0.005",
+       "-ssi_output", ""]
+BUILDING = ["static", "-options_file", "runs/building/fixed-base.opts", "-ssi_output_overwrite"]
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_options_of_another_kind_of_run_are_named(tmp_path, n):
+    """-ssi_fem_* and -ssi_contact in a BEM run, -ssi_lags_load and -ssi_memory_limit in a FEM run: one
+    warning line naming them, before the run (the run goes on: a shared options file is legitimate)."""
+    r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_fem_E", "1e9", "-ssi_contact", "bonded"], nranks=n)
+    warns = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: warning: options this run does not read")]
+    assert warns == ["petsc-ssi: warning: options this run does not read (fem, ssi options; it reads the common and "
+                     "bem, seismic ones): -ssi_fem_E -ssi_contact"], r.stdout
+    assert r.stdout.index(warns[0]) < r.stdout.index("[ssi] BEM:"), r.stdout
+    if n == 1:
+        r = cli(FEM + ["-ssi_lags_load", str(tmp_path / "lags"), "-ssi_memory_limit", "3"])
+        assert ("petsc-ssi: warning: options this run does not read (bem options; it reads the common and fem, "
+                "seismic ones): -ssi_lags_load -ssi_memory_limit") in r.stdout, r.stdout
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_solver_options_without_our_prefix_are_refused(tmp_path, n):
+    """-ksp_type / -pc_type reach no solver (ours are -ssi_bem_, -ssi_fem_, -ssi_modes_ prefixed):
+    refused in one line, naming the prefixed spelling, instead of a run with the defaults."""
+    r = cli(FEM + ["-ksp_type", "gmres", "-pc_type", "jacobi"], nranks=n, check=False)
+    line = one_line_error(r)
+    assert line.startswith("petsc-ssi: error: -ksp_type: no solver of petsc-ssi reads PETSc options without its "
+                           "prefix; write -ssi_bem_ksp_type or -ssi_fem_ksp_type"), line
+    assert line.endswith("(also: -pc_type)"), line
+    assert "[fem]" not in r.stdout
+
+
+COUPLED = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800",
+           "-ssi_mesh_size", "2,2", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5",
+           "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size", "1,1,0.5", "-ssi_dt", "0.0125", "-ssi_t_end", "0.025",
+           "-ssi_warn_beta", "0", "-ssi_output_overwrite"]
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_interface_offset_on_bricks_is_refused(tmp_path, n):
+    """-ssi_interface_offset offsets a shell slab's interface; on brick faces it did nothing, silently."""
+    r = cli(COUPLED + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_interface_offset", "1"], nranks=n, check=False)
+    assert one_line_error(r) == ("petsc-ssi: error: -ssi_interface_offset: the interface (-ssi_fem_interface base) "
+                                 "has no shell slab nodes; the offset applies to a shell foundation slab only and "
+                                 "does nothing here: drop it")
+    assert "assembl" not in r.stdout.lower(), r.stdout
+
+
+MESH_PARAMS = [
+    ("nbxx=2", "-ssi_fem_mesh_params: 'nbxx' is not a parameter of meshes/building.geo (did you mean nbx?); its "
+               "parameters: nbx, nby, sx, sy, ns, hs, h, hc, half"),
+    ("h=-1", "-ssi_fem_mesh_params: h=-1: meshes/building.geo needs h >= 1e-06"),
+    ("half=2", "-ssi_fem_mesh_params: half=2: meshes/building.geo allows half in {0, 1} only"),
+    ("ns=2.5", "-ssi_fem_mesh_params: ns=2.5: meshes/building.geo needs ns in steps of 1 from 1"),
+]
+
+
+@pytest.mark.parametrize("params, msg", MESH_PARAMS, ids=[p for p, _ in MESH_PARAMS])
+def test_mesh_params_the_geo_cannot_use_are_refused(tmp_path, params, msg):
+    """gmsh takes an undeclared ONELAB parameter (a misspelt name) or a value out of the .geo's declared
+    range without a word: the building was meshed with its defaults, or with h = -1, and solved."""
+    r = cli(BUILDING + ["-ssi_output", str(tmp_path / "s.h5"), "-ssi_fem_mesh_params", params], check=False)
+    assert one_line_error(r) == "petsc-ssi: error: " + msg
+    assert "[static]" not in r.stdout
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_mesh_params_without_a_geo_and_a_zero_mass_per_area_are_refused(tmp_path, n):
+    line = one_line_error(cli(FEM + ["-ssi_fem_mesh_params", "h=1"], nranks=n, check=False))
+    assert line.startswith("petsc-ssi: error: -ssi_fem_mesh_params: the box generator (-ssi_fem_mesh box) has no "
+                           "parameters"), line
+    line = one_line_error(cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_mesh_params", "h=1"], nranks=n,
+                              check=False))
+    assert line.startswith("petsc-ssi: error: -ssi_mesh_params: the grid generator (-ssi_mesh grid) has no "
+                           "parameters"), line
+    # mass_per_area 0 meant 'not given': the slab kept rho * thickness, silently
+    r = cli(BUILDING + ["-ssi_output", str(tmp_path / "s.h5"), "-ssi_fem_part_roof_mass_per_area", "0"], nranks=n,
+            check=False)
+    assert one_line_error(r) == ("petsc-ssi: error: -ssi_fem_part_roof_mass_per_area 0: must be > 0 (0 does nothing: "
+                                 "the shell's mass per area stays rho * thickness; for a massless shell set "
+                                 "-ssi_fem_part_roof_rho 0)")
+
+
+@pytest.mark.parametrize("args, msg", [
+    (["--spectrum", "--fmax", "-1"], "--fmax -1: must be > 0 Hz"),
+    (["--spectrum", "--peaks", "-3"], "--peaks -3: must be >= 0"),
+    (["--spectrum", "--min-sep", "-1"], "--min-sep -1: must be >= 0 Hz"),
+    (["--transfer", "0", "0", "--eps", "0"], "--eps 0: must be > 0"),
+])
+def test_post_numbers_out_of_range_are_refused(tmp_path, args, msg):
+    """post --fmax -1 kept no frequency and --peaks -3 printed none, with status 0."""
+    import h5py
+    import numpy as np
+    path = str(tmp_path / "r.h5")
+    t = np.arange(64) * 0.01
+    with h5py.File(path, "w") as f:
+        f["receivers/t"] = t
+        f["receivers/u"] = np.sin(2 * np.pi * 10 * t)[:, None, None] * np.ones((1, 1, 3))
+        f["receivers/points"] = np.zeros((1, 3))
+    r = cli(["post", path] + args, check=False)
+    assert r.returncode == 2 and r.stderr.strip() == f"petsc-ssi post: error: {msg}", (r.stdout, r.stderr)

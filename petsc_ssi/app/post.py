@@ -337,6 +337,22 @@ def transfer_command(a, out=None):
 
 # ---------------------------------------------------------------- command line
 
+def _check_numbers(a):
+    """PostError for a number option out of its range (argparse checks only the type): a negative
+    --fmax kept no frequency, a negative --peaks printed none, without a word."""
+    rules = [("fmax", a.fmax, lambda v: v > 0, "must be > 0 Hz"),
+             ("peaks", a.peaks, lambda v: v >= 0, "must be >= 0"),
+             ("pad", a.pad, lambda v: v >= 1, "must be >= 1 (a factor on the number of samples)"),
+             ("min-sep", a.min_sep, lambda v: v >= 0, "must be >= 0 Hz"),
+             ("fmin", a.fmin, lambda v: v >= 0, "must be >= 0 Hz"),
+             ("eps", a.eps, lambda v: v > 0, "must be > 0"),
+             ("tukey-alpha", a.tukey_alpha, lambda v: 0 <= v <= 1, "must lie in [0, 1]"),
+             ("receiver", a.receiver, lambda v: v >= 0, "must be >= 0")]
+    for name, value, ok, why in rules:
+        if value is not None and not (np.isfinite(value) and ok(value)):
+            raise PostError(f"--{name} {value:g}: {why}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -374,6 +390,7 @@ def main(argv=None):
     a.series = a.series or f"receivers/{a.quantity}"
     from ..spectrum import SpectrumError
     try:
+        _check_numbers(a)
         if a.spectrum and a.transfer:
             raise PostError("give either --spectrum or --transfer, not both")
         if a.spectrum:

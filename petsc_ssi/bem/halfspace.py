@@ -5,6 +5,8 @@ before any assembly: the surface mesh (``read_surface_mesh``), the regions (load
 the receivers, the lags and the interpolation plan, the node partition (``lagset``) and the
 memory check (``check_memory``). ``bem.build.build_marcher`` then assembles.
 """
+import os
+
 import numpy as np
 
 from ..petsc import SSIError, collective, printf, warn
@@ -38,6 +40,9 @@ def read_surface_mesh(cfg, comm, planes):
     mesh = None
     with collective(comm, f"-ssi_mesh {cfg.mesh}", "{what}: cannot read the mesh ({error})"):
         if comm.getRank() == 0:
+            if cfg.mesh == "grid" and str(cfg.get("mesh_params", "") or "").strip():
+                raise SSIError("-ssi_mesh_params: the grid generator (-ssi_mesh grid) has no parameters; they set "
+                               "the DefineConstant parameters of a .geo given as -ssi_mesh")
             if cfg.mesh == "grid":
                 mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
             else:
@@ -47,7 +52,11 @@ def read_surface_mesh(cfg, comm, planes):
                 if patch:
                     params.update({"a": patch[0], "b": patch[1]})
                 from ..fem.mesh import parse_mesh_params
-                params.update(parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params"))
+                user = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
+                if user and os.path.exists(cfg.mesh):
+                    from ..mesh.gmsh import check_parameters
+                    check_parameters(cfg.mesh, user, "-ssi_mesh_params")
+                params.update(user)
                 mesh = surface.read_gmsh(cfg.mesh, params)
             mesh.check()
             z = np.abs(mesh.nodes[:, 2])

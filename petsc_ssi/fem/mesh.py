@@ -30,6 +30,7 @@ coincident nodes that should be merged, each element's own geometry check
 (zero length or area, inverted cells, a frame orientation parallel to the
 member), and a group with nodes in no element (unconnected) when it is used.
 """
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -494,6 +495,9 @@ def renumber_rcm(mesh):
 def build_mesh(cfg, specs=None):
     """Serial: the mesh the options describe (no renumbering). ``specs``: the parts."""
     if cfg.fem_mesh == "box":
+        if str(cfg.get("fem_mesh_params", "") or "").strip():
+            raise SSIError("-ssi_fem_mesh_params: the box generator (-ssi_fem_mesh box) has no parameters; they "
+                           "set the DefineConstant parameters of a .geo given as -ssi_fem_mesh")
         if specs is not None and not all(s.legacy for s in specs):
             raise SSIError("-ssi_fem_parts needs a gmsh mesh (-ssi_fem_mesh FILE.geo|.msh); the box generator "
                            "makes one hex8 part")
@@ -506,6 +510,9 @@ def build_mesh(cfg, specs=None):
     params = parse_mesh_params(cfg.get("fem_mesh_params", ""))
     if params and not cfg.fem_mesh.endswith(".geo"):
         raise SSIError("-ssi_fem_mesh_params needs a .geo mesh (-ssi_fem_mesh)")
+    if params and os.path.exists(cfg.fem_mesh):
+        from ..mesh.gmsh import check_parameters
+        check_parameters(cfg.fem_mesh, params, "-ssi_fem_mesh_params")
     return read_gmsh(cfg.fem_mesh, specs, params)
 
 

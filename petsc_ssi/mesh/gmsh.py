@@ -46,6 +46,70 @@ class GmshModel:
     source: str = ""
 
 
+def declared_parameters(path):
+    """{name: {'default', 'choices', 'min', 'max', 'step'}} of the ONELAB parameters a .geo declares
+    with ``DefineConstant[ name = {default, Name "Parameters/name", Choices {..}, Min a, Max b,
+    Step s}, ... ];`` (its own text; files it Includes are not read). Attributes absent: None."""
+    import re
+    with open(path) as fh:
+        text = re.sub(r"//[^\n]*", "", fh.read())
+    out = {}
+    for block in re.finditer(r"DefineConstant\s*\[", text):
+        i, depth, start = block.end(), 1, block.end()
+        while i < len(text) and depth:
+            depth += {"[": 1, "]": -1}.get(text[i], 0)
+            i += 1
+        body = text[start:i - 1]
+        for m in re.finditer(r"(\w+)\s*=\s*\{", body):
+            j, depth = m.end(), 1
+            while j < len(body) and depth:
+                depth += {"{": 1, "}": -1}.get(body[j], 0)
+                j += 1
+            entry = body[m.end():j - 1]
+            name = re.search(r'Name\s*"Parameters/([^"]+)"', entry)
+            info = {"choices": None, "min": None, "max": None, "step": None}
+            ch = re.search(r"Choices\s*\{([^}]*)\}", entry)
+            if ch:
+                try:
+                    info["choices"] = [float(v) for v in ch.group(1).split(",") if v.strip()]
+                except ValueError:        # named choices ({0="a", 1="b"}): the numbers before '='
+                    info["choices"] = [float(v.split("=")[0]) for v in ch.group(1).split(",") if v.strip()]
+            for key in ("Min", "Max", "Step"):
+                v = re.search(key + r"\s+([-+0-9.eE]+)", entry)
+                if v:
+                    info[key.lower()] = float(v.group(1))
+            out[name.group(1) if name else m.group(1)] = info
+    return out
+
+
+def check_parameters(path, params, what):
+    """SSIError unless every parameter of ``params`` ({name: value}, the user's) is one the .geo
+    ``path`` declares (DefineConstant) and its value one the declaration allows (Choices, Min, Max,
+    Step from Min): gmsh takes an undeclared name or a value out of range without a word."""
+    import difflib
+    if not params:
+        return
+    if not str(path).endswith(".geo"):
+        raise SSIError(f"{what}: '{path}' is not a .geo: its parameters ({', '.join(params)}) would do nothing")
+    decl = declared_parameters(path)
+    for name, value in params.items():
+        if name not in decl:
+            near = difflib.get_close_matches(name, list(decl), n=1)
+            raise SSIError(f"{what}: '{name}' is not a parameter of {path}" + (f" (did you mean {near[0]}?)" if near
+                           else "") + f"; its parameters: {', '.join(decl) or 'none'}")
+        d, v = decl[name], float(value)
+        if d["choices"] is not None and v not in d["choices"]:
+            raise SSIError(f"{what}: {name}={value:g}: {path} allows {name} in "
+                           f"{{{', '.join(f'{c:g}' for c in d['choices'])}}} only")
+        if (d["min"] is not None and v < d["min"]) or (d["max"] is not None and v > d["max"]):
+            rng = (f">= {d['min']:g}" if d["max"] is None else f"<= {d['max']:g}" if d["min"] is None
+                   else f"in [{d['min']:g}, {d['max']:g}]")
+            raise SSIError(f"{what}: {name}={value:g}: {path} needs {name} {rng}")
+        if d["step"] and abs((v - (d["min"] or 0.0)) / d["step"] - round((v - (d["min"] or 0.0)) / d["step"])) > 1e-9:
+            raise SSIError(f"{what}: {name}={value:g}: {path} needs {name} in steps of {d['step']:g}"
+                           + (f" from {d['min']:g}" if d["min"] else ""))
+
+
 def read(path, dim=3, order=1, params=None):
     """Serial: read ``path`` (.msh, or .geo meshed up to ``dim``) with gmsh; see the module docstring.
 
