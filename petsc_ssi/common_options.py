@@ -44,3 +44,18 @@ register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this 
 register("restart", "str", "", "", "resume the run from this checkpoint (same options, any rank count; the "
          "output of the interrupted run is continued)", "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
+register("max_steps", "int", 1000000, "steps", "refuse a run of more time steps than this, before any work: "
+         "t_end / dt is reported with the predicted time of the loop, and a t_end or dt off by a few orders "
+         "of magnitude would otherwise step for days; raise it for a longer run", "common", validator=at_least(1))
+
+
+def _steps_check(cfg):
+    from .timegrid import n_steps
+    n = n_steps(cfg.t_end, cfg.dt)
+    if n > cfg.max_steps:
+        return (f"-ssi_t_end {cfg.t_end:g} with -ssi_dt {cfg.dt:g} is {n:.4g} time steps, more than -ssi_max_steps "
+                f"{cfg.max_steps}; check t_end and dt, or raise -ssi_max_steps to run them")
+    return None
+
+
+register_check(("common",), _steps_check)

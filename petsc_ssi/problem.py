@@ -266,6 +266,33 @@ class TransientProblem:
             warn(f"could not update {self.cfg.output} during the run ({exc}); the run goes on", self.comm)
         self._last_flush = time.perf_counter()      # after the write: a slow write does not make every step flush
 
+    def loop_estimate(self):
+        """(seconds of the whole time loop, seconds per step, what it covers) predicted before the
+        run, or None where the kind has no model (the BEM's: ``bem.cost.loop_seconds``)."""
+        prob = getattr(self, "prob", None)
+        est = getattr(prob, "loop_estimate", None)
+        return None if est is None else (est[0], est[1], "the soil's BEM")
+
+    def announce_loop(self):
+        """Collective, before the set-up: one line with the number of steps and, where a model
+        exists, the predicted time of the loop; SSIError beyond -ssi_max_steps (a run whose t_end
+        comes from elsewhere, a seismic record's length, is checked here; -ssi_t_end itself when
+        the options resolve)."""
+        from .monitor import fmt_time
+        todo = self.n_steps - self.n
+        limit = int(self.cfg.get("max_steps", 0) or 0)
+        if limit and self.n_steps > limit:
+            raise SSIError(f"the run to t = {self.time(self.n_steps):.6g} s with -ssi_dt {self.grid.dt:g} is "
+                           f"{self.n_steps:.4g} time steps, more than -ssi_max_steps {limit}; check t_end and dt, "
+                           "or raise -ssi_max_steps to run them")
+        est = self.loop_estimate()
+        line = (f"[ssi] time loop: {todo} steps of {self.grid.dt:.4g} s to t = {self.time(self.n_steps):.6g} s")
+        if est is not None:
+            scale = todo / max(self.n_steps, 1)
+            line += (f"; predicted {fmt_time(est[0] * scale)} ({est[2]}: about {est[1]:.2g} s per step once every "
+                     "stored lag is in the history sum, and the field snapshots; bem/cost.py's model)")
+        printf(line)
+
     def run(self):
         """Collective: setup, start, every step, finish; returns the results.
 
@@ -277,6 +304,7 @@ class TransientProblem:
         non-finite solution) writes the results up to the last step with ``run_status`` 'stopped
         ...' before the error is raised. Other exceptions (a bug, PETSc or MPI failures) write
         nothing more. With -ssi_restart the steps start after the checkpoint's."""
+        self.announce_loop()
         self.setup()
         self.start()
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end

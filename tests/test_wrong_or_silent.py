@@ -184,3 +184,31 @@ def test_post_numbers_out_of_range_are_refused(tmp_path, args, msg):
         f["receivers/points"] = np.zeros((1, 3))
     r = cli(["post", path] + args, check=False)
     assert r.returncode == 2 and r.stderr.strip() == f"petsc-ssi post: error: {msg}", (r.stdout, r.stderr)
+
+
+# ------------------------------------------------------------ a t_end that would step for ever
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_run_of_too_many_steps_is_refused_before_any_work(tmp_path, n):
+    """-ssi_t_end 1e6 on a small case started stepping for ever (2e8 steps); now refused in one line
+    naming the count, before the mesh; a FEM run too."""
+    r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_t_end", "1e6"], nranks=n, check=False, timeout=60)
+    assert one_line_error(r) == ("petsc-ssi: error: -ssi_t_end 1e+06 with -ssi_dt 0.005 is 2e+08 time steps, more "
+                                 "than -ssi_max_steps 1000000; check t_end and dt, or raise -ssi_max_steps to run them")
+    assert "[ssi]" not in r.stdout
+    r = cli(FEM + ["-ssi_t_end", "1", "-ssi_max_steps", "100"], nranks=n, check=False, timeout=60)
+    assert "is 200 time steps, more than -ssi_max_steps 100" in one_line_error(r)
+
+
+def test_the_steps_and_the_predicted_time_are_told_before_the_loop(tmp_path):
+    """Before the assembly: the number of steps (ceil(t_end / dt), here 0.1 / 0.005 = 20) and the cost
+    model's predicted time of the loop."""
+    import re
+    r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_t_end", "0.1", "-ssi_monitor"])
+    m = re.search(r"\[ssi\] time loop: (\d+) steps of 0.005 s to t = 0.1 s; predicted ([0-9.]+)s \(the soil's BEM: "
+                  r"about ([0-9.e-]+) s per step", r.stdout)
+    assert m and int(m.group(1)) == 20, r.stdout
+    assert float(m.group(2)) > 0 and float(m.group(3)) > 0
+    assert r.stdout.index(m.group(0)) < r.stdout.index("assembl"), r.stdout
+    r = cli(FEM)
+    assert "[ssi] time loop: 2 steps of 0.005 s to t = 0.01 s\n" in r.stdout, r.stdout

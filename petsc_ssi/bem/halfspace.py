@@ -383,6 +383,11 @@ class HalfSpace:
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
         self.mem_peak_estimate = peak
+        from .cost import loop_seconds
+        stride = self.grid.stride
+        self.loop_estimate = loop_seconds(est, self.mesh.n_nodes, lags, self.n_steps, mpi.Get_size(),
+                                          int(round(share * mpi.Get_size())), self.n_steps // stride if stride else 0,
+                                          dense=2 * nd >= lags)
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
