@@ -10,7 +10,8 @@ register("problem", "enum", "bem", "", "what to run: bem (half-space alone), fem
          "common", choices=("bem", "fem", "ssi"))
 register("dt", "real", 7.5e-4, "s", "time step", "common", validator=positive)
 register("t_end", "real", 0.04, "s", "end time of the run", "common", validator=positive)
-register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it)", "common")
+register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it); '' "
+         "(no output) only in a FEM run: a BEM or coupled run refuses it", "common")
 register("output_stride", "int", 1, "steps", "write the fields every this many steps (0: receivers only)", "common",
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE "

@@ -99,6 +99,14 @@ class CheckpointObserver:
             p._flush()
 
 
+def no_output_refused(cfg, what):
+    """SSIError for -ssi_output '' in a run whose results live in its file (BEM, coupled): such a
+    run ended after the assembly in an HDF5 error. Only a FEM run takes '' (no output)."""
+    if not str(cfg.get("output") or "").strip():
+        raise SSIError(f"-ssi_output '': {what} run keeps its results in its output file; give a file name "
+                       "(only a FEM run, -ssi_problem fem, runs without one)")
+
+
 class TransientProblem:
     """Base class; see the module docstring."""
     kind = ""

@@ -212,3 +212,27 @@ def test_the_steps_and_the_predicted_time_are_told_before_the_loop(tmp_path):
     assert r.stdout.index(m.group(0)) < r.stdout.index("assembl"), r.stdout
     r = cli(FEM)
     assert "[ssi] time loop: 2 steps of 0.005 s to t = 0.01 s\n" in r.stdout, r.stdout
+
+
+# ------------------------------------------------------------ no output file; a structure command without a structure
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_no_output_file_is_refused_where_the_results_live_in_it(n):
+    """-ssi_output '' on a BEM or coupled run assembled, then ended in an HDF5 error and a traceback;
+    now refused in one line before any work. (A FEM run takes '' as 'no output'.)"""
+    for args, what in ((BEM, "a BEM"), (COUPLED, "a coupled")):
+        r = cli(args + ["-ssi_output", ""], nranks=n, check=False, timeout=60)
+        assert one_line_error(r) == (f"petsc-ssi: error: -ssi_output '': {what} run keeps its results in its output "
+                                     "file; give a file name (only a FEM run, -ssi_problem fem, runs without one)")
+        assert "[ssi]" not in r.stdout, r.stdout
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_static_and_modes_need_a_structure(tmp_path, n):
+    """`petsc-ssi static` with a soil-only options set meshed the default 1 m box and failed on a
+    receiver (or solved the box); now one line saying a structure is needed."""
+    for cmd in ("static", "modes"):
+        r = cli([cmd] + BEM + ["-ssi_output", str(tmp_path / "s.h5"), "-ssi_receivers", "3,0,0"], nranks=n,
+                check=False, timeout=60)
+        assert one_line_error(r).startswith(f"petsc-ssi: error: petsc-ssi {cmd} needs a structure, and these options "
+                                            "describe none (no -ssi_fem_* option, -ssi_problem bem)"), r.stdout
