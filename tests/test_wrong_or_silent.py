@@ -236,3 +236,77 @@ def test_static_and_modes_need_a_structure(tmp_path, n):
                 check=False, timeout=60)
         assert one_line_error(r).startswith(f"petsc-ssi: error: petsc-ssi {cmd} needs a structure, and these options "
                                             "describe none (no -ssi_fem_* option, -ssi_problem bem)"), r.stdout
+
+
+# ------------------------------------------------------------ post --plot of a structure's output
+
+def _write_receivers(path, attrs, points, u, extra=()):
+    import h5py
+    import numpy as np
+    with h5py.File(path, "w") as f:
+        f.attrs.update(attrs)
+        f["receivers/t"] = np.arange(u.shape[0]) * 0.01
+        f["receivers/points"] = np.asarray(points, float)
+        f["receivers/u"] = u
+        for name in extra:
+            f["receivers/" + name] = 2 * u
+    return str(path)
+
+
+def _captured_plot(monkeypatch, fn):
+    """Run ``fn()`` with petsc_ssi.plot's figures kept: the list of figures it drew."""
+    import petsc_ssi.plot as plot
+    figs = []
+    real = plot._mpl
+
+    def mpl():
+        plt = real()
+
+        class Wrap:
+            def __getattr__(self, name):
+                return getattr(plt, name)
+
+            def subplots(self, *a, **k):
+                fig, axs = plt.subplots(*a, **k)
+                figs.append(fig)
+                return fig, axs
+
+            def close(self, fig):
+                pass
+        return Wrap()
+    monkeypatch.setattr(plot, "_mpl", mpl)
+    fn()
+    return figs
+
+
+def test_post_plot_of_a_structure_draws_its_own_quantity_against_time(tmp_path, monkeypatch):
+    """A roof receiver at x = y = 0 swaying in x: the plot was the Lamb form (r taken as 1 m, the
+    'radial' component 0: a flat line). Now t [s] and the stored series in its unit, the curve the
+    file's own numbers; --quantity velocity draws the velocity in m/s. A BEM run loaded on a patch
+    with receivers off the axis keeps the Lamb form."""
+    import numpy as np
+    from petsc_ssi.plot import receiver_plot
+    t = np.arange(50) * 0.01
+    u = np.zeros((50, 1, 3))
+    u[:, 0, 0] = 1e-3 * np.sin(2 * np.pi * 2 * t)
+    path = _write_receivers(tmp_path / "s.h5", {"problem": "fem"}, [[0, 0, 9]], u, extra=("velocity",))
+    for series, label, factor in (("receivers/u", "displacement [m]", 1), ("receivers/velocity", "velocity [m/s]", 2)):
+        figs = _captured_plot(monkeypatch, lambda: receiver_plot(path, png=str(tmp_path / "p.png"), series=series))
+        ax = figs[0].axes[0]
+        assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == label, (ax.get_xlabel(), ax.get_ylabel())
+        x, y = ax.lines[0].get_data()
+        assert np.array_equal(x, t) and np.array_equal(y, factor * u[:, 0, 0])      # the sway, not a flat line
+    # the Lamb form stays for a loaded patch with receivers off the axis ...
+    lamb = {"problem": "bem", "load_p0": 1.0, "load_patch": "1,1", "cp": 548.0, "cs": 316.0, "rho": 2000.0}
+    p2 = _write_receivers(tmp_path / "b.h5", lamb, [[3, 0, 0]], u)
+    figs = _captured_plot(monkeypatch, lambda: receiver_plot(p2, png=str(tmp_path / "q.png"), reference=False))
+    assert figs[0].axes[0].get_xlabel() == r"$\tau = c_s t / r$"
+    # ... but not with a receiver on it (r = 0)
+    p3 = _write_receivers(tmp_path / "c.h5", lamb, [[3, 0, 0], [0, 0, 0]], np.concatenate([u, u], 1))
+    figs = _captured_plot(monkeypatch, lambda: receiver_plot(p3, png=str(tmp_path / "r.png")))
+    assert figs[0].axes[0].get_xlabel() in ("", "t [s]") and figs[0].axes[-1].get_xlabel() == "t [s]"
+    # through the command line: a PNG, status 0; a quantity the file lacks: one line
+    r = cli(["post", path, "--plot", str(tmp_path / "v.png"), "--quantity", "velocity"])
+    assert (tmp_path / "v.png").stat().st_size > 0
+    r = cli(["post", p2, "--plot", str(tmp_path / "w.png"), "--quantity", "velocity"], check=False)
+    assert r.returncode == 2 and r.stderr.startswith("petsc-ssi post: error: ") and "Traceback" not in r.stderr

@@ -405,7 +405,8 @@ def main(argv=None):
             write_csv(a.file)
         if a.plot:
             from ..plot import receiver_plot
-            receiver_plot(a.file, png=a.plot)
+            read_series(a.file, a.series)          # a missing series: one line, not a traceback
+            receiver_plot(a.file, png=a.plot, series=a.series)
         if not (a.info or (a.receivers and a.csv) or a.plot):
             ap.error("nothing to do: give --receivers --csv, --plot PNG, --info, --spectrum or --transfer A B")
     except (OSError, PostError, SpectrumError) as exc:
