@@ -24,6 +24,8 @@ def test_options_files_in_a_cycle_are_named(tmp_path, n):
     (tmp_path / "self.opts").write_text(f"-ssi_dt 1e-3\n-options_file {tmp_path}/self.opts\n")
     line = one_line_error(cli(["-options_file", str(tmp_path / "self.opts")], nranks=n, check=False))
     assert line == f"petsc-ssi: error: -options_file {tmp_path}/self.opts includes itself (remove its -options_file line)"
+    if n > 1:
+        return                     # the rest is the same check before PETSc starts: -n 1 only (cheap tests)
     (tmp_path / "a.opts").write_text(f"-ssi_dt 1e-3 -options_file {tmp_path}/b.opts\n")
     (tmp_path / "b.opts").write_text(f"# b\n-options_file {tmp_path}/c.opts\n")
     (tmp_path / "c.opts").write_text(f"-ssi_t_end 1\n-options_file {tmp_path}/a.opts\n")
@@ -39,7 +41,7 @@ def test_options_files_in_a_cycle_are_named(tmp_path, n):
 # ------------------------------------------------------------ impedance: symmetry planes of the footing
 
 IMP = ["impedance", "-ssi_cp", "548", "-ssi_cs", "316", "-ssi_rho", "2000", "-ssi_mesh_size", "6,4",
-       "-ssi_mesh_h", "0.5", "-ssi_dt", "8e-4", "-ssi_t_end", "0.024", "-ssi_warn_beta", "0",
+       "-ssi_mesh_h", "0.5", "-ssi_dt", "8e-4", "-ssi_t_end", "0.012", "-ssi_warn_beta", "0",
        "-ssi_output_overwrite"]
 
 
@@ -55,7 +57,7 @@ def test_impedance_of_an_off_centre_footing_uses_only_its_planes(tmp_path):
     only y = 0 is used, the line says so, x_ref is the footing's centre, and K0 (vertical, rocking)
     equals the whole surface's (-ssi_impedance_symmetry 0) to 1e-6 (the plane's round-off only)."""
     args = IMP + ["-ssi_disp_group", "box:0,2,-1,1", "-ssi_impedance_modes", "vertical,rocking"]
-    r = cli(args + ["-ssi_output", str(tmp_path / "sym.h5")], nranks=2)
+    r = cli(args + ["-ssi_output", str(tmp_path / "sym.h5")])
     assert ("[impedance] symmetry planes used: y = 0 (x = 0 not used: the footing (spanning x in [0, 2] m) is "
             "not symmetric about it); reference point x_ref = (1, 0, 0) m") in r.stdout, r.stdout
     cli(args + ["-ssi_output", str(tmp_path / "whole.h5"), "-ssi_impedance_symmetry", "0"])
@@ -74,7 +76,9 @@ def test_impedance_needs_soil_around_the_footing(tmp_path, n):
     assert line == ("petsc-ssi: error: -ssi_disp_group surface: the footing is the whole meshed surface; petsc-ssi "
                     "impedance needs the footing as a part of the surface with soil around it (mesh a larger "
                     "surface or name a smaller group)")
-    r = cli(args + ["-ssi_disp_group", "box:1,3,-1,1"], nranks=n, check=False)
+    if n > 1:
+        return
+    r = cli(args + ["-ssi_disp_group", "box:1,3,-1,1"], check=False)
     assert "the footing reaches the edge of the meshed surface (at x = 3, y = " in one_line_error(r)
     assert "[impedance] mode" not in r.stdout
 
@@ -151,13 +155,16 @@ def test_mesh_params_the_geo_cannot_use_are_refused(tmp_path, params, msg):
 
 @pytest.mark.parametrize("n", [1, 2])
 def test_mesh_params_without_a_geo_and_a_zero_mass_per_area_are_refused(tmp_path, n):
-    line = one_line_error(cli(FEM + ["-ssi_fem_mesh_params", "h=1"], nranks=n, check=False))
-    assert line.startswith("petsc-ssi: error: -ssi_fem_mesh_params: the box generator (-ssi_fem_mesh box) has no "
-                           "parameters"), line
+    if n == 1:
+        line = one_line_error(cli(FEM + ["-ssi_fem_mesh_params", "h=1"], check=False))
+        assert line.startswith("petsc-ssi: error: -ssi_fem_mesh_params: the box generator (-ssi_fem_mesh box) has no "
+                               "parameters"), line
     line = one_line_error(cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_mesh_params", "h=1"], nranks=n,
                               check=False))
     assert line.startswith("petsc-ssi: error: -ssi_mesh_params: the grid generator (-ssi_mesh grid) has no "
                            "parameters"), line
+    if n > 1:
+        return
     # mass_per_area 0 meant 'not given': the slab kept rho * thickness, silently
     r = cli(BUILDING + ["-ssi_output", str(tmp_path / "s.h5"), "-ssi_fem_part_roof_mass_per_area", "0"], nranks=n,
             check=False)
@@ -196,7 +203,9 @@ def test_a_run_of_too_many_steps_is_refused_before_any_work(tmp_path, n):
     assert one_line_error(r) == ("petsc-ssi: error: -ssi_t_end 1e+06 with -ssi_dt 0.005 is 2e+08 time steps, more "
                                  "than -ssi_max_steps 1000000; check t_end and dt, or raise -ssi_max_steps to run them")
     assert "[ssi]" not in r.stdout
-    r = cli(FEM + ["-ssi_t_end", "1", "-ssi_max_steps", "100"], nranks=n, check=False, timeout=60)
+    if n > 1:
+        return
+    r = cli(FEM + ["-ssi_t_end", "1", "-ssi_max_steps", "100"], check=False, timeout=60)
     assert "is 200 time steps, more than -ssi_max_steps 100" in one_line_error(r)
 
 
@@ -220,7 +229,7 @@ def test_the_steps_and_the_predicted_time_are_told_before_the_loop(tmp_path):
 def test_no_output_file_is_refused_where_the_results_live_in_it(n):
     """-ssi_output '' on a BEM or coupled run assembled, then ended in an HDF5 error and a traceback;
     now refused in one line before any work. (A FEM run takes '' as 'no output'.)"""
-    for args, what in ((BEM, "a BEM"), (COUPLED, "a coupled")):
+    for args, what in ((BEM, "a BEM"), (COUPLED, "a coupled"))[n - 1:]:
         r = cli(args + ["-ssi_output", ""], nranks=n, check=False, timeout=60)
         assert one_line_error(r) == (f"petsc-ssi: error: -ssi_output '': {what} run keeps its results in its output "
                                      "file; give a file name (only a FEM run, -ssi_problem fem, runs without one)")
@@ -231,7 +240,7 @@ def test_no_output_file_is_refused_where_the_results_live_in_it(n):
 def test_static_and_modes_need_a_structure(tmp_path, n):
     """`petsc-ssi static` with a soil-only options set meshed the default 1 m box and failed on a
     receiver (or solved the box); now one line saying a structure is needed."""
-    for cmd in ("static", "modes"):
+    for cmd in ("static", "modes")[:3 - n]:
         r = cli([cmd] + BEM + ["-ssi_output", str(tmp_path / "s.h5"), "-ssi_receivers", "3,0,0"], nranks=n,
                 check=False, timeout=60)
         assert one_line_error(r).startswith(f"petsc-ssi: error: petsc-ssi {cmd} needs a structure, and these options "
