@@ -43,6 +43,7 @@ DefineConstant[
   ns = {3, Min 1, Max 1000, Step 1, Name "Parameters/ns"}, hs = {3.0, Min 0.001, Name "Parameters/hs"},
   h = {0.6, Min 0.001, Name "Parameters/h"}, hc = {0.3, Min 0.001, Name "Parameters/hc"},
   half = {0, Name "Parameters/half", Choices {0, 1}} ];
+// (Min, Step, Choices: the values petsc-ssi accepts in -ssi_fem_mesh_params; gmsh itself does not check)
 
 Lx = nbx * sx; Ly = nby * sy; tol = 1e-6 * (sx + sy);
 

@@ -5,9 +5,10 @@
 // Physical groups: "slab" (surface: the shell part), "columns" (curves: the frame part),
 // "base" (points: the column feet), "top_corner" (point: the slab corner above column 3).
 // Parameters (gmsh -setnumber or ONELAB): Lx, Ly, H, nx, ny, nz (elements per side/column).
-DefineConstant[ Lx = {4.0, Name "Parameters/Lx"}, Ly = {3.0, Name "Parameters/Ly"},
-                H = {3.0, Name "Parameters/H"}, nx = {8, Name "Parameters/nx"},
-                ny = {6, Name "Parameters/ny"}, nz = {6, Name "Parameters/nz"} ];
+DefineConstant[ Lx = {4.0, Name "Parameters/Lx", Min 1e-6}, Ly = {3.0, Name "Parameters/Ly", Min 1e-6},
+                H = {3.0, Name "Parameters/H", Min 1e-6}, nx = {8, Name "Parameters/nx", Min 1, Step 1},
+                ny = {6, Name "Parameters/ny", Min 1, Step 1}, nz = {6, Name "Parameters/nz", Min 1, Step 1} ];
+// (Min, Step: the values petsc-ssi accepts in -ssi_fem_mesh_params; gmsh itself does not check)
 
 Point(1) = {0, 0, H};   Point(2) = {Lx, 0, H};
 Point(3) = {Lx, Ly, H}; Point(4) = {0, Ly, H};

@@ -10,7 +10,8 @@ register("problem", "enum", "bem", "", "what to run: bem (half-space alone), fem
          "common", choices=("bem", "fem", "ssi"))
 register("dt", "real", 7.5e-4, "s", "time step", "common", validator=positive)
 register("t_end", "real", 0.04, "s", "end time of the run", "common", validator=positive)
-register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it)", "common")
+register("output", "str", "out/run.h5", "", "HDF5 output file (an .xmf for ParaView and a .json record are written beside it); '' "
+         "(no output) only in a FEM run: a BEM or coupled run refuses it", "common")
 register("output_stride", "int", 1, "steps", "write the fields every this many steps (0: receivers only)", "common",
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("receivers", "str", "", "m", "receiver points 'x,y,z;x,y,z' (snapped to the surface mesh / nearest FE "
@@ -48,3 +49,19 @@ register("disk_check", "bool", True, "", "before the assembly, compare the free 
          "with the run's estimated output (fields x snapshots x nodes x 8 B, receiver and interface series) and "
          "refuse a run that cannot fit (0: skip the check; the per-snapshot check still stops a run whose disk "
          "fills)", "common")
+
+register("max_steps", "int", 1000000, "steps", "refuse a run of more time steps than this, before any work: "
+         "t_end / dt is reported with the predicted time of the loop, and a t_end or dt off by a few orders "
+         "of magnitude would otherwise step for days; raise it for a longer run", "common", validator=at_least(1))
+
+
+def _steps_check(cfg):
+    from .timegrid import n_steps
+    n = n_steps(cfg.t_end, cfg.dt)
+    if n > cfg.max_steps:
+        return (f"-ssi_t_end {cfg.t_end:g} with -ssi_dt {cfg.dt:g} is {n:.4g} time steps, more than -ssi_max_steps "
+                f"{cfg.max_steps}; check t_end and dt, or raise -ssi_max_steps to run them")
+    return None
+
+
+register_check(("common",), _steps_check)

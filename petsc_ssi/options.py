@@ -153,6 +153,8 @@ def resolve(groups=None, comm=None):
             hint = f" (did you mean -ssi_{near[0]}?)" if near else ""
             err = f"unknown option -{key}{hint}; -help lists every -ssi_ option"
             break
+    if err is None:
+        err = _unprefixed_solver_option(allopts)
     values, sources = {}, {}
     if err is None:
         for name, opt in _REGISTRY.items():
@@ -190,7 +192,50 @@ def resolve(groups=None, comm=None):
                 err = msg
                 break
     collective_error(err, comm)
+    if groups is not None:
+        _warn_other_groups(allopts, groups, comm)
     return cfg
+
+
+# PETSc object options that only a solver object reads: every solver of petsc-ssi has a prefix
+# (-ssi_bem_, -ssi_fem_, -ssi_modes_), so without one they reach nothing
+_SOLVER_OPTIONS = ("ksp_", "pc_", "eps_", "st_", "snes_", "ts_", "tao_")
+_SOLVER_HINT = "-ssi_bem_ for the soil's step solve, -ssi_fem_ for the structure's, -ssi_modes_ for petsc-ssi modes"
+
+
+def _unprefixed_solver_option(allopts):
+    """The error for a solver option without petsc-ssi's prefix (-ksp_type, -pc_factor_...), or None."""
+    bad = sorted(k for k in allopts if k.startswith(_SOLVER_OPTIONS))
+    if not bad:
+        return None
+    return (f"-{bad[0]}: no solver of petsc-ssi reads PETSc options without its prefix; write "
+            f"-ssi_bem_{bad[0]} or -ssi_fem_{bad[0]} ({_SOLVER_HINT})"
+            + (f" (also: {' '.join('-' + k for k in bad[1:])})" if len(bad) > 1 else ""))
+
+
+_READ_GROUPS = set()        # the option groups this process has resolved (a command may resolve twice)
+_WARNED = set()
+
+
+def _warn_other_groups(allopts, groups, comm):
+    """One warning line naming the -ssi_ options the user set that belong to groups this command does
+    not read (-ssi_fem_* in a BEM run, -ssi_lags_load in a FEM run): they do nothing here. Each
+    option is named once per process; groups an earlier resolve read are not named."""
+    _READ_GROUPS.update(groups)
+    idle = []
+    for key in allopts:
+        name = key[len(PREFIX):] if key.startswith(PREFIX) else None
+        opt = _REGISTRY.get(name)
+        if opt is None or opt.group in _READ_GROUPS or opt.group == "common" or key in _WARNED:
+            continue
+        idle.append((opt.group, key))
+    if idle:
+        _WARNED.update(k for _, k in idle)
+        idle.sort()
+        theirs = ", ".join(sorted({g for g, _ in idle}))
+        ours = ", ".join(sorted(set(groups) - {"common"}))
+        warn(f"options this run does not read ({theirs} options; it reads the common and {ours} ones): "
+             + " ".join("-" + k for _, k in idle), comm)
 
 
 GETSTRING_MAX = 1023

@@ -134,6 +134,14 @@ def _size(b):
     return f"{b / 1e9:.3g} GB" if b >= 1e9 else f"{b / 1e6:.3g} MB"
 
 
+def no_output_refused(cfg, what):
+    """SSIError for -ssi_output '' in a run whose results live in its file (BEM, coupled): such a
+    run ended after the assembly in an HDF5 error. Only a FEM run takes '' (no output)."""
+    if not str(cfg.get("output") or "").strip():
+        raise SSIError(f"-ssi_output '': {what} run keeps its results in its output file; give a file name "
+                       "(only a FEM run, -ssi_problem fem, runs without one)")
+
+
 class TransientProblem:
     """Base class; see the module docstring."""
     kind = ""
@@ -369,6 +377,33 @@ class TransientProblem:
             warn(f"could not update {self.cfg.output} during the run ({exc}); the run goes on", self.comm)
         self._last_flush = time.perf_counter()      # after the write: a slow write does not make every step flush
 
+    def loop_estimate(self):
+        """(seconds of the whole time loop, seconds per step, what it covers) predicted before the
+        run, or None where the kind has no model (the BEM's: ``bem.cost.loop_seconds``)."""
+        prob = getattr(self, "prob", None)
+        est = getattr(prob, "loop_estimate", None)
+        return None if est is None else (est[0], est[1], "the soil's BEM")
+
+    def announce_loop(self):
+        """Collective, before the set-up: one line with the number of steps and, where a model
+        exists, the predicted time of the loop; SSIError beyond -ssi_max_steps (a run whose t_end
+        comes from elsewhere, a seismic record's length, is checked here; -ssi_t_end itself when
+        the options resolve)."""
+        from .monitor import fmt_time
+        todo = self.n_steps - self.n
+        limit = int(self.cfg.get("max_steps", 0) or 0)
+        if limit and self.n_steps > limit:
+            raise SSIError(f"the run to t = {self.time(self.n_steps):.6g} s with -ssi_dt {self.grid.dt:g} is "
+                           f"{self.n_steps:.4g} time steps, more than -ssi_max_steps {limit}; check t_end and dt, "
+                           "or raise -ssi_max_steps to run them")
+        est = self.loop_estimate()
+        line = (f"[ssi] time loop: {todo} steps of {self.grid.dt:.4g} s to t = {self.time(self.n_steps):.6g} s")
+        if est is not None:
+            scale = todo / max(self.n_steps, 1)
+            line += (f"; predicted {fmt_time(est[0] * scale)} ({est[2]}: about {est[1]:.2g} s per step once every "
+                     "stored lag is in the history sum, and the field snapshots; bem/cost.py's model)")
+        printf(line)
+
     def run(self):
         """Collective: setup, start, every step, finish; returns the results.
 
@@ -387,6 +422,7 @@ class TransientProblem:
             self.release_locks()
 
     def _run(self):
+        self.announce_loop()
         self.setup()
         self.start()
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end

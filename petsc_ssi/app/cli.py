@@ -59,22 +59,50 @@ def versions():
 
 
 def _bad_options_file(argv):
-    """One line if an -options_file is missing, unreadable or has a line PETSc would reject (a value
-    without its option: PETSc stops in PetscInitialize with a page of diagnostics), else None."""
-    for i, a in enumerate(argv[:-1]):
-        if a != "-options_file":
-            continue
-        path = argv[i + 1]
+    """One line if an -options_file is missing, unreadable, has a line PETSc would reject (a value
+    without its option: PETSc stops in PetscInitialize with a page of diagnostics) or includes itself
+    through its own -options_file lines, directly or through other files (PETSc recurses until the
+    stack overflows: a segmentation fault), else None. Included files are checked the same way;
+    their paths are taken as PETSc takes them (relative to the working directory)."""
+    import os
+
+    def files_in(args):
+        return [args[i + 1] for i, a in enumerate(args[:-1]) if a == "-options_file"]
+
+    def visit(path, chain):
+        key = os.path.realpath(path)
+        if key in chain:
+            names = [p for _, p in chain.values()] + [path]
+            return ("petsc-ssi: error: -options_file " + " -> ".join(names[names.index(chain[key][1]):])
+                    + ": the options files include each other in a cycle (remove one -options_file line)"
+                    if len(names) > 2 or names[0] != path else
+                    f"petsc-ssi: error: -options_file {path} includes itself (remove its -options_file line)")
         try:
             with open(path) as fh:
                 lines = fh.read().splitlines()
         except OSError as exc:
-            return f"petsc-ssi: error: -options_file {path}: {exc.strerror or exc}"
+            where = f" (included by {list(chain.values())[-1][1]})" if chain else ""
+            return f"petsc-ssi: error: -options_file {path}{where}: {exc.strerror or exc}"
+        tokens = []
         for k, line in enumerate(lines, 1):
             text = line.split("#", 1)[0].strip()
             if text and not text.startswith("-") and text.split()[0] not in ("alias",):
                 return (f"petsc-ssi: error: -options_file {path}, line {k}: '{text.split()[0]}' is not an option "
                         "(one '-name value' per line)")
+            if text and not text.startswith("alias"):
+                tokens += text.split()
+        chain = dict(chain)
+        chain[key] = (len(chain), path)
+        for inc in files_in(tokens):
+            bad = visit(inc, chain)
+            if bad:
+                return bad
+        return None
+
+    for path in files_in(argv):
+        bad = visit(path, {})
+        if bad:
+            return bad
     return None
 
 

@@ -18,6 +18,11 @@ planes each allows (a footing symmetric about x = 0 and y = 0, x_ref = the origi
     vertical    u0 = (0, 0, 1)    x=sym,  y=sym       horizontal  u0 = (1, 0, 0)   x=anti, y=sym
     rocking     theta0 = (0,1,0)  x=anti, y=sym       torsion     theta0 = (0,0,1) x=anti, y=anti
 
+A plane is used only where the footing and the meshed surface are both symmetric about it (checked
+on the whole surface before the runs: every node mirrored lands on a node, or the mesh is a half
+model ending on the plane with the footing against it); the command says in one line which planes
+it uses and why any is not. The rigid motions' reference point x_ref (-ssi_disp_ref) is by default
+the footing's centroid, so an off-centre footing rocks and twists about its own centre
 (-ssi_impedance_symmetry 0 meshes the whole surface instead). Outputs, from -ssi_output's stem:
 <stem>-<mode>.h5 (each run), <stem>-impedance.csv (a0, K, k, c per mode), <stem>-impedance.png
 (k and c against a0, with each mode's high-frequency dashpot limit: rho c_p A, rho c_s A,
@@ -70,6 +75,94 @@ CROSS = {"horizontal": ("horizontal-rocking", "moment", 1),      # M_y per unit 
          "rocking": ("rocking-horizontal", "force", 0)}          # F_x per unit theta_y
 
 
+def _mirror_equal(pts, ax, tol):
+    """Whether the point set (N, 2+) maps onto itself under x_ax -> -x_ax (to ``tol``)."""
+    from scipy.spatial import cKDTree
+    q = np.array(pts[:, :2], float)
+    q[:, ax] *= -1.0
+    d, _ = cKDTree(pts[:, :2]).query(q)
+    return bool(d.max() <= tol)
+
+
+def _check_soil_around(mesh, elems, group, tol):
+    """SSIError unless the footing ``elems`` is a part of the meshed surface with soil all around it:
+    not the whole surface, and touching the surface's outer edge nowhere (edges on a plane x = 0 or
+    y = 0 of a half model excepted: the soil continues in the mirror image). An impedance of a
+    footing without soil around it is not the footing's, and its comparison with the published
+    curves meaningless."""
+    if len(elems) == mesh.n_cells:
+        raise SSIError(f"-ssi_disp_group {group}: the footing is the whole meshed surface; petsc-ssi impedance "
+                       "needs the footing as a part of the surface with soil around it (mesh a larger surface or "
+                       "name a smaller group)")
+    corners = mesh.cells[:, :4]
+    edges = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    outer = np.unique(uniq[count == 1])
+    X = mesh.nodes
+    for ax in (0, 1):                          # a half model's edge on its plane is not an edge of the soil
+        if X[:, ax].min() > -tol and np.abs(X[:, ax]).min() < tol:
+            outer = outer[np.abs(X[outer, ax]) > tol]
+    foot = np.unique(mesh.cells[elems])
+    touch = np.intersect1d(foot, outer)
+    if touch.size:
+        p = X[touch[0]]
+        raise SSIError(f"-ssi_disp_group {group}: the footing reaches the edge of the meshed surface (at "
+                       f"x = {p[0]:.4g}, y = {p[1]:.4g} m); petsc-ssi impedance needs soil around the footing "
+                       "(mesh a larger surface)")
+
+
+def usable_planes(cfg, comm):
+    """Collective: which symmetry planes x = 0, y = 0 the footing (-ssi_disp_group) and the surface mesh
+    allow, from the whole surface (meshed without planes; cheap, no assembly): (axes, x_ref, one
+    line saying which planes are used and why any is not). A plane is usable when the footing's nodes
+    and the mesh's nodes both map onto themselves mirrored about it, or when the mesh is a half model
+    ending on the plane (its nodes on one side, some on it) with the footing against the plane; and
+    x_ref (-ssi_disp_ref, default the footing's centroid) lies on it."""
+    from ..bem.halfspace import read_surface_mesh
+    from ..bem.lagset import Regions
+    from ..bem.input_motion import region_centroid
+    from ..bem.resultants import parse_vector
+    mesh = read_surface_mesh(cfg, comm, [])
+    elems = mesh.select(cfg.disp_group)
+    h = float(mesh.element_sizes().max())
+    tol = 1e-6 * h
+    _check_soil_around(mesh, elems, cfg.disp_group, tol)
+    regions = Regions(mesh, (), elems)
+    xref = (parse_vector(cfg.disp_ref, "disp_ref") if cfg.user_set("disp_ref")
+            else region_centroid(mesh, regions, []))
+    X, F = mesh.nodes, mesh.nodes[regions.disp_nodes]
+    axes, why = [], []
+    for ax, name in ((0, "x"), (1, "y")):
+        lo, hi = float(F[:, ax].min()), float(F[:, ax].max())
+        half_model = X[:, ax].min() > -tol and np.abs(X[:, ax]).min() < tol
+        if half_model:
+            ok = abs(lo) < tol
+            reason = f"the mesh is a half model on {name} >= 0 but the footing spans {name} in [{lo:.4g}, {hi:.4g}] m, " \
+                     "away from the plane"
+        elif not _mirror_equal(F, ax, tol):
+            ok, reason = False, f"the footing (spanning {name} in [{lo:.4g}, {hi:.4g}] m) is not symmetric about it"
+        elif not _mirror_equal(X, ax, tol):
+            ok, reason = False, "the meshed surface is not symmetric about it"
+        else:
+            ok, reason = True, ""
+        if ok and abs(xref[ax]) > tol:
+            ok, reason = False, f"x_ref (-ssi_disp_ref) is off it ({name} = {xref[ax]:.4g} m)"
+        if ok:
+            axes.append(ax)
+        else:
+            why.append(f"{name} = 0 not used: {reason}")
+    used = ", ".join(f"{'xy'[a]} = 0" for a in axes) or "none"
+    line = (f"[impedance] symmetry planes used: {used}" + (f" ({'; '.join(why)})" if why else "")
+            + f"; reference point x_ref = ({', '.join(f'{v:.4g}' for v in xref)}) m")
+    return axes, xref, line
+
+
+def _restrict(sym, axes):
+    """A mode's symmetry spec ('x=anti,y=sym') keeping the planes of ``axes`` only ('none' if none)."""
+    keep = [p for p in sym.split(",") if "xy".index(p.split("=")[0]) in axes]
+    return ",".join(keep) or "none"
+
+
 def _region_geometry(prob):
     """The prescribed region, whole (the modelled part times its symmetry images: x, x^2 and y^2
     are even under the reflections), by 6 x 6 Gauss points: {'hx', 'hy'} half-extents, 'A' area,
@@ -87,8 +180,12 @@ def _region_geometry(prob):
     for ax in (0, 1):
         v = X[..., ax]
         half.append(float(np.abs(v).max() if any(a == ax for a, _ in prob.planes) else 0.5 * np.ptp(v)))
-    Ix = float((J * xg[..., 1] ** 2).sum()) * nimg
-    Iy = float((J * xg[..., 0] ** 2).sum()) * nimg
+    c = np.zeros(2)               # the whole region's centroid (0 on each plane)
+    for ax in (0, 1):
+        if not any(a == ax for a, _ in prob.planes):
+            c[ax] = float((J * xg[..., ax]).sum() / J.sum())
+    Ix = float((J * (xg[..., 1] - c[1]) ** 2).sum()) * nimg
+    Iy = float((J * (xg[..., 0] - c[0]) ** 2).sum()) * nimg
     A = float(J.sum()) * nimg
     hx, hy = half
     shape = "other"
@@ -197,6 +294,15 @@ def main():
         if cfg0.user_set(name):
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
     want = _a0_range(cfg0.impedance_a0)
+    if cfg0.impedance_symmetry:
+        axes, xref, line = usable_planes(cfg0, comm)
+        printf(line)
+    else:
+        axes, xref, _ = usable_planes(cfg0, comm)
+        axes = []
+        printf("[impedance] symmetry planes used: none (-ssi_impedance_symmetry 0)")
+    if not cfg0.user_set("disp_ref"):
+        db.setValue("ssi_disp_ref", ",".join(repr(float(v)) for v in xref))
     stem = os.path.splitext(cfg0.output or "out/impedance.h5")[0]
     check_outputs(stem, modes, comm, bool(cfg0.get("output_overwrite")))
     rise = cfg0.impedance_rise or 4 * cfg0.dt
@@ -206,13 +312,14 @@ def main():
         opt, motion, sym, what, comp, speed, measure = MODES[mode]
         for k in ("disp_value", "disp_rotation"):
             db.setValue("ssi_" + k, ",".join(f"{AMP * float(v):g}" for v in motion.split(",")) if k == opt else "0,0,0")
-        db.setValue("ssi_symmetry", sym if cfg0.impedance_symmetry else "none")
+        sym = _restrict(sym, axes)
+        db.setValue("ssi_symmetry", sym)
         db.setValue("ssi_disp_history", "smoothstep")
         db.setValue("ssi_disp_t0", repr(rise))
         db.setValue("ssi_output", f"{stem}-{mode}.h5")
         cfg = options.resolve(("common", "bem"))
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
-               f"{sym if cfg0.impedance_symmetry else 'none'}, smooth step over {rise:.4g} s")
+               f"{sym}, smooth step over {rise:.4g} s")
         t_run = time.perf_counter()
         p = BEMTransient(cfg, comm)
         res = p.run()

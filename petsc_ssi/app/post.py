@@ -1,8 +1,9 @@
 """``petsc-ssi post FILE.h5 [--receivers --csv] [--plot PNG] [--info] [--spectrum | --transfer A B]``.
 
 Reads an output file with h5py (serial; no PETSc needed):
-  --receivers --csv   one row per receiver and step, header
-                      ``receiver,x,y,z,t,ux,uy,uz`` (SI units)
+  --receivers --csv [OUT.csv]  one row per receiver and step (standard output without a
+                      name) of the --quantity or --series: header ``receiver,x,y,z,t,ux,uy,uz``
+                      [m] (vx.. [m/s], ax.. [m/s^2], rx.. [rad]; SI units)
   --plot PNG          receiver time histories (with the Pekeris patch solution
                       when the run was a Lamb problem)
   --info              what the file holds
@@ -169,14 +170,39 @@ def receivers(path):
         return g["points"][:], g["t"][:], g["u"][:]
 
 
-def write_csv(path, out=None):
+CSV_COLUMNS = {"receivers/u": "u", "receivers/velocity": "v", "receivers/acceleration": "a",
+               "receivers/rotation": "r"}
+
+
+def write_csv(path, out=None, series="receivers/u"):
+    """One row per receiver and step of ``series`` (a (K, R, 3) receiver series, --quantity or
+    --series): receiver,x,y,z,t then its three components, named ux,uy,uz [m], vx,vy,vz [m/s],
+    ax,ay,az [m/s^2], rx,ry,rz [rad] (others: NAME_x,NAME_y,NAME_z in the dataset's units); SI
+    units; a receiver without rotations (not at a frame or shell node) has empty rotation cells."""
+    import h5py
     out = sys.stdout if out is None else out
-    pts, t, u = receivers(path)
-    out.write("receiver,x,y,z,t,ux,uy,uz\n")
-    for k, p in enumerate(pts):
+    series = series.strip("/")
+    grp, _, name = series.rpartition("/")
+    if not os.path.exists(path):
+        raise PostError(f"{path}: no such file")
+    with h5py.File(path, "r") as f:
+        if series not in f:
+            have = [k for k in (f[grp].keys() if grp in f else []) if k not in ("t", "points")]
+            raise PostError(f"{path} holds no series {series}" + (f" (the group {grp} holds: {', '.join(sorted(have))})"
+                                                                   if have else ""))
+        x = f[series][:]
+        if x.ndim != 3 or x.shape[2] != 3 or grp + "/points" not in f:
+            raise PostError(f"--receivers --csv: {series} is not a receiver series (K, R, 3) with {grp}/points; "
+                            "--spectrum --csv writes any series")
+        pts, t = f[grp + "/points"][:], f[grp + "/t"][:]
+        has = f[grp + "/has_rotation"][:].astype(bool) if name == "rotation" and grp + "/has_rotation" in f else None
+    p = CSV_COLUMNS.get(series)
+    cols = [p + c for c in "xyz"] if p else [f"{name}_{c}" for c in "xyz"]
+    out.write("receiver,x,y,z,t," + ",".join(cols) + "\n")
+    for k, q in enumerate(pts):
         for i, ti in enumerate(t):
-            ux, uy, uz = u[i, k]
-            out.write(f"{k},{p[0]:.9g},{p[1]:.9g},{p[2]:.9g},{ti:.9g},{ux:.9e},{uy:.9e},{uz:.9e}\n")
+            vals = ",," if has is not None and not has[k] else ",".join(f"{v:.9e}" for v in x[i, k])
+            out.write(f"{k},{q[0]:.9g},{q[1]:.9g},{q[2]:.9g},{ti:.9g},{vals}\n")
 
 
 def info(path, out=None):
@@ -424,6 +450,22 @@ def transfer_command(a, out=None):
 
 # ---------------------------------------------------------------- command line
 
+def _check_numbers(a):
+    """PostError for a number option out of its range (argparse checks only the type): a negative
+    --fmax kept no frequency, a negative --peaks printed none, without a word."""
+    rules = [("fmax", a.fmax, lambda v: v > 0, "must be > 0 Hz"),
+             ("peaks", a.peaks, lambda v: v >= 0, "must be >= 0"),
+             ("pad", a.pad, lambda v: v >= 1, "must be >= 1 (a factor on the number of samples)"),
+             ("min-sep", a.min_sep, lambda v: v >= 0, "must be >= 0 Hz"),
+             ("fmin", a.fmin, lambda v: v >= 0, "must be >= 0 Hz"),
+             ("eps", a.eps, lambda v: v > 0, "must be > 0"),
+             ("tukey-alpha", a.tukey_alpha, lambda v: 0 <= v <= 1, "must lie in [0, 1]"),
+             ("receiver", a.receiver, lambda v: v >= 0, "must be >= 0")]
+    for name, value, ok, why in rules:
+        if value is not None and not (np.isfinite(value) and ok(value)):
+            raise PostError(f"--{name} {value:g}: {why}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="petsc-ssi post", description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -431,8 +473,8 @@ def main(argv=None):
     ap.add_argument("file", nargs="?")
     ap.add_argument("--receivers", action="store_true", help="receiver series")
     ap.add_argument("--csv", nargs="?", const=True, default=None, metavar="OUT.csv",
-                    help="CSV (receivers: on standard output; spectrum/transfer: to OUT.csv, "
-                         "standard output without a name)")
+                    help="CSV to OUT.csv, standard output without a name (receivers: the "
+                         "--quantity or --series; spectrum, transfer)")
     ap.add_argument("--plot", metavar="PNG", help="plot receiver histories to PNG")
     ap.add_argument("--info", action="store_true")
     ap.add_argument("--spectrum", action="store_true", help="amplitude spectrum of a series")
@@ -469,6 +511,7 @@ def main(argv=None):
             return 2
         return 0
     try:
+        _check_numbers(a)
         inputs = [a.file] + [_parse_ref(r, a.file, a.series)[0] for r in (a.transfer or ())]
         check_outputs([("--csv", a.csv if (a.spectrum or a.transfer) else None), ("--png", a.png),
                        ("--plot", a.plot)], inputs, a.overwrite)
@@ -484,10 +527,16 @@ def main(argv=None):
         if a.info:
             info(a.file)
         if a.receivers and a.csv:
-            write_csv(a.file)
+            fh, close = _open_out(a.csv)            # --csv OUT.csv: that file; --csv alone: standard output
+            try:
+                write_csv(a.file, fh, a.series)
+            finally:
+                if close:
+                    fh.close()
         if a.plot:
             from ..plot import receiver_plot
-            receiver_plot(a.file, png=a.plot)
+            read_series(a.file, a.series)          # a missing series: one line, not a traceback
+            receiver_plot(a.file, png=a.plot, series=a.series)
         if not (a.info or (a.receivers and a.csv) or a.plot):
             ap.error("nothing to do: give --receivers --csv, --plot PNG, --info, --spectrum or --transfer A B")
     except (OSError, PostError, SpectrumError) as exc:

@@ -17,10 +17,24 @@ def structure_command(name):
     from ..fem.model import build_model
     from ..io.output import check_output, command_output
     cfg = ssi_options.resolve(("common", "fem"))
+    _needs_structure(cfg, name, ssi_options)
     cfg.set("output", command_output(cfg.output, name))
     if cfg.output:
         check_output(cfg.output, comm, cfg.output_overwrite)
     return PETSc, comm, cfg, build_model(cfg, comm)
+
+
+def _needs_structure(cfg, name, ssi_options):
+    """SSIError unless the options describe a structure: some -ssi_fem_* option (the mesh, the box,
+    the parts, a material, a load...) or -ssi_problem fem (whose default is the box). A soil-only
+    options set used to mesh the default 1 m box and fail later on a receiver, or solve it."""
+    fem = [o.name for o in ssi_options.options().values() if o.group == "fem" and o.name != "modes_n"]
+    if cfg.problem == "fem" and cfg.user_set("problem") or any(cfg.user_set(n) for n in fem):
+        return
+    from ..petsc import SSIError
+    raise SSIError(f"petsc-ssi {name} needs a structure, and these options describe none (no -ssi_fem_* option, "
+                   f"-ssi_problem {cfg.problem}): give -ssi_fem_mesh FILE with -ssi_fem_parts, or -ssi_fem_box_cells "
+                   "(or -ssi_problem fem for the default box)")
 
 
 def main():

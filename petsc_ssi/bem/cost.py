@@ -501,3 +501,33 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
     return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
                         candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
                         sub=sub)
+
+
+# Per-step work the fitted constants do not see, measured on the development machine with a 4 m x 4 m
+# surface of 1 m elements (81 nodes), 100 steps: 0.3 s of loop with -ssi_output_stride 0 (the Python
+# work of a step: recorder, receivers, guard), 1.7 s with stride 1 (a field snapshot, u and p, into
+# the HDF5 file and its XDMF). They dominate small cases only; the history sum dominates large ones.
+STEP_FLOOR_S = 2.5e-3
+SNAPSHOT_S = 1.4e-2
+
+
+def loop_seconds(lag_bytes, n_nodes, lags, steps, ranks, per_node, snapshots=0, dense=True, c=None):
+    """A cheap figure of the time loop's wall time [s] before it starts, from the model's
+    constants (``predict``'s history, solve and per-step terms without the per-rank counts): every
+    step streams the stored lag matrices that reach back to it (step n: min(n, L) of the ``lags``
+    L, ``lag_bytes`` over all ranks, each rank its 1/p at b_dense, slowed by the ``per_node`` ranks
+    sharing a memory bus; b_sparse where most lags are ``dense`` False: block-sparse), two
+    matrix-vector products per lag, one solve with the step matrix's
+    factors (N^1.5) and the per-step rest (at least STEP_FLOOR_S), and SNAPSHOT_S per field
+    snapshot written. Returns (total, per step once all L lags are in use, snapshots excluded)."""
+    c = c or load_constants()[0]
+    cores = max(os.cpu_count() or 1, 1)
+    m = max(1, min(per_node, cores))
+    over = max(1.0, per_node / float(cores))
+    full = over * (lag_bytes / max(ranks, 1) / c["b_dense" if dense else "b_sparse"] * (1 + c["sigma"] * (m - 1))
+                   + (c["c_op"] + (c["c_op_mpi"] if ranks > 1 else 0.0)) * 2 * lags)
+    rest = c["c_sol"] * n_nodes ** 1.5 * (1 + c["kappa"] * (ranks - 1)) + max(c["c_step"], STEP_FLOOR_S)
+    L = max(int(lags), 1)
+    ramp = min(steps, L)                     # steps 1..L use 1..L lags, the rest all L
+    used = ramp * (ramp + 1) / 2.0 + max(steps - L, 0) * L
+    return full * used / L + rest * steps + SNAPSHOT_S * snapshots, full + rest

@@ -5,6 +5,8 @@ before any assembly: the surface mesh (``read_surface_mesh``), the regions (load
 the receivers, the lags and the interpolation plan, the node partition (``lagset``) and the
 memory check (``check_memory``). ``bem.build.build_marcher`` then assembles.
 """
+import os
+
 import numpy as np
 
 from ..petsc import SSIError, collective, printf, warn
@@ -38,6 +40,9 @@ def read_surface_mesh(cfg, comm, planes):
     mesh = None
     with collective(comm, f"-ssi_mesh {cfg.mesh}", "{what}: cannot read the mesh ({error})"):
         if comm.getRank() == 0:
+            if cfg.mesh == "grid" and str(cfg.get("mesh_params", "") or "").strip():
+                raise SSIError("-ssi_mesh_params: the grid generator (-ssi_mesh grid) has no parameters; they set "
+                               "the DefineConstant parameters of a .geo given as -ssi_mesh")
             if cfg.mesh == "grid":
                 mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
             else:
@@ -387,6 +392,11 @@ class HalfSpace:
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
         self.mem_peak_estimate = peak
+        from .cost import loop_seconds
+        stride = self.grid.stride
+        self.loop_estimate = loop_seconds(est, self.mesh.n_nodes, lags, self.n_steps, mpi.Get_size(),
+                                          int(round(share * mpi.Get_size())), self.n_steps // stride if stride else 0,
+                                          dense=2 * nd >= lags)
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "

@@ -14,7 +14,7 @@ import numpy as np
 from ..petsc import printf
 from ..monitor import staged, fmt_time, event
 from ..io.output import Output, provenance
-from ..problem import TransientProblem
+from ..problem import TransientProblem, no_output_refused
 from .halfspace import HalfSpace
 from .build import build_marcher
 from .stability import DivergenceGuard
@@ -26,6 +26,7 @@ class BEMTransient(TransientProblem):
 
     def __init__(self, cfg, comm=None):
         super().__init__(cfg, comm)
+        no_output_refused(cfg, "a BEM")
         self.check_output()
         self.log = printf if cfg.monitor else (lambda m: None)
         with staged("SSI BEM setup"):

@@ -9,7 +9,7 @@ from ..options import Config
 from ..bem.halfspace import HalfSpace
 from ..bem.lagset import Regions
 from ..fem.model import build_model
-from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces
+from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces, interface_offsets
 from .step import STRATEGIES
 
 
@@ -50,6 +50,10 @@ def build_coupled(cfg, comm):
         iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
                                 prob.planes, prob.h)
         sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.dofmap)
+        if cfg.interface_offset and not np.abs(interface_offsets(model.mesh, iface, cfg.fem_interface)).any():
+            raise SSIError(f"-ssi_interface_offset: the interface (-ssi_fem_interface {cfg.fem_interface}) has no "
+                           "shell slab nodes; the offset applies to a shell foundation slab only and does nothing "
+                           "here: drop it")
         load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
         both = np.intersect1d(load, iface.be_elems)
         if both.size:

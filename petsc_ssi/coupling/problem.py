@@ -17,7 +17,7 @@ import numpy as np
 from ..petsc import printf, warn, SSIError
 from ..monitor import staged, fmt_time
 from ..io.output import Output
-from ..problem import TransientProblem
+from ..problem import TransientProblem, no_output_refused
 from ..io.output import provenance
 from ..io.forces import add_force_recorder
 from ..io.structure import receiver_record
@@ -40,6 +40,7 @@ class SSITransient(TransientProblem):
 
     def __init__(self, cfg, comm=None):
         super().__init__(cfg, comm)
+        no_output_refused(cfg, "a coupled")
         self.check_output(also=(structure_output_path(cfg.output),))
         self.log = printf if cfg.monitor else (lambda m: None)
         comm = self.comm

@@ -494,6 +494,9 @@ def renumber_rcm(mesh):
 def build_mesh(cfg, specs=None):
     """Serial: the mesh the options describe (no renumbering). ``specs``: the parts."""
     if cfg.fem_mesh == "box":
+        if str(cfg.get("fem_mesh_params", "") or "").strip():
+            raise SSIError("-ssi_fem_mesh_params: the box generator (-ssi_fem_mesh box) has no parameters; they "
+                           "set the DefineConstant parameters of a .geo given as -ssi_fem_mesh")
         if specs is not None and not all(s.legacy for s in specs):
             raise SSIError("-ssi_fem_parts needs a gmsh mesh (-ssi_fem_mesh FILE.geo|.msh); the box generator "
                            "makes one hex8 part")

@@ -193,6 +193,9 @@ def _spec(name, g):
     for p in ("added_mass", "mass_per_area", "shear_factor"):
         if p in v and not v[p] >= 0:
             raise SSIError(f"{opt(p)} {v[p]:g}: must be >= 0")
+    if "mass_per_area" in v and v["mass_per_area"] == 0:      # 0 is the 'not set' of the shell: rho * t
+        raise SSIError(f"{opt('mass_per_area')} 0: must be > 0 (0 does nothing: the shell's mass per area "
+                       f"stays rho * thickness; for a massless shell set {opt('rho')} 0)")
     props = Props(E=v["E"], nu=v["nu"], rho=v["rho"])
     for p in ("thickness", "mass_per_area", "added_mass", "shear_factor", "drilling"):
         if p in v:
