@@ -192,8 +192,11 @@ class Reader:
             if comm.getRank() == 0:
                 with _h5(path, "r") as f:
                     data = {k: f["serial"][k][()] for k in f["serial"]}
+                    names = sorted(k for k in f.keys() if k != "serial")
                 data = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in data.items()}
-        self.serial = comm.tompi4py().bcast(data, root=0)
+                data = (data, names)
+        self.serial, self.names = comm.tompi4py().bcast(data, root=0)
+        self.names = frozenset(self.names)
         self.viewer = PETSc.Viewer().createHDF5(path, mode="r", comm=comm)
 
     def output_state(self, prefix):
@@ -201,6 +204,10 @@ class Reader:
         if prefix + "_times" not in self.serial:      # the interrupted run wrote no output
             return None
         return {"times": self.serial[prefix + "_times"], "fields": self.serial[prefix + "_fields"]}
+
+    def has(self, name):
+        """Whether the checkpoint holds the Vec ``name``."""
+        return name in self.names
 
     def load(self, name, vec):
         """Collective: the saved Vec ``name`` into ``vec`` (same global size)."""
