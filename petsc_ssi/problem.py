@@ -77,9 +77,9 @@ class CheckpointObserver:
     """An observer of the recorder (``io.recorder`` protocol) that ``TransientProblem.run`` adds:
     after each step but the last, one collective poll (``_poll``: a signal any rank caught;
     -ssi_output_flush and -ssi_checkpoint_interval due by rank 0's clock), a checkpoint every
-    -ssi_checkpoint_every steps, when the interval is due and on a signal; on a signal the run
-    stops after that checkpoint (SSIError); a due flush makes the output readable. A script that
-    steps by itself gets none of this."""
+    -ssi_checkpoint_every steps and when the interval is due; on a signal the run stops
+    (``TransientProblem._stop``: the output, then a checkpoint, then SSIError); a due flush makes
+    the output readable. A script that steps by itself gets none of this."""
 
     def __init__(self, problem, sig):
         self.p, self.sig = problem, sig
@@ -294,10 +294,10 @@ class TransientProblem:
         While stepping, the output is made readable every -ssi_output_flush seconds, checked at the
         end of each step (attribute ``run_status`` 'running'), and a checkpoint is written every
         -ssi_checkpoint_every steps and -ssi_checkpoint_interval seconds. SIGTERM, SIGINT or
-        SIGUSR1 stops the run at the end of the current step with a checkpoint (after the last step
-        the run just finishes); a stop by a signal or by an SSIError (the divergence guard, a
-        non-finite solution) writes the results up to the last step with ``run_status`` 'stopped
-        ...' before the error is raised. Other exceptions (a bug, PETSc or MPI failures) write
+        SIGUSR1 stops the run at the end of the current step, the output written first, then a
+        checkpoint (after the last step the run just finishes); a stop by a signal or by an
+        SSIError (the divergence guard, a non-finite solution) writes the results up to the last
+        step with ``run_status`` 'stopped ...' before the error is raised. Other exceptions (a bug, PETSc or MPI failures) write
         nothing more. With -ssi_restart the steps start after the checkpoint's."""
         self.setup()
         self.start()

@@ -17,7 +17,8 @@ It is written to ``FILE.tmp`` and renamed over ``FILE`` only when complete, so a
 write leaves the previous checkpoint. ``-ssi_checkpoint FILE`` names it (default
 ``<output stem>-checkpoint.h5``; ``%d`` in the name is replaced by the step, to keep every one);
 ``-ssi_checkpoint_every N`` (steps) and ``-ssi_checkpoint_interval S`` (wall seconds) say when;
-SIGTERM, SIGINT and SIGUSR1 write one at the end of the current step before the run stops.
+SIGTERM, SIGINT and SIGUSR1 write one at the end of the current step, after the output, before
+the run stops (``TransientProblem._stop``; under mpirun only if its kill leaves the time: README).
 ``-ssi_restart FILE`` resumes: the same options (refused otherwise, naming the option that
 differs), any rank count; the output of the interrupted run is continued in place.
 
