@@ -229,3 +229,32 @@ def test_sigterm_to_mpirun_on_a_loaded_machine_writes_the_checkpoint(tmp_path):
     with h5py.File(ck) as f:
         assert int(f.attrs["step"]) == n and 30 <= n < 2000
         assert sorted(k for k in f.keys() if k.startswith("bem_u_ring_"))    # the ring, packed
+
+
+def test_a_checkpoint_with_one_dataset_per_step_still_restarts(tmp_path):
+    """Checkpoints written before the ring was packed (issue 30) hold one dataset per step,
+    ``bem_u_000023`` of shape (N/3, 3): such a file (made here from a packed one, columns of
+    ``bem_u_ring_000`` taken out, the packed datasets removed) restarts to the uninterrupted run
+    bit for bit on one rank."""
+    args = BEM + ["-ssi_t_end", "0.1"]                             # 40 steps
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    cli(args + ["-ssi_output", str(ref / "r.h5"), "-ssi_checkpoint", str(tmp_path / "ck-%d.h5"),
+                "-ssi_checkpoint_every", "25"])
+    ck = str(tmp_path / "ck-25.h5")
+    with h5py.File(ck, "a") as f:
+        n = int(f.attrs["step"])
+        for side in ("u", "p"):
+            blocks = sorted(k for k in f.keys() if k.startswith(f"bem_{side}_ring_"))
+            cols = np.concatenate([np.asarray(f[b]).reshape(np.asarray(f[b]).shape[0], -1) for b in blocks], axis=1)
+            steps = range(n - cols.shape[1] + 1, n + 1)
+            for j, m in enumerate(steps):
+                f.create_dataset(f"bem_{side}_{m:06d}", data=cols[:, j].reshape(-1, 3))
+            for b in blocks:
+                del f[b]
+        assert len(steps) > 1 and not any(k.startswith("bem_u_ring") for k in f.keys())
+    rs = tmp_path / "rs"
+    shutil.copytree(ref, rs)
+    r = cli(args + ["-ssi_output", str(rs / "r.h5"), "-ssi_restart", ck])
+    assert "restarted from" in r.stdout and "after step 25" in r.stdout, r.stdout[-2000:]
+    assert_same_files(str(rs / "r.h5"), str(ref / "r.h5"))
