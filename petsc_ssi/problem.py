@@ -276,7 +276,9 @@ class TransientProblem:
         t2 = time.perf_counter()
         if path:
             msg += f"; resume with -ssi_restart {path}"
-        msg += f" (output written {t1 - t0:.2g} s after the signal, checkpoint {t2 - t0:.2g} s)"
+        took = ([f"output written {t1 - t0:.2g} s after the signal"] if self.cfg.get("output") else []) + \
+            ([f"checkpoint {t2 - t0:.2g} s"] if path else [])
+        msg += f" ({', '.join(took)})" if took else ""
         raise SSIError(msg)
 
     def _flush(self):
