@@ -128,6 +128,9 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
+STAGE = "_flush_staging"       # the group a flush writes its series to before they replace the old ones
+
+
 def _group(parent, name):
     """A new HDF5 group without modification times (h5py's create_group cannot say so)."""
     import h5py
@@ -311,12 +314,38 @@ class Output:
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
         earlier flush wrote); XDMF; JSON."""
         with _h5(self.path, "a") as f:             # no lock: a reader may hold the file open mid-run
-            for name in ("topology", "time", "receivers") + tuple(groups or ()):
+            # Staged, so that a kill (SIGKILL, a lost node) in the middle leaves the last flush's data
+            # readable: the new series go to the group STAGE, HDF5 writes them out (H5Fflush), and
+            # only then replace the old ones (moves), flushed again. Deleting first and writing
+            # after left a window where the file pointed past its end (issue 30: 'addr overflow'
+            # on receivers/u after a SIGKILL at -n 2).
+            names = ("topology", "time", "receivers") + tuple(groups or ())
+            if STAGE in f:
+                del f[STAGE]
+            st = _group(f, STAGE)
+            if self.cells is not None:
+                st.create_dataset("topology", data=self.cells, track_times=False)
+            st.create_dataset("time", data=np.asarray(self.times), track_times=False)
+            if receivers is not None:
+                g = _group(st, "receivers")
+                for k, v in receivers.items():
+                    g.create_dataset(k, data=np.asarray(v), track_times=False)
+            for gname, data in (groups or {}).items():
+                g = _group(st, gname)
+                for k, v in data.items():
+                    unit = None
+                    if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
+                        v, unit = v                     # (array, unit): the unit as an attribute
+                    d = g.create_dataset(k, data=np.asarray(v), track_times=False)
+                    if unit is not None:
+                        d.attrs["unit"] = unit
+            f.flush()
+            for name in names:
                 if name in f:
                     del f[name]
-            if self.cells is not None:
-                f.create_dataset("topology", data=self.cells, track_times=False)
-            f.create_dataset("time", data=np.asarray(self.times), track_times=False)
+                if name in st:
+                    f.move(f"{STAGE}/{name}", name)
+            del f[STAGE]
             f.attrs["run_status"] = status
             f.attrs["cell_type"] = self.cell_type or ""
             f.attrs["fields"] = ",".join(self.fields)
@@ -325,19 +354,7 @@ class Output:
             f.attrs["petsc_ssi_version"] = __version__
             for k, v in (attrs or {}).items():
                 f.attrs[k] = v
-            if receivers is not None:
-                g = _group(f, "receivers")
-                for k, v in receivers.items():
-                    g.create_dataset(k, data=np.asarray(v), track_times=False)
-            for gname, data in (groups or {}).items():
-                g = _group(f, gname)
-                for k, v in data.items():
-                    unit = None
-                    if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
-                        v, unit = v                     # (array, unit): the unit as an attribute
-                    d = g.create_dataset(k, data=np.asarray(v), track_times=False)
-                    if unit is not None:
-                        d.attrs["unit"] = unit
+            f.flush()
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
