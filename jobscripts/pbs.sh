@@ -33,6 +33,12 @@ RANKS=${RANKS//:/ }
 export PBS_NUM_NODES=$NODES
 export CORES=${CORES:-$(( NRANKS / NODES ))}
 export MPIEXEC=${MPIEXEC:-mpiexec}
+# At the walltime PBS sends SIGTERM, then SIGKILL after the queue's kill_delay; Open MPI's mpiexec,
+# which gets the SIGTERM too, SIGKILLs the ranks 2 x this many seconds later (default 1 s: too
+# short for petsc-ssi's output and checkpoint on a loaded node; README: "Signals under mpirun and
+# schedulers"). PBS sends no signal ahead of the limit: use -ssi_checkpoint_interval, or
+# `qsig -s USR1 JOBID` (mpiexec forwards SIGUSR1 to the ranks at once, without a kill).
+export OMPI_MCA_odls_base_sigkill_timeout=${OMPI_MCA_odls_base_sigkill_timeout:-30}
 if [ -n "${PBS_NODEFILE:-}" ] && [ -z "${MPIFLAGS:-}" ]; then
   MPIFLAGS="--hostfile $PBS_NODEFILE"        # Open MPI; MPICH/PBS-aware launchers: MPIFLAGS=" "
 fi

@@ -52,12 +52,51 @@ if "numba" not in __import__("sys").modules:
     _os.environ["NUMBA_CACHE_DIR"] = _numba_cache_dir()
 
 
+# the modules with numba kernels cached on disk (njit(cache=True)); see numba_cache_status
+KERNEL_MODULES = ("petsc_ssi.bem.kernels", "petsc_ssi.bem.quadrature", "petsc_ssi.bem.assemble",
+                  "petsc_ssi.bem.lagmats", "petsc_ssi.bem.bsr")
+
+
+def numba_cache_status():
+    """(fresh, total): of the cached numba kernels (``njit(cache=True)`` in ``KERNEL_MODULES``), how
+    many have an entry numba will load for THIS checkout of the sources. numba files its cache
+    index under the source file's directory path (``<cache>/<dir>_<sha1 of the path>/``) and
+    keeps an entry only while the source's mtime and size match its stamp, so a second checkout
+    of the same sources (another path, or files rewritten by git) finds nothing in the cache that
+    the first one filled, and compiles every kernel again (30 to 80 s) even though the directory
+    of the sources' hash holds kernels. This asks numba's own index of each kernel (imports the
+    kernel modules: numba, no compile)."""
+    import importlib
+    fresh = total = 0
+    for name in KERNEL_MODULES:
+        mod = importlib.import_module(name)
+        for obj in vars(mod).values():
+            cf = getattr(getattr(obj, "_cache", None), "_cache_file", None)
+            py = getattr(obj, "py_func", None)
+            if cf is None or py is None or py.__module__ != name:
+                continue
+            total += 1
+            try:
+                fresh += bool(cf._load_index())
+            except Exception:          # an unreadable index: numba compiles (and rewrites it)
+                pass
+    return fresh, total
+
+
 def numba_cache_warm():
-    """Whether numba's cache for this version of the sources holds compiled kernels (else the
+    """Whether numba's cache holds compiled kernels for this checkout of the sources (else the
     first BEM assembly compiles them: about a minute; ``python -m petsc_ssi.app.warmup`` does it
-    ahead, and ``make deps`` runs that)."""
-    d = _os.environ.get("NUMBA_CACHE_DIR", "")
-    for _, _, files in _os.walk(d):
-        if any(f.endswith(".nbi") for f in files):
-            return True
-    return False
+    ahead, and ``make deps`` runs that). Kernels a run of another checkout compiled do not count
+    (``numba_cache_status``)."""
+    return numba_cache_status()[0] > 0
+
+
+def checkout_key():
+    """A key of this checkout as numba's cache sees it: the package's path and the (mtime, size)
+    of every module with cached kernels (what numba's index entries are stamped with)."""
+    h = _hashlib.sha1(_os.path.dirname(_os.path.abspath(__file__)).encode())
+    for name in KERNEL_MODULES:
+        path = _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), *name.split(".")[1:]) + ".py"
+        st = _os.stat(path)
+        h.update(f"{name} {st.st_mtime!r} {st.st_size}".encode())
+    return h.hexdigest()[:12]

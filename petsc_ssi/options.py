@@ -263,7 +263,7 @@ def _is_petsc_object_option(name):
     for pfx in ("bem_", "fem_", "coupling_", "modes_"):
         if name.startswith(pfx):
             rest = name[len(pfx):]
-            if rest.split("_")[0] in ("ksp", "pc", "mat", "eps", "st", "snes", "vec"):
+            if rest.split("_")[0] in ("ksp", "pc", "mat", "eps", "st", "snes", "vec", "redundant", "sub"):
                 return True
     return False
 

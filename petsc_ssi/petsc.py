@@ -258,6 +258,32 @@ def set_default_options(prefix, defaults, log=None):
     return applied
 
 
+def check_reproducible_solver(prefix, comm, what):
+    """Collective (every rank decides alike): with ``-ssi_reproducible`` on more than one rank, one
+    line when the solver options of ``prefix`` keep MUMPS's parallel factorisation, which a
+    user's explicit ``-<prefix>pc_factor_mat_solver_type mumps`` does (the defaults then leave it):
+    its reruns are not bitwise. Measured on the coupled case of tests/coupling/test_coupled_cli.py at
+    -n 2, two reruns each: with the structure's D on MUMPS 1931 to 1944 values of the structure's
+    file differed (1e-13 relative, from the second step on), whatever MUMPS's sequential analysis
+    (-mat_mumps_icntl_28 1), ordering (_icntl_7 0 or 5), _icntl_13 1 or _icntl_14 100; with D on
+    SuperLU_dist, or on MUMPS redundantly (whole on every rank), and the soil on either, none (the
+    likely cause, not traced inside MUMPS: its parallel factorisation is scheduled dynamically and
+    sums contribution blocks in the order the messages arrive). Returns whether it warned."""
+    PETSc = init()
+    db = PETSc.Options()
+    if comm.getSize() == 1 or not db.getBool("ssi_reproducible", False):
+        return False
+    pc = (db.getString(prefix + "pc_type", "") or "").lower()
+    pkg = (db.getString(prefix + "pc_factor_mat_solver_type", "") or "").lower()
+    if pc in ("lu", "cholesky") and pkg == "mumps":
+        warn(f"-ssi_reproducible: -{prefix}pc_factor_mat_solver_type mumps keeps MUMPS for {what}, whose parallel "
+             "factorisation is not bitwise repeatable (reruns differ at round-off); leave it unset for SuperLU_dist, "
+             f"or -{prefix}pc_type redundant -{prefix}redundant_pc_factor_mat_solver_type mumps (MUMPS on the "
+             "whole matrix on every rank)", comm)
+        return True
+    return False
+
+
 def has_package(name):
     """Whether this PETSc build has an external package (MUMPS, hypre, ...)."""
     PETSc = init()

@@ -106,14 +106,14 @@ def run_ssi(**opts):
             db.delValue("ssi_" + k)
 
 
-def signal_midway(args, log, after, send, nranks=1, timeout=240):
-    """Start ``petsc-ssi args`` (under mpirun for ``nranks`` > 1) with a progress line every step,
+def signal_midway(args, log, after, send, nranks=1, timeout=240, mpirun_args=()):
+    """Start ``petsc-ssi args`` (under mpirun for ``nranks`` > 1, with ``mpirun_args``) with a progress line every step,
     wait for the line of step ``after``, then ``send(p)`` (p: the Popen of python or of mpirun);
     returns (exit status, the log's text). The run must be long enough to be signalled midway."""
     import time
     cmd = [PY, "-m", "petsc_ssi"] + list(args) + ["-ssi_monitor", "-ssi_monitor_every", "1"]
     if nranks > 1:
-        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + list(mpirun_args) + cmd
     with open(log, "w") as fh:
         p = subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT,
                              env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))

@@ -117,3 +117,70 @@ def test_a_signal_stops_a_coupled_contact_run(tmp_path):
     with h5py.File(s) as f, h5py.File(sr) as g:
         assert str(f.attrs["run_status"]).startswith("stopped after step")
         assert np.abs(f["receivers/u"][:] - g["receivers/u"][:]).max() <= 1e-6 * np.abs(g["receivers/u"][:]).max()
+
+
+def _start(args, log, nranks):
+    """``petsc-ssi args`` (under mpirun for nranks > 1) in a session of its own (killed whole)."""
+    import os
+    import subprocess
+    from helpers import PY, ROOT
+    cmd = [PY, "-m", "petsc_ssi"] + list(args) + ["-ssi_monitor", "-ssi_monitor_every", "1"]
+    if nranks > 1:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
+    with open(log, "w") as fh:
+        return subprocess.Popen(cmd, cwd=ROOT, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True,
+                                env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+
+
+def _wait_for(log, text, p, timeout=240):
+    import time
+    t0 = time.time()
+    while time.time() - t0 < timeout and p.poll() is None:
+        if text in open(log).read():
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"no '{text}' in the log:\n" + open(log).read()[-2000:])
+
+
+@pytest.mark.parametrize("nranks", [1, 2])
+def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
+    """SIGKILL without warning (a lost node; mpirun's kill when the stop outlasts its timeout) to the
+    whole job, at 3 moments drawn at random (seeded) after the run's 5th step, the output flushed
+    every 0.05 s and a snapshot every 3 steps: each time h5py opens the file, run_status is
+    'running', and the steps the last flush recorded are all there, finite, and equal bit for bit
+    to the same steps of an uninterrupted run (receivers, times, every snapshot)."""
+    import os
+    import random
+    import signal as sg
+    import time
+    rng = random.Random(30 + nranks)
+    args = BEM + ["-ssi_t_end", "20", "-ssi_output_flush", "0.05", "-ssi_output_stride", "3"]
+    got = []
+    for k in range(3):
+        out, log = str(tmp_path / f"k{k}.h5"), str(tmp_path / f"k{k}.log")
+        p = _start(args + ["-ssi_output", out], log, nranks)
+        try:
+            _wait_for(log, "step 5/", p)
+            time.sleep(rng.uniform(0.0, 1.5))
+        finally:
+            os.killpg(p.pid, sg.SIGKILL)
+            p.wait(timeout=60)
+        with h5py.File(out, "r") as f:
+            assert str(f.attrs["run_status"]) == "running"
+            t, u, times = f["receivers/t"][:], f["receivers/u"][:], f["time"][:]
+            snaps = [f[f"displacement_{j:06d}"][:] for j in range(len(times))]
+        n = len(t)
+        assert n >= 1 and u.shape[0] == n and np.isfinite(u).all()      # the first step flushed (setup > 0.05 s)
+        assert np.allclose(t, 0.005 * np.arange(1, n + 1), rtol=1e-12, atol=0)
+        assert len(times) >= n // 3 and all(np.isfinite(s).all() for s in snaps)
+        got.append((n, u, times, snaps))
+    nmax = max(g[0] for g in got)
+    ref = str(tmp_path / "ref.h5")
+    cli(BEM + ["-ssi_t_end", repr(nmax * 0.005), "-ssi_output_stride", "3", "-ssi_output", ref], nranks=nranks)
+    with h5py.File(ref, "r") as f:
+        ru, rtimes = f["receivers/u"][:], f["time"][:]
+        for n, u, times, snaps in got:
+            assert np.array_equal(u, ru[:n]) and np.array_equal(times, rtimes[:len(times)])
+            for j, s in enumerate(snaps):
+                assert np.array_equal(s, f[f"displacement_{j:06d}"][:]), j
+    assert len({g[0] for g in got}) > 1                  # the kills came at different steps

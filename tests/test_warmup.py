@@ -101,3 +101,87 @@ def test_cache_dir_is_not_nested_in_child_processes(tmp_path):
     env["NUMBA_CACHE_DIR"] = d1
     second = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True)
     assert second.stdout.split("DIR ", 1)[1].strip() == d1, second.stdout
+
+
+STATUS = "import petsc_ssi; print('STATUS', *petsc_ssi.numba_cache_status(), petsc_ssi.checkout_key())"
+
+
+def _second_checkout(tmp_path):
+    """A second checkout of the same sources: the package copied (new path, new mtimes, as a git
+    worktree or clone gives); returns (its root, clean(cache, key): remove what it left in the
+    shared cache, numba's sub-directory for its path and its warm-up mark)."""
+    import hashlib
+    import shutil
+    root = tmp_path / "clone"
+    root.mkdir()
+    shutil.copytree(os.path.join(ROOT, "petsc_ssi"), root / "petsc_ssi",
+                    ignore=shutil.ignore_patterns("__pycache__"), copy_function=shutil.copy)
+
+    def clean(cache, key):
+        d = str(root / "petsc_ssi" / "bem")                     # numba's sub-directory for that path
+        shutil.rmtree(os.path.join(cache, "bem_" + hashlib.sha1(d.encode()).hexdigest()), ignore_errors=True)
+        if os.path.exists(os.path.join(cache, "warmup-done-" + key)):
+            os.remove(os.path.join(cache, "warmup-done-" + key))
+    return root, clean
+
+
+def _status(cwd, env):
+    r = subprocess.run([sys.executable, "-c", STATUS + "; import os; print('DIR', os.environ['NUMBA_CACHE_DIR'])"],
+                       cwd=str(cwd), env=dict(env, PYTHONPATH=str(cwd)), capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    line = [ln.split() for ln in r.stdout.splitlines() if ln.startswith("STATUS")][0]
+    cache = [ln.split(None, 1)[1] for ln in r.stdout.splitlines() if ln.startswith("DIR")][0]
+    return int(line[1]), int(line[2]), line[3], cache
+
+
+def test_a_second_checkout_is_not_taken_for_warm(tmp_path):
+    """Issue 30: numba files its cache index under the source file's path and stamps it with the
+    file's mtime and size, so a second checkout of the same sources (same hash, same cache
+    directory) loads nothing the first one compiled. The warm check asks numba's index for THIS
+    checkout: warm in the repository (warmed first if needed), cold in a copy of the package, and
+    the checkout keys (the warm-up's mark) differ."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    fresh, total, key, cache = _status(ROOT, env)
+    if not fresh:                                        # a cold cache: warm this checkout first
+        subprocess.run([sys.executable, "-m", "petsc_ssi.app.warmup"], cwd=ROOT, env=env, check=True,
+                       capture_output=True, timeout=900)
+        fresh, total, key, cache = _status(ROOT, env)
+    assert total >= 20 and fresh > 0, (fresh, total)
+    clone, clean = _second_checkout(tmp_path)
+    f2, t2, key2, cache2 = _status(clone, env)
+    try:
+        assert cache2 == cache                           # the same sources: the same cache directory ...
+        assert t2 == total and f2 == 0                   # ... and none of its kernels for this checkout
+        assert key2 != key
+    finally:
+        clean(cache2, key2)
+
+
+def test_a_second_checkout_compiles_once_and_says_so(tmp_path):
+    """A second checkout whose first run compiles says so in one line (this checkout's path in it);
+    its warm-up then compiles the rest and marks this checkout warm, and a new process's run there
+    compiles nothing (numba's compile_extra counted, as above), though the repository's own
+    checkout had filled the same cache directory before."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    clone, clean = _second_checkout(tmp_path)
+    cenv = dict(env, PYTHONPATH=str(clone))
+    py = lambda args: subprocess.run([sys.executable] + args, cwd=str(clone), env=cenv,  # noqa: E731
+                                     capture_output=True, text=True, timeout=900)
+    _, _, key, cache = _status(clone, env)
+    try:
+        r = py(RUN + ["-ssi_output", str(tmp_path / "a.h5")])
+        lines = [ln for ln in r.stdout.splitlines() if "compiling the BEM kernels" in ln]
+        assert r.returncode == 0 and len(lines) == 1 and "first run of this checkout" in lines[0], r.stdout[-3000:]
+        assert str(clone / "petsc_ssi") in lines[0]
+        w = py(["-m", "petsc_ssi.app.warmup"])
+        assert w.returncode == 0 and "[warmup] done" in w.stdout, w.stdout + w.stderr
+        w = py(["-m", "petsc_ssi.app.warmup"])
+        assert "[warmup] numba cache is warm" in w.stdout and str(clone / "petsc_ssi") in w.stdout, w.stdout
+        p = py(["-c", PROBE_RUN] + RUN[2:] + ["-ssi_lag_storage", "sparse", "-ssi_history_block", "2",
+                                              "-ssi_output", str(tmp_path / "b.h5")])
+        assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+        line = [ln for ln in p.stdout.splitlines() if ln.startswith("COMPILED")]
+        assert line and line[0].startswith("COMPILED 0 "), line or p.stdout[-3000:]
+        assert "compiling" not in p.stdout
+    finally:
+        clean(cache, key)

@@ -4,8 +4,11 @@ The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.p
 the first time a version of the sources runs on a machine (about a minute) and cached under
 ``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
 case on one process so that they are compiled now, says so, and exits at once when the cache is
-already warm: when the warm-up itself has finished in it (the file ``WARM_MARK`` in the cache), not
-merely when some run compiled some kernels there. ``make deps`` calls it.
+already warm for this checkout: when the warm-up itself has finished in it for these files at this
+path (the file ``WARM_MARK-<checkout key>`` in the cache: numba keys its index by the source file's
+path and stamps it with its mtime and size, so a second checkout of the same sources compiles
+again; ``petsc_ssi.checkout_key``), not merely when some run compiled some kernels there. ``make
+deps`` calls it.
 """
 import os
 import sys
@@ -19,9 +22,9 @@ WARM_MARK = "warmup-done"
 def main():
     import petsc_ssi
     d = os.environ.get("NUMBA_CACHE_DIR", "")
-    mark = os.path.join(d, WARM_MARK)
-    if os.path.exists(mark):
-        print(f"[warmup] numba cache is warm ({d})")
+    mark = os.path.join(d, f"{WARM_MARK}-{petsc_ssi.checkout_key()}")
+    if os.path.exists(mark) and petsc_ssi.numba_cache_warm():
+        print(f"[warmup] numba cache is warm ({d}, this checkout: {os.path.dirname(petsc_ssi.__file__)})")
         return 0
     if petsc_ssi.numba_cache_warm():
         print(f"[warmup] numba cache partly warm ({d}): loading the kernels, compiling what a run has not", flush=True)
@@ -47,7 +50,8 @@ def main():
         _single_kernels()
     os.makedirs(d, exist_ok=True)
     with open(mark, "w") as fh:
-        fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache\n")
+        fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache for the "
+                 f"checkout {os.path.dirname(petsc_ssi.__file__)}\n")
     print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
     return 0
 

@@ -87,9 +87,10 @@ def announce_compile():
     """Say once per process that the kernels compile now (a cold numba cache)."""
     if not _ANNOUNCED:
         _ANNOUNCED.append(True)
-        printf("[ssi] compiling the BEM kernels with numba: the first run of this version on this machine "
-               f"waits about a minute here (cached in {os.environ.get('NUMBA_CACHE_DIR')}; "
-               "'python -m petsc_ssi.app.warmup' or 'make deps' does it ahead)")
+        import petsc_ssi
+        printf("[ssi] compiling the BEM kernels with numba (first run of this checkout, "
+               f"{os.path.dirname(petsc_ssi.__file__)}, on this machine: ~1 min; cached in "
+               f"{os.environ.get('NUMBA_CACHE_DIR')}; 'python -m petsc_ssi.app.warmup' or 'make deps' does it ahead)")
 
 
 class _NoEvent:

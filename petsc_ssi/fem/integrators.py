@@ -93,7 +93,7 @@ warning, once per integrator.
 import numpy as np
 
 from ..petsc import init, SSIError, check, collective_error, set_default_options, \
-    direct_solver_defaults, printf, warn
+    direct_solver_defaults, printf, warn, check_reproducible_solver
 from ..monitor import event
 from .assembly import check_mass, owned_dofs, eliminate_dofs
 from .options import alpha_m
@@ -142,6 +142,7 @@ def make_solver(A, prefix, solver, comm, coords_vec=None, log=printf, near_null=
     PETSc = init()
     defaults = direct_solver_defaults(comm) if solver == "direct" else dict(SOLVER_ITERATIVE)
     set_default_options(prefix, defaults, log=log)
+    check_reproducible_solver(prefix, comm, "the structure")
     if near_null is not None:
         A.setNearNullSpace(near_null)
     elif coords_vec is not None:

@@ -21,7 +21,8 @@ It is written to ``FILE.tmp`` and renamed over ``FILE`` only when complete, so a
 write leaves the previous checkpoint. ``-ssi_checkpoint FILE`` names it (default
 ``<output stem>-checkpoint.h5``; ``%d`` in the name is replaced by the step, to keep every one);
 ``-ssi_checkpoint_every N`` (steps) and ``-ssi_checkpoint_interval S`` (wall seconds) say when;
-SIGTERM, SIGINT and SIGUSR1 write one at the end of the current step before the run stops.
+SIGTERM, SIGINT and SIGUSR1 write one at the end of the current step, after the output, before
+the run stops (``TransientProblem._stop``; under mpirun only if its kill leaves the time: README).
 ``-ssi_restart FILE`` resumes: the same options (refused otherwise, naming the option that
 differs), any rank count; the output of the interrupted run is continued in place.
 
@@ -245,8 +246,11 @@ class Reader:
             if comm.getRank() == 0:
                 with _h5(path, "r") as f:
                     data = {k: f["serial"][k][()] for k in f["serial"]}
+                    names = sorted(k for k in f.keys() if k != "serial")
                 data = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in data.items()}
-        self.serial = comm.tompi4py().bcast(data, root=0)
+                data = (data, names)
+        self.serial, self.names = comm.tompi4py().bcast(data, root=0)
+        self.names = frozenset(self.names)
         self.viewer = PETSc.Viewer().createHDF5(path, mode="r", comm=comm)
 
     def output_state(self, prefix):
@@ -254,6 +258,10 @@ class Reader:
         if prefix + "_times" not in self.serial:      # the interrupted run wrote no output
             return None
         return {"times": self.serial[prefix + "_times"], "fields": self.serial[prefix + "_fields"]}
+
+    def has(self, name):
+        """Whether the checkpoint holds the Vec ``name``."""
+        return name in self.names
 
     def load(self, name, vec):
         """Collective: the saved Vec ``name`` into ``vec`` (same global size)."""

@@ -149,6 +149,9 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
+STAGE = "_flush_staging"       # the group a flush writes its series to before they replace the old ones
+
+
 def _group(parent, name):
     """A new HDF5 group without modification times (h5py's create_group cannot say so)."""
     import h5py
@@ -335,24 +338,21 @@ class Output:
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
         earlier flush wrote); XDMF; JSON."""
         with _h5(self.path, "a") as f:             # no lock: a reader may hold the file open mid-run
-            for name in ("topology", "time", "receivers") + tuple(groups or ()):
-                if name in f:
-                    del f[name]
+            # Staged, so that a kill (SIGKILL, a lost node) in the middle leaves the last flush's data
+            # readable: the new series go to the group STAGE, HDF5 writes them out (H5Fflush), and
+            # only then replace the old ones (moves), flushed again. Deleting first and writing
+            # after left a window where the file pointed past its end (issue 30: 'addr overflow'
+            # on receivers/u after a SIGKILL at -n 2).
+            names = ("topology", "time", "receivers") + tuple(groups or ())
+            if STAGE in f:
+                del f[STAGE]
+            st = _group(f, STAGE)
             if self.cells is not None:
-                f.create_dataset("topology", data=self.cells, track_times=False)
-            f.create_dataset("time", data=np.asarray(self.times), track_times=False)
-            f.attrs["run_status"] = status
-            f.attrs["run_id"] = self.run_id
-            f.attrs["cell_type"] = self.cell_type or ""
-            f.attrs["fields"] = ",".join(self.fields)
-            f.attrs["n_snapshots"] = len(self.times)
-            from .. import __version__
-            f.attrs["petsc_ssi_version"] = __version__
-            for k, v in (attrs or {}).items():
-                f.attrs[k] = v
+                st.create_dataset("topology", data=self.cells, track_times=False)
+            st.create_dataset("time", data=np.asarray(self.times), track_times=False)
             for gname, data in ((("receivers", receivers),) if receivers is not None else ()) + \
                     tuple((groups or {}).items()):
-                g = _group(f, gname)
+                g = _group(st, gname)
                 for k, v in data.items():
                     unit, extra = UNITS.get(f"{gname}/{k}"), {}
                     if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
@@ -364,7 +364,24 @@ class Output:
                         d.attrs["unit"] = unit
                     for ak, av in extra.items():
                         d.attrs[ak] = av
+            f.flush()
+            for name in names:
+                if name in f:
+                    del f[name]
+                if name in st:
+                    f.move(f"{STAGE}/{name}", name)
+            del f[STAGE]
+            f.attrs["run_status"] = status
+            f.attrs["run_id"] = self.run_id
+            f.attrs["cell_type"] = self.cell_type or ""
+            f.attrs["fields"] = ",".join(self.fields)
+            f.attrs["n_snapshots"] = len(self.times)
+            from .. import __version__
+            f.attrs["petsc_ssi_version"] = __version__
+            for k, v in (attrs or {}).items():
+                f.attrs[k] = v
             self._field_units(f, (attrs or {}).get("time_is"))
+            f.flush()
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
