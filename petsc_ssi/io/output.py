@@ -160,6 +160,26 @@ def _group(parent, name):
     return h5py.Group(h5py.h5g.create(parent.id, name.encode(), gcpl=gcpl))
 
 
+def compactable(path, slack=2.0, margin=8e6):
+    """Rank 0: whether the file holds much more than its datasets (more than ``slack`` times their
+    bytes plus ``margin``): each flush during a run replaces the series (receivers, interface,
+    demands) and HDF5 does not reuse the space of deleted datasets, so a long run's file would grow
+    with the number of flushes times the series' size (262 MB for 29 MB of data, 6000 steps and a
+    flush every 10 s). Files with virtual datasets (io/forces.py) are left as they are: a copy
+    would store their data twice."""
+    import h5py
+    live, virtual = [0], [False]
+    with _h5(path, "r") as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                if obj.is_virtual:
+                    virtual[0] = True
+                else:
+                    live[0] += obj.id.get_storage_size()
+        f.visititems(visit)
+    return not virtual[0] and os.path.getsize(path) > slack * live[0] + margin
+
+
 def rewrite_without_times(path):
     """Rank 0: ``path`` copied object by object into a file whose objects carry no modification
     times, then renamed over it, so identical data give identical bytes. (PETSc's HDF5 viewer
@@ -385,8 +405,8 @@ class Output:
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
-        if final and self.deterministic:
-            rewrite_without_times(self.path)
+        if final and (self.deterministic or compactable(self.path)):
+            rewrite_without_times(self.path)        # also gives back the space earlier flushes freed
         self._write_xdmf()
         if record is not None:
             record = dict(record, run_status=status)
