@@ -202,8 +202,9 @@ class TransientProblem:
         self._locks = lock.acquire(paths, self.comm, self) if paths else []
 
     def release_locks(self):
-        """The locks of the run's files given back (``io.lock``); ``run`` does it at its end and
-        on any error; a script that steps by itself may call it after finish() (else: at exit)."""
+        """The locks of the run's files given back (``io.lock``): at the end of ``finish`` (the run is
+        done), and ``run`` on any error; a script that steps by itself and stops before finish()
+        may call it (else: at exit)."""
         from .io import lock
         lock.release(getattr(self, "_locks", ()), self.comm)
         self._locks = []

@@ -124,6 +124,7 @@ class BEMTransient(TransientProblem):
         res["stats"]["peak_rss_max_rank_bytes"], res["stats"]["peak_rss_sum_bytes"] = peak_rss(self.comm)
         write_results(cfg, self.comm, prob, self.out, res, status=self.final_status())
         printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
+        self.release_locks()                    # the run is done: its files are free again
         return res
 
 

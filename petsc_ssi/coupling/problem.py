@@ -246,6 +246,7 @@ class SSITransient(TransientProblem):
         self.integ.destroy()
         self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
+        self.release_locks()                    # the run is done: its files are free again
         return res
 
 

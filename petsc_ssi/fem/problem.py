@@ -184,6 +184,7 @@ class FEMTransient(TransientProblem):
         if self.demands is not None:
             out["demands"] = self.demands.arrays() if comm.getRank() == 0 else None
             self.demands.destroy()
+        self.release_locks()                    # the run is done: its files are free again
         return out
 
 
