@@ -542,11 +542,9 @@ def main(argv=None, out=None):
         at = _attrs(a.file) if os.path.exists(a.file) else {}
         if at.get("structure_output"):
             inputs.append(os.path.join(os.path.dirname(os.path.abspath(a.file)), str(at["structure_output"])))
-        _rsp._check_output("--csv", a.csv, inputs, a.overwrite)
-        _rsp._check_output("--png", a.png, inputs, a.overwrite)
-        if a.csv and a.png and a.csv != "-" and _rsp._same(a.csv, a.png):
-            raise _error(f"--png {a.png}: the same file as --csv")
-        if _rsp._same(a.file, a.glance):
+        _post.check_outputs([("--csv", a.csv), ("--png", a.png)], inputs, a.overwrite)  # never an input,
+        # its sidecars or an HDF5 result; an existing CSV/PNG only with --overwrite
+        if _post._same_file(a.file, a.glance):
             raise _error(f"--glance {a.glance}: the same file as SSI.h5")
         ps = load_ssi(a.file, a.receiver, a.component)
         pf = load_fixed(a.glance, a.receiver, a.component)
