@@ -77,6 +77,28 @@ SLOW = {
     # the paper's building under 30 s of record at 3 steps: the half building's option file (same
     # mesh) and the seismic building's (same seismic options) stay
     "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/seismic/paper-building.opts]",
+    # measured after the merges (make test at 1057 s on the idle machine): each has a sibling that stays
+    # - the checkpoint key's refusals one by one (21 s; test_integrity's restart refusals stay)
+    "tests/test_checkpoint.py::test_a_restart_that_changes_the_run_is_refused",
+    # - checkpoint and lag names against every output and sidecar (20 s; the locks' tests stay)
+    "tests/test_integrity.py::test_checkpoint_and_lag_files_may_not_be_outputs",
+    # - the full building's bonded option file (19 s; the half building's stay, as its variants here)
+    "tests/test_runs_opts.py::test_options_file_runs_reduced[runs/building/ssi-full-bonded.opts]",
+    # - a signal's checkpoint of a BEM run (13 s; the coupled contact run's stays)
+    "tests/test_checkpoint.py::test_a_signal_writes_a_checkpoint_that_restarts_a_bem_run",
+    # - impedance: symmetry-reduced == full and -n 2 (11 s; the off-centre footing's planes stay),
+    #   the requested band's warning (8 s) and the meshed surface's low-frequency limit (6 s)
+    "tests/bem/test_impedance.py::test_symmetry_reduced_runs_equal_full_runs_and_two_ranks_equal_one",
+    "tests/bem/test_impedance.py::test_requested_band_outside_the_trusted_one_warns",
+    "tests/bem/test_impedance.py::test_the_meshed_surface_limits_the_low_frequencies",
+    # - blocked == per-step history with a prescribed motion (11 s; the stabilised case stays)
+    "tests/bem/test_history_block.py::test_blocked_equals_per_step[prescribed motion]",
+    # - a rigid motion's resultants at -n 2 and through a restart (9 s; the square's stiffness stays)
+    "tests/bem/test_rigid_motion.py::test_two_ranks_equal_one_and_a_restart_keeps_the_resultants",
+    # - single lags' file reload (6 s; the double lag file's bitwise reload stays)
+    "tests/bem/test_single.py::test_single_lag_file_reloads_bitwise",
+    # - random kills at -n 1 (6 s; the -n 2 case stays)
+    "tests/test_output_survives.py::test_a_kill_at_random_moments_keeps_the_flushed_steps[1]",
 }
 _MPI = _re.compile(r"nranks\s*=\s*[2-9]|mpirun|mpiexec|\"-n\", \"?[2-9]|-n 2")
 _RUNS = _re.compile(r"\bcli\(|run_bem\(|run_ssi\(|run_fem\(|subprocess|from helpers import")
