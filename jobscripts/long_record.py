@@ -111,9 +111,9 @@ def main(d):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 4))
     for n, w in sorted(walls.items()):
-        k = np.arange(1, len(w) + 1)
-        m = max(len(w) // 200, 1)                       # a running mean over m steps
-        wm = np.convolve(np.nan_to_num(w, nan=np.nanmedian(w)), np.ones(m) / m, mode="same")
+        m = 240 if len(w) > 2400 else 24                # a running mean over whole history blocks (24 steps)
+        wm = np.convolve(np.nan_to_num(w, nan=np.nanmedian(w)), np.ones(m) / m, mode="valid")
+        k = np.arange(len(wm)) + (m + 1) / 2.0          # the centre step of each window
         ax.plot(k, 1e3 * wm, label=f"{n} rank{'s' if n > 1 else ''} (mean of {m} steps)")
     ax.set_xlabel("step [-] (dt = 5 ms)")
     ax.set_ylabel("wall time per step [ms]")
