@@ -254,19 +254,13 @@ def check_outputs(stem, modes, comm, overwrite):
     ``<stem>-<mode>.h5`` with its sidecars, ``<stem>-impedance.csv`` and ``.png``) may be written
     and replaces nothing unless -ssi_output_overwrite (``io.output.check_output``'s rule); SSIError
     in one line on every rank otherwise."""
-    from ..io.output import check_output
+    from ..io.output import check_output, replace_error
     from ..petsc import collective_error
     for mode in modes:
         check_output(f"{stem}-{mode}.h5", comm, overwrite)
     err = None
     for f in (stem + "-impedance.csv", stem + "-impedance.png"):
-        if os.path.isdir(f):
-            err = f"-ssi_output {stem}.h5: {f} is a directory"
-        elif os.path.lexists(f) and not os.path.isfile(f):
-            err = f"-ssi_output {stem}.h5: {f} exists and is not a regular file"
-        elif os.path.lexists(f) and not overwrite:
-            err = (f"-ssi_output {stem}.h5: {f} exists (a previous result); add -ssi_output_overwrite to replace "
-                   "it, or choose another -ssi_output")
+        err = replace_error(f, f"-ssi_output {stem}.h5", "-ssi_output", overwrite)
         if err:
             break
     collective_error(err, comm)

@@ -99,6 +99,19 @@ def command_output(path, command, argv=None):
     return f"{stem}-{command}{ext or '.h5'}"
 
 
+def replace_error(f, label, what="-ssi_output", overwrite=False):
+    """The one-line reason the output file ``f`` (named in messages as ``label``) may not be
+    written, or None: a directory, not a regular file, or an earlier result without overwrite."""
+    if os.path.isdir(f):
+        return f"{label}: {f} is a directory"
+    if os.path.lexists(f) and not os.path.isfile(f):
+        return f"{label}: {f} exists and is not a regular file"
+    if os.path.lexists(f) and not overwrite:
+        return (f"{label}: {f} exists (a previous result); add -ssi_output_overwrite to replace it, "
+                f"or choose another {what}")
+    return None
+
+
 def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     """Collective, before any heavy work: SSIError (one line, every rank) unless ``path`` (and the
     outputs ``also``, e.g. the structure's file of a coupled run) can be written: not a sidecar
@@ -119,13 +132,7 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
     for p in paths:
         for f in output_files(p):
-            if os.path.isdir(f):
-                err = f"{what} {p}: {f} is a directory"
-            elif os.path.lexists(f) and not os.path.isfile(f):
-                err = f"{what} {p}: {f} exists and is not a regular file"
-            elif os.path.lexists(f) and not overwrite:
-                err = (f"{what} {p}: {f} exists (a previous result); add -ssi_output_overwrite to replace it, "
-                       f"or choose another {what}")
+            err = replace_error(f, f"{what} {p}", what, overwrite)
             if err:
                 break
         if err:
