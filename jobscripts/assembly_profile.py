@@ -1,6 +1,6 @@
 """Where one rank's BEM assembly spends its time (issue 13, item 2): runs LagSet.assemble and the
-Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing assemble_rows,
-Buckets.add, lag_sort and the Mat constructors, and prints per rank those times, the kernel (sys)
+Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing assemble_rows
+(which writes the blocks where they are kept) and the Mat constructors, and prints per rank those times, the kernel (sys)
 time and minor page faults (getrusage), resident and huge-page memory, and per-chunk ms/row.
 
   mpirun -n 2 python jobscripts/assembly_profile.py [-rows R]   (R > 0: only R rows from row 1000)
@@ -32,15 +32,16 @@ def wrap(mod, name):
     setattr(mod, name, g)
 for n in ("assemble_rows",):
     wrap(model, n)
-wrap(model.Buckets, "add"); wrap(model, "lag_sort")
 for n in ("baij", "dense"):
     wrap(lagmats, n)
 t = time.perf_counter(); ls.assemble(); ta = time.perf_counter() - t
 print(PETSc.COMM_WORLD.rank, "chunk", ls.chunk_rows(ls.L), f"assemble {ta:.2f}", {k: round(v, 2) for k, v in T.items()})
 import resource
 ru = resource.getrusage(resource.RUSAGE_SELF); print("rss", open("/proc/self/status").read().split("VmRSS:")[1].split("\n")[0], "AnonHuge", [l for l in open("/proc/self/smaps_rollup") if "AnonHuge" in l])
-print(PETSc.COMM_WORLD.rank, "per chunk ms/row, ns/block:", [(int(r), round(1e3*d/ls.chunk_rows(ls.L), 1), round(1e9*d/max(n,1))) for d, n, r in TS[::7]], "sys", ru.ru_stime, "minflt", ru.ru_minflt, flush=True)
+print(PETSc.COMM_WORLD.rank, "per call (first row, ms/row):", [(int(r), round(1e3*d/max(n,1), 1)) for d, n, r in TS[::7]], "sys", ru.ru_stime, "minflt", ru.ru_minflt, flush=True)
 N = prob.mesh.n_nodes
 t = time.perf_counter()
 H, info = lagmats.build(PETSc.COMM_WORLD, ls.H, ls.L, ls.node_range, N, N, R, "sparse", 0.35)
-print(PETSc.COMM_WORLD.rank, f"build {time.perf_counter() - t:.2f}", {k: round(v, 2) for k, v in T.items()})
+print(PETSc.COMM_WORLD.rank, f"build {time.perf_counter() - t:.2f}", {k: round(v, 2) for k, v in T.items()},
+      "rss", open("/proc/self/status").read().split("VmRSS:")[1].split("\n")[0].strip(),
+      "peak", open("/proc/self/status").read().split("VmHWM:")[1].split("\n")[0].strip())

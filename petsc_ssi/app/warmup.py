@@ -70,7 +70,10 @@ def _shared_cache_kernels(PETSc):
                 Regions(mesh, load_elems=mesh.groups["load"]), [], opts)
     gq, gw = np.polynomial.legendre.leggauss(2)
     gr, gwr = np.polynomial.legendre.leggauss(12)
-    ls._share_cache(*new_cache(), 1, 3, 0.0, 1.0 / (1e-9 * float(ls.Vh.min())), gq, gw, gr, gwr)
+    for flat in (True, False):                   # the flat surface's block patterns and the full one
+        ls.mH, ls.mG = (4, 5) if flat else (9, 9)
+        ls._share_cache(*new_cache(), 1, 3, 0.0, 1.0 / (1e-9 * float(ls.Vh.min())), gq, gw, gr, gwr, ls.pattern(),
+                        np.zeros(2))
 
 
 def _single_kernels():
@@ -80,14 +83,18 @@ def _single_kernels():
     import numpy as np
     from ..bem import bsr
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
-    data = np.ones((1, 3, 3), np.float32)
-    bsr._matvec(indptr, cols, data, np.ones(3), np.zeros(3))
     x = np.ones(3)
     x.flags.writeable = False                # the python Mat's products read a read-only gathered x
-    bsr._matvec(indptr, cols, data, x, np.zeros(3))
-    bsr._matvec(indptr, cols, data.astype(np.float64), x, np.zeros(3))   # (double lags: the coupled runs)
-    bsr._panel(indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
-
+    for m in bsr.PATTERNS:                   # every block pattern (flat H and G, full)
+        for dt in (np.float32, np.float64):  # (double lags: the coupled runs)
+            data = np.ones((1, m), dt)
+            for xx in (np.ones(3), x):
+                bsr.matvec(m, indptr, cols, data, xx, np.zeros(3))
+            bsr.panel(m, indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
+    diag = np.ones((1, 3, 3))
+    bsr._diag_add(diag, 0, x, np.zeros(3), 1.0)
+    bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)
+    bsr._diag_panel(diag, 0, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
 
 if __name__ == "__main__":
     sys.exit(main())

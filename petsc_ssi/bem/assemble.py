@@ -130,69 +130,42 @@ def new_cache():
 
 @njit(cache=True)
 def _pool_end(cmeta, ncache):
-    """First free position of the cache pools (entry k holds (hi - lo + 1) * 81 doubles from cmeta[k, 2])."""
+    """First free lag slot of the cache pools (entry k holds hi - lo + 1 lag slots from slot cmeta[k, 2]:
+    9 m doubles each in a pool of a pattern of m values, ``_compact``)."""
     pool_n = 0
     for k in range(ncache):
-        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
+        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1)
         if e > pool_n:
             pool_n = e
     return pool_n
 
 
 @njit(cache=True)
-def _add_pair(src, nl, lo, cols, sign, i, slot, trow, tlag, tcol, tval, n, skip_zero):
-    """Add one pair's blocks src[li, a] * diag(sign) (lag lo + li, column cols[a]; cols[a] < 0: no
-    column) to row i's entries: slot[lag, col] is the entry of a block already met in this row
-    (-1: none yet), else a new one is made. With ``skip_zero`` an all-zero block makes no entry
-    (H: only non-zero blocks are stored; G keeps every traction column). Returns the entry count.
-    The triplet arrays have room for nl * 9 more entries (the caller grows them once per pair)."""
+def _compact(dst, off, B, nl, pp, pq):
+    """dst[off + (9 li + a) m + j] = B[li, a, pp[j], pq[j]] (m = len(pp)): the pattern's entries of a
+    pair's blocks, lag slot by lag slot, node by node (the layout of the cache pools and scratch)."""
+    m = pp.shape[0]
+    k = off
     for li in range(nl):
-        lag = lo + li
         for a in range(9):
-            col = cols[a]
-            if col < 0:
-                continue
-            if skip_zero:
-                nz = False
-                for p in range(3):
-                    for q in range(3):
-                        if src[li, a, p, q] != 0.0:
-                            nz = True
-                if not nz:
-                    continue
-            s = slot[lag, col]
-            if s < 0:
-                s = n
-                slot[lag, col] = s
-                trow[s] = i
-                tlag[s] = lag
-                tcol[s] = col
-                for p in range(3):
-                    for q in range(3):
-                        tval[s, p, q] = 0.0
-                n += 1
-            for p in range(3):
-                for q in range(3):
-                    tval[s, p, q] += src[li, a, p, q] * sign[q]
-    return n
+            for j in range(m):
+                dst[k] = B[li, a, pp[j], pq[j]]
+                k += 1
 
 
 @njit(cache=True)
-def _sort_row(slot, lag_lo, L, e0, n, tlag, tcol, tval, tmp):
-    """Put row entries e0..n in (lag, column) order by one pass over the slot map, which is cleared on
-    the way (ready for the next row); ``tmp`` (at least n - e0 blocks) is scratch. Rows of a chunk
-    then come out sorted as block CSR needs them, lag by lag, with no sort afterwards."""
-    tmp[:n - e0] = tval[e0:n]
-    k = e0
-    for lag in range(lag_lo, L + 1):
-        for col in range(slot.shape[1]):
-            s = slot[lag, col]
-            if s >= 0:
-                tval[k] = tmp[s - e0]
-                tlag[k] = lag
-                tcol[k] = col
-                slot[lag, col] = -1
-                k += 1
+def _check_dropped(B, nl, keep, dropped):
+    """dropped[0] = max(dropped[0], largest |B[li, a, p, q]| outside the pattern (keep False)): the
+    entries a flat pattern leaves out, exact zeros on a plane; every integral is checked once, where
+    it is computed, whatever path (cache, scratch, shared cache) it then takes."""
+    for li in range(nl):
+        for a in range(9):
+            for p in range(3):
+                for q in range(3):
+                    if not keep[p, q]:
+                        v = abs(B[li, a, p, q])
+                        if v > dropped[0]:
+                            dropped[0] = v
 
 
 @njit(cache=True)
@@ -210,48 +183,178 @@ def _cached(use_cache, cidx, ckeys, cmeta, VXv, xc, qinv, key, lo, hi, want_u):
     return -1, -1, hsh
 
 
-def new_work(L, n_nodes, n_tcols, blocks=1 << 16):
-    """Work arrays of ``assemble_rows``, kept from one call to the next (a call's triplets are used
-    before the next): triplets of H (row, lag, column, block) and of G, scratch blocks, and the slot
-    maps (-1) of lags 0..L by column. Reusing them spares each call its page faults (made anew, the
-    paper case's 3 GB per rank of triplet buffers cost more in the kernel than the assembly itself)."""
-    g = max(blocks // 64, 256)
-    return (np.zeros(blocks, np.int64), np.zeros(blocks, np.int64), np.zeros(blocks, np.int64),
-            np.zeros((blocks, 3, 3)), np.zeros(g, np.int64), np.zeros(g, np.int64), np.zeros(g, np.int64),
-            np.zeros((g, 3, 3)), np.zeros((1024, 3, 3)), np.full((L + 1, n_nodes), -1, np.int64),
-            np.full((L + 1, max(n_tcols, 1)), -1, np.int64))
+def new_work(n_nodes, n_tcols, n_virtual, mH=9, mG=9):
+    """Work arrays of ``assemble_rows``, kept from one call to the next: the pair list of a row
+    (element, lags lo..hi, where its integrals are), the integrals of pairs not in the element
+    cache (grown as needed), and per matrix one row of blocks by column (``mH``, ``mG`` values a
+    block: bsr.PATTERNS), its touched flags and list. A row's blocks of one lag are summed there (a
+    few tens of KB: in cache) and written once, where they are kept."""
+    nt = max(n_tcols, 1)
+    return (np.zeros((max(n_virtual, 1), 6), np.int64), np.zeros(1024), np.zeros(1024),
+            np.zeros((n_nodes, mH)), np.zeros((nt, mG)), np.zeros(n_nodes, np.bool_), np.zeros(nt, np.bool_),
+            np.zeros(n_nodes, np.int64), np.zeros(nt, np.int64))
 
 
 @njit(cache=True)
-def assemble_rows(rows, mesh, wave, quad, free_term, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  work, cache_max=1 << 62):
-    """Collective-free numba kernel: triplets of H and G for ``rows``.
+def _room(out, lag, n):
+    """Make room for ``n`` more blocks in lag ``lag`` of ``out`` (growing its arrays by half, in
+    place of the typed lists' entries, when it has none)."""
+    cols, vals, vals32, fill, counts, single_from = out
+    f = fill[lag]
+    c = cols[lag]
+    if f + n <= c.shape[0]:
+        return
+    cap = max(int(1.5 * (f + n)), 1024)
+    c2 = np.empty(cap, np.int32)
+    c2[:f] = c[:f]
+    cols[lag] = c2
+    if single_from > 0 and lag >= single_from:
+        v = vals32[lag]
+        v2 = np.empty((cap, v.shape[1]), np.float32)
+        v2[:f] = v[:f]
+        vals32[lag] = v2
+    else:
+        v = vals[lag]
+        w2 = np.empty((cap, v.shape[1]))
+        w2[:f] = v[:f]
+        vals[lag] = w2
+
+
+@njit(cache=True)
+def _emit_lag(lag, n, cl, buf, li, out):
+    """Append the blocks buf[cl[k]] (k < n, columns ascending) of one row to lag ``lag`` of ``out`` =
+    (columns, values, float32 values, fill, counts, single_from): typed Lists of per-lag arrays (values
+    from ``single_from`` > 0 on in float32, rounded as they are written), fill[l] the blocks lag l
+    holds, counts[l, li] += the row's (li: its place among the rank's rows)."""
+    if n == 0:
+        return
+    _room(out, lag, n)
+    cols, vals, vals32, fill, counts, single_from = out
+    f = fill[lag]
+    c = cols[lag]
+    m = buf.shape[1]
+    if single_from > 0 and lag >= single_from:
+        v32 = vals32[lag]
+        for k in range(n):
+            col = cl[k]
+            c[f + k] = col
+            for j in range(m):
+                v32[f + k, j] = buf[col, j]
+    else:
+        v = vals[lag]
+        for k in range(n):
+            col = cl[k]
+            c[f + k] = col
+            for j in range(m):
+                v[f + k, j] = buf[col, j]
+    fill[lag] = f + n
+    counts[lag, li] += n
+
+
+@njit(cache=True)
+def emit_row(n, tlag, tcol, tval, li, out):
+    """Append one row's blocks given as triplets 0..n (in (lag, column) order) to ``out`` (as
+    ``_emit_lag``; ``Buckets.add``)."""
+    cols, vals, vals32, fill, counts, single_from = out
+    m = tval.shape[1]
+    k = 0
+    while k < n:
+        lag = tlag[k]
+        k2 = k
+        while k2 < n and tlag[k2] == lag:
+            k2 += 1
+        _room(out, lag, k2 - k)
+        f = fill[lag]
+        c = cols[lag]
+        if single_from > 0 and lag >= single_from:
+            v32 = vals32[lag]
+            for e in range(k, k2):
+                c[f + e - k] = tcol[e]
+                for j in range(m):
+                    v32[f + e - k, j] = tval[e, j]
+        else:
+            v = vals[lag]
+            for e in range(k, k2):
+                c[f + e - k] = tcol[e]
+                for j in range(m):
+                    v[f + e - k, j] = tval[e, j]
+        fill[lag] = f + (k2 - k)
+        counts[lag, li] += k2 - k
+        k = k2
+
+
+@njit(cache=True)
+def _accumulate(src, base, m, cols, sign, sj, buf, touch, lst, n, skip_zero):
+    """Add one pair's blocks of one lag (src[base + m a + j]: node a, the j-th entry of the pattern,
+    ``_compact``) times diag(sign) (sign[sj[j]]: the sign of the entry's column component) into the
+    row buffer ``buf`` by column (cols[a] < 0: no column). A column met for the first time is zeroed
+    and listed (``touch``, ``lst``[:n]). With ``skip_zero`` a block whose entries are all zero adds
+    nothing (H: only blocks with a non-zero contribution are stored; G keeps every traction column).
+    Returns n."""
+    for a in range(9):
+        col = cols[a]
+        if col < 0:
+            continue
+        b = base + m * a
+        if skip_zero:
+            nz = False
+            for j in range(m):
+                if src[b + j] != 0.0:
+                    nz = True
+            if not nz:
+                continue
+        if not touch[col]:
+            touch[col] = True
+            lst[n] = col
+            n += 1
+            for j in range(m):
+                buf[col, j] = 0.0
+        for j in range(m):
+            buf[col, j] += src[b + j] * sign[sj[j]]
+    return n
+
+
+@njit(cache=True)
+def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
+                  work, dropped, hout, gout, loc, cache_max=1 << 62):
+    """Collective-free numba kernel: the blocks of H and G of ``rows``, written where they are kept.
 
     mesh = (xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh): collocation points and the virtual elements
     (nodes, global columns, image signs, traction columns, bounding spheres, sizes);
     wave = (L, dt, alpha, beta, rho, nu, lag_lo, toff); quad = (ns_base, near_factor, ns_max, gq, gw,
-    gr, gwr, tol, h_ref); work: ``new_work`` (its slot maps size the columns).
+    gr, gwr, tol, h_ref); pattern = (H's entries (p, q), G's, H's keep mask, G's: bsr.PATTERNS);
+    ``dropped`` (2,) the largest dropped magnitude of H and of G; work: ``new_work``; hout, gout: the
+    per-lag block CSR arrays of H and G (``_emit_lag``); loc: a node's place among the rank's rows.
 
-    Returns (work, nh, ng, nev, hits, cache arrays): the triplets are work[0:4][:nh] (H) and
-    work[4:8][:ng] (G), lags 1-based, row by row and within a row by (lag, column): split by lag,
-    each lag is block CSR with sorted columns. ``nev`` counts (point, lag) kernel evaluations,
-    ``hits`` the pairs taken from the cache. With ``use_cache`` the element integrals of a pair are
+    Per row: first every pair (row, virtual element) whose wave window reaches lags lag_lo..L is
+    listed with where its element integrals are (the element cache, or integrated now: into the
+    cache, or the work's scratch when the cache is off or full); then lag by lag the pairs'
+    blocks are summed in a row buffer by column (in element order: the sums of a block are those of
+    the literal loop, bit for bit) and written, columns ascending, straight into the lag's arrays:
+    rows ascending, no sort or copy after. The free term is not added (the Buckets and Mats of H_1
+    carry it apart).
+
+    Returns (work, nev, hits, cache arrays): ``nev`` counts (point, lag) kernel evaluations, ``hits``
+    the pairs taken from the cache. With ``use_cache`` the element integrals of a pair are
     reused for every later pair with the same relative geometry (quantised to 1/qinv): translated
     copies of an element on a structured mesh are integrated once. The key includes the node order,
     so images and singular pairs are keyed correctly; the integrals depend on nothing else
     (material, dt and lags are fixed). Only lags lag_lo..L are computed, at kernel times l dt + toff
     (a cache must not be shared between calls with different lag_lo, L or toff). The cache stops
-    growing at ``cache_max`` bytes per pool (reuse goes on). Each block sums its pairs in element
-    order, then the free term.
+    growing at ``cache_max`` bytes per pool (reuse goes on).
     """
     xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh = mesh
     L, dt, alpha, beta, rho, nu, lag_lo, toff = wave
     ns_base, near_factor, ns_max, gq, gw, gr, gwr, tol, h_ref = quad
-    hrow, hlag, hcol, hval, grw, glag, gcol, gval, tmp, slotH, slotG = work
+    hp, hq, gp, gq_, hkeep, gkeep = pattern
+    mH, mG = hp.shape[0], gp.shape[0]
+    sP, sU = 9 * mH, 9 * mG                    # doubles a lag slot of the P (H) and U (G) pools
+    smax = max(sP, sU)
+    pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG = work
+    dH = dropped[0:1]
+    dG = dropped[1:2]
     mu = rho * beta * beta
     nv = VX.shape[0]
-    nh = 0
-    ng_ = 0
     Ub = np.zeros((L, 9, 3, 3))
     Pb = np.zeros((L, 9, 3, 3))
     Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
@@ -260,14 +363,13 @@ def assemble_rows(rows, mesh, wave, quad, free_term, use_cache, cidx, ckeys, cme
     ncache = len(cidx)
     pool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
-    fcol = np.full(9, -1, np.int64)         # the free term: one block at (lag 1, column i)
-    ones = np.ones(3)
     reach = alpha * (dt * L + toff)
     for ii in range(rows.shape[0]):
         i = rows[ii]
         xc = xnodes[i]
-        h0 = nh
-        g0 = ng_
+        npair = 0
+        sc_n = 0
+        # the row's pairs: pairs[k] = (element, lo, hi, want_u, where (0: cache pools, 1: scratch), offset)
         for v in range(nv):
             lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
                                             toff, tol, ns_base, ns_max, near_factor)
@@ -279,80 +381,80 @@ def assemble_rows(rows, mesh, wave, quad, free_term, use_cache, cidx, ckeys, cme
                     want_u = True
             nl = hi - lo + 1
             found, fill_u, hsh = _cached(use_cache, cidx, ckeys, cmeta, VX[v], xc, qinv, key, lo, hi, want_u)
+            where = 0
             if found >= 0:
                 off = cmeta[found, 2]
-                Psrc = cpoolP[off:off + nl * 81].reshape((nl, 9, 3, 3))
-                Usrc = cpoolU[off:off + nl * 81].reshape((nl, 9, 3, 3)) if want_u else Ub[:nl]
                 hits += 1
             else:
                 nev += _integrate(xc, VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu,
                                   want_u, toff, h_ref, Ub, Pb, Us, Ps)
+                if mH < 9:
+                    _check_dropped(Pb, nl, hkeep, dH)
+                if want_u and mG < 9:
+                    _check_dropped(Ub, nl, gkeep, dG)
                 if fill_u >= 0:                 # complete the entry with its U blocks
                     off = cmeta[fill_u, 2]
-                    cpoolU[off:off + nl * 81] = Ub[:nl].ravel()
+                    _compact(cpoolU, off * sU, Ub, nl, gp, gq_)
                     cmeta[fill_u, 3] = 1
-                elif use_cache and hsh not in cidx and 8 * (pool_n + nl * 81) <= cache_max:
+                elif use_cache and hsh not in cidx and 8 * (pool_n + nl) * smax <= cache_max:
                     c = ncache
                     ckeys = _grow(ckeys, c)
                     cmeta = _grow(cmeta, c)
-                    while pool_n + nl * 81 > cpoolP.shape[0]:
+                    while (pool_n + nl) * sP > cpoolP.shape[0]:
                         cpoolP = _grow(cpoolP, cpoolP.shape[0])
+                    while (pool_n + nl) * sU > cpoolU.shape[0]:
                         cpoolU = _grow(cpoolU, cpoolU.shape[0])
                     ckeys[c] = key
                     cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
                     cmeta[c, 3] = 1 if want_u else 0
-                    cpoolP[pool_n:pool_n + nl * 81] = Pb[:nl].ravel()
+                    _compact(cpoolP, pool_n * sP, Pb, nl, hp, hq)
                     if want_u:
-                        cpoolU[pool_n:pool_n + nl * 81] = Ub[:nl].ravel()
-                    pool_n += nl * 81
+                        _compact(cpoolU, pool_n * sU, Ub, nl, gp, gq_)
+                    off = pool_n
+                    pool_n += nl
                     cidx[hsh] = c
                     ncache += 1
-                Psrc = Pb[:nl]
-                Usrc = Ub[:nl]
-            # room for every block this pair can add, made once per pair
-            # (array views or calls per block cost ~200 ns each in numba)
-            need = nh + nl * 9
-            hrow = _grow(hrow, need); hlag = _grow(hlag, need); hcol = _grow(hcol, need)
-            hval = _grow(hval, need)
-            nh = _add_pair(Psrc, nl, lo, Vnode[v], Vsign[v], i, slotH, hrow, hlag, hcol, hval, nh, True)
-            if want_u:
-                needg = ng_ + nl * 9
-                grw = _grow(grw, needg); glag = _grow(glag, needg); gcol = _grow(gcol, needg)
-                gval = _grow(gval, needg)
-                ng_ = _add_pair(Usrc, nl, lo, Vtcol[v], Vsign[v], i, slotG, grw, glag, gcol, gval, ng_, False)
-        # free term c_lk (I/2 at smooth points; freeterm module at edges/corners)
-        if lag_lo == 1:
-            hrow = _grow(hrow, nh); hlag = _grow(hlag, nh); hcol = _grow(hcol, nh)
-            hval = _grow(hval, nh)
-            fcol[0] = i
-            nh = _add_pair(free_term[i:i + 1].reshape((1, 1, 3, 3)), 1, 1, fcol, ones, i, slotH, hrow, hlag,
-                           hcol, hval, nh, False)
-        tmp = _grow(tmp, max(nh - h0, ng_ - g0))
-        _sort_row(slotH, lag_lo, L, h0, nh, hlag, hcol, hval, tmp)
-        _sort_row(slotG, lag_lo, L, g0, ng_, glag, gcol, gval, tmp)
-    return ((hrow, hlag, hcol, hval, grw, glag, gcol, gval, tmp, slotH, slotG), nh, ng_, nev, hits,
-            ckeys, cmeta, cpoolP, cpoolU)
-
-
-@njit(cache=True)
-def lag_sort(row, lag, col, val, L, loc, counts, scol, sval):
-    """Stable counting sort of a chunk's triplets by lag into ``scol``, ``sval`` (reused buffers at
-    least as long); ``counts[lag, loc[row]]`` += blocks of that row and lag (loc: position of a row
-    among the rank's rows). Returns the bounds:
-    lag l (1..L) is scol[b[l]:b[l + 1]], rows ascending (and columns within a row, as emitted)."""
-    b = np.zeros(L + 2, np.int64)
-    for k in range(lag.shape[0]):
-        b[lag[k] + 1] += 1
-        counts[lag[k], loc[row[k]]] += 1
-    for l in range(1, L + 2):
-        b[l] += b[l - 1]
-    pos = b.copy()
-    for k in range(lag.shape[0]):
-        j = pos[lag[k]]
-        scol[j] = col[k]
-        sval[j] = val[k]
-        pos[lag[k]] = j + 1
-    return b
+                else:                           # no cache (or full): the row's scratch
+                    while (sc_n + nl) * sP > scP.shape[0]:
+                        scP = _grow(scP, scP.shape[0])
+                    while (sc_n + nl) * sU > scU.shape[0]:
+                        scU = _grow(scU, scU.shape[0])
+                    _compact(scP, sc_n * sP, Pb, nl, hp, hq)
+                    if want_u:
+                        _compact(scU, sc_n * sU, Ub, nl, gp, gq_)
+                    where = 1
+                    off = sc_n
+                    sc_n += nl
+            pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
+            pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
+            npair += 1
+        # lag by lag: the row's blocks summed by column, then written where they are kept
+        li = loc[i]
+        for lag in range(lag_lo, L + 1):
+            nH = 0
+            nG = 0
+            for k in range(npair):
+                lo = pairs[k, 1]
+                if lag < lo or lag > pairs[k, 2]:
+                    continue
+                v = pairs[k, 0]
+                slot = pairs[k, 5] + (lag - lo)
+                srcP = scP if pairs[k, 4] == 1 else cpoolP
+                nH = _accumulate(srcP, slot * sP, mH, Vnode[v], Vsign[v], hq, bufH, touchH, lstH, nH, True)
+                if pairs[k, 3] == 1:
+                    srcU = scU if pairs[k, 4] == 1 else cpoolU
+                    nG = _accumulate(srcU, slot * sU, mG, Vtcol[v], Vsign[v], gq_, bufG, touchG, lstG, nG, False)
+            if nH:
+                cl = np.sort(lstH[:nH])
+                _emit_lag(lag, nH, cl, bufH, li, hout)
+                for k in range(nH):
+                    touchH[cl[k]] = False
+            if nG:
+                cl = np.sort(lstG[:nG])
+                _emit_lag(lag, nG, cl, bufG, li, gout)
+                for k in range(nG):
+                    touchG[cl[k]] = False
+    return ((pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG), nev, hits, ckeys, cmeta, cpoolP, cpoolU)
 
 
 # ---------------------------------------------------------------------------
@@ -364,7 +466,7 @@ def lag_sort(row, lag, col, val, L, loc, counts, scol, sval):
 
 @njit(cache=True)
 def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_base, near_factor, ns_max,
-                    tol, qinv, lag_lo=1, toff=0.0, cache_max=1 << 62):
+                    tol, qinv, lag_lo=1, toff=0.0, cache_max=1 << 62, stride=81):
     """The distinct pair geometries that ``assemble_rows`` with a cache would store for ``rows``, in the
     order it meets them, up to the same cache cap: (keys (m, 27), hashes (m,), meta (m, 6) = [lo, hi,
     sing, ns, want_u, element], points (m, 3)). A hash met again with a different key or lag window is
@@ -397,7 +499,7 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
                     meta[c, 4] = 1
                 continue
             nl = hi - lo + 1
-            if 8 * (pool_n + nl * 81) > cache_max:
+            if 8 * (pool_n + nl) * stride > cache_max:
                 continue
             keys = _grow(keys, m); hs = _grow(hs, m); meta = _grow(meta, m); pts = _grow(pts, m)
             keys[m] = key
@@ -406,23 +508,26 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
             meta[m, 5] = v
             pts[m] = xc
             cidx[hsh] = m
-            pool_n += nl * 81
+            pool_n += nl
             m += 1
     return keys[:m], hs[:m], meta[:m], pts[:m]
 
 
 @njit(cache=True)
-def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff=0.0, h_ref=1.0):
-    """Integrals of the listed pairs (meta, points as from enumerate_pairs): (offsets (m + 1,) into the
-    P pool, P pool, offsets (m + 1,) into the U pool (only records with want_u take room), U pool,
-    kernel evaluations)."""
+def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff, h_ref, pattern, dropped):
+    """Integrals of the listed pairs (meta, points as from enumerate_pairs), the pattern's entries
+    (``pattern`` as in ``assemble_rows``; the others checked into ``dropped``, ``_check_dropped``):
+    (offsets (m + 1,) into the P pool, P pool, offsets (m + 1,) into the U pool (only records with
+    want_u take room), U pool, kernel evaluations); a lag slot takes 9 m doubles (``_compact``)."""
+    hp, hq, gp, gq_, hkeep, gkeep = pattern
+    sP, sU = 9 * hp.shape[0], 9 * gp.shape[0]
     m = meta.shape[0]
     off = np.zeros(m + 1, np.int64)
     uoff = np.zeros(m + 1, np.int64)
     for r in range(m):
-        n = (meta[r, 1] - meta[r, 0] + 1) * 81
-        off[r + 1] = off[r] + n
-        uoff[r + 1] = uoff[r] + (n if meta[r, 4] == 1 else 0)
+        nl = meta[r, 1] - meta[r, 0] + 1
+        off[r + 1] = off[r] + nl * sP
+        uoff[r + 1] = uoff[r] + (nl * sU if meta[r, 4] == 1 else 0)
     P = np.zeros(off[m])
     U = np.zeros(uoff[m])
     mu = rho * beta * beta
@@ -435,45 +540,48 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
         nl = hi - lo + 1
         nev += _integrate(pts[r], VX[meta[r, 5]], meta[r, 2], meta[r, 3], gq, gw, gr, gwr, lo, hi, dt, alpha,
                           beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps)
-        P[off[r]:off[r + 1]] = Pb[:nl].ravel()
+        if sP < 81:
+            _check_dropped(Pb, nl, hkeep, dropped[0:1])
+        _compact(P, off[r], Pb, nl, hp, hq)
         if meta[r, 4] == 1:
-            U[uoff[r]:uoff[r + 1]] = Ub[:nl].ravel()
+            if sU < 81:
+                _check_dropped(Ub, nl, gkeep, dropped[1:2])
+            _compact(U, uoff[r], Ub, nl, gp, gq_)
     return off, P, uoff, U, nev
 
 
 @njit(cache=True)
-def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs, uoffs):
+def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs, uoffs, sP, sU):
     """Add records (keys, hashes, meta as from enumerate_pairs) to an element cache, their P blocks at
-    buf[poffs[r]:] and U blocks at buf[uoffs[r]:] (uoffs[r] < 0: no U); returns the cache arrays."""
+    buf[poffs[r]:] (sP doubles a lag slot) and U blocks at buf[uoffs[r]:] (sU; uoffs[r] < 0: no U);
+    returns the cache arrays."""
     ncache = len(cidx)
-    pool_n = 0
-    for k in range(ncache):
-        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1) * 81
-        if e > pool_n:
-            pool_n = e
+    pool_n = _pool_end(cmeta, ncache)
     total = pool_n
     for r in range(keys.shape[0]):
-        total += (meta[r, 1] - meta[r, 0] + 1) * 81
-    if total > cpoolP.shape[0]:                  # sized once (not by doubling): the pools hold what was asked
-        P2 = np.zeros(total)
+        total += meta[r, 1] - meta[r, 0] + 1
+    if total * sP > cpoolP.shape[0]:            # sized once (not by doubling): the pools hold what was asked
+        P2 = np.zeros(total * sP)
         P2[:cpoolP.shape[0]] = cpoolP
-        U2 = np.zeros(total)
+        cpoolP = P2
+    if total * sU > cpoolU.shape[0]:
+        U2 = np.zeros(total * sU)
         U2[:cpoolU.shape[0]] = cpoolU
-        cpoolP, cpoolU = P2, U2
+        cpoolU = U2
     ckeys = _grow(ckeys, ncache + keys.shape[0])
     cmeta = _grow(cmeta, ncache + keys.shape[0])
     for r in range(keys.shape[0]):
         if hs[r] in cidx:
             continue
-        n = (meta[r, 1] - meta[r, 0] + 1) * 81
+        nl = meta[r, 1] - meta[r, 0] + 1
         c = ncache
         ckeys[c] = keys[r]
         cmeta[c, 0] = meta[r, 0]; cmeta[c, 1] = meta[r, 1]; cmeta[c, 2] = pool_n
         cmeta[c, 3] = 1 if uoffs[r] >= 0 else 0
-        cpoolP[pool_n:pool_n + n] = buf[poffs[r]:poffs[r] + n]
+        cpoolP[pool_n * sP:(pool_n + nl) * sP] = buf[poffs[r]:poffs[r] + nl * sP]
         if uoffs[r] >= 0:
-            cpoolU[pool_n:pool_n + n] = buf[uoffs[r]:uoffs[r] + n]
-        pool_n += n
+            cpoolU[pool_n * sU:(pool_n + nl) * sU] = buf[uoffs[r]:uoffs[r] + nl * sU]
+        pool_n += nl
         cidx[hs[r]] = c
         ncache += 1
     return ckeys, cmeta, cpoolP, cpoolU

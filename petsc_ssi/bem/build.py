@@ -18,15 +18,16 @@ def _block_of(cfg, comm, H, G, HI, GI):
     of its G (read by the same panel products), dense or block-sparse, summed over the ranks."""
     from . import bsr
     Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
-    d = np.zeros((3, len(Hs)))              # dense bytes, block-sparse bytes, block-sparse blocks
+    d = np.zeros((3, len(Hs)))              # dense bytes, block-sparse bytes, block-sparse values
     for i, (Hm, Gm) in enumerate(zip(Hs, Gs)):
         for M in (Hm, Gm):
             if M is None:
                 continue
             ctx = bsr.context(M)
-            d[1 if ctx is not None else 0, i] += lagmats.mat_bytes(M)
-            if ctx is not None:
-                d[2, i] += ctx.indices.size
+            sparse = ctx is not None and ctx.kind == "bsr"
+            d[1 if sparse else 0, i] += lagmats.mat_bytes(M)
+            if sparse:
+                d[2, i] += ctx.blocks * ctx.pattern
     tot = np.zeros_like(d)
     comm.tompi4py().Allreduce(d, tot)
     return history_block(cfg, tot[0], tot[1], tot[2])
@@ -136,10 +137,11 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     mem_exact = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in H + G))
     mem_interp = mpi.allreduce(sum(lagmats.mat_bytes(M) for M in HI + GI))
     kinds = dict(prob.lags_manifest["mats"])
-    ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "dense")
+    ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}", "").startswith(("dense", "split")))
     from . import bsr
-    nsingle = sum(1 for M in H if bsr.context(M) is not None and bsr.context(M).data.dtype == np.float32)
-    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}") == "baij") - nsingle
+    nsingle = sum(1 for M in H if bsr.context(M) is not None and bsr.context(M).kind == "bsr"
+                  and bsr.context(M).data.dtype == np.float32)
+    nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}", "").startswith("bsr")) - nsingle
     ls.kernel_evaluations = ls.cache_hits = 0
     ls.cache_bytes = 0.0
     printf(f"[ssi] lag matrices loaded from {cfg.lags_load} in {fmt_time(t_asm)} (no assembly): {plan.Lx} exact "

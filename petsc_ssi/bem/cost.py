@@ -119,7 +119,7 @@ def pair_table(prob, ls, L, chunk=64, rows=None):
     return np.concatenate(rows), np.concatenate(keys), np.concatenate(los), np.concatenate(his)
 
 
-def cache_counts(table, a, b, cap_floats, Lx, interp_lags=(), shared=None):
+def cache_counts(table, a, b, cap_floats, Lx, interp_lags=(), shared=None, stride=81):
     """Rows a..b-1 (one rank): the pair-lags it integrates (the element cache's
     misses, and every pair met after the cache is full) for the exact lags
     1..Lx and for each interpolating matrix (its own call, one lag), and the
@@ -127,15 +127,16 @@ def cache_counts(table, a, b, cap_floats, Lx, interp_lags=(), shared=None):
     distinct pair-lags of the exact lags, of the interpolating calls): the
     cache shared between p ranks, where each distinct geometry is integrated
     once, by its owner (1/p of them each); the rank still stores every
-    geometry it meets, up to the cap."""
+    geometry it meets, up to the cap. The pools take ``stride`` doubles a lag slot at most
+    (assemble._compact: 9 m, m the entries of the block pattern); returns the lag slots stored."""
     rows, keys, lo, hi = table
     m = (rows >= a) & (rows < b) & (lo <= Lx)
     k, n = keys[m], (np.minimum(hi[m], Lx) - lo[m] + 1).astype(np.int64)
     _, first = np.unique(k, return_index=True)
     order = np.sort(first)                   # distinct geometries in the order met
-    need = np.cumsum(n[order] * 81)
+    need = np.cumsum(n[order] * stride)
     stored = need <= cap_floats
-    pool = float(need[stored][-1]) if stored.any() else 0.0
+    pool = float(need[stored][-1]) / stride if stored.any() else 0.0
     overflow = 0.0
     if not stored.all():                     # geometries met after the cache filled: every pair integrates
         cached = np.isin(k, k[order[stored]])
@@ -178,6 +179,7 @@ class Counts:
         self.nt = prob.regions.n_t
         self.steps = prob.n_steps
         self.L = prob.L
+        self.mH, self.mG = ls.mH, ls.mG          # values a block (bem/bsr.py PATTERNS)
         self.active = bool(plan.active)
         self.Lx = plan.Lx
         self.k = plan.k if plan.active else 0
@@ -215,7 +217,7 @@ class Counts:
             for i, (p, r, a, b) in enumerate(jobs):
                 if i % comm.getSize() == comm.getRank():
                     cc[(p, r)] = cache_counts(table, a, b, CACHE_MAX / 8, self.Lx, self.interp_lags,
-                                              (p,) + g if g and p > 1 else None)
+                                              (p,) + g if g and p > 1 else None, stride=9 * max(self.mH, self.mG))
             for part in mpi.allgather(cc):
                 self.cache.update(part)
             del table
@@ -230,11 +232,12 @@ class Counts:
         self.storage, self.fill = self._storage(cfg, used, limit)
         # the time-blocked history sum's block: the run's choice from these matrices' bytes
         tot = self.nb_total_used()
-        mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt)
+        mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt, self.mH, self.mG)
         g = g * (tot > 0) * (self.nt > 0)
         self.block, self.sub = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
                                    np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0),
-                                   np.where(self.storage, 0.0, tot) + np.where(self.single, g / 40.0, 0.0))
+                                   np.where(self.storage, 0.0, self.mH * tot)
+                                   + np.where(self.single, g / (4.0 * self.mG + 4) * self.mG, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(self.ranges[p])] for p in ranks}
 
@@ -255,7 +258,7 @@ class Counts:
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
         N = self.N
-        mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt)
+        mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt, self.mH, self.mG)
         asm, rss = transient_bytes(used[:self.Lx].sum() / p, N, self.Lx, N / p, parts=True)
         asm_i = transient_bytes(max(list(used[self.Lx:]) + [0.0]) / p, N, 1, N / p, parts=True)[0] if self.k else 0.0
         return peak_bytes(mats, trip, g, asm * p, rss * p, n_exact=self.Lx, asm_interp=asm_i * p)
@@ -267,7 +270,7 @@ class Counts:
         used = np.r_[nb[:Lx], [nb[l - 1] for l in self.interp_lags]]
         dense = self.storage
         nonempty = self.nb_total_used() > 0
-        mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt)
+        mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt, self.mH, self.mG)
         mat_bytes = mat_bytes * nonempty
         g_bytes = g_bytes * nonempty if self.nt else np.zeros(len(used))
         build = np.cumsum(mat_bytes) + (trip.sum() - np.cumsum(trip))
@@ -281,8 +284,8 @@ class Counts:
             # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
             # one of the block's steps reads a state known at its start; the rest are per-step products
             uses, width = self._blocked_uses(n, used)
-            entries = np.where(dense, mat_bytes / 8.0, 9.0 * used) * nonempty
-            g_entries = 9.0 * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
+            entries = np.where(dense, mat_bytes / 8.0, self.mH * used) * nonempty
+            g_entries = self.mG * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
             fd = float(np.sum(width * 2.0 * (entries * dense + g_entries * ~self.single)))
             fs = float(np.sum(width * 2.0 * (entries * ~dense + g_entries * self.single)))
         hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
@@ -290,7 +293,7 @@ class Counts:
         prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
         # integrated pair-lags: with the cache its misses; without, every pair (~ blocks / 4)
         integ, pool = cache if cache is not None else (float(used.sum()) / 4.0, 0.0)
-        return {"B": float(used.sum()), "I": integ, "C": 16.0 * pool, "D": float(np.sum(mat_bytes * dense)),
+        return {"B": float(used.sum()), "I": integ, "C": 8.0 * 9 * (self.mH + self.mG) * pool, "D": float(np.sum(mat_bytes * dense)),
                 "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods, "FD": fd, "FS": fs,
                 "mats": float(mat_bytes.sum() + g_bytes.sum()), "trip": float(trip.sum()),
                 "build": float(build.max() + g_bytes.sum()), "rows": nrows}
@@ -368,18 +371,20 @@ def _chunk_rows(n_nodes, lag_hi, n_rows):
     return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
 
 
-def lag_bytes(used, dense, single, n_cols, n_rows, n_t):
+def lag_bytes(used, dense, single, n_cols, n_rows, n_t, mH=9, mG=9):
     """Per stored matrix (arrays over them): (bytes of its Mat, of its assembly buckets, of its G),
-    for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns: dense 72 B per block of the
-    whole row block, block-sparse 76 B per stored block (9 doubles, an int32 column), single
-    precision (``single``: -ssi_lag_single_from) 40 B (9 floats, a column) whatever the fill; the
-    buckets take the same bytes (their 15 % headroom is allocated but never touched, so not
-    resident); G (the ``n_t`` traction columns) dense, or at most 40 B per block single."""
+    for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns, each block holding the ``mH``
+    entries of H's pattern (bem/bsr.py PATTERNS: 9, or 4 on a flat surface; G's ``mG``: 9 or 5):
+    dense 8 mH B per block of the whole row block, block-sparse 8 mH + 4 B per stored block (the
+    values, an int32 column: 76 B full, 36 B flat), single precision (``single``:
+    -ssi_lag_single_from) 4 mH + 4 B whatever the fill; the buckets take the same bytes (their 15 %
+    headroom is allocated but never touched, so not resident); G (the ``n_t`` traction columns)
+    dense (8 mG B a block), or 4 mG + 4 B a block single."""
     single = np.asarray(single, bool)
     dense = np.asarray(dense, bool) & ~single
-    mats = np.where(single, 40.0 * used, np.where(dense, 72.0 * n_cols * n_rows, 76.0 * used))
-    trip = np.where(single, 40.0, 76.0) * used
-    g = np.where(single, 40.0, 72.0) * n_rows * max(n_t, 1)
+    mats = np.where(single, (4.0 * mH + 4) * used, np.where(dense, 8.0 * mH * n_cols * n_rows, (8.0 * mH + 4) * used))
+    trip = np.where(single, 4.0 * mH + 4, 8.0 * mH + 4) * used
+    g = np.where(single, 4.0 * mG + 4, 8.0 * mG) * n_rows * max(n_t, 1)
     return mats, trip, g
 
 
@@ -445,20 +450,19 @@ def _sub_candidates(b, sub=0):
 
 
 def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4, 8, 12, 16, 24, 32),
-                 sparse_blocks=None, sub=0):
+                 sparse_values=None, sub=0):
     """(b, s): the steps per block and per sub-block that minimise the modelled time per step of the
     history sum, from the bytes of each stored matrix (index 0: lag 1, ..., then the interpolating
     ones, taken as the lags that follow; dense and block-sparse apart): in a block of a run long
     enough to reach every lag (``march.block_terms``), its panel products at the rates above for
     their widths (2 flops per stored value and state) and the per-step products, streamed. b = 1
-    streams every matrix every step. ``sparse_blocks``: the 3x3 blocks of the block-sparse matrices
-    (18 flops each per state; default their bytes / 76, the double blocks; single-precision ones
-    store 40 B a block); ``sub``: a fixed sub-block size (0: chosen too). Step by step is an
+    streams every matrix every step. ``sparse_values``: the stored values of the block-sparse matrices
+    (2 flops each per state; default 9 per 76 B, full double blocks); ``sub``: a fixed sub-block size (0: chosen too). Step by step is an
     outcome only when 1 is a candidate: a user's -ssi_history_block b (candidates (b,)) is kept."""
     from .march import block_terms
     d = np.asarray(dense_bytes, float)
     s = np.asarray(sparse_bytes, float)
-    sb = s / 76.0 if sparse_blocks is None else np.asarray(sparse_blocks, float)
+    sv = s * 9.0 / 76.0 if sparse_values is None else np.asarray(sparse_values, float)
     every = d + s
     nmat = len(every)
     best, best_t = ((1, 1), float(np.sum(every[1:])) / (STREAM_GBPS * 1e9)) if 1 in candidates else (None, np.inf)
@@ -480,7 +484,7 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
                 for w, cnt in ((b, wb / b), (sub_b, ws / sub_b)):
                     if cnt:
                         rd, rs = rate[w]
-                        t += cnt * w * (d[i] * 2 / 8 / rd + sb[i] * 18 / rs)
+                        t += cnt * w * (d[i] * 2 / 8 / rd + sv[i] * 2 / rs)
                 t += steps * every[i] / (STREAM_GBPS * 1e9)
             t /= b
             if t < best_t or best is None:
@@ -488,7 +492,7 @@ def choose_block(dense_bytes, sparse_bytes, stabilized=True, candidates=(1, 2, 4
     return best
 
 
-def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
+def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_values=None):
     """(b, s): the steps per block of the time-blocked history sum and per sub-block:
     -ssi_history_block and -ssi_history_sub, or with 0 the ``choose_block`` of the stored
     matrices' bytes (b = 1 without them)."""
@@ -499,7 +503,7 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_blocks=None):
     if dense_bytes is None:
         return 1, 1
     return choose_block(dense_bytes, sparse_bytes, cfg.scheme.startswith("stabili"),
-                        candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_blocks=sparse_blocks,
+                        candidates=(b,) if b else (1, 2, 4, 8, 12, 16, 24, 32), sparse_values=sparse_values,
                         sub=sub)
 
 

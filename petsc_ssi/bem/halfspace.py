@@ -62,6 +62,7 @@ def read_surface_mesh(cfg, comm, planes):
                 k = int(z.argmax())
                 raise SSIError(f"-ssi_mesh {cfg.mesh}: the surface mesh must lie in the plane z = 0 (the free "
                                f"surface of the half-space z < 0); node {k} is at z = {mesh.nodes[k, 2]:.6g} m")
+            mesh.nodes[:, 2] = 0.0       # on the plane, exactly: the lag blocks' flat pattern (bem/bsr.py) holds
     return mpi.bcast(mesh)
 
 

@@ -6,7 +6,11 @@ precision (``-ssi_lag_single_from``: the buckets hold them as float32) are block
 their fill: 40 B per block against 72 B per block of a dense double lag.
 
 The block CSR of the local rows, lag by lag, comes from ``model.Buckets`` (``assemble``);
-rows are the locally owned nodes, columns global node (or traction) ids.
+rows are the locally owned nodes, columns global node (or traction) ids. Blocks hold the entries
+of the matrix's pattern (``bsr.PATTERNS``: on a flat surface H 4 and G 5 of 9): a block-sparse lag
+keeps them as they are, a dense one of a flat surface becomes a ``bsr.DenseSplit`` (its two dense
+pieces), a dense one of the full pattern a MATMPIDENSE. The free term of H_1 (``Buckets.diag``) goes
+with its Mat (added to MATMPIDENSE's diagonal blocks; carried apart by the python Mats).
 """
 import numpy as np
 from numba import njit
@@ -25,15 +29,21 @@ def _scatter_dense(arr, rl, cols, vals):
                 arr[r + p, c + q] = vals[k, p, q]
 
 
-def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
+def baij(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals, pattern=9, diag=None, row0=0):
     """Block-sparse (3x3 node blocks, ``bsr``: the package's block CSR behind a python Mat) from the
-    block CSR of the local rows (``Buckets.take_csr``: columns sorted within a row)."""
+    block CSR of the local rows (``Buckets.take_csr``: columns sorted within a row), blocks in
+    ``pattern``, ``diag`` the free term of the rows (node ``row0`` first) or None."""
     from . import bsr
-    return bsr.from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals)
+    return bsr.from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals, pattern, diag, row0)
 
 
-def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
-    """MPIDENSE from the block CSR of the local rows."""
+def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals, pattern=9, diag=None, row0=0):
+    """A dense lag from the block CSR of the local rows: MPIDENSE (full pattern; the free term added
+    to its diagonal blocks) or a ``bsr.DenseSplit`` (a flat pattern)."""
+    from . import bsr
+    if pattern != bsr.FULL:
+        return bsr.DenseSplit.from_csr(comm, pattern, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals,
+                                       diag, row0).mat
     PETSc = init()
     A = PETSc.Mat().createDense(size=((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob)),
                                 bsize=3, comm=comm)          # bs 3 as BAIJ and loaded Mats: the traction
@@ -41,7 +51,12 @@ def dense(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals):
     A.setUp()
     arr = A.getDenseArray()
     arr[...] = 0.0
-    _scatter_dense(arr, np.repeat(np.arange(nrow_loc, dtype=np.int64), np.diff(indptr)), cols, vals)
+    _scatter_dense(arr, np.repeat(np.arange(nrow_loc, dtype=np.int64), np.diff(indptr)), cols,
+                   np.asarray(vals).reshape(-1, 3, 3))
+    if diag is not None:
+        for p in range(3):
+            for q in range(3):
+                arr[3 * np.arange(nrow_loc) + p, 3 * (row0 + np.arange(nrow_loc)) + q] += diag[:, p, q]
     A.restoreDenseArray() if hasattr(A, "restoreDenseArray") else None
     A.assemble()
     return A
@@ -60,8 +75,10 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     mpi.Allreduce(counts, gcounts)
     mats, info = [], []
     for li in range(L):
+        F = buckets.diag(li + 1)
         csr = buckets.take_csr(li + 1)
-        A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill)
+        A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill,
+                        buckets.m, F, r0)
         mats.append(A)
         info.append((li + 1, kind, int(gcounts[li])))
         del csr
@@ -69,23 +86,25 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     return mats, info
 
 
-def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill):
-    if nb == 0:
+def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill, pattern=9, diag=None, row0=0):
+    if nb == 0 and diag is None:
         return None, "empty"
+    extra = (pattern, diag, row0)
     if csr[2].dtype == np.float32:       # -ssi_lag_single_from: block-sparse whatever the fill (a dense
-        return baij(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr), "single"    # lag: every block)
+        return baij(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr, *extra), "single"    # lag: every block)
     f = nb / float(n_rows_glob * n_cols_glob)
     use_dense = storage == "dense" or (storage == "auto" and f > fill)
     mk = dense if use_dense else baij
-    return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr), ("dense" if use_dense else "baij")
+    return mk(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr, *extra), ("dense" if use_dense else "baij")
 
 
 def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc, storage="auto", fill=0.95):
     """Collective: the Mat of one lag of ``buckets`` (an interpolating matrix)."""
     r0, r1 = node_range
+    F = buckets.diag(lag)
     csr = buckets.take_csr(lag)
     nb = comm.tompi4py().allreduce(len(csr[1]))
-    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill)
+    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill, buckets.m, F, r0)
 
 
 def mat_bytes(A):

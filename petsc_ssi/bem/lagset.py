@@ -15,7 +15,7 @@ from .cost import (CACHE_MAX, _per_row, _chunk_rows, single_lags, lag_bytes, tra
                    pair_table, cache_counts)
 from .windows import bounding_spheres, estimate_blocks
 from . import symmetry
-from .assemble import (assemble_rows, new_cache, index_len, new_work, lag_sort, enumerate_pairs, integrate_records,
+from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_records,
                        cache_insert, SING_TOL)
 
 
@@ -102,51 +102,58 @@ class _NoEvent:
 
 
 class Buckets:
-    """Node-block triplets of the local rows (``rows``, of ``n_nodes``), by lag (1-based), as block CSR
-    being built: per lag one growing array of columns (int32) and one of blocks, and the blocks per
-    (lag, row). ``add`` appends a chunk of rows (``assemble_rows``' output: rows ascending, by lag
-    and column within a row), so each lag is CSR with sorted columns as it stands and no sort or
-    concatenation follows. ``csr(l)`` gives (indptr, cols, vals), ``peek(l)`` (rows, cols, vals);
-    ``take(l)`` and ``take_csr(l)`` free the lag. The arrays start at ``capacity[l - 1]`` blocks
-    (the memory estimate's count) and grow by half when needed: large arrays allocated once, each
-    page faulted in once (small per-chunk pieces, mapped and unmapped chunk after chunk, cost the
-    paper case more time in page faults than its assembly). numpy backs them by huge pages unless
-    ``-ssi_huge_pages off`` (jobscripts/huge_pages_bench.sh: the paper case assembles much faster with them)."""
+    """The blocks of the local rows (``rows``, of ``n_nodes``) by lag (1-based), as block CSR being
+    built where they are kept: per lag one array of columns (int32) and one of blocks (blocks x
+    ``m``: the entries of the matrix's pattern, ``bsr.PATTERNS``), and the blocks per (lag, row).
+    The assembly kernel writes each row's blocks straight into them (``assemble.emit_row``, through
+    the typed lists ``out()``), rows ascending and columns sorted, so no sort, concatenation or copy
+    follows; ``add`` does the same for triplets given from Python. ``csr(l)`` gives (indptr, cols,
+    vals), ``peek(l)`` (rows, cols, full 3x3 blocks with the free term); ``take_csr(l)`` frees the lag.
+    Lag 1 of H carries the free term apart (``free``, ``diag``). The arrays are allocated at
+    ``capacity[l - 1]`` blocks (the memory estimate's count, with headroom: allocated, never touched,
+    not resident) and grow by half when a row finds no room (in the kernel, ``assemble._room``): each
+    page is written once, in place. numpy backs them by huge pages unless ``-ssi_huge_pages off``."""
 
     GROW = 1.5
     TRIM = 0.9            # a lag using less of its array is copied to its size when taken
 
-    def __init__(self, L, rows, n_nodes, capacity=None, single_from=0):
+    def __init__(self, L, rows, n_nodes, capacity=None, single_from=0, m=9, free=None):
         self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
+        self.m = int(m)                         # values a block: bsr.PATTERNS (9: full 3x3)
+        self.free = None if free is None else np.asarray(free, float).reshape(-1, 3, 3)   # lag 1's free term
         self.single_from = int(single_from)     # lags >= this (> 0) keep their blocks in float32
         if self.single_from in (1, 2):
             raise ValueError("Buckets: lags 1 and 2 (the step matrix) stay double (single_from 0 or >= 3)")
         self.loc = np.full(n_nodes, -1, np.int64)
         self.loc[self.rows] = np.arange(self.nloc)
         self.counts = np.zeros((L + 1, max(self.nloc, 1)), np.int64)
-        self.n = np.zeros(L + 1, np.int64)
-        self.cap = np.zeros(L + 1, np.int64)
+        self.n = np.zeros(L + 1, np.int64)      # blocks each lag holds (written by the kernel)
+        cap = np.zeros(L + 1, np.int64)
         if capacity is not None:
-            self.cap[1:] = np.asarray(capacity, np.int64)[:L]
-        self._c = [None] * (L + 1)
-        self._v = [None] * (L + 1)
+            cap[1:] = np.asarray(capacity, np.int64)[:L]
+        from numba.typed import List
+        self._c, self._v, self._v32 = List(), List(), List()
+        none64, none32 = np.empty((0, self.m)), np.empty((0, self.m), np.float32)
+        for lag in range(L + 1):
+            single = self.dtype(lag) == np.float32
+            self._c.append(np.empty(int(cap[lag]), np.int32))
+            self._v.append(none64 if single else np.empty((int(cap[lag]), self.m)))
+            self._v32.append(np.empty((int(cap[lag]), self.m), np.float32) if single else none32)
 
-    def add(self, row, lag, col, val, scol, sval):
-        """Append a chunk's triplets (``scol``, ``sval``: reused scratch at least as long)."""
-        b = lag_sort(row, lag, col, val, self.L, self.loc, self.counts, scol, sval)
-        for l in np.nonzero(b[2:] > b[1:-1])[0] + 1:
-            lo, hi = int(b[l]), int(b[l + 1])
-            m, n = hi - lo, int(self.n[l])
-            if self._c[l] is None or n + m > len(self._c[l]):
-                cap = max(int(self.cap[l]) if self._c[l] is None else 0, int(self.GROW * (n + m)), 1024)
-                c2, v2 = np.empty(cap, np.int32), np.empty((cap, 3, 3), self.dtype(l))
-                if n:
-                    c2[:n] = self._c[l][:n]
-                    v2[:n] = self._v[l][:n]
-                self._c[l], self._v[l] = c2, v2
-            self._c[l][n:n + m] = scol[lo:hi]
-            self._v[l][n:n + m] = sval[lo:hi]            # (rounded to float32 for a single lag)
-            self.n[l] = n + m
+    def out(self):
+        """The kernel's view (``assemble.emit_row``): (columns, values, float32 values, fill, counts,
+        single_from)."""
+        return (self._c, self._v, self._v32, self.n, self.counts, self.single_from)
+
+    def add(self, row, lag, col, val):
+        """Append triplets (rows ascending, any order within a row; ``val`` (n, m)) as the kernel does."""
+        from .assemble import emit_row
+        row, lag, col = np.asarray(row, np.int64), np.asarray(lag, np.int64), np.asarray(col, np.int64)
+        val = np.ascontiguousarray(val, float).reshape(len(row), self.m)
+        for r in np.unique(row):
+            k = np.nonzero(row == r)[0]
+            k = k[np.lexsort((col[k], lag[k]))]
+            emit_row(len(k), lag[k], col[k], val[k], int(self.loc[r]), self.out())
 
     def dtype(self, lag):
         """The value type lag ``lag`` is kept in: float32 from ``single_from`` on (-ssi_lag_single_from)."""
@@ -157,28 +164,46 @@ class Buckets:
         n = int(self.n[lag])
         indptr = np.zeros(self.nloc + 1, np.int64)
         np.cumsum(self.counts[lag, :self.nloc], out=indptr[1:])
-        if self._c[lag] is None:
-            return indptr, np.zeros(0, np.int32), np.zeros((0, 3, 3), self.dtype(lag))
-        return indptr, self._c[lag][:n], self._v[lag][:n]
+        vals = self._v32 if self.dtype(lag) == np.float32 else self._v
+        return indptr, self._c[lag][:n], vals[lag][:n]
+
+    def diag(self, lag):
+        """The free term of the local rows if lag ``lag`` carries it (lag 1 of H), else None."""
+        return self.free if (lag == 1 and self.free is not None) else None
 
     def peek(self, lag):
+        """(rows, columns, full 3x3 blocks) of one lag, the free term added to the diagonal blocks of
+        lag 1 (a block made where the kernel's is absent), in (row, column) order: the blocks as the
+        collocation equations have them (the step matrix, tests)."""
+        from .bsr import expand
         indptr, c, v = self.csr(lag)
         rows = np.repeat(self.rows, np.diff(indptr))
-        return rows, c, v
+        v = expand(v, self.m).astype(float)
+        F = self.diag(lag)
+        if F is None:
+            return rows, c, v
+        loc = self.loc[rows]
+        d = c == rows
+        v[d] += F[loc[d]]                                   # (the kernel's sum, then the free term)
+        miss = np.ones(self.nloc, bool)
+        miss[loc[d]] = False
+        rows = np.r_[rows, self.rows[miss]]
+        c = np.r_[c, self.rows[miss]].astype(np.int32)
+        v = np.concatenate([v, F[miss]])
+        o = np.lexsort((c, rows))
+        return rows[o], c[o], v[o]
 
     def take_csr(self, lag):
         """``csr(lag)``; the lag is no longer held here (its arrays copied to size when mostly unused)."""
         indptr, c, v = self.csr(lag)
-        if self._c[lag] is not None and len(c) < self.TRIM * len(self._c[lag]):
+        if len(c) < self.TRIM * len(self._c[lag]):
             c, v = c.copy(), v.copy()
-        self._c[lag] = self._v[lag] = None
+        self._c[lag] = np.empty(0, np.int32)
+        self._v[lag] = np.empty((0, self.m))
+        self._v32[lag] = np.empty((0, self.m), np.float32)
         self.n[lag] = 0
         self.counts[lag] = 0
         return indptr, c, v
-
-    def take(self, lag):
-        rows = self.peek(lag)[0]
-        return (rows,) + self.take_csr(lag)[1:]
 
     def count(self, lag):
         return int(self.n[lag])
@@ -262,6 +287,14 @@ class LagSet:
         self.regions, self.planes, self.opts = regions, planes, opts
         VX, VN, VS, VT = symmetry.virtual_elements(mesh.cell_coords(), mesh.cells, regions.tcols, planes)
         self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
+        # the block patterns (bsr.PATTERNS): every collocation point and element in one plane z = z0
+        # (every surface petsc_ssi accepts: its nodes are set on z = 0) -> H 4 and G 5 entries a block;
+        # otherwise the general 3x3 (opts "block_pattern": "full" forces it: the check of both paths)
+        from .bsr import FULL, H4, G5
+        z0 = float(mesh.nodes[0, 2]) if mesh.n_nodes else 0.0
+        self.flat = (opts.get("block_pattern", "auto") != "full" and bool(np.all(mesh.nodes[:, 2] == z0))
+                     and bool(np.all(VX[..., 2] == z0)))
+        self.mH, self.mG = (H4, G5) if self.flat else (FULL, FULL)
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
         from .partition import node_ranges, lag_weights
         # the nodes (rows) of each rank: contiguous ranges of equal estimated work (-ssi_partition);
@@ -318,7 +351,7 @@ class LagSet:
         f = use / float(N * N)
         single = single_lags(np.r_[np.arange(1, lags + 1), list(extra_lags)], single_from)
         dense = ((f > fill) if storage == "auto" else np.full(len(use), storage == "dense")) & ~single
-        mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t)
+        mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t, self.mH, self.mG)
         cache = None if sample else self.cache_estimate(lags, extra_lags)    # (sample: the bound per block)
         asm, rss = (mpi.allreduce(v) for v in transient_bytes(local_blocks, N, L, len(self.rows), cache, parts=True))
         asm_i = mpi.allreduce(transient_bytes(local_interp, N, 1, len(self.rows), parts=True)[0]) if len(extra_lags) else 0.0
@@ -326,6 +359,15 @@ class LagSet:
         return float(mats.sum() + g.sum()), float(peak), int(dense.sum())
 
     CACHE_MAX = CACHE_MAX        # bytes per cache pool (P and U): 1 GiB per rank at most
+
+    def pattern(self):
+        """The kernels' block patterns (bem/bsr.py PATTERNS): (H's p, q, G's p, q, H's keep mask, G's)."""
+        from .bsr import positions
+        (hp, hq), (gp, gq) = positions(self.mH), positions(self.mG)
+        hkeep, gkeep = np.zeros((3, 3), np.bool_), np.zeros((3, 3), np.bool_)
+        hkeep[hp, hq] = True
+        gkeep[gp, gq] = True
+        return hp, hq, gp, gq, hkeep, gkeep
 
     def cache_estimate(self, lags, extra_lags=()):
         """Bytes of this rank's element cache in the assembly of the exact lags 1..``lags`` (both
@@ -338,8 +380,9 @@ class LagSet:
         if getattr(self, "_cache_est", (None,))[0] != key:
             table = pair_table(self, self, max([lags] + list(extra_lags)), rows=self.rows)
             r0, r1 = self.node_range
-            pool = cache_counts(table, r0, r1, self.CACHE_MAX / 8, lags, extra_lags)[1]
-            self._cache_est = (key, 16.0 * pool)
+            sP, sU = 9 * self.mH, 9 * self.mG
+            slots = cache_counts(table, r0, r1, self.CACHE_MAX / 8, lags, extra_lags, stride=max(sP, sU))[1]
+            self._cache_est = (key, 8.0 * (sP + sU) * slots)
         return self._cache_est[1]
 
     def _per_row(self, lag_hi):
@@ -350,7 +393,8 @@ class LagSet:
         2x over-allocated) per call, at least one row."""
         return _chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
-    def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr):
+    def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr, pattern,
+                     dropped):
         """Collective: fill this rank's element cache with every distinct pair geometry its rows meet,
         each integrated once over all ranks. A geometry's owner is its hash modulo the ranks; requests
         go to the owners (all-to-all of keys), the owner integrates the representative of the lowest
@@ -358,13 +402,14 @@ class LagSet:
         the blocks back (all-to-all-v of doubles). Returns the cache arrays and the owned evaluations."""
         o = self.opts
         mpi = self.comm.tompi4py()
-        from mpi4py import MPI
         p = mpi.Get_size()
+        sP, sU = 9 * len(pattern[0]), 9 * len(pattern[2])       # doubles a lag slot (assemble._compact)
+        smax = max(sP, sU)
         with collective(self.comm, "listing the element-cache geometries"):     # e.g. MemoryError on one rank
             keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
                                                   self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
                                                   o["subdivisions"], o["near_factor"], o["max_subdivisions"],
-                                                  SING_TOL, qinv, lag_lo, toff, self.CACHE_MAX)
+                                                  SING_TOL, qinv, lag_lo, toff, self.CACHE_MAX, smax)
         owner = np.mod(_mix64(hs), p)
         mine = [np.nonzero(owner == r)[0] for r in range(p)]
         got = mpi.alltoall([(keys[i], hs[i], meta[i], pts[i]) for i in mine])
@@ -378,7 +423,8 @@ class LagSet:
         with collective(self.comm, "integrating the shared element-cache geometries"):
             off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
                                                      lag_hi, self.dt, self.mat.cp, self.mat.cs, self.mat.rho,
-                                                     self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()))
+                                                     self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()),
+                                                     pattern, dropped)
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
         seg = np.cumsum([0] + [len(g[2]) for g in got])
         jobs = []
@@ -387,9 +433,10 @@ class LagSet:
             w = u[got[r][2][:, 4] == 1]
             jobs.append((off[u], off[u + 1] - off[u], uoff[w], uoff[w + 1] - uoff[w]))
         got = None
-        nl81 = (meta[:, 1] - meta[:, 0] + 1) * 81
+        nl = meta[:, 1] - meta[:, 0] + 1
+        nlP, nlU = nl * sP, nl * sU
         wu = meta[:, 4] == 1
-        rcount = [int(nl81[i].sum() + nl81[i][wu[i]].sum()) for i in mine]
+        rcount = [int(nlP[i].sum() + nlU[i][wu[i]].sum()) for i in mine]
         rbuf = np.empty(sum(rcount))
         rd = np.r_[0, np.cumsum(rcount)[:-1]].astype(np.int64)
         _send_segments(mpi, [(P, ps, pl, U, us, ul) for ps, pl, us, ul in jobs], rbuf, rcount, rd)
@@ -399,11 +446,12 @@ class LagSet:
         uoffs = np.full(len(keys), -1, np.int64)
         for r in range(p):
             i = mine[r]
-            cp = np.cumsum(nl81[i])
-            poffs[i] = rd[r] + cp - nl81[i]
+            cp = np.cumsum(nlP[i])
+            poffs[i] = rd[r] + cp - nlP[i]
             w = i[wu[i]]
-            uoffs[w] = rd[r] + (cp[-1] if len(i) else 0) + np.cumsum(nl81[w]) - nl81[w]
-        ckeys, cmeta, cpP, cpU = cache_insert(cidx, ckeys, cmeta, cpP, cpU, keys, hs, meta, rbuf, poffs, uoffs)
+            uoffs[w] = rd[r] + (cp[-1] if len(i) else 0) + np.cumsum(nlU[w]) - nlU[w]
+        ckeys, cmeta, cpP, cpU = cache_insert(cidx, ckeys, cmeta, cpP, cpU, keys, hs, meta, rbuf, poffs, uoffs,
+                                              sP, sU)
         return ckeys, cmeta, cpP, cpU, int(nev)
 
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly",
@@ -421,8 +469,19 @@ class LagSet:
         nimg = len(self.Vc) // self.mesh.n_cells
         cap = 1.15 * estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg)
         cap[:lag_lo - 1] = 0
-        H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from)
-        G = Buckets(lag_hi, rows, self.mesh.n_nodes, single_from=single_from)
+        mH, mG = self.mH, self.mG
+        H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=mH,
+                    free=self.cfree[rows] if lag_lo == 1 else None)
+        # G: a block for every traction column a row's wave window reaches; room for all of them (never
+        # touched beyond what is written: not resident) unless that is more than the node's memory
+        gcap = np.full(lag_hi, len(rows) * self.regions.n_t, np.int64)
+        gcap[:lag_lo - 1] = 0
+        from ..sysmem import machine_memory
+        if gcap.sum() * (8.0 * mG + 4) > 0.5 * machine_memory():
+            gcap[:] = 0
+        G = Buckets(lag_hi, rows, self.mesh.n_nodes, gcap, single_from=single_from, m=mG)
+        pattern = self.pattern()
+        dropped = np.zeros(2)
         nev = 0
         ev = _NoEvent() if quiet else event("SSI_BEM_Assembly")
         ev.begin()
@@ -437,23 +496,22 @@ class LagSet:
         if o.get("cache", True) and o.get("cache_share", True) and self.comm.getSize() > 1:
             with event("SSI_BEM_Integrate"):
                 ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
-                                                                qinv, gq, gw, gr, gwr)
-        work = new_work(lag_hi, self.mesh.n_nodes, self.regions.n_t)
-        scol, sval = np.empty(0, np.int32), np.empty((0, 3, 3))
+                                                                qinv, gq, gw, gr, gwr, pattern, dropped)
+        work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
         for s in range(0, len(rows), chunk):
-            work, nh, ng, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
-                rows[s:s + chunk], mesh, wave, quad, self.cfree, bool(o.get("cache", True)), cidx, ckeys, cmeta,
-                cpP, cpU, qinv, work, self.CACHE_MAX)
-            if len(scol) < max(nh, ng):                        # the sorted copy of a chunk, reused
-                m = max(len(work[3]), len(work[7]))
-                scol, sval = np.empty(m, np.int32), np.empty((m, 3, 3))
-            H.add(*[a[:nh] for a in work[0:4]], scol, sval)
-            G.add(*[a[:ng] for a in work[4:8]], scol, sval)
+            work, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
+                rows[s:s + chunk], mesh, wave, quad, pattern, bool(o.get("cache", True)), cidx, ckeys, cmeta,
+                cpP, cpU, qinv, work, dropped, H.out(), G.out(), H.loc, self.CACHE_MAX)
             nev += n_ev
             hits += n_hit
             prog.update(min(s + chunk, len(rows)))
-        work = scol = sval = None
+        work = None
         ev.end()
+        from mpi4py import MPI
+        lost = self.comm.tompi4py().allreduce(float(dropped.max()), op=MPI.MAX)
+        if lost != 0.0:        # (cannot happen on a plane: r . n = 0 makes those entries exact zeros)
+            raise SSIError(f"BEM assembly: a flat-surface block entry outside its pattern is {lost:.3g}, not 0 "
+                           "(bem/bsr.py PATTERNS); report this with the mesh")
         self.cache_entries = int(index_len(cidx))
         self.cache_hits = self.comm.tompi4py().allreduce(hits)
         self.cache_bytes = self.comm.tompi4py().allreduce(cpP.nbytes + cpU.nbytes)

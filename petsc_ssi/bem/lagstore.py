@@ -9,7 +9,10 @@ the assembly by loading the matrices a first run saved.
 
 ``FILE`` is a PETSc binary file with the step matrix (after the symmetry rows and columns are
 set), the exact lags H_l and G_l and the interpolating matrices HI_j, GI_j, in that order, each
-in the storage it had (dense, or 3x3 block-sparse as MPIBAIJ; an empty lag is not written). ``FILE.json``
+in the storage it had: MATDENSE as it is; the package's block-sparse and split dense lags
+(bem/bsr.py) as an MPIAIJ holding only their block pattern's entries (on a flat surface 4 of 9 a
+block of H, 5 of G: 48 and 60 B a block in the file, a full MPIBAIJ took 108), H_1's free term as
+an MPIAIJ of its own after it; an empty lag is not written. ``FILE.json``
 lists them and holds the key (``lag_key``: the values above, SHA-256 of the mesh and of the
 traction nodes) and the CRC32 of every 8 MiB piece of ``FILE``'s bytes (``io.integrity``: summed
 by the ranks in turn, no gather), written last, so a save that was cut short has no ``.json`` and
@@ -27,7 +30,7 @@ import numpy as np
 
 from ..petsc import init, collective, collective_error, collective_io, SSIError
 
-FORMAT = 2          # 2: with the CRC32 of the file's content (format 1 had none: refused)
+FORMAT = 3          # 3: lags in their block pattern (2: full MPIBAIJ blocks; 1: no CRC32s; both refused)
 
 
 def _h(a):
@@ -77,6 +80,9 @@ def _read_json(path, comm, what):
             if data.get("format") == 1:
                 raise SSIError(f"{what} {path}: a lag file of an older petsc-ssi without checksums of its content "
                                "(format 1): save it again with -ssi_lags_save")
+            if data.get("format") == 2:
+                raise SSIError(f"{what} {path}: a lag file of an older petsc-ssi with full 3x3 blocks (format 2; "
+                               "this one stores each lag's block pattern): save it again with -ssi_lags_save")
             if data.get("format") != FORMAT or "key" not in data or "crc32" not in data:
                 raise SSIError(f"{what} {path}: not a petsc-ssi lag file (format {FORMAT})")
             if os.path.getsize(path) != data.get("bytes"):
@@ -132,11 +138,15 @@ def _mats(march):
 
 
 def _kind(M):
+    """The manifest's name of a Mat's storage: 'empty', 'dense' (MATDENSE), 'aij' (the step matrix),
+    'bsr<m>' (block-sparse, pattern m: bsr.PATTERNS) or 'split<m>' (bsr.DenseSplit), '+diag' when
+    a free term follows it in the file."""
     from . import bsr
     if M is None:
         return "empty"
-    if bsr.context(M) is not None:
-        return "baij"
+    ctx = bsr.context(M)
+    if ctx is not None:
+        return f"{ctx.kind.replace('dense', 'split')}{ctx.pattern}" + ("+diag" if ctx.diag is not None else "")
     t = M.getType()
     return "dense" if "dense" in t else ("baij" if "baij" in t else "aij")
 
@@ -158,10 +168,12 @@ def save(path, comm, march, key):
             ctx = bsr.context(M)
             if ctx is None:
                 M.view(viewer)
-            else:                                 # written as MPIBAIJ, one lag at a time
-                A = ctx.to_baij()
-                A.view(viewer)
-                A.destroy()
+                continue
+            for make in (ctx.to_aij, ctx.diag_aij if ctx.diag is not None else None):
+                if make is not None:              # its pattern's entries as MPIAIJ, one lag at a time
+                    A = make()
+                    A.view(viewer)
+                    A.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     import time
@@ -195,6 +207,13 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
     PETSc = init()
     nloc = node_range[1] - node_range[0]
     types = {"dense": PETSc.Mat.Type.DENSE, "baij": PETSc.Mat.Type.BAIJ, "aij": PETSc.Mat.Type.AIJ}
+
+    def aij(cols):
+        M = PETSc.Mat().create(comm=comm)
+        M.setSizes(((3 * nloc, 3 * n_nodes), cols))
+        M.setType(PETSc.Mat.Type.AIJ)
+        M.load(viewer)
+        return M
     viewer = PETSc.Viewer().createBinary(path, mode="r", comm=comm)
     out = {"A": [], "H": [], "G": [], "HI": [], "GI": []}
 
@@ -205,17 +224,22 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
                 out[group].append(None)
                 continue
             cols = (3 * tcol_loc, 3 * n_t) if group in ("G", "GI") else (3 * nloc, 3 * n_nodes)
+            if kind.startswith(("bsr", "split")):
+                from . import bsr
+                base, _, extra = kind.partition("+")
+                M = aij(cols)
+                D = aij(cols) if extra == "diag" else None
+                M = bsr.from_aij(M, int(base.lstrip("bsrplit")), D, dense=base.startswith("split"))
+                idx = int(name[len(group):])
+                lag = interp_lags[idx - 1] if group in ("HI", "GI") else idx
+                if kind.startswith("bsr") and 0 < single_from <= lag:
+                    bsr.context(M).to_single()
+                out[group].append(M)
+                continue
             M = PETSc.Mat().create(comm=comm)
             M.setSizes(((3 * nloc, 3 * n_nodes), cols), bsize=3)
             M.setType(types[kind])
             M.load(viewer)
-            if kind == "baij":
-                from . import bsr
-                M = bsr.from_mat(M)
-                idx = int(name[len(group):])
-                lag = interp_lags[idx - 1] if group in ("HI", "GI") else idx
-                if 0 < single_from <= lag:
-                    bsr.context(M).to_single()
             out[group].append(M)
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
     viewer.destroy()

@@ -458,17 +458,18 @@ class Marcher:
                 else:
                     R += x @ At
             else:                                         # block-sparse: one pass over its blocks
-                ctx = bsr.context(M)
+                ctx = bsr.context(M)                      # (bsr.BSRMat or bsr.DenseSplit)
                 if RT is None:
                     RT = np.zeros((R.shape[1], w))
                 ctx.panel(x, RT, sign)
-                self.PETSc.Log.logFlops(18.0 * w * ctx.indices.size)
+                self.PETSc.Log.logFlops(ctx.flops(w))
         if RT is not None:
             R += RT.T
 
     @staticmethod
     def _panel_kind(M):
-        """'dense', 'bsr' (a matrix the block forms a panel product with) or None (step by step)."""
+        """'dense' (MATDENSE), 'bsr' (a python Mat of ``bsr``: block-sparse or a flat surface's dense
+        pieces), matrices the block forms a panel product with, or None (step by step)."""
         if "dense" in M.getType():
             return "dense"
         return "bsr" if bsr.context(M) is not None else None
@@ -521,8 +522,8 @@ class Marcher:
             else:
                 ctx = bsr.context(M)
                 y = np.empty(acc.size)
-                bsr._matvec(ctx.indptr, ctx.indices, ctx.data, x, y)
-                self.PETSc.Log.logFlops(18.0 * ctx.indices.size)
+                ctx.matvec(x, y)
+                self.PETSc.Log.logFlops(ctx.flops())
             if side == "u":
                 acc -= y
             else:

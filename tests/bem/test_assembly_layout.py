@@ -1,19 +1,21 @@
 """The assembly's accumulation and layout (bem/assemble.py, model.Buckets; issue 13 item 2) against a
 literal sum: for every row and every virtual element (symmetry images included), the element
 integrals of the pair (the same quadrature call the kernel makes) times the image's column signs are
-added into dense H_l and G_l, then the free term. The kernel keeps a slot map per row, emits each row
+added into dense H_l and G_l (the free term of H_1 apart). The kernel keeps a slot map per row, emits each row
 by (lag, column), and the Buckets append chunks into per-lag block CSR: the stored blocks must equal
 the literal sums exactly (same additions in the same order), be exactly the blocks that received a
 non-zero contribution (H) or a traction column (G), and come in CSR order. Chunks of one and of
 several rows give the same arrays bit for bit; the element cache (integrals of a translated copy of
-a pair) changes them by round-off only."""
+a pair) changes them by round-off only. On the flat surface the blocks keep only their pattern's
+entries (bem/bsr.py: H 4, G 5 of 9), and the literal sums are exactly zero in the others; the
+general 3x3 path (``block_pattern`` "full") stores the same sums with the zeros."""
 import numpy as np
 import pytest
 
 from helpers import petsc
 
 
-def _lagset(planes, chunk_cache):
+def _lagset(planes, chunk_cache, pattern="auto"):
     PETSc = petsc()
     from petsc_ssi.mesh.surface import grid
     from petsc_ssi.bem.lagset import Material, Regions, LagSet
@@ -21,7 +23,7 @@ def _lagset(planes, chunk_cache):
     mesh = grid(4.0, 4.0, 1.0, (1.0, 1.0), **({"xmin": 0.0, "ymin": 0.0} if planes else {}))
     reg = Regions(mesh, load_elems=mesh.groups["load"])
     opts = {"gauss": 2, "singular_order": 12, "subdivisions": 4, "near_factor": 2.0, "max_subdivisions": 32,
-            "cache": chunk_cache}
+            "cache": chunk_cache, "block_pattern": pattern}
     pl = symmetry.parse("x=sym,y=anti") if planes else []
     return LagSet(PETSc.COMM_SELF, mesh, Material(548.0, 316.0, 2000.0), 1.5e-3, 7, reg, pl, opts)
 
@@ -56,18 +58,22 @@ def _literal(ls):
                     if ls.VT[v, a] >= 0:
                         G[lo + li, i, ls.VT[v, a]] += Ub[li, a] * ls.VS[v]
                         gm[lo + li, i, ls.VT[v, a]] = True
-        H[1, i, i] += ls.cfree[i]
-        hm[1, i, i] = True
     return H, G, hm, gm
 
 
-@pytest.mark.parametrize("planes", [False, True])
-def test_blocks_equal_the_literal_sums_in_csr_order(planes):
-    ls = _lagset(planes, False)
+@pytest.mark.parametrize("planes,pattern", [(False, "auto"), (True, "auto"), (True, "full")])
+def test_blocks_equal_the_literal_sums_in_csr_order(planes, pattern):
+    from petsc_ssi.bem.bsr import positions, FULL
+    ls = _lagset(planes, False, pattern)
+    assert ls.flat == (pattern == "auto")
     H, G, hm, gm = _literal(ls)
     ls.assemble(chunk=3)
     nblocks = 0
     for B, D, M in ((ls.H, H, hm), (ls.G, G, gm)):
+        assert B.m == ((4 if B is ls.H else 5) if ls.flat else FULL)
+        p, q = positions(B.m)
+        off = np.ones((3, 3), bool)
+        off[p, q] = False
         for l in range(1, ls.L + 1):
             indptr, cols, vals = B.csr(l)
             assert indptr[-1] == len(cols) == M[l].sum()
@@ -75,8 +81,18 @@ def test_blocks_equal_the_literal_sums_in_csr_order(planes):
             key = rows.astype(np.int64) * D.shape[2] + cols
             assert np.all(np.diff(key) > 0)                       # rows ascending, columns ascending in a row
             assert np.all(M[l][rows, cols])                        # exactly the touched blocks
-            assert np.array_equal(vals, D[l][rows, cols])          # the same sums, bit for bit
+            assert np.array_equal(vals, D[l][rows, cols][:, p, q])  # the same sums, bit for bit
+            assert not np.any(D[l][..., off])                      # the pattern's zeros are exact zeros
             nblocks += len(cols)
+        # the blocks of the collocation equations (free term of H_1 added): literal sum, then c_ij
+        r, c, v = B.peek(1)
+        ref = D[1].copy()
+        if B is ls.H:
+            ref[ls.rows, ls.rows] += ls.cfree[ls.rows]
+        mask = M[1].copy()
+        if B is ls.H:
+            mask[ls.rows, ls.rows] = True
+        assert len(c) == mask.sum() and np.array_equal(v, ref[r, c])
     assert nblocks > 1000 and np.abs(G).max() > 0 and ls.regions.n_t > 0
 
 

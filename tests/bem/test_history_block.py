@@ -226,7 +226,7 @@ def test_an_explicit_block_size_is_kept():
     class Cfg(dict):
         scheme = "stabilized"
     d = np.full(3, 1e6)
-    assert history_block(Cfg(), np.zeros(3), d, d / 76) == (1, 1)           # the model: step by step
-    assert history_block(Cfg(history_block=2), np.zeros(3), d, d / 76) == (2, 2)
-    assert history_block(Cfg(history_block=1), np.zeros(3), d, d / 76) == (1, 1)
-    assert history_block(Cfg(history_block=16, history_sub=4), np.zeros(3), d, d / 76) == (16, 4)
+    assert history_block(Cfg(), np.zeros(3), d, 9 * d / 76) == (1, 1)           # the model: step by step
+    assert history_block(Cfg(history_block=2), np.zeros(3), d, 9 * d / 76) == (2, 2)
+    assert history_block(Cfg(history_block=1), np.zeros(3), d, 9 * d / 76) == (1, 1)
+    assert history_block(Cfg(history_block=16, history_sub=4), np.zeros(3), d, 9 * d / 76) == (16, 4)

@@ -49,11 +49,11 @@ def test_buckets_round_the_far_lags_to_float32():
     row = np.sort(rng.integers(0, 4, n))
     lag = rng.integers(1, 6, n)
     col = rng.integers(0, 7, n).astype(np.int64)
-    val = rng.standard_normal((n, 3, 3))
+    val = rng.standard_normal((n, 9))
     out = []
     for sf in (0, 3):
         B = Buckets(5, rows, 7, single_from=sf)
-        B.add(row, lag, col, val, np.empty(n, np.int32), np.empty((n, 3, 3)))
+        B.add(row, lag, col, val)
         out.append([B.csr(l) for l in range(1, 6)])
     for l in range(1, 6):
         (p0, c0, v0), (p1, c1, v1) = out[0][l - 1], out[1][l - 1]
@@ -140,14 +140,14 @@ def test_peak_counts_the_interpolating_assemblies():
     assert peak_bytes(mats[:2], trip[:2], [1.0], 5.0, 2.0) == pytest.approx(1.1 * (25.0 + 1.0 + 2.0))
 
 
-def test_block_choice_counts_blocks_not_bytes():
-    """A float32 block-sparse matrix has the flops of a double one with the same blocks in 40/76 of
-    its bytes: the block choice takes the blocks when given."""
+def test_block_choice_counts_values_not_bytes():
+    """A float32 block-sparse matrix has the flops of a double one with the same values in 40/76 of
+    its bytes: the block choice takes the stored values when given."""
     from petsc_ssi.bem.cost import choose_block
     d = np.zeros(40)
     blocks = np.full(40, 2.0e6)
-    assert choose_block(d, 76.0 * blocks) == choose_block(d, 76.0 * blocks, sparse_blocks=blocks)
-    b40, s40 = choose_block(d, 40.0 * blocks, sparse_blocks=blocks)
+    assert choose_block(d, 76.0 * blocks) == choose_block(d, 76.0 * blocks, sparse_values=9 * blocks)
+    b40, s40 = choose_block(d, 40.0 * blocks, sparse_values=9 * blocks)
     assert b40 >= 2 and 1 <= s40 <= b40
 
 
