@@ -315,6 +315,24 @@ def _accumulate(src, base, m, cols, sign, sj, buf, touch, lst, n, skip_zero):
 
 
 @njit(cache=True)
+def _ordered(lst, n, touch):
+    """The n touched columns listed in lst, ascending, their flags cleared: a scan of the flags when
+    they are many (n log n sorting of most of the row costs more), else a sort of the list."""
+    if 16 * n > touch.shape[0]:
+        k = 0
+        for c in range(touch.shape[0]):
+            if touch[c]:
+                lst[k] = c
+                touch[c] = False
+                k += 1
+        return lst[:n]
+    cl = np.sort(lst[:n])
+    for k in range(n):
+        touch[cl[k]] = False
+    return cl
+
+
+@njit(cache=True)
 def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
                   work, dropped, hout, gout, loc, cache_max=1 << 62):
     """Collective-free numba kernel: the blocks of H and G of ``rows``, written where they are kept.
@@ -445,15 +463,11 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                     srcU = scU if pairs[k, 4] == 1 else cpoolU
                     nG = _accumulate(srcU, slot * sU, mG, Vtcol[v], Vsign[v], gq_, bufG, touchG, lstG, nG, False)
             if nH:
-                cl = np.sort(lstH[:nH])
+                cl = _ordered(lstH, nH, touchH)
                 _emit_lag(lag, nH, cl, bufH, li, hout)
-                for k in range(nH):
-                    touchH[cl[k]] = False
             if nG:
-                cl = np.sort(lstG[:nG])
+                cl = _ordered(lstG, nG, touchG)
                 _emit_lag(lag, nG, cl, bufG, li, gout)
-                for k in range(nG):
-                    touchG[cl[k]] = False
     return ((pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG), nev, hits, ckeys, cmeta, cpoolP, cpoolU)
 
 

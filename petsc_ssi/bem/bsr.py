@@ -374,7 +374,7 @@ class BSRMat:
     def diag_aij(self):
         """Collective: the free term (block diagonal) as an MPIAIJ of the same rows and columns."""
         PETSc = init()
-        nloc = self.indptr.size - 1
+        nloc = self.diag.shape[0]
         C = (3 * (self.row0 + np.arange(nloc)))[:, None, None] + np.zeros((1, 3, 1), np.int64) + np.arange(3)
         ip = np.arange(0, 9 * nloc + 1, 3, dtype=np.int64)
         A = PETSc.Mat().createAIJ(size=self.sizes, csr=(ip.astype(PETSc.IntType), C.ravel().astype(PETSc.IntType),

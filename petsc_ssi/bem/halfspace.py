@@ -344,6 +344,7 @@ class HalfSpace:
         plan = plan if plan is not None else self.interp_plan()
         interp = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []
         opts = dict(self.quad_options(), partition=self.cfg.partition, work_lags=plan.Lx,
+                    block_pattern=self.cfg.get("lag_pattern", "auto"),
                     lag_weights=lag_weights(plan.Lx, self.L, self.cfg.scheme.startswith("stabili"), interp))
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes, opts)
 

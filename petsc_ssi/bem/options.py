@@ -43,10 +43,18 @@ register("history_sub", "int", 0, "steps", "sub-blocks of the time-blocked histo
          "start the terms of the block's states known by then are formed as panel products too, so only lags up to "
          "about s + 2 stay in per-step products (s >= -ssi_history_block: one level; 0: automatic, with the block "
          "size)", "bem", validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
-register("lag_fill", "real", 0.95, "", "auto storage: lags with block fill above this are dense (0.95: dense where it stores fewer bytes, 72 B per block of the whole lag against 76 B per stored block)", "bem",
+register("lag_pattern", "enum", "auto", "", "the entries a 3x3 block of the lag matrices stores: auto (where every "
+         "collocation point and element lie in one plane, as on every surface petsc-ssi accepts, H keeps the 4 "
+         "entries coupling in-plane with out-of-plane components and G the 5 of the in-plane pair and zz, the others "
+         "being exact zeros: bem/bsr.py; else all 9) or full (all 9 everywhere: the general path, to check the flat "
+         "one or to measure what it saves; the same results to round-off)", "bem", choices=("auto", "full"))
+register("lag_fill", "real", 0.95, "", "auto storage: lags with block fill above this are dense (0.95: dense where it "
+         "stores fewer bytes; per block of the whole lag dense 8 m B against 8 m + 4 B per stored block, m the "
+         "entries of the block pattern, -ssi_lag_pattern)", "bem",
          validator=lambda v: None if 0 <= v <= 1 else "must be in [0, 1]")
 register("lag_single_from", "int", 0, "lag", "store the lags from this one on in single precision: float32 "
-         "block-sparse (40 B per 3x3 block, against 76 B block-sparse or 72 B per block dense), also the "
+         "block-sparse (4 m + 4 B per 3x3 block of m stored entries, against 8 m + 4 B block-sparse or 8 m B per block "
+         "dense; m = 4 for H on a flat surface, -ssi_lag_pattern), also the "
          "interpolating matrices that stand for them (an interpolating matrix counts as the lag of its kernel time, "
          "rounded down: the first one is usually the last exact lag); the products accumulate in double. 0: every "
          "lag in double; lags 1 and 2 (the step matrix) stay double", "bem",

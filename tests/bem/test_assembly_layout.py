@@ -15,12 +15,15 @@ import pytest
 from helpers import petsc
 
 
-def _lagset(planes, chunk_cache, pattern="auto"):
+def _lagset(planes, chunk_cache, pattern="auto", bump=0.0):
     PETSc = petsc()
     from petsc_ssi.mesh.surface import grid
     from petsc_ssi.bem.lagset import Material, Regions, LagSet
     from petsc_ssi.bem import symmetry
     mesh = grid(4.0, 4.0, 1.0, (1.0, 1.0), **({"xmin": 0.0, "ymin": 0.0} if planes else {}))
+    if bump:           # a surface not in a plane z = const (the CLI refuses it; the kernels take any geometry):
+        x, y = mesh.nodes[:, 0], mesh.nodes[:, 1]      # a tilted plane (a kink-free surface: free term I/2),
+        mesh.nodes[:, 2] = bump * x + 0.5 * bump * y   # whose blocks are full in the x, y, z frame
     reg = Regions(mesh, load_elems=mesh.groups["load"])
     opts = {"gauss": 2, "singular_order": 12, "subdivisions": 4, "near_factor": 2.0, "max_subdivisions": 32,
             "cache": chunk_cache, "block_pattern": pattern}
@@ -61,11 +64,14 @@ def _literal(ls):
     return H, G, hm, gm
 
 
-@pytest.mark.parametrize("planes,pattern", [(False, "auto"), (True, "auto"), (True, "full")])
-def test_blocks_equal_the_literal_sums_in_csr_order(planes, pattern):
+@pytest.mark.parametrize("planes,pattern,bump", [(False, "auto", 0.0), (True, "auto", 0.0), (True, "full", 0.0),
+                                                 (False, "auto", 0.2)])
+def test_blocks_equal_the_literal_sums_in_csr_order(planes, pattern, bump):
+    """Flat (with and without symmetry images), flat on the general path, and a surface not in a plane
+    z = const: there the general path is taken and the entries a flat pattern leaves out are not zero."""
     from petsc_ssi.bem.bsr import positions, FULL
-    ls = _lagset(planes, False, pattern)
-    assert ls.flat == (pattern == "auto")
+    ls = _lagset(planes, False, pattern, bump)
+    assert ls.flat == (pattern == "auto" and not bump)
     H, G, hm, gm = _literal(ls)
     ls.assemble(chunk=3)
     nblocks = 0
@@ -82,8 +88,14 @@ def test_blocks_equal_the_literal_sums_in_csr_order(planes, pattern):
             assert np.all(np.diff(key) > 0)                       # rows ascending, columns ascending in a row
             assert np.all(M[l][rows, cols])                        # exactly the touched blocks
             assert np.array_equal(vals, D[l][rows, cols][:, p, q])  # the same sums, bit for bit
-            assert not np.any(D[l][..., off])                      # the pattern's zeros are exact zeros
+            if ls.flat:
+                assert not np.any(D[l][..., off])                  # the pattern's zeros are exact zeros
             nblocks += len(cols)
+        if bump:                                                   # what the general path is for
+            from petsc_ssi.bem.bsr import positions as pos
+            flat_off = np.ones((3, 3), bool)
+            flat_off[pos(4 if B is ls.H else 5)] = False
+            assert np.abs(D[2:][..., flat_off]).max() > 1e-3 * np.abs(D[2:]).max()
         # the blocks of the collocation equations (free term of H_1 added): literal sum, then c_ij
         r, c, v = B.peek(1)
         ref = D[1].copy()
@@ -94,6 +106,16 @@ def test_blocks_equal_the_literal_sums_in_csr_order(planes, pattern):
             mask[ls.rows, ls.rows] = True
         assert len(c) == mask.sum() and np.array_equal(v, ref[r, c])
     assert nblocks > 1000 and np.abs(G).max() > 0 and ls.regions.n_t > 0
+
+
+def test_a_flat_pattern_on_a_surface_that_is_not_flat_is_refused():
+    """The assembly checks every integral's entries outside the pattern: forced onto a bumped surface,
+    the flat pattern stops with an error instead of dropping them."""
+    from petsc_ssi.petsc import SSIError
+    ls = _lagset(False, True, bump=0.2)
+    ls.mH, ls.mG = 4, 5
+    with pytest.raises(SSIError, match="outside its pattern"):
+        ls.assemble()
 
 
 def test_chunks_and_cache_do_not_change_the_arrays():

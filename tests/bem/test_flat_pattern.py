@@ -1,0 +1,137 @@
+"""The flat surface's block patterns (issue 29; bem/bsr.py PATTERNS): where every collocation point
+and element lie in one plane, H keeps 4 of the 9 entries of each 3x3 block and G 5, and the
+products skip the exact zeros.
+
+What is checked: the pattern kernels (matrix-vector product and panel product, float64 and
+float32 values) give the full 3x3 kernels' numbers on the expanded blocks (the same products and
+sums minus exact zeros: equal arrays); the split dense storage of a flat surface and the free term
+carried apart give the dense numpy products to round-off; whole runs with the flat pattern equal
+the general path (-ssi_lag_pattern full) to 1e-12 for every storage (block-sparse, dense, single
+precision, interpolating matrices, a prescribed-displacement region's G) on 1 and 2 ranks; a lag
+file of the flat pattern is smaller than the full one and reloads on another rank count. The
+general path on a surface that is not flat is tests/bem/test_assembly_layout.py's."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from helpers import cli, petsc
+from test_history_block import BEM, INTERP, DISP, same
+from test_single import stored_gb
+
+
+def _random_pattern_csr(rng, m, nrow, ncol, fill, dtype=np.float64):
+    indptr, indices = [0], []
+    for _ in range(nrow):
+        cols = np.sort(rng.permutation(ncol)[:max(1, int(fill * ncol))])
+        indices.extend(cols)
+        indptr.append(len(indices))
+    data = rng.standard_normal((len(indices), m)).astype(dtype)
+    return np.array(indptr, np.int64), np.array(indices, np.int32), data
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+@pytest.mark.parametrize("m", [4, 5])
+def test_pattern_kernels_give_the_full_kernels_numbers(m, dtype):
+    from petsc_ssi.bem import bsr
+    rng = np.random.default_rng(m)
+    indptr, indices, data = _random_pattern_csr(rng, m, 23, 31, 0.4, dtype)
+    full = bsr.expand(data, m)                        # (n, 3, 3), zeros outside the pattern
+    assert np.array_equal(bsr.compact(full, m), data)
+    x = rng.standard_normal(3 * 31)
+    y, yf = np.empty(3 * 23), np.empty(3 * 23)
+    bsr.matvec(m, indptr, indices, data, x, y)
+    bsr.matvec(9, indptr, indices, np.ascontiguousarray(full.reshape(-1, 9)), x, yf)
+    assert np.array_equal(y, yf) and np.abs(y).max() > 0
+    for b in (1, 7, 32):
+        XT = rng.standard_normal((3 * 31, b))
+        R0 = rng.standard_normal((3 * 23, b))
+        R, Rf = R0.copy(), R0.copy()
+        bsr.panel(m, indptr, indices, data, XT, R, -1.0)
+        bsr.panel(9, indptr, indices, np.ascontiguousarray(full.reshape(-1, 9)), XT, Rf, -1.0)
+        assert np.array_equal(R, Rf)
+
+
+def _dense_of(m, indptr, indices, data, nrow, ncol, diag=None, row0=0):
+    from petsc_ssi.bem import bsr
+    A = np.zeros((3 * nrow, 3 * ncol))
+    full = bsr.expand(data, m)
+    for i in range(nrow):
+        for k in range(indptr[i], indptr[i + 1]):
+            A[3 * i:3 * i + 3, 3 * indices[k]:3 * indices[k] + 3] = full[k]
+        if diag is not None:
+            A[3 * i:3 * i + 3, 3 * (row0 + i):3 * (row0 + i) + 3] += diag[i]
+    return A
+
+
+@pytest.mark.parametrize("m", [4, 5])
+def test_split_dense_and_the_free_term_give_the_dense_products(m):
+    """A flat surface's dense lag in two dense pieces (bsr.DenseSplit), and a block-sparse one with the
+    free term carried apart, against numpy's dense products of the same matrix: 1e-13."""
+    PETSc = petsc()
+    from petsc_ssi.bem import bsr
+    rng = np.random.default_rng(10 + m)
+    nrow, ncol, row0 = 13, 29, 5
+    indptr, indices, data = _random_pattern_csr(rng, m, nrow, ncol, 0.6)
+    diag = rng.standard_normal((nrow, 3, 3))
+    A = _dense_of(m, indptr, indices, data, nrow, ncol, diag, row0)
+    x = rng.standard_normal(3 * ncol)
+    XT = rng.standard_normal((3 * ncol, 6))
+    for ctx in (bsr.DenseSplit.from_csr(PETSc.COMM_SELF, m, nrow, ncol, nrow, ncol, indptr, indices, data, diag,
+                                        row0),
+                bsr.BSRMat(PETSc.COMM_SELF, indptr, indices, data, nrow, ncol, nrow, ncol, m, diag, row0)):
+        y = np.empty(3 * nrow)
+        ctx.matvec(x, y)
+        tol = 1e-13 * np.abs(A).sum(1).max() * np.abs(x).max()
+        assert np.abs(y - A @ x).max() <= tol
+        RT = np.zeros((3 * nrow, 6))
+        ctx.panel(XT, RT, -1.0)
+        assert np.abs(RT + A @ XT).max() <= 1e-13 * (np.abs(A) @ np.abs(XT)).max()
+        # the stored bytes: m of 9 entries a block (dense: every node pair)
+        values = ctx.data.size if ctx.kind == "bsr" else sum(P.size for _, _, P in ctx.pieces)
+        assert values == m * (len(indices) if ctx.kind == "bsr" else nrow * ncol)
+
+
+CASES = {        # (options, ranks): every storage the lags have, a G of traction columns, interpolation
+    "block-sparse, interpolated, 2 ranks": (BEM + INTERP + ["-ssi_lag_storage", "sparse"], 2),
+    "dense, prescribed motion, 2 ranks": (DISP + ["-ssi_lag_storage", "dense", "-ssi_t_end", "0.03"], 2),
+    "single precision, symmetry, 2 ranks": (BEM + INTERP + ["-ssi_lag_single_from", "5", "-ssi_symmetry",
+                                                             "x=sym,y=sym"], 2),
+    "auto storage, prescribed motion, 1 rank": (DISP + ["-ssi_t_end", "0.03"], 1),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_flat_pattern_is_the_general_path(case, tmp_path):
+    args, n = CASES[case]
+    out = {}
+    for pattern in ("auto", "full"):
+        path = str(tmp_path / f"{pattern}.h5")
+        r = cli(args + ["-ssi_output", path, "-ssi_lag_pattern", pattern], nranks=n)
+        out[pattern] = (path, stored_gb(r.stdout)[1])
+    same(out["full"][0], out["auto"][0], rtol=1e-12)
+    # the flat pattern stores fewer bytes (H 36 B a block against 76, G 40 against 72 dense)
+    assert out["auto"][1] < 0.75 * out["full"][1]
+
+
+def test_a_lag_file_holds_the_pattern_and_reloads(tmp_path):
+    """Saved at 2 ranks with dense lags (split pieces, H_1's free term apart) and with block-sparse
+    ones: the file lists those kinds, is smaller than the general path's, and a run loading it at 1
+    rank equals the run that assembled to 1e-12."""
+    args = DISP + ["-ssi_lag_storage", "dense", "-ssi_t_end", "0.03"]
+    sizes = {}
+    for pattern in ("auto", "full"):
+        lags = str(tmp_path / f"{pattern}.lags")
+        cli(args + ["-ssi_output", str(tmp_path / f"save-{pattern}.h5"), "-ssi_lags_save", lags,
+                    "-ssi_lag_pattern", pattern], nranks=2)
+        sizes[pattern] = os.path.getsize(lags)
+        kinds = [k for _, k in json.load(open(lags + ".json"))["mats"]]
+        if pattern == "auto":
+            assert "split4+diag" in kinds and "split5" in kinds
+        else:
+            assert "dense" in kinds
+    assert sizes["auto"] < 0.7 * sizes["full"]
+    r = cli(args + ["-ssi_output", str(tmp_path / "load.h5"), "-ssi_lags_load", str(tmp_path / "auto.lags")])
+    assert "loaded from" in r.stdout
+    same(str(tmp_path / "save-auto.h5"), str(tmp_path / "load.h5"), rtol=1e-12)
