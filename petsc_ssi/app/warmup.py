@@ -90,7 +90,8 @@ def _single_kernels():
             data = np.ones((1, m), dt)
             for xx in (np.ones(3), x):
                 bsr.matvec(m, indptr, cols, data, xx, np.zeros(3))
-            bsr.panel(m, indptr, cols, data, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
+            for w in (2, bsr.PAIR_FROM):
+                bsr.panel(m, indptr, cols, data, np.ones((3, w)), np.zeros((3, w)), 1.0)
     diag = np.ones((1, 3, 3))
     bsr._diag_add(diag, 0, x, np.zeros(3), 1.0)
     bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)

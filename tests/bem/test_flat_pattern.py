@@ -44,7 +44,7 @@ def test_pattern_kernels_give_the_full_kernels_numbers(m, dtype):
     bsr.matvec(m, indptr, indices, data, x, y)
     bsr.matvec(9, indptr, indices, np.ascontiguousarray(full.reshape(-1, 9)), x, yf)
     assert np.array_equal(y, yf) and np.abs(y).max() > 0
-    for b in (1, 7, 32):
+    for b in (1, 7, 32):                              # (32: H4 two rows at a time, bsr.PAIR_FROM)
         XT = rng.standard_normal((3 * 31, b))
         R0 = rng.standard_normal((3 * 23, b))
         R, Rf = R0.copy(), R0.copy()
