@@ -1,9 +1,12 @@
-"""Where one rank's BEM assembly spends its time (issue 13, item 2): runs LagSet.assemble and the
-Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing assemble_rows
-(which writes the blocks where they are kept) and the Mat constructors, and prints per rank those times, the kernel (sys)
-time and minor page faults (getrusage), resident and huge-page memory, and per-chunk ms/row.
+"""Where one rank's BEM assembly spends its time (issues 13 and 29): runs LagSet.assemble and the
+Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing the integration
+of the shared element cache (LagSet._share_cache), the kernel that sums the blocks and writes them
+where they are kept (assemble_rows) and the Mat constructors, and prints per rank those times, the
+kernel (sys) time and minor page faults (getrusage), resident and huge-page memory, and ms per row.
+With -prefault 1 the lag arrays are written once (zeros) as they are allocated, timed apart: the
+first touch of their pages, which the kernel otherwise pays as it writes.
 
-  mpirun -n 2 python jobscripts/assembly_profile.py [-rows R]   (R > 0: only R rows from row 1000)
+  mpirun -n 2 python jobscripts/assembly_profile.py [-rows R] [-prefault 1]   (R > 0: R rows from row 1000)
 """
 import sys, time
 import numpy as np
@@ -18,6 +21,7 @@ cfg = options.resolve(("common", "bem"))
 prob = HalfSpace(cfg, PETSc.COMM_WORLD, log=lambda m: None)
 ls = prob.lagset(prob.interp_plan())
 R = int(PETSc.Options().getInt("rows", 64))
+PRE = PETSc.Options().getBool("prefault", False)
 if R: ls.rows = ls.rows[1000:1000 + R]
 if R: ls.node_range = (1000, 1000 + R)
 R = len(ls.rows)
@@ -27,15 +31,25 @@ def wrap(mod, name):
     f = getattr(mod, name)
     def g(*a, **k):
         t = time.perf_counter(); r = f(*a, **k); d = time.perf_counter() - t; T[name] = T.get(name, 0) + d
-        if name == "assemble_rows": TS.append((d, r[1], a[0][0]))
+        if name == "assemble_rows": TS.append((d, len(a[0]), a[0][0]))
         return r
     setattr(mod, name, g)
 for n in ("assemble_rows",):
     wrap(model, n)
+wrap(model.LagSet, "_share_cache")
+_init = model.Buckets.__init__
+def init_prefault(self, *a, **k):
+    _init(self, *a, **k)
+    if PRE:
+        t = time.perf_counter()
+        for l in range(len(self._c)):
+            self._c[l].fill(0); self._v[l].fill(0.0); self._v32[l].fill(0.0)
+        T["first touch"] = T.get("first touch", 0) + time.perf_counter() - t
+model.Buckets.__init__ = init_prefault
 for n in ("baij", "dense"):
     wrap(lagmats, n)
 t = time.perf_counter(); ls.assemble(); ta = time.perf_counter() - t
-print(PETSc.COMM_WORLD.rank, "chunk", ls.chunk_rows(ls.L), f"assemble {ta:.2f}", {k: round(v, 2) for k, v in T.items()})
+print(PETSc.COMM_WORLD.rank, f"assemble {ta:.2f} s:", {k: round(v, 2) for k, v in T.items()})
 import resource
 ru = resource.getrusage(resource.RUSAGE_SELF); print("rss", open("/proc/self/status").read().split("VmRSS:")[1].split("\n")[0], "AnonHuge", [l for l in open("/proc/self/smaps_rollup") if "AnonHuge" in l])
 print(PETSc.COMM_WORLD.rank, "per call (first row, ms/row):", [(int(r), round(1e3*d/max(n,1), 1)) for d, n, r in TS[::7]], "sys", ru.ru_stime, "minflt", ru.ru_minflt, flush=True)

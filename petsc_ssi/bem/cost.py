@@ -18,7 +18,7 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
                                                        a cost per Mat (creation, collectives)
   factor     c_fac * N^1.5                              (sparse LU of the local step matrix)
   history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
-             * (1 + sigma (m - 1))                     the run (a dense lag: 72 N n_r B,
+             * (1 + sigma (m - 1))                     the run (a dense lag: 8 m N n_r B,
              + (c_op + c_op_mpi [p > 1]) * P_r
              + FD_r / r_panel_dense                    time-blocked sum (-ssi_history_block b,
              + FS_r / r_panel_sparse                   -ssi_history_sub s): flops of the block and
@@ -26,7 +26,7 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
                                                        column: width b or s; march.block_terms), dense and
                                                        block-sparse; HD, HS, P then count only
                                                        the per-step products
-                                                       sparse: 76 B per block), m ranks per
+                                                       sparse: 8 m + 4 B per block), m ranks per
                                                        node sharing the memory bus; P_r
                                                        matrix-vector products
   solve      c_sol * steps * N^1.5 * (1 + kappa (p - 1))
@@ -40,8 +40,9 @@ are the maximum over ranks; with more ranks per node than cores
 Memory (peak of the processes, summed over ranks as -memory_view reports):
   p * m0 + gamma * max(rho_trip * (T + c_cache * C + p * m_asm),
                        max_k [Mats of lags <= k + T of lags > k] + G)
-with T = 76 B per block (40 B single precision, -ssi_lag_single_from, as its Mats;
-model.lag_bytes) the blocks of the assembly, C the bytes of the
+with T = 8 m + 4 B per block (m the entries of the block pattern, bem/bsr.py: 4 for H on a flat
+surface, 9 in general; 4 m + 4 in single precision, -ssi_lag_single_from, as its Mats;
+lag_bytes) the blocks of the assembly, C the bytes of the
 element caches (pair_table: the distinct pair geometries each rank meets,
 capped as the assembly caps them) and m_asm a per-rank transient. With the
 cache shared between ranks (-ssi_cache_share, the default) I_r is 1/p of the
@@ -363,7 +364,8 @@ CACHE_MAX = 512 << 20
 
 
 def _per_row(n_nodes, lag_hi):
-    """Bytes of raw triplets one row may need in a numba call (96 B per block, 2x over-allocated)."""
+    """A bound of the bytes one row's work may take in the assembly kernel (the integrals of its pairs
+    outside the element cache, 9 m doubles a lag slot per pool, in arrays that grow by doubling)."""
     return 96.0 * 2 * n_nodes * max(lag_hi, 1) * 0.6
 
 
@@ -395,16 +397,16 @@ def single_lags(lags, single_from):
 
 
 def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
-    """Bytes a rank holds beside the triplets and Mats: while it assembles, the element cache
+    """Bytes a rank holds beside the blocks and Mats: while it assembles, the element cache
     (``cache`` bytes as counted from the pair geometries, ``LagSet.cache_estimate``, or without it
     the bound of 324 B per block of its rows; each of its two pools capped at CACHE_MAX) and one
-    chunk of raw triplets with its sorted copy; throughout, the process as it stands (resident size
-    now, measured). ``parts``: (assembly-only bytes, process bytes), else their sum."""
+    row's work (the integrals of its pairs the cache does not hold, bounded by ``_per_row``; the
+    kernel writes the blocks where they are kept, assemble.assemble_rows); throughout, the process
+    as it stands (resident size now, measured). ``parts``: (assembly-only bytes, process bytes), else
+    their sum."""
     cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
-    # a chunk's triplet arrays are allocated for twice the blocks they get (``_per_row``): the half
-    # touched and the sorted copy of it
-    chunk = _chunk_rows(n_nodes, lags, n_rows) * _per_row(n_nodes, lags)
-    return (cache + chunk, process_rss()) if parts else cache + chunk + process_rss()
+    row = _per_row(n_nodes, lags)
+    return (cache + row, process_rss()) if parts else cache + row + process_rss()
 
 
 def peak_bytes(mats, trip, g, asm, rss, n_exact=None, asm_interp=0.0):

@@ -318,17 +318,17 @@ class LagSet:
         """Collective: estimated bytes of the stored Mats and the assembly peak (all ranks).
 
         ``lags``: number of exact lags; ``extra_lags``: lag indices standing in
-        for interpolating matrices. Each lag is stored dense (N^2 x 72 B) or
-        block-sparse (76 B per block) by the same rule as the build (``lag_bytes``); the assembled
-        blocks (``Buckets``: 76 B per block, 40 B single, in arrays sized from this count with 15 %
+        for interpolating matrices. Each lag is stored dense (N^2 x 8 m B) or
+        block-sparse (8 m + 4 B per block; m the entries of its block pattern, bem/bsr.py) by the same
+        rule as the build (``lag_bytes``); the assembled blocks (``Buckets``: the same bytes, 4 m + 4
+        single, in arrays sized from this count with 15 %
         headroom that is never touched, so not resident) become the block-sparse Mats
         as they are, or are freed lag by lag as dense Mats are built, so the
         peak is max_k [Mats of lags <= k + blocks of lags > k] (``peak_bytes``, also the
         interpolating matrices' assemblies after them), times 1.1. Per rank on top:
         the element cache (``cache_estimate``: 81 doubles per distinct pair geometry and lag
         in each of two pools, which grow by doubling: twice that; each pool capped at
-        CACHE_MAX) and one chunk of raw triplets while the blocks are assembled (``chunk_rows``, up
-        to twice over-allocated) and the process as it stands now (its resident size, measured after
+        CACHE_MAX) and one row's work while the blocks are assembled and the process as it stands now (its resident size, measured after
         loading the kernels unless ``load`` is False). ``sample`` > 0: the blocks counted on every
         k-th local row only (at most ``sample`` rows per rank) and scaled up, a fast estimate.
         ``single_from`` > 0: lags from it on (exact or interpolating) kept in single precision
