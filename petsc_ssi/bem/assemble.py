@@ -124,20 +124,25 @@ def index_len(cidx):
 
 def new_cache():
     """An element-integral cache (kept across calls of ``assemble_rows``)."""
-    return (_new_index(), np.zeros((16, 27), np.int64), np.zeros((16, 4), np.int64),
+    return (_new_index(), np.zeros((16, 27), np.int64), np.zeros((16, 5), np.int64),
             np.zeros(1024), np.zeros(1024))
 
 
 @njit(cache=True)
 def _pool_end(cmeta, ncache):
-    """First free lag slot of the cache pools (entry k holds hi - lo + 1 lag slots from slot cmeta[k, 2]:
-    9 m doubles each in a pool of a pattern of m values, ``_compact``)."""
+    """First free lag slots of the cache pools, (P, U): entry k = cmeta[k] (lo, hi, P slot, has U,
+    U slot) holds hi - lo + 1 lag slots from its P slot, and as many from its U slot if it has U
+    blocks (only pairs with a traction column do): 9 m doubles a slot in a pool of a pattern of m
+    values (``_compact``)."""
     pool_n = 0
+    upool_n = 0
     for k in range(ncache):
-        e = cmeta[k, 2] + (cmeta[k, 1] - cmeta[k, 0] + 1)
-        if e > pool_n:
-            pool_n = e
-    return pool_n
+        nl = cmeta[k, 1] - cmeta[k, 0] + 1
+        if cmeta[k, 2] + nl > pool_n:
+            pool_n = cmeta[k, 2] + nl
+        if cmeta[k, 3] == 1 and cmeta[k, 4] + nl > upool_n:
+            upool_n = cmeta[k, 4] + nl
+    return pool_n, upool_n
 
 
 @njit(cache=True)
@@ -190,7 +195,7 @@ def new_work(n_nodes, n_tcols, n_virtual, mH=9, mG=9):
     block: bsr.PATTERNS), its touched flags and list. A row's blocks of one lag are summed there (a
     few tens of KB: in cache) and written once, where they are kept."""
     nt = max(n_tcols, 1)
-    return (np.zeros((max(n_virtual, 1), 6), np.int64), np.zeros(1024), np.zeros(1024),
+    return (np.zeros((max(n_virtual, 1), 7), np.int64), np.zeros(1024), np.zeros(1024),
             np.zeros((n_nodes, mH)), np.zeros((nt, mG)), np.zeros(n_nodes, np.bool_), np.zeros(nt, np.bool_),
             np.zeros(n_nodes, np.int64), np.zeros(nt, np.int64))
 
@@ -379,7 +384,7 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     nev = 0
     hits = 0
     ncache = len(cidx)
-    pool_n = _pool_end(cmeta, ncache)
+    pool_n, upool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
     reach = alpha * (dt * L + toff)
     for ii in range(rows.shape[0]):
@@ -387,7 +392,8 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
         xc = xnodes[i]
         npair = 0
         sc_n = 0
-        # the row's pairs: pairs[k] = (element, lo, hi, want_u, where (0: cache pools, 1: scratch), offset)
+        # the row's pairs: pairs[k] = (element, lo, hi, want_u, where (0: cache pools, 1: scratch), P slot,
+        # U slot)
         for v in range(nv):
             lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
                                             toff, tol, ns_base, ns_max, near_factor)
@@ -400,8 +406,10 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
             nl = hi - lo + 1
             found, fill_u, hsh = _cached(use_cache, cidx, ckeys, cmeta, VX[v], xc, qinv, key, lo, hi, want_u)
             where = 0
+            offU = 0
             if found >= 0:
                 off = cmeta[found, 2]
+                offU = cmeta[found, 4]
                 hits += 1
             else:
                 nev += _integrate(xc, VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu,
@@ -412,22 +420,30 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                     _check_dropped(Ub, nl, gkeep, dG)
                 if fill_u >= 0:                 # complete the entry with its U blocks
                     off = cmeta[fill_u, 2]
-                    _compact(cpoolU, off * sU, Ub, nl, gp, gq_)
+                    while (upool_n + nl) * sU > cpoolU.shape[0]:
+                        cpoolU = _grow(cpoolU, cpoolU.shape[0])
+                    _compact(cpoolU, upool_n * sU, Ub, nl, gp, gq_)
                     cmeta[fill_u, 3] = 1
+                    cmeta[fill_u, 4] = upool_n
+                    offU = upool_n
+                    upool_n += nl
                 elif use_cache and hsh not in cidx and 8 * (pool_n + nl) * smax <= cache_max:
                     c = ncache
                     ckeys = _grow(ckeys, c)
                     cmeta = _grow(cmeta, c)
                     while (pool_n + nl) * sP > cpoolP.shape[0]:
                         cpoolP = _grow(cpoolP, cpoolP.shape[0])
-                    while (pool_n + nl) * sU > cpoolU.shape[0]:
-                        cpoolU = _grow(cpoolU, cpoolU.shape[0])
                     ckeys[c] = key
                     cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
                     cmeta[c, 3] = 1 if want_u else 0
                     _compact(cpoolP, pool_n * sP, Pb, nl, hp, hq)
                     if want_u:
-                        _compact(cpoolU, pool_n * sU, Ub, nl, gp, gq_)
+                        while (upool_n + nl) * sU > cpoolU.shape[0]:
+                            cpoolU = _grow(cpoolU, cpoolU.shape[0])
+                        _compact(cpoolU, upool_n * sU, Ub, nl, gp, gq_)
+                        cmeta[c, 4] = upool_n
+                        offU = upool_n
+                        upool_n += nl
                     off = pool_n
                     pool_n += nl
                     cidx[hsh] = c
@@ -442,9 +458,11 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                         _compact(scU, sc_n * sU, Ub, nl, gp, gq_)
                     where = 1
                     off = sc_n
+                    offU = sc_n
                     sc_n += nl
             pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
             pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
+            pairs[npair, 6] = offU
             npair += 1
         # lag by lag: the row's blocks summed by column, then written where they are kept
         li = loc[i]
@@ -461,7 +479,8 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                 nH = _accumulate(srcP, slot * sP, mH, Vnode[v], Vsign[v], hq, bufH, touchH, lstH, nH, True)
                 if pairs[k, 3] == 1:
                     srcU = scU if pairs[k, 4] == 1 else cpoolU
-                    nG = _accumulate(srcU, slot * sU, mG, Vtcol[v], Vsign[v], gq_, bufG, touchG, lstG, nG, False)
+                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], Vsign[v], gq_, bufG, touchG,
+                                     lstG, nG, False)
             if nH:
                 cl = _ordered(lstH, nH, touchH)
                 _emit_lag(lag, nH, cl, bufH, li, hout)
@@ -570,16 +589,18 @@ def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs,
     buf[poffs[r]:] (sP doubles a lag slot) and U blocks at buf[uoffs[r]:] (sU; uoffs[r] < 0: no U);
     returns the cache arrays."""
     ncache = len(cidx)
-    pool_n = _pool_end(cmeta, ncache)
-    total = pool_n
+    pool_n, upool_n = _pool_end(cmeta, ncache)
+    total, utotal = pool_n, upool_n
     for r in range(keys.shape[0]):
         total += meta[r, 1] - meta[r, 0] + 1
+        if uoffs[r] >= 0:
+            utotal += meta[r, 1] - meta[r, 0] + 1
     if total * sP > cpoolP.shape[0]:            # sized once (not by doubling): the pools hold what was asked
         P2 = np.zeros(total * sP)
         P2[:cpoolP.shape[0]] = cpoolP
         cpoolP = P2
-    if total * sU > cpoolU.shape[0]:
-        U2 = np.zeros(total * sU)
+    if utotal * sU > cpoolU.shape[0]:
+        U2 = np.zeros(utotal * sU)
         U2[:cpoolU.shape[0]] = cpoolU
         cpoolU = U2
     ckeys = _grow(ckeys, ncache + keys.shape[0])
@@ -594,7 +615,9 @@ def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs,
         cmeta[c, 3] = 1 if uoffs[r] >= 0 else 0
         cpoolP[pool_n * sP:(pool_n + nl) * sP] = buf[poffs[r]:poffs[r] + nl * sP]
         if uoffs[r] >= 0:
-            cpoolU[pool_n * sU:(pool_n + nl) * sU] = buf[uoffs[r]:uoffs[r] + nl * sU]
+            cpoolU[upool_n * sU:(upool_n + nl) * sU] = buf[uoffs[r]:uoffs[r] + nl * sU]
+            cmeta[c, 4] = upool_n
+            upool_n += nl
         pool_n += nl
         cidx[hs[r]] = c
         ncache += 1
