@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 from numba import njit, types
-from numba.typed import Dict
+from numba.typed import Dict, List
 
 from .quadrature import integrate_pair, singular_static
 
@@ -120,6 +120,40 @@ def _new_index():
 def index_len(cidx):
     """Entries of the cache's hash map (compiled and cached: see ``_new_index``)."""
     return len(cidx)
+
+
+_COLS, _VALS, _VALS32 = (types.Array(types.int32, 1, "C"), types.Array(types.float64, 2, "C"),
+                         types.Array(types.float32, 2, "C"))
+
+
+@njit(cache=True)
+def new_lists(n, m):
+    """(columns, values, float32 values): typed Lists of n empty per-lag arrays (int32; n x m float64;
+    float32), the lag arrays the kernel writes (``_emit_lag``). Made, read and changed in compiled code
+    only (``set_lag``, ``get_lag``): typed Lists made or used from Python compile their methods in
+    every process (numba caches none of them; tests/test_warmup.py counts)."""
+    c = List.empty_list(_COLS)
+    v = List.empty_list(_VALS)
+    v32 = List.empty_list(_VALS32)
+    for _ in range(n):
+        c.append(np.empty(0, np.int32))
+        v.append(np.empty((0, m)))
+        v32.append(np.empty((0, m), np.float32))
+    return c, v, v32
+
+
+@njit(cache=True)
+def set_lag(c, v, v32, i, ci, vi, v32i):
+    """Lag i's arrays of the typed lists of ``new_lists``."""
+    c[i] = ci
+    v[i] = vi
+    v32[i] = v32i
+
+
+@njit(cache=True)
+def get_lag(c, v, v32, i):
+    """(columns, values, float32 values) of lag i (the arrays themselves, not copies)."""
+    return c[i], v[i], v32[i]
 
 
 def new_cache():

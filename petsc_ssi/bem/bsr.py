@@ -382,7 +382,8 @@ class BSRMat:
         self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
         self.comm = comm
         self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
-        self.mat.setUp()
+        self.mat.setBlockSizes(3, 3)            # node blocks: its Vecs (traction histories, checkpoints) keep
+        self.mat.setUp()                        # the layout of MATDENSE's and the step matrix's
 
     @property
     def nbytes(self):
@@ -471,7 +472,8 @@ class DenseSplit:
         self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
         self.comm = comm
         self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
-        self.mat.setUp()
+        self.mat.setBlockSizes(3, 3)            # node blocks: its Vecs (traction histories, checkpoints) keep
+        self.mat.setUp()                        # the layout of MATDENSE's and the step matrix's
 
     @classmethod
     def from_csr(cls, comm, pattern, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals, diag=None, row0=0):

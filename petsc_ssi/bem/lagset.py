@@ -115,7 +115,8 @@ class Buckets:
     page is written once, in place. numpy backs them by huge pages unless ``-ssi_huge_pages off``."""
 
     GROW = 1.5
-    TRIM = 0.9            # a lag using less of its array is copied to its size when taken
+    TRIM = 0.5            # a lag using less of its array (a growth's overshoot) is copied to its size when taken;
+                          # the estimate's 15 % headroom is never touched, so not resident: kept, no copy
 
     def __init__(self, L, rows, n_nodes, capacity=None, single_from=0, m=9, free=None):
         self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
@@ -131,14 +132,14 @@ class Buckets:
         cap = np.zeros(L + 1, np.int64)
         if capacity is not None:
             cap[1:] = np.asarray(capacity, np.int64)[:L]
-        from numba.typed import List
-        self._c, self._v, self._v32 = List(), List(), List()
-        none64, none32 = np.empty((0, self.m)), np.empty((0, self.m), np.float32)
+        from .assemble import new_lists, set_lag
+        self._c, self._v, self._v32 = new_lists(L + 1, self.m)
         for lag in range(L + 1):
-            single = self.dtype(lag) == np.float32
-            self._c.append(np.empty(int(cap[lag]), np.int32))
-            self._v.append(none64 if single else np.empty((int(cap[lag]), self.m)))
-            self._v32.append(np.empty((int(cap[lag]), self.m), np.float32) if single else none32)
+            k = int(cap[lag])
+            if k:
+                single = self.dtype(lag) == np.float32
+                set_lag(self._c, self._v, self._v32, lag, np.empty(k, np.int32),
+                        np.empty((0 if single else k, self.m)), np.empty((k if single else 0, self.m), np.float32))
 
     def out(self):
         """The kernel's view (``assemble.emit_row``): (columns, values, float32 values, fill, counts,
@@ -164,8 +165,9 @@ class Buckets:
         n = int(self.n[lag])
         indptr = np.zeros(self.nloc + 1, np.int64)
         np.cumsum(self.counts[lag, :self.nloc], out=indptr[1:])
-        vals = self._v32 if self.dtype(lag) == np.float32 else self._v
-        return indptr, self._c[lag][:n], vals[lag][:n]
+        from .assemble import get_lag
+        c, v, v32 = get_lag(self._c, self._v, self._v32, lag)
+        return indptr, c[:n], (v32 if self.dtype(lag) == np.float32 else v)[:n]
 
     def diag(self, lag):
         """The free term of the local rows if lag ``lag`` carries it (lag 1 of H), else None."""
@@ -196,11 +198,11 @@ class Buckets:
     def take_csr(self, lag):
         """``csr(lag)``; the lag is no longer held here (its arrays copied to size when mostly unused)."""
         indptr, c, v = self.csr(lag)
-        if len(c) < self.TRIM * len(self._c[lag]):
+        from .assemble import get_lag, set_lag
+        if len(c) < self.TRIM * len(get_lag(self._c, self._v, self._v32, lag)[0]):
             c, v = c.copy(), v.copy()
-        self._c[lag] = np.empty(0, np.int32)
-        self._v[lag] = np.empty((0, self.m))
-        self._v32[lag] = np.empty((0, self.m), np.float32)
+        set_lag(self._c, self._v, self._v32, lag, np.empty(0, np.int32), np.empty((0, self.m)),
+                np.empty((0, self.m), np.float32))
         self.n[lag] = 0
         self.counts[lag] = 0
         return indptr, c, v
