@@ -65,11 +65,16 @@ for name, drop in (("full 3x3 blocks", False), ("flat pattern's entries", True))
         ksp.solve(b, x)
     t_sol = (time.perf_counter() - t0) / 200
     out[name] = (nnz, t_fac, t_sol, x.copy())
+    for obj in (ksp, A, b, x):                 # collectively, before the next (not at exit's garbage collection)
+        obj.destroy()
     if comm.getRank() == 0:
         print(f"{name}: {nnz} entries, factorisation {t_fac * 1e3:.1f} ms, solve {t_sol * 1e3:.2f} ms")
 (x1, x2) = (v[3] for v in out.values())
 d = x1.copy()
 d.axpy(-1.0, x2)
+rel = d.norm(PETSc.NormType.INFINITY) / x1.norm(PETSc.NormType.INFINITY)
 if comm.getRank() == 0:
-    print(f"solutions differ by {d.norm(PETSc.NormType.INFINITY) / x1.norm(PETSc.NormType.INFINITY):.2e} of their "
-          "largest value")
+    print(f"solutions differ by {rel:.2e} of their largest value")
+for v in (d, x1, x2):
+    v.destroy()
+ls = prob = None

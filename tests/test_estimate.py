@@ -121,13 +121,13 @@ def test_model_within_30pct_of_the_benchmark(case):
 
 def test_estimate_command_does_not_assemble():
     p = cli(["estimate", "-options_file", SMALL, "-ssi_estimate_ranks", "1,2,4",
-             "-ssi_estimate_node_memory", "0.5", "-ssi_estimate_ranks_per_node", "2", "-log_view"])
+             "-ssi_estimate_node_memory", "0.35", "-ssi_estimate_ranks_per_node", "2", "-log_view"])
     out = p.stdout
     assert "[ssi] estimate of this BEM run" in out
     assert "867 DOFs" in out and "lags stored 55 (55 exact + 0 interpolating" in out
     rows = re.findall(r"^\[ssi\]\s+(\d+)\s+(\d+) \|.*\| (yes|NO)", out, re.M)
     assert [(int(a), int(b)) for a, b, _ in rows] == [(1, 1), (2, 1), (4, 2)]
-    assert rows[0][2] == "NO"          # 0.56 GB predicted on 1 rank: does not fit a 0.5 GB node
+    assert rows[0][2] == "NO"          # 0.41 GB predicted on 1 rank: does not fit a 0.35 GB node
     assert "verdict" in out
     assert "SSI_BEM_Assembly" not in out and "SSI BEM assembly" not in out
 
