@@ -391,8 +391,9 @@ class LagSet:
         return _per_row(self.mesh.n_nodes, lag_hi)
 
     def chunk_rows(self, lag_hi):
-        """Rows per numba call: about 256 MB of triplets (96 B per block, up to
-        2x over-allocated) per call, at least one row."""
+        """Rows per numba call (the progress monitor's steps: the kernel writes each row's blocks where
+        they are kept, so its memory does not grow with it): the rule of a chunk of about 256 MB of
+        triplets the kernel once held, at least one row."""
         return _chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
     def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr, pattern,

@@ -115,6 +115,34 @@ def test_the_flat_pattern_is_the_general_path(case, tmp_path):
     assert out["auto"][1] < 0.75 * out["full"][1]
 
 
+@pytest.mark.parametrize("m", [4, 5])
+def test_the_stored_entries_go_through_a_lag_files_aij_and_back(m):
+    """A lag file holds each python Mat as an MPIAIJ of its stored entries (and H_1's free term as
+    one of its own): from it, the same blocks, free term and products, block-sparse or split dense."""
+    PETSc = petsc()
+    from petsc_ssi.bem import bsr
+    rng = np.random.default_rng(20 + m)
+    nrow, ncol = 11, 17
+    indptr, indices, data = _random_pattern_csr(rng, m, nrow, ncol, 0.5)
+    diag = rng.standard_normal((nrow, 3, 3))
+    x = rng.standard_normal(3 * ncol)
+    for dense in (False, True):
+        cls = bsr.DenseSplit.from_csr if dense else None
+        ctx = (cls(PETSc.COMM_SELF, m, nrow, ncol, nrow, ncol, indptr, indices, data, diag, 0) if dense else
+               bsr.BSRMat(PETSc.COMM_SELF, indptr, indices, data, nrow, ncol, nrow, ncol, m, diag, 0))
+        A, D = ctx.to_aij(), ctx.diag_aij()
+        assert A.getInfo()["nz_used"] == m * (nrow * ncol if dense else len(indices))
+        back = bsr.context(bsr.from_aij(A, m, D, dense=dense))
+        assert back.kind == ctx.kind and back.pattern == m and np.array_equal(back.diag, diag)
+        y, y2 = np.empty(3 * nrow), np.empty(3 * nrow)
+        ctx.matvec(x, y)
+        back.matvec(x, y2)
+        assert np.array_equal(y, y2)
+        if not dense:
+            assert np.array_equal(back.indptr, indptr) and np.array_equal(back.indices, indices)
+            assert np.array_equal(back.data, data)
+
+
 def test_a_lag_file_holds_the_pattern_and_reloads(tmp_path):
     """Saved at 2 ranks with dense lags (split pieces, H_1's free term apart) and with block-sparse
     ones: the file lists those kinds, is smaller than the general path's, and a run loading it at 1
