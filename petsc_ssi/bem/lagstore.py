@@ -226,10 +226,11 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
             cols = (3 * tcol_loc, 3 * n_t) if group in ("G", "GI") else (3 * nloc, 3 * n_nodes)
             if kind.startswith(("bsr", "split")):
                 from . import bsr
-                base, _, extra = kind.partition("+")
+                base, _, extra = kind.partition("+")              # e.g. "split4+diag": storage, pattern, free term
+                storage, pattern = base.rstrip("0123456789"), int(base[len(base.rstrip("0123456789")):])
                 M = aij(cols)
                 D = aij(cols) if extra == "diag" else None
-                M = bsr.from_aij(M, int(base.lstrip("bsrplit")), D, dense=base.startswith("split"))
+                M = bsr.from_aij(M, pattern, D, dense=storage == "split")
                 idx = int(name[len(group):])
                 lag = interp_lags[idx - 1] if group in ("HI", "GI") else idx
                 if kind.startswith("bsr") and 0 < single_from <= lag:
