@@ -133,6 +133,39 @@ def signal_midway(args, log, after, send, nranks=1, timeout=240, mpirun_args=())
     return rc, open(log).read()
 
 
+def kill_session(p, timeout=30):
+    """SIGKILL to every process of the session ``p`` (a Popen started with start_new_session=True)
+    leads, at once, then wait until none is left: what a lost node or a scheduler's kill does to a
+    whole job. ``os.killpg(p.pid)`` is not that: mpirun puts each rank in a process group of its
+    own, so it kills mpirun alone and leaves the ranks writing for a while."""
+    import signal
+    import time
+
+    def members():
+        out = []
+        for d in os.listdir("/proc"):
+            if d.isdigit():
+                try:
+                    with open(f"/proc/{d}/stat") as fh:
+                        fields = fh.read().rsplit(")", 1)[1].split()
+                except OSError:
+                    continue
+                if int(fields[3]) == p.pid and fields[0] != "Z":
+                    out.append(int(d))
+        return out
+    for pid in members():
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    p.wait(timeout=timeout)
+    t0 = time.time()
+    while members():
+        if time.time() - t0 > timeout:
+            raise AssertionError(f"processes of session {p.pid} survive SIGKILL")
+        time.sleep(0.01)
+
+
 def write_surface_msh(path, order=2, xmin=-2.0, z=0.0):
     """A 4 m x 4 m gmsh surface of quadrilaterals (order 2: nine-node) at height z."""
     import gmsh

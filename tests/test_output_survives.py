@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import cli, signal_midway
+from helpers import cli, kill_session, signal_midway
 
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_receivers", "2,0,0;0,0,0",
@@ -145,13 +145,11 @@ def _wait_for(log, text, p, timeout=240):
 @pytest.mark.parametrize("nranks", [1, 2])
 def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
     """SIGKILL without warning (a lost node; mpirun's kill when the stop outlasts its timeout) to the
-    whole job, at 3 moments drawn at random (seeded) after the run's 5th step, the output flushed
+    whole job (mpirun and every rank: helpers.kill_session), at 3 moments drawn at random (seeded) after the run's 5th step, the output flushed
     every 0.05 s and a snapshot every 3 steps: each time h5py opens the file, run_status is
     'running', and the steps the last flush recorded are all there, finite, and equal bit for bit
     to the same steps of an uninterrupted run (receivers, times, every snapshot)."""
-    import os
     import random
-    import signal as sg
     import time
     rng = random.Random(30 + nranks)
     args = BEM + ["-ssi_t_end", "20", "-ssi_output_flush", "0.05", "-ssi_output_stride", "3"]
@@ -163,8 +161,7 @@ def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
             _wait_for(log, "step 5/", p)
             time.sleep(rng.uniform(0.0, 1.5))
         finally:
-            os.killpg(p.pid, sg.SIGKILL)
-            p.wait(timeout=60)
+            kill_session(p)                          # mpirun and every rank at once
         with h5py.File(out, "r") as f:
             assert str(f.attrs["run_status"]) == "running"
             t, u, times = f["receivers/t"][:], f["receivers/u"][:], f["time"][:]
@@ -184,3 +181,25 @@ def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
             for j, s in enumerate(snaps):
                 assert np.array_equal(s, f[f"displacement_{j:06d}"][:]), j
     assert len({g[0] for g in got}) > 1                  # the kills came at different steps
+
+
+def test_the_serial_rewrite_holds_hdf5_metadata_until_its_flushes(tmp_path):
+    """io.output._hold_metadata turns the metadata cache's evictions (and its automatic resizing,
+    which HDF5 requires off with them) off on the file rank 0 rewrites at a flush, so the file on
+    disk changes only inside the flushes; _flush_extended first extends the file to the end HDF5
+    has allocated (a kill after the superblock's write left 'truncated file' in
+    jobscripts/kill_flush_stress.py without it)."""
+    import h5py
+    from petsc_ssi.io.output import _flush_extended, _hold_metadata
+    path = str(tmp_path / "m.h5")
+    with h5py.File(path, "w") as f:
+        assert f.id.get_mdc_config().evictions_enabled
+        _hold_metadata(f)
+        cfg = f.id.get_mdc_config()
+        assert not cfg.evictions_enabled and cfg.incr_mode == 0 and cfg.decr_mode == 0 and cfg.flash_incr_mode == 0
+        f.create_dataset("a", data=np.arange(100000.0))
+        _flush_extended(f, path)
+        import os
+        assert os.path.getsize(path) >= f.id.get_filesize() >= 800000
+    with h5py.File(path, "r") as f:
+        assert np.array_equal(f["a"][:], np.arange(100000.0))
