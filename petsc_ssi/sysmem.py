@@ -88,3 +88,30 @@ def peak_rss(comm):
     hwm = _hwm()
     mpi = comm.tompi4py()
     return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
+
+
+_TRIM = []
+
+
+def release_freed():
+    """Give the memory freed into the C heap back to the system (glibc's ``malloc_trim``); returns
+    True when it was called. Large temporaries (the shared element cache's integrals and the
+    messages that carry them, numba's arrays) are freed into glibc's heap, which keeps them resident
+    once its dynamic mmap threshold has risen past their size: about 0.34 GB a rank on the paper's
+    Lamb case, held through the rest of the assembly and counted in its peak (issue 29). A no-op
+    where the C library has no ``malloc_trim`` (musl, macOS)."""
+    if not _TRIM:
+        fn = None
+        try:
+            import ctypes
+            import ctypes.util
+            fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6"), "malloc_trim", None)
+            if fn is not None:
+                fn.argtypes, fn.restype = [ctypes.c_size_t], ctypes.c_int
+        except (OSError, AttributeError):
+            fn = None
+        _TRIM.append(fn)
+    if _TRIM[0] is None:
+        return False
+    _TRIM[0](0)
+    return True

@@ -479,7 +479,7 @@ class LagSet:
         # touched beyond what is written: not resident) unless that is more than the node's memory
         gcap = np.full(lag_hi, len(rows) * self.regions.n_t, np.int64)
         gcap[:lag_lo - 1] = 0
-        from ..sysmem import machine_memory
+        from ..sysmem import machine_memory, release_freed
         if gcap.sum() * (8.0 * mG + 4) > 0.5 * machine_memory():
             gcap[:] = 0
         G = Buckets(lag_hi, rows, self.mesh.n_nodes, gcap, single_from=single_from, m=mG)
@@ -500,6 +500,7 @@ class LagSet:
             with event("SSI_BEM_Integrate"):
                 ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
                                                                 qinv, gq, gw, gr, gwr, pattern, dropped)
+            release_freed()         # the integrals' temporaries and messages: not resident through the assembly
         work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
         for s in range(0, len(rows), chunk):
             work, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
@@ -509,6 +510,7 @@ class LagSet:
             hits += n_hit
             prog.update(min(s + chunk, len(rows)))
         work = None
+        release_freed()
         ev.end()
         from mpi4py import MPI
         lost = self.comm.tompi4py().allreduce(float(dropped.max()), op=MPI.MAX)
