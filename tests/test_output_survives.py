@@ -182,24 +182,3 @@ def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
                 assert np.array_equal(s, f[f"displacement_{j:06d}"][:]), j
     assert len({g[0] for g in got}) > 1                  # the kills came at different steps
 
-
-def test_the_serial_rewrite_holds_hdf5_metadata_until_its_flushes(tmp_path):
-    """io.output._hold_metadata turns the metadata cache's evictions (and its automatic resizing,
-    which HDF5 requires off with them) off on the file rank 0 rewrites at a flush, so the file on
-    disk changes only inside the flushes; _flush_extended first extends the file to the end HDF5
-    has allocated (a kill after the superblock's write left 'truncated file' in
-    jobscripts/kill_flush_stress.py without it)."""
-    import h5py
-    from petsc_ssi.io.output import _flush_extended, _hold_metadata
-    path = str(tmp_path / "m.h5")
-    with h5py.File(path, "w") as f:
-        assert f.id.get_mdc_config().evictions_enabled
-        _hold_metadata(f)
-        cfg = f.id.get_mdc_config()
-        assert not cfg.evictions_enabled and cfg.incr_mode == 0 and cfg.decr_mode == 0 and cfg.flash_incr_mode == 0
-        f.create_dataset("a", data=np.arange(100000.0))
-        _flush_extended(f, path)
-        import os
-        assert os.path.getsize(path) >= f.id.get_filesize() >= 800000
-    with h5py.File(path, "r") as f:
-        assert np.array_equal(f["a"][:], np.arange(100000.0))

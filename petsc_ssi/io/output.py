@@ -222,39 +222,6 @@ def _h5(path, mode):
         return h5py.File(path, mode)
 
 
-def _hold_metadata(f):
-    """Keep the HDF5 file ``f``'s changed metadata in memory until its next flush: no evictions from
-    HDF5's metadata cache (which needs its automatic resizing off too). By default the cache writes
-    entries out whenever it makes room, in no particular order, so a kill between two flushes could
-    leave on disk a group or header that points past the end the superblock records ('address of
-    object past end of allocation', issue 30); held, the file on disk changes only inside the
-    flushes. Without h5py's cache-config calls the default stays (one warning-free no-op)."""
-    try:
-        cfg = f.id.get_mdc_config()
-        cfg.evictions_enabled = False
-        cfg.incr_mode = 0          # H5C_incr__off
-        cfg.flash_incr_mode = 0    # H5C_flash_incr__off
-        cfg.decr_mode = 0          # H5C_decr__off
-        f.id.set_mdc_config(cfg)
-    except (AttributeError, TypeError, ValueError, RuntimeError):
-        pass
-
-
-def _flush_extended(f, path):
-    """Flush ``f`` (held by ``_hold_metadata``) after extending the file on disk to the end HDF5 has
-    allocated: the flush writes the superblock (address 0) first, and a kill before the entries at
-    the file's end were written would otherwise leave a superblock recording an end beyond the file
-    ('truncated file'). The extension is zeros that the flush then overwrites."""
-    try:
-        end = int(f.id.get_filesize())
-        if end > os.path.getsize(path):
-            with open(path, "r+b") as fh:
-                fh.truncate(end)
-    except (AttributeError, OSError, ValueError):
-        pass
-    f.flush()
-
-
 class Output:
     """Collective writer of one run's fields and series."""
 
@@ -398,7 +365,6 @@ class Output:
         """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
         earlier flush wrote); XDMF; JSON."""
         with _h5(self.path, "a") as f:             # no lock: a reader may hold the file open mid-run
-            _hold_metadata(f)
             # Staged, so that a kill (SIGKILL, a lost node) in the middle leaves the last flush's data
             # readable: the new series go to the group STAGE, HDF5 writes them out (H5Fflush), and
             # only then replace the old ones (moves), flushed again. Deleting first and writing
@@ -425,7 +391,7 @@ class Output:
                         d.attrs["unit"] = unit
                     for ak, av in extra.items():
                         d.attrs[ak] = av
-            _flush_extended(f, self.path)
+            f.flush()
             for name in names:
                 if name in f:
                     del f[name]
@@ -442,11 +408,10 @@ class Output:
             for k, v in (attrs or {}).items():
                 f.attrs[k] = v
             self._field_units(f, (attrs or {}).get("time_is"))
-            _flush_extended(f, self.path)
+            f.flush()
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
-            _flush_extended(f, self.path)
         if final and (self.deterministic or compactable(self.path)):
             rewrite_without_times(self.path)        # also gives back the space earlier flushes freed
         self._write_xdmf()
