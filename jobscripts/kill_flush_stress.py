@@ -1,8 +1,8 @@
 """How often a SIGKILL leaves the output unreadable (issue 30): a writer that does nothing but what a
 run's output does between steps (a snapshot through PETSc's HDF5 viewer, then io.output.Output.flush:
 the viewer closed, rank 0's staged rewrite of time, receivers and a group, the viewer reopened),
-in a loop, is killed whole (SIGKILL to every process of its session, mpirun and the ranks at once) at a random moment, and the file is then opened
-with h5py and every dataset of the last flush read. Repeated KILLS times; prints the failures
+in a loop, is killed whole (SIGKILL to every process of its session, mpirun and the ranks at once)
+at a random moment, and the file is then opened with h5py and every dataset of the last flush read. Repeated KILLS times; prints the failures
 (the exception of each) and their count. Because the writer only writes, the kills land in the
 write windows far more often than in a real run's.
 
@@ -19,12 +19,8 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def kill_session(p):
-    sys.path.insert(0, os.path.join(ROOT, "tests"))
-    from helpers import kill_session as kill       # SIGKILL to mpirun and every rank at once
-    kill(p)
+sys.path.insert(0, os.path.join(ROOT, "tests"))
+from helpers import kill_session  # noqa: E402  (SIGKILL to mpirun and every rank at once)
 
 
 def writer(path):
@@ -84,15 +80,17 @@ def main():
         cmd = [sys.executable, os.path.abspath(__file__), "--writer", path]
         if nranks > 1:
             cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
-        log = open(os.path.join(tmp, "writer.log"), "w")
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=log, start_new_session=True, text=True,
-                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-        first = p.stdout.readline()                    # the first flush is done
-        if not first.startswith("flushed"):
+        log = os.path.join(tmp, "writer.log")
+        with open(log, "w") as fh:
+            p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=fh, start_new_session=True, text=True,
+                                 env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+            first = p.stdout.readline()                # the first flush is done
+            if first.startswith("flushed"):
+                time.sleep(rng.uniform(0.0, 1.0))
             kill_session(p)
-            raise SystemExit("the writer did not start: " + open(log.name).read()[-2000:])
-        time.sleep(rng.uniform(0.0, 1.0))
-        kill_session(p)
+            p.stdout.close()
+        if not first.startswith("flushed"):
+            raise SystemExit("the writer did not start: " + open(log).read()[-2000:])
         try:
             steps.append(check(path))
         except Exception as e:                          # noqa: BLE001 (every failure is counted)

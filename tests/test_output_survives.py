@@ -145,8 +145,8 @@ def _wait_for(log, text, p, timeout=240):
 @pytest.mark.parametrize("nranks", [1, 2])
 def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
     """SIGKILL without warning (a lost node; mpirun's kill when the stop outlasts its timeout) to the
-    whole job (mpirun and every rank: helpers.kill_session), at 3 moments drawn at random (seeded) after the run's 5th step, the output flushed
-    every 0.05 s and a snapshot every 3 steps: each time h5py opens the file, run_status is
+    whole job (mpirun and every rank: helpers.kill_session), at 3 moments drawn at random (seeded)
+    after the run's 5th step, the output flushed every 0.05 s and a snapshot every 3 steps: each time h5py opens the file, run_status is
     'running', and the steps the last flush recorded are all there, finite, and equal bit for bit
     to the same steps of an uninterrupted run (receivers, times, every snapshot)."""
     import random
@@ -181,4 +181,3 @@ def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
             for j, s in enumerate(snaps):
                 assert np.array_equal(s, f[f"displacement_{j:06d}"][:]), j
     assert len({g[0] for g in got}) > 1                  # the kills came at different steps
-

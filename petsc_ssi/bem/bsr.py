@@ -194,8 +194,8 @@ def _panel_h4(indptr, indices, d, XT, RT, sign):
 def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
     """``_panel_h4`` two rows at a time: a column both rows hold (neighbouring nodes see nearly the same
     columns) has its rows of XT read once for both; each row's sums in the same order as ``_panel_h4``
-    (the same bits). Faster for wide panels (24-29 % at b = 32 on the paper case's lags), slower for
-    narrow ones (``python jobscripts/panel_kernels.py``)."""
+    (the same bits). Faster for wide panels (20-29 % at b = 32 on the paper case's lags), slower for
+    narrow ones (``python jobscripts/panel_variants.py``)."""
     b = XT.shape[1]
     n = indptr.size - 1
     a0 = np.empty(b); a1 = np.empty(b); a2 = np.empty(b)
