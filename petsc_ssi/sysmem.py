@@ -97,8 +97,9 @@ def release_freed():
     """Give the memory freed into the C heap back to the system (glibc's ``malloc_trim``); returns
     True when it was called. Large temporaries (the shared element cache's integrals and the
     messages that carry them, numba's arrays) are freed into glibc's heap, which keeps them resident
-    once its dynamic mmap threshold has risen past their size: about 0.34 GB a rank on the paper's
-    Lamb case, held through the rest of the assembly and counted in its peak (issue 29). A no-op
+    once its dynamic mmap threshold has risen past their size: about 0.35 GB a rank on the paper's
+    Lamb case (``jobscripts/assembly_memory.py``), held through the rest of the assembly and counted
+    in its peak (issue 29). A no-op
     where the C library has no ``malloc_trim`` (musl, macOS)."""
     if not _TRIM:
         fn = None

@@ -1,6 +1,7 @@
 """sysmem.release_freed (issue 29): memory freed into glibc's heap is given back to the system.
 The BEM assembly calls it after the shared element cache's integration, whose temporaries and
-messages otherwise stayed resident through the rest of the assembly (paper case: 0.34 GB a rank,
+messages otherwise stayed resident through the rest of the assembly (paper case: 0.35 GB a rank,
+jobscripts/assembly_memory.py;
 the peak over the node 5.07 -> 4.40 GB with -ssi_lag_single_from 3, 7.78 -> 7.10 GB in double)."""
 import numpy as np
 import pytest
