@@ -3,7 +3,8 @@ run's output does between steps (a snapshot through PETSc's HDF5 viewer, then io
 the viewer closed, rank 0's staged rewrite of time, receivers and a group, the viewer reopened),
 in a loop, is killed whole (SIGKILL to every process of its session, mpirun and the ranks at once)
 at a random moment, and the file is then opened with h5py and every dataset of the last flush read. Repeated KILLS times; prints the failures
-(the exception of each) and their count. Because the writer only writes, the kills land in the
+(the exception of each) and their count (an unreadable file is kept as k<N>-bad<i>.h5, its parts
+as k<N>-bad<i>.parts: the links inside it name k<N>.parts, renamed back to read it). Because the writer only writes, the kills land in the
 write windows far more often than in a real run's.
 
   python jobscripts/kill_flush_stress.py [KILLS] [NRANKS] [SEED]     (default 200 1 1)
@@ -98,6 +99,8 @@ def main():
             where = [ln for ln in traceback.format_exc().splitlines() if "kill_flush_stress" in ln or "f[" in ln]
             bad.append(f"kill {i}: {type(e).__name__}: {(str(e).splitlines() or [''])[0][:200]} ({'; '.join(w.strip() for w in where[-2:])})")
             os.replace(path, path[:-3] + f"-bad{i}.h5")
+            if os.path.isdir(path[:-3] + ".parts"):              # its parts, where its links point
+                os.replace(path[:-3] + ".parts", path[:-3] + f"-bad{i}.parts")
             print(bad[-1], flush=True)
     print(f"{kills} kills at {nranks} rank(s): {len(bad)} unreadable "
           f"(flushes done before a kill: {min(steps, default=0)}..{max(steps, default=0)})")

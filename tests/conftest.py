@@ -97,14 +97,6 @@ SLOW = {
     "tests/bem/test_rigid_motion.py::test_two_ranks_equal_one_and_a_restart_keeps_the_resultants",
     # - single lags' file reload (6 s; the double lag file's bitwise reload stays)
     "tests/bem/test_single.py::test_single_lag_file_reloads_bitwise",
-    # - random kills at -n 1 and -n 2 (6 s each). Not a cost move: a SIGKILL that lands inside HDF5's
-    #   own flush can leave the root group's heap torn ('bad heap free list'; issue 30, open), and the
-    #   -n 2 case, whose run is mostly flushes (every 0.05 s), failed in 2 of about 9 fresh-clone runs
-    #   (2026-11-25 and 26), also after its kill was made a whole-session kill. jobscripts/
-    #   kill_flush_stress.py measures the rate (1 in 400 kills of a flush-only writer). Kept in make
-    #   test: the signal stops (SIGTERM, SIGUSR1, the guard) that write the file whole.
-    "tests/test_output_survives.py::test_a_kill_at_random_moments_keeps_the_flushed_steps[1]",
-    "tests/test_output_survives.py::test_a_kill_at_random_moments_keeps_the_flushed_steps[2]",
     # - the flat pattern against the general path in single precision and at -n 1 (15 s; block-sparse
     #   with interpolation and dense with a prescribed region at -n 2 stay)
     "tests/bem/test_flat_pattern.py::test_the_flat_pattern_is_the_general_path[single precision, symmetry, 2 ranks]",

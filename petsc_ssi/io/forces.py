@@ -244,9 +244,6 @@ class ForceRecorder:
         cell attributes [(name, dataset, unit)]."""
         import h5py
         from .output import _group
-        for name in ["forces"] + [k for k in f if k.startswith("cell_peak_")]:
-            if name in f:
-                del f[name]
         g = _group(f, "forces")
         g.create_dataset("snapshots", data=np.asarray(self.snapshots, np.int64), track_times=False)
         d = g.create_dataset("time", data=np.asarray(self.times, float), track_times=False)
@@ -259,7 +256,8 @@ class ForceRecorder:
             if K:
                 layout = h5py.VirtualLayout(shape=(K, E, p.c), dtype="f8")
                 for i, k in enumerate(self.snapshots):
-                    layout[i] = h5py.VirtualSource(".", f"forces_{p.name}_{k:06d}", shape=(E, p.c))
+                    name = f"forces_{p.name}_{k:06d}"
+                    layout[i] = h5py.VirtualSource(self.out.source_of(name), name, shape=(E, p.c))
                 ds = g.create_virtual_dataset(p.name, layout, fillvalue=np.nan)
             else:
                 ds = g.create_dataset(p.name, shape=(0, E, p.c), dtype="f8", track_times=False)

@@ -17,7 +17,11 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
 
 Distributed fields are written collectively by the PETSc viewer; the small
 serial data (topology, time, receiver series) by rank 0 with h5py after the
-viewer is closed. Rank-0-only file work never leaves the other ranks waiting:
+viewer is closed. While the run goes on, the viewer's datasets live in parts
+(``<stem>.parts/``, new HDF5 files closed at each flush and never written again)
+and ``FILE.h5``, written anew and renamed at each flush, links to them; the final
+close puts every dataset into ``FILE.h5`` and removes the parts (``Output``).
+Rank-0-only file work never leaves the other ranks waiting:
 an error there is caught, passed to every rank (``petsc.collective_error``)
 and raised everywhere as the same one-line SSIError. ``FILE.xmf`` (XDMF 3, temporal collection) is written on
 rank 0 so ParaView opens the result; ``FILE.json`` holds the resolved options,
@@ -31,7 +35,7 @@ import time as _time
 
 import numpy as np
 
-from ..petsc import init, collective, collective_error, collective_io, ensure_space
+from ..petsc import init, collective, collective_error, collective_io, ensure_space, SSIError
 
 XDMF_CELL = {"quad9": ("Quadrilateral_9", 9), "quad4": ("Quadrilateral", 4),
              "hex8": ("Hexahedron", 8), "line2": ("Polyline", 2), "tri3": ("Triangle", 3)}
@@ -135,6 +139,13 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
             err = replace_error(f, f"{what} {p}", what, overwrite)
             if err:
                 break
+        d_parts = parts_dir(p)
+        if err is None and os.path.lexists(d_parts):
+            if not os.path.isdir(d_parts) or os.path.islink(d_parts):
+                err = f"{what} {p}: {d_parts} (where the run keeps its parts) exists and is not a directory"
+            elif not overwrite:
+                err = (f"{what} {p}: {d_parts} exists (the parts of an earlier run); add -ssi_output_overwrite "
+                       f"to replace it, or choose another {what}")
         if err:
             break
     if err is None and not os.access(d, os.W_OK | os.X_OK):
@@ -156,7 +167,6 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
-STAGE = "_flush_staging"       # the group a flush writes its series to before they replace the old ones
 
 
 def _group(parent, name):
@@ -167,50 +177,51 @@ def _group(parent, name):
     return h5py.Group(h5py.h5g.create(parent.id, name.encode(), gcpl=gcpl))
 
 
-def compactable(path, slack=2.0, margin=8e6):
-    """Rank 0: whether the file holds much more than its datasets (more than ``slack`` times their
-    bytes plus ``margin``): each flush during a run replaces the series (receivers, interface,
-    demands) and HDF5 does not reuse the space of deleted datasets, so a long run's file would grow
-    with the number of flushes times the series' size (262 MB for 29 MB of data, 6000 steps and a
-    flush every 10 s). Files with virtual datasets (io/forces.py) are left as they are: a copy
-    would store their data twice."""
-    import h5py
-    live, virtual = [0], [False]
-    with _h5(path, "r") as f:
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                if obj.is_virtual:
-                    virtual[0] = True
-                else:
-                    live[0] += obj.id.get_storage_size()
-        f.visititems(visit)
-    return not virtual[0] and os.path.getsize(path) > slack * live[0] + margin
+def parts_dir(path):
+    """The directory of a running output's parts: ``<stem>.parts`` beside ``FILE.h5``."""
+    return os.path.splitext(path)[0] + ".parts"
 
 
-def rewrite_without_times(path):
-    """Rank 0: ``path`` copied object by object into a file whose objects carry no modification
-    times, then renamed over it, so identical data give identical bytes. (PETSc's HDF5 viewer
-    creates its datasets with HDF5's default, which records the times; it has no switch.)"""
+MERGE_EVERY = 16         # a flush merges the last 16 parts of one level into one part of the next
+_FROZEN = 99             # the level of a part a restart adopted (never merged again)
+
+
+def _part_number(rel):
+    """The number of a part's file name (p000012.h5, m1-000017.h5, r000005.h5), or -1."""
+    import re
+    m = re.search(r"(\d+)\.h5$", os.path.basename(rel))
+    return int(m.group(1)) if m else -1
+
+
+def _fsync(path):
+    """``path``'s bytes (a file or a directory) on the disk before what follows (a rename)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:                              # a file system without fsync on directories
+        pass
+    finally:
+        os.close(fd)
+
+
+def _new_file(path):
+    """A new HDF5 file (truncated) whose objects carry no modification times: the same data give
+    the same bytes (PETSc's viewer has no switch for this; h5py's create_group has none either)."""
     import h5py
-    tmp = path + ".notimes.tmp"
     fcpl = h5py.h5p.create(h5py.h5p.FILE_CREATE)
     fcpl.set_obj_track_times(False)
-    with _h5(path, "r") as src, h5py.File(h5py.h5f.create(tmp.encode(), h5py.h5f.ACC_TRUNC, fcpl=fcpl)) as dst:
-        def copy(s, d):
-            for k, v in s.attrs.items():
-                d.attrs[k] = v
-            for name in s:
-                obj = s[name]
-                if isinstance(obj, h5py.Group):
-                    copy(obj, _group(d, name))
-                else:
-                    ds = d.create_dataset(name, data=obj[()], track_times=False, chunks=obj.chunks,
-                                          maxshape=obj.maxshape if obj.chunks else None)   # as PETSc made it:
-                    # a restart appends through PETSc's viewer, which extends chunked datasets
-                    for k, v in obj.attrs.items():
-                        ds.attrs[k] = v
-        copy(src, dst)
-    os.replace(tmp, path)
+    return h5py.File(h5py.h5f.create(path.encode(), h5py.h5f.ACC_TRUNC, fcpl=fcpl))
+
+
+def _copy_dataset(src, dst, name):
+    """Rank 0: dataset ``src`` (any file) as ``dst[name]``, its data and attributes, no times."""
+    d = dst.create_dataset(name, data=src[()], track_times=False)
+    for k, v in src.attrs.items():
+        d.attrs[k] = v
+    return d
 
 
 def _h5(path, mode):
@@ -223,63 +234,157 @@ def _h5(path, mode):
 
 
 class Output:
-    """Collective writer of one run's fields and series."""
+    """Collective writer of one run's fields and series.
+
+    Nothing that a flush made readable is ever written to again, so a kill at any moment (SIGKILL,
+    a lost node) leaves the last flush whole (issue 30; HDF5 updates its metadata in place, and a
+    kill inside such an update tore the file): the distributed datasets go through the PETSc
+    viewer into *parts*, new HDF5 files in ``<stem>.parts/``, one per flush interval that wrote
+    any; a flush closes the current part and rank 0 then writes ``FILE.h5`` anew beside it (the
+    series, the attributes and an HDF5 external link per dataset of the parts) and renames it over
+    the old one. A reader opens ``FILE.h5`` as usual (h5py and ParaView follow the links). Every
+    ``MERGE_EVERY`` parts of one level are copied into one part of the next (so a long run keeps
+    few files), and the final close writes ``FILE.h5`` with every dataset in it and removes the
+    parts."""
 
     def __init__(self, path, comm, resume=None, run_id=""):
         """``run_id``: the run's id (``TransientProblem.run_id``), the attribute ``run_id`` of the
         file, which a restart compares with its checkpoint's. ``resume``: the snapshot list of an interrupted run ({'times', 'fields'}, a checkpoint's):
-        its file is continued (opened to append; later snapshots overwrite those the interrupted run
-        wrote after its checkpoint); a missing file is started anew, with a warning."""
+        its file is continued (its datasets kept, where they are; later snapshots replace those the
+        interrupted run wrote after its checkpoint); a missing file is started anew, with a warning."""
         PETSc = init()
         self.PETSc = PETSc
         self.path = path
         self.comm = comm
         self.rank = comm.getRank()
         self.run_id = run_id or ""
-        d = os.path.dirname(os.path.abspath(path))
-
-        def stale():
-            for f in output_files(path)[1:]:          # an older run's sidecars must not describe this file
-                if os.path.isfile(f):
-                    os.remove(f)
-        self._rank0(lambda: os.makedirs(d, exist_ok=True), f"cannot create the output directory {d}")
+        self.dir = os.path.dirname(os.path.abspath(path))
+        self.parts = parts_dir(path)
+        self._rank0(lambda: os.makedirs(self.dir, exist_ok=True), f"cannot create the output directory {self.dir}")
         self.times = []
         self.fields = []
-        mode = "w"
+        self.links = {}          # dataset name -> its part (path relative to the output's directory)
+        self.part_list = []      # [[part, level]] in the order written
+        self.seq = 0             # the next part's number
+        self.final = False       # the file being written is the final one (every dataset in it)
+        self.viewer = None       # the open part's viewer, or None
+        self._written = []       # the datasets of the open part
+        self.closed = False      # the final close is done (a flush after it does nothing)
+        fresh = True
         if resume is not None:
             exists = comm.tompi4py().bcast(os.path.isfile(path) if self.rank == 0 else None, root=0)
             if exists:
-                mode = "a"
+                fresh = False
                 self.times = [float(t) for t in resume["times"]]
                 self.fields = [f for f in resume["fields"].split(",") if f]
+                self._adopt()
             elif len(resume["times"]):
                 from ..petsc import warn
                 warn(f"{path} (the output of the interrupted run) is missing: a new one is written, without the "
                      f"{len(resume['times'])} field snapshots before the restart (the receiver series are whole)", comm)
-        if mode == "w":
-            self._rank0(stale, f"cannot remove the old sidecars of {path}")
-        self.viewer = PETSc.Viewer().createHDF5(path, mode=mode, comm=comm)
+        if fresh:
+            self._rank0(self._stale, f"cannot remove the old sidecars and parts of {path}")
         self.cells = None
         self.cell_type = None
         self.n_nodes = 0
-        # -ssi_reproducible: the finished file is rewritten without HDF5 modification times
-        self.deterministic = PETSc.Options().getBool("ssi_reproducible", False)
         # writers of more data (e.g. io.forces.ForceRecorder): write_collective(out) before the
-        # viewer closes, write_serial(h5 file) on rank 0 -> XDMF cell attributes [(name, dataset, unit)]
+        # part closes, write_serial(h5 file) on rank 0 -> XDMF cell attributes [(name, dataset, unit)]
         self.writers = []
         self.cell_attributes = []
+
+    def _stale(self):
+        """Rank 0: an older run's sidecars and parts must not describe this file."""
+        import shutil
+        for f in output_files(self.path)[1:]:
+            if os.path.isfile(f):
+                os.remove(f)
+        if os.path.isdir(self.parts):
+            shutil.rmtree(self.parts)
+
+    def _adopt(self):
+        """Collective: the datasets of the interrupted run's file (a restart), on every rank: its
+        external links stay where they point; a file that holds its datasets itself (a finished or
+        stopped run's, or one written by a version before the parts) becomes a part, hard-linked
+        (copied where the file system has no hard links) into the parts directory."""
+        def work():
+            import shutil
+            import h5py
+            links, parts = {}, []
+            with _h5(self.path, "r") as f:
+                own = []
+                for name in f:
+                    ln = f.get(name, getlink=True)
+                    if isinstance(ln, h5py.ExternalLink):
+                        if not os.path.isfile(os.path.join(self.dir, ln.filename)):
+                            raise SSIError(f"{self.path} links its dataset {name} to {ln.filename}, which is "
+                                           f"missing: the file and its parts directory go together")
+                        links[name] = ln.filename
+                        if ln.filename not in parts:
+                            parts.append(ln.filename)
+                    elif isinstance(f.get(name), h5py.Dataset) and name not in ("topology", "time") \
+                            and not name.startswith("cell_peak_"):
+                        own.append(name)
+            seq = 1 + max([_part_number(p) for p in parts] + [-1])
+            if own:
+                os.makedirs(self.parts, exist_ok=True)
+                rel = os.path.join(os.path.basename(self.parts), f"r{seq:06d}.h5")
+                dst = os.path.join(self.dir, rel)
+                try:
+                    os.link(self.path, dst)
+                except OSError:
+                    shutil.copyfile(self.path, dst)
+                parts.append(rel)
+                links.update({name: rel for name in own})
+                seq += 1
+            return links, parts, seq
+        box = []
+        self._rank0(lambda: box.append(work()), f"reading {self.path} to continue it")
+        links, parts, seq = self.comm.tompi4py().bcast(box[0] if box else None, root=0)
+        self.links, self.seq = links, seq
+        self.part_list = [[p, _FROZEN] for p in parts]
 
     def state(self):
         """The snapshot list, for a checkpoint: {'times', 'fields'}."""
         return {"times": np.asarray(self.times, float), "fields": ",".join(self.fields)}
+
+    def source_of(self, name):
+        """The file that holds dataset ``name`` as seen from FILE.h5 (an HDF5 virtual dataset's
+        source): '.' in the final file, else its part."""
+        return "." if self.final else self.links.get(name, ".")
+
+    def _part(self):
+        """Collective: the open part's viewer (a new part opened when none is)."""
+        if self.viewer is None:
+            rel = os.path.join(os.path.basename(self.parts), f"p{self.seq:06d}.h5")
+            self.seq += 1
+            self._rank0(lambda: os.makedirs(self.parts, exist_ok=True), f"cannot create {self.parts}")
+            self._open = rel
+            self._written = []
+            self.viewer = self.PETSc.Viewer().createHDF5(os.path.join(self.dir, rel), mode="w", comm=self.comm)
+        return self.viewer
+
+    def _view(self, vecs, what):
+        """Collective: Vecs {dataset name: Vec} into the open part (a Vec of block size c gives an
+        (n / c, c) dataset)."""
+        viewer = self._part()
+
+        def write():
+            for name, vec in vecs.items():
+                old = vec.getName()
+                vec.setName(name)
+                try:
+                    vec.view(viewer)
+                finally:
+                    vec.setName(old)
+        collective_io(write, what, self.comm)
+        self._written += [n for n in vecs if n not in self._written]
 
     def write_mesh(self, coords_vec, cells, cell_type):
         """``coords_vec``: PETSc Vec (bs 3) of node coordinates in the field
         layout; ``cells``: (E, n) int array, needed on rank 0 only; or, with
         ``cell_type`` 'mixed', a list [(xdmf type name, (E, n) cells)] of blocks
         (written as one XDMF Mixed topology)."""
-        coords_vec.setName("coordinates")
-        collective_io(lambda: coords_vec.view(self.viewer), f"writing {self.path}", self.comm)
+        self._view({"coordinates": coords_vec}, f"writing {self.path}")
         self.n_nodes = coords_vec.getSize() // 3
         self.n_cells = 0
         if cell_type == "mixed":
@@ -294,16 +399,8 @@ class Output:
         k = len(self.times)
         ensure_space(self.path, 8.0 * sum(v.getSize() for v in fields.values()),
                      self.comm, f"snapshot {k} (t = {t:.6g} s)")
-
-        def write():
-            for name, vec in fields.items():
-                old = vec.getName()
-                vec.setName(f"{name}_{k:06d}")
-                try:
-                    vec.view(self.viewer)
-                finally:
-                    vec.setName(old)
-        collective_io(write, f"writing {self.path} (snapshot {k}, t = {t:.6g} s)", self.comm)
+        self._view({f"{name}_{k:06d}": vec for name, vec in fields.items()},
+                   f"writing {self.path} (snapshot {k}, t = {t:.6g} s)")
         for name in fields:
             if name not in self.fields:
                 self.fields.append(name)
@@ -311,48 +408,107 @@ class Output:
 
     def write_vecs(self, vecs, what):
         """Collective: distributed Vecs {dataset name: Vec} through the viewer (a Vec of block
-        size c gives an (n / c, c) dataset; an existing dataset of that name is overwritten)."""
+        size c gives an (n / c, c) dataset; a dataset of that name written before is replaced)."""
         ensure_space(self.path, 8.0 * sum(v.getSize() for v in vecs.values()), self.comm, what)
-
-        def write():
-            for name, vec in vecs.items():
-                old = vec.getName()
-                vec.setName(name)
-                try:
-                    vec.view(self.viewer)
-                finally:
-                    vec.setName(old)
-        collective_io(write, f"writing {self.path} ({what})", self.comm)
+        self._view(vecs, f"writing {self.path} ({what})")
 
     def close(self, receivers=None, attrs=None, record=None, groups=None, status="completed", final=True):
-        """Collective: close the viewer, then rank 0 adds the serial data and
-        writes the XDMF and JSON files. ``receivers``: dict with 'points'
+        """Collective: close the open part, then rank 0 writes FILE.h5 (the serial data, the
+        links or, ``final``, every dataset) and the XDMF and JSON files. ``receivers``: dict with 'points'
         (R,3), 'nodes' (R,) optional, 't' (K,), 'u' (K,R,3), on rank 0.
         ``groups``: {group: {name: array, (array, unit) or (array, unit, {attribute: value})}}
         more serial data (rank 0). ``status``: how the run
         ended (the file's attribute ``run_status`` and the record's)."""
+        if self.closed:
+            return
         for w in self.writers:
             w.write_collective(self)
-        viewer, self.viewer = self.viewer, None
-        collective_io(viewer.destroy, f"closing {self.path}", self.comm)
-        self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status, final), f"writing {self.path}")
+        self._seal()
+        merged = self._merge() if not final else []
+        self.final = final
+        try:
+            self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status, final),
+                        f"writing {self.path}")
+        finally:
+            self.final = False
+        if merged or final:
+            self._rank0(lambda: self._remove(merged, final), f"removing the merged parts of {self.path}")
+        self.closed = final
 
     def flush(self, receivers=None, attrs=None, record=None, groups=None, status="running"):
         """Collective: make the file readable as it stands (a run killed or stopped later keeps
-        it): the viewer is closed, rank 0 (re)writes time, topology, receivers, groups, the
-        attributes with ``run_status`` and the sidecars, and the viewer reopens to append."""
+        it): the open part closed, rank 0 writes time, topology, receivers, groups, the attributes
+        with ``run_status``, links to the parts and the sidecars; the next write opens a new part."""
+        self.close(receivers, attrs, record, groups, status, final=False)
+
+    def _seal(self):
+        """Collective: the open part closed, finished by rank 0 (the units of its datasets, its
+        bytes on the disk) before FILE.h5 names it."""
         if self.viewer is None:
             return
-        try:
-            self.close(receivers, attrs, record, groups, status, final=False)
-        except BaseException:                      # a failed flush (a reader holding the file) keeps writing
-            self._reopen()
-            raise
-        self._reopen()
+        viewer, self.viewer = self.viewer, None
+        collective_io(viewer.destroy, f"closing {self.path}'s part {self._open}", self.comm)
+        rel, names = self._open, list(self._written)
 
-    def _reopen(self):
-        if self.viewer is None:
-            self.viewer = self.PETSc.Viewer().createHDF5(self.path, mode="a", comm=self.comm)
+        def finish():
+            full = os.path.join(self.dir, rel)
+            with _h5(full, "a") as f:
+                for name in names:
+                    unit = self._unit(name)
+                    if unit is not None:
+                        f[name].attrs["unit"] = unit
+            _fsync(full)
+        self._rank0(finish, f"writing {rel}")
+        self.links.update({name: rel for name in names})
+        self.part_list.append([rel, 0])
+
+    def _merge(self):
+        """Collective: while the last MERGE_EVERY parts have one level, rank 0 copies them (later
+        datasets over earlier ones) into one new part of the next level, which their links then
+        name. Returns the parts replaced (removed once FILE.h5 no longer names them)."""
+        gone = []
+        while len(self.part_list) >= MERGE_EVERY:
+            last = self.part_list[-MERGE_EVERY:]
+            level = last[0][1]
+            if level == _FROZEN or any(p[1] != level for p in last):
+                break
+            olds = [p[0] for p in last]
+            rel = os.path.join(os.path.basename(self.parts), f"m{level + 1}-{self.seq:06d}.h5")
+            self.seq += 1
+            names = [(n, r) for n, r in self.links.items() if r in olds]
+
+            def work():
+                full = os.path.join(self.dir, rel)
+                tmp = full + ".tmp"
+                with _new_file(tmp) as dst:
+                    srcs = {}
+                    try:
+                        for name, r in names:
+                            if r not in srcs:
+                                srcs[r] = _h5(os.path.join(self.dir, r), "r")
+                            _copy_dataset(srcs[r][name], dst, name)
+                    finally:
+                        for s in srcs.values():
+                            s.close()
+                _fsync(tmp)
+                os.replace(tmp, full)
+            self._rank0(work, f"merging {len(olds)} parts of {self.path}")
+            self.links.update({n: rel for n, _ in names})
+            self.part_list[-MERGE_EVERY:] = [[rel, level + 1]]
+            gone += olds
+        return gone
+
+    def _remove(self, merged, final):
+        """Rank 0: parts FILE.h5 no longer names (after it was replaced); all of them when final."""
+        import shutil
+        if final:
+            if os.path.isdir(self.parts):
+                shutil.rmtree(self.parts)
+            return
+        for rel in merged:
+            f = os.path.join(self.dir, rel)
+            if os.path.isfile(f):
+                os.remove(f)
 
     def _rank0(self, work, what):
         """Collective: ``work()`` on rank 0; an exception there is raised on every rank as a
@@ -362,24 +518,30 @@ class Output:
                 work()
 
     def _write_serial(self, receivers, attrs, record, groups=None, status="completed", final=True):
-        """Rank 0: topology, time, attributes and receivers into the HDF5 file (replacing what an
-        earlier flush wrote); XDMF; JSON."""
-        with _h5(self.path, "a") as f:             # no lock: a reader may hold the file open mid-run
-            # Staged, so that a kill (SIGKILL, a lost node) in the middle leaves the last flush's data
-            # readable: the new series go to the group STAGE, HDF5 writes them out (H5Fflush), and
-            # only then replace the old ones (moves), flushed again. Deleting first and writing
-            # after left a window where the file pointed past its end (issue 30: 'addr overflow'
-            # on receivers/u after a SIGKILL at -n 2).
-            names = ("topology", "time", "receivers") + tuple(groups or ())
-            if STAGE in f:
-                del f[STAGE]
-            st = _group(f, STAGE)
+        """Rank 0: FILE.h5 written anew beside the old one and renamed over it (a kill leaves one or
+        the other whole): links to the parts' datasets (or, final, the datasets themselves),
+        topology, time, attributes and receivers; XDMF; JSON."""
+        import h5py
+        tmp = self.path + ".part.tmp"
+        with _new_file(tmp) as f:
+            srcs = {}
+            try:
+                for name, rel in self.links.items():
+                    if final:
+                        if rel not in srcs:
+                            srcs[rel] = _h5(os.path.join(self.dir, rel), "r")
+                        _copy_dataset(srcs[rel][name], f, name)
+                    else:
+                        f[name] = h5py.ExternalLink(rel, "/" + name)
+            finally:
+                for s in srcs.values():
+                    s.close()
             if self.cells is not None:
-                st.create_dataset("topology", data=self.cells, track_times=False)
-            st.create_dataset("time", data=np.asarray(self.times), track_times=False)
+                f.create_dataset("topology", data=self.cells, track_times=False)
+            f.create_dataset("time", data=np.asarray(self.times), track_times=False)
             for gname, data in ((("receivers", receivers),) if receivers is not None else ()) + \
                     tuple((groups or {}).items()):
-                g = _group(st, gname)
+                g = _group(f, gname)
                 for k, v in data.items():
                     unit, extra = UNITS.get(f"{gname}/{k}"), {}
                     if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):
@@ -391,13 +553,6 @@ class Output:
                         d.attrs["unit"] = unit
                     for ak, av in extra.items():
                         d.attrs[ak] = av
-            f.flush()
-            for name in names:
-                if name in f:
-                    del f[name]
-                if name in st:
-                    f.move(f"{STAGE}/{name}", name)
-            del f[STAGE]
             f.attrs["run_status"] = status
             f.attrs["run_id"] = self.run_id
             f.attrs["cell_type"] = self.cell_type or ""
@@ -408,12 +563,12 @@ class Output:
             for k, v in (attrs or {}).items():
                 f.attrs[k] = v
             self._field_units(f, (attrs or {}).get("time_is"))
-            f.flush()
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
-        if final and (self.deterministic or compactable(self.path)):
-            rewrite_without_times(self.path)        # also gives back the space earlier flushes freed
+        _fsync(tmp)
+        os.replace(tmp, self.path)
+        _fsync(self.dir)
         self._write_xdmf()
         if record is not None:
             record = dict(record, run_status=status)
@@ -423,25 +578,31 @@ class Output:
             os.replace(tmp, os.path.splitext(self.path)[0] + ".json")
 
     def _field_units(self, f, time_is=None):
-        """Rank 0: ``unit`` attributes of the datasets the PETSc viewer wrote (coordinates and the
-        snapshots' fields, UNITS), of time and topology; snapshots already done are skipped."""
-        for name, unit in (("coordinates", "m"), ("topology", "1"),
-                           ("time", "1 (" + time_is + ")" if time_is else "s")):
-            if name in f and f[name].attrs.get("unit") != unit:
+        """Rank 0: ``unit`` attributes of FILE.h5's own time and topology (the parts' datasets got
+        theirs when their part was closed: ``_unit``)."""
+        for name, unit in (("topology", "1"), ("time", "1 (" + time_is + ")" if time_is else "s")):
+            if name in f:
                 f[name].attrs["unit"] = unit
-        done = getattr(self, "_units_done", 0)
-        for k in range(done, len(self.times)):
-            for name in self.fields:
-                d = f.get(f"{name}_{k:06d}")
-                if d is not None:
-                    d.attrs["unit"] = UNITS.get(name, "")
-        self._units_done = len(self.times)
+
+    def _unit(self, name):
+        """The ``unit`` attribute of a dataset the viewer wrote: coordinates, a snapshot's field
+        (UNITS; '' for a field without one), else None (the writer's own datasets)."""
+        if name == "coordinates":
+            return "m"
+        field = name.rsplit("_", 1)[0]
+        return UNITS.get(field, "") if field in self.fields else None
 
     def _write_xdmf(self):
         if self.cells is None:
             return
         from xml.sax.saxutils import escape
         base = escape(os.path.basename(self.path))      # '&', '<', '>' in a file name: valid XML
+
+        def where(name):
+            """A viewer dataset's file and path: its part while the run goes on (ParaView's XDMF
+            reader does not follow HDF5's external links), FILE.h5 once final."""
+            rel = self.source_of(name)
+            return f"{base if rel == '.' else escape(rel)}:/{name}"
         ne = self.n_cells
         nn = self.n_nodes
         if self.cell_type == "mixed":
@@ -462,7 +623,7 @@ class Output:
                 lines.append(f'<Time Value="{self.times[k]:.9g}"/>')
             lines.append(topo)
             lines.append(f'<Geometry GeometryType="XYZ"><DataItem Dimensions="{nn} 3" NumberType="Float" '
-                         f'Precision="8" Format="HDF">{base}:/coordinates</DataItem></Geometry>')
+                         f'Precision="8" Format="HDF">{where("coordinates")}</DataItem></Geometry>')
             for name, dset, unit in self.cell_attributes:
                 lines.append(f'<Attribute Name="{escape(name)}" AttributeType="Scalar" Center="Cell">'
                              f'<DataItem Dimensions="{ne}" NumberType="Float" Precision="8" Format="HDF">'
@@ -472,7 +633,7 @@ class Output:
                     lines.append(f'<Attribute Name="{name}" AttributeType="Vector" Center="Node">'
                                  f'<DataItem Dimensions="{nn} 3" NumberType="Float" Precision="8" '
                                  f'Format="HDF">'
-                                 f'{base}:/{name}_{k:06d}</DataItem></Attribute>')
+                                 f'{where(f"{name}_{k:06d}")}</DataItem></Attribute>')
             lines.append("</Grid>")
         lines += ["</Grid>", "</Domain>", "</Xdmf>"]
         tmp = os.path.splitext(self.path)[0] + ".xmf.tmp"
