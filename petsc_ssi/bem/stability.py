@@ -187,12 +187,11 @@ def _scratch(path, comm):
 def _cleanup(path, comm):
     comm.tompi4py().Barrier()
     if comm.getRank() == 0:
-        base = os.path.splitext(path)[0]
-        for ext in (".h5", ".xmf", ".json"):
-            try:
-                os.remove(base + ext)
-            except OSError:
-                pass
+        from ..io.output import remove_output
+        try:
+            remove_output(path)
+        except OSError:
+            pass
 
 
 def guard(cfg, prob, march, unorm, n):

@@ -88,6 +88,16 @@ def output_files(path):
     return [path] + [stem + s for s in SIDECARS]
 
 
+def remove_output(path):
+    """Rank 0: a scratch run's output gone: FILE.h5, its sidecars and its parts directory."""
+    import shutil
+    for f in output_files(path):
+        if os.path.isfile(f):
+            os.remove(f)
+    if os.path.isdir(parts_dir(path)):
+        shutil.rmtree(parts_dir(path), ignore_errors=True)
+
+
 def command_output(path, command, argv=None):
     """The output of ``petsc-ssi modes`` or ``static``: -ssi_output as given on the command line;
     from an options file (or the default) ``<stem>-<command>.h5``, so the command run with a
