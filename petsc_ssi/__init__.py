@@ -21,6 +21,11 @@ import warnings as _warnings
 # axes: that warning says nothing about its plots.
 _warnings.filterwarnings("ignore", message="Unable to import Axes3D", category=UserWarning)
 
+# numba's error highlighting (colorama, initialised when numba's compiler machinery loads) writes a
+# terminal reset, ESC[0m, at exit whenever stdout is a terminal: under mpirun, which gives every rank
+# a pseudo-terminal, each run's output ended with one per rank (issue 30). Messages carry no colours.
+_os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
+
 __version__ = "0.1.0"
 
 

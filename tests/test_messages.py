@@ -122,3 +122,18 @@ def test_restart_key_ignores_huge_pages_and_a_moved_file(tmp_path):
     diff = key_difference(saved, run_key(_cfg(fem_mesh=str(b), huge_pages="numpy", cs=20.0)))
     assert diff == "the file of -ssi_fem_mesh changed since the checkpoint (SHA-256 differs)", diff
     assert "-ssi_cs is 21.0" in key_difference(saved, run_key(_cfg(fem_mesh=str(a), huge_pages="numpy", cs=21.0)))
+
+
+def test_no_terminal_codes_under_mpirun():
+    """numba's error highlighting (colorama) wrote ESC[0m at exit whenever stdout is a terminal, and
+    mpirun gives every rank a pseudo-terminal: each run's output under mpirun ended with one per rank
+    (issue 30). petsc_ssi turns the highlighting off before numba loads; the BEM assembly's module
+    (numba's typed containers load the compiler machinery) under mpirun -n 2 now prints nothing."""
+    import subprocess
+    from helpers import PY
+    code = "import petsc_ssi.bem.assemble"
+    p = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", PY, "-c", code],
+                       cwd=ROOT, capture_output=True, timeout=120,
+                       env={k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING"})
+    assert p.returncode == 0, p.stderr.decode()[-2000:]
+    assert b"\x1b" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-200:]

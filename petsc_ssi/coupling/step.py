@@ -40,7 +40,7 @@ import time
 
 import numpy as np
 
-from ..petsc import init, printf
+from ..petsc import init, printf, solve_columns
 from ..monitor import event
 from .interface import force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
@@ -210,42 +210,48 @@ class Coupler:
         return out
 
     def _bem_columns(self):
-        """Z[:, j] = A^{-1} H_s e_j for the interface DOFs (local rows; 3 n_I solves)."""
+        """Z[:, j] = A^{-1} H_s e_j for the interface DOFs (local rows; 3 n_I right-hand sides,
+        solved many at a time: ``petsc.solve_columns``)."""
         m = self.march
-        e, rhs, z = (m.u_tmpl.duplicate() for _ in range(3))
+        e = m.u_tmpl.duplicate()
         Z = np.zeros((e.getLocalSize(), 3 * self.nI))
         lut = -np.ones(3 * self.nI, np.int64)
         lut[self.own_k] = self.own_loc
-        for j in range(3 * self.nI):
-            if self.zero[j]:
-                continue
+        cols = np.flatnonzero(~self.zero)
+
+        def fill(i, rhs):
+            j = cols[i]
             e.set(0.0)
             if lut[j] >= 0:
                 e.getArray()[lut[j]] = 1.0
             m.mult_step_H(e, rhs)
-            m.solve(rhs, z)
-            Z[:, j] = z.getArray(readonly=True)
-        for v in (e, rhs, z):
-            v.destroy()
+
+        def take(i, z):
+            Z[:, cols[i]] = z.getArray(readonly=True)
+        with event("SSI_BEM_Solve"):
+            solve_columns(m.ksp, m.u_tmpl, len(cols), fill, take)
+        e.destroy()
         return Z
 
     def fem_columns(self):
         """D^{-1} T^T e_j (local rows) and C = T D^{-1} T^T (replicated) for the interface
-        dofs j (3 n_I solves; T^T e_j masked: a fixed dof takes no interface force)."""
+        dofs j (3 n_I right-hand sides, solved many at a time; T^T e_j masked: a fixed dof takes
+        no interface force)."""
         integ = self.integ
-        e, z = integ.u.duplicate(), integ.u.duplicate()
-        out = np.zeros((e.getLocalSize(), 3 * self.nI))
+        out = np.zeros((integ.u.getLocalSize(), 3 * self.nI))
         C = np.zeros((3 * self.nI, 3 * self.nI))
         unit = np.zeros(3 * self.nI)
-        for j in range(3 * self.nI):
+
+        def fill(j, e):
             unit[:] = 0.0
             unit[j] = 1.0
             self.Top.spread(unit, e)
             e.pointwiseMult(e, integ.mask)
-            integ.solve(e, z)
+
+        def take(j, z):
             out[:, j] = z.getArray(readonly=True)
             C[:, j] = self.Top.gather(z)
-        e.destroy(); z.destroy()
+        solve_columns(integ.ksp, integ.u, 3 * self.nI, fill, take)
         return out, C
 
     def step(self, f_ext, uffI=None):
