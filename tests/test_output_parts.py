@@ -173,3 +173,20 @@ def test_a_restart_without_the_parts_is_refused(tmp_path):
     shutil.rmtree(parts_dir(p))
     with pytest.raises(SSIError, match=r"m\.h5 links its dataset coordinates to m\.parts/p000000\.h5, which is missing"):
         Output(p, PETSc.COMM_WORLD, resume={"times": [0.01], "fields": "displacement"})
+
+
+def test_no_room_for_the_final_copy_keeps_the_links(tmp_path, monkeypatch, capsys):
+    """A disk without room to copy the parts into FILE.h5 at the end: a warning, and FILE.h5 stays
+    whole, linked to its parts, with the final status."""
+    import shutil
+    from collections import namedtuple
+    p = str(tmp_path / "f.h5")
+    out, _ = _run(p, 3, final=False)
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda d: usage(1e9, 1e9, 1000.0))
+    out.close(receivers=_series(3), attrs={"steps_done": 3})
+    assert "too little to copy its parts" in capsys.readouterr().out
+    _check(p, 3, 3)
+    with h5py.File(p, "r") as f:
+        assert f.attrs["run_status"] == "completed"
+        assert isinstance(f.get("displacement_000000", getlink=True), h5py.ExternalLink)

@@ -434,6 +434,9 @@ class Output:
         for w in self.writers:
             w.write_collective(self)
         self._seal()
+        closing = final
+        if final and self.links and not self._room_to_copy():
+            final = False                       # FILE.h5 keeps linking its parts
         merged = self._merge() if not final else []
         self.final = final
         try:
@@ -443,13 +446,33 @@ class Output:
             self.final = False
         if merged or final:
             self._rank0(lambda: self._remove(merged, final), f"removing the merged parts of {self.path}")
-        self.closed = final
+        self.closed = closing
 
     def flush(self, receivers=None, attrs=None, record=None, groups=None, status="running"):
         """Collective: make the file readable as it stands (a run killed or stopped later keeps
         it): the open part closed, rank 0 writes time, topology, receivers, groups, the attributes
         with ``run_status``, links to the parts and the sidecars; the next write opens a new part."""
         self.close(receivers, attrs, record, groups, status, final=False)
+
+    def _room_to_copy(self):
+        """Collective: whether the output's file system has room for the final copy of the parts
+        into FILE.h5 (their bytes, 10 % and 1 MB more, while the parts still exist); else a warning:
+        FILE.h5 stays linked to its parts."""
+        import shutil
+        need, free = 0.0, 0.0
+        if self.rank == 0:
+            for rel in set(self.links.values()):
+                f = os.path.join(self.dir, rel)
+                need += os.path.getsize(f) if os.path.isfile(f) else 0.0
+            need = 1.1 * need + 1e6
+            free = float(shutil.disk_usage(self.dir).free)
+        need, free = self.comm.tompi4py().bcast((need, free), root=0)
+        if need <= free:
+            return True
+        from ..petsc import warn
+        warn(f"{self.path}: {free / 1e6:.3g} MB free, too little to copy its parts ({need / 1e6:.3g} MB) into it: it "
+             f"links to them in {self.parts} (keep the two together)", self.comm)
+        return False
 
     def _seal(self):
         """Collective: the open part closed, finished by rank 0 (the units of its datasets, its
