@@ -24,7 +24,41 @@ def stage(name):
     PETSc = init()
     if name not in _STAGES:
         _STAGES[name] = PETSc.Log.Stage(name)
+        if len(_STAGES) == 1:
+            _hide_unused_stage(PETSc, _STAGES[name])
     return _STAGES[name]
+
+
+def _petsc_library():
+    """The path of the PETSc shared library this process has loaded (Linux: /proc/self/maps), or None."""
+    try:
+        with open("/proc/self/maps") as fh:
+            for line in fh:
+                path = line.split()[-1]
+                base = path.rsplit("/", 1)[-1]
+                if base.startswith("libpetsc") and ".so" in base:
+                    return path
+    except OSError:
+        pass
+    return None
+
+
+def _hide_unused_stage(PETSc, first):
+    """PETSc 3.18 with petsc4py registers a stage 1 that nothing pushes, and -log_view printed it as
+    an empty 'Event Stage 1: Unknown' (issue 30). Where petsc_ssi's first stage gets the id 2 on 3.18,
+    stage 1 is that one (not petsc_ssi's, which registers its stages here only): it is made invisible
+    (PetscLogStageSetVisible through ctypes; petsc4py has no handle on a stage it did not create).
+    Any other version, id or failure leaves -log_view as it is."""
+    if tuple(PETSc.Sys.getVersion()[:2]) != (3, 18) or first.id != 2:
+        return
+    lib = _petsc_library()
+    if lib is None:
+        return
+    try:
+        import ctypes
+        ctypes.CDLL(lib).PetscLogStageSetVisible(ctypes.c_int(1), ctypes.c_int(0))
+    except (OSError, AttributeError):
+        pass
 
 
 class staged:
