@@ -183,3 +183,35 @@ def write_surface_msh(path, order=2, xmin=-2.0, z=0.0):
         gmsh.write(str(path))
     finally:
         gmsh.finalize()
+
+
+PV_HEAD = ("import sys, json\nfrom paraview.simple import XDMFReader\nfrom paraview import servermanager as sm\n"
+           "from vtk.numpy_interface import dataset_adapter as dsa\nimport numpy as np\n"
+           "r = XDMFReader(FileNames=[sys.argv[1]])\n")
+
+
+def pv_or_skip():
+    """pvpython's path; skips the test without it (apt-get install paraview): call it before the
+    run the test reads, so a machine without ParaView does not pay for the run."""
+    import shutil
+    import pytest
+    pv = shutil.which("pvpython")
+    if pv is None:
+        pytest.skip("ParaView (pvpython) is not installed: apt-get install paraview")
+    return pv
+
+
+def pvpython(body, xmf, tmp_path):
+    """ParaView's XDMF reader on ``xmf``: ``body`` (after PV_HEAD, which opens it as ``r``) run by
+    pvpython, offscreen; returns the last JSON line it printed, parsed. Skips the test without
+    pvpython (apt-get install paraview)."""
+    import json
+    import subprocess
+    pv = pv_or_skip()
+    script = os.path.join(str(tmp_path), "pv_read.py")
+    with open(script, "w") as fh:
+        fh.write(PV_HEAD + body)
+    p = subprocess.run([pv, "--force-offscreen-rendering", script, xmf], capture_output=True, text=True,
+                       timeout=180, env=dict(os.environ, DISPLAY=""))
+    assert p.returncode == 0, p.stdout + p.stderr
+    return json.loads([ln for ln in p.stdout.splitlines() if ln[:1] in "{["][-1])

@@ -138,27 +138,15 @@ def test_paraview_reads_a_running_file(tmp_path):
     """ParaView's XDMF reader does not follow HDF5's external links (it reported "Can't Open Dataset
     FILE.h5:/coordinates" and crashed): while the run goes on the .xmf names each dataset's part. Every
     snapshot reads right from the flushed, unfinished output (skipped without pvpython)."""
-    import json
-    import shutil
-    import subprocess
-    pv = shutil.which("pvpython")
-    if pv is None:
-        pytest.skip("ParaView (pvpython) is not installed: apt-get install paraview")
+    from helpers import pv_or_skip, pvpython
+    pv_or_skip()
     p = str(tmp_path / "run.h5")
     _run(p, 3, final=False)
-    script = tmp_path / "read.py"
-    script.write_text(
-        "import sys, json\nfrom paraview.simple import XDMFReader\nfrom paraview import servermanager as sm\n"
-        "from vtk.numpy_interface import dataset_adapter as dsa\nimport numpy as np\n"
-        "r = XDMFReader(FileNames=[sys.argv[1]])\nr.UpdatePipelineInformation()\nout = []\n"
-        "for t in r.TimestepValues:\n    r.UpdatePipeline(t)\n"
-        "    d = dsa.WrapDataObject(sm.Fetch(r))\n"
-        "    out.append([t, int(d.GetNumberOfPoints()), np.asarray(d.PointData['displacement']).tolist()])\n"
-        "print(json.dumps(out))\n")
-    q = subprocess.run([pv, "--force-offscreen-rendering", str(script), p.replace(".h5", ".xmf")],
-                       capture_output=True, text=True, timeout=180, env=dict(os.environ, DISPLAY=""))
-    assert q.returncode == 0, q.stdout + q.stderr
-    got = json.loads([ln for ln in q.stdout.splitlines() if ln.startswith("[")][-1])
+    got = pvpython("r.UpdatePipelineInformation()\nout = []\n"
+                   "for t in r.TimestepValues:\n    r.UpdatePipeline(t)\n"
+                   "    d = dsa.WrapDataObject(sm.Fetch(r))\n"
+                   "    out.append([t, int(d.GetNumberOfPoints()), np.asarray(d.PointData['displacement']).tolist()])\n"
+                   "print(json.dumps(out))\n", p.replace(".h5", ".xmf"), tmp_path)
     assert [g[0] for g in got] == pytest.approx([0.01, 0.02, 0.03])
     for j, (t, npts, u) in enumerate(got):
         assert npts == N and np.all(np.array(u) == j + 1), j

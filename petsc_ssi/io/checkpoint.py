@@ -200,15 +200,8 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
     ensure_space(path, 8.0 * sum(v.getSize() for v in vecs.values()), comm, f"checkpoint after step {step}")
     viewer = PETSc.Viewer().createHDF5(tmp, mode="w", comm=comm)
 
-    def write_vecs():
-        for name, v in vecs.items():
-            old = v.getName()
-            v.setName(name)
-            try:
-                v.view(viewer)
-            finally:
-                v.setName(old)
-    collective_io(write_vecs, f"writing the checkpoint {tmp}", comm)
+    from .output import view_vecs
+    collective_io(lambda: view_vecs(viewer, vecs), f"writing the checkpoint {tmp}", comm)
     collective_io(viewer.destroy, f"closing the checkpoint {tmp}", comm)
     with collective(comm, f"checkpoint {path}", "{what}: {error}"):
         if comm.getRank() == 0:

@@ -187,6 +187,18 @@ def _group(parent, name):
     return h5py.Group(h5py.h5g.create(parent.id, name.encode(), gcpl=gcpl))
 
 
+def view_vecs(viewer, vecs):
+    """Collective: Vecs {dataset name: Vec} through a PETSc HDF5 viewer, each under that name (the
+    Vec's own name kept)."""
+    for name, vec in vecs.items():
+        old = vec.getName()
+        vec.setName(name)
+        try:
+            vec.view(viewer)
+        finally:
+            vec.setName(old)
+
+
 def parts_dir(path):
     """The directory of a running output's parts: ``<stem>.parts`` beside ``FILE.h5``."""
     return os.path.splitext(path)[0] + ".parts"
@@ -377,16 +389,7 @@ class Output:
         """Collective: Vecs {dataset name: Vec} into the open part (a Vec of block size c gives an
         (n / c, c) dataset)."""
         viewer = self._part()
-
-        def write():
-            for name, vec in vecs.items():
-                old = vec.getName()
-                vec.setName(name)
-                try:
-                    vec.view(viewer)
-                finally:
-                    vec.setName(old)
-        collective_io(write, what, self.comm)
+        collective_io(lambda: view_vecs(viewer, vecs), what, self.comm)
         self._written += [n for n in vecs if n not in self._written]
 
     def write_mesh(self, coords_vec, cells, cell_type):

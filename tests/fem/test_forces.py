@@ -342,25 +342,14 @@ def test_forces_option_refuses_brick_parts():
 
 def test_forces_xdmf_opens_in_paraview(tmp_path):
     """ParaView reads the cell fields (skipped without pvpython)."""
-    import shutil
-    import subprocess
-    pv = shutil.which("pvpython")
-    if pv is None:
-        pytest.skip("ParaView (pvpython) is not installed")
+    from helpers import pv_or_skip, pvpython
+    pv_or_skip()
     s = str(tmp_path / "s.h5")
     _run(s, 1, 5)
-    script = tmp_path / "read.py"
-    script.write_text(
-        "import sys, json\nfrom paraview.simple import XDMFReader\nfrom paraview import servermanager as sm\n"
-        "from vtk.numpy_interface import dataset_adapter as dsa\n"
-        "r = XDMFReader(FileNames=[sys.argv[1]])\nr.UpdatePipeline()\n"
-        "d = dsa.WrapDataObject(sm.Fetch(r))\n"
-        "import numpy as np\nm = np.asarray(d.CellData['peak_M3'])\n"
-        "print(json.dumps({'cells': int(d.GetNumberOfCells()), 'm': [None if v != v else v for v in m.tolist()]}))\n")
-    p = subprocess.run([pv, "--force-offscreen-rendering", str(script), s.replace(".h5", ".xmf")],
-                       capture_output=True, text=True, timeout=180, env=dict(os.environ, DISPLAY=""))
-    assert p.returncode == 0, p.stdout + p.stderr
-    got = __import__("json").loads([ln for ln in p.stdout.splitlines() if ln.startswith("{")][-1])
+    got = pvpython("r.UpdatePipeline()\nd = dsa.WrapDataObject(sm.Fetch(r))\n"
+                   "m = np.asarray(d.CellData['peak_M3'])\n"
+                   "print(json.dumps({'cells': int(d.GetNumberOfCells()), "
+                   "'m': [None if v != v else v for v in m.tolist()]}))\n", s.replace(".h5", ".xmf"), tmp_path)
     with h5py.File(s) as f:
         want = f["cell_peak_M3"][()]
     assert got["cells"] == want.size

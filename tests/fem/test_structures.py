@@ -6,7 +6,6 @@ Each test compares with an independent reference: a scipy assembly written in th
 (tests/fem/data/hex8_before_dofmap.npz, written by commit 8e2fe32 on the same cases), or the
 1-rank run.
 """
-import json
 import os
 import sys
 
@@ -316,27 +315,14 @@ def test_xdmf_of_a_mixed_model_opens_in_paraview(name, tmp_path):
     """ParaView reads the Mixed-topology XDMF: every cell (48 shells + 24 frames), and the
     displacement equals the HDF5 data in double precision; also when the file name has XML's
     special characters (escaped in the .xmf)."""
-    import shutil
-    import subprocess
-    pv = shutil.which("pvpython")
-    if pv is None:
-        pytest.skip("ParaView (pvpython) is not installed: apt-get install paraview")
+    from helpers import pv_or_skip, pvpython
+    pv_or_skip()
     s = str(tmp_path / name)
     ok(run_cli(["static", "-options_file", SLAB, "-ssi_output", s]))
-    script = tmp_path / "read.py"
-    script.write_text(
-        "import sys, json\nfrom paraview.simple import XDMFReader\nfrom paraview import servermanager as sm\n"
-        "from vtk.numpy_interface import dataset_adapter as dsa\n"
-        "r = XDMFReader(FileNames=[sys.argv[1]])\nr.UpdatePipeline()\n"
-        "d = dsa.WrapDataObject(sm.Fetch(r))\n"
-        "import numpy as np\nu = np.asarray(d.PointData['displacement'])\n"
-        "print(json.dumps({'cells': int(d.GetNumberOfCells()), 'points': int(d.GetNumberOfPoints()),"
-        " 'u': u.tolist(), 'dtype': str(u.dtype)}))\n")
-    env = dict(os.environ, DISPLAY="")
-    p = subprocess.run([pv, "--force-offscreen-rendering", str(script), s.replace(".h5", ".xmf")],
-                       capture_output=True, text=True, timeout=180, env=env)
-    assert p.returncode == 0, p.stdout + p.stderr
-    got = json.loads([ln for ln in p.stdout.splitlines() if ln.startswith("{")][-1])
+    got = pvpython("r.UpdatePipeline()\nd = dsa.WrapDataObject(sm.Fetch(r))\n"
+                   "u = np.asarray(d.PointData['displacement'])\n"
+                   "print(json.dumps({'cells': int(d.GetNumberOfCells()), 'points': int(d.GetNumberOfPoints()),"
+                   " 'u': u.tolist(), 'dtype': str(u.dtype)}))\n", s.replace(".h5", ".xmf"), tmp_path)
     assert got["cells"] == 72
     with h5py.File(s) as f:
         u = f["displacement_000000"][:]
