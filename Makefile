@@ -16,7 +16,7 @@ export OMP_NUM_THREADS ?= 1
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
-PIP_PKGS := numba gmsh matplotlib pytest pytest-timeout obspy
+PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout obspy
 
 .PHONY: all deps demo test test-unit test-mpi test-slow test-all bench clean help-options
 

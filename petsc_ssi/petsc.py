@@ -350,6 +350,7 @@ def solve_columns(ksp, template, m, fill, take, chunk=256):
         pkg = pc.getFactorSolverType()
         if pkg == "mumps" or (pkg == "petsc" and template.getComm().getSize() == 1):
             try:
+                ksp.setUp()                        # the factors of the current operator
                 F = pc.getFactorMatrix()
             except PETSc.Error:
                 F = None

@@ -269,8 +269,13 @@ class TransientProblem:
         if self._key is None:
             self._key = checkpoint.run_key(self.cfg)
         with staged("SSI checkpoint"):
-            if flush and self.cfg.get("output"):
-                self._flush()              # the output holds every snapshot the checkpoint lists, even after SIGKILL
+            if flush and self.cfg.get("output") and not self._flush():
+                # the output holds every snapshot a checkpoint lists, even after SIGKILL: without that
+                # flush no checkpoint (the previous one stays)
+                from .petsc import warn
+                warn(f"no checkpoint after step {self.n}: the output could not be updated first", self.comm)
+                self._last_ckpt = time.perf_counter()          # tried: the next one at the next interval
+                return None
             vecs, serial = self.checkpoint_state()
             checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial,
                              run_id=getattr(self, "run_id", ""))
@@ -394,13 +399,17 @@ class TransientProblem:
         raise SSIError(msg)
 
     def _flush(self):
-        """Collective: a 'running' flush; a failure (a reader holding the file) is a warning."""
+        """Collective: a 'running' flush; a failure (a full disk) is a warning. Returns whether it
+        succeeded (the same on every rank)."""
         from .petsc import warn
+        ok = True
         try:
             self.write_partial("running")
         except SSIError as exc:
+            ok = False
             warn(f"could not update {self.cfg.output} during the run ({exc}); the run goes on", self.comm)
         self._last_flush = time.perf_counter()      # after the write: a slow write does not make every step flush
+        return ok
 
     def loop_estimate(self):
         """(seconds of the whole time loop, seconds per step, what it covers) predicted before the

@@ -215,6 +215,13 @@ def _part_number(rel):
     return int(m.group(1)) if m else -1
 
 
+def _snapshot_number(name):
+    """k of a snapshot's dataset name '<field>_<k:06d>' (also the member forces'), or -1."""
+    import re
+    m = re.search(r"_(\d{6})$", name)
+    return int(m.group(1)) if m else -1
+
+
 def _fsync(path):
     """``path``'s bytes (a file or a directory) on the disk before what follows (a rename)."""
     try:
@@ -238,12 +245,28 @@ def _new_file(path):
     return h5py.File(h5py.h5f.create(path.encode(), h5py.h5f.ACC_TRUNC, fcpl=fcpl))
 
 
-def _copy_dataset(src, dst, name):
-    """Rank 0: dataset ``src`` (any file) as ``dst[name]``, its data and attributes, no times."""
-    d = dst.create_dataset(name, data=src[()], track_times=False)
+def _copy_dataset(src, dst, name, slab=1 << 26):
+    """Rank 0: dataset ``src`` (any file) as ``dst[name]``, its data and attributes, no times; read
+    and written in slabs of rows of about ``slab`` bytes (a snapshot of a large mesh is not held
+    whole on rank 0)."""
+    if src.ndim == 0 or src.size * src.dtype.itemsize <= slab:
+        d = dst.create_dataset(name, data=src[()], track_times=False)
+    else:
+        d = dst.create_dataset(name, shape=src.shape, dtype=src.dtype, track_times=False)
+        rows = max(1, int(slab // max(1, src[0:1].nbytes)))
+        for i in range(0, src.shape[0], rows):
+            d[i:i + rows] = src[i:i + rows]
     for k, v in src.attrs.items():
         d.attrs[k] = v
     return d
+
+
+def _tmp_gone(tmp):
+    """Rank 0: a temporary file of a failed write removed (its retry writes another)."""
+    try:
+        os.remove(tmp)
+    except OSError:
+        pass
 
 
 def _h5(path, mode):
@@ -346,7 +369,14 @@ class Output:
                     elif isinstance(f.get(name), h5py.Dataset) and name not in ("topology", "time") \
                             and not name.startswith("cell_peak_"):
                         own.append(name)
-            seq = 1 + max([_part_number(p) for p in parts] + [-1])
+            # snapshots the interrupted run wrote after its checkpoint: not this run's (later ones replace them)
+            stale = [n for n in list(links) + own if _snapshot_number(n) >= len(self.times)]
+            for n in stale:
+                links.pop(n, None)
+            own = [n for n in own if n not in stale]
+            parts = [p for p in parts if p in links.values()]
+            present = os.listdir(self.parts) if os.path.isdir(self.parts) else []
+            seq = 1 + max([_part_number(p) for p in parts + present] + [-1])   # no name used before
             if own:
                 os.makedirs(self.parts, exist_ok=True)
                 rel = os.path.join(os.path.basename(self.parts), f"r{seq:06d}.h5")
@@ -437,10 +467,12 @@ class Output:
         for w in self.writers:
             w.write_collective(self)
         self._seal()
-        closing = final
+        closing, room = final, True
         if final and self.links and not self._room_to_copy():
-            final = False                       # FILE.h5 keeps linking its parts
-        merged = self._merge() if not final else []
+            final = room = False                # FILE.h5 keeps linking its parts
+        # merges only in a running flush: not at a stop (the kill that follows a signal leaves little
+        # time) nor when the disk has no room
+        merged = self._merge() if not final and room and status == "running" else []
         self.final = final
         try:
             self._rank0(lambda: self._write_serial(receivers, attrs, record, groups, status, final),
@@ -457,21 +489,26 @@ class Output:
         with ``run_status``, links to the parts and the sidecars; the next write opens a new part."""
         self.close(receivers, attrs, record, groups, status, final=False)
 
-    def _room_to_copy(self):
-        """Collective: whether the output's file system has room for the final copy of the parts
-        into FILE.h5 (their bytes, 10 % and 1 MB more, while the parts still exist); else a warning:
-        FILE.h5 stays linked to its parts."""
+    def _room_for(self, parts):
+        """Collective: (whether the output's file system has room for a copy of ``parts``: their
+        bytes, 10 % and 1 MB more, while they still exist), the same on every rank."""
         import shutil
         need, free = 0.0, 0.0
         if self.rank == 0:
-            for rel in set(self.links.values()):
+            for rel in set(parts):
                 f = os.path.join(self.dir, rel)
                 need += os.path.getsize(f) if os.path.isfile(f) else 0.0
             need = 1.1 * need + 1e6
             free = float(shutil.disk_usage(self.dir).free)
-        need, free = self.comm.tompi4py().bcast((need, free), root=0)
-        if need <= free:
+        self._need = self.comm.tompi4py().bcast((need, free), root=0)
+        return self._need[0] <= self._need[1]
+
+    def _room_to_copy(self):
+        """Collective: whether the output's file system has room for the final copy of the parts
+        into FILE.h5; else a warning: FILE.h5 stays linked to its parts."""
+        if self._room_for(self.links.values()):
             return True
+        need, free = self._need
         from ..petsc import warn
         warn(f"{self.path}: {free / 1e6:.3g} MB free, too little to copy its parts ({need / 1e6:.3g} MB) into it: it "
              f"links to them in {self.parts} (keep the two together)", self.comm)
@@ -494,9 +531,12 @@ class Output:
                     if unit is not None:
                         f[name].attrs["unit"] = unit
             _fsync(full)
-        self._rank0(finish, f"writing {rel}")
-        self.links.update({name: rel for name in names})
-        self.part_list.append([rel, 0])
+            _fsync(self.parts)
+        try:
+            self._rank0(finish, f"writing {rel}")
+        finally:                                  # the viewer wrote it whole: named even without its units
+            self.links.update({name: rel for name in names})
+            self.part_list.append([rel, 0])
 
     def _merge(self):
         """Collective: while the last MERGE_EVERY parts have one level, rank 0 copies them (later
@@ -513,21 +553,29 @@ class Output:
             self.seq += 1
             names = [(n, r) for n, r in self.links.items() if r in olds]
 
+            if not self._room_for(olds):
+                break                             # merging can wait: the parts stay as they are
+
             def work():
                 full = os.path.join(self.dir, rel)
                 tmp = full + ".tmp"
-                with _new_file(tmp) as dst:
-                    srcs = {}
-                    try:
-                        for name, r in names:
-                            if r not in srcs:
-                                srcs[r] = _h5(os.path.join(self.dir, r), "r")
-                            _copy_dataset(srcs[r][name], dst, name)
-                    finally:
-                        for s in srcs.values():
-                            s.close()
-                _fsync(tmp)
-                os.replace(tmp, full)
+                try:
+                    with _new_file(tmp) as dst:
+                        srcs = {}
+                        try:
+                            for name, r in sorted(names):
+                                if r not in srcs:
+                                    srcs[r] = _h5(os.path.join(self.dir, r), "r")
+                                _copy_dataset(srcs[r][name], dst, name)
+                        finally:
+                            for s in srcs.values():
+                                s.close()
+                    _fsync(tmp)
+                    os.replace(tmp, full)
+                    _fsync(self.parts)
+                except BaseException:
+                    _tmp_gone(tmp)
+                    raise
             self._rank0(work, f"merging {len(olds)} parts of {self.path}")
             self.links.update({n: rel for n, _ in names})
             self.part_list[-MERGE_EVERY:] = [[rel, level + 1]]
@@ -557,12 +605,31 @@ class Output:
         """Rank 0: FILE.h5 written anew beside the old one and renamed over it (a kill leaves one or
         the other whole): links to the parts' datasets (or, final, the datasets themselves),
         topology, time, attributes and receivers; XDMF; JSON."""
-        import h5py
         tmp = self.path + ".part.tmp"
+        try:
+            self._write_file(tmp, receivers, attrs, groups, status, final)
+            _fsync(tmp)
+            os.replace(tmp, self.path)
+        except BaseException:
+            _tmp_gone(tmp)
+            raise
+        _fsync(self.dir)
+        self._write_xdmf()
+        if record is not None:
+            record = dict(record, run_status=status)
+            tmp = os.path.splitext(self.path)[0] + ".json.tmp"
+            with open(tmp, "w") as fh:
+                json.dump(record, fh, indent=1, sort_keys=True, default=str)
+            os.replace(tmp, os.path.splitext(self.path)[0] + ".json")
+
+    def _write_file(self, tmp, receivers, attrs, groups, status, final):
+        """Rank 0: the new FILE.h5 as ``tmp`` (the datasets in name order: a restarted run's file is
+        the same bytes as an uninterrupted one's)."""
+        import h5py
         with _new_file(tmp) as f:
             srcs = {}
             try:
-                for name, rel in self.links.items():
+                for name, rel in sorted(self.links.items()):
                     if final:
                         if rel not in srcs:
                             srcs[rel] = _h5(os.path.join(self.dir, rel), "r")
@@ -602,16 +669,6 @@ class Output:
             self.cell_attributes = []
             for w in self.writers:
                 self.cell_attributes += w.write_serial(f)
-        _fsync(tmp)
-        os.replace(tmp, self.path)
-        _fsync(self.dir)
-        self._write_xdmf()
-        if record is not None:
-            record = dict(record, run_status=status)
-            tmp = os.path.splitext(self.path)[0] + ".json.tmp"
-            with open(tmp, "w") as fh:
-                json.dump(record, fh, indent=1, sort_keys=True, default=str)
-            os.replace(tmp, os.path.splitext(self.path)[0] + ".json")
 
     def _field_units(self, f, time_is=None):
         """Rank 0: ``unit`` attributes of FILE.h5's own time and topology (the parts' datasets got
