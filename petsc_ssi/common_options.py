@@ -24,11 +24,15 @@ register("output_overwrite", "bool", False, "", "replace an existing -ssi_output
 register("output_flush", "real", 10.0, "s", "make the output file readable (time, receivers, sidecars, run "
          "status) at least this often during the run, so a stopped run keeps its results; 0: only at the end",
          "common", validator=lambda v: None if v >= 0 else "must be >= 0")
+register("output_merge", "bool", True, "", "at the end, copy the datasets of the output's parts (FILE.parts/, where "
+         "the run writes its snapshots so that a kill never tears what a flush made readable) into FILE.h5 and "
+         "remove them: rank 0 reads and writes them once more (0.37-0.40 GB/s on the development machine, "
+         "jobscripts/final_copy_rate.py); 0: FILE.h5 keeps linking its parts (move the two together)", "common")
 register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed rank count: on more than one rank "
          "the direct solves default to SuperLU_dist instead of MUMPS (MUMPS's parallel sums change order between "
          "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
-         "(-ssi_bem_pc_type redundant); the finished HDF5 files are rewritten without modification times, so "
-         "identical results give identical files", "common")
+         "(-ssi_bem_pc_type redundant). Finished HDF5 files carry no modification times (with or without this "
+         "option), so identical results give identical files", "common")
 register("huge_pages", "enum", "numpy", "", "numpy's request (madvise) that the large arrays it allocates, the stored "
          "lag blocks among them, be backed by transparent huge pages: numpy (as numpy has it: on unless "
          "NUMPY_MADVISE_HUGEPAGE=0), on, or off. Where the kernel compacts memory for such a request "

@@ -212,3 +212,20 @@ def test_a_restart_drops_the_snapshots_after_its_checkpoint(tmp_path):
     _check(p, 4, 4)
     with h5py.File(p, "r") as f:
         assert "displacement_000004" not in f and "displacement_000005" not in f
+
+
+def test_output_merge_off_keeps_the_links(tmp_path):
+    """-ssi_output_merge 0: the final close writes FILE.h5 with the final status and links to its
+    parts, copying nothing (for outputs too large to copy once more at the end)."""
+    p = str(tmp_path / "k.h5")
+    opts = PETSc.Options()
+    opts["ssi_output_merge"] = "0"
+    try:
+        _run(p, 3)
+    finally:
+        opts.delValue("ssi_output_merge")
+    _check(p, 3, 3)
+    with h5py.File(p, "r") as f:
+        assert f.attrs["run_status"] == "completed"
+        assert isinstance(f.get("displacement_000002", getlink=True), h5py.ExternalLink)
+    assert os.path.isdir(parts_dir(p))

@@ -44,7 +44,7 @@ FORMAT = 2          # 2: with run_id and the CRC32 of every dataset's data (1: r
 # Options that steer how a run is carried out, watched or written, not what it computes: a restart
 # may change them. Every other -ssi_ option defines the run and must be the same on restart.
 RUN_CONTROL = frozenset((
-    "output", "output_overwrite", "output_flush", "output_stride", "monitor", "monitor_every", "plot",
+    "output", "output_overwrite", "output_flush", "output_merge", "output_stride", "monitor", "monitor_every", "plot",
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
     "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",

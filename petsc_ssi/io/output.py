@@ -315,6 +315,8 @@ class Output:
         self.viewer = None       # the open part's viewer, or None
         self._written = []       # the datasets of the open part
         self.closed = False      # the final close is done (a flush after it does nothing)
+        # -ssi_output_merge 0: the final FILE.h5 keeps linking its parts (no copy at the end)
+        self.merge = PETSc.Options().getBool("ssi_output_merge", True)
         fresh = True
         if resume is not None:
             exists = comm.tompi4py().bcast(os.path.isfile(path) if self.rank == 0 else None, root=0)
@@ -468,7 +470,9 @@ class Output:
             w.write_collective(self)
         self._seal()
         closing, room = final, True
-        if final and self.links and not self._room_to_copy():
+        if final and self.links and not self.merge:
+            final = False                       # -ssi_output_merge 0: FILE.h5 keeps linking its parts
+        elif final and self.links and not self._room_to_copy():
             final = room = False                # FILE.h5 keeps linking its parts
         # merges only in a running flush: not at a stop (the kill that follows a signal leaves little
         # time) nor when the disk has no room
