@@ -224,11 +224,15 @@ def test_sigterm_to_mpirun_on_a_loaded_machine_writes_the_checkpoint(tmp_path):
             h.kill()
             h.wait()
     ck = str(tmp_path / "k-checkpoint.h5")
+    # mpirun, once signalled, may stop relaying the ranks' output (2026-11-26: the ranks stopped after
+    # step 269 with output and checkpoint written, the log ended at step 267): the files say what
+    # happened; the stop line, when it reaches the log, also says when
     errs = [ln for ln in text.splitlines() if ln.startswith("petsc-ssi: error: stopped by SIGTERM")]
-    assert len(errs) == 1 and f"resume with -ssi_restart {ck}" in errs[0], text[-2000:]
-    took = re.search(r"output written ([0-9.e+-]+) s after the signal, checkpoint ([0-9.e+-]+) s", errs[0])
-    assert took and float(took.group(1)) <= float(took.group(2)) < 5.0, errs[0]
-    assert os.path.exists(ck) and not os.path.exists(ck + ".tmp")
+    if errs:
+        assert len(errs) == 1 and f"resume with -ssi_restart {ck}" in errs[0], text[-2000:]
+        took = re.search(r"output written ([0-9.e+-]+) s after the signal, checkpoint ([0-9.e+-]+) s", errs[0])
+        assert took and float(took.group(1)) <= float(took.group(2)) < 5.0, errs[0]
+    assert os.path.exists(ck) and not os.path.exists(ck + ".tmp"), text[-2000:]
     with h5py.File(out) as f:
         n = len(f["receivers/t"])
         assert str(f.attrs["run_status"]).startswith(f"stopped after step {n} of 2000: stopped by SIGTERM")
