@@ -30,6 +30,7 @@ library versions, git revision and number of ranks (PyLith's habit).
 import json
 import os
 import platform
+import re
 import subprocess
 import time as _time
 
@@ -177,8 +178,6 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
-
-
 def _group(parent, name):
     """A new HDF5 group without modification times (h5py's create_group cannot say so)."""
     import h5py
@@ -210,14 +209,12 @@ _FROZEN = 99             # the level of a part a restart adopted (never merged a
 
 def _part_number(rel):
     """The number of a part's file name (p000012.h5, m1-000017.h5, r000005.h5), or -1."""
-    import re
     m = re.search(r"(\d+)\.h5$", os.path.basename(rel))
     return int(m.group(1)) if m else -1
 
 
 def _snapshot_number(name):
     """k of a snapshot's dataset name '<field>_<k:06d>' (also the member forces'), or -1."""
-    import re
     m = re.search(r"_(\d{6})$", name)
     return int(m.group(1)) if m else -1
 
@@ -340,13 +337,8 @@ class Output:
         self.cell_attributes = []
 
     def _stale(self):
-        """Rank 0: an older run's sidecars and parts must not describe this file."""
-        import shutil
-        for f in output_files(self.path)[1:]:
-            if os.path.isfile(f):
-                os.remove(f)
-        if os.path.isdir(self.parts):
-            shutil.rmtree(self.parts)
+        """Rank 0: an older run's file, sidecars and parts must not describe this run's."""
+        remove_output(self.path)
 
     def _adopt(self):
         """Collective: the datasets of the interrupted run's file (a restart), on every rank: its
@@ -553,27 +545,18 @@ class Output:
             if level == _FROZEN or any(p[1] != level for p in last):
                 break
             olds = [p[0] for p in last]
+            if not self._room_for(olds):
+                break                             # merging can wait: the parts stay as they are
             rel = os.path.join(os.path.basename(self.parts), f"m{level + 1}-{self.seq:06d}.h5")
             self.seq += 1
             names = [(n, r) for n, r in self.links.items() if r in olds]
-
-            if not self._room_for(olds):
-                break                             # merging can wait: the parts stay as they are
 
             def work():
                 full = os.path.join(self.dir, rel)
                 tmp = full + ".tmp"
                 try:
                     with _new_file(tmp) as dst:
-                        srcs = {}
-                        try:
-                            for name, r in sorted(names):
-                                if r not in srcs:
-                                    srcs[r] = _h5(os.path.join(self.dir, r), "r")
-                                _copy_dataset(srcs[r][name], dst, name)
-                        finally:
-                            for s in srcs.values():
-                                s.close()
+                        self._copy_parts(dst, names)
                     _fsync(tmp)
                     os.replace(tmp, full)
                     _fsync(self.parts)
@@ -585,6 +568,19 @@ class Output:
             self.part_list[-MERGE_EVERY:] = [[rel, level + 1]]
             gone += olds
         return gone
+
+    def _copy_parts(self, dst, items):
+        """Rank 0: the datasets [(name, part)] copied from their parts into the open file ``dst``,
+        in name order (the same data give the same bytes, restarted or not)."""
+        srcs = {}
+        try:
+            for name, rel in sorted(items):
+                if rel not in srcs:
+                    srcs[rel] = _h5(os.path.join(self.dir, rel), "r")
+                _copy_dataset(srcs[rel][name], dst, name)
+        finally:
+            for f in srcs.values():
+                f.close()
 
     def _remove(self, merged, final):
         """Rank 0: parts FILE.h5 no longer names (after it was replaced); all of them when final."""
@@ -631,18 +627,11 @@ class Output:
         the same bytes as an uninterrupted one's)."""
         import h5py
         with _new_file(tmp) as f:
-            srcs = {}
-            try:
+            if final:
+                self._copy_parts(f, self.links.items())
+            else:
                 for name, rel in sorted(self.links.items()):
-                    if final:
-                        if rel not in srcs:
-                            srcs[rel] = _h5(os.path.join(self.dir, rel), "r")
-                        _copy_dataset(srcs[rel][name], f, name)
-                    else:
-                        f[name] = h5py.ExternalLink(rel, "/" + name)
-            finally:
-                for s in srcs.values():
-                    s.close()
+                    f[name] = h5py.ExternalLink(rel, "/" + name)
             if self.cells is not None:
                 f.create_dataset("topology", data=self.cells, track_times=False)
             f.create_dataset("time", data=np.asarray(self.times), track_times=False)
