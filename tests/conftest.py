@@ -130,6 +130,9 @@ SLOW = {
     "tests/test_integrity.py::test_a_damaged_lag_file_is_refused",
     # - the full disk at -n 1 (4 s; -n 2 and the refusal before the assembly stay)
     "tests/test_disk_full.py::test_a_full_disk_stops_the_run_and_keeps_its_steps[1]",
+    # - a restart with another block size (4 s; the restarts inside a block with sub-blocks of 3 at
+    #   steps 10 and 58 stay): make test was 906 s in a fresh clone with ParaView's tests running
+    "tests/bem/test_history_block.py::test_a_restart_with_another_block_size",
 }
 _MPI = _re.compile(r"nranks\s*=\s*[2-9]|mpirun|mpiexec|\"-n\", \"?[2-9]|-n 2")
 _RUNS = _re.compile(r"\bcli\(|run_bem\(|run_ssi\(|run_fem\(|subprocess|from helpers import")
