@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit, types
 from numba.typed import Dict, List
 
-from .quadrature import integrate_pair, singular_static
+from .quadrature import integrate_pair, singular_static, plane_points, integrate_plane
 
 
 SING_TOL = 1e-8      # a collocation point within SING_TOL * h of an element node is that node (singular pair)
@@ -89,6 +89,70 @@ def _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, n
         singular_static(X, sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps, h_ref)
         Ub[0] += Us
         Pb[0] += Ps
+    return nev
+
+
+@njit(cache=True)
+def plane_geometry(VX, ns, gq, gw):
+    """``quadrature.plane_points`` of every virtual element at ``ns`` subdivisions: (sub (nv, ns^2, 4),
+    pts (nv, ns^2 ng^2, 4), Ntab (ns^2 ng^2, 9)), computed once per assembly (``plane``)."""
+    ng2 = gq.shape[0] ** 2
+    nv = VX.shape[0]
+    sub = np.zeros((nv, ns * ns, 4))
+    pts = np.zeros((nv, ns * ns * ng2, 4))
+    Ntab = np.zeros((ns * ns * ng2, 9))
+    for v in range(nv):
+        plane_points(VX[v], ns, gq, gw, sub[v], pts[v], Ntab)
+    return sub, pts, Ntab
+
+
+def plane(flat, VX, ns, gq, gw, ns_max):
+    """The ``plane`` argument of ``assemble_rows`` and ``integrate_records``: (flat, the elements'
+    geometry at the base subdivisions, scratch for other subdivisions): with ``flat`` (every node
+    and element in the plane z = 0) regular pairs take ``quadrature.integrate_plane``."""
+    ng2 = len(gq) ** 2
+    if flat:
+        sub, pts, Ntab = plane_geometry(VX, ns, gq, gw)
+    else:
+        sub, pts, Ntab = np.zeros((0, 1, 4)), np.zeros((0, 1, 4)), np.zeros((0, 9))
+    m = ns_max * ns_max if flat else 0
+    return (bool(flat), sub, pts, Ntab, np.zeros((m, 4)), np.zeros((m * ng2, 4)), np.zeros((m * ng2, 9)))
+
+
+@njit(cache=True)
+def _pair_integrals(xc, v, X, sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u,
+                    toff, h_ref, Ub, Pb, Us, Ps, plane, pattern, dH, dG, Pc, Uc):
+    """A pair's integrals of lags lo..hi in the patterns' layout (``_compact``): Pc[:9 m_H nl] and, with
+    ``want_u``, Uc[:9 m_G nl]. A regular pair of the plane z = 0 (``plane``'s flag) by
+    ``integrate_plane`` (the pattern's entries only; the element's geometry from ``plane`` at the base
+    subdivisions, else computed into its scratch), any other by ``_integrate`` (the full blocks, the
+    entries a flat pattern drops checked into dH, dG, then compacted). Returns the kernel evaluations."""
+    hp, hq, gp, gq_, hkeep, gkeep = pattern
+    mH, mG = hp.shape[0], gp.shape[0]
+    nl = hi - lo + 1
+    flat, gsub, gpts, Ntab, ssub, spts, sN = plane
+    if flat and sing < 0:
+        ng2 = gq.shape[0] ** 2
+        P = Pc[:nl * 9 * mH].reshape((nl, 9, mH))
+        U = Uc[:nl * 9 * mG].reshape((nl, 9, mG))
+        P[:] = 0.0
+        if want_u:
+            U[:] = 0.0
+        if ns == ns_base:
+            return integrate_plane(xc, gsub[v], gpts[v], Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U, want_u, toff)
+        m = ns * ns
+        plane_points(X, ns, gq, gw, ssub[:m], spts[:m * ng2], sN[:m * ng2])
+        return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, dt, alpha, beta, rho, P, U,
+                               want_u, toff)
+    nev = _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u, toff, h_ref,
+                     Ub, Pb, Us, Ps)
+    if mH < 9:
+        _check_dropped(Pb, nl, hkeep, dH)
+    _compact(Pc, 0, Pb, nl, hp, hq)
+    if want_u:
+        if mG < 9:
+            _check_dropped(Ub, nl, gkeep, dG)
+        _compact(Uc, 0, Ub, nl, gp, gq_)
     return nev
 
 
@@ -373,7 +437,7 @@ def _ordered(lst, n, touch):
 
 @njit(cache=True)
 def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  work, dropped, hout, gout, loc, cache_max=1 << 62):
+                  work, dropped, hout, gout, loc, plane, cache_max=1 << 62):
     """Collective-free numba kernel: the blocks of H and G of ``rows``, written where they are kept.
 
     mesh = (xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh): collocation points and the virtual elements
@@ -381,7 +445,8 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     wave = (L, dt, alpha, beta, rho, nu, lag_lo, toff); quad = (ns_base, near_factor, ns_max, gq, gw,
     gr, gwr, tol, h_ref); pattern = (H's entries (p, q), G's, H's keep mask, G's: bsr.PATTERNS);
     ``dropped`` (2,) the largest dropped magnitude of H and of G; work: ``new_work``; hout, gout: the
-    per-lag block CSR arrays of H and G (``_emit_lag``); loc: a node's place among the rank's rows.
+    per-lag block CSR arrays of H and G (``_emit_lag``); loc: a node's place among the rank's rows;
+    plane: ``plane`` (regular pairs of a flat surface by ``quadrature.integrate_plane``).
 
     Per row: first every pair (row, virtual element) whose wave window reaches lags lag_lo..L is
     listed with where its element integrals are (the element cache, or integrated now: into the
@@ -415,6 +480,8 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     Ub = np.zeros((L, 9, 3, 3))
     Pb = np.zeros((L, 9, 3, 3))
     Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
+    Pc = np.zeros(L * sP)
+    Uc = np.zeros(L * sU)
     nev = 0
     hits = 0
     ncache = len(cidx)
@@ -446,17 +513,14 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                 offU = cmeta[found, 4]
                 hits += 1
             else:
-                nev += _integrate(xc, VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu,
-                                  want_u, toff, h_ref, Ub, Pb, Us, Ps)
-                if mH < 9:
-                    _check_dropped(Pb, nl, hkeep, dH)
-                if want_u and mG < 9:
-                    _check_dropped(Ub, nl, gkeep, dG)
+                nev += _pair_integrals(xc, v, VX[v], sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, alpha, beta,
+                                       rho, nu, mu, want_u, toff, h_ref, Ub, Pb, Us, Ps, plane, pattern, dH, dG, Pc,
+                                       Uc)
                 if fill_u >= 0:                 # complete the entry with its U blocks
                     off = cmeta[fill_u, 2]
                     while (upool_n + nl) * sU > cpoolU.shape[0]:
                         cpoolU = _grow(cpoolU, cpoolU.shape[0])
-                    _compact(cpoolU, upool_n * sU, Ub, nl, gp, gq_)
+                    cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
                     cmeta[fill_u, 3] = 1
                     cmeta[fill_u, 4] = upool_n
                     offU = upool_n
@@ -470,11 +534,11 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                     ckeys[c] = key
                     cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
                     cmeta[c, 3] = 1 if want_u else 0
-                    _compact(cpoolP, pool_n * sP, Pb, nl, hp, hq)
+                    cpoolP[pool_n * sP:(pool_n + nl) * sP] = Pc[:nl * sP]
                     if want_u:
                         while (upool_n + nl) * sU > cpoolU.shape[0]:
                             cpoolU = _grow(cpoolU, cpoolU.shape[0])
-                        _compact(cpoolU, upool_n * sU, Ub, nl, gp, gq_)
+                        cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
                         cmeta[c, 4] = upool_n
                         offU = upool_n
                         upool_n += nl
@@ -487,9 +551,9 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                         scP = _grow(scP, scP.shape[0])
                     while (sc_n + nl) * sU > scU.shape[0]:
                         scU = _grow(scU, scU.shape[0])
-                    _compact(scP, sc_n * sP, Pb, nl, hp, hq)
+                    scP[sc_n * sP:(sc_n + nl) * sP] = Pc[:nl * sP]
                     if want_u:
-                        _compact(scU, sc_n * sU, Ub, nl, gp, gq_)
+                        scU[sc_n * sU:(sc_n + nl) * sU] = Uc[:nl * sU]
                     where = 1
                     off = sc_n
                     offU = sc_n
@@ -581,9 +645,11 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
 
 
 @njit(cache=True)
-def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff, h_ref, pattern, dropped):
+def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff, h_ref, pattern, dropped,
+                      ns_base, plane):
     """Integrals of the listed pairs (meta, points as from enumerate_pairs), the pattern's entries
-    (``pattern`` as in ``assemble_rows``; the others checked into ``dropped``, ``_check_dropped``):
+    (``pattern`` as in ``assemble_rows``; the others checked into ``dropped``, ``_check_dropped``;
+    ``plane``: as in ``assemble_rows``, ``ns_base`` the subdivisions its geometry is for):
     (offsets (m + 1,) into the P pool, P pool, offsets (m + 1,) into the U pool (only records with
     want_u take room), U pool, kernel evaluations); a lag slot takes 9 m doubles (``_compact``)."""
     hp, hq, gp, gq_, hkeep, gkeep = pattern
@@ -601,19 +667,19 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
     Ub = np.zeros((L, 9, 3, 3))
     Pb = np.zeros((L, 9, 3, 3))
     Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
+    Pc = np.zeros(L * sP)
+    Uc = np.zeros(L * sU)
     nev = 0
     for r in range(m):
         lo, hi = meta[r, 0], meta[r, 1]
         nl = hi - lo + 1
-        nev += _integrate(pts[r], VX[meta[r, 5]], meta[r, 2], meta[r, 3], gq, gw, gr, gwr, lo, hi, dt, alpha,
-                          beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps)
-        if sP < 81:
-            _check_dropped(Pb, nl, hkeep, dropped[0:1])
-        _compact(P, off[r], Pb, nl, hp, hq)
+        v = meta[r, 5]
+        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], ns_base, gq, gw, gr, gwr, lo, hi, dt,
+                               alpha, beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps, plane,
+                               pattern, dropped[0:1], dropped[1:2], Pc, Uc)
+        P[off[r]:off[r] + nl * sP] = Pc[:nl * sP]
         if meta[r, 4] == 1:
-            if sU < 81:
-                _check_dropped(Ub, nl, gkeep, dropped[1:2])
-            _compact(U, uoff[r], Ub, nl, gp, gq_)
+            U[uoff[r]:uoff[r] + nl * sU] = Uc[:nl * sU]
     return off, P, uoff, U, nev
 
 

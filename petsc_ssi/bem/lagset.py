@@ -297,6 +297,10 @@ class LagSet:
         self.flat = (opts.get("block_pattern", "auto") != "full" and bool(np.all(mesh.nodes[:, 2] == z0))
                      and bool(np.all(VX[..., 2] == z0)))
         self.mH, self.mG = (H4, G5) if self.flat else (FULL, FULL)
+        # the plane z = 0 itself: regular pairs by quadrature.integrate_plane (the geometry of each
+        # element's Gauss points computed once, the pattern's entries only: the same bits)
+        self.in_plane = self.flat and z0 == 0.0
+        self._plane = None
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
         from .partition import node_ranges, lag_weights
         # the nodes (rows) of each rank: contiguous ranges of equal estimated work (-ssi_partition);
@@ -387,6 +391,17 @@ class LagSet:
             self._cache_est = (key, 8.0 * (sP + sU) * slots)
         return self._cache_est[1]
 
+    def plane(self, gq, gw):
+        """The ``plane`` argument of the assembly kernels (``assemble.plane``), made once: the Gauss
+        points' geometry of every virtual element at -ssi_subdivisions (nv ns^2 ng^2 x 4 doubles: 2 KB
+        an element at the defaults) when the surface is the plane z = 0."""
+        o = self.opts
+        key = (len(gq), int(o["subdivisions"]), int(o["max_subdivisions"]))
+        if self._plane is None or self._plane[0] != key:
+            from .assemble import plane
+            self._plane = (key, plane(self.in_plane, self.VX, key[1], gq, gw, key[2]))
+        return self._plane[1]
+
     def _per_row(self, lag_hi):
         return _per_row(self.mesh.n_nodes, lag_hi)
 
@@ -427,7 +442,7 @@ class LagSet:
             off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
                                                      lag_hi, self.dt, self.mat.cp, self.mat.cs, self.mat.rho,
                                                      self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()),
-                                                     pattern, dropped)
+                                                     pattern, dropped, int(o["subdivisions"]), self.plane(gq, gw))
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
         seg = np.cumsum([0] + [len(g[2]) for g in got])
         jobs = []
@@ -505,7 +520,7 @@ class LagSet:
         for s in range(0, len(rows), chunk):
             work, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
                 rows[s:s + chunk], mesh, wave, quad, pattern, bool(o.get("cache", True)), cidx, ckeys, cmeta,
-                cpP, cpU, qinv, work, dropped, H.out(), G.out(), H.loc, self.CACHE_MAX)
+                cpP, cpU, qinv, work, dropped, H.out(), G.out(), H.loc, self.plane(gq, gw), self.CACHE_MAX)
             nev += n_ev
             hits += n_hit
             prog.update(min(s + chunk, len(rows)))

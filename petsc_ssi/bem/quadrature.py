@@ -320,3 +320,143 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_
             for p in range(3):
                 for q in range(3):
                     Ps[c, p, q] += wth * fm1 * k0[p, q] * lg
+
+
+# ---------------------------------------------------------------------------
+# Elements in the plane z = 0 (every soil surface petsc_ssi accepts, and its symmetry images): the
+# geometry of an element's Gauss points does not depend on the collocation point, and with g_z = 0,
+# n = (0, 0, +-1), g . n = 0 the traction kernel keeps four entries and the displacement kernel five
+# (bsr.PATTERNS). ``plane_points`` computes the geometry once per element; ``integrate_plane`` is
+# ``integrate_pair`` for a regular pair of the plane, the same operations on every kept entry in the
+# same order minus the terms that are exact zeros there, so the same bits
+# (tests/bem/test_plane_kernel.py).
+
+@njit(cache=True)
+def plane_points(X, ns, gq, gw, sub, pts, Ntab):
+    """The quadrature of ``integrate_pair`` for an element X in the plane z = 0, point by point as it
+    computes it: sub[s] = (centre, radius) of subdivision s = si ns + sj (its bounding sphere),
+    pts[k] = (x, y, Gauss weight x subdivision area x Jacobian, n_z) and Ntab[k] the nine shape
+    functions at Gauss point k = s ng^2 + p ng + q (the same for every element)."""
+    ng = gq.shape[0]
+    h = 2.0 / ns
+    N = np.zeros(9); d1 = np.zeros(9); d2 = np.zeros(9)
+    x = np.zeros(3); jn = np.zeros(3); cen = np.zeros(3); tmp = np.zeros(3)
+    k = 0
+    for si in range(ns):
+        for sj in range(ns):
+            cx = -1.0 + h * (si + 0.5)
+            cy = -1.0 + h * (sj + 0.5)
+            rad = _sub_sphere(X, cx, cy, 0.5 * h, N, d1, d2, cen, jn, tmp)
+            s = si * ns + sj
+            sub[s, 0] = cen[0]; sub[s, 1] = cen[1]; sub[s, 2] = cen[2]; sub[s, 3] = rad
+            for p in range(ng):
+                for q in range(ng):
+                    xi = cx + 0.5 * h * gq[p]
+                    eta = cy + 0.5 * h * gq[q]
+                    J = point_geometry(X, xi, eta, N, d1, d2, x, jn)
+                    pts[k, 0] = x[0]
+                    pts[k, 1] = x[1]
+                    pts[k, 2] = gw[p] * gw[q] * 0.25 * h * h * J
+                    pts[k, 3] = jn[2] / J
+                    for c in range(9):
+                        Ntab[k, c] = N[c]
+                    k += 1
+
+
+@njit(cache=True)
+def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U, want_u, toff=0.0):
+    """``integrate_pair`` of a regular pair (``sing`` < 0) whose collocation point xc and element lie in
+    the plane z = 0, the element given by ``plane_points`` (sub, pts, Ntab; ng2 Gauss points a
+    subdivision). Accumulates lags lo..hi into P[l - lo, node, j] (the entries of bsr's flat H
+    pattern: (x,z), (y,z), (z,x), (z,y)) and, with ``want_u``, U[l - lo, node, j] (flat G: (x,x),
+    (x,y), (y,x), (y,y), (z,z)); the caller zeroes them. Returns the kernel evaluations.
+
+    With g_z = 0 and n = (0, 0, n_z), integrate_pair's traction tensor a1 g_l n_k + a2 n_l g_k +
+    a3 gn g_l g_k (+ a2 gn d_lk) is (a1 g_l) n_z at (l, z), (a2 n_z) g_k at (z, k) and exact zeros
+    elsewhere (each kept entry is its first product plus exact zeros), and the displacement tensor
+    B1 g_a g_b + A1 d_ab keeps the in-plane block and A1 at (z, z): the same values, bit for bit."""
+    mu = rho * beta * beta
+    lam = rho * alpha * alpha - 2.0 * mu
+    s4 = 1.0 / (4.0 * math.pi * rho)
+    nl = hi - lo + 1
+    S2 = np.zeros((nl + 3, 4))
+    S1 = np.zeros((nl + 3, 2))
+    ia = 1.0 / alpha
+    ib = 1.0 / beta
+    fdt = s4 / dt
+    nev = 0
+    for s in range(sub.shape[0]):
+        dc = math.sqrt((sub[s, 0] - xc[0]) ** 2 + (sub[s, 1] - xc[1]) ** 2 + (sub[s, 2] - xc[2]) ** 2)
+        rad = sub[s, 3]
+        dmin = max(dc - rad, 0.0)
+        dmax = dc + rad
+        slo = max(lo, int(math.floor((dmin * ia - toff) / dt)) + 1)
+        shi = min(hi, int(math.floor((dmax * ib - toff) / dt)) + 2)
+        if slo > shi:
+            continue
+        for k in range(s * ng2, (s + 1) * ng2):
+            w = pts[k, 2]
+            nz = pts[k, 3]
+            g0 = pts[k, 0] - xc[0]
+            g1 = pts[k, 1] - xc[1]
+            r = math.sqrt(g0 * g0 + g1 * g1)
+            if r < 1e-14:
+                continue
+            ir = 1.0 / r
+            g0 *= ir
+            g1 *= ir
+            plo = max(slo, int(math.floor((r * ia - toff) / dt)) + 1)
+            phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
+            if plo > phi:
+                continue
+            for j in range(plo - 2, phi + 1):
+                jj = j - (plo - 2)
+                t = j * dt + toff
+                if t <= 0.0:
+                    S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
+                    S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
+                else:
+                    a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
+                    S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
+                    if want_u:
+                        a1, b1 = ab1(r, t, alpha, beta)
+                        S1[jj, 0] = a1; S1[jj, 1] = b1
+            for l in range(plo, phi + 1):
+                jj = l - (plo - 2)
+                li = l - lo
+                A = (S2[jj, 0] - 2.0 * S2[jj - 1, 0] + S2[jj - 2, 0]) * fdt
+                B = (S2[jj, 1] - 2.0 * S2[jj - 1, 1] + S2[jj - 2, 1]) * fdt
+                dA = (S2[jj, 2] - 2.0 * S2[jj - 1, 2] + S2[jj - 2, 2]) * fdt
+                dB = (S2[jj, 3] - 2.0 * S2[jj - 1, 3] + S2[jj - 2, 3]) * fdt
+                nev += 1
+                if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0:
+                    continue
+                br = B / r
+                a1 = lam * (dA + dB + 2.0 * br) + 2.0 * mu * br
+                a2 = mu * (dA + br)
+                v0 = a1 * g0 * nz * w
+                v1 = a1 * g1 * nz * w
+                v2 = a2 * nz * g0 * w
+                v3 = a2 * nz * g1 * w
+                for c in range(9):
+                    Nc = Ntab[k, c]
+                    P[li, c, 0] += v0 * Nc
+                    P[li, c, 1] += v1 * Nc
+                    P[li, c, 2] += v2 * Nc
+                    P[li, c, 3] += v3 * Nc
+                if want_u:
+                    A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
+                    B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
+                    u0 = (B1 * g0 * g0 + A1) * w
+                    u1 = B1 * g0 * g1 * w
+                    u2 = B1 * g1 * g0 * w
+                    u3 = (B1 * g1 * g1 + A1) * w
+                    u4 = A1 * w
+                    for c in range(9):
+                        Nc = Ntab[k, c]
+                        U[li, c, 0] += u0 * Nc
+                        U[li, c, 1] += u1 * Nc
+                        U[li, c, 2] += u2 * Nc
+                        U[li, c, 3] += u3 * Nc
+                        U[li, c, 4] += u4 * Nc
+    return nev
