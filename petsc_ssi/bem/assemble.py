@@ -131,7 +131,7 @@ def _pair_integrals(xc, v, X, sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, al
     mH, mG = hp.shape[0], gp.shape[0]
     nl = hi - lo + 1
     flat, gsub, gpts, Ntab, ssub, spts, sN = plane
-    if flat and sing < 0:
+    if flat and sing < 0 and mH == 4 and mG == 5:          # (the flat patterns: bsr.H4, bsr.G5)
         ng2 = gq.shape[0] ** 2
         P = Pc[:nl * 9 * mH].reshape((nl, 9, mH))
         U = Uc[:nl * 9 * mG].reshape((nl, 9, mG))

@@ -436,7 +436,7 @@ class LagSet:
         allm = np.concatenate([g[2] for g in got])
         first, inv = _first_occurrences(allh, allm, lambda: np.concatenate([np.c_[g[0], g[2][:, :2]] for g in got]))
         umeta = allm[first].copy()
-        np.maximum.at(umeta[:, 4], inv, allm[:, 4])
+        umeta[inv[allm[:, 4] == 1], 4] = 1                    # (flags 0/1: np.maximum.at, without its slowness)
         allh = None
         with collective(self.comm, "integrating the shared element-cache geometries"):
             off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,

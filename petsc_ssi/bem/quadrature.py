@@ -44,6 +44,7 @@ import numpy as np
 from numba import njit
 
 from .kernels import ab1, ab2_fast, kelvin_u, kelvin_p
+from .simd import acc4
 
 # natural coordinates of the nine nodes and 1D Lagrange indices (quad9 module)
 _NXI = np.array([-1., 1., 1., -1., 0., 1., 0., -1., 0.])
@@ -369,7 +370,8 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
     the plane z = 0, the element given by ``plane_points`` (sub, pts, Ntab; ng2 Gauss points a
     subdivision). Accumulates lags lo..hi into P[l - lo, node, j] (the entries of bsr's flat H
     pattern: (x,z), (y,z), (z,x), (z,y)) and, with ``want_u``, U[l - lo, node, j] (flat G: (x,x),
-    (x,y), (y,x), (y,y), (z,z)); the caller zeroes them. Returns the kernel evaluations.
+    (x,y), (y,x), (y,y), (z,z)); the caller zeroes them (C-contiguous: P (>= nl, 9, 4), U (>= nl, 9, 5),
+    updated four entries at a time by ``simd.acc4``). Returns the kernel evaluations.
 
     With g_z = 0 and n = (0, 0, n_z), integrate_pair's traction tensor a1 g_l n_k + a2 n_l g_k +
     a3 gn g_l g_k (+ a2 gn d_lk) is (a1 g_l) n_z at (l, z), (a2 n_z) g_k at (z, k) and exact zeros
@@ -385,6 +387,10 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
     ib = 1.0 / beta
     fdt = s4 / dt
     nev = 0
+    if P.shape[1] != 9 or P.shape[2] != 4 or U.shape[1] != 9 or U.shape[2] != 5:
+        raise ValueError("integrate_plane: P must be (lags, 9, 4) and U (lags, 9, 5)")
+    Pf = P.reshape(P.size)              # (contiguous: the vector updates address them flat)
+    Uf = U.reshape(U.size)
     for s in range(sub.shape[0]):
         dc = math.sqrt((sub[s, 0] - xc[0]) ** 2 + (sub[s, 1] - xc[1]) ** 2 + (sub[s, 2] - xc[2]) ** 2)
         rad = sub[s, 3]
@@ -438,12 +444,9 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
                 v1 = a1 * g1 * nz * w
                 v2 = a2 * nz * g0 * w
                 v3 = a2 * nz * g1 * w
+                b = li * 36                     # P[li, c, 0:4] += (v0, v1, v2, v3) N_c, 4-wide (simd.acc4)
                 for c in range(9):
-                    Nc = Ntab[k, c]
-                    P[li, c, 0] += v0 * Nc
-                    P[li, c, 1] += v1 * Nc
-                    P[li, c, 2] += v2 * Nc
-                    P[li, c, 3] += v3 * Nc
+                    acc4(Pf, b + 4 * c, v0, v1, v2, v3, Ntab[k, c])
                 if want_u:
                     A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
                     B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
@@ -452,11 +455,9 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
                     u2 = B1 * g1 * g0 * w
                     u3 = (B1 * g1 * g1 + A1) * w
                     u4 = A1 * w
+                    b = li * 45
                     for c in range(9):
                         Nc = Ntab[k, c]
-                        U[li, c, 0] += u0 * Nc
-                        U[li, c, 1] += u1 * Nc
-                        U[li, c, 2] += u2 * Nc
-                        U[li, c, 3] += u3 * Nc
-                        U[li, c, 4] += u4 * Nc
+                        acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
+                        Uf[b + 5 * c + 4] += u4 * Nc
     return nev
