@@ -37,6 +37,8 @@ loaded one becomes one again (``from_aij``); a full-pattern MPIBAIJ of an older 
 import numpy as np
 from numba import njit
 
+from .simd import h4_4, h4pair_4
+
 from ..petsc import init
 
 # entries (p, q) of a 3x3 block each pattern keeps, in storage order
@@ -164,8 +166,9 @@ def _panel(indptr, indices, data, XT, RT, sign):
 
 @njit(cache=True)
 def _panel_h4(indptr, indices, d, XT, RT, sign):
-    """``_panel`` for pattern H4 (d[k] = a02, a12, a20, a21)."""
+    """``_panel`` for pattern H4 (d[k] = a02, a12, a20, a21); XT, RT C-contiguous."""
     b = XT.shape[1]
+    b4 = b - b % 4
     acc0 = np.empty(b)
     acc1 = np.empty(b)
     acc2 = np.empty(b)
@@ -179,7 +182,9 @@ def _panel_h4(indptr, indices, d, XT, RT, sign):
             x0 = XT[c]
             x1 = XT[c + 1]
             x2 = XT[c + 2]
-            for t in range(b):
+            for t in range(0, b4, 4):               # four states at a time (simd.h4_4: the same bits)
+                h4_4(acc0, acc1, acc2, t, a02, a12, a20, a21, x0, x1, x2)
+            for t in range(b4, b):
                 u2 = x2[t]
                 acc0[t] += a02 * u2
                 acc1[t] += a12 * u2
@@ -194,9 +199,12 @@ def _panel_h4(indptr, indices, d, XT, RT, sign):
 def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
     """``_panel_h4`` two rows at a time: a column both rows hold (neighbouring nodes see nearly the same
     columns) has its rows of XT read once for both; each row's sums in the same order as ``_panel_h4``
-    (the same bits). Faster for wide panels (20-29 % at b = 32 on the paper case's lags), slower for
-    narrow ones (``python jobscripts/panel_variants.py``)."""
+    (the same bits). With the states four at a time, faster than one row at a time at every width from 8
+    (`python jobscripts/panel_widths.py`: 0.36-0.37 against 0.46-0.53 ns per block and state at
+    b = 32 on the paper case's lags, 0.51 against 0.66 at b = 12); the scalar kernels before were
+    faster for narrow panels one row at a time (``jobscripts/panel_variants.py``)."""
     b = XT.shape[1]
+    b4 = b - b % 4                      # states four at a time (simd.h4_4, h4pair_4: the same bits), then the rest
     n = indptr.size - 1
     a0 = np.empty(b); a1 = np.empty(b); a2 = np.empty(b)
     e0 = np.empty(b); e1 = np.empty(b); e2 = np.empty(b)
@@ -215,7 +223,9 @@ def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
                     x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
                     p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
                     q02, q12, q20, q21 = d[l, 0], d[l, 1], d[l, 2], d[l, 3]
-                    for t in range(b):
+                    for t in range(0, b4, 4):
+                        h4pair_4(a0, a1, a2, e0, e1, e2, t, p02, p12, p20, p21, q02, q12, q20, q21, x0, x1, x2)
+                    for t in range(b4, b):
                         u0 = x0[t]; u1 = x1[t]; u2 = x2[t]
                         a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * u0 + p21 * u1
                         e0[t] += q02 * u2; e1[t] += q12 * u2; e2[t] += q20 * u0 + q21 * u1
@@ -224,7 +234,9 @@ def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
                     c = 3 * ck
                     x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
                     p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-                    for t in range(b):
+                    for t in range(0, b4, 4):
+                        h4_4(a0, a1, a2, t, p02, p12, p20, p21, x0, x1, x2)
+                    for t in range(b4, b):
                         u2 = x2[t]
                         a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * x0[t] + p21 * x1[t]
                     k += 1
@@ -232,7 +244,9 @@ def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
                     c = 3 * cl
                     x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
                     q02, q12, q20, q21 = d[l, 0], d[l, 1], d[l, 2], d[l, 3]
-                    for t in range(b):
+                    for t in range(0, b4, 4):
+                        h4_4(e0, e1, e2, t, q02, q12, q20, q21, x0, x1, x2)
+                    for t in range(b4, b):
                         u2 = x2[t]
                         e0[t] += q02 * u2; e1[t] += q12 * u2; e2[t] += q20 * x0[t] + q21 * x1[t]
                     l += 1
@@ -243,7 +257,9 @@ def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
                 c = 3 * indices[k]
                 x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
                 p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-                for t in range(b):
+                for t in range(0, b4, 4):
+                    h4_4(a0, a1, a2, t, p02, p12, p20, p21, x0, x1, x2)
+                for t in range(b4, b):
                     u2 = x2[t]
                     a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * x0[t] + p21 * x1[t]
         for t in range(b):
@@ -304,11 +320,14 @@ def matvec(m, indptr, indices, data, x, y):
     (_matvec_h4 if m == H4 else _matvec_g5 if m == G5 else _matvec)(indptr, indices, data, x, y)
 
 
-PAIR_FROM = 24      # panel width from which H4 panels take two rows at a time (``_panel_h4_pair``)
+PAIR_FROM = 8       # panel width from which H4 panels take two rows at a time (``_panel_h4_pair``; jobscripts/panel_widths.py)
 
 
 def panel(m, indptr, indices, data, XT, RT, sign):
-    """RT += sign * A XT for pattern m."""
+    """RT += sign * A XT for pattern m (XT, RT C-contiguous: the kernels read and write their rows
+    four states at a time)."""
+    if not (XT.flags.c_contiguous and RT.flags.c_contiguous):
+        raise ValueError("bsr.panel: the panels must be C-contiguous")
     if m == H4:
         f = _panel_h4_pair if XT.shape[1] >= PAIR_FROM else _panel_h4
     else:
