@@ -112,6 +112,26 @@ def _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, out):
         out[l, l] += a2 * gn
 
 
+@njit(cache=True, inline="always")
+def _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u):
+    """At a point at distance r, rows j - (plo - 2) of S2 = (A, B, dA, dB) of the twice-integrated
+    response at the kernel times T = j dt + toff, j = plo - 2 .. phi (zero for T <= 0), and with
+    ``want_u`` of S1 = (A, B) of the once-integrated one: the samples whose differences are the lags
+    plo..phi (``integrate_pair``, ``integrate_plane``)."""
+    for j in range(plo - 2, phi + 1):
+        jj = j - (plo - 2)
+        t = j * dt + toff
+        if t <= 0.0:
+            S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
+            S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
+        else:
+            a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
+            S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
+            if want_u:
+                a1, b1 = ab1(r, t, alpha, beta)
+                S1[jj, 0] = a1; S1[jj, 1] = b1
+
+
 @njit(cache=True)
 def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                    Ub, Pb, want_u, toff=0.0):
@@ -183,18 +203,7 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                         plo = 1
                     if plo > phi:
                         continue
-                    for j in range(plo - 2, phi + 1):
-                        jj = j - (plo - 2)
-                        t = j * dt + toff
-                        if t <= 0.0:
-                            S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
-                            S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
-                        else:
-                            a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
-                            S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
-                            if want_u:
-                                a1, b1 = ab1(r, t, alpha, beta)
-                                S1[jj, 0] = a1; S1[jj, 1] = b1
+                    _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
                     if subtract:
                         kelvin_u(g, r, nu, mu, ku)
                         kelvin_p(g, n, r, nu, kp)
@@ -415,18 +424,7 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
             phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
             if plo > phi:
                 continue
-            for j in range(plo - 2, phi + 1):
-                jj = j - (plo - 2)
-                t = j * dt + toff
-                if t <= 0.0:
-                    S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
-                    S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
-                else:
-                    a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
-                    S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
-                    if want_u:
-                        a1, b1 = ab1(r, t, alpha, beta)
-                        S1[jj, 0] = a1; S1[jj, 1] = b1
+            _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
             for l in range(plo, phi + 1):
                 jj = l - (plo - 2)
                 li = l - lo
