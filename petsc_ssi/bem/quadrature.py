@@ -132,6 +132,17 @@ def _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u
                 S1[jj, 0] = a1; S1[jj, 1] = b1
 
 
+@njit(cache=True, inline="always")
+def _lag_differences(S2, jj, fdt):
+    """(A, B, dA, dB) of lag row jj: the second differences of ``_time_samples``' twice-integrated
+    samples times fdt (``integrate_pair``, ``integrate_plane``)."""
+    A = (S2[jj, 0] - 2.0 * S2[jj - 1, 0] + S2[jj - 2, 0]) * fdt
+    B = (S2[jj, 1] - 2.0 * S2[jj - 1, 1] + S2[jj - 2, 1]) * fdt
+    dA = (S2[jj, 2] - 2.0 * S2[jj - 1, 2] + S2[jj - 2, 2]) * fdt
+    dB = (S2[jj, 3] - 2.0 * S2[jj - 1, 3] + S2[jj - 2, 3]) * fdt
+    return A, B, dA, dB
+
+
 @njit(cache=True)
 def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                    Ub, Pb, want_u, toff=0.0):
@@ -159,8 +170,6 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
     S1 = np.zeros((nl + 3, 2))
     pt = np.zeros((3, 3)); ut = np.zeros((3, 3))
     ku = np.zeros((3, 3)); kp = np.zeros((3, 3))
-    cdt_a = alpha * dt
-    cdt_b = beta * dt
     ia = 1.0 / alpha
     ib = 1.0 / beta
     nev = 0
@@ -211,10 +220,7 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
                     for l in range(plo, phi + 1):
                         jj = l - (plo - 2)
                         li = l - lo
-                        A = (S2[jj, 0] - 2.0 * S2[jj - 1, 0] + S2[jj - 2, 0]) * fdt
-                        B = (S2[jj, 1] - 2.0 * S2[jj - 1, 1] + S2[jj - 2, 1]) * fdt
-                        dA = (S2[jj, 2] - 2.0 * S2[jj - 1, 2] + S2[jj - 2, 2]) * fdt
-                        dB = (S2[jj, 3] - 2.0 * S2[jj - 1, 3] + S2[jj - 2, 3]) * fdt
+                        A, B, dA, dB = _lag_differences(S2, jj, fdt)
                         nev += 1
                         if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0 and not (subtract and l == 1):
                             continue
@@ -428,10 +434,7 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U,
             for l in range(plo, phi + 1):
                 jj = l - (plo - 2)
                 li = l - lo
-                A = (S2[jj, 0] - 2.0 * S2[jj - 1, 0] + S2[jj - 2, 0]) * fdt
-                B = (S2[jj, 1] - 2.0 * S2[jj - 1, 1] + S2[jj - 2, 1]) * fdt
-                dA = (S2[jj, 2] - 2.0 * S2[jj - 1, 2] + S2[jj - 2, 2]) * fdt
-                dB = (S2[jj, 3] - 2.0 * S2[jj - 1, 3] + S2[jj - 2, 3]) * fdt
+                A, B, dA, dB = _lag_differences(S2, jj, fdt)
                 nev += 1
                 if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0:
                     continue
