@@ -16,7 +16,12 @@ export OMP_NUM_THREADS ?= 1
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
-PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout obspy
+PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy
+# pytest workers of `make test` (pytest-xdist, whole test files to a worker): the suite is mostly
+# serial Python and short mpiruns, so 2 workers on a 2-core machine took it from 900-940 s to 545 s.
+# The slow tier stays serial (its cases hold GBs each). TEST_JOBS=0: no workers, one process.
+TEST_JOBS ?= 2
+XDIST = $(if $(filter 0,$(TEST_JOBS)),,-n $(TEST_JOBS) --dist loadfile)
 
 .PHONY: all deps demo test test-unit test-mpi test-slow test-all bench clean help-options
 
@@ -53,13 +58,13 @@ demo: deps
 # Tiers (pytest.ini, tests/conftest.py): `make test` is every tier but slow (what CI runs);
 # the slow tier holds the heavy cases and runs before a release.
 test: deps
-	$(PY) -m pytest -q -m "not slow" tests
+	$(PY) -m pytest -q -m "not slow" $(XDIST) tests
 
 test-unit: deps
-	$(PY) -m pytest -q -m "unit and not slow" tests
+	$(PY) -m pytest -q -m "unit and not slow" $(XDIST) tests
 
 test-mpi: deps
-	$(PY) -m pytest -q -m "mpi and not slow" tests
+	$(PY) -m pytest -q -m "mpi and not slow" $(XDIST) tests
 
 test-slow: deps
 	$(PY) -m pytest -q -m slow tests
