@@ -4,19 +4,23 @@
 # it the history sum and the BEM solves (whose time includes waiting for the other rank's history
 # sum), and the peak memory over the node. The run-to-run spread of one machine, beside the single
 # invocation of flat_bench.sh.
-#   bash jobscripts/paper_repeat.sh [REPEAT]      (default 3; about 25 s a run on 2 cores)
+#   bash jobscripts/paper_repeat.sh [REPEAT] [OPTIONS...]   (default 3; about 25 s a run on 2 cores)
+# OPTIONS are added to every run's command line (e.g. -ssi_huge_pages off); the logs are named by them.
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 REPEAT=${1:-3}
+shift || true
+EXTRA=("$@")
+TAG=$(echo "${EXTRA[*]:-}" | tr -c 'A-Za-z0-9_\n' '_' | sed 's/^_*//')
 OUT=out/bench/paper_repeat
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup > /dev/null
 echo "| run | total [s] | BEM assembly [s] | time loop [s] | history sum [s] | BEM solves [s] | peak memory, all ranks [GB] |"
 echo "|---|---|---|---|---|---|---|"
 for r in $(seq 1 "$REPEAT"); do
-  log="$OUT/paper-r$r.log"
+  log="$OUT/paper${TAG:+-$TAG}-r$r.log"
   mpirun --allow-run-as-root --oversubscribe -n 2 "$PY" -m petsc_ssi -options_file runs/pekeris/paper.opts \
-    -ssi_output "$OUT/paper.h5" -ssi_output_overwrite -log_view -memory_view > "$log" 2>&1
+    -ssi_output "$OUT/paper.h5" -ssi_output_overwrite -log_view -memory_view "${EXTRA[@]}" > "$log" 2>&1
   "$PY" - "$log" "$r" <<'PY'
 import re, sys
 log, r = open(sys.argv[1]).read(), sys.argv[2]
