@@ -386,11 +386,12 @@ def emit_row(n, tlag, tcol, tval, li, out):
         k = k2
 
 
-@njit(cache=True)
-def _accumulate(src, base, m, cols, sign, sj, buf, touch, lst, n, skip_zero):
+@njit(cache=True, inline="always")
+def _accumulate(src, base, m, cols, sg, buf, touch, lst, n, skip_zero):
     """Add one pair's blocks of one lag (src[base + m a + j]: node a, the j-th entry of the pattern,
-    ``_compact``) times diag(sign) (sign[sj[j]]: the sign of the entry's column component) into the
-    row buffer ``buf`` by column (cols[a] < 0: no column). A column met for the first time is zeroed
+    ``_compact``) times the element's image signs (sg[j]: the sign of entry j's column component) into
+    the row buffer ``buf`` by column (cols[a] < 0: no column). Inlined, so that a constant m (the flat
+    patterns' 4 and 5) gives loops of known length, unrolled (the same operations in the same order). A column met for the first time is zeroed
     and listed (``touch``, ``lst``[:n]). With ``skip_zero`` a block whose entries are all zero adds
     nothing (H: only blocks with a non-zero contribution are stored; G keeps every traction column).
     Returns n."""
@@ -413,7 +414,7 @@ def _accumulate(src, base, m, cols, sign, sj, buf, touch, lst, n, skip_zero):
             for j in range(m):
                 buf[col, j] = 0.0
         for j in range(m):
-            buf[col, j] += src[b + j] * sign[sj[j]]
+            buf[col, j] += src[b + j] * sg[j]
     return n
 
 
@@ -488,6 +489,13 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     pool_n, upool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
     reach = alpha * (dt * L + toff)
+    sgH = np.empty((nv, mH))                    # an element's image sign of each pattern entry's column
+    sgG = np.empty((nv, mG))
+    for v in range(nv):
+        for j in range(mH):
+            sgH[v, j] = Vsign[v, hq[j]]
+        for j in range(mG):
+            sgG[v, j] = Vsign[v, gq_[j]]
     for ii in range(rows.shape[0]):
         i = rows[ii]
         xc = xnodes[i]
@@ -574,11 +582,18 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
                 v = pairs[k, 0]
                 slot = pairs[k, 5] + (lag - lo)
                 srcP = scP if pairs[k, 4] == 1 else cpoolP
-                nH = _accumulate(srcP, slot * sP, mH, Vnode[v], Vsign[v], hq, bufH, touchH, lstH, nH, True)
+                if mH == 4:                     # the flat pattern: a constant width, loops unrolled
+                    nH = _accumulate(srcP, slot * sP, 4, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
+                else:
+                    nH = _accumulate(srcP, slot * sP, mH, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
                 if pairs[k, 3] == 1:
                     srcU = scU if pairs[k, 4] == 1 else cpoolU
-                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], Vsign[v], gq_, bufG, touchG,
-                                     lstG, nG, False)
+                    if mG == 5:
+                        nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, 5, Vtcol[v], sgG[v], bufG,
+                                         touchG, lstG, nG, False)
+                    else:
+                        nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], sgG[v], bufG,
+                                         touchG, lstG, nG, False)
             if nH:
                 cl = _ordered(lstH, nH, touchH)
                 _emit_lag(lag, nH, cl, bufH, li, hout)
