@@ -608,7 +608,8 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
 # the distinct pair geometries its rows meet (enumerate_pairs), an owner rank
 # per geometry (its hash modulo the ranks) integrates it once (integrate_records)
 # and sends it back, and each rank fills its cache with what it asked for
-# (cache_insert) before assemble_rows runs, which then finds every pair there.
+# (cache_index: the blocks are received in place) before assemble_rows runs, which then finds every
+# pair there.
 
 @njit(cache=True)
 def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_base, near_factor, ns_max,
@@ -699,41 +700,22 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
 
 
 @njit(cache=True)
-def cache_insert(cidx, ckeys, cmeta, cpoolP, cpoolU, keys, hs, meta, buf, poffs, uoffs, sP, sU):
-    """Add records (keys, hashes, meta as from enumerate_pairs) to an element cache, their P blocks at
-    buf[poffs[r]:] (sP doubles a lag slot) and U blocks at buf[uoffs[r]:] (sU; uoffs[r] < 0: no U);
-    returns the cache arrays."""
+def cache_index(cidx, ckeys, cmeta, keys, hs, meta, pslot, uslot):
+    """Index records (keys, hashes, meta as from enumerate_pairs) whose blocks already lie in an
+    empty element cache's pools: record r's P blocks at lag slot pslot[r] of the P pool, its U blocks
+    at uslot[r] of the U pool (uslot[r] < 0: none); a record whose hash is already indexed is
+    skipped (its blocks are unused). Returns (ckeys, cmeta)."""
     ncache = len(cidx)
-    pool_n, upool_n = _pool_end(cmeta, ncache)
-    total, utotal = pool_n, upool_n
-    for r in range(keys.shape[0]):
-        total += meta[r, 1] - meta[r, 0] + 1
-        if uoffs[r] >= 0:
-            utotal += meta[r, 1] - meta[r, 0] + 1
-    if total * sP > cpoolP.shape[0]:            # sized once (not by doubling): the pools hold what was asked
-        P2 = np.zeros(total * sP)
-        P2[:cpoolP.shape[0]] = cpoolP
-        cpoolP = P2
-    if utotal * sU > cpoolU.shape[0]:
-        U2 = np.zeros(utotal * sU)
-        U2[:cpoolU.shape[0]] = cpoolU
-        cpoolU = U2
     ckeys = _grow(ckeys, ncache + keys.shape[0])
     cmeta = _grow(cmeta, ncache + keys.shape[0])
     for r in range(keys.shape[0]):
         if hs[r] in cidx:
             continue
-        nl = meta[r, 1] - meta[r, 0] + 1
         c = ncache
         ckeys[c] = keys[r]
-        cmeta[c, 0] = meta[r, 0]; cmeta[c, 1] = meta[r, 1]; cmeta[c, 2] = pool_n
-        cmeta[c, 3] = 1 if uoffs[r] >= 0 else 0
-        cpoolP[pool_n * sP:(pool_n + nl) * sP] = buf[poffs[r]:poffs[r] + nl * sP]
-        if uoffs[r] >= 0:
-            cpoolU[upool_n * sU:(upool_n + nl) * sU] = buf[uoffs[r]:uoffs[r] + nl * sU]
-            cmeta[c, 4] = upool_n
-            upool_n += nl
-        pool_n += nl
+        cmeta[c, 0] = meta[r, 0]; cmeta[c, 1] = meta[r, 1]; cmeta[c, 2] = pslot[r]
+        cmeta[c, 3] = 1 if uslot[r] >= 0 else 0
+        cmeta[c, 4] = uslot[r] if uslot[r] >= 0 else 0
         cidx[hs[r]] = c
         ncache += 1
-    return ckeys, cmeta, cpoolP, cpoolU
+    return ckeys, cmeta

@@ -9,14 +9,14 @@ import os
 
 import numpy as np
 
-from ..petsc import SSIError, collective, collective_error, printf
+from ..petsc import SSIError, collective, printf
 from ..monitor import Progress, event
 from .cost import (CACHE_MAX, _per_row, _chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
                    pair_table, cache_counts)
 from .windows import bounding_spheres, estimate_blocks
 from . import symmetry
 from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_records,
-                       cache_insert, SING_TOL)
+                       cache_index, SING_TOL)
 
 
 class Material:
@@ -246,18 +246,19 @@ def _mix64(h):
     return x
 
 
-def _send_segments(mpi, jobs, rbuf, rcount, rd):
-    """Collective all-to-all of segments of doubles: to rank r the segments P[ps:ps + pl] then
-    U[us:us + ul] of ``jobs[r]`` = (P, ps, pl, U, us, ul), one after the other, without packing them
-    into a send buffer (an MPI datatype at the segments' addresses: no packed copy of the element
-    cache, which was as large as the cache itself, in fresh memory); from rank r ``rcount[r]``
-    doubles into rbuf[rd[r]:]."""
+def _send_segments(mpi, jobs, recv):
+    """Collective all-to-all of segments of doubles, in place at both ends: to rank r the segments
+    P[ps:ps + pl] then U[us:us + ul] of ``jobs[r]`` = (P, ps, pl, U, us, ul), one after the other;
+    from rank r, in the same order, into the segments ``recv[r]`` = (lengths, absolute addresses).
+    MPI datatypes at the segments' addresses: no packed copy of the element cache at either end (a
+    send buffer and a receive buffer each as large as the cache itself, in fresh memory)."""
     from mpi4py import MPI
     p = mpi.Get_size()
     made = []
 
     def segments(lens, addr):
         """(datatype, count) of the doubles at absolute addresses ``addr``, ``lens`` each."""
+        lens, addr = np.asarray(lens, np.int64), np.asarray(addr, np.int64)
         keep = lens > 0
         if not keep.any():
             return MPI.DOUBLE, 0
@@ -267,12 +268,10 @@ def _send_segments(mpi, jobs, rbuf, rcount, rd):
     for P, ps, pl, U, us, ul in jobs:
         aP = MPI.Get_address(P) if P.size else 0            # (an empty pool: every length 0)
         aU = MPI.Get_address(U) if U.size else 0
-        send.append(segments(np.r_[pl, ul].astype(np.int64),
-                             np.r_[aP + 8 * np.asarray(ps, np.int64), aU + 8 * np.asarray(us, np.int64)]))
-    base = MPI.Get_address(rbuf) if len(rbuf) else 0
-    recv = [segments(np.array([rcount[r]], np.int64), np.array([base + 8 * rd[r]], np.int64)) for r in range(p)]
+        send.append(segments(np.r_[pl, ul], np.r_[aP + 8 * np.asarray(ps, np.int64), aU + 8 * np.asarray(us, np.int64)]))
+    rv = [segments(lens, addr) for lens, addr in recv]
     stypes, scounts = [t for t, _ in send], [c for _, c in send]
-    rtypes, rcounts = [t for t, _ in recv], [c for _, c in recv]
+    rtypes, rcounts = [t for t, _ in rv], [c for _, c in rv]
     try:
         mpi.Alltoallw([MPI.BOTTOM, (scounts, [0] * p), stypes], [MPI.BOTTOM, (rcounts, [0] * p), rtypes])
     finally:
@@ -451,25 +450,26 @@ class LagSet:
             w = u[got[r][2][:, 4] == 1]
             jobs.append((off[u], off[u + 1] - off[u], uoff[w], uoff[w + 1] - uoff[w]))
         got = None
+        # this rank's records straight into fresh pools, in record order: record i's P blocks at lag slot
+        # pslot[i] of the P pool, its U blocks (if it wants them) at uslot[i] of the U pool
+        if index_len(cidx):
+            raise RuntimeError("_share_cache fills an empty element cache only")
         nl = meta[:, 1] - meta[:, 0] + 1
-        nlP, nlU = nl * sP, nl * sU
         wu = meta[:, 4] == 1
-        rcount = [int(nlP[i].sum() + nlU[i][wu[i]].sum()) for i in mine]
-        rbuf = np.empty(sum(rcount))
-        rd = np.r_[0, np.cumsum(rcount)[:-1]].astype(np.int64)
-        _send_segments(mpi, [(P, ps, pl, U, us, ul) for ps, pl, us, ul in jobs], rbuf, rcount, rd)
-        P = U = jobs = None
-        # where each of this rank's records landed in rbuf
-        poffs = np.zeros(len(keys), np.int64)
-        uoffs = np.full(len(keys), -1, np.int64)
+        pslot = np.cumsum(nl) - nl
+        uslot = np.where(wu, np.cumsum(np.where(wu, nl, 0)) - np.where(wu, nl, 0), -1)
+        cpP = np.empty(max(int(nl.sum()), 1) * sP)           # (at least a slot: an address to give MPI)
+        cpU = np.empty(max(int(nl[wu].sum()), 1) * sU)
+        from mpi4py import MPI
+        aP, aU = MPI.Get_address(cpP), MPI.Get_address(cpU)
+        recv = []
         for r in range(p):
             i = mine[r]
-            cp = np.cumsum(nlP[i])
-            poffs[i] = rd[r] + cp - nlP[i]
             w = i[wu[i]]
-            uoffs[w] = rd[r] + (cp[-1] if len(i) else 0) + np.cumsum(nlU[w]) - nlU[w]
-        ckeys, cmeta, cpP, cpU = cache_insert(cidx, ckeys, cmeta, cpP, cpU, keys, hs, meta, rbuf, poffs, uoffs,
-                                              sP, sU)
+            recv.append((np.r_[nl[i] * sP, nl[w] * sU], np.r_[aP + 8 * sP * pslot[i], aU + 8 * sU * uslot[w]]))
+        _send_segments(mpi, [(P, ps, pl, U, us, ul) for ps, pl, us, ul in jobs], recv)
+        P = U = jobs = recv = None
+        ckeys, cmeta = cache_index(cidx, ckeys, cmeta, keys, hs, meta, pslot, uslot)
         return ckeys, cmeta, cpP, cpU, int(nev)
 
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly",
