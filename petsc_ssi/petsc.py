@@ -57,7 +57,9 @@ def set_huge_pages(mode):
     madvise(MADV_HUGEPAGE) to back every array of 4 MB and more by 2 MB pages (arrays numba allocates
     inside compiled code are not numpy's: the element cache's pools keep the kernel's default);
     where the kernel then compacts memory on the spot (transparent_hugepage/defrag
-    'madvise'), first writes stall erratically (jobscripts/first_touch.py). Returns the advice in
+    'madvise'), or where a virtual machine hands free 2 MB blocks back to its host (free page
+    reporting), first writes stall erratically (jobscripts/first_touch.py, jobscripts/README.md's
+    first-touch section). Returns the advice in
     effect (True/False), or None where this numpy has no such switch (then nothing changes)."""
     if mode not in ("off", "on", "numpy"):
         raise SSIError(f"-ssi_huge_pages {mode}: expected off, on or numpy")

@@ -116,3 +116,40 @@ def release_freed():
         return False
     _TRIM[0](0)
     return True
+
+
+_MADVISE = []
+MADV_NOHUGEPAGE = 15            # Linux (include/uapi/asm-generic/mman-common.h)
+_PAGE = 4096
+
+
+def small_pages_from(a, nbytes):
+    """Ask the kernel to back the bytes of array ``a`` from ``nbytes`` on (rounded up to a 4 kB page)
+    by small pages: madvise(MADV_NOHUGEPAGE). The lag arrays are allocated with headroom over the
+    memory estimate's block count; where numpy advises huge pages, the 2 MB page holding the last
+    block a lag actually stores is faulted in whole, about 1 MB of zeros per array on average
+    (0.13 GB a rank on the paper's Lamb case, issue 29). With small pages from a little before
+    the estimate on, the array's end costs a 4 kB page instead. Returns True when the advice was
+    taken; a no-op (False) where there is no madvise (not Linux) or the range is empty."""
+    if not _MADVISE:
+        fn = None
+        try:
+            import ctypes
+            import ctypes.util
+            import sys
+            if sys.platform.startswith("linux"):
+                fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True),
+                             "madvise", None)
+                if fn is not None:
+                    fn.argtypes, fn.restype = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int], ctypes.c_int
+        except (OSError, AttributeError):
+            fn = None
+        _MADVISE.append(fn)
+    if _MADVISE[0] is None or a.nbytes == 0:
+        return False
+    start = a.ctypes.data + max(int(nbytes), 0)
+    start = (start + _PAGE - 1) // _PAGE * _PAGE
+    end = (a.ctypes.data + a.nbytes) // _PAGE * _PAGE
+    if end <= start:
+        return False
+    return _MADVISE[0](start, end - start, MADV_NOHUGEPAGE) == 0
