@@ -4,6 +4,7 @@
 ``process_rss``      resident memory now; ``proc_status_bytes`` any field of /proc/self/status
 ``peak_rss``         collective: (largest, summed) peak resident memory of the ranks so far
 """
+import mmap
 import os
 
 
@@ -120,7 +121,7 @@ def release_freed():
 
 _MADVISE = []
 MADV_NOHUGEPAGE = 15            # Linux (include/uapi/asm-generic/mman-common.h)
-_PAGE = 4096
+_PAGE = mmap.PAGESIZE
 
 
 def small_pages_from(a, nbytes):
