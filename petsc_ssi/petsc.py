@@ -80,16 +80,12 @@ def set_huge_pages(mode):
 
 
 def release_memory():
-    """Return freed heap memory to the system (glibc malloc_trim). The BEM
-    frees its triplets lag by lag while building the Mats; without trimming,
-    glibc keeps the freed pages and the paper case peaked at 20 GB where the
-    Mats needed 7 GB (measured: trimming cut RSS from 7.8 to 2.7 GB on a
-    reduced case). Cheap, and a no-op where glibc is not there."""
-    try:
-        import ctypes
-        ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
+    """Return freed heap memory to the system (glibc malloc_trim: ``sysmem.release_freed``). The BEM
+    frees its triplets lag by lag while building the Mats; without trimming, glibc keeps the freed
+    pages and the paper case peaked at 20 GB where the Mats needed 7 GB (measured: trimming cut RSS
+    from 7.8 to 2.7 GB on a reduced case). Cheap, and a no-op where glibc is not there."""
+    from .sysmem import release_freed
+    release_freed()
 
 
 def init(argv=None):

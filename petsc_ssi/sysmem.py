@@ -91,7 +91,24 @@ def peak_rss(comm):
     return mpi.allreduce(hwm, op=MPI.MAX), mpi.allreduce(hwm)
 
 
-_TRIM = []
+_LIBC = {}
+
+
+def _libc(name, argtypes, restype):
+    """The C library's function ``name`` through ctypes (errno kept), typed; None where this C library
+    or platform has none. Looked up once per process."""
+    if name not in _LIBC:
+        fn = None
+        try:
+            import ctypes
+            import ctypes.util
+            fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True), name, None)
+            if fn is not None:
+                fn.argtypes, fn.restype = argtypes, restype
+        except (OSError, AttributeError):
+            fn = None
+        _LIBC[name] = fn
+    return _LIBC[name]
 
 
 def release_freed():
@@ -102,55 +119,36 @@ def release_freed():
     Lamb case (``jobscripts/assembly_memory.py``), held through the rest of the assembly and counted
     in its peak (issue 29). A no-op
     where the C library has no ``malloc_trim`` (musl, macOS)."""
-    if not _TRIM:
-        fn = None
-        try:
-            import ctypes
-            import ctypes.util
-            fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6"), "malloc_trim", None)
-            if fn is not None:
-                fn.argtypes, fn.restype = [ctypes.c_size_t], ctypes.c_int
-        except (OSError, AttributeError):
-            fn = None
-        _TRIM.append(fn)
-    if _TRIM[0] is None:
+    import ctypes
+    fn = _libc("malloc_trim", [ctypes.c_size_t], ctypes.c_int)
+    if fn is None:
         return False
-    _TRIM[0](0)
+    fn(0)
     return True
 
 
-_MADVISE = []
 MADV_NOHUGEPAGE = 15            # Linux (include/uapi/asm-generic/mman-common.h)
 _PAGE = mmap.PAGESIZE
 
 
 def small_pages_from(a, nbytes):
-    """Ask the kernel to back the bytes of array ``a`` from ``nbytes`` on (rounded up to a 4 kB page)
-    by small pages: madvise(MADV_NOHUGEPAGE). The lag arrays are allocated with headroom over the
+    """Ask the kernel to back the bytes of array ``a`` from ``nbytes`` on (rounded up to a page) by
+    small pages: madvise(MADV_NOHUGEPAGE). The lag arrays are allocated with headroom over the
     memory estimate's block count; where numpy advises huge pages, the 2 MB page holding the last
     block a lag actually stores is faulted in whole, about 1 MB of zeros per array on average
-    (0.13 GB a rank on the paper's Lamb case, issue 29). With small pages from a little before
-    the estimate on, the array's end costs a 4 kB page instead. Returns True when the advice was
-    taken; a no-op (False) where there is no madvise (not Linux) or the range is empty."""
-    if not _MADVISE:
-        fn = None
-        try:
-            import ctypes
-            import ctypes.util
-            import sys
-            if sys.platform.startswith("linux"):
-                fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True),
-                             "madvise", None)
-                if fn is not None:
-                    fn.argtypes, fn.restype = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int], ctypes.c_int
-        except (OSError, AttributeError):
-            fn = None
-        _MADVISE.append(fn)
-    if _MADVISE[0] is None or a.nbytes == 0:
+    (0.12-0.14 GB a rank on the paper's Lamb case, issue 29: jobscripts/lag_tail_pages.py). With
+    small pages from a little before the estimate on, the array's end costs a small page instead.
+    Returns True when the advice was taken; a no-op (False) where there is no madvise (not Linux)
+    or the range is empty."""
+    import ctypes
+    import sys
+    fn = _libc("madvise", [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int], ctypes.c_int) \
+        if sys.platform.startswith("linux") else None
+    if fn is None or a.nbytes == 0:
         return False
     start = a.ctypes.data + max(int(nbytes), 0)
     start = (start + _PAGE - 1) // _PAGE * _PAGE
     end = (a.ctypes.data + a.nbytes) // _PAGE * _PAGE
     if end <= start:
         return False
-    return _MADVISE[0](start, end - start, MADV_NOHUGEPAGE) == 0
+    return fn(start, end - start, MADV_NOHUGEPAGE) == 0
