@@ -33,13 +33,14 @@ register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed
          "runs); a coupled run factorises the soil's step matrix whole on every rank with PETSc's LU instead "
          "(-ssi_bem_pc_type redundant). Finished HDF5 files carry no modification times (with or without this "
          "option), so identical results give identical files", "common")
-register("huge_pages", "enum", "numpy", "", "numpy's request (madvise) that the large arrays it allocates, the stored "
-         "lag blocks among them, be backed by transparent huge pages: numpy (as numpy has it: on unless "
-         "NUMPY_MADVISE_HUGEPAGE=0), on, or off. Where the kernel compacts memory for such a request "
-         "(/sys/kernel/mm/transparent_hugepage/defrag 'madvise'), a first write may stall (jobscripts/first_touch.py), "
-         "yet whole runs on the development machine were faster with huge pages, the paper case by far "
-         "(jobscripts/huge_pages_bench.sh); results do not depend on it", "common",
-         choices=("off", "on", "numpy"))
+register("huge_pages", "enum", "auto", "", "transparent huge pages for the large arrays, the stored lag blocks among "
+         "them: auto (numpy's advice as numpy has it, on unless NUMPY_MADVISE_HUGEPAGE=0, except that the BEM's lag "
+         "arrays get 4 kB pages where the machine is a virtual machine whose balloon hands free memory back to its "
+         "host: there a huge page's first write cost 2-5 times a small page's, and the paper's Lamb case "
+         "assembled in 5.7-5.8 s instead of 9.6-10.2 s, its history sum 0.3 s slower), numpy (numpy's advice for "
+         "every array), on, or off (no huge pages for the lag arrays either). Which is faster is the machine's: "
+         "jobscripts/paper_repeat.sh and huge_pages_bench.sh measure it; results do not depend on it", "common",
+         choices=("auto", "off", "on", "numpy"))
 register("checkpoint", "str", "", "", "checkpoint file (default <output stem>-checkpoint.h5); '%d' in the name "
          "becomes the step, to keep every checkpoint; never an output or sidecar of the run", "common")
 register("checkpoint_every", "int", 0, "steps", "write a checkpoint every this many steps (0: never; a signal "

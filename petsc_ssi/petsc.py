@@ -52,8 +52,9 @@ def _pin_mmap_threshold(nbytes=256 << 10):
 
 def set_huge_pages(mode):
     """numpy's transparent-huge-page advice for the arrays it allocates from now on (-ssi_huge_pages):
-    'off', 'on', or 'numpy' (left as it is: numpy's default, on unless NUMPY_MADVISE_HUGEPAGE=0, where
-    nothing in the process changed it). numpy (1.18 on, Linux) asks the kernel with
+    'off', 'on', or 'numpy' and 'auto' (left as it is: numpy's default, on unless
+    NUMPY_MADVISE_HUGEPAGE=0, where nothing in the process changed it; with 'auto' the BEM's lag
+    arrays are given small pages where ``sysmem.free_page_reporting``: ``lag_small_pages``). numpy (1.18 on, Linux) asks the kernel with
     madvise(MADV_HUGEPAGE) to back every array of 4 MB and more by 2 MB pages (arrays numba allocates
     inside compiled code are not numpy's: the element cache's pools keep the kernel's default);
     where the kernel then compacts memory on the spot (transparent_hugepage/defrag
@@ -61,8 +62,8 @@ def set_huge_pages(mode):
     reporting), first writes stall erratically (jobscripts/first_touch.py, jobscripts/README.md's
     first-touch section). Returns the advice in
     effect (True/False), or None where this numpy has no such switch (then nothing changes)."""
-    if mode not in ("off", "on", "numpy"):
-        raise SSIError(f"-ssi_huge_pages {mode}: expected off, on or numpy")
+    if mode not in ("off", "on", "numpy", "auto"):
+        raise SSIError(f"-ssi_huge_pages {mode}: expected auto, off, on or numpy")
     ma = None
     for name in ("numpy._core.multiarray", "numpy.core.multiarray"):
         try:
@@ -74,9 +75,25 @@ def set_huge_pages(mode):
         ma = None
     if ma is None:
         return None
-    if mode != "numpy":
+    if mode in ("on", "off"):
         ma._set_madvise_hugepage(mode == "on")
     return bool(ma._get_madvise_hugepage())
+
+
+def lag_small_pages(mode):
+    """Whether the BEM's lag arrays are to be backed by small (4 kB) pages under -ssi_huge_pages
+    ``mode``: with 'auto' (the default), where this machine's balloon hands free memory back to its
+    host (``sysmem.free_page_reporting``), since there a huge page's first write costs two to five
+    times a small page's and the assembly writes every stored block into fresh memory (the paper's
+    Lamb case: assembly 5.7-5.8 s against 9.6-10.2 s, the history sum 0.3 s slower from the small
+    pages' address translation: jobscripts/README.md's first-touch section); 'off' too. With 'on'
+    and 'numpy' they follow numpy's advice."""
+    if mode == "off":
+        return True
+    if mode != "auto":
+        return False
+    from .sysmem import free_page_reporting
+    return free_page_reporting()
 
 
 def release_memory():

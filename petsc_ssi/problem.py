@@ -158,7 +158,7 @@ class TransientProblem:
         self._locks = []                # the lock files of the run's outputs (check_output)
         self._key = None
         from .petsc import set_huge_pages
-        self.huge_pages = set_huge_pages(cfg.get("huge_pages", "numpy"))   # before the large arrays
+        self.huge_pages = set_huge_pages(cfg.get("huge_pages", "auto"))    # before the large arrays
 
     _METHOD = {"set up": "setup", "started": "start", "finished": "finish"}
 

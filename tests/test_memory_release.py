@@ -55,3 +55,24 @@ def test_a_lag_arrays_tail_gets_small_pages():
     assert not small_pages_from(a, a.nbytes)               # nothing past the end
     a[:] = 1.0                                              # the array is written as before
     assert float(a.sum()) == float(a.size)
+
+
+def test_small_lag_buckets_have_small_pages_throughout():
+    """Buckets(small=True) (-ssi_huge_pages auto on a VM that reports free pages, or off): every lag
+    array of 2 MB and more is marked 'nh' from its first page to its last; without it, a lag array's
+    head keeps numpy's advice and only its tail past SMALL_FROM of the expected blocks is small."""
+    import sys
+    import os
+    if not sys.platform.startswith("linux") or not os.path.isdir("/sys/kernel/mm/transparent_hugepage"):
+        pytest.skip("no transparent huge pages (Linux's madvise flags in /proc/self/smaps)")
+    from petsc_ssi.bem.lagset import Buckets
+    from petsc_ssi.bem.assemble import get_lag
+    n = 1 << 20                                             # blocks a lag: 4 MB of columns, 32 MB of values
+    for small in (True, False):
+        B = Buckets(2, np.arange(4), 4, capacity=[n, n], m=4, expected=[n, n], small=small)
+        for lag in (1, 2):
+            c, v, _ = get_lag(B._c, B._v, B._v32, lag)
+            for a in (c, v):
+                head, tail = a.ctypes.data + 4096, a.ctypes.data + a.nbytes - 4096
+                assert "nh" in _vm_flags(tail), (small, lag, _vm_flags(tail))
+                assert ("nh" in _vm_flags(head)) is small, (small, lag, _vm_flags(head))

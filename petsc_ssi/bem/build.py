@@ -97,7 +97,9 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"{single_txt}), "
            f"mean block fill {100 * fill:.1f}%, stored {mem / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations, {ls.cache_hits} element pairs reused "
-           f"(cache {ls.cache_bytes / 1e6:.3g} MB)")
+           f"(cache {ls.cache_bytes / 1e6:.3g} MB)"
+           + ("; lag arrays in 4 kB pages (-ssi_huge_pages: this machine hands free memory back to its host)"
+              if ls.opts.get("small_pages") and cfg.get("huge_pages", "auto") == "auto" else ""))
     b, sub = _block_of(cfg, comm, H, G, HI, GI)
     march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
     _say_block(march)

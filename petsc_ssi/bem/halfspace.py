@@ -341,10 +341,12 @@ class HalfSpace:
         with it every rounding of a parallel run, depends on the stored lags only, so a run stopped
         after n steps equals a run of n steps bit for bit (tests/test_output_survives.py)."""
         from .partition import lag_weights
+        from ..petsc import lag_small_pages
         plan = plan if plan is not None else self.interp_plan()
         interp = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []
         opts = dict(self.quad_options(), partition=self.cfg.partition, work_lags=plan.Lx,
                     block_pattern=self.cfg.get("lag_pattern", "auto"),
+                    small_pages=lag_small_pages(self.cfg.get("huge_pages", "auto")),
                     lag_weights=lag_weights(plan.Lx, self.L, self.cfg.scheme.startswith("stabili"), interp))
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes, opts)
 

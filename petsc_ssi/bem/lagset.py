@@ -112,10 +112,12 @@ class Buckets:
     Lag 1 of H carries the free term apart (``free``, ``diag``). The arrays are allocated at
     ``capacity[l - 1]`` blocks (the memory estimate's count, with headroom: allocated, never touched,
     not resident) and grow by half when a row finds no room (in the kernel, ``assemble._room``): each
-    page is written once, in place. numpy backs them by huge pages unless ``-ssi_huge_pages off``,
-    except from ``SMALL_FROM`` of the ``expected`` blocks on (small pages: the 2 MB page holding a
-    lag's last block is not faulted in whole: 0.12-0.14 GB a rank counted on the paper case, its
-    measured peak 0.18 GB lower over the node)."""
+    page is written once, in place. ``small``: every page of them small (madvise MADV_NOHUGEPAGE:
+    ``petsc.lag_small_pages``, -ssi_huge_pages auto on a VM that hands free memory back to its host,
+    or off); otherwise numpy's advice holds (huge pages unless ``-ssi_huge_pages off``), except from
+    ``SMALL_FROM`` of the ``expected`` blocks on (small pages: the 2 MB page holding a lag's last
+    block is not faulted in whole: 0.12-0.14 GB a rank counted on the paper case, its measured peak
+    0.18 GB lower over the node)."""
 
     GROW = 1.5
     TRIM = 0.5            # a lag using less of its array (a growth's overshoot) is copied to its size when taken;
@@ -123,7 +125,8 @@ class Buckets:
 
     SMALL_FROM = 0.85     # of the expected blocks: a lag array's pages from there on are small (sysmem.small_pages_from)
 
-    def __init__(self, L, rows, n_nodes, capacity=None, single_from=0, m=9, free=None, expected=None):
+    def __init__(self, L, rows, n_nodes, capacity=None, single_from=0, m=9, free=None, expected=None,
+                 small=False):
         self.L, self.rows, self.nloc = L, np.asarray(rows, np.int64), len(rows)
         self.m = int(m)                         # values a block: bsr.PATTERNS (9: full 3x3)
         self.free = None if free is None else np.asarray(free, float).reshape(-1, 3, 3)   # lag 1's free term
@@ -150,10 +153,10 @@ class Buckets:
                 c = np.empty(k, np.int32)
                 v = np.empty((0 if single else k, self.m))
                 v32 = np.empty((k if single else 0, self.m), np.float32)
-                if exp[lag] > 0:            # the last stored block's page: small, not a whole 2 MB page
-                    b = int(self.SMALL_FROM * exp[lag])
-                    for a in (c, v, v32):
-                        if a.shape[0]:
+                if small or exp[lag] > 0:   # all small, or the last stored block's: not a whole 2 MB page
+                    b = 0 if small else int(self.SMALL_FROM * exp[lag])
+                    for a in (c, v, v32):   # (an array under 2 MB holds no whole huge page: left alone)
+                        if a.shape[0] and (a.nbytes >= 2 << 20 or not small):
                             small_pages_from(a, b * (a.nbytes // a.shape[0]))
                 set_lag(self._c, self._v, self._v32, lag, c, v, v32)
 
@@ -505,8 +508,9 @@ class LagSet:
         est[:lag_lo - 1] = 0
         cap = 1.15 * est
         mH, mG = self.mH, self.mG
+        small = bool(self.opts.get("small_pages", False))      # -ssi_huge_pages (petsc.lag_small_pages)
         H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=mH,
-                    free=self.cfree[rows] if lag_lo == 1 else None, expected=est)
+                    free=self.cfree[rows] if lag_lo == 1 else None, expected=est, small=small)
         # G: a block for every traction column a row's wave window reaches; room for all of them (never
         # touched beyond what is written: not resident) unless that is more than the node's memory
         gcap = np.full(lag_hi, len(rows) * self.regions.n_t, np.int64)
@@ -514,7 +518,7 @@ class LagSet:
         from ..sysmem import machine_memory, release_freed
         if gcap.sum() * (8.0 * mG + 4) > 0.5 * machine_memory():
             gcap[:] = 0
-        G = Buckets(lag_hi, rows, self.mesh.n_nodes, gcap, single_from=single_from, m=mG)
+        G = Buckets(lag_hi, rows, self.mesh.n_nodes, gcap, single_from=single_from, m=mG, small=small)
         pattern = self.pattern()
         dropped = np.zeros(2)
         nev = 0
