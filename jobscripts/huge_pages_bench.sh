@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# -ssi_huge_pages on against off (the default) in whole runs: each case REPEAT times (default 3) at 1
+# -ssi_huge_pages on against off in whole runs (the default, auto, is one of the two: off for the lag
+# arrays where the machine's balloon reports free pages to its host): each case REPEAT times (default 3) at 1
 # and 2 ranks with numpy's transparent-huge-page advice on and off, alternating (on, off, on, off,
 # ...) so that a slow spell of the machine hits both, all with -log_view; the table
 # (jobscripts/scaling_repeat_table.py, cases named CASE-hpon and CASE-hpoff) gives the fastest and
