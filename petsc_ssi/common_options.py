@@ -36,8 +36,8 @@ register("reproducible", "bool", False, "", "bitwise identical reruns at a fixed
 register("huge_pages", "enum", "auto", "", "transparent huge pages for the large arrays, the stored lag blocks among "
          "them: auto (numpy's advice as numpy has it, on unless NUMPY_MADVISE_HUGEPAGE=0, except that the BEM's lag "
          "arrays get 4 kB pages where the machine is a virtual machine whose balloon hands free memory back to its "
-         "host: there a huge page's first write cost 2-5 times a small page's, and the paper's Lamb case "
-         "assembled in 5.7-5.8 s instead of 9.6-10.2 s, its history sum 0.3 s slower), numpy (numpy's advice for "
+         "host: there a huge page's first write cost 2-4 times a small page's, and the paper's Lamb case "
+         "assembled in 5.2-7.2 s instead of 9.3-10.2 s, its history sum up to 0.3 s slower), numpy (numpy's advice for "
          "every array), on, or off (no huge pages for the lag arrays either). Which is faster is the machine's: "
          "jobscripts/paper_repeat.sh and huge_pages_bench.sh measure it; results do not depend on it", "common",
          choices=("auto", "off", "on", "numpy"))

@@ -54,7 +54,8 @@ def set_huge_pages(mode):
     """numpy's transparent-huge-page advice for the arrays it allocates from now on (-ssi_huge_pages):
     'off', 'on', or 'numpy' and 'auto' (left as it is: numpy's default, on unless
     NUMPY_MADVISE_HUGEPAGE=0, where nothing in the process changed it; with 'auto' the BEM's lag
-    arrays are given small pages where ``sysmem.free_page_reporting``: ``lag_small_pages``). numpy (1.18 on, Linux) asks the kernel with
+    arrays are given small pages where ``sysmem.free_page_reporting``: ``lag_small_pages``).
+    numpy (1.18 on, Linux) asks the kernel with
     madvise(MADV_HUGEPAGE) to back every array of 4 MB and more by 2 MB pages (arrays numba allocates
     inside compiled code are not numpy's: the element cache's pools keep the kernel's default);
     where the kernel then compacts memory on the spot (transparent_hugepage/defrag
@@ -83,11 +84,11 @@ def set_huge_pages(mode):
 def lag_small_pages(mode):
     """Whether the BEM's lag arrays are to be backed by small (4 kB) pages under -ssi_huge_pages
     ``mode``: with 'auto' (the default), where this machine's balloon hands free memory back to its
-    host (``sysmem.free_page_reporting``), since there a huge page's first write costs two to five
+    host (``sysmem.free_page_reporting``), since there a huge page's first write costs two to four
     times a small page's and the assembly writes every stored block into fresh memory (the paper's
-    Lamb case: assembly 5.7-5.8 s against 9.6-10.2 s, the history sum 0.3 s slower from the small
-    pages' address translation: jobscripts/README.md's first-touch section); 'off' too. With 'on'
-    and 'numpy' they follow numpy's advice."""
+    Lamb case on the development VM: assembly 5.2-7.2 s in 14 runs against 9.3-10.2 s in 6, the
+    history sum up to 0.3 s slower from the small pages' address translation: jobscripts/README.md's
+    first-touch section); 'off' too. With 'on' and 'numpy' they follow numpy's advice."""
     if mode == "off":
         return True
     if mode != "auto":

@@ -5,7 +5,6 @@ before any assembly: the surface mesh (``read_surface_mesh``), the regions (load
 the receivers, the lags and the interpolation plan, the node partition (``lagset``) and the
 memory check (``check_memory``). ``bem.build.build_marcher`` then assembles.
 """
-import os
 
 import numpy as np
 

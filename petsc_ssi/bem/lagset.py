@@ -114,7 +114,7 @@ class Buckets:
     not resident) and grow by half when a row finds no room (in the kernel, ``assemble._room``): each
     page is written once, in place. ``small``: every page of them small (madvise MADV_NOHUGEPAGE:
     ``petsc.lag_small_pages``, -ssi_huge_pages auto on a VM that hands free memory back to its host,
-    or off); otherwise numpy's advice holds (huge pages unless ``-ssi_huge_pages off``), except from
+    or off; an array the kernel grows is numba's and gets the system's default); otherwise numpy's advice holds (huge pages unless ``-ssi_huge_pages off``), except from
     ``SMALL_FROM`` of the ``expected`` blocks on (small pages: the 2 MB page holding a lag's last
     block is not faulted in whole: 0.12-0.14 GB a rank counted on the paper case, its measured peak
     0.18 GB lower over the node)."""
