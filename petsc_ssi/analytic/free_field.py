@@ -441,6 +441,30 @@ class HilbertTransform:
         if tg[0] > self.taper_before:     # precursor beyond the window: the tail's value there
             self.tail_level = float(abs(self._tail(np.array([self.taper_before]), 0).imag[0]))
 
+    def set_taper(self, before, width=None):
+        """Taper the acausal precursor before ``before`` (a C2 ramp of ``width``, default 20 dt, ending
+        there; None: no taper). Sets ``support_start`` and ``tail_level``."""
+        self._set_taper(before, width)
+
+    def quiet_before(self, tol, start=0.0):
+        """The latest time tau_b <= ``start`` before which the untapered |H[f]| stays within ``tol``
+        times its largest value (on the computed window, and by the moment expansion beyond it),
+        or None where it does not before -1e6 (f's integral not finite there)."""
+        tg = self._t_first + self.dt * np.arange(self._n + 2 * self._ne)
+        h = np.abs(self._series(0.0)[0][0].imag)
+        lim = float(tol) * float(h.max())
+        if not lim > 0:
+            return float(start)
+        above = np.nonzero(h > lim)[0]
+        if above[0] > 0:
+            return float(min(tg[above[0] - 1], start))
+        t = min(tg[0], -1.0)              # the window's first point already exceeds: the tail, further out
+        while abs(self._tail(np.array([t]), 0).imag[0]) > lim:
+            t *= 2.0
+            if t < -1e6:
+                return None
+        return float(min(t, start))
+
     def _window(self, t):
         """C2 ramp W (0 before support_start, 1 after taper_before) and W', W''."""
         w = self.taper_width
@@ -628,6 +652,25 @@ class PlaneWave:
             return hilbert_of(self.g, t_grid)
         raise FreeFieldError(f"{self.wave} at {self.angle:g} deg needs H[g]: "
                              f"pass hilbert= or t_grid=")
+
+    def taper_precursor(self, tol, width_frac=0.1):
+        """Where the field needs H[g] computed from samples (``hilbert_of``): taper H[g]'s acausal
+        precursor (a ~1/t tail before g starts) from the latest time before which |H[g]| stays within
+        ``tol`` of its largest value (``HilbertTransform.quiet_before``), over a C2 ramp of
+        ``width_frac`` of the precursor's length (at least 20 samples) ending there; ``auto_start``
+        then starts the wave before the ramp. Returns (taper_before, width, tail_level: the largest
+        |H[g]| the taper changes), or None where no H[g] is computed. Raises FreeFieldError where
+        |H[g]| does not fall that low before t = -1e6."""
+        if not self.needs_hilbert or not hasattr(self._hil, "quiet_before"):
+            return None
+        start = float(getattr(self.g, "t_start", 0.0))
+        tb = self._hil.quiet_before(tol, start)
+        if tb is None:
+            raise FreeFieldError(f"H[g] does not fall below {tol:g} of its peak before t = -1e6: g does "
+                                 f"not return to rest")
+        width = max(20.0 * self._hil.dt, width_frac * (start - tb))
+        self._hil.set_taper(tb, width)
+        return tb, width, self._hil.tail_level
 
     # --- public API
     def surface_coefficients(self):

@@ -184,6 +184,7 @@ class SeismicInput:
     def __init__(self, cfg, comm, cs, cp, rho, points, ref, dt):
         self.cfg, self.kind = cfg, cfg.seismic
         self.motions = None
+        self.precursor = None           # (taper_before, width, tail level) of a tapered H[g] (free_field)
         self.motions, self.notes = collective_motions(cfg, comm)
         with collective(comm, f"-ssi_seismic {self.kind}", "{what}: {error}"):
             self.waves = self._waves(cs, cp, rho, _ref_point(cfg.seismic_ref, ref))
@@ -201,16 +202,32 @@ class SeismicInput:
             m = self.motions[""]
             wave = {"sh": "sh", "sv": "sv", "p": "p", "rayleigh": "rayleigh"}[self.kind]
             grid = np.arange(-0.5 * m.duration, 2.0 * m.duration + m.t[-1], max(np.min(np.diff(m.t)), 1e-4))
-            return [PlaneWave(wave, cs, cp, m, angle=c.seismic_angle if wave != "rayleigh" else 0.0,
-                              azimuth=c.seismic_azimuth, x0=x0, control=c.seismic_control,
-                              component=c.seismic_direction, postcritical=c.seismic_postcritical, rho=rho,
-                              t_grid=grid)]
+            w = PlaneWave(wave, cs, cp, m, angle=c.seismic_angle if wave != "rayleigh" else 0.0,
+                          azimuth=c.seismic_azimuth, x0=x0, control=c.seismic_control,
+                          component=c.seismic_direction, postcritical=c.seismic_postcritical, rho=rho,
+                          t_grid=grid)
+            if w.needs_hilbert:
+                self._at_rest(m, grid[-1] - m.t[-1])
+                self.precursor = w.taper_precursor(c.seismic_hilbert_tol)
+            return [w]
         except FreeFieldError as exc:
             msg = str(exc)
             if self.kind == "sv" and "critical" in msg:
                 msg = (f"SV at {c.seismic_angle:g} degrees is beyond the critical angle "
                        f"{critical_angle(cs, cp):.4f} degrees of this soil; add -ssi_seismic_postcritical")
             raise SSIError(msg) from None
+
+    def _at_rest(self, m, after):
+        """Refuse a record whose displacement does not return to rest (a Hilbert transform, which a
+        Rayleigh or post-critical SV field holds, does not exist for a permanent offset or drift):
+        the final displacement, and the drift of the final velocity over the ``after`` seconds the
+        transform's grid reaches past the record, within 1 % of PGD."""
+        pgd, d_end, v_end = (float(np.max(np.abs(m.stats[k]))) for k in ("pgd", "d_end", "v_end"))
+        if d_end > 0.01 * pgd or v_end * after > 0.01 * pgd:
+            raise SSIError(f"the record's displacement does not return to rest (final displacement {d_end:.3g} m, "
+                           f"final velocity {v_end:.3g} m/s, PGD {pgd:.3g} m): the Hilbert transform that "
+                           f"-ssi_seismic {self.kind} needs does not exist for a permanent offset; high-pass filter "
+                           f"the record (-ssi_seismic_highpass, e.g. 0.1 Hz)")
 
     def _start(self, points, dt):
         auto = max(w.auto_start(points, dt) for w in self.waves)
@@ -279,7 +296,14 @@ class SeismicInput:
                 (f", angle {c.seismic_angle:g} deg, azimuth {c.seismic_azimuth:g} deg" if self.kind in ("sh", "sv", "p")
                  else "") + f", control {c.seismic_control}, start t0 = {self.t0:.6g} s, free field until "
                 f"{self.duration:.6g} s")
-        return [head] + record_lines(self.motions, "[ssi]")
+        lines = [head]
+        if self.precursor is not None:
+            tb, w, tail = self.precursor
+            lines.append(f"[ssi]   the field holds H[g], the record's Hilbert transform, which starts before the record: "
+                         f"tapered to zero over {w:.4g} s before {tb:.4g} s of the record (where |H[g]| stays within "
+                         f"{c.seismic_hilbert_tol:g} of its peak: -ssi_seismic_hilbert_tol; largest value tapered "
+                         f"{tail:.3g} m); the wave starts {-(tb - w):.4g} s before the record")
+        return lines + record_lines(self.motions, "[ssi]")
 
     def arrays(self):
         """{name: (array, unit)} of the output group 'seismic': the processed motions (per component)

@@ -33,8 +33,14 @@ register("seismic_direction", "enum", "auto", "", "the surface component the rec
          choices=("auto", "horizontal", "vertical", "transverse"))
 register("seismic_angle", "real", 0.0, "deg", "incidence angle from the vertical, 0 <= angle < 90 (sh, sv, p)", G)
 register("seismic_azimuth", "real", 0.0, "deg", "horizontal propagation direction, from +x toward +y", G)
-register("seismic_postcritical", "bool", False, "", "allow SV beyond the critical angle (Hilbert-transform "
-         "field, acausal tails tapered)", G)
+register("seismic_postcritical", "bool", False, "", "allow SV beyond the critical angle (a Hilbert-transform "
+         "field: its acausal precursor is tapered, -ssi_seismic_hilbert_tol)", G)
+register("seismic_hilbert_tol", "real", 0.01, "", "rayleigh and post-critical SV: the free field holds the "
+         "Hilbert transform H[g] of the record, which begins before the record does (a tail ~1/t where the "
+         "displacement's integral is not zero). It is tapered to zero from where it stays below this fraction "
+         "of its peak, and the automatic start begins the wave before that: smaller is more exact and starts "
+         "earlier (more steps); the run's log gives the length", G,
+         validator=lambda v: None if 0.0 < v < 1.0 else "must lie in (0, 1)")
 register("seismic_ref", "str", "auto", "m", "control point 'x,y' on the surface (auto: the centroid of the "
          "interface, or of the prescribed region, else the origin)", G)
 register("seismic_start", "str", "auto", "s", "time shift t0 of the wave: auto (the smallest that keeps the free "

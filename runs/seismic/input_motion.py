@@ -3,7 +3,9 @@ footing: the numbers runs/seismic/README.md cites (section 'Foundation input mot
 tests/bem/test_input_motion.py and tests/bem/test_haskind.py assert.
 
 Soil c_p 42, c_s 20 m/s, rho 1800 kg/m^3; a 1 m x 1 m footing (box -0.5..0.5) on a 2 m x 2 m surface;
-records: a sin^4 acceleration pulse of length T then the reversed pulse (1 m/s^2).
+records: a sin^4 acceleration pulse of length T then the reversed pulse (1 m/s^2); for the Rayleigh wave
++, -, -, +, -, +, +, - pulses, whose displacement returns to rest with a zero integral (its Hilbert
+transform exists and its precursor is short).
 
 1. ``petsc-ssi input-motion`` under vertical S (x, y) and P (z) at once (T = 0.1 s, 0.5 m elements):
    the footing against the free field.
@@ -39,9 +41,12 @@ SOIL = ["-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", 
         "-ssi_output_stride", "0"]
 
 
-def pulse(path, T, cols=(1.0,)):
-    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
-    a = np.where(t < T, np.sin(np.pi * t / T) ** 4, 0.0) - np.where(t >= T, np.sin(np.pi * (t - T) / T) ** 4, 0.0)
+def pulse(path, T, cols=(1.0,), rest=False):
+    n = 8 if rest else 2         # rest: +, -, -, +, -, +, +, -: the displacement returns to 0 and its integral is 0
+                                 # (a Rayleigh wave's H[g] exists and its precursor falls as 1/t^2, not 1/t)
+    t = np.arange(0.0, n * T + 1e-9, T / 80)
+    a = sum(sg * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
+            for k, sg in enumerate((1, -1, -1, 1, -1, 1, 1, -1)[:n]))
     np.savetxt(path, np.c_[t, np.outer(a, cols)], header="units: m/s2")
     return path
 
@@ -99,7 +104,7 @@ def main():
             rows += [(f"SH60: {k}", f"T={T}", v) for k, v in vals.items()]
         print("\nRayleigh along x, y=sym: max |q - q_ff| / max |q_ff| at the centre")
         for T in (0.2, 0.4):
-            rec = pulse(os.path.join(tmp, f"r{T}.txt"), T)
+            rec = pulse(os.path.join(tmp, f"r{T}.txt"), T, rest=True)
             g = input_motion(tmp, f"ray{T}", ["-ssi_seismic", "rayleigh", "-ssi_seismic_record", rec,
                                               "-ssi_symmetry", "y=sym"])
             q = np.c_[g["translation"], g["rotation"]]
