@@ -140,6 +140,23 @@ def _control(path):
         return "surface", "assumed: the default (neither seismic/control nor the JSON record says)"
 
 
+def _same_control(ssi, fixed):
+    """Refuse a pair of runs whose records drive different motions: -ssi_seismic_control differs, or
+    the fixed base took 'incident' before its base moved as twice the record (its output has no
+    seismic/control then: until 2026-11-26 a fixed base moved as the record itself)."""
+    import h5py
+    c_s, _ = _control(ssi)
+    c_f, said = _control(fixed)
+    if c_s != c_f:
+        raise _error(f"the runs' -ssi_seismic_control differ: {c_s} in {ssi}, {c_f} in {fixed} ({said}): the "
+                     f"bases would not move alike; rerun one of them")
+    with h5py.File(fixed, "r") as f:
+        old = "seismic" in f and "seismic/control" not in f
+    if c_f == "incident" and old:
+        raise _error(f"{fixed}: a fixed base run with -ssi_seismic_control incident by an earlier petsc-ssi, whose "
+                     f"base moved as the record instead of twice it (the free surface); rerun it")
+
+
 def free_field(path, times, component):
     """(step means (n,) [m/s^2] of the free-field surface acceleration along ``component`` at the
     run times ``times`` (0 at the first), one line saying what it is) from the seismic group of
@@ -546,6 +563,7 @@ def main(argv=None, out=None):
         # its sidecars or an HDF5 result; an existing CSV/PNG only with --overwrite
         if _post._same_file(a.file, a.glance):
             raise _error(f"--glance {a.glance}: the same file as SSI.h5")
+        _same_control(a.file, a.glance)
         ps = load_ssi(a.file, a.receiver, a.component)
         pf = load_fixed(a.glance, a.receiver, a.component)
         S, F = ({"pair": p, "b": a.ko_b} for p in (ps, pf))

@@ -142,6 +142,9 @@ class SupportMotion:
             raise SSIError(f"-ssi_seismic {cfg.seismic}: a fixed base moves as one: the structure alone (-ssi_problem "
                            "fem) takes -ssi_seismic vertical (one record per component)")
         self.cfg, self.kind = cfg, cfg.seismic
+        # the base moves as the free surface: the record itself (control surface), or twice the incident
+        # wave it gives (control incident: at vertical incidence S and P double at the free surface)
+        self.factor = 2.0 if cfg.seismic_control == "incident" else 1.0
         self.motions, self.notes = collective_motions(cfg, comm)
         t0 = _start(cfg)
         self.t0 = cfg.dt if t0 is None else t0
@@ -151,7 +154,7 @@ class SupportMotion:
         """The ground's velocity along ``axis`` at times t (any shape) [m/s]."""
         m = self.motions.get(axis)
         t = np.asarray(t, float)
-        return np.zeros_like(t) if m is None else m(t - self.t0, 1)
+        return np.zeros_like(t) if m is None else self.factor * m(t - self.t0, 1)
 
     def mean_acceleration(self, axis, t0, t1):
         """The mean ground acceleration along ``axis`` over [t0, t1] (arrays allowed) [m/s^2]."""
@@ -161,15 +164,20 @@ class SupportMotion:
         """The ground's acceleration along ``axis`` at times t (any shape) [m/s^2]."""
         m = self.motions.get(axis)
         t = np.asarray(t, float)
-        return np.zeros_like(t) if m is None else m(t - self.t0, 2)
+        return np.zeros_like(t) if m is None else self.factor * m(t - self.t0, 2)
 
     def summary_lines(self):
         lines = [f"[fem] support motion (-ssi_seismic vertical, fixed base, relative-motion form): start t0 = "
-                 f"{self.t0:.6g} s, record until {self.duration:.6g} s"]
+                 f"{self.t0:.6g} s, record until {self.duration:.6g} s, control {self.cfg.seismic_control}"
+                 + (" (the base moves as the free surface: twice the incident record)" if self.factor != 1.0
+                    else "")]
         return lines + record_lines(self.motions, "[fem]")
 
     def arrays(self):
-        return motion_arrays(self.motions, self.t0)
+        out = motion_arrays(self.motions, self.t0)
+        out["control"] = (np.bytes_(self.cfg.seismic_control), "-ssi_seismic_control: surface (the base moves as "
+                          "the record) or incident (as twice the record: the free surface at vertical incidence)")
+        return out
 
 
 class SeismicInput:

@@ -243,3 +243,35 @@ def test_two_ranks_equal_one(tmp_path, record):
             out[n] = (f["interface/ub"][()], f["interface/p"][()], f["receivers/u"][()])
     for a, b in zip(out[1], out[2]):
         assert np.abs(a - b).max() <= 1e-9 * max(np.abs(b).max(), 1e-300)
+
+
+def test_fixed_base_takes_the_incident_control(tmp_path, record, capsys):
+    """-ssi_seismic_control incident (the record is the incident wave; at vertical incidence the free
+    surface moves twice it): the fixed base moves as the free surface, twice the record, so its
+    ground acceleration and its (linear) response are exactly twice those of control surface. Until
+    2026-11-26 it moved as the record (an independent test found the glance then reported SSI / fixed
+    ratios of 2.0). The glance refuses a pair whose controls differ, and takes the pair that agrees:
+    the coupled run's free field equals the fixed base's ground acceleration."""
+    from helpers import cli
+    from petsc_ssi.app import glance, post
+    common = _fem_only(TOWER) + ["-ssi_seismic_record", record, "-ssi_dt", "0.0125", "-ssi_t_end", "0.5"]
+    fem = ["-ssi_problem", "fem", "-ssi_fem_fixed", "base", "-ssi_receivers", "0,0,2"]
+    out = {c: tmp_path / f"fixed-{c}.h5" for c in ("surface", "incident")}
+    for c, path in out.items():
+        cli(fem + common + ["-ssi_output", str(path), "-ssi_seismic_control", c])
+    t, g_s, _, _ = post.read_series(str(out["surface"]), "receivers/ground_acceleration", 0, "x")
+    _, g_i, _, _ = post.read_series(str(out["incident"]), "receivers/ground_acceleration", 0, "x")
+    _, u_s, _, _ = post.read_series(str(out["surface"]), "receivers/u", 0, "x")
+    _, u_i, _, _ = post.read_series(str(out["incident"]), "receivers/u", 0, "x")
+    assert np.abs(g_s).max() > 0.5 and np.abs(u_s).max() > 0
+    assert np.abs(g_i - 2 * g_s).max() <= 1e-12 * np.abs(g_s).max()
+    assert np.abs(u_i - 2 * u_s).max() <= 1e-9 * np.abs(u_s).max()
+    ssi = tmp_path / "ssi.h5"
+    cli(["-ssi_problem", "ssi", "-ssi_cp", "40", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
+         "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_structure_receivers", "0,0,2", "-ssi_warn_beta",
+         "0", "-ssi_output", str(ssi), "-ssi_seismic_control", "incident"] + common)
+    assert glance.main([str(ssi), "--glance", str(out["surface"])]) == 2
+    assert "-ssi_seismic_control differ" in capsys.readouterr().err
+    assert glance.main([str(ssi), "--glance", str(out["incident"])]) == 0
+    ff, _ = glance.free_field(str(ssi), t, "x")
+    assert np.abs(ff - g_i[:, 0]).max() <= 1e-12 * np.abs(g_i).max()
