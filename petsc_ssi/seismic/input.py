@@ -87,8 +87,13 @@ def _records(cfg):
                            component=comp)
     if c.seismic != "vertical":
         return {"": read(c.seismic_record, c.seismic_component or None)}
+    traces = [x.strip() for x in c.seismic_traces.split(",")] if c.get("seismic_traces") else [None] * 3
+    traces = [int(x) if x is not None and x.isdigit() else x for x in traces]     # an index, or a channel
     if not c.seismic_record:
-        return {a: read(c.get(f"seismic_record_{a}")) for a in AXES if c.get(f"seismic_record_{a}")}
+        return {a: read(c.get(f"seismic_record_{a}"), tr) for a, tr in zip(AXES, traces)
+                if c.get(f"seismic_record_{a}") and tr != "-"}
+    if c.get("seismic_traces"):                                    # one multi-trace file, a trace per axis
+        return {a: read(c.seismic_record, tr) for a, tr in zip(AXES, traces) if tr != "-"}
     rec = read(c.seismic_record)
     if np.ndim(rec.values) == 2:                                   # a 't ax ay az' table
         return {a: dataclasses.replace(rec, values=rec.values[:, k]) for k, a in enumerate(AXES)}

@@ -24,6 +24,10 @@ register("seismic_units", "str", "auto", "", "record units: auto (the file's), g
          "cm, mm", G)
 register("seismic_component", "str", "", "", "the trace of a multi-trace ObsPy file (channel code suffix or "
          "index) or the column of a 4-column table (x, y, z)", G)
+register("seismic_traces", "str", "", "", "-ssi_seismic vertical with multi-trace files (miniSEED, SAC, ... "
+         "through ObsPy): the traces that drive x, y and z, e.g. 'E,N,Z', 'HNE,HNN,HNZ' or '0,1,2' (a channel "
+         "code, its suffix or the trace's index; '-' leaves an axis out); with one file in -ssi_seismic_record "
+         "each listed trace drives its axis, with -ssi_seismic_record_x/_y/_z each file gives its axis's trace", G)
 register("seismic_scale", "real", 1.0, "", "amplitude factor after unit conversion", G)
 register("seismic_control", "enum", "surface", "", "surface: the record is the free-field surface (outcrop) "
          "motion at the control point; incident: the record is the incident wave (the surface motion is twice "
@@ -75,10 +79,20 @@ def _checks(cfg):
                    "-ssi_seismic_record_x/_y/_z"
         if cfg.seismic_record and any(comps):
             return "-ssi_seismic vertical: give either -ssi_seismic_record or -ssi_seismic_record_x/_y/_z, not both"
+        if cfg.seismic_traces:
+            tr = [x.strip() for x in cfg.seismic_traces.split(",")]
+            if len(tr) != 3 or any(not x for x in tr) or all(x == "-" for x in tr):
+                return f"-ssi_seismic_traces {cfg.seismic_traces}: give three traces x,y,z (a channel code, its " \
+                       "suffix or an index; '-' leaves an axis out), e.g. E,N,Z"
+            if cfg.seismic_record and cfg.user_set("seismic_component"):
+                return "-ssi_seismic_traces and -ssi_seismic_component: give one (traces: x,y,z of a multi-trace file)"
     else:
         if any(comps):
             return f"-ssi_seismic_record_x/_y/_z are for -ssi_seismic vertical; -ssi_seismic {w} takes " \
                    "-ssi_seismic_record"
+        if cfg.seismic_traces:
+            return f"-ssi_seismic_traces is for -ssi_seismic vertical (three axes); -ssi_seismic {w} takes one " \
+                   "trace: -ssi_seismic_component"
         if not cfg.seismic_record:
             return f"-ssi_seismic {w}: give the record (-ssi_seismic_record FILE)"
     if w in ("sh", "sv", "p") and not 0.0 <= cfg.seismic_angle < 90.0:

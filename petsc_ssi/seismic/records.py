@@ -314,7 +314,9 @@ def _read_obspy(path, raw, fmt, component):
 def _pick_trace(path, st, component):
     if component is None:
         if len(st) != 1:
-            _refuse(path, f"{len(st)} traces ({', '.join(tr.id for tr in st)}): give component=")
+            _refuse(path, f"{len(st)} traces ({', '.join(tr.id for tr in st)}): say which (-ssi_seismic_component C "
+                          f"for one record; -ssi_seismic_traces X,Y,Z for -ssi_seismic vertical: a channel code, its "
+                          f"suffix or the trace's index per axis)")
         return st[0]
     if isinstance(component, (int, np.integer)):
         if not 0 <= component < len(st):

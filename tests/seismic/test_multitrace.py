@@ -1,0 +1,61 @@
+"""-ssi_seismic vertical from multi-trace files (miniSEED through ObsPy): -ssi_seismic_traces says
+which trace drives x, y and z. Found by an independent test (2026-11-26): a 3-component miniSEED
+could drive -ssi_seismic sv (-ssi_seismic_component N) but not vertical, in any form, and the error
+named a Python keyword ('give component=') instead of an option."""
+import h5py
+import numpy as np
+import pytest
+
+from helpers import cli
+
+FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_box_size", "1,1,1", "-ssi_fem_box_origin",
+       "-0.5,-0.5,0", "-ssi_fem_E", "3e7", "-ssi_fem_rho", "2000", "-ssi_fem_fixed", "base", "-ssi_dt", "0.01",
+       "-ssi_t_end", "0.2", "-ssi_receivers", "0,0,1", "-ssi_seismic", "vertical", "-ssi_seismic_units", "m/s2",
+       "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none"]
+
+
+@pytest.fixture(scope="module")
+def three(tmp_path_factory):
+    """HNE, HNN, HNZ traces at 100 Hz: a sin^4 pulse of 1, 2 and 3 m/s^2 (written in the order Z, E, N)."""
+    obspy = pytest.importorskip("obspy")
+    t = np.arange(0.0, 0.5, 0.01)
+    p = np.where(t < 0.3, np.sin(np.pi * t / 0.3) ** 4, 0.0)
+    traces = [obspy.Trace(data=(amp * p).astype(np.float64),
+                          header={"network": "XX", "station": "SSI", "channel": ch, "sampling_rate": 100.0})
+              for ch, amp in (("HNZ", 3.0), ("HNE", 1.0), ("HNN", 2.0))]
+    path = tmp_path_factory.mktemp("ms") / "three.mseed"
+    obspy.Stream(traces).write(str(path), format="MSEED")
+    return str(path)
+
+
+def _pga(path):
+    with h5py.File(path, "r") as f:
+        return {a: float(f[f"seismic/{a}_raw_pga"][()]) for a in "xyz" if f"seismic/{a}_raw_pga" in f}
+
+
+@pytest.mark.parametrize("form,expect", [
+    (["-ssi_seismic_traces", "E,N,Z"], {"x": 1.0, "y": 2.0, "z": 3.0}),
+    (["-ssi_seismic_traces", "HNN,-,0"], {"x": 2.0, "z": 3.0}),                 # a channel code, none, an index
+    (["-ssi_seismic_record_x", "F", "-ssi_seismic_record_z", "F", "-ssi_seismic_traces", "N,E,Z"], {"x": 2.0, "z": 3.0}),
+])
+def test_each_axis_takes_its_trace(tmp_path, three, form, expect):
+    out = tmp_path / "o.h5"
+    args = FEM + ["-ssi_output", str(out)] + [three if x == "F" else x for x in form]
+    if "-ssi_seismic_record_x" not in form:
+        args += ["-ssi_seismic_record", three]
+    cli(args)
+    got = _pga(out)
+    assert set(got) == set(expect) and all(abs(got[a] - expect[a]) < 1e-12 for a in expect), got
+
+
+@pytest.mark.parametrize("extra,words", [
+    ([], "-ssi_seismic_traces X,Y,Z"),
+    (["-ssi_seismic_traces", "E,N"], "give three traces"),
+    (["-ssi_seismic_traces", "E,N,Q"], "'Q' matches 0 of the traces"),
+])
+def test_a_multi_trace_file_without_its_traces_is_refused_in_one_line(tmp_path, three, extra, words):
+    p = cli(FEM + ["-ssi_output", str(tmp_path / "o.h5"), "-ssi_seismic_record", three] + extra, nranks=2,
+            check=False, timeout=300)
+    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
+    assert words in errors[0], errors[0]
