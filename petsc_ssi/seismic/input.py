@@ -115,14 +115,31 @@ def read_motions(cfg):
         if m.duration < c.dt:
             raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
                            f"dt = {c.dt:g} s")
+        if not float(np.max(np.abs(m.a))) > 0.0:
+            raise SSIError(f"record '{rec.source}'" + (f" ({axis})" if axis else "") + ": its acceleration is zero "
+                           "everywhere after processing: no motion to apply")
         out[axis] = m
     return out
+
+
+def _unused_angle_notes(cfg):
+    """Notes for an azimuth that does not change the wave: -ssi_seismic vertical (each record drives its
+    axis) and P at vertical incidence (it moves z alone)."""
+    if not cfg.user_set("seismic_azimuth") or cfg.seismic_azimuth == 0.0:
+        return []
+    if cfg.seismic == "vertical":
+        return [f"-ssi_seismic_azimuth {cfg.seismic_azimuth:g} is not used by -ssi_seismic vertical (each "
+                "record drives its own axis x, y or z)"]
+    if cfg.seismic == "p" and cfg.seismic_angle == 0.0:
+        return [f"-ssi_seismic_azimuth {cfg.seismic_azimuth:g} does not change P at vertical incidence (it moves "
+                "z alone)"]
+    return []
 
 
 def collective_motions(cfg, comm):
     """Collective: (motions, notes): ``read_motions`` on rank 0, broadcast; the processing's
     warnings (``RecordWarning``) as one-line notes; one-line SSIError on every rank on a defect."""
-    motions, notes = None, []
+    motions, notes = None, _unused_angle_notes(cfg)
     with collective(comm, "-ssi_seismic", "{what}: {error}"):
         if comm.getRank() == 0:
             with warnings.catch_warnings(record=True) as caught:
@@ -131,7 +148,7 @@ def collective_motions(cfg, comm):
                     motions = read_motions(cfg)
                 except RecordError as exc:
                     raise SSIError(str(exc)) from None
-            notes = [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
+            notes += [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
     return comm.tompi4py().bcast((motions, notes), root=0)
 
 

@@ -173,8 +173,21 @@ def _detect(path, raw, fmt):
     lines = raw.decode("latin-1").splitlines()
     if lines and "PEER" in lines[0].upper() or len(lines) > 3 and _npts_match(lines[3]):
         return "peer"
-    first = next((ln for ln in (re.sub(r"#.*", "", x).strip() for x in lines) if ln), "")
-    return "table" if re.fullmatch(r"[-+0-9.eE,\s]+", first) else "obspy"
+    rows = [ln for ln in (re.sub(r"#.*", "", x).strip() for x in lines[:50]) if ln][:2]
+    if rows and _numeric_row(rows[0]):
+        return "table"
+    if len(rows) == 2 and _header_row(rows[0]) and _numeric_row(rows[1]):
+        return "table"                                      # a table under a row of column names
+    return "obspy"
+
+
+def _numeric_row(line):
+    return re.fullmatch(r"[-+0-9.eE,\s]+", line) is not None
+
+
+def _header_row(line):
+    """Column names ('time,acc', 't [s]  a [m/s2]'): words, no digits leading a field."""
+    return re.fullmatch(r"[A-Za-z_][\w\s,;/\[\]().*^-]*", line) is not None
 
 
 def _npts_match(line):
@@ -236,6 +249,7 @@ def _peer_line4(path, line):
 
 
 def _floats(path, tokens):
+    tokens = [t.replace("D", "E").replace("d", "e") for t in tokens]      # Fortran's 0.1D-02 too
     try:
         return np.array(tokens, dtype=float)
     except ValueError:
@@ -253,7 +267,11 @@ def _is_float(s):
 
 def _read_table(path, raw, fmt, component):
     text = raw.decode("latin-1")
-    body = re.sub(r"#.*", "", text).replace(",", " ")
+    lines = re.sub(r"#.*", "", text).splitlines()
+    first = next((k for k, ln in enumerate(lines) if ln.strip()), None)
+    if first is not None and _header_row(lines[first].strip()):
+        lines[first] = ""                                   # a row of column names
+    body = "\n".join(lines).replace(",", " ")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
@@ -297,7 +315,11 @@ def _read_obspy(path, raw, fmt, component):
     try:
         st = obspy.read(io.BytesIO(raw), format=f)
     except Exception as exc:                               # ObsPy raises many kinds
-        _refuse(path, f"not a PEER file, a table or a format ObsPy reads ({type(exc).__name__}: {exc})")
+        msg = str(exc)
+        if "Unknown format" in msg or "tmp" in msg:         # (ObsPy names its temporary copy, not this file)
+            msg = "ObsPy does not recognise its format"
+        _refuse(path, f"not a PEER file, a table of numbers (optionally under one row of column names) or a "
+                      f"format ObsPy reads ({type(exc).__name__}: {msg})")
     tr = _pick_trace(path, st, component)
     form = tr.stats.get("_format", f or "")
     vals = np.asarray(tr.data, dtype=float)
