@@ -115,10 +115,11 @@ def read_motions(cfg):
         if m.duration < c.dt:
             raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
                            f"dt = {c.dt:g} s")
-        if not float(np.max(np.abs(m.a))) > 0.0:
-            raise SSIError(f"record '{rec.source}'" + (f" ({axis})" if axis else "") + ": its acceleration is zero "
-                           "everywhere after processing: no motion to apply")
         out[axis] = m
+    if not any(float(np.max(np.abs(m.a))) > 0.0 for m in out.values()):     # (a zero column of 't ax ay az': fine)
+        srcs = sorted({str(m.source) for m in out.values()})
+        raise SSIError(f"record '{', '.join(srcs)}': its acceleration is zero everywhere after processing: no motion "
+                       "to apply")
     return out
 
 
