@@ -162,6 +162,10 @@ class HalfSpace:
             printf(line)
         for note in self.seismic.notes:
             warn(note, self.comm)
+        if cfg.t_end <= self.seismic.t0:
+            warn(f"-ssi_t_end {cfg.t_end:g} s ends before the record starts (t0 = {self.seismic.t0:.6g} s of run time: "
+                 f"the wave's lead, see the seismic input line): the run sees only the free field's lead; give a "
+                 f"later -ssi_t_end or leave it out (the run then lasts the record)", self.comm)
         return self.seismic
 
     def _seismic_symmetry(self):

@@ -238,7 +238,7 @@ class SeismicInput:
                           component=c.seismic_direction, postcritical=c.seismic_postcritical, rho=rho,
                           t_grid=grid)
             if w.needs_hilbert:
-                self._at_rest(m, grid[-1] - m.t[-1])
+                self._at_rest(m)
                 self.precursor = w.taper_precursor(c.seismic_hilbert_tol)
             return [w]
         except FreeFieldError as exc:
@@ -248,13 +248,13 @@ class SeismicInput:
                        f"{critical_angle(cs, cp):.4f} degrees of this soil; add -ssi_seismic_postcritical")
             raise SSIError(msg) from None
 
-    def _at_rest(self, m, after):
+    def _at_rest(self, m):
         """Refuse a record whose displacement does not return to rest (a Hilbert transform, which a
         Rayleigh or post-critical SV field holds, does not exist for a permanent offset or drift):
-        the final displacement, and the drift of the final velocity over the ``after`` seconds the
-        transform's grid reaches past the record, within 1 % of PGD."""
-        pgd, d_end, v_end = (float(np.max(np.abs(m.stats[k]))) for k in ("pgd", "d_end", "v_end"))
-        if d_end > 0.01 * pgd or v_end * after > 0.01 * pgd:
+        the final displacement within 1 % of PGD, the final velocity within 1 % of PGV (the record
+        processing's own warning level)."""
+        pgd, pgv, d_end, v_end = (float(np.max(np.abs(m.stats[k]))) for k in ("pgd", "pgv", "d_end", "v_end"))
+        if d_end > 0.01 * pgd or v_end > 0.01 * pgv:
             raise SSIError(f"the record's displacement does not return to rest (final displacement {d_end:.3g} m, "
                            f"final velocity {v_end:.3g} m/s, PGD {pgd:.3g} m): the Hilbert transform that "
                            f"-ssi_seismic {self.kind} needs does not exist for a permanent offset; high-pass filter "

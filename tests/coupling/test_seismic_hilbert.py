@@ -108,3 +108,14 @@ def test_a_record_not_at_rest_is_refused(tmp_path):
     assert r.returncode == 2 and len(errors) == 1, r.stdout[-2000:] + r.stderr[-2000:]
     assert "does not return to rest" in errors[0] and "-ssi_seismic_highpass" in errors[0], errors[0]
     assert "assembly" not in r.stdout
+
+
+def test_a_run_ending_before_the_record_is_warned(tmp_path, dpulse):
+    """-ssi_t_end before the wave's lead is over (the taper begins about 4 s before this record)."""
+    args = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "0.5", "-ssi_cp", "42", "-ssi_cs", "20",
+            "-ssi_dt", "0.006", "-ssi_t_end", "0.06", "-ssi_seismic", "rayleigh", "-ssi_seismic_record", dpulse,
+            "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none", "-ssi_output", str(tmp_path / "o.h5"),
+            "-ssi_warn_beta", "0"]
+    p = cli(args)
+    said = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning:") and "before the record" in ln]
+    assert len(said) == 1 and "-ssi_t_end 0.06 s" in said[0], p.stdout
