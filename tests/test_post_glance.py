@@ -277,3 +277,17 @@ def test_refuses_an_oblique_wave_and_a_run_without_earthquake(tmp_path, capsys):
         del f.attrs["seismic"]
     status, _, err = run([s, "--glance", fx], capsys)
     assert status == 2 and "without an earthquake" in err
+
+
+def test_an_undamped_fixed_base_has_no_damping_ratio(tmp_path, capsys):
+    """An undamped fixed base (zeta 0: the fit's floor, about 1e-30 in an independent test's run) is
+    shown as undamped with no SSI / fixed ratio (that test's glance printed 3.5e+26)."""
+    s = write_ssi(str(tmp_path))
+    fx = write_fixed(str(tmp_path), zeta=0.0)
+    status, out, err = run([s, "--glance", fx, "--csv", tmp_path / "g.csv"], capsys)
+    assert status == 0, err
+    line = next(ln for ln in out.splitlines() if ln.startswith("| damping ratio zeta"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    assert cells[3] == "< 1e-06 (undamped)" and cells[4] == "", line
+    z = read_csv(tmp_path / "g.csv")["damping ratio zeta (SDOF fit)"]
+    assert z[2] < 1e-6 and math.isnan(z[3])

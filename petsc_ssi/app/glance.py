@@ -428,8 +428,10 @@ def table(S, F):
     def row(q, u, a, b, ratio=True):
         r = a / b if (ratio and a is not None and b is not None and b != 0) else None
         return (q, u, a, b, r)
+    zs, zf = S["fit"].zeta, F["fit"].zeta
     rows = [row("first frequency f0 (SDOF fit)", "Hz", S["fit"].f0, F["fit"].f0),
-            row("damping ratio zeta (SDOF fit)", "-", S["fit"].zeta, F["fit"].zeta),
+            # (a damping ratio under UNDAMPED is the fit's round-off of an undamped structure: no ratio)
+            row("damping ratio zeta (SDOF fit)", "-", zs, zf, ratio=zf >= UNDAMPED),
             row("period T0 = 1/f0 (ratio: period lengthening)", "s", 1 / S["fit"].f0, 1 / F["fit"].f0),
             row(f"peak of the smoothed spectral ratio (Konno-Ohmachi b = {S['b']:g}) at", "Hz",
                 S["ratio"].f_peak, F["ratio"].f_peak),
@@ -447,8 +449,15 @@ def table(S, F):
     return rows
 
 
-def _fmt(v):
-    return "not recorded" if v is None else f"{v:.4g}"
+UNDAMPED = 1e-6        # an identified damping ratio below this is shown as such (the fit's floor of an undamped run)
+
+
+def _fmt(v, q=""):
+    if v is None:
+        return "not recorded"
+    if q.startswith("damping ratio") and 0 <= v < UNDAMPED:
+        return f"< {UNDAMPED:g} (undamped)"
+    return f"{v:.4g}"
 
 
 def text_table(rows, S, F):
@@ -458,7 +467,7 @@ def text_table(rows, S, F):
             a_s = _fmt(a) + (f" (storey {S['demands']['drift'][1]})" if a is not None else "")
             b_s = _fmt(b) + (f" (storey {F['demands']['drift'][1]})" if b is not None else "")
         else:
-            a_s, b_s = _fmt(a), _fmt(b)
+            a_s, b_s = _fmt(a, q), _fmt(b, q)
         out.append(f"| {q} | {u} | {a_s} | {b_s} | {'' if r is None else f'{r:.4g}'} |")
     return out
 
@@ -615,6 +624,9 @@ def _header(S, F, a):
     note = _points_note(ps.point, pf.point)
     if note:
         lines.append(note)
+    if S["demands"]["drift"] is not None or F["demands"]["drift"] is not None:
+        lines.append("drift: with SSI the storeys' total drift (the foundation's rocking included), on the fixed "
+                     "base their deformation drift (group demands of each structure output)")
     lines.append("identification: f_peak = the largest value of the ratio of Konno-Ohmachi smoothed amplitude "
                  f"spectra (b = {a.ko_b:g}); f0, zeta = output-error least-squares fit of an SDOF "
                  "oscillator's absolute acceleration, c0 g + c1 a_abs(f0, zeta), to the band-passed roof "
