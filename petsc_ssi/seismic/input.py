@@ -137,6 +137,24 @@ def _unused_angle_notes(cfg):
     return []
 
 
+NYQUIST_SHARE = 0.05     # of a record's acceleration energy above the run's Nyquist frequency: said
+
+
+def _nyquist_notes(motions, dt):
+    """A note per record with more than NYQUIST_SHARE of its acceleration's energy above 1 / (2 dt):
+    the run takes the record's mean over each step, which filters (and partly folds) that content."""
+    from .records import energy_above
+    out = []
+    fn = 0.5 / dt
+    for axis, m in motions.items():
+        share = float(np.max(energy_above(m.t, m.a, fn)))
+        if share > NYQUIST_SHARE:
+            out.append(f"record '{m.source}'" + (f" ({axis})" if axis else "") + f": {100 * share:.0f} % of its "
+                       f"acceleration's energy lies above the run's Nyquist frequency 1 / (2 dt) = {fn:.4g} Hz; the "
+                       f"run takes its mean over each step of {dt:g} s, which filters it: a smaller -ssi_dt resolves it")
+    return out
+
+
 def collective_motions(cfg, comm):
     """Collective: (motions, notes): ``read_motions`` on rank 0, broadcast; the processing's
     warnings (``RecordWarning``) as one-line notes; one-line SSIError on every rank on a defect."""
@@ -150,6 +168,7 @@ def collective_motions(cfg, comm):
                 except RecordError as exc:
                     raise SSIError(str(exc)) from None
             notes += [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
+            notes += _nyquist_notes(motions, cfg.dt)
     return comm.tompi4py().bcast((motions, notes), root=0)
 
 

@@ -604,6 +604,21 @@ def _fmt(x, spec=".4g"):
     return "/".join(format(float(v), spec) for v in np.atleast_1d(x))
 
 
+def energy_above(t, a, f):
+    """The fraction of the energy (sum of |A(f)|^2) of the acceleration samples ``a`` at times ``t``
+    (uniform, or linearly resampled at their smallest step) above the frequency ``f`` [Hz]; per
+    column for (n, 3) ``a``."""
+    t, a = np.asarray(t, float), np.asarray(a, float)
+    h = float(np.min(np.diff(t)))
+    if not np.allclose(np.diff(t), h, rtol=1e-6, atol=0):
+        tu = np.arange(t[0], t[-1] + 0.5 * h, h)
+        a = np.stack([np.interp(tu, t, c) for c in np.atleast_2d(a.T)], axis=1).reshape((len(tu),) + a.shape[1:])
+    A = np.abs(np.fft.rfft(a, axis=0)) ** 2
+    fr = np.fft.rfftfreq(a.shape[0], h)
+    tot = A.sum(axis=0)
+    return np.where(tot > 0, A[fr > f].sum(axis=0) / np.where(tot > 0, tot, 1.0), 0.0)
+
+
 @dataclasses.dataclass(eq=False)
 class Motion:
     """Processed control motion: samples t, a, v, d (SI) and the time function motion(t, deriv).

@@ -60,3 +60,20 @@ def test_a_record_of_zeros_is_refused_and_an_unused_azimuth_is_said(tmp_path):
     p = cli(FEM + ["-ssi_seismic_record", str(r), "-ssi_seismic_azimuth", "30", "-ssi_output", str(tmp_path / "a.h5")])
     said = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning:") and "azimuth" in ln]
     assert len(said) == 1 and "not used by -ssi_seismic vertical" in said[0], p.stdout
+
+
+def test_content_above_the_runs_nyquist_frequency_is_said(tmp_path):
+    """A 30 Hz harmonic record under steps of 0.02 s (Nyquist 25 Hz): said; under 0.005 s: not."""
+    r = tmp_path / "h30.txt"
+    t = np.arange(0.0, 1.0, 0.002)
+    np.savetxt(r, np.c_[t, np.sin(2 * np.pi * 30 * t) * np.sin(np.pi * t) ** 2])
+    for dt, said in (("0.02", 1), ("0.005", 0)):
+        p = cli([x if x != "0.01" else dt for x in FEM] + ["-ssi_seismic_record", str(r),
+                                                             "-ssi_output", str(tmp_path / f"n{dt}.h5")])
+        lines = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning:") and "Nyquist" in ln]
+        assert len(lines) == said, p.stdout
+        if said:
+            assert "25 Hz" in lines[0] and "-ssi_dt" in lines[0]
+    from petsc_ssi.seismic.records import energy_above
+    assert energy_above(t, np.sin(2 * np.pi * 30 * t), 25.0) > 0.99
+    assert energy_above(t, np.sin(2 * np.pi * 30 * t), 35.0) < 0.01
