@@ -74,8 +74,16 @@ def motion_arrays(motions, t0):
             out[pre + name] = (arr, unit)
         out[pre + "sha256"] = (np.bytes_(m.sha256), "SHA-256 of the record file")
         out[pre + "source"] = (np.bytes_(str(m.source)), "path")
-    out["t0"] = (np.array(t0), "s (run time = record time + t0)")
+        out[pre + "record_t0"] = (np.array(float(m.record_t0)), "s: the record's time at the motion's t = 0 (record "
+                                  "time = motion time t + record_t0; before the record's first kept sample when a "
+                                  "high-pass pad leads it)")
+    out["t0"] = (np.array(t0), "s (run time = motion time t + t0)")
     return out
+
+
+def record_start(motions, t0):
+    """Run time [s] of the first kept sample of the records (after a high-pass's leading pad)."""
+    return t0 + max(float(m.processing.get("highpass_pad_s", 0.0)) for m in motions.values())
 
 
 def _records(cfg):

@@ -403,9 +403,12 @@ def _l2(x, y, t):
     return np.sum(h * (2 * x[:-1] * y[:-1] + x[:-1] * y[1:] + x[1:] * y[:-1] + 2 * x[1:] * y[1:]) / 6, axis=0)
 
 
-def to_acceleration(t, x, quantity):
+def to_acceleration(t, x, quantity, at_rest=True):
     """(a, v0, d0): the piecewise-linear a (module docstring, step 5) whose exact integral from
-    (v0, d0) passes through the samples x (n, c) of the given quantity."""
+    (v0, d0) passes through the samples x (n, c) of the given quantity. A displacement's spline
+    starts with zero velocity where ``at_rest`` (a record that starts at rest: processed records,
+    whose start ``process`` checks), else with its own slope (not-a-knot: the raw record's
+    statistics, whose start may be moving)."""
     x = _as2d(x)
     if quantity == "acceleration":
         return x.copy(), 0.0, 0.0
@@ -417,12 +420,15 @@ def to_acceleration(t, x, quantity):
         return p + c * sign, x[0].copy(), 0.0
     from scipy.interpolate import CubicSpline
     zero = np.zeros(x.shape[1])
-    spline = CubicSpline(t, x, axis=0, bc_type=((1, zero), (2, zero)))
-    return spline(t, 2), 0.0, x[0].copy()
+    if at_rest:
+        spline = CubicSpline(t, x, axis=0, bc_type=((1, zero), (2, zero)))
+        return spline(t, 2), 0.0, x[0].copy()
+    spline = CubicSpline(t, x, axis=0)
+    return spline(t, 2), spline(t[0], 1), x[0].copy()
 
 
 def _kinematics(t, x, quantity):
-    a, v0, d0 = to_acceleration(t, x, quantity)
+    a, v0, d0 = to_acceleration(t, x, quantity, at_rest=False)
     v, d = integrate(t, a, v0, d0)
     return a, v, d
 
@@ -569,6 +575,8 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
     if baseline != "none":
         xw = xw - (x[:i0] if i0 >= 2 else xw).mean(0)
     tm = t[i0:i1 + 1] - t[i0] + pad_start
+    if taper == 0:
+        _check_start_at_rest(path, tm, xw, record.quantity)
     a, v0, d0 = to_acceleration(tm, xw * hann_taper(tm, taper)[:, None], record.quantity)
     npad = 0
     if highpass > 0:
@@ -591,6 +599,31 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
                     record_info=_record_info(record), processing=proc, ndim=np.ndim(record.values))
     motion.warn()
     return motion
+
+
+def _check_start_at_rest(path, t, x, quantity):
+    """Refuse an untapered velocity or displacement record that does not start at rest: the motion
+    is at rest before its first sample, so a first velocity (or a displacement's first value or
+    slope) would be a jump, an impulse of acceleration the record does not hold. Limits: 1 % of
+    the record's peak of that quantity (the slope against the peak of the differences)."""
+    x = _as2d(x)
+    if quantity == "acceleration" or len(t) < 2:
+        return
+    how = ("taper it (-ssi_seismic_taper, e.g. 0.05) or window it from where it is at rest "
+           "(-ssi_seismic_window)")
+    if quantity == "velocity":
+        v0, pgv = np.abs(x[0]), np.abs(x).max(0)
+        if np.any(v0 > 0.01 * pgv):
+            _refuse(path, f"the velocity record does not start at rest (first sample {_fmt(v0)} m/s, PGV "
+                          f"{_fmt(pgv)} m/s): with no taper the run would start it with a jump; {how}")
+        return
+    slope = np.abs(x[1] - x[0]) / (t[1] - t[0])
+    rate = (np.abs(np.diff(x, axis=0)) / np.diff(t)[:, None]).max(0)
+    d0, pgd = np.abs(x[0]), np.abs(x).max(0)
+    if np.any(slope > 0.01 * rate) or np.any(d0 > 0.01 * pgd):
+        _refuse(path, f"the displacement record does not start at rest (first sample {_fmt(d0)} m of PGD "
+                      f"{_fmt(pgd)} m, first slope {_fmt(slope)} m/s of the largest {_fmt(rate)} m/s): with no taper "
+                      f"the run would start it with a jump; {how}")
 
 
 def _record_info(record):

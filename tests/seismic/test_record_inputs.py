@@ -77,3 +77,46 @@ def test_content_above_the_runs_nyquist_frequency_is_said(tmp_path):
     from petsc_ssi.seismic.records import energy_above
     assert energy_above(t, np.sin(2 * np.pi * 30 * t), 25.0) > 0.99
     assert energy_above(t, np.sin(2 * np.pi * 30 * t), 35.0) < 0.01
+
+
+def _cut_harmonic(path, quantity, units):
+    """A 2 Hz harmonic motion (acceleration amplitude 1 m/s^2) cut at t = 0.3 s, where it moves:
+    velocity -cos / w, displacement -sin / w^2 of the acceleration sin(w t)."""
+    w = 2 * np.pi * 2.0
+    t = np.arange(0.0, 2.0, 0.005)
+    s = t + 0.3
+    x = {"velocity": -np.cos(w * s) / w, "displacement": -np.sin(w * s) / w ** 2}[quantity]
+    np.savetxt(path, np.c_[t, x], header=f"units: {units}")
+    return str(path)
+
+
+@pytest.mark.parametrize("quantity,units", [("velocity", "m/s"), ("displacement", "m")])
+def test_an_untapered_record_that_does_not_start_at_rest_is_refused(tmp_path, quantity, units):
+    """With no taper, the motion would jump from rest to the record's first velocity: an impulse the
+    record does not hold (an independent test: a DT2 cut where it moves gave a PGA 16 times the real
+    one). Refused; with a taper the record is taken, and the raw record's PGA (its own slope at the
+    start, not a forced rest) is the harmonic's amplitude to 1 %."""
+    rec = R.read_record(_cut_harmonic(tmp_path / f"{quantity}.txt", quantity, units), quantity=quantity)
+    with pytest.raises(RecordError, match="does not start at rest.*-ssi_seismic_taper"):
+        R.process(rec, taper=0.0, baseline="none")
+    m = R.process(rec, taper=0.05, baseline="none")
+    assert abs(float(np.max(m.stats_raw["pga"])) - 1.0) < 0.01, m.stats_raw["pga"]
+
+
+def test_a_run_ending_inside_the_high_pass_pad_is_warned(tmp_path):
+    """A high-pass at 0.5 Hz leads the record by a pad of 0.75 * 4 / 0.5 = 6 s: a fixed base run to
+    3 s never sees the record (an independent test: peak base shear 0.04 N instead of 5 kN). Said;
+    the output states the record's time of the motion's start (record_t0)."""
+    import h5py
+    r = tmp_path / "pulse.txt"
+    t = np.arange(0.0, 0.3, 0.01)
+    np.savetxt(r, np.c_[t, np.sin(np.pi * t / 0.3) ** 4])
+    out = tmp_path / "hp.h5"
+    args = [x if x != "0.1" else "3" for x in FEM]             # -ssi_t_end 3
+    p = cli(args + ["-ssi_seismic_record", str(r), "-ssi_seismic_highpass", "0.5", "-ssi_output", str(out)])
+    said = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning:") and "before the record" in ln]
+    assert len(said) == 1 and "-ssi_t_end 3 s" in said[0], p.stdout
+    with h5py.File(out, "r") as f:
+        assert float(f["seismic/x_record_t0"][()]) == pytest.approx(-6.0, abs=0.011)
+        unit = f["seismic/t0"].attrs["unit"]
+        assert "motion time t + t0" in (unit.decode() if isinstance(unit, bytes) else str(unit))
