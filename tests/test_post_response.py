@@ -436,3 +436,21 @@ def test_overwrite_replaces_an_existing_output(structure, tmp_path, capsys):
     st, _, err = run([structure, "--periods", "0.1", "--csv", csv, "--overwrite"], capsys)
     _ok(st, err)
     assert read_csv(csv)[0][:3] == ["period [s]", "damping [-]", "SA [m/s^2]"]
+
+
+def test_round_off_components_are_said_and_a_one_component_geomean_refused(tmp_path, capsys):
+    """(An independent test, 2026-11-26.) A component peaking at 1e-12 of the largest is round-off:
+    its spectra and ratios are said to be noise. The geometric mean of a pair with one silent
+    component is 0 at every period: refused in one line."""
+    t = np.arange(400) * 0.01
+    ax = np.sin(2 * np.pi * 1.5 * t) * np.sin(np.pi * t / 4) ** 2
+    tab = tmp_path / "t.txt"
+    np.savetxt(tab, np.column_stack([t, ax, 0.5 * ax, 1e-12 * ax]))
+    st, out, err = run(["--table", tab, "--component", "all", "--periods", "0.2,0.6"], capsys)
+    _ok(st, err)
+    notes = [ln for ln in out.splitlines() if "round-off, not motion" in ln]
+    assert len(notes) == 1 and "z component" in notes[0], out
+    one = tmp_path / "one.txt"
+    np.savetxt(one, np.column_stack([t, ax, 0 * ax, 0 * ax]))
+    st, out, err = run(["--table", one, "--geomean", "--periods", "0.2,0.6"], capsys)
+    assert st == 2 and "--geomean: the y component" in err and len(err.strip().splitlines()) == 1, err

@@ -309,6 +309,11 @@ def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, ov
             raise _error(f"--rotd/--geomean need the x and y components; {series.path} gives "
                          f"{', '.join(series.components)}")
         ax, ay = series.a[:, 0], series.a[:, 1]
+        px, py = float(np.abs(ax).max()), float(np.abs(ay).max())
+        if geomean and min(px, py) <= ROUNDOFF * max(px, py):
+            raise _error(f"--geomean: the {'x' if px < py else 'y'} component of {series.path} peaks at "
+                         f"{min(px, py):.3g} m/s^2 against {max(px, py):.3g}: it carries no motion (a one-component "
+                         f"run), and the geometric mean would be 0 at every period; take the components alone")
         if rotd:
             for s in rs.rotd(series.t, ax, ay, periods, damping, oversample=k).values():
                 out.append((s.label, s))
@@ -321,6 +326,22 @@ def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, ov
             out.append((c, rs.response_spectrum(series.t, series.a[:, j], periods, damping,
                                                 oversample=k)))
     return out, k
+
+
+ROUNDOFF = 1e-9        # a component peaking below this share of the largest one carries round-off, not motion
+
+
+def noise_notes(*series):
+    """Notes for components whose acceleration peaks below ROUNDOFF of their series' largest: a
+    spectrum (and a ratio) of round-off says nothing."""
+    out = []
+    for s in series:
+        peaks = np.abs(np.asarray(s.a, float)).max(axis=0)
+        for c, pk in zip(s.components, np.atleast_1d(peaks)):
+            if pk <= ROUNDOFF * float(np.max(peaks)):
+                out.append(f"note: {os.path.basename(s.path)}'s {c} component peaks at {pk:.3g} m/s^2 against "
+                           f"{float(np.max(peaks)):.3g}: round-off, not motion; its spectra and ratios are noise")
+    return out
 
 
 def ratios(spec_a, spec_b):
@@ -500,6 +521,8 @@ def main(argv=None, out=None):
             specs_b, kb = spectra(B, periods, a.damping, a.rotd, a.geomean, a.oversample)
             specs = ratios(specs, specs_b)
         header = _summary(A, B, specs, ptext, periods, a, k, kb if B is not None else None)
+        if not (a.rotd or a.geomean):
+            header += noise_notes(*([A] if B is None else [A, B]))
         peaks = peak_lines(specs, a.plot_quantity, ratio=B is not None)
         if a.csv == "-":
             write_table(out, specs, header + peaks, ratio=B is not None)
