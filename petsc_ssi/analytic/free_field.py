@@ -434,12 +434,15 @@ class HilbertTransform:
             raise FreeFieldError("hilbert_of: taper_before/taper_width must be finite, width >= 0")
         self.taper_before, self.taper_width = float(before), w
         self.support_start = self.taper_before - w
-        tg = self._t_first + self.dt * np.arange(self._n + 2 * self._ne)
-        h = -self._series(0.0)[0][0].imag
+        tg, h = self._grid_values()
         pre = tg <= self.taper_before
         self.tail_level = float(np.max(np.abs(h[pre]))) if pre.any() else 0.0
         if tg[0] > self.taper_before:     # precursor beyond the window: the tail's value there
             self.tail_level = float(abs(self._tail(np.array([self.taper_before]), 0).imag[0]))
+
+    def _grid_values(self):
+        """(times, untapered H[f]) on the computed window's grid."""
+        return self._t_first + self.dt * np.arange(self._n + 2 * self._ne), -self._series(0.0)[0][0].imag
 
     def set_taper(self, before, width=None):
         """Taper the acausal precursor before ``before`` (a C2 ramp of ``width``, default 20 dt, ending
@@ -450,8 +453,8 @@ class HilbertTransform:
         """The latest time tau_b <= ``start`` before which the untapered |H[f]| stays within ``tol``
         times its largest value (on the computed window, and by the moment expansion beyond it),
         or None where it does not before -1e6 (f's integral not finite there)."""
-        tg = self._t_first + self.dt * np.arange(self._n + 2 * self._ne)
-        h = np.abs(self._series(0.0)[0][0].imag)
+        tg, h = self._grid_values()
+        h = np.abs(h)
         lim = float(tol) * float(h.max())
         if not lim > 0:
             return float(start)

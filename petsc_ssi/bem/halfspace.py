@@ -162,12 +162,11 @@ class HalfSpace:
             printf(line)
         for note in self.seismic.notes:
             warn(note, self.comm)
-        from ..seismic.input import record_start
-        start = record_start(self.seismic.motions, self.seismic.t0)
-        if cfg.t_end <= start:
-            warn(f"-ssi_t_end {cfg.t_end:g} s ends before the record starts (at {start:.6g} s of run time: the wave's "
-                 f"lead and any high-pass pad, see the seismic input lines): the run sees only their lead; give a "
-                 f"later -ssi_t_end or leave it out (the run then lasts the record)", self.comm)
+        from ..seismic.input import late_end
+        late = late_end(cfg.t_end, self.seismic.motions, self.seismic.t0,
+                        "the wave's lead and any high-pass pad, see the seismic input lines")
+        if late:
+            warn(late, self.comm)
         return self.seismic
 
     def _seismic_symmetry(self):

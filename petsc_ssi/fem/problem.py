@@ -52,12 +52,11 @@ class FEMTransient(TransientProblem):
                     printf(line)
                 for note in self.support.notes:
                     warn(note, self.comm)
-                from ..seismic.input import record_start
-                start = record_start(self.support.motions, self.support.t0)
-                if cfg.t_end <= start:
-                    warn(f"-ssi_t_end {cfg.t_end:g} s ends before the record starts (at {start:.6g} s of run time: "
-                         f"the start and any high-pass pad, see the support motion lines): the base does not move; "
-                         f"give a later -ssi_t_end or leave it out (the run then lasts the record)", self.comm)
+                from ..seismic.input import late_end
+                late = late_end(cfg.t_end, self.support.motions, self.support.t0,
+                                "the start and any high-pass pad, see the support motion lines")
+                if late:
+                    warn(late, self.comm)
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
         self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None

@@ -86,6 +86,16 @@ def record_start(motions, t0):
     return t0 + max(float(m.processing.get("highpass_pad_s", 0.0)) for m in motions.values())
 
 
+def late_end(t_end, motions, t0, lead):
+    """The warning for a run whose ``t_end`` comes before the records' first kept sample (``lead``:
+    what precedes it, for the message), or None."""
+    start = record_start(motions, t0)
+    if t_end > start:
+        return None
+    return (f"-ssi_t_end {t_end:g} s ends before the record starts (at {start:.6g} s of run time: {lead}): the run "
+            f"sees none of it; give a later -ssi_t_end or leave it out (the run then lasts the record)")
+
+
 def _records(cfg):
     """{axis: Record} of -ssi_seismic_record* ('' for the one record of an oblique or Rayleigh wave)."""
     c = cfg

@@ -315,8 +315,8 @@ def _read_obspy(path, raw, fmt, component):
     try:
         st = obspy.read(io.BytesIO(raw), format=f)
     except Exception as exc:                               # ObsPy raises many kinds
-        msg = str(exc)
-        if "Unknown format" in msg or "tmp" in msg:         # (ObsPy names its temporary copy, not this file)
+        msg = re.sub(r"\S*obspy-\S*\.tmp", path, str(exc))   # (ObsPy names its temporary copy, not this file)
+        if "Unknown format" in msg:
             msg = "ObsPy does not recognise its format"
         _refuse(path, f"not a PEER file, a table of numbers (optionally under one row of column names) or a "
                       f"format ObsPy reads ({type(exc).__name__}: {msg})")
