@@ -39,7 +39,9 @@ all: test
 
 $(VENV)/.stamp: .deps/apt.stamp setup.py Makefile
 	@[ -x $(PY) ] || /usr/bin/python3 -m venv --system-site-packages $(VENV)
-	@echo "[deps] installing into $(VENV): $(PIP_PKGS) (numpy kept at Debian's 1.x)"
+	@# the list printed through a make variable: its quotes ("matplotlib>=3.7") inside an echo's own
+	@# quotes had made the shell redirect into a file named '=3.7 pytest ...'
+	@echo '[deps] installing into $(VENV): $(subst ",,$(PIP_PKGS)) (numpy kept at Debian'"'"'s 1.x)'
 	@NPV=$$(/usr/bin/python3 -c "import numpy; print(numpy.__version__)"); \
 	  $(PY) -m pip install -q --disable-pip-version-check "numpy==$$NPV" $(PIP_PKGS)
 	@$(PY) -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
