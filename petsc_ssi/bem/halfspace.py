@@ -12,6 +12,7 @@ from ..petsc import SSIError, collective, printf, warn
 from ..mesh import surface
 from .. import timegrid
 from . import symmetry, receivers as rec, histories
+from ..sources.traction import soil_sources, check_sources
 from .resultants import RigidMotion
 from .lagset import Material, Regions, LagSet
 from .windows import causal_lags
@@ -76,7 +77,9 @@ def _history(cfg, which):
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
-    def __init__(self, cfg, comm, log=printf, defer_seismic=False):
+    def __init__(self, cfg, comm, log=printf, defer_seismic=False, sources=None):
+        """``sources``: the surface tractions that load the soil (``petsc_ssi.sources``); None: those
+        of the options (-ssi_load_*)."""
         self.cfg, self.comm, self.log = cfg, comm, log
         self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
         self.planes = symmetry.parse(cfg.symmetry)
@@ -91,7 +94,6 @@ class HalfSpace:
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
         self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
         self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
-        load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
         if cfg.load_group and cfg.load_p0 == 0.0:
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
@@ -100,13 +102,19 @@ class HalfSpace:
         if cfg.user_set("disp_value") and not cfg.disp_group:
             warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
         # histories are built (and tables read and checked) before any heavy work
-        self._load_f = _history(cfg, "load") if len(load) else None
+        self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
+        check_sources(self.mesh, self.sources)
+        given = sources is not None
+        load = (np.unique(np.concatenate([s.elements for s in self.sources])) if self.sources
+                else np.zeros(0, np.int64))
         self._disp_f = _history(cfg, "disp") if len(disp) else None
         self.regions = Regions(self.mesh, load, disp)
+        self.bind_sources()
+        for src in self.sources if given else ():
+            printf(f"[ssi] source: {src.describe()}")
         for name in ("disp_rotation", "disp_ref"):
             if cfg.user_set(name) and not cfg.disp_group:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
-        symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
         self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and len(disp) > 0
         xref = self._massless_reference() if self.massless else None
         self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if len(disp) else None
@@ -415,14 +423,26 @@ class HalfSpace:
                            f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
                            f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
 
+    def bind_sources(self):
+        """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes
+        contradict (a uniform field on a patch is even: components with S = -1 must vanish)."""
+        for src in self.sources:
+            src.bind(self.mesh, self.regions.load_nodes)
+            for v in src.amplitudes():
+                symmetry.check_compatible(self.planes, v, None)
+
     def known_p(self):
-        c = self.cfg
-        f = self._load_f
-        tr = np.array([0.0, 0.0, -c.load_p0])   # p0 > 0 pushes the surface down (-z)
-        nl = self.regions.n_load
+        """callable(n) -> the traction of step n at the loaded nodes (3 n_load,) [Pa]: the sum of
+        the sources' step means (``petsc_ssi.sources``)."""
+        srcs, nl, dt = self.sources, self.regions.n_load, self.dt
+        if len(srcs) == 1 and len(srcs[0].idx) == nl:        # one source over the whole region
+            return lambda n: srcs[0].step_mean(n, dt).ravel()
 
         def kp(n):
-            return np.tile(tr * histories.step_mean(f, n, self.dt, c.load_history, c.load_t0), nl)
+            out = np.zeros((nl, 3))
+            for s in srcs:
+                out[s.idx] += s.step_mean(n, dt)
+            return out.ravel()
         return kp
 
     def disp_factor(self, n):

@@ -24,13 +24,15 @@ from . import options as _options  # noqa: F401  (declares the -ssi_ options of 
 class BEMTransient(TransientProblem):
     kind = "bem"
 
-    def __init__(self, cfg, comm=None):
+    def __init__(self, cfg, comm=None, sources=None):
+        """``sources``: the surface tractions on the soil (``petsc_ssi.sources``); None: those of the
+        options (-ssi_load_*)."""
         super().__init__(cfg, comm)
         no_output_refused(cfg, "a BEM")
         self.check_output()
         self.log = printf if cfg.monitor else (lambda m: None)
         with staged("SSI BEM setup"):
-            self.prob = HalfSpace(cfg, self.comm, log=printf)
+            self.prob = HalfSpace(cfg, self.comm, log=printf, sources=sources)
             self.plan, self.ls = self.prob.prepare()
         self.grid = self.prob.grid
         self.march = self.rec = self.out = None

@@ -54,12 +54,14 @@ def build_coupled(cfg, comm):
             raise SSIError(f"-ssi_interface_offset: the interface (-ssi_fem_interface {cfg.fem_interface}) has no "
                            "shell slab nodes; the offset applies to a shell foundation slab only and does nothing "
                            "here: drop it")
-        load = prob.mesh.select(cfg.load_group) if cfg.load_group else np.zeros(0, np.int64)
+        load = prob.regions.load_elems                   # the soil's sources' elements
         both = np.intersect1d(load, iface.be_elems)
         if both.size:
-            raise SSIError(f"-ssi_load_group {cfg.load_group}: {both.size} loaded soil elements lie under the "
+            names = ", ".join(s.name for s in prob.sources)
+            raise SSIError(f"{names}: {both.size} loaded soil elements lie under the "
                            "structure (the interface); load the structure instead (-ssi_fem_load_*)")
         prob.regions = Regions(prob.mesh, load, iface.be_elems)
+        prob.bind_sources()
         if not np.array_equal(prob.regions.disp_nodes, iface.be_nodes):
             raise SSIError("interface: internal error, node order of the soil regions differs")
     # a load on the soil away from the structure (an incident wave field, total field): the

@@ -1,0 +1,26 @@
+"""Sources: what drives a run, as objects the domains sum over (issue 40, item 1).
+
+A source is data about the excitation, not code in a domain. The soil (``bem.halfspace.HalfSpace``)
+is given a list of sources and sums them; nothing patches a built domain from outside.
+
+The surface-traction protocol (``traction.SurfaceTraction`` is the one implementation; a new kind
+of surface load is a class with these members, or plain data given to ``SurfaceTraction``):
+
+    elements                 the soil elements it loads (int array): the soil's loaded region is
+                             the union of its sources' elements
+    bind(nodes, x)           called once by the soil with the region's nodes (ids, in the soil's
+                             traction-column order) and their coordinates (n, 3) [m]; returns the
+                             indices of the nodes it loads
+    step_mean(m, dt)         the traction at those nodes (k, 3) [Pa, the soil's outward normal
+                             convention: t = sigma n with n = +z on the free surface z = 0, so a
+                             load pushing the surface down is t_z < 0] averaged over step m, the
+                             interval ((m-1) dt, m dt]: the BEM's piecewise-constant traction is
+                             this mean (the L2 projection, ``petsc_ssi.histories``)
+    amplitudes()             the distinct traction vectors (k, 3) [Pa] it applies: the soil refuses
+                             those its symmetry planes contradict (``bem.symmetry.check_compatible``)
+    describe()               one line for the run's log
+
+Where a new excitation goes: a new kind of source is a module here; the domains take it through
+their ``sources`` argument (``bem.problem.BEMTransient(cfg, comm, sources=[...])``).
+"""
+from .traction import SurfaceTraction, uniform_patch, soil_sources  # noqa: F401
