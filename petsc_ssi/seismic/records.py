@@ -1,6 +1,7 @@
 """Earthquake records for the seismic input: read, convert to SI, process, evaluate (numpy/scipy only).
 
-Pipeline (shared/notes/seismic-input.md, 5.2):
+Pipeline (the usual steps of strong-motion processing: Boore & Bommer 2005, Soil Dyn. Earthq. Eng.
+25, 93-115):
     read_record(path) -> Record        values in SI (m/s^2, m/s or m), file SHA-256, metadata
     process(record)   -> Motion        scale, window, Hann taper, acceleration, exact integration, baseline
     motion(t, deriv)                   d (deriv 0), v (1), a (2) at any times, vectorised
