@@ -326,6 +326,24 @@ class SeismicInput:
         """The free-field acceleration at ``points`` at time t [m/s^2]."""
         return self._sum("acceleration", points, t)
 
+    def velocity(self, points, t):
+        """The free-field velocity at ``points`` (n, 3) at time t [m/s]."""
+        return self._sum("velocity", points, t)
+
+    def stress(self, points, t):
+        """The free-field Cauchy stress at ``points`` (n, 3) at time t (scalar): (n, 3, 3) [Pa],
+        tension positive (zero traction on the free surface z = 0)."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        return sum((w.stress(pts, t) for w in self.waves), np.zeros((len(pts), 3, 3)))
+
+    def traction(self, points, normals, t):
+        """The free field's traction t_ff = sigma_ff n on faces through ``points`` (n, 3) with unit
+        normals ``normals`` (n, 3) (any orientation: a basement's walls and bottom) at time t [Pa].
+        On a face of the soil's boundary the scattered field's traction is -t_ff (the total
+        traction there is zero, or the structure's)."""
+        n = np.asarray(normals, float).reshape(-1, 3)
+        return np.einsum("pij,pj->pi", self.stress(points, t), n)
+
     def rotation(self, points, t):
         """The rotation of the free surface at surface ``points`` (n, 3) at time t (scalar or 1-D):
         1/2 curl u_ff = (du_z/dy, -du_z/dx, (du_y/dx - du_x/dy)/2) [rad], (n, 3) or (nt, n, 3). Each

@@ -221,6 +221,53 @@ def test_free_surface_rotation_is_half_the_curl(wave, angle, azimuth, tmp_path):
     assert np.abs(rot - 0.5 * curl).max() < 1e-4 * np.abs(rot).max()
 
 
+@pytest.mark.parametrize("wave,angle,azimuth", [("sv", 25.0, 40.0), ("p", 35.0, -70.0), ("sh", 50.0, 10.0)])
+def test_free_field_traction_on_faces_of_any_orientation(wave, angle, azimuth, tmp_path):
+    """SeismicInput.traction (issue 40: the free field's traction t_ff = sigma_ff n on a face of any
+    orientation, what an excavation's walls and bottom need) against Hooke's law on strains from
+    centred finite differences of the free-field displacement, at points below the surface on faces
+    with oblique normals; and zero on the free surface (n = +z)."""
+    from helpers import petsc
+    PETSc = petsc()
+    from petsc_ssi import options
+    import petsc_ssi.app.kinds  # noqa: F401
+    from petsc_ssi.seismic.input import SeismicInput
+    rec = pulse(tmp_path / "p.txt", 0.2)
+    opts = dict(seismic=wave, seismic_angle=angle, seismic_azimuth=azimuth, seismic_record=rec,
+                seismic_units="m/s2", seismic_taper=0, seismic_baseline="none", cp=CP, cs=CS, rho=RHO)
+    db = PETSc.Options()
+    for k, v in opts.items():
+        db.setValue("ssi_" + k, str(v))
+    try:
+        cfg = options.resolve(("common", "bem", "seismic"))
+        pts = np.array([[0.3, -0.2, -1.0], [-0.7, 0.4, -2.5], [1.0, 0.5, -0.6], [0.2, 0.1, 0.0]])
+        s = SeismicInput(cfg, PETSc.COMM_WORLD, CS, CP, RHO, pts, np.zeros(3), 0.006)
+    finally:
+        for k in opts:
+            db.delValue("ssi_" + k)
+    mu = RHO * CS ** 2
+    lam = RHO * CP ** 2 - 2 * mu
+    normals = np.array([[1.0, 0.0, 0.0], [0.0, -0.6, 0.8], [0.48, 0.6, -0.64], [0.0, 0.0, 1.0]])
+    d = 1e-3
+    worst = scale = 0.0
+    for t in np.linspace(0.05, 0.4, 6):
+        grad = np.zeros((3, 3, 3))                   # du_i / dx_j at the three points below the surface
+        for j in range(3):
+            e = np.zeros(3)
+            e[j] = d
+            grad[:, :, j] = (s.u(pts[:3] + e, t) - s.u(pts[:3] - e, t)) / (2 * d)
+        eps = 0.5 * (grad + grad.transpose(0, 2, 1))
+        sig = lam * np.trace(eps, axis1=1, axis2=2)[:, None, None] * np.eye(3) + 2 * mu * eps
+        ref = np.einsum("pij,pj->pi", sig, normals[:3])
+        got = s.traction(pts, normals, t)
+        scale = max(scale, np.abs(ref).max())
+        worst = max(worst, np.abs(got[:3] - ref).max())
+        assert np.abs(got[3]).max() <= 1e-9 * max(np.abs(got[:3]).max(), 1e-30)     # free surface
+    assert scale > 100.0                             # Pa: the faces are loaded (1.9-2.6 kPa here)
+    print(f"traction: largest {scale:.4g} Pa, finite-difference difference {worst:.3g} Pa")
+    assert worst < 1e-4 * scale, (worst, scale)
+
+
 def test_restart_keeps_the_motion(tmp_path):
     """-ssi_problem bem -ssi_disp_rigid massless, checkpoint after step 12 of 25, restarted: the footing's
     motion series (kept in the checkpoint) and its step states give the same output bit for bit."""
