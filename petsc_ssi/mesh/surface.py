@@ -63,6 +63,43 @@ class SurfaceMesh:
         distorted element (an O-grid's) is measured by its longest segment, whatever its node 0."""
         return segment_sizes(self.cell_coords())
 
+    # ---------------------------------------------------------------- what the boundary is
+    def in_plane(self, rel=1e-9):
+        """Whether every node lies on the plane z = 0, within ``rel`` of the mesh's plan extent."""
+        ext = float(np.ptp(self.nodes[:, :2], axis=0).max()) if self.n_nodes else 1.0
+        return bool(self.n_nodes == 0 or np.abs(self.nodes[:, 2]).max() <= rel * (ext or 1.0))
+
+    def require_plane(self, what, why):
+        """SSIError (naming the highest or deepest node) unless every node lies on z = 0 (``in_plane``);
+        then put them on it exactly. ``what``: the input named in the error; ``why``: what needs
+        the plane. The one place a soil surface is held to z = 0."""
+        if not self.in_plane():
+            k = int(np.abs(self.nodes[:, 2]).argmax())
+            raise SSIError(f"{what}: the surface mesh must lie in the plane z = 0 (the free surface of the "
+                           f"half-space z < 0: {why}); node {k} is at z = {self.nodes[k, 2]:.6g} m")
+        self.nodes[:, 2] = 0.0
+
+    @property
+    def flat(self):
+        """Whether the surface is the plane z = 0 exactly (every node's z is 0)."""
+        return bool(np.all(self.nodes[:, 2] == 0.0))
+
+    def node_normals(self):
+        """Unit normals (N, 3) at the nodes, out of the soil: the mean of the unit normals of the
+        elements that share each node (at an edge or a corner a mean direction; ``kinks`` says
+        where the surface is not smooth)."""
+        X = self.cell_coords()
+        xi = quad9.NODE_XI
+        _, jn = quad9.geometry(X[:, None, :, :], xi[None, :, 0], xi[None, :, 1])
+        n = jn / np.linalg.norm(jn, axis=-1, keepdims=True)          # (E, 9, 3)
+        acc = np.zeros((self.n_nodes, 3))
+        np.add.at(acc, self.cells.ravel(), n.reshape(-1, 3))
+        return acc / np.linalg.norm(acc, axis=1, keepdims=True)
+
+    def edges_and_corners(self, planes=(), max_angle_deg=1.0):
+        """(node ids, angles deg) where the surface is not smooth (``kinks``)."""
+        return kinks(self, planes, max_angle_deg)
+
     def check(self):
         """Validate a nine-node surface: conforming ids, positive orientation."""
         if self.cells.ndim != 2 or self.cells.shape[1] != 9:

@@ -1,0 +1,55 @@
+"""The soil boundary says what it is (issue 40, item 3; ``mesh.surface.SurfaceMesh``): whether it is the
+plane z = 0, its unit normals out of the soil at the nodes, its edges and corners, and the one
+refusal of a surface off the plane (with the reason), on a flat grid and on a made step (a pit's
+edge: the ground z = 0 meeting a vertical wall)."""
+import numpy as np
+import pytest
+
+from petsc_ssi.mesh.quad9 import NODE_XI
+from petsc_ssi.mesh.surface import SurfaceMesh, grid
+from petsc_ssi.petsc import SSIError
+
+pytestmark = pytest.mark.unit
+
+
+def _element(corner, du, dv):
+    """Nine-node element x = corner + (1 + xi)/2 du + (1 + eta)/2 dv (normal du x dv)."""
+    c, du, dv = (np.asarray(a, float) for a in (corner, du, dv))
+    return c + 0.5 * (1 + NODE_XI[:, :1]) * du + 0.5 * (1 + NODE_XI[:, 1:]) * dv
+
+
+def step_mesh():
+    """The ground on x in [-1, 0], y in [0, 1] (z = 0, normal +z) and the pit's wall x = 0,
+    z in [-1, 0] (the pit at x > 0: the wall's normal out of the soil is +x): 15 nodes."""
+    ground = _element([-1, 0, 0], [1, 0, 0], [0, 1, 0])            # normal (1,0,0) x (0,1,0) = +z
+    wall = _element([0, 0, 0], [0, 0, -1], [0, 1, 0])              # normal (0,0,-1) x (0,1,0) = +x
+    X = np.vstack([ground, wall])
+    nodes, inv = np.unique(np.round(X, 12), axis=0, return_inverse=True)
+    return SurfaceMesh(nodes, inv.reshape(2, 9))
+
+
+def test_a_flat_grid_is_the_plane_with_upward_normals_and_no_edges():
+    m = grid(4.0, 2.0, 1.0)
+    assert m.in_plane() and m.flat
+    assert np.allclose(m.node_normals(), [0.0, 0.0, 1.0], atol=1e-15)
+    assert len(m.edges_and_corners()[0]) == 0
+    m.require_plane("-ssi_mesh test", "why")                        # nothing to refuse
+
+
+def test_a_step_knows_its_normals_and_its_edge():
+    m = step_mesh()
+    assert m.n_nodes == 15 and not m.in_plane() and not m.flat
+    n = m.node_normals()
+    x = m.nodes
+    on_edge = np.abs(x[:, 0]) + np.abs(x[:, 2]) < 1e-12           # x = 0, z = 0: where ground meets wall
+    ground = (x[:, 0] < -1e-12)
+    wall = (x[:, 2] < -1e-12)
+    assert on_edge.sum() == 3 and ground.sum() == 6 and wall.sum() == 6
+    assert np.allclose(n[ground], [0, 0, 1], atol=1e-14)
+    assert np.allclose(n[wall], [1, 0, 0], atol=1e-14)
+    assert np.allclose(n[on_edge], [2 ** -0.5, 0, 2 ** -0.5], atol=1e-14)
+    nodes, ang = m.edges_and_corners()
+    assert set(nodes) == set(np.nonzero(on_edge)[0]) and np.allclose(ang, 90.0)
+    with pytest.raises(SSIError, match=r"-ssi_mesh pit: the surface mesh must lie in the plane z = 0 \(the free "
+                                       r"surface of the half-space z < 0: a reason\); node \d+ is at z = -1 m"):
+        m.require_plane("-ssi_mesh pit", "a reason")
