@@ -27,6 +27,14 @@ class TimeGrid:
         self.dt, self.t_end, self.stride = float(dt), float(t_end), int(stride)
         self.n_steps = n_steps(self.t_end, self.dt)
 
+    @classmethod
+    def of_run(cls, cfg, durations=()):
+        """The grid of a run of options ``cfg``: to -ssi_t_end when the user gave it, else to the
+        longest of the sources' ``durations`` (a seismic record's length), else to -ssi_t_end's
+        default. Made once, before any domain; the options are not changed."""
+        t_end = cfg.t_end if cfg.user_set("t_end") or not len(durations) else max(durations)
+        return cls(cfg.dt, t_end, cfg.output_stride)
+
     def time(self, n):
         """t_n = n dt, s."""
         return n * self.dt

@@ -64,6 +64,13 @@ def read_surface_mesh(cfg, comm, planes):
     return mpi.bcast(mesh)
 
 
+def read_soil_surface(cfg, comm, planes):
+    """Collective: the surface mesh (``read_surface_mesh``), checked against the symmetry planes."""
+    mesh = read_surface_mesh(cfg, comm, planes)
+    symmetry.check_mesh(mesh.nodes, planes, float(mesh.element_sizes().max()))
+    return mesh
+
+
 def _history(cfg, which):
     """The -ssi_<which>_history as a callable, read and checked now."""
     try:
@@ -75,24 +82,28 @@ def _history(cfg, which):
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
-    def __init__(self, cfg, comm, log=printf, defer_seismic=False, sources=None):
+    def __init__(self, cfg, comm, log=printf, sources=None, mesh=None, interface=None):
         """``sources``: the surface tractions that load the soil (``petsc_ssi.sources``); None: those
-        of the options (-ssi_load_*)."""
+        of the options (-ssi_load_*). ``mesh``: the surface mesh when the caller has read it
+        (``read_soil_surface``). ``interface``: a coupled run's interface
+        (``coupling.interface.build_interface``): its soil elements carry the structure's tractions,
+        its centroid is the seismic input's default control point and its nodes are points of
+        interest. The seismic input, a source with a duration, comes before the time grid: without
+        -ssi_t_end the run lasts the record (``timegrid.TimeGrid.of_run``); nothing is written into
+        the options."""
         self.cfg, self.comm, self.log = cfg, comm, log
         self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
         self.planes = symmetry.parse(cfg.symmetry)
-        self.mesh = read_surface_mesh(cfg, comm, self.planes)
+        self.mesh = mesh if mesh is not None else read_soil_surface(cfg, comm, self.planes)
         h = float(self.mesh.element_sizes().max())
         self.h = h
-        symmetry.check_mesh(self.mesh.nodes, self.planes, h)
         bad, ang = surface.kinks(self.mesh, self.planes)
         if len(bad):
             printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
                    f"free term from the interior solid angle (Hartmann)")
-        # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
-        self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
-        self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
+        if interface is not None:
+            disp = interface.be_elems
         if cfg.load_group and cfg.load_p0 == 0.0:
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         if cfg.user_set("load_p0") and not cfg.load_group:
@@ -102,35 +113,62 @@ class HalfSpace:
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
         check_sources(self.mesh, self.sources)
-        given = sources is not None
         load = (np.unique(np.concatenate([s.elements for s in self.sources])) if self.sources
                 else np.zeros(0, np.int64))
-        self._disp_f = _history(cfg, "disp") if len(disp) else None
+        if interface is not None:
+            self._check_interface(load, interface)
+        self._disp_f = _history(cfg, "disp") if len(disp) and interface is None else None
         self.regions = Regions(self.mesh, load, disp)
+        if interface is not None and not np.array_equal(self.regions.disp_nodes, interface.be_nodes):
+            raise SSIError("interface: internal error, node order of the soil regions differs")
         self.bind_sources()
-        for src in self.sources if given else ():
+        for src in self.sources if sources is not None else ():
             printf(f"[ssi] source: {src.describe()}")
         for name in ("disp_rotation", "disp_ref"):
             if cfg.user_set(name) and not cfg.disp_group:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
-        self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and len(disp) > 0
+        prescribed = len(disp) > 0 and interface is None
+        self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and prescribed
         xref = self._massless_reference() if self.massless else None
-        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if len(disp) else None
+        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if prescribed else None
         self.receivers = rec.parse(cfg.receivers)
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
             rec.locate(self.mesh, q)
             if abs(p[2]) > 1e-6 * max(h, 1.0):
                 raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        # a coupled run's structure: points of interest (the interpolation rule, the diffraction warning)
+        self.sites = interface.x if interface is not None else np.zeros((0, 3))
+        self.seismic = None
+        if cfg.get("seismic", "none") != "none":
+            self.seismic = self._seismic_input(self._control_point(interface))
+        # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
+        self.grid = timegrid.TimeGrid.of_run(cfg, [self.seismic.duration] if self.seismic is not None else [])
+        self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
         self._lags()
         self._warnings(h)
-        self.seismic = None
-        if cfg.get("seismic", "none") != "none" and self.massless:     # the control point: x_ref by default
-            self.attach_seismic(self.motion.xref)
-        elif cfg.get("seismic", "none") != "none" and len(disp):
-            self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
-        elif cfg.get("seismic", "none") != "none" and not defer_seismic:
-            self.attach_seismic(np.zeros(3))
+        if self.seismic is not None:
+            self._seismic_lines()
+        if interface is not None:
+            self.diffraction_warning(interface.x, "the structure (interface nodes)")
+
+    def _check_interface(self, load, interface):
+        both = np.intersect1d(load, interface.be_elems)
+        if both.size:
+            names = ", ".join(s.name for s in self.sources)
+            raise SSIError(f"{names}: {both.size} loaded soil elements lie under the structure (the "
+                           "interface); load the structure instead (-ssi_fem_load_*)")
+
+    def _control_point(self, interface):
+        """The seismic input's default control point: a massless footing's x_ref, the prescribed
+        region's or the interface's centroid, else the origin."""
+        if interface is not None:
+            return interface.x.mean(0)
+        if self.massless:
+            return self.motion.xref
+        if self.motion is not None:
+            return self.mesh.nodes[self.regions.disp_nodes].mean(0)
+        return np.zeros(3)
 
     def _massless_reference(self):
         """-ssi_disp_rigid massless: the footing's reference point x_ref [m], -ssi_disp_ref or by
@@ -150,38 +188,34 @@ class HalfSpace:
                                f"reference point must lie on the plane {'xy'[ax]} = 0")
         return xr
 
-    def attach_seismic(self, ref):
-        """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with
-        ``ref`` the default control point (the centroid of the interface or the prescribed region).
-        Refuses a symmetry plane the wave breaks; without -ssi_t_end the run lasts the record."""
+    def _seismic_input(self, ref):
+        """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with ``ref``
+        the default control point. Refuses a symmetry plane the wave breaks."""
         from ..seismic.input import SeismicInput
-        cfg = self.cfg
-        self.seismic = SeismicInput(cfg, self.comm, self.mat.cs, self.mat.cp, self.mat.rho, self.mesh.nodes,
-                                    ref, self.dt)
-        self._seismic_symmetry()
-        if not cfg.user_set("t_end"):
-            cfg.set("t_end", self.seismic.duration)
-            self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
-            self.n_steps = self.grid.n_steps
-            self._lags()
+        seismic = SeismicInput(self.cfg, self.comm, self.mat.cs, self.mat.cp, self.mat.rho, self.mesh.nodes,
+                               ref, self.cfg.dt)
+        self._seismic_symmetry(seismic)
+        return seismic
+
+    def _seismic_lines(self):
+        """The seismic input's log lines and notes, and a warning when the run ends before the wave's
+        lead and pads are over."""
         for line in self.seismic.summary_lines():
             printf(line)
         for note in self.seismic.notes:
             warn(note, self.comm)
         from ..seismic.input import late_end
-        late = late_end(cfg.t_end, self.seismic.motions, self.seismic.t0,
+        late = late_end(self.grid.t_end, self.seismic.motions, self.seismic.t0,
                         "the wave's lead and any high-pass pad, see the seismic input lines")
         if late:
             warn(late, self.comm)
-        return self.seismic
 
-    def _seismic_symmetry(self):
-        """A symmetry plane must hold for the free field: a uniform (vertical) wave moving along
+    def _seismic_symmetry(self, s):
+        """A symmetry plane must hold for the free field ``s``: a uniform (vertical) wave moving along
         the plane's normal needs 'anti', along the plane 'sym'; an oblique or Rayleigh wave may not
         travel across a plane (only along it)."""
         if not self.planes:
             return
-        s = self.seismic
         for ax, kind in self.planes:
             if s.kind != "vertical" and abs(s.waves[0].e_h[ax]) > 1e-12:
                 raise SSIError(f"-ssi_symmetry {'xy'[ax]}={'sym' if kind > 0 else 'anti'}: the {s.kind} wave "
@@ -257,7 +291,7 @@ class HalfSpace:
         for p in np.atleast_2d(points):
             q, _ = symmetry.map_point(p, self.planes)
             t_d = min(t_d, (d_se + np.linalg.norm(edge[:, :2] - q[:2], axis=1)).min() / self.mat.cp)
-        if t_d < self.cfg.t_end:
+        if t_d < self.grid.t_end:
             self._diffracted.append((what, t_d))
         return t_d
 
@@ -267,7 +301,7 @@ class HalfSpace:
         if self._diffracted:
             t0 = min(t for _, t in self._diffracted)
             warn(f"waves from the load diffracted at the mesh edge (path load -> edge -> point at c_p) arrive "
-                 f"before t_end = {self.cfg.t_end:g} s, the earliest at t = {t0:.4g} s, at "
+                 f"before t_end = {self.grid.t_end:g} s, the earliest at t = {t0:.4g} s, at "
                  + ", ".join(f"{w} (t = {t:.4g} s)" for w, t in self._diffracted))
         self._diffracted = []
 

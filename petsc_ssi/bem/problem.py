@@ -149,7 +149,7 @@ def write_results(cfg, comm, prob, out, res, status="completed", final=True):
         attrs["disp_rigid"] = "massless"
     if cfg.mesh_patch and cfg.load_group == "load":
         attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
-    rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})})
+    rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})}, grid=prob.grid)
     (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status, groups=groups)
     ev.end()
     if not final:

@@ -6,8 +6,8 @@ import numpy as np
 
 from ..petsc import SSIError, collective, printf
 from ..options import Config
-from ..bem.halfspace import HalfSpace
-from ..bem.lagset import Regions
+from ..bem.halfspace import HalfSpace, read_soil_surface
+from ..bem import symmetry
 from ..fem.model import build_model
 from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces, interface_offsets
 from .step import STRATEGIES
@@ -41,35 +41,22 @@ def build_coupled(cfg, comm):
     if ignored:
         warn(f"{' '.join(ignored)} act{'s' if len(ignored) == 1 else ''} only with -ssi_contact unilateral; "
              f"ignored (the interface is {cfg.contact})", comm)
-    prob = HalfSpace(cfg, comm, log=printf, defer_seismic=True)     # the wave's control point: the interface
+    planes = symmetry.parse(cfg.symmetry)
+    mesh = read_soil_surface(cfg, comm, planes)
     fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
     model = build_model(fe_cfg, comm, assemble_matrices=False, receivers_what="-ssi_structure_receivers",
                         check_mesh=lambda mesh: check_on_surface(mesh, cfg.fem_interface))
     iface = sym = None
     with collective(comm, "matching the interface"):
-        iface = build_interface(prob.mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
-                                prob.planes, prob.h)
-        sym = fem_symmetry_dofs(model.mesh, prob.planes, dofmap=model.dofmap)
+        iface = build_interface(mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,
+                                planes, float(mesh.element_sizes().max()))
+        sym = fem_symmetry_dofs(model.mesh, planes, dofmap=model.dofmap)
         if cfg.interface_offset and not np.abs(interface_offsets(model.mesh, iface, cfg.fem_interface)).any():
             raise SSIError(f"-ssi_interface_offset: the interface (-ssi_fem_interface {cfg.fem_interface}) has no "
                            "shell slab nodes; the offset applies to a shell foundation slab only and does nothing "
                            "here: drop it")
-        load = prob.regions.load_elems                   # the soil's sources' elements
-        both = np.intersect1d(load, iface.be_elems)
-        if both.size:
-            names = ", ".join(s.name for s in prob.sources)
-            raise SSIError(f"{names}: {both.size} loaded soil elements lie under the "
-                           "structure (the interface); load the structure instead (-ssi_fem_load_*)")
-        prob.regions = Regions(prob.mesh, load, iface.be_elems)
-        prob.bind_sources()
-        if not np.array_equal(prob.regions.disp_nodes, iface.be_nodes):
-            raise SSIError("interface: internal error, node order of the soil regions differs")
-    # a load on the soil away from the structure (an incident wave field, total field): the
-    # structure is a point of interest for the edge-diffraction warning and the interpolation rule
-    prob.sites = iface.x
-    if cfg.get("seismic", "none") != "none":
-        prob.attach_seismic(iface.x.mean(0))
-    prob.diffraction_warning(iface.x, "the structure (interface nodes)")
+    # the soil with its interface: the structure's tractions, the seismic control point, points of interest
+    prob = HalfSpace(cfg, comm, log=printf, mesh=mesh, interface=iface)
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
     model.dofmap.set_fixed(model.fixed)
     return prob, model, iface, fe_cfg

@@ -265,7 +265,7 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
              "structure_output": os.path.basename(structure_output_path(cfg.output))}
     if getattr(prob, "seismic", None) is not None:
         attrs["seismic"] = prob.seismic.kind
-    rec_ = provenance(cfg, comm, {"stats": res["stats"]})
+    rec_ = provenance(cfg, comm, {"stats": res["stats"]}, grid=prob.grid)
     recd = None
     if res["u"] is not None:
         recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}

@@ -46,18 +46,18 @@ class FEMTransient(TransientProblem):
             if cfg.get("seismic", "none") != "none":        # a fixed base moving with the record
                 from ..seismic.input import SupportMotion
                 self.support = SupportMotion(cfg, self.comm)
-                if not cfg.user_set("t_end"):
-                    cfg.set("t_end", self.support.duration)
-                for line in self.support.summary_lines():
-                    printf(line)
-                for note in self.support.notes:
-                    warn(note, self.comm)
-                from ..seismic.input import late_end
-                late = late_end(cfg.t_end, self.support.motions, self.support.t0,
-                                "the start and any high-pass pad, see the support motion lines")
-                if late:
-                    warn(late, self.comm)
-        self.grid = timegrid.TimeGrid(cfg.dt, cfg.t_end, cfg.output_stride)
+        # without -ssi_t_end a run under a record lasts the record (nothing is written into the options)
+        self.grid = timegrid.TimeGrid.of_run(cfg, [self.support.duration] if self.support is not None else [])
+        if self.support is not None:
+            for line in self.support.summary_lines():
+                printf(line)
+            for note in self.support.notes:
+                warn(note, self.comm)
+            from ..seismic.input import late_end
+            late = late_end(self.grid.t_end, self.support.motions, self.support.t0,
+                            "the start and any high-pass pad, see the support motion lines")
+            if late:
+                warn(late, self.comm)
         self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None
         self.check_disk()
@@ -212,7 +212,8 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
         if receivers is not None and "acceleration" in receivers:
             receivers["ground_acceleration"] = ground(receivers["t"])
             receivers["absolute_acceleration"] = receivers["acceleration"] + receivers["ground_acceleration"][:, None, :]
-    extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
+    extra = {"time_grid": {"dt_s": cfg.dt, "t_end_s": n_steps * cfg.dt, "n_steps": n_steps},
+             "fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                      "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
                      "elements": model.mesh.element_counts(),
                      "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}

@@ -743,8 +743,10 @@ def _git_revision():
     return _GIT[0]
 
 
-def provenance(cfg, comm, extra=None):
-    """The run record: resolved options, library versions, git revision, ranks."""
+def provenance(cfg, comm, extra=None, grid=None):
+    """The run record: resolved options, library versions, git revision, ranks; with ``grid`` (the
+    run's ``timegrid.TimeGrid``) its step, end and steps under 'time_grid' (a run under a record
+    without -ssi_t_end lasts the record: the options keep what the user gave)."""
     PETSc = init()
     import petsc4py
     import mpi4py
@@ -767,6 +769,8 @@ def provenance(cfg, comm, extra=None):
     except Exception:  # gmsh is optional for runs on structured meshes
         pass
     rec["git"] = _git_revision()
+    if grid is not None:
+        rec["time_grid"] = {"dt_s": grid.dt, "t_end_s": grid.time(grid.n_steps), "n_steps": grid.n_steps}
     if extra:
         rec.update(extra)
     return rec
