@@ -101,7 +101,7 @@ def test_fem_restart_is_bitwise(integrator, tmp_path):
     for a, b in run_and_restart(FEM + ["-ssi_fem_integrator", integrator], tmp_path, 1, 17, 17):
         d = assert_same_files(b, a)
         assert np.abs(d["receivers/u"]).max() > 0
-        assert len(d["demands/t"]) == 51 and np.abs(d["demands/base_shear"]).max() > 0    # io/demands.py
+        assert len(d["demands/t"]) == 51 and np.abs(d["demands/base_shear"]).max() > 0    # fem/demands.py
 
 
 @pytest.mark.parametrize("coupling", ["implicit", "staggered"])
@@ -113,7 +113,7 @@ def test_coupled_contact_restart_is_bitwise(coupling, tmp_path):
     pairs = run_and_restart(args, tmp_path, 2, 30, 30, outputs=("r.h5", "r_structure.h5"))
     for a, b in pairs:
         assert_same_files(b, a)
-    dem = datasets(pairs[1][0])                # the storey demands' series (io/demands.py; a vertical load: no shear)
+    dem = datasets(pairs[1][0])                # the storey demands' series (fem/demands.py; a vertical load: no shear)
     assert len(dem["demands/t"]) == len(dem["demands/base_shear"]) == 81
     closed = datasets(pairs[0][0])["interface/closed"]
     assert not closed[30:].all() and not closed[:30].all()      # open before and after the checkpoint

@@ -140,6 +140,35 @@ def test_library_does_not_import_the_application():
     assert not bad, "library modules import the application layer:\n" + "\n".join(bad)
 
 
+# Leaves: modules that promise, in their docstrings, to stand alone (numpy/scipy/numba only), so that
+# they can be tested and reused alone: they import no module of the package.
+LEAVES = ("petsc_ssi.analytic.free_field", "petsc_ssi.analytic.pekeris", "petsc_ssi.analytic.impedance_refs",
+          "petsc_ssi.seismic.records", "petsc_ssi.seismic.response_spectrum", "petsc_ssi.spectrum",
+          "petsc_ssi.timegrid", "petsc_ssi.sysmem", "petsc_ssi.mesh.quad9", "petsc_ssi.bem.kernels",
+          "petsc_ssi.bem.simd", "petsc_ssi.bem.windows", "petsc_ssi.bem.stability_map",
+          "petsc_ssi.fem.elements.base", "petsc_ssi.coupling.contact")
+# Folders: io/ holds files, formats and the recorder; the observers of a domain live beside it
+# (issue 40), so io/ imports none of the domains' packages.
+FOLDER_RULES = {"petsc_ssi.io": ("petsc_ssi.bem", "petsc_ssi.fem", "petsc_ssi.coupling", "petsc_ssi.seismic")}
+
+
+def folder_violations(g, where, leaves=LEAVES, rules=FOLDER_RULES):
+    bad = [f"leaf {m} imports {t} ({where[(m, t)]})" for m in leaves if m in g for t in sorted(g[m])]
+    for folder, banned in rules.items():
+        for m in sorted(g):
+            if m == folder or m.startswith(folder + "."):
+                bad += [f"{m} -> {t} ({where[(m, t)]})" for t in sorted(g[m])
+                        if any(t == b or t.startswith(b + ".") for b in banned)]
+    return bad
+
+
+def test_leaves_and_folders_keep_their_rules():
+    g, where = graph()
+    assert all(m in g for m in LEAVES), [m for m in LEAVES if m not in g]
+    bad = folder_violations(g, where)
+    assert not bad, "\n".join(bad)
+
+
 def test_the_checks_can_fail(tmp_path):
     """The same checks on a small package with a cycle inside a function and an importlib load,
     and a library module importing its app: both are found."""
@@ -153,4 +182,14 @@ def test_the_checks_can_fail(tmp_path):
     (pkg / "c.py").write_text("from .app import cli\n")
     g, _ = graph(str(pkg))
     assert cycles(g) == [["petsc_ssi.a", "petsc_ssi.b"]]
+    (pkg / "io").mkdir()
+    (pkg / "io" / "__init__.py").write_text("")
+    (pkg / "io" / "rec.py").write_text("def f():\n    from ..bem import x\n")
+    (pkg / "bem").mkdir()
+    (pkg / "bem" / "__init__.py").write_text("")
+    (pkg / "bem" / "x.py").write_text("")
+    (pkg / "leaf.py").write_text("from .a import f\n")
+    g, where = graph(str(pkg))
+    bad = folder_violations(g, where, leaves=("petsc_ssi.leaf",))
+    assert len(bad) == 2 and "leaf petsc_ssi.leaf imports petsc_ssi.a" in bad[0] and "petsc_ssi.io.rec ->" in bad[1]
     assert "petsc_ssi.app.cli" in g["petsc_ssi.c"]

@@ -183,9 +183,9 @@ def test_no_room_for_the_final_copy_keeps_the_links(tmp_path, monkeypatch, capsy
 def test_member_forces_virtual_datasets_carry_no_time(tmp_path):
     """The member forces' series is a virtual dataset; h5py's create_virtual_dataset records its
     creation time, so two runs' identical results gave files of other bytes (a second apart). The
-    forces' writer creates it without one (io/forces.py _virtual)."""
+    forces' writer creates it without one (fem/forces.py _virtual)."""
     import time
-    from petsc_ssi.io.forces import _virtual
+    from petsc_ssi.fem.forces import _virtual
     from petsc_ssi.io.output import _new_file
     digests = []
     for k in range(2):

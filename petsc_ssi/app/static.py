@@ -64,7 +64,7 @@ def main():
         out = Output(cfg.output, comm)
         fw = FieldWriter(out, model, comm)
         fw.write(1.0, u)
-        from ..io.forces import add_force_recorder
+        from ..fem.forces import add_force_recorder
         forces = add_force_recorder(cfg, out, model, comm)          # -ssi_structure_forces
         if forces is not None:
             forces.record(1.0, u, write=True)

@@ -57,7 +57,8 @@ class BEMTransient(TransientProblem):
 
     def start(self):
         self._advance("set up", "started")
-        from ..io.recorder import Recorder, SoilRecorder
+        from ..io.recorder import Recorder
+        from .recorder import SoilRecorder
         rd = self._open_restart()
         self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,

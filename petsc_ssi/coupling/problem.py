@@ -19,7 +19,7 @@ from ..monitor import staged, fmt_time
 from ..io.output import Output
 from ..problem import TransientProblem, no_output_refused
 from ..io.output import provenance
-from ..io.forces import add_force_recorder
+from ..fem.forces import add_force_recorder
 from ..io.structure import receiver_record
 from ..monitor import event
 from ..bem.build import build_marcher
@@ -48,7 +48,7 @@ class SSITransient(TransientProblem):
             self.hist = load_history(cfg, comm)
             self.prob, self.model, self.iface, self.fe_cfg = build_coupled(cfg, comm)
             iface = self.iface
-            from ..io.demands import DemandSpec
+            from ..fem.demands import DemandSpec
             from ..petsc import collective
             with collective(comm, "checking the storey demands' options"):
                 self.demand_spec = DemandSpec(cfg, self.model, "-ssi_structure_receivers", base="interface",
@@ -107,7 +107,9 @@ class SSITransient(TransientProblem):
 
     def start(self):
         self._advance("set up", "started")
-        from ..io.recorder import Recorder, SoilRecorder, StructureRecorder, StepClock
+        from ..io.recorder import Recorder, StepClock
+        from ..bem.recorder import SoilRecorder
+        from ..fem.recorder import StructureRecorder
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
             (("uff",) if self.prob.seismic is not None else ())
@@ -122,7 +124,7 @@ class SSITransient(TransientProblem):
         self.forces = add_force_recorder(cfg, self.sout, self.model, comm, self.rec)
         self.rec.add(_FiniteCheck(self.integ))
         self.clock = self.rec.add(StepClock())
-        from ..io.demands import Demands       # base shear, overturning moment, drifts (io/demands.py)
+        from ..fem.demands import Demands       # base shear, overturning moment, drifts (fem/demands.py)
         self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"))
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))

@@ -12,7 +12,7 @@ from ..points import parse_triple
 from .. import common_options  # noqa: F401  (the common options every problem reads)
 from . import parts as _parts  # noqa: F401  (-help lists the per-part options)
 from ..seismic import options as _seismic_options  # noqa: F401  (a fixed base moving with a record)
-from ..io import demands as _demands  # noqa: F401  (-ssi_structure_drift_*: the storey demands' options)
+from . import demands as _demands  # noqa: F401  (-ssi_structure_drift_*: the storey demands' options)
 
 G = "fem"
 
@@ -85,7 +85,7 @@ register("structure_forces", "str", "", "", "member forces of frame and shell pa
          "frame and shell part; '' or none: no forces): frame end forces (N, V2, V3, T, M2, M3 at both ends, local "
          "axes) and shell stress resultants (N11, N22, N12, M11, M22, M12, Q1, Q2 at the centre, local frame) with "
          "every structure snapshot, their peak over all steps, and the peaks as XDMF cell fields "
-         "(petsc_ssi/io/forces.py)", G)
+         "(petsc_ssi/fem/forces.py)", G)
 register("modes_n", "int", 6, "", "petsc-ssi modes: number of natural modes", G, validator=at_least(1))
 
 
@@ -126,7 +126,7 @@ def _forces_check(cfg):
     if not text or text == "none":
         return None
     from .parts import parse_parts
-    from ..io.forces import parse_force_parts
+    from .forces import parse_force_parts
     try:
         specs = parse_parts(cfg)
     except SSIError:

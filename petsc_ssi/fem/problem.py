@@ -20,7 +20,7 @@ import numpy as np
 from ..petsc import printf, warn
 from ..monitor import event, staged
 from ..io.output import Output, provenance
-from ..io.forces import add_force_recorder
+from .forces import add_force_recorder
 from ..problem import TransientProblem
 from .. import timegrid
 from . import options as _options  # noqa: F401  (declares the structure's -ssi_fem_ options)
@@ -38,7 +38,7 @@ class FEMTransient(TransientProblem):
         with staged("FEM setup"):
             self.hist = load_history(cfg, self.comm)          # before assembly and factorisation
             self.model = build_model(cfg, self.comm, assemble_matrices=False)
-            from ..io.demands import DemandSpec
+            from .demands import DemandSpec
             from ..petsc import collective
             with collective(self.comm, "checking the storey demands' options"):
                 self.demand_spec = DemandSpec(cfg, self.model, "-ssi_receivers", base="reactions")
@@ -117,7 +117,8 @@ class FEMTransient(TransientProblem):
 
     def start(self):
         self._advance("set up", "started")
-        from ..io.recorder import Recorder, StructureRecorder
+        from ..io.recorder import Recorder
+        from .recorder import StructureRecorder
         cfg, comm = self.cfg, self.comm
         rd = self._open_restart()
         with event("FEM_io"):
@@ -126,8 +127,8 @@ class FEMTransient(TransientProblem):
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
             self.forces = add_force_recorder(cfg, self.out, self.model, comm, self.rec)
-        if self.demand_spec.any:                  # base shear, overturning moment, drifts (io/demands.py)
-            from ..io.demands import Demands
+        if self.demand_spec.any:                  # base shear, overturning moment, drifts (fem/demands.py)
+            from .demands import Demands
             sup = self.support                    # the base moves with the ground: its inertia m a_g
             ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
             self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
@@ -197,7 +198,7 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
                   demands=None):
     """Collective: receivers, attributes and run record into the output; ``final``: close it
     (else flush it: readable, still open). ``demands``: the storey demands' observer (the group
-    'demands', io/demands.py)."""
+    'demands', fem/demands.py)."""
     if out is None:
         return
     t, u = srec.rec.arrays()

@@ -9,7 +9,7 @@ petsc4py 3.18, whose HDF5 viewer has no group/timestepping calls, and newer):
   topology               (E, n)  cell connectivity (0-based)        [rank 0]
   time                   (K,)    time of snapshot k                 [rank 0]
   receivers/...          receiver series (see ``write_receivers``)  [rank 0]
-  (writers)              more data of ``Output.writers`` (e.g. io/forces.py's member forces:
+  (writers)              more data of ``Output.writers`` (e.g. fem/forces.py's member forces:
                          distributed Vecs through the viewer before it closes, then rank 0's
                          h5py work, which may name cell fields: XDMF Center="Cell" attributes)
   attrs: cell_type, fields, n_snapshots, petsc_ssi_version, run_status, run_id (shared with
@@ -331,7 +331,7 @@ class Output:
         self.cells = None
         self.cell_type = None
         self.n_nodes = 0
-        # writers of more data (e.g. io.forces.ForceRecorder): write_collective(out) before the
+        # writers of more data (e.g. fem.forces.ForceRecorder): write_collective(out) before the
         # part closes, write_serial(h5 file) on rank 0 -> XDMF cell attributes [(name, dataset, unit)]
         self.writers = []
         self.cell_attributes = []

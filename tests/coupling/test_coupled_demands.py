@@ -1,4 +1,4 @@
-"""Storey demands of a coupled run (io/demands.py, issue 28 item 2): base shear, overturning moment
+"""Storey demands of a coupled run (fem/demands.py, issue 28 item 2): base shear, overturning moment
 and drift ratio in the group 'demands' of <output>_structure.h5.
 
 The case: the block of tests/coupling/test_seismic.py (1 m x 1 m x 0.25 m bricks, 4 x 4 x 1 cells,

@@ -1,4 +1,4 @@
-"""Storey demands (io/demands.py): base shear, overturning moment, inter-storey drift ratios.
+"""Storey demands (fem/demands.py): base shear, overturning moment, inter-storey drift ratios.
 
 The structure: a two-storey shear frame of the project's frame elements: four columns (0.2 x 0.2 m,
 E 30 GPa, two elements per storey of h = 3 m) on a 12 m x 12 m plan, clamped at z = 0, and beams
@@ -98,7 +98,7 @@ def test_static_shear_frame_drifts_shear_and_moment(msh, PETSc):
     from petsc_ssi.fem.model import build_model
     from petsc_ssi.fem.static import static_solve
     from petsc_ssi.fem.parts import rect_section
-    from petsc_ssi.io.demands import DemandSpec, Demands
+    from petsc_ssi.fem.demands import DemandSpec, Demands
     F1, F2, F2y = 40e3, 60e3, 20e3
     loads = f"lev1,{F1 / 4},0,0;lev2,{F2 / 4},{F2y / 4},0"
     with Opts(fem_point_load=loads, **frame_opts(msh)) as cfg:
@@ -151,7 +151,7 @@ def test_fixed_base_equilibrium_every_step(msh, record, tmp_path, alpha_m):
         -sum_free m [(v^n - v^{n-1})/dt + (ag^n + ag^{n-1})/2] - alpha_m sum_free m [vbar + dt (ag^n - ag^{n-1})/4]
         - sum_base m (a_g(t_n) + a_g(t_{n-1}))/2
 
-    (io/demands.py: the integrator's own equation on the free dofs summed over x; ag^n the mean
+    (fem/demands.py: the integrator's own equation on the free dofs summed over x; ag^n the mean
     ground acceleration over [t_n - dt/2, t_n + dt/2], the integrator's load; the base's nodes move
     with the ground, a_g(t_n) the record's value) to 1e-9 of its peak; the overturning moment
     likewise with the inertia forces' moment (rotary inertia included). The output's peak envelopes
@@ -177,7 +177,7 @@ def test_fixed_base_equilibrium_every_step(msh, record, tmp_path, alpha_m):
     vt = v.copy()                                       # (K, N, 3) translations' velocities
     mt = m[dm.translation_dofs(nodes)]                  # (N, 3) [kg]
     # the rotations' velocities: no load acts on them, so the scheme's u^n - u^{n-1} = dt (v^n + v^{n-1}) / 2
-    # holds there exactly (io/demands.py); at rest at t = 0
+    # holds there exactly (fem/demands.py); at rest at t = 0
     th = rec["rotation"]
     om = np.zeros_like(th)
     for n in range(1, len(t)):
@@ -244,7 +244,7 @@ def test_fixed_base_equilibrium_every_step(msh, record, tmp_path, alpha_m):
 def test_bad_demand_options(msh, PETSc, opts, words):
     """Each misuse is an SSIError of the replicated check (DemandSpec, before any assembly)."""
     from petsc_ssi.fem.model import build_model
-    from petsc_ssi.io.demands import DemandSpec
+    from petsc_ssi.fem.demands import DemandSpec
     from petsc_ssi.petsc import SSIError
     o = frame_opts(msh)
     o.update(receivers="0,0,0;0,0,6", **opts)

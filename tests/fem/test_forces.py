@@ -1,6 +1,6 @@
 """Member forces (issue 28 item 2): frame end forces and shell stress resultants from the element
 kernels (``Frame.end_forces``, ``shell.resultants``) against closed forms, and the output of a run
-with -ssi_structure_forces (``io.forces.ForceRecorder``: per-snapshot datasets, envelopes, the
+with -ssi_structure_forces (``fem.forces.ForceRecorder``: per-snapshot datasets, envelopes, the
 XDMF cell fields) against the kernels applied to the run's own displacement snapshots.
 
 The static solves use the test's own scipy assembly (elements/np_assembly.py); the frame element
@@ -330,7 +330,7 @@ def test_forces_option_bad_input(value, message, tmp_path):
 
 def test_forces_option_refuses_brick_parts():
     from petsc_ssi.fem.parts import PartSpec
-    from petsc_ssi.io.forces import parse_force_parts
+    from petsc_ssi.fem.forces import parse_force_parts
     from petsc_ssi.petsc import SSIError
     specs = [PartSpec("block", "hex8", None), PartSpec("beam", "frame", None)]
     assert parse_force_parts("all", specs) == ["beam"] and parse_force_parts("none", specs) == []

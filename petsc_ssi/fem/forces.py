@@ -42,8 +42,8 @@ one batched product with operators built once (``einsum``).
 import numpy as np
 
 from ..petsc import init, SSIError
-from ..fem.elements.frame import END_FORCES, END_FORCE_UNITS
-from ..fem.elements.shell import RESULTANTS, RESULTANT_UNITS, resultant_operator
+from .elements.frame import END_FORCES, END_FORCE_UNITS
+from .elements.shell import RESULTANTS, RESULTANT_UNITS, resultant_operator
 
 KINDS = ("frame", "shell")
 FRAME_CONVENTION = ("end forces the nodes exert on the element, local axes (x' node 0 -> node 1, z' the "
@@ -243,7 +243,7 @@ class ForceRecorder:
         """Rank 0, the file open (h5py): the 'forces' group and the cell fields; returns the XDMF
         cell attributes [(name, dataset, unit)]."""
         import h5py
-        from .output import _group
+        from ..io.output import _group
         g = _group(f, "forces")
         g.create_dataset("snapshots", data=np.asarray(self.snapshots, np.int64), track_times=False)
         d = g.create_dataset("time", data=np.asarray(self.times, float), track_times=False)
