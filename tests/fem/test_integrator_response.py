@@ -1,0 +1,132 @@
+"""The integrators' steady response to a harmonic load and their free vibration against the closed
+forms of fem/integrator_response.py (issue 46): the classes themselves, run on one dof."""
+import numpy as np
+import pytest
+
+from fem_helpers import sdof_mats
+from petsc_ssi.fem import integrator_response as ir
+from petsc_ssi.fem.integrators import make_integrator
+
+DT, MASS = 5e-3, 2.0
+
+
+def _run(kind, W, zeta, load, u0=0.0, v0=0.0, steps=240):
+    """u^0..u^N of the class ``kind`` on one dof (omega dt = W, mass-proportional zeta at omega);
+    ``load(n)`` is the load sample g^n [N] (None: free)."""
+    from petsc_ssi.petsc import init
+    PETSc = init()
+    omega = W / DT
+    K, m = sdof_mats(MASS * omega ** 2, MASS)
+    integ = make_integrator(kind, K, m, DT, 2 * zeta * omega)
+
+    def vec(x):
+        v = m.duplicate()
+        v.set(x)
+        return v
+    g = (lambda n: None) if load is None else (lambda n: vec(load(n)))
+    integ.start(vec(u0), vec(v0), g(0))
+    us = [integ.u.getArray()[0]]
+    for n in range(1, steps + 1):
+        integ.step(g(n))
+        us.append(integ.u.getArray()[0])
+    integ.destroy()
+    K.destroy()
+    assert PETSc is not None
+    return np.array(us)
+
+
+def measured_ratio(kind, W, x, zeta=0.0, F=3.0):
+    """The steady amplitude of the class under F cos(Omega t) (its samples: the cell mean for green and
+    newmark, the interval mean for midpoint) over the exact one, as a complex number: least squares of
+    u^n on cos(theta n), sin(theta n) and the class's own free responses from u0 = 1 and from v0 = 1
+    (the transient is a combination of them), so the fit is exact to round-off."""
+    th = 2 * np.pi * x
+    S = np.sinc(x)
+    shift = 0.5 * th if ir.SAMPLING[kind] == "interval" else 0.0
+
+    def load(n):
+        return 0.0 if (kind == "midpoint" and n == 0) else F * S * np.cos(th * n - shift)
+    u = _run(kind, W, zeta, load)
+    n = np.arange(len(u))
+    basis = np.column_stack([np.cos(th * n), np.sin(th * n), _run(kind, W, zeta, None, u0=1.0),
+                             _run(kind, W, zeta, None, v0=1.0)])
+    coef, *_ = np.linalg.lstsq(basis, u, rcond=None)
+    assert np.abs(basis @ coef - u).max() < 1e-8 * np.abs(u).max()
+    omega, Om = W / DT, th / DT
+    exact = F / (MASS * (omega ** 2 - Om ** 2 + 2j * zeta * omega * Om))
+    return (coef[0] - 1j * coef[1]) / exact
+
+
+CASES = [(W, x) for W in (50.0, 2.0, 0.3) for x in (0.05, 0.17, 0.3, 0.39, 0.45)]
+
+
+@pytest.mark.parametrize("kind", ir.SCHEMES)
+def test_steady_amplitude_of_the_classes_is_the_closed_form(kind):
+    """Undamped: the measured ratio equals the closed form to 1 % (in fact to round-off) at stiff
+    (omega dt = 50), moderate and soft oscillators and f dt from 0.05 to 0.45; the phase too (the
+    closed form is real)."""
+    for W, x in CASES:
+        meas, cf = measured_ratio(kind, W, x), ir.closed_form_ratio(kind, W, x)
+        assert abs(meas / cf - 1.0) < 0.01, (kind, W, x, meas, cf)
+        assert abs(meas / cf - 1.0) < 1e-6, (kind, W, x, meas, cf)
+
+
+@pytest.mark.parametrize("kind", ir.SCHEMES)
+def test_damped_steady_amplitude_is_the_transfer_function(kind):
+    for W, x in ((50.0, 0.39), (1.0, 0.1), (0.3, 0.25)):
+        meas, tf = measured_ratio(kind, W, x, zeta=0.05), ir.steady_ratio(kind, W, x, zeta=0.05)
+        assert abs(meas / tf - 1.0) < 1e-6, (kind, W, x, meas, tf)
+
+
+def test_green_is_newmark_times_one_over_cos2():
+    """The cause: U_green = 4z/(1+z)^2 U_newmark for every oscillator and damping."""
+    for W in (0.3, 1.5, 50.0):                      # (not 2.0: newmark's discrete resonance at f dt 1/4)
+        for zeta in (0.0, 0.05):
+            for x in (0.05, 0.25, 0.39, 0.45):
+                g, n = ir.steady_ratio("green", W, x, zeta), ir.steady_ratio("newmark", W, x, zeta)
+                if abs(n) > 1e-6:
+                    assert g / n == pytest.approx(1.0 / np.cos(np.pi * x) ** 2, rel=1e-6)
+    # the stiff limit: x1.80 at f dt 1/4, x6.69 at 0.39, x28.5 at 0.45 (green); newmark below 1
+    amp = [float(ir.stiff_amplification("green", x)) for x in (0.25, 0.39, 0.45)]
+    assert amp == pytest.approx([1.8006, 6.6926, 28.549], rel=1e-3)
+    assert np.all(ir.stiff_amplification("newmark", np.linspace(0.01, 0.49, 49)) < 1.0)
+    assert measured_ratio("green", 50.0, 0.39) == pytest.approx(6.69, rel=0.02)
+
+
+@pytest.mark.parametrize("kind", ir.SCHEMES)
+def test_free_vibration_radius_and_period(kind):
+    """The class's free run u^{n+1} = p u^n + q u^{n-1} (fitted) has the eigenvalues of ``free_vibration``:
+    radius 1 and T_h/T = (W/2)/arctan(W/2) undamped (trapezoidal), and the damped radius."""
+    for W, zeta in ((0.5, 0.0), (2.0, 0.0), (1.0, 0.05)):
+        u = _run(kind, W, zeta, None, u0=1.0, steps=40)[2:]
+        A = np.column_stack([u[1:-1], u[:-2]])
+        p, q = np.linalg.lstsq(A, u[2:], rcond=None)[0]
+        lam = np.roots([1.0, -p, -q])
+        rho, period = ir.free_vibration(kind, W, zeta)
+        assert np.abs(lam).max() == pytest.approx(rho, rel=1e-6)
+        assert W / abs(np.angle(lam[0])) == pytest.approx(period, rel=1e-6)
+        if zeta == 0.0:
+            assert rho == pytest.approx(1.0, abs=1e-12)
+            assert period == pytest.approx(0.5 * W / np.arctan(0.5 * W), rel=1e-12)
+
+
+def test_safe_band_and_record_note():
+    """green keeps a stiff mode within 5 % up to f dt 0.0766, midpoint 0.120, newmark everywhere; the
+    note fires for a record with energy above the band and names a dt that puts it inside."""
+    assert ir.safe_band("green") == pytest.approx(0.0766, abs=2e-4)
+    assert ir.safe_band("midpoint") == pytest.approx(0.1197, abs=2e-4)
+    assert ir.safe_band("newmark") == 0.5
+    t = np.arange(0.0, 2.0, 0.001)
+    env = np.sin(np.pi * t / 2.0) ** 2                         # (a record is tapered)
+    low = np.sin(2 * np.pi * 5 * t) * env
+    hf = low + 0.5 * np.sin(2 * np.pi * 70 * t) * env
+    assert ir.record_note("green", 5e-3, t, low, "low") is None
+    assert ir.record_note("newmark", 5e-3, t, hf, "hf") is None
+    note = ir.record_note("green", 5e-3, t, hf, "hf", advice="use newmark")
+    assert note is not None and "the 20 % of its acceleration's energy above 15.32 Hz" in note, note
+    # 70 Hz at 5 ms: x4.2 (S/cos^2 at f dt 0.35) on a third of the peak: the record's peak x1.98
+    assert ir.stiff_peak_ratio("green", 5e-3, t, hf) == pytest.approx(1.98, abs=0.01)
+    assert "a peak x1.98 the record's" in note and "-ssi_dt 0.0017 keeps that within 5 %" in note, note
+    assert note.endswith("; use newmark"), note
+    assert ir.stiff_peak_ratio("green", 1.7e-3, t, hf) <= 1.05 < ir.stiff_peak_ratio("green", 1.9e-3, t, hf)
+    assert ir.record_note("green", 1.7e-3, t, hf, "hf") is None
