@@ -173,6 +173,31 @@ def _nyquist_notes(motions, dt):
     return out
 
 
+def structure_scheme(cfg):
+    """The structure's time integrator of a run with a seismic record: -ssi_fem_integrator on a fixed
+    base (-ssi_problem fem), the coupling strategy's (-ssi_coupling) with the soil, None without a
+    structure."""
+    problem = cfg.get("problem", "bem")
+    if problem == "fem":
+        return cfg.get("fem_integrator", "green")
+    if problem == "ssi":
+        from ..coupling.step import STRATEGIES
+        return STRATEGIES[cfg.get("coupling", "implicit")].integrator
+    return None
+
+
+def _scheme_notes(motions, dt, scheme):
+    """A note per record with energy where the structure's integrator ``scheme`` amplifies a load
+    (fem/integrator_response.py ``record_note``: the Green scheme's 1/cos^2(pi f dt))."""
+    if scheme is None:
+        return []
+    from ..fem.integrator_response import record_note
+    advice = {"green": "-ssi_fem_integrator newmark does not amplify it (-ssi_problem fem; with the soil, "
+                       "-ssi_coupling implicit amplifies it as 1/cos(pi f dt))"}.get(scheme, "")
+    notes = (record_note(scheme, dt, m.t, m.a, m.source, axis, advice=advice) for axis, m in motions.items())
+    return [n for n in notes if n]
+
+
 def collective_motions(cfg, comm):
     """Collective: (motions, notes): ``read_motions`` on rank 0, broadcast; the processing's
     warnings (``RecordWarning``) as one-line notes; one-line SSIError on every rank on a defect."""
@@ -187,6 +212,7 @@ def collective_motions(cfg, comm):
                     raise SSIError(str(exc)) from None
             notes += [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
             notes += _nyquist_notes(motions, cfg.dt)
+            notes += _scheme_notes(motions, cfg.dt, structure_scheme(cfg))
     return comm.tompi4py().bcast((motions, notes), root=0)
 
 

@@ -130,3 +130,37 @@ def test_safe_band_and_record_note():
     assert note.endswith("; use newmark"), note
     assert ir.stiff_peak_ratio("green", 1.7e-3, t, hf) <= 1.05 < ir.stiff_peak_ratio("green", 1.9e-3, t, hf)
     assert ir.record_note("green", 1.7e-3, t, hf, "hf") is None
+
+
+BOX = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "1,1,2", "-ssi_fem_box_size", "1,1,1", "-ssi_fem_box_origin",
+       "-0.5,-0.5,0", "-ssi_fem_E", "30e9", "-ssi_fem_fixed", "base", "-ssi_seismic", "vertical",
+       "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none", "-ssi_receivers", "0.5,0.5,1"]
+
+
+def test_a_stiff_structure_under_a_record_at_70_hz_is_warned_and_the_named_dt_resolves_it(tmp_path):
+    """A stiff block (first mode ~ 600 Hz) on a fixed base under 5 Hz + 70 Hz (a third of the peak):
+    at dt = 5 ms green's roof peak absolute acceleration exceeds newmark's by over 30 % and the run
+    warns, naming -ssi_dt 0.0017; newmark does not warn; at dt = 1.7 ms green does not warn and its roof
+    peak is within 5 % of newmark's."""
+    import h5py
+    from helpers import cli
+    t = np.arange(0.0, 0.6, 0.001)
+    env = np.sin(np.pi * t / 0.6) ** 2
+    rec = tmp_path / "hf.txt"
+    np.savetxt(rec, np.c_[t, (np.sin(2 * np.pi * 5 * t) + 0.5 * np.sin(2 * np.pi * 70 * t)) * env],
+               header="units: m/s2")
+    peak, warned = {}, {}
+    for kind, dt in (("green", "0.005"), ("newmark", "0.005"), ("green", "0.0017"), ("newmark", "0.0017")):
+        out = tmp_path / f"{kind}-{dt}.h5"
+        p = cli(BOX + ["-ssi_dt", dt, "-ssi_fem_integrator", kind, "-ssi_seismic_record", str(rec),
+                       "-ssi_output", str(out)])
+        warned[kind, dt] = [ln for ln in p.stdout.splitlines()
+                            if ln.startswith("petsc-ssi: warning:") and "static response" in ln]
+        with h5py.File(out, "r") as f:
+            peak[kind, dt] = float(np.abs(f["receivers/absolute_acceleration"][:, 0, 0]).max())
+    assert len(warned["green", "0.005"]) == 1, warned
+    w = warned["green", "0.005"][0]
+    assert "above 15.32 Hz" in w and "-ssi_dt 0.0017 keeps that within 5 %" in w and "newmark" in w, w
+    assert not warned["newmark", "0.005"] and not warned["green", "0.0017"] and not warned["newmark", "0.0017"]
+    assert peak["green", "0.005"] / peak["newmark", "0.005"] > 1.3, peak
+    assert peak["green", "0.0017"] / peak["newmark", "0.0017"] == pytest.approx(1.0, abs=0.05), peak
