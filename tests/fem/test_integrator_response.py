@@ -93,6 +93,22 @@ def test_green_is_newmark_times_one_over_cos2():
     assert measured_ratio("green", 50.0, 0.39) == pytest.approx(6.69, rel=0.02)
 
 
+def test_a_three_point_load_average_would_make_green_newmark():
+    """The impulse h (g^{n-1} + 2 g^n + g^{n+1})/4 (module docstring): the class fed that sample answers
+    like newmark (measured), where the plain sample gives x1/cos^2."""
+    th, x, W, F = 2 * np.pi * 0.39, 0.39, 50.0, 3.0
+    g = lambda n: F * np.sinc(x) * np.cos(th * n)                     # noqa: E731
+    u = _run("green", W, 0.0, lambda n: (g(n - 1) + 2 * g(n) + g(n + 1)) / 4)
+    n = np.arange(len(u))
+    basis = np.column_stack([np.cos(th * n), np.sin(th * n), _run("green", W, 0.0, None, u0=1.0),
+                             _run("green", W, 0.0, None, v0=1.0)])
+    c = np.linalg.lstsq(basis, u, rcond=None)[0]
+    omega = W / DT
+    meas = (c[0] - 1j * c[1]) * MASS * (omega ** 2 - (th / DT) ** 2) / F
+    assert meas == pytest.approx(ir.closed_form_ratio("newmark", W, x), rel=1e-6)
+    assert ir.steady_ratio("green", W, x, smoothed=True) == pytest.approx(ir.steady_ratio("newmark", W, x), rel=1e-6)
+
+
 @pytest.mark.parametrize("kind", ir.SCHEMES)
 def test_free_vibration_radius_and_period(kind):
     """The class's free run u^{n+1} = p u^n + q u^{n-1} (fitted) has the eigenvalues of ``free_vibration``:
