@@ -10,14 +10,14 @@ from petsc_ssi.fem.integrators import make_integrator
 DT, MASS = 5e-3, 2.0
 
 
-def _run(kind, W, zeta, load, u0=0.0, v0=0.0, steps=240):
+def _run(kind, W, zeta, load, u0=0.0, v0=0.0, steps=80, ad=(0.25, 0.5)):
     """u^0..u^N of the class ``kind`` on one dof (omega dt = W, mass-proportional zeta at omega);
     ``load(n)`` is the load sample g^n [N] (None: free)."""
     from petsc_ssi.petsc import init
     PETSc = init()
     omega = W / DT
     K, m = sdof_mats(MASS * omega ** 2, MASS)
-    integ = make_integrator(kind, K, m, DT, 2 * zeta * omega)
+    integ = make_integrator(kind, K, m, DT, 2 * zeta * omega, (), *ad)
 
     def vec(x):
         v = m.duplicate()
@@ -35,7 +35,7 @@ def _run(kind, W, zeta, load, u0=0.0, v0=0.0, steps=240):
     return np.array(us)
 
 
-def measured_ratio(kind, W, x, zeta=0.0, F=3.0):
+def measured_ratio(kind, W, x, zeta=0.0, F=3.0, ad=(0.25, 0.5)):
     """The steady amplitude of the class under F cos(Omega t) (its samples: the cell mean for green and
     newmark, the interval mean for midpoint) over the exact one, as a complex number: least squares of
     u^n on cos(theta n), sin(theta n) and the class's own free responses from u0 = 1 and from v0 = 1
@@ -46,10 +46,10 @@ def measured_ratio(kind, W, x, zeta=0.0, F=3.0):
 
     def load(n):
         return 0.0 if (kind == "midpoint" and n == 0) else F * S * np.cos(th * n - shift)
-    u = _run(kind, W, zeta, load)
+    u = _run(kind, W, zeta, load, ad=ad)
     n = np.arange(len(u))
-    basis = np.column_stack([np.cos(th * n), np.sin(th * n), _run(kind, W, zeta, None, u0=1.0),
-                             _run(kind, W, zeta, None, v0=1.0)])
+    basis = np.column_stack([np.cos(th * n), np.sin(th * n), _run(kind, W, zeta, None, u0=1.0, ad=ad),
+                             _run(kind, W, zeta, None, v0=1.0, ad=ad)])
     coef, *_ = np.linalg.lstsq(basis, u, rcond=None)
     assert np.abs(basis @ coef - u).max() < 1e-8 * np.abs(u).max()
     omega, Om = W / DT, th / DT
@@ -76,6 +76,17 @@ def test_damped_steady_amplitude_is_the_transfer_function(kind):
     for W, x in ((50.0, 0.39), (1.0, 0.1), (0.3, 0.25)):
         meas, tf = measured_ratio(kind, W, x, zeta=0.05), ir.steady_ratio(kind, W, x, zeta=0.05)
         assert abs(meas / tf - 1.0) < 1e-6, (kind, W, x, meas, tf)
+
+
+@pytest.mark.parametrize("kind", ["green", "newmark"])
+def test_dissipative_constants_match_the_transfer_function(kind):
+    """alpha = 0.36, delta = 0.6 (delta^2 = alpha: the Green scheme's other family): the classes against
+    step_matrices' transfer function; green still amplifies a stiff mode (x1.73 at f dt 1/4, x5.1 at 0.39)."""
+    for W, x in ((50.0, 0.25), (50.0, 0.39), (1.0, 0.1)):
+        meas = measured_ratio(kind, W, x, ad=(0.36, 0.6))
+        assert meas == pytest.approx(ir.steady_ratio(kind, W, x, alpha=0.36, delta=0.6), rel=1e-6)
+    if kind == "green":
+        assert abs(ir.steady_ratio("green", 50.0, 0.39, alpha=0.36, delta=0.6)) == pytest.approx(5.127, rel=1e-3)
 
 
 def test_green_is_newmark_times_one_over_cos2():
@@ -180,3 +191,19 @@ def test_a_stiff_structure_under_a_record_at_70_hz_is_warned_and_the_named_dt_re
     assert not warned["newmark", "0.005"] and not warned["green", "0.0017"] and not warned["newmark", "0.0017"]
     assert peak["green", "0.005"] / peak["newmark", "0.005"] > 1.3, peak
     assert peak["green", "0.0017"] / peak["newmark", "0.0017"] == pytest.approx(1.0, abs=0.05), peak
+
+
+def test_which_runs_check_their_record():
+    """The fixed base checks its -ssi_fem_integrator, the staggered coupling its Green scheme; the implicit
+    coupling (interface force solved with the soil; runs/integrators/coupled.csv) and the soil alone none."""
+    from petsc_ssi.seismic.input import structure_scheme
+
+    class Cfg(dict):
+        def get(self, k, d=None):
+            return dict.get(self, k, d)
+    assert structure_scheme(Cfg(problem="fem", fem_integrator="green")) == "green"
+    assert structure_scheme(Cfg(problem="fem", fem_integrator="newmark")) == "newmark"
+    assert structure_scheme(Cfg(problem="ssi", coupling="staggered")) == "green"
+    assert structure_scheme(Cfg(problem="ssi", coupling="implicit")) is None
+    assert structure_scheme(Cfg(problem="ssi")) is None
+    assert structure_scheme(Cfg(problem="bem")) is None
