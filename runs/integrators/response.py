@@ -32,18 +32,18 @@ def tables():
     for xi in x:
         row = {"f_dt [cycles/step]": xi, "f at dt 5 ms [Hz]": xi / DT}
         for k in ir.SCHEMES:
-            row[f"stiff {k} [1]"] = float(ir.stiff_amplification(k, xi))
+            row[f"stiff {k} [-]"] = float(ir.stiff_amplification(k, xi))
         for W, z in OSC:
             for k in ir.SCHEMES:
-                row[f"omega_dt {W:.4g} zeta {z:g} {k} [1]"] = abs(ir.steady_ratio(k, W, xi, z))
+                row[f"omega_dt {W:.4g} zeta {z:g} {k} [-]"] = abs(ir.steady_ratio(k, W, xi, z))
         rows.append(row)
     free = []
     for W in np.round(np.linspace(0.05, 3.0, 60), 6):
         row = {"omega_dt [rad/step]": W}
         for k in ir.SCHEMES:
             rho, per = ir.free_vibration(k, W)
-            row[f"{k} spectral radius [1]"] = rho
-            row[f"{k} period elongation T_h/T [1]"] = per
+            row[f"{k} spectral radius [-]"] = rho
+            row[f"{k} period elongation T_h/T [-]"] = per
         free.append(row)
     return rows, free
 
@@ -64,37 +64,37 @@ def plot(rows, free, path):
     fig, axs = plt.subplots(1, 3, figsize=(15, 4.6))
     ax = axs[0]
     for k in ir.SCHEMES:
-        ax.semilogy(x, [r[f"stiff {k} [1]"] for r in rows], color=COLORS[k], label=k)
+        ax.semilogy(x, [r[f"stiff {k} [-]"] for r in rows], color=COLORS[k], label=k)
     ax.axhline(1.0, color="k", lw=0.8, ls=":")
     ax.axhline(1.0 + ir.SAFE_TOL, color="0.5", lw=0.8, ls="--", label=f"1 + {ir.SAFE_TOL:g}")
     ax.set_title("stiff mode (omega >> 2 pi f): steady / static")
     ax.set_xlabel("load frequency f dt [cycles/step]")
-    ax.set_ylabel("amplification, discrete / exact [1]")
+    ax.set_ylabel("amplification, discrete / exact [-]")
     sec = ax.secondary_xaxis("top", functions=(lambda v: v / DT, lambda v: v * DT))
     sec.set_xlabel("f at dt = 5 ms [Hz]")
     ax.legend()
     ax = axs[1]
     for (W, z), ls in zip(OSC, ("-", "--")):
         for k in ir.SCHEMES:
-            ax.semilogy(x, [r[f"omega_dt {W:.4g} zeta {z:g} {k} [1]"] for r in rows], color=COLORS[k], ls=ls,
+            ax.semilogy(x, [r[f"omega_dt {W:.4g} zeta {z:g} {k} [-]"] for r in rows], color=COLORS[k], ls=ls,
                         label=f"{k}, omega dt {W:.3g} ({W / (2 * np.pi * DT):.0f} Hz at 5 ms)")
     ax.axhline(1.0, color="k", lw=0.8, ls=":")
     ax.set_title("oscillator, zeta = 2 %: steady / exact")
     ax.set_xlabel("load frequency f dt [cycles/step]")
-    ax.set_ylabel("amplification, discrete / exact [1]")
+    ax.set_ylabel("amplification, discrete / exact [-]")
     sec = ax.secondary_xaxis("top", functions=(lambda v: v / DT, lambda v: v * DT))
     sec.set_xlabel("f at dt = 5 ms [Hz]")
     ax.legend(fontsize=7)
     ax = axs[2]
     W = np.array([r["omega_dt [rad/step]"] for r in free])
     for k, ls in zip(ir.SCHEMES, ("-", "--", ":")):
-        ax.plot(W, [r[f"{k} period elongation T_h/T [1]"] for r in free], color=COLORS[k], ls=ls,
+        ax.plot(W, [r[f"{k} period elongation T_h/T [-]"] for r in free], color=COLORS[k], ls=ls,
                 label=f"{k}: T_h / T")
-        ax.plot(W, [r[f"{k} spectral radius [1]"] for r in free], color=COLORS[k], ls=ls, lw=0.8,
+        ax.plot(W, [r[f"{k} spectral radius [-]"] for r in free], color=COLORS[k], ls=ls, lw=0.8,
                 label=f"{k}: spectral radius")
     ax.set_title("free vibration (undamped)")
     ax.set_xlabel("omega dt [rad/step]")
-    ax.set_ylabel("period elongation T_h/T, spectral radius [1]")
+    ax.set_ylabel("period elongation T_h/T, spectral radius [-]")
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
