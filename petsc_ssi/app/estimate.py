@@ -132,7 +132,7 @@ def _refuses(cnt, p, q):
     """Whether the run's own check (HalfSpace.check_memory: the estimated peak shared
     by the ranks, the most loaded node's part against the per-node limit) refuses it."""
     used = cnt.nb_total_used()
-    return cnt._peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
+    return cnt.peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
 
 
 def main():

@@ -248,14 +248,14 @@ class Counts:
         fill = cfg.lag_fill
         if cfg.lag_storage == "auto":
             dense = (f > fill) & ~self.single
-            if self._peak_rule(used, dense) > limit:
+            if self.peak_rule(used, dense) > limit:
                 dense_sp = np.zeros_like(dense)
-                if self._peak_rule(used, dense_sp) <= limit:
+                if self.peak_rule(used, dense_sp) <= limit:
                     return dense_sp, 1.01
             return dense, fill
         return np.full(len(used), cfg.lag_storage == "dense") & ~self.single, fill
 
-    def _peak_rule(self, used, dense, p=1):
+    def peak_rule(self, used, dense, p=1):
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
         N = self.N
@@ -363,14 +363,14 @@ def predict(cnt, c, p, q, cores):
 CACHE_MAX = 512 << 20
 
 
-def _per_row(n_nodes, lag_hi):
+def row_work_bytes(n_nodes, lag_hi):
     """A bound of the bytes one row's work may take in the assembly kernel (the integrals of its pairs
     outside the element cache, 9 m doubles a lag slot per pool, in arrays that grow by doubling)."""
     return 96.0 * 2 * n_nodes * max(lag_hi, 1) * 0.6
 
 
-def _chunk_rows(n_nodes, lag_hi, n_rows):
-    return int(max(1, min(64, 256e6 // _per_row(n_nodes, lag_hi), n_rows // 20 + 1)))
+def chunk_rows(n_nodes, lag_hi, n_rows):
+    return int(max(1, min(64, 256e6 // row_work_bytes(n_nodes, lag_hi), n_rows // 20 + 1)))
 
 
 def lag_bytes(used, dense, single, n_cols, n_rows, n_t, mH=9, mG=9):
@@ -400,12 +400,12 @@ def transient_bytes(blocks, n_nodes, lags, n_rows, cache=None, parts=False):
     """Bytes a rank holds beside the blocks and Mats: while it assembles, the element cache
     (``cache`` bytes as counted from the pair geometries, ``LagSet.cache_estimate``, or without it
     the bound of 324 B per block of its rows; each of its two pools capped at CACHE_MAX) and one
-    row's work (the integrals of its pairs the cache does not hold, bounded by ``_per_row``; the
+    row's work (the integrals of its pairs the cache does not hold, bounded by ``row_work_bytes``; the
     kernel writes the blocks where they are kept, assemble.assemble_rows); throughout, the process
     as it stands (resident size now, measured). ``parts``: (assembly-only bytes, process bytes), else
     their sum."""
     cache = min(2.0 * CACHE_MAX, 324.0 * blocks if cache is None else 2.0 * cache)   # pools grow by doubling
-    row = _per_row(n_nodes, lags)
+    row = row_work_bytes(n_nodes, lags)
     return (cache + row, process_rss()) if parts else cache + row + process_rss()
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..petsc import SSIError, collective, printf
 from ..monitor import Progress, event
-from .cost import (CACHE_MAX, _per_row, _chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
+from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
                    pair_table, cache_counts)
 from .windows import bounding_spheres, estimate_blocks
 from . import symmetry
@@ -420,14 +420,14 @@ class LagSet:
             self._plane = (key, plane(self.in_plane, self.VX, key[1], gq, gw, key[2]))
         return self._plane[1]
 
-    def _per_row(self, lag_hi):
-        return _per_row(self.mesh.n_nodes, lag_hi)
+    def row_work_bytes(self, lag_hi):
+        return row_work_bytes(self.mesh.n_nodes, lag_hi)
 
     def chunk_rows(self, lag_hi):
         """Rows per numba call (the progress monitor's steps: the kernel writes each row's blocks where
         they are kept, so its memory does not grow with it): the rule of a chunk of about 256 MB of
         triplets the kernel once held, at least one row."""
-        return _chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
+        return chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
     def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr, pattern,
                      dropped):

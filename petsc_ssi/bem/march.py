@@ -148,6 +148,7 @@ class Marcher:
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)
+        self.norm_prefix_max = []   # the divergence guard's running max of |u| (bem/stability.py guard)
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
 

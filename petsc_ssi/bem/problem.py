@@ -79,7 +79,7 @@ class BEMTransient(TransientProblem):
         n = int(self.restart["step"])
         self.march.restore(reader, n)
         self.rec.restore(reader.serial, n)
-        self.march._prefix_max = list(np.maximum.accumulate(self.rec.unorm))    # the guard's running max
+        self.march.norm_prefix_max[:] = np.maximum.accumulate(self.rec.unorm)    # the guard's running max
 
     def step(self, n):
         self._check_step(n)

@@ -200,7 +200,7 @@ def guard(cfg, prob, march, unorm, n):
     norm above guard_factor times the largest norm of the first half of the
     run so far. A loaded, damped (radiating) half-space cannot do that."""
     nrm = unorm[-1]
-    pm = march.__dict__.setdefault("_prefix_max", [])      # running max of |u|: O(1) per step
+    pm = march.norm_prefix_max                             # running max of |u|: O(1) per step
     pm.append(max(pm[-1], nrm) if pm else nrm)
     ref = guard_reference(pm, n)
     if not guard_trips(nrm, ref, n, cfg.guard_factor):

@@ -241,7 +241,10 @@ class ImplicitSolve(LUCache):
         K[O] = self.Z[O]
         return K
 
-    def _lu(self, closed, O):
+    def lu(self, closed, O=None):
+        """The LU of the contact state ``closed`` (cached; ``O`` its open dofs, from the law when not
+        given): the step's solve, or a factorisation made ahead (the bonded state, at set-up)."""
+        O = self.law.open_dofs(closed) if O is None else O
         return self.get(closed.tobytes(), lambda: self._matrix(O))
 
     def __call__(self, q, w, r):
@@ -252,7 +255,7 @@ class ImplicitSolve(LUCache):
             t = self.law.target(closed)
             g = g_closed.copy()
             g[O] = q[O] - t[O]
-            s = sla.lu_solve(self._lu(closed, O), g, check_finite=False)
+            s = sla.lu_solve(self.lu(closed, O), g, check_finite=False)
             p = q - self.Z @ s
             p[O] = t[O]
             uf = w - self.CM @ (self.a * p + r)

@@ -92,7 +92,7 @@ class ImplicitStep:
         self.cp = cp
         cp.DEloc, C = cp.fem_columns()
         self.solver = ImplicitSolve(cp.law, cp.Z_II, 2.0 * C, cp.M3, 1.0)   # midpoint: u = w + D^-1 (2 f)
-        self.solver._lu(cp.law.closed, cp.law.open_dofs(cp.law.closed))      # the bonded LU, now
+        self.solver.lu(cp.law.closed)                                       # the bonded LU, now
 
     def predict(self, f_ext):
         return self.cp.integ.predict(f_ext)

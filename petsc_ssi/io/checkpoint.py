@@ -76,11 +76,12 @@ def key_difference(saved, now):
     """The first option that differs between two keys, as a phrase, or None. An option the
     checkpoint's version did not have counts as its default there (an option added since). An
     option naming an input file compares by the file's SHA-256, not its path."""
-    from ..options import _REGISTRY
+    from ..options import options
+    registry = options()
     for name in sorted(set(saved) | set(now)):
         a, b = saved.get(name), now.get(name)
-        if a is None and name in _REGISTRY and not name.startswith("file:"):
-            d = _REGISTRY[name].default
+        if a is None and name in registry and not name.startswith("file:"):
+            d = registry[name].default
             a = repr(d) if isinstance(d, float) else str(d)
         if a == b:
             continue
