@@ -348,6 +348,28 @@ class TransientProblem:
         self._state = "stepping"
 
     # ------------------------------------------------------------ output that survives
+    io_event = "SSI_IO"           # the PETSc log event of the run's output
+
+    def output_parts(self, res):
+        """[(Output or None, {receivers, attrs, groups, record})] of the run's results ``res``: one
+        item per output file (subclasses; the base has none)."""
+        return []
+
+    def written(self, res):
+        """After the final write (subclasses: plots, the log line)."""
+
+    def write_results(self, res, status="completed", final=True):
+        """Collective: every output of the run (``output_parts``) with its receivers, attributes,
+        serial groups and run record, and ``status``; ``final``: closed (else flushed: readable,
+        still open). The one writer of results every problem uses."""
+        from .monitor import event
+        with event(self.io_event):
+            for out, parts in self.output_parts(res):
+                if out is not None:
+                    (out.close if final else out.flush)(status=status, **parts)
+        if final:
+            self.written(res)
+
     def write_partial(self, status):
         """Collective: the output file made readable with the results up to the last step and
         ``status`` (subclasses; the base has no output)."""

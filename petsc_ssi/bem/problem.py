@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from ..petsc import printf
-from ..monitor import staged, fmt_time, event
+from ..monitor import staged, fmt_time
 from ..io.output import Output, provenance
 from ..problem import TransientProblem, no_output_refused
 from .halfspace import HalfSpace
@@ -103,7 +103,34 @@ class BEMTransient(TransientProblem):
                "resultants": rec.soil.resultants(rec.steps, rec.times)}
         if self.footing is not None:
             res["input_motion"] = self.footing.arrays(rec.times)
-        write_results(self.cfg, self.comm, self.prob, self.out, res, status=status, final=False)
+        self.write_results(res, status=status, final=False)
+
+    def output_parts(self, res):
+        """The soil's output: receivers, attributes, the groups (a prescribed region's resultants, the
+        seismic input, a massless footing's input motion) and the run record."""
+        cfg, comm, prob = self.cfg, self.comm, self.prob
+        recd = None
+        if res["u"] is not None:
+            recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+        attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
+                 "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
+        groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
+        if getattr(prob, "seismic", None) is not None:
+            groups = dict(groups or {}, seismic=prob.seismic.arrays())
+            attrs["seismic"] = prob.seismic.kind
+        if res.get("input_motion") is not None:
+            groups = dict(groups or {}, input_motion=res["input_motion"])
+            attrs["disp_rigid"] = "massless"
+        if cfg.mesh_patch and cfg.load_group == "load":
+            attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
+        record = provenance(cfg, comm, {"stats": res.get("stats", {})}, grid=prob.grid)
+        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups})]
+
+    def written(self, res):
+        cfg = self.cfg
+        if cfg.plot and self.comm.getRank() == 0 and res["u"] is not None:
+            from ..plot import receiver_plot
+            receiver_plot(cfg.output, cfg)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
@@ -125,36 +152,7 @@ class BEMTransient(TransientProblem):
             "mem_peak_estimate": prob.mem_peak_estimate}
         from ..sysmem import peak_rss
         res["stats"]["peak_rss_max_rank_bytes"], res["stats"]["peak_rss_sum_bytes"] = peak_rss(self.comm)
-        write_results(cfg, self.comm, prob, self.out, res, status=self.final_status())
+        self.write_results(res, status=self.final_status())
         printf(f"[ssi] done in {fmt_time(res['stats']['wall_s'])}: output {cfg.output}")
         self.release_locks()                    # the run is done: its files are free again
         return res
-
-
-def write_results(cfg, comm, prob, out, res, status="completed", final=True):
-    """Collective: write the receivers, attributes and run record; ``final``: close the output
-    (else flush it: readable, still open)."""
-    ev = event("SSI_IO")
-    ev.begin()
-    recd = None
-    if res["u"] is not None:
-        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
-    attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
-             "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
-    groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
-    if getattr(prob, "seismic", None) is not None:
-        groups = dict(groups or {}, seismic=prob.seismic.arrays())
-        attrs["seismic"] = prob.seismic.kind
-    if res.get("input_motion") is not None:
-        groups = dict(groups or {}, input_motion=res["input_motion"])
-        attrs["disp_rigid"] = "massless"
-    if cfg.mesh_patch and cfg.load_group == "load":
-        attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
-    rec_ = provenance(cfg, comm, {"stats": res.get("stats", {})}, grid=prob.grid)
-    (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status, groups=groups)
-    ev.end()
-    if not final:
-        return
-    if cfg.plot and comm.getRank() == 0 and recd is not None:
-        from ..plot import receiver_plot
-        receiver_plot(cfg.output, cfg)

@@ -21,7 +21,6 @@ from ..problem import TransientProblem, no_output_refused
 from ..io.output import provenance
 from ..fem.forces import add_force_recorder
 from ..io.structure import receiver_record
-from ..monitor import event
 from ..bem.build import build_marcher
 from ..fem.integrators import make_model_integrator
 from ..fem.loads import load_history
@@ -128,11 +127,8 @@ class SSITransient(TransientProblem):
         self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"))
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
-        if rd is None:
-            self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel))
-            if self.forces is not None:
-                self.forces.record(self.time(0), self.integ.u)
-            self.demands.record(self.time(0), self.integ.u)            # at rest: no interface force yet
+        if rd is None:                            # the records of t = 0 (no fields: the soil has none at rest)
+            self.rec.initial(self.time(0), structure=(self.integ.u, self.integ.velocity(self.vel)))
         self._resume()
         self.clock.start()
 
@@ -147,8 +143,7 @@ class SSITransient(TransientProblem):
                        "cp_closed_prev": cp.closed_prev})
         vecs = self.march.checkpoint_vecs()
         vecs.update(self.integ.checkpoint_vecs())
-        if self.forces is not None:
-            vecs.update(self.forces.checkpoint_vecs())
+        vecs.update(self.rec.checkpoint_vecs())           # the observers' (member force envelopes)
         return vecs, serial
 
     def restore_state(self, reader):
@@ -156,8 +151,7 @@ class SSITransient(TransientProblem):
         n = int(self.restart["step"])
         self.march.restore(reader, n)
         self.integ.restore(reader)
-        if self.forces is not None:
-            self.forces.restore_vecs(reader)
+        self.rec.restore_vecs(reader)
         self.rec.restore(s, n)
         law.closed = np.asarray(s["law_closed"], bool).copy()
         law.ub_prev = np.asarray(s["law_ub_prev"], float).copy()
@@ -213,15 +207,40 @@ class SSITransient(TransientProblem):
 
     def write_partial(self, status):
         res = self.results()
-        res["_outputs"] = (self.out, self.sout)
         res["stats"] = {"steps_done": self.n}
-        write_results(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False)
+        self.write_results(res, status=status, final=False)
+
+    def output_parts(self, res):
+        """Both outputs: the soil's (receivers, the interface series, the seismic input, the step
+        times) and the structure's (receivers, demands), each with attributes; the run record in
+        the soil's."""
+        cfg, comm, prob, model = self.cfg, self.comm, self.prob, self.model
+        attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
+                 "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
+                 "contact_preload": float(res["interface"].get("preload", 0.0)),
+                 "structure_output": os.path.basename(structure_output_path(cfg.output))}
+        if getattr(prob, "seismic", None) is not None:
+            attrs["seismic"] = prob.seismic.kind
+        record = provenance(cfg, comm, {"stats": res["stats"]}, grid=prob.grid)
+        recd = None
+        if res["u"] is not None:
+            recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+        inter = res["interface"] if comm.getRank() == 0 else None
+        groups = _groups(prob, inter)
+        if comm.getRank() == 0 and res.get("timing") is not None:
+            groups = dict(groups or {}, timing=res["timing"])
+        srecd = None
+        if comm.getRank() == 0 and len(model.receiver_nodes):
+            srecd = receiver_record(model, res["structure"])
+        sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
+        sattrs = {"problem": "ssi-structure", "alpha_m": self.am, "dt": cfg.dt}
+        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups}),
+                (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups})]
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob
         res = self.results()
-        res["_outputs"] = (self.out, self.sout)
         if cfg.step_times:
             res["timing"] = {"step_wall": (np.asarray(self.clock.values, float), "s")}
         law = coupler.law
@@ -244,7 +263,7 @@ class SSITransient(TransientProblem):
                    f"({fmt_time(coupler.solver_cap().t_factor)}), active-set algebra {fmt_time(law.t_algebra)} in "
                    f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
                    "factorisation of the BEM step matrix")
-        write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
+        self.write_results(res, status=self.final_status())
         self.integ.destroy()
         self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
@@ -255,36 +274,6 @@ class SSITransient(TransientProblem):
 def structure_output_path(path):
     stem, ext = os.path.splitext(path)
     return stem + "_structure" + (ext or ".h5")
-
-
-def write_results(cfg, comm, prob, model, iface, res, am, status="completed", final=True):
-    """Collective: both outputs (soil with the interface series, structure) with receivers,
-    attributes and the run record; ``final``: close them (else flush: readable, still open)."""
-    out, sout = res.pop("_outputs")
-    attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
-             "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
-             "contact_preload": float(res["interface"].get("preload", 0.0)),
-             "structure_output": os.path.basename(structure_output_path(cfg.output))}
-    if getattr(prob, "seismic", None) is not None:
-        attrs["seismic"] = prob.seismic.kind
-    rec_ = provenance(cfg, comm, {"stats": res["stats"]}, grid=prob.grid)
-    recd = None
-    if res["u"] is not None:
-        recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
-    with event("SSI_IO"):
-        inter = res["interface"] if comm.getRank() == 0 else None
-        groups = _groups(prob, inter)
-        if comm.getRank() == 0 and res.get("timing") is not None:
-            groups = dict(groups or {}, timing=res["timing"])
-        (out.close if final else out.flush)(receivers=recd, attrs=attrs, record=rec_, status=status,
-                                            groups=groups)
-        srecd = None
-        if comm.getRank() == 0 and len(model.receiver_nodes):
-            srecd = receiver_record(model, res["structure"])
-        sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
-        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
-                                                                      "dt": cfg.dt}, record=None, status=status,
-                                              groups=sgroups)
 
 
 def interface_centroid(prob, iface):

@@ -298,6 +298,10 @@ class Demands:
                       + ", ".join(str(len(n)) for n in spec.level_nodes) + " nodes)" if len(spec.levels) else ""))
 
     # ------------------------------------------------------------ the recorder's protocol
+    def initial(self, t, step, write=False):
+        if step.get("structure") is not None:
+            self.record(t, step["structure"][0])            # at rest: no interface force yet
+
     def observe(self, n, t, step):
         s = step.get("structure")
         if s is None:

@@ -169,6 +169,10 @@ class ForceRecorder:
             out.writers.append(self)
 
     # ------------------------------------------------------------ the recorder's protocol
+    def initial(self, t, step, write=False):
+        if step.get("structure") is not None:
+            self.record(t, step["structure"][0], write=write)
+
     def observe(self, n, t, step):
         if step.get("structure") is not None:
             self.compute(step["structure"][0])

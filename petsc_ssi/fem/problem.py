@@ -133,13 +133,9 @@ class FEMTransient(TransientProblem):
             ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
             self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
         self.integ.start(f0=self.load(0))
-        if rd is None:
-            self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),
-                                      write=self.grid.writes(0))
-            if self.forces is not None:
-                self.forces.record(self.time(0), self.integ.u, write=self.grid.writes(0))
-            if self.demands is not None:
-                self.demands.record(self.time(0), self.integ.u)
+        if rd is None:                            # the records of t = 0 (series, fields, forces, demands)
+            self.rec.initial(self.time(0), write=self.grid.writes(0),
+                             structure=(self.integ.u, self.integ.velocity(self.vel)))
         self._resume()
         self.state = (self.integ.u, self.vel)
 
@@ -148,14 +144,12 @@ class FEMTransient(TransientProblem):
         serial.update(self._output_state("out", self.out))
         serial.update(self.integ.checkpoint_scalars())
         vecs = self.integ.checkpoint_vecs()
-        if self.forces is not None:
-            vecs.update(self.forces.checkpoint_vecs())
+        vecs.update(self.rec.checkpoint_vecs())           # the observers' (member force envelopes)
         return vecs, serial
 
     def restore_state(self, reader):
         self.integ.restore(reader)
-        if self.forces is not None:
-            self.forces.restore_vecs(reader)
+        self.rec.restore_vecs(reader)
         self.rec.restore(reader.serial, int(self.restart["step"]))
 
     def step(self, n):
@@ -168,20 +162,52 @@ class FEMTransient(TransientProblem):
         self.state = (self.integ.u, self.vel)
         return self.state
 
-    def _support_output(self):
-        """(ground acceleration of given times, the 'seismic' output group) with a support motion."""
-        return (self.ground_acceleration, self.support.arrays()) if self.support is not None else None
+    io_event = "FEM_io"
 
     def write_partial(self, status):
-        _close_output(self.cfg, self.out, self.model, self.rec.structure, self.comm, self.am, self.n_steps,
-                      self.integ, status=status, final=False, support=self._support_output(), demands=self.demands)
+        self.write_results(None, status=status, final=False)
+
+    def output_parts(self, res):
+        """The structure's output (none without -ssi_output): receivers (with the ground's and the
+        absolute acceleration under a support motion), attributes, the groups (demands, the support
+        motion) and the run record."""
+        cfg, comm, model, am, n_steps = self.cfg, self.comm, self.model, self.am, self.n_steps
+        if self.out is None:
+            return []
+        receivers = self.rec.structure.receivers() if comm.getRank() == 0 else None
+        groups, attrs = {}, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+        if self.demands is not None and comm.getRank() == 0:
+            groups["demands"] = self.demands.group()
+        if self.support is not None:
+            groups["seismic"] = self.support.arrays()
+            attrs["seismic"] = "support motion (relative-motion form: u, velocity, acceleration relative to the base)"
+            if receivers is not None and "acceleration" in receivers:
+                receivers["ground_acceleration"] = self.ground_acceleration(receivers["t"])
+                receivers["absolute_acceleration"] = (receivers["acceleration"]
+                                                      + receivers["ground_acceleration"][:, None, :])
+        extra = {"time_grid": {"dt_s": cfg.dt, "t_end_s": n_steps * cfg.dt, "n_steps": n_steps},
+                 "fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
+                         "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
+                         "elements": model.mesh.element_counts(),
+                         "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
+        if cfg.fem_integrator == "green":
+            extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
+        return [(self.out, {"receivers": receivers, "attrs": attrs, "groups": groups or None,
+                            "record": provenance(cfg, comm, extra)})]
+
+    def written(self, res):
+        cfg = self.cfg
+        if self.out is None:
+            return
+        if cfg.plot and self.comm.getRank() == 0 and len(self.model.receiver_nodes):
+            _plot(cfg.output, *self.rec.structure.rec.arrays())
+        printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
-        cfg, comm, model = self.cfg, self.comm, self.model
+        comm, model = self.comm, self.model
         t, u = self.rec.structure.rec.arrays()
-        _close_output(cfg, self.out, model, self.rec.structure, comm, self.am, self.n_steps, self.integ,
-                      status=self.final_status(), support=self._support_output(), demands=self.demands)
+        self.write_results(None, status=self.final_status())
         if comm.getRank() == 0 and len(model.receiver_nodes):
             printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                    f"{u[-1, 0, 2]:.6e}) m")
@@ -192,42 +218,6 @@ class FEMTransient(TransientProblem):
             self.demands.destroy()
         self.release_locks()                    # the run is done: its files are free again
         return out
-
-
-def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="completed", final=True, support=None,
-                  demands=None):
-    """Collective: receivers, attributes and run record into the output; ``final``: close it
-    (else flush it: readable, still open). ``demands``: the storey demands' observer (the group
-    'demands', fem/demands.py)."""
-    if out is None:
-        return
-    t, u = srec.rec.arrays()
-    receivers = srec.receivers() if comm.getRank() == 0 else None
-    groups, attrs = {}, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
-    if demands is not None and comm.getRank() == 0:
-        groups["demands"] = demands.group()
-    if support is not None:
-        ground, arrays = support
-        groups["seismic"] = arrays
-        attrs["seismic"] = "support motion (relative-motion form: u, velocity, acceleration relative to the base)"
-        if receivers is not None and "acceleration" in receivers:
-            receivers["ground_acceleration"] = ground(receivers["t"])
-            receivers["absolute_acceleration"] = receivers["acceleration"] + receivers["ground_acceleration"][:, None, :]
-    extra = {"time_grid": {"dt_s": cfg.dt, "t_end_s": n_steps * cfg.dt, "n_steps": n_steps},
-             "fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
-                     "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
-                     "elements": model.mesh.element_counts(),
-                     "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
-    if cfg.fem_integrator == "green":
-        extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
-    with event("FEM_io"):
-        (out.close if final else out.flush)(receivers=receivers, attrs=attrs, groups=groups or None,
-                                            record=provenance(cfg, comm, extra), status=status)
-    if not final:
-        return
-    if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
-        _plot(cfg.output, t, u)
-    printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
 
 
 def _plot(path, t, u):

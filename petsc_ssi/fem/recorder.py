@@ -16,6 +16,10 @@ class StructureRecorder:
         self.fw = FieldWriter(out, model, comm) if out is not None else None
         self.rec = ReceiverSeries(model.dofmap, model.receiver_nodes, comm)
 
+    def initial(self, t, step, write=False):
+        if step.get("structure") is not None:
+            self.record(t, *step["structure"], write=write)
+
     def observe(self, n, t, step):
         if step.get("structure") is not None:
             self.record(t, *step["structure"])

@@ -15,7 +15,7 @@ output is a new observer. Collective unless said otherwise.
 """
 import numpy as np
 
-from ..monitor import Progress, event
+from ..monitor import Progress
 
 
 class InterfaceSeries:
@@ -120,6 +120,9 @@ class ProgressLine:
 class Recorder:
     """Collective: what a run keeps, as a list of observers (PyLith's observers) with one protocol:
 
+      initial(t, step, write) the state at t = 0 (step 0, before the first step): series that
+                             start at rest (the structure's receivers, member forces, demands);
+                             ``write``: its fields too
       observe(n, t, step)    step n at time t; ``step`` holds what the problem gives: 'soil' (u, p)
                              Vecs, 'structure' (u, v) Vecs, 'interface' (a dict), 'norm', 'status'
       snapshot(n, t, step)   the fields of a step the time grid writes (``TimeGrid.writes``),
@@ -127,6 +130,8 @@ class Recorder:
                              snapshot can fail on a full disk)
       state(n_times)         {name: array} for a checkpoint (rank 0's)
       restore(s, n)          the same from a checkpoint after step n
+      checkpoint_vecs()      {name: Vec} for a checkpoint (saved globally: any rank count restarts)
+      restore_vecs(reader)   the same from a checkpoint's reader
 
     each method optional. The recorder keeps the steps and times itself; ``soil``, ``structure``
     and ``interface`` name the observers the problems read back, and ``add`` appends one (e.g. the
@@ -180,6 +185,28 @@ class Recorder:
                     o.snapshot(n, t, step)
         for o in self.extra + [self.progress]:
             o.observe(n, t, step)
+
+    def initial(self, t, write=False, **step):
+        """Collective: the state at t = 0 (``step``: the keys of ``step``) to every observer's
+        ``initial``; with ``write`` its fields too. Not a step: the steps and times the recorder
+        keeps start at step 1."""
+        for o in self._all():
+            if hasattr(o, "initial"):
+                o.initial(t, step, write)
+
+    def checkpoint_vecs(self):
+        """Collective: {name: Vec} of every observer's ``checkpoint_vecs``."""
+        vecs = {}
+        for o in self._all():
+            if hasattr(o, "checkpoint_vecs"):
+                vecs.update(o.checkpoint_vecs())
+        return vecs
+
+    def restore_vecs(self, reader):
+        """Collective: every observer's ``restore_vecs`` from a checkpoint's reader."""
+        for o in self._all():
+            if hasattr(o, "restore_vecs"):
+                o.restore_vecs(reader)
 
     def state(self):
         """Collective: the series so far, for a checkpoint ({name: array}, rank 0's)."""
