@@ -121,7 +121,8 @@ def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
     round-off of the lift-off velocity, so the difference in uf (and in the gap uf - ub) grows with the
     flight, from 4e-17 m at lift-off to 6e-15 m at the end. Observed: 7.7e-13 and 1.50e-12 (uf, gap)
     at -n 1 on one machine (the order of the sums changes between runs), 1.24e-12 in a fresh clone
-    (issue 45: it failed the former 1e-12), 2.0e-13 - 3.1e-13 (p, uf) at -n 2; a wrong history term at 1e-6 would still fail by 4 orders."""
+    (issue 45: it failed the former 1e-12), 2.0e-13 - 3.1e-13 (p, uf) at -n 2; a history term wrong
+    by 1e-6 would still fail by 4 orders."""
     ref, blk, two = (str(tmp_path / f"{k}.h5") for k in ("ref", "blk", "two"))
     cli(SSI + ["-ssi_output", ref, "-ssi_history_block", "1"])
     cli(SSI + ["-ssi_output", blk, "-ssi_history_block", "6"])
