@@ -166,9 +166,10 @@ def test_preload_under_a_vertical_p_wave(tmp_path, p_wave):
         assert np.array_equal(big[k], bonded[k]), k
     assert bonded["pN"].max() < 50.0                  # the hand bound: the largest dynamic tension
     # the interface traction of the implicit step == the BEM's traction field node by node: the step
-    # solves for s - u_ff (measured 2.8e-11 N of a 2.9 N force; 5.2e-7 N while it formed
+    # solves for s - u_ff (measured 2.8e-11 N of a 2.9 N force, and 9.4e-12 of the force in a rerun: 1e-9
+    # keeps a margin of 100x over that round-off; 5.2e-7 N, 1.8e-7 of the force, while it formed
     # p = (q + Z u_ff) - Z s from totals, which fails here)
-    assert bonded["force_map_error"].max() <= 1e-10 * np.abs(bonded["force_fe"]).max()
+    assert bonded["force_map_error"].max() <= 1e-9 * np.abs(bonded["force_fe"]).max()
     # the closed block follows the TOTAL ground motion (the gap is on u_b = u_sc + u_ff)
     scale = np.abs(big["uff"]).max()
     assert scale > 0.5 and np.abs(big["ub"] - big["uff"]).max() < 1e-5 * scale
