@@ -84,8 +84,11 @@ def test_single_lags_change_the_run_by_rounding_only(tmp_path):
 def test_single_lags_interpolated_coupled_and_parallel(tmp_path):
     """With the far lags interpolated (the interpolating matrices single too), in a coupled run
     with unilateral contact, and on 2 ranks: within 1e-6 of the double run, and the 2-rank run the
-    1-rank run to round-off."""
-    for name, args in (("interp", BEM + INTERP), ("ssi", SSI)):
+    1-rank run to round-off: 1e-11 of the run's largest displacement or traction with the far lags
+    interpolated (observed 1.4e-15), 1e-9 in the coupled run (observed 5.9e-12, the contact gap: the
+    block lifts off and its free flight carries the round-off of the lift-off velocity,
+    test_history_block's coupled case; the former 1e-11 left a margin of 1.7x)."""
+    for name, args, rtol in (("interp", BEM + INTERP, 1e-11), ("ssi", SSI, 1e-9)):
         ref, sgl, par = (str(tmp_path / f"{name}-{k}.h5") for k in ("ref", "sgl", "par"))
         cli(args + ["-ssi_output", ref])
         r = cli(args + ["-ssi_output", sgl, "-ssi_lag_single_from", "3"]).stdout
@@ -93,7 +96,7 @@ def test_single_lags_interpolated_coupled_and_parallel(tmp_path):
         d = rel_diff(ref, sgl)
         assert 1e-13 < d <= 1e-6, (name, d)
         cli(args + ["-ssi_output", par, "-ssi_lag_single_from", "3", "-ssi_reproducible"], nranks=2)
-        same(sgl, par, rtol=1e-11)
+        same(sgl, par, rtol=rtol)
 
 
 def test_single_lag_file_reloads_bitwise(tmp_path):
