@@ -311,7 +311,11 @@ def test_motion_zero_before_start_and_after_end(pl_motion):
 
 def test_three_component_motion(tmp_path):
     """A (n, 3) record gives motion(t) of shape t.shape + (3,), each column equal to the same
-    component processed alone (1e-13 of the largest value)."""
+    component processed alone to round-off: 1e-13 of max|a| T^2 (T the record's duration). The
+    displacement is a double integral of the acceleration less a fitted baseline, a difference of
+    quantities of that size, and the columns' sums run in another order than one column's. Observed
+    (column 0): 5.6e-16 of max|a| T^2, 1.1e-13 of the displacement's own largest value (which failed
+    the former 1e-13 of that on one machine)."""
     t = np.linspace(0, 2, 201)
     cols = np.stack([np.sin(3 * t), np.cos(5 * t) * t, t * (2 - t)], axis=1)
     m3 = _quiet_process(_record(t, cols))
@@ -319,7 +323,8 @@ def test_three_component_motion(tmp_path):
     assert m3(tq, 1).shape == (2, 2, 3)
     for j in range(3):
         mj = _quiet_process(_record(t, cols[:, j]))
-        np.testing.assert_allclose(m3(tq, 0)[..., j], mj(tq, 0), rtol=0, atol=1e-13 * np.abs(mj(tq, 0)).max())
+        scale = np.abs(cols[:, j]).max() * mj.duration ** 2
+        np.testing.assert_allclose(m3(tq, 0)[..., j], mj(tq, 0), rtol=0, atol=1e-13 * scale)
 
 
 # ---------------------------------------------------------------------------------------------- velocity, displacement
