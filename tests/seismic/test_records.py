@@ -425,13 +425,14 @@ def test_warnings_final_velocity_and_pga_change():
 
 
 def test_hann_taper_matches_obspy():
-    """The taper equals ObsPy's Trace.taper(p, 'hann') (gmprocess's taper) to 1e-14 for several n, p
+    """The taper equals ObsPy's Trace.taper(p, 'hann') (gmprocess's taper) to 1e-13 (of its largest
+    value, 1; observed 3.2e-15: the two evaluate the cosine differently) for several n, p
     (not p = 0.5 with n even, where ObsPy switches to a plain Hann window of length n)."""
     obspy = pytest.importorskip("obspy")
     for n, p in ((1000, 0.05), (1001, 0.05), (777, 0.1), (65, 0.5), (10, 0.01)):
         tr = obspy.Trace(data=np.ones(n))
         tr.taper(p, type="hann")
-        np.testing.assert_allclose(R.hann_taper(np.arange(n) * 0.01, p), tr.data, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(R.hann_taper(np.arange(n) * 0.01, p), tr.data, rtol=0, atol=1e-13)
 
 
 def test_time_window_and_pad():
