@@ -79,7 +79,7 @@ def test_single_lags_change_the_run_by_rounding_only(tmp_path):
     # the float32 products: per step (the automatic choice for this run) and time-blocked the same
     # sums in another order (observed 4.0e-16; the step-by-step run this compared before was the
     # automatic choice itself, bit for bit)
-    assert "history sum: step by step" in r1
+    assert "history sum: step by step" in r1, "the automatic choice changed: run sgl with -ssi_history_block 1"
     out = cli(BEM + ["-ssi_output", blk, "-ssi_lag_single_from", "3", "-ssi_history_block", "5"]).stdout
     assert "time-blocked, 5 steps per block" in out
     same(sgl, blk)
