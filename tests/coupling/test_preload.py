@@ -244,7 +244,7 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
     """A box pull that lifts the block off and lets it land, with the weight preload: restarted
     from the checkpoint of step 10 (block in the air) on 2 ranks with -ssi_reproducible it is the
     uninterrupted run bit for bit; -n 2 == -n 1 with the same contact status every step, the
-    series to 1e-7 in flight and 1e-6 after the landing (relative to each series' largest value).
+    series to 1e-6 in flight and 1e-5 after the landing (relative to each series' largest value).
     Staggered: a heavy block (m = 2000 kg) for the step's stability."""
     import shutil
     case = SSI + extra
@@ -265,10 +265,13 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
     c = series(tmp_path / "n1.h5")
     assert np.array_equal(c["closed"], a["closed"])
     assert c["preload"] == a["preload"] == pytest.approx(mass * G_N, rel=1e-12)   # summed exactly (fsum)
-    for k in ("ub", "uf", "p"):        # the open set's capacitance solves (Z_OO) amplify the round-off
-        sc = np.abs(a[k]).max()        # of the rank count: measured 4.4e-8 in flight, 1.7e-7 after landing
-        assert np.abs(c[k][:11] - a[k][:11]).max() <= 1e-7 * sc, k
-        assert np.abs(c[k] - a[k]).max() <= 1e-6 * sc, k
+    # the open set's capacitance solves (Z_OO) amplify the round-off of the rank count: measured
+    # (implicit) 4.4e-8 and 7.8e-8 in flight, 1.7e-7 and 2.2e-7 after landing in two sessions, which
+    # left 1.3x and 4.6x under the former 1e-7 and 1e-6; staggered at most 7.7e-10
+    for k in ("ub", "uf", "p"):
+        sc = np.abs(a[k]).max()
+        assert np.abs(c[k][:11] - a[k][:11]).max() <= 1e-6 * sc, k
+        assert np.abs(c[k] - a[k]).max() <= 1e-5 * sc, k
 
 
 @pytest.mark.parametrize("kw,words", [
