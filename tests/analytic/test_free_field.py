@@ -94,7 +94,9 @@ def angles_for(nu):
 @pytest.mark.parametrize("nu", NUS)
 @pytest.mark.parametrize("wave", ["p", "sv"])
 def test_surface_coefficients_match_independent_solve(wave, nu):
-    """Closed forms vs the 2x2 boundary-condition solve, pre- and post-critical: 1e-12."""
+    """Closed forms vs the 2x2 boundary-condition solve, pre- and post-critical: 1e-11 of the
+    amplitudes' scale (observed 1.8e-13: SV at 37.8 deg, nu = 0.2, next to the critical angle, where
+    the 2x2 solve is ill-conditioned; the former 1e-12 left a margin of 5.6x)."""
     cp = cp_of(nu)
     for th in angles_for(nu):
         pw = ff.PlaneWave(wave, CS, cp, ff.Ricker(5.0), angle=th, control="incident",
@@ -102,11 +104,11 @@ def test_surface_coefficients_match_independent_solve(wave, nu):
         Ah, Av, At = pw.surface_coefficients()
         R, u = independent_surface(wave, th, nu)
         scale = max(1.0, abs(u[0]), abs(u[1]))
-        assert abs(Ah - u[0]) < 1e-12 * scale, (wave, nu, th)
-        assert abs(Av - u[1]) < 1e-12 * scale, (wave, nu, th)
+        assert abs(Ah - u[0]) < 1e-11 * scale, (wave, nu, th)
+        assert abs(Av - u[1]) < 1e-11 * scale, (wave, nu, th)
         assert At == 0.0
         R_mod = np.array(ff.reflection_coefficients(wave, th, CS, cp))
-        np.testing.assert_allclose(R_mod, R, rtol=0, atol=1e-12 * max(1.0, np.abs(R).max()))
+        np.testing.assert_allclose(R_mod, R, rtol=0, atol=1e-11 * max(1.0, np.abs(R).max()))
 
 
 TABLE = {  # nu: [(angle, P u_h, P u_v, SV u_h, SV u_v)] (note sec. 2.8), 4 decimals
@@ -254,7 +256,8 @@ def test_surface_and_depth_forms_agree():
 
 
 def test_vertical_sh_depth_field_closed_form():
-    """SH at any angle: u = e_t [g(tau + d cos/beta) + g(tau - d cos/beta)] (note 2.3): 1e-15."""
+    """SH at any angle: u = e_t [g(tau + d cos/beta) + g(tau - d cos/beta)] (note 2.3): 1e-14 of the
+    largest displacement (observed 1.1e-16 absolute; the former absolute 1e-15 left a margin of 9x)."""
     g, th, psi = ff.Ricker(4.0, 0.4), 25.0, 70.0
     pw = ff.PlaneWave("sh", CS, cp_of(0.3), g, angle=th, azimuth=psi, control="incident")
     X = np.array([[10.0, -3.0, -7.0], [0.0, 0.0, -20.0], [-4.0, 8.0, 0.0]])
@@ -264,7 +267,7 @@ def test_vertical_sh_depth_field_closed_form():
     tau = t[:, None] - X @ eh * math.sin(math.radians(th)) / CS
     dc = -X[:, 2] * math.cos(math.radians(th)) / CS
     ref = (g(tau + dc) + g(tau - dc))[..., None] * et
-    np.testing.assert_allclose(pw.displacement(X, t), ref, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(pw.displacement(X, t), ref, rtol=0, atol=1e-14 * np.abs(ref).max())
     assert pw.displacement(X, 0.3).shape == (3, 3)
 
 

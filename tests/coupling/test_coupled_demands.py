@@ -95,7 +95,11 @@ def test_coupled_base_shear_is_the_interface_force_and_the_inertia(tmp_path, rec
     u = s["u"]
     ref_drift = (u[:, z > 0.2, :2].mean(axis=1) - u[:, z < 0.05, :2].mean(axis=1)) / 0.25
     assert g["drift_ratio"].shape == (K, 1, 2)
-    assert np.abs(g["drift_ratio"][:, 0] - ref_drift).max() <= 1e-12 * np.abs(ref_drift).max()
+    # a difference of displacements (the block moves with the ground: the drift is 3e-3 of u / 0.25):
+    # its round-off follows u / 0.25 (observed 3.7e-16 of it; 1.3e-13 of the drift's own largest value,
+    # only 8x under the former 1e-12 of that)
+    uscale = np.abs(u[..., :2]).max() / 0.25
+    assert np.abs(g["drift_ratio"][:, 0] - ref_drift).max() <= 1e-12 * uscale
     assert np.abs(ref_drift[:, 0]).max() > 1e-6
     # the base's rocking: a least-squares plane u_z = c + theta_x y - theta_y x through the base nodes
     base = z < 0.05

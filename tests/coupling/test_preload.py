@@ -166,9 +166,10 @@ def test_preload_under_a_vertical_p_wave(tmp_path, p_wave):
         assert np.array_equal(big[k], bonded[k]), k
     assert bonded["pN"].max() < 50.0                  # the hand bound: the largest dynamic tension
     # the interface traction of the implicit step == the BEM's traction field node by node: the step
-    # solves for s - u_ff (measured 2.8e-11 N of a 2.9 N force; 5.2e-7 N while it formed
+    # solves for s - u_ff (measured 2.8e-11 N of a 2.9 N force, and 9.4e-12 of the force in a rerun: 1e-9
+    # keeps a margin of 100x over that round-off; 5.2e-7 N, 1.8e-7 of the force, while it formed
     # p = (q + Z u_ff) - Z s from totals, which fails here)
-    assert bonded["force_map_error"].max() <= 1e-10 * np.abs(bonded["force_fe"]).max()
+    assert bonded["force_map_error"].max() <= 1e-9 * np.abs(bonded["force_fe"]).max()
     # the closed block follows the TOTAL ground motion (the gap is on u_b = u_sc + u_ff)
     scale = np.abs(big["uff"]).max()
     assert scale > 0.5 and np.abs(big["ub"] - big["uff"]).max() < 1e-5 * scale
@@ -243,7 +244,7 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
     """A box pull that lifts the block off and lets it land, with the weight preload: restarted
     from the checkpoint of step 10 (block in the air) on 2 ranks with -ssi_reproducible it is the
     uninterrupted run bit for bit; -n 2 == -n 1 with the same contact status every step, the
-    series to 1e-7 in flight and 1e-6 after the landing (relative to each series' largest value).
+    series to 1e-6 in flight and 1e-5 after the landing (relative to each series' largest value).
     Staggered: a heavy block (m = 2000 kg) for the step's stability."""
     import shutil
     case = SSI + extra
@@ -264,10 +265,13 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
     c = series(tmp_path / "n1.h5")
     assert np.array_equal(c["closed"], a["closed"])
     assert c["preload"] == a["preload"] == pytest.approx(mass * G_N, rel=1e-12)   # summed exactly (fsum)
-    for k in ("ub", "uf", "p"):        # the open set's capacitance solves (Z_OO) amplify the round-off
-        sc = np.abs(a[k]).max()        # of the rank count: measured 4.4e-8 in flight, 1.7e-7 after landing
-        assert np.abs(c[k][:11] - a[k][:11]).max() <= 1e-7 * sc, k
-        assert np.abs(c[k] - a[k]).max() <= 1e-6 * sc, k
+    # the open set's capacitance solves (Z_OO) amplify the round-off of the rank count: measured
+    # (implicit) 4.4e-8 and 7.8e-8 in flight, 1.7e-7 and 2.2e-7 after landing in two sessions, which
+    # left 1.3x and 4.6x under the former 1e-7 and 1e-6; staggered at most 7.7e-10
+    for k in ("ub", "uf", "p"):
+        sc = np.abs(a[k]).max()
+        assert np.abs(c[k][:11] - a[k][:11]).max() <= 1e-6 * sc, k
+        assert np.abs(c[k] - a[k]).max() <= 1e-5 * sc, k
 
 
 @pytest.mark.parametrize("kw,words", [

@@ -76,7 +76,9 @@ def _record(n=4000, dt=0.005, seed=0, fmax=8.0):
 # ----------------------------------------------------------------------------- exactness
 def test_step_matrices_equal_matrix_exponential():
     """A, B against scipy's expm of the augmented system (y, a, a') over omega h from 1e-7
-    (where explicit Nigam-Jennings formulas cancel) to 50: relative 1e-12."""
+    (where explicit Nigam-Jennings formulas cancel) to 50: relative 1e-11 of the largest entry
+    (observed 1.1e-13, at zeta 0.99 and omega h 50; the former 1e-12 left a margin of 9x; the
+    cancellation it guards against is ~eps / (omega h)^2)."""
     h = 0.01
     for zeta in (0.0, 0.05, 0.7, 0.99):
         for wh in (1e-7, 1e-4, 1e-2, 0.3, 0.49, 0.51, 2.0, 50.0):
@@ -87,8 +89,8 @@ def test_step_matrices_equal_matrix_exponential():
             W[1, 2], W[2, 3] = -1.0, 1.0
             E = sl.expm(W * h)
             Bref = np.stack([E[:2, 2] - E[:2, 3] / h, E[:2, 3] / h], axis=1)
-            assert _relerr(A[..., 0], E[:2, :2]) < 1e-12, (zeta, wh)
-            assert _relerr(B[..., 0], Bref) < 1e-12, (zeta, wh)
+            assert _relerr(A[..., 0], E[:2, :2]) < 1e-11, (zeta, wh)
+            assert _relerr(B[..., 0], Bref) < 1e-11, (zeta, wh)
 
 
 @pytest.mark.parametrize("kind", ["uniform", "nonuniform"])
@@ -126,8 +128,9 @@ def test_response_at_samples_does_not_depend_on_dt(period, zeta):
 
 def test_history_blocks_do_not_change_results(monkeypatch):
     """Histories are integrated and reduced in blocks; with 7-row blocks (many block
-    boundaries, also inside oversampled steps) spectra, RotD and histories are identical
-    (relative 1e-14) to the single-block run."""
+    boundaries, also inside oversampled steps) spectra, RotD and histories are bit for bit the
+    single-block run's: a block holds rows of the same element-wise recursion, and the reductions
+    over the blocks are maxima (observed equal; the former tolerance was relative 1e-14)."""
     t, ax, ay = _record(n=400)
     args = (PERIODS, DAMPING)
     ref = (rs.response_spectrum(t, ax, *args, oversample=3), rs.rotd(t, ax, ay, *args),
@@ -136,9 +139,9 @@ def test_history_blocks_do_not_change_results(monkeypatch):
     new = (rs.response_spectrum(t, ax, *args, oversample=3), rs.rotd(t, ax, ay, *args),
            rs.sdof_history(t, ax, 0.3, 0.05, 3))
     for q in rs.QUANTITIES:
-        assert _relerr(new[0][q], ref[0][q]) < 1e-14
-    assert _relerr(new[1][50]["PSA"], ref[1][50]["PSA"]) < 1e-14
-    assert _relerr(new[2].u, ref[2].u) < 1e-14
+        assert np.array_equal(new[0][q], ref[0][q], equal_nan=True), q
+    assert np.array_equal(new[1][50]["PSA"], ref[1][50]["PSA"])
+    assert np.array_equal(new[2].u, ref[2].u)
 
 
 # ----------------------------------------------------------------------------- closed forms
