@@ -17,6 +17,8 @@ import pytest
 
 from helpers import cli, signal_midway
 
+pytestmark = pytest.mark.mpi
+
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
        "-ssi_t_end", "0.15", "-ssi_receivers", "3,0,0;0,0,0", "-ssi_output_stride", "10", "-ssi_warn_beta", "0"]
@@ -146,6 +148,8 @@ def test_a_signal_writes_a_checkpoint_that_restarts_a_coupled_contact_run(tmp_pa
     assert_same_files(str(tmp_path / "k_structure.h5"), str(tmp_path / "ref_structure.h5"))
 
 
+# slow tier: a signal's checkpoint of a BEM run (13 s; the coupled contact run's stays)
+@pytest.mark.slow
 def test_a_signal_writes_a_checkpoint_that_restarts_a_bem_run(tmp_path):
     """SIGTERM to a one-rank BEM run: the checkpoint restarts it to the uninterrupted result bit
     for bit (and the stopped file held the steps up to the stop)."""
@@ -173,6 +177,8 @@ BAD = [
 ]
 
 
+# slow tier: the checkpoint key's refusals one by one (21 s; test_integrity's restart refusals stay)
+@pytest.mark.slow
 def test_a_restart_that_changes_the_run_is_refused(tmp_path):
     """Options that define the run (soil, contact, end time, problem kind) may not change on
     restart: one line naming the option, on every rank of 2, before any assembly; a missing file
@@ -197,6 +203,10 @@ def test_a_restart_that_changes_the_run_is_refused(tmp_path):
         assert p.returncode == 2 and msg in p.stdout and "Traceback" not in p.stdout + p.stderr, p.stdout[-2000:]
 
 
+# slow tier: SIGTERM to mpirun under three CPU hogs: mpirun's own two timeouts (2 x 5 s) are waited out (18 s
+#  measured); the ranks' stop order and the packed checkpoint stay in make test (test_output_survives,
+#  test_checkpoint's signal tests)
+@pytest.mark.slow
 def test_sigterm_to_mpirun_on_a_loaded_machine_writes_the_checkpoint(tmp_path):
     """SIGTERM to mpirun itself (Open MPI 4.1 forwards it to the ranks odls_base_sigkill_timeout
     seconds later and SIGKILLs them as long again after that), with three CPU hogs on the two

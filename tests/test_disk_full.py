@@ -14,6 +14,8 @@ import pytest
 
 from helpers import ROOT, PY
 
+pytestmark = pytest.mark.mpi
+
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
        "-ssi_t_end", "0.5", "-ssi_output_stride", "1", "-ssi_warn_beta", "0", "-ssi_receivers", "3,0,0",

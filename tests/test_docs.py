@@ -2,6 +2,9 @@
 import os
 
 from helpers import ROOT
+import pytest
+
+pytestmark = pytest.mark.run
 
 
 def test_readme_option_table_is_current():

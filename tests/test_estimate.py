@@ -19,6 +19,8 @@ import pytest
 
 from helpers import ROOT, cli
 
+pytestmark = pytest.mark.run
+
 SMALL = os.path.join(ROOT, "runs", "pekeris", "small.opts")
 
 

@@ -10,6 +10,8 @@ import pytest
 
 from helpers import cli, read_h5
 
+pytestmark = pytest.mark.mpi
+
 
 def test_the_switch_takes_effect_and_refuses_bad_values():
     from petsc_ssi.petsc import set_huge_pages, SSIError

@@ -25,6 +25,9 @@ import h5py
 import numpy as np
 
 from helpers import cli
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 SMALL = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
          "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_t_end", "0.03",
@@ -135,6 +138,8 @@ def test_a_restart_does_not_continue_another_runs_output(tmp_path):
         assert str(fc.attrs["run_id"]) == ida and str(fc.attrs["run_status"]) == "completed"
 
 
+# slow tier: checkpoint and lag names against every output and sidecar (20 s; the locks' tests stay)
+@pytest.mark.slow
 def test_checkpoint_and_lag_files_may_not_be_outputs(tmp_path):
     """A checkpoint or lag file named like the output, a sidecar of it, or each other: refused at
     -n 1 and -n 2 even with -ssi_output_overwrite, before any step; the earlier result untouched."""

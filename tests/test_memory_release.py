@@ -8,6 +8,8 @@ import pytest
 
 from petsc_ssi.sysmem import process_rss, release_freed
 
+pytestmark = pytest.mark.unit
+
 
 def test_freed_heap_memory_is_given_back():
     """3000 arrays of 100 kB (below glibc's mmap threshold: from the heap, touched), all freed but

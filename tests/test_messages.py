@@ -13,6 +13,8 @@ import pytest
 
 from helpers import ROOT, cli
 
+pytestmark = pytest.mark.mpi
+
 GEO = os.path.join(ROOT, "meshes", "building.geo")
 
 

@@ -11,6 +11,9 @@ import h5py
 import numpy as np
 
 from helpers import ROOT, cli
+import pytest
+
+pytestmark = pytest.mark.run
 
 SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2",
        "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size",

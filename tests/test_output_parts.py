@@ -17,6 +17,8 @@ from petsc_ssi.io import output as output_mod
 from petsc_ssi.io.output import Output, parts_dir
 from petsc_ssi.petsc import init, SSIError
 
+pytestmark = pytest.mark.run
+
 PETSc = init()
 N = 50
 

@@ -9,6 +9,8 @@ import pytest
 
 from helpers import cli, write_surface_msh
 
+pytestmark = pytest.mark.mpi
+
 SMALL = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
          "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_t_end", "0.01",
          "-ssi_output_stride", "0"]

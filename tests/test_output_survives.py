@@ -11,6 +11,8 @@ import pytest
 
 from helpers import cli, kill_session, signal_midway
 
+pytestmark = pytest.mark.mpi
+
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_receivers", "2,0,0;0,0,0",
        "-ssi_output_stride", "5"]

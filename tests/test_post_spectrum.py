@@ -13,6 +13,8 @@ from helpers import ROOT, PY, cli
 from petsc_ssi import spectrum as sp
 from petsc_ssi.app.post import main as post_main
 
+pytestmark = pytest.mark.run
+
 # two sines with an integer number of periods in T = N dt = 2 s: 5 Hz (10 periods) and 12.5 Hz (25)
 N, DT = 200, 0.01
 F1, A1, F2, A2 = 5.0, 1.5, 12.5, 0.4

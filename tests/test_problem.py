@@ -7,6 +7,8 @@ import pytest
 
 from helpers import petsc
 
+pytestmark = pytest.mark.run
+
 SSI = dict(problem="ssi", cp=42, cs=20, rho=1800, mesh_size="2,2", mesh_h=0.5, mesh_patch="0.5,0.5",
            fem_box_cells="4,4,1", fem_box_size="1,1,0.25", fem_box_origin="-0.5,-0.5,0", fem_E=300e9, fem_rho=200,
            fem_load_group="top", fem_load_p0=1000, fem_load_history="box", fem_load_t0=0.05,

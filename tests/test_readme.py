@@ -11,6 +11,9 @@ import subprocess
 import sys
 
 from helpers import ROOT
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 
 def running_block():

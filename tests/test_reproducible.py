@@ -11,6 +11,8 @@ import pytest
 
 from helpers import cli
 
+pytestmark = pytest.mark.mpi
+
 FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "3,3,3", "-ssi_fem_fixed", "base", "-ssi_fem_load_group", "top",
        "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history", "box", "-ssi_fem_load_t0", "0.01", "-ssi_dt", "1e-3",
        "-ssi_t_end", "0.05", "-ssi_receivers", "0.5,0.5,0.5", "-ssi_output_stride", "10"]

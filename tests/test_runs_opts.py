@@ -11,7 +11,25 @@ import pytest
 
 from helpers import ROOT, cli, read_h5
 
+pytestmark = pytest.mark.run
+
 OPTS = sorted(glob.glob(os.path.join(ROOT, "runs", "**", "*.opts"), recursive=True))
+# the slow tier (make test-slow): each over a minute; a smaller sibling of each stays in make test
+SLOW = {
+    # the full building's files: the half building's and the CI building stay
+    "runs/building/ssi-common.opts", "runs/building/ssi-half-common.opts",
+    "runs/building/ssi-full-bonded-ny4.opts", "runs/building/ssi-full-bonded-released.opts",
+    "runs/building/ssi-full-unilateral.opts", "runs/building/ssi-full-bonded.opts",
+    # the disk's and the rectangle's impedances: the square's stays
+    "runs/impedance/disk.opts", "runs/impedance/rectangle.opts",
+    # the antisymmetric foundation cases: anti-unilateral and the symmetric ones stay
+    "runs/foundation/anti-bonded.opts", "runs/foundation/anti-unilateral-cohesive.opts",
+    # the paper's building under a record: the half building's file (same mesh) and the seismic building stay
+    "runs/seismic/paper-building.opts",
+}
+PARAMS = [pytest.param(p, id=os.path.relpath(p, ROOT),
+                       marks=[pytest.mark.slow] if os.path.relpath(p, ROOT) in SLOW else [])
+          for p in OPTS]
 
 
 def _value(text, name, default=None):
@@ -27,7 +45,7 @@ def _read(path):
     return text
 
 
-@pytest.mark.parametrize("path", OPTS, ids=[os.path.relpath(p, ROOT) for p in OPTS])
+@pytest.mark.parametrize("path", PARAMS)
 def test_options_file_runs_reduced(path, tmp_path):
     text = _read(path)
     problem = _value(text, "problem", "bem")

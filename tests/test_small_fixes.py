@@ -6,6 +6,9 @@ import subprocess
 import sys
 
 from helpers import ROOT, cli
+import pytest
+
+pytestmark = pytest.mark.run
 
 SHADOW = "raise ImportError('a different matplotlib built this mpl_toolkits')\n"
 

@@ -6,6 +6,8 @@ import pytest
 
 from petsc_ssi.petsc import init, solve_columns, SSIError
 
+pytestmark = pytest.mark.unit
+
 PETSc = init()
 
 

@@ -6,12 +6,18 @@ import subprocess
 import sys
 
 from helpers import ROOT
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 RUN = ["-m", "petsc_ssi", "-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch",
        "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005", "-ssi_t_end", "0.01",
        "-ssi_warn_beta", "0", "-ssi_output_overwrite"]
 
 
+# slow tier: a cold numba cache compiled from scratch (47 s): make deps warms the cache CI uses, and
+#  test_warmup's other tests check the warm state
+@pytest.mark.slow
 def test_cold_cache_is_announced_then_the_warm_up_covers_every_run(tmp_path):
     """One compile: a run with an empty cache announces it (one line); the warm-up then finds the
     cache only partly warm (a run compiled what it met), loads and compiles the rest, and marks it;
@@ -157,6 +163,9 @@ def test_a_second_checkout_is_not_taken_for_warm(tmp_path):
         clean(cache2, key2)
 
 
+# slow tier: a second checkout compiles every kernel once (30-80 s, 279 s on the loaded machine): the cheap
+#  test_a_second_checkout_is_not_taken_for_warm checks the per-checkout warm check it rests on
+@pytest.mark.slow
 def test_a_second_checkout_compiles_once_and_says_so(tmp_path):
     """A second checkout whose first run compiles says so in one line (this checkout's path in it);
     its warm-up then compiles the rest and marks this checkout warm, and a new process's run there

@@ -5,6 +5,8 @@ import pytest
 
 from helpers import cli
 
+pytestmark = pytest.mark.run
+
 
 def one_line_error(r):
     """The single error line of a refused run (exit status 2, no traceback)."""

@@ -13,6 +13,8 @@ from scipy import integrate
 
 from petsc_ssi.analytic import impedance_refs as ir
 
+pytestmark = pytest.mark.unit
+
 NU3 = 1.0 / 3.0
 A0_T1 = np.array([0.25, 0.5, 1.0, 1.5, 2.0])
 

@@ -11,6 +11,8 @@ from scipy import integrate, special
 
 from petsc_ssi.analytic import pekeris as pk
 
+pytestmark = pytest.mark.unit
+
 SQ3 = math.sqrt(3.0)
 TAU_P = 1.0 / SQ3
 GAMMA = math.sqrt((3.0 + SQ3) / 4.0)          # c_s / c_R for nu = 1/4

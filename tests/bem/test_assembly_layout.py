@@ -14,6 +14,8 @@ import pytest
 
 from helpers import petsc
 
+pytestmark = pytest.mark.run
+
 
 def _lagset(planes, chunk_cache, pattern="auto", bump=0.0):
     PETSc = petsc()

@@ -9,6 +9,8 @@ import pytest
 
 from helpers import ROOT, cli
 
+pytestmark = pytest.mark.run
+
 
 def test_thresholds_are_the_maps():
     from petsc_ssi.bem.stability import MAP_STABLE_FROM, MAP_BETA_MAX

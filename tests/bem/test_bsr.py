@@ -6,6 +6,8 @@ import pytest
 
 from petsc_ssi.bem import bsr
 
+pytestmark = pytest.mark.unit
+
 
 def random_bsr(rng, nrow, ncol, fill, dtype=np.float64):
     """A random 3x3-block CSR (columns unsorted in each row) and its dense (3 nrow x 3 ncol) matrix."""

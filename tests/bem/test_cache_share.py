@@ -6,6 +6,8 @@ import pytest
 
 from petsc_ssi.bem.lagset import _first_occurrences, _mix64
 
+pytestmark = pytest.mark.unit
+
 
 @pytest.mark.parametrize("collide", [False, True])
 def test_first_occurrences(collide):

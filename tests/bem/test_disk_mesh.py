@@ -11,6 +11,8 @@ import pytest
 
 from helpers import ROOT, petsc, run_bem
 
+pytestmark = pytest.mark.run
+
 GEO = os.path.join(ROOT, "meshes", "disk_soil.geo")
 A = 1.0
 CASE = dict(mesh=GEO, mesh_size="6,6", mesh_h=0.25, mesh_patch=f"{A:g},{A:g}", dt=7.5e-4, t_end=0.003,

@@ -6,6 +6,8 @@ import pytest
 
 from helpers import resolve_error, cli, ROOT, write_surface_msh
 
+pytestmark = pytest.mark.mpi
+
 SMALL = dict(mesh_size="4,4", mesh_h=1.0, t_end=0.003)
 
 

@@ -5,6 +5,8 @@ import pytest
 from petsc_ssi.bem.freeterm import cone_moments, free_term_from_cone, free_terms
 from petsc_ssi.mesh.surface import grid
 
+pytestmark = pytest.mark.run
+
 NU = 0.25
 
 

@@ -4,6 +4,9 @@ import h5py
 import numpy as np
 
 from helpers import run_bem, relmax, ROOT
+import pytest
+
+pytestmark = pytest.mark.run
 
 
 def test_geo_equals_grid(tmp_path):

@@ -9,6 +9,8 @@ from helpers import run_bem
 from petsc_ssi.petsc import SSIError
 from petsc_ssi.bem.stability import guard_step
 
+pytestmark = pytest.mark.run
+
 BETA = 0.05
 DT = BETA * 0.5 / 316.0
 CASE = dict(mesh_size="6,6", mesh_h=1.0, mesh_patch="1,1", load_group="load", load_p0=1000,

@@ -38,6 +38,9 @@ to 0.5 here, which is that known defect, not a tolerance of the input-motion met
 import numpy as np
 
 from helpers import petsc
+import pytest
+
+pytestmark = pytest.mark.run
 
 CP, CS, RHO = 42.0, 20.0, 1800.0
 

@@ -13,6 +13,8 @@ import pytest
 
 from helpers import cli
 
+pytestmark = pytest.mark.mpi
+
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "10,10", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025", "-ssi_t_end", "0.15",
        "-ssi_receivers", "3,0,0;0,0,0", "-ssi_output_stride", "7", "-ssi_warn_beta", "0"]
@@ -95,7 +97,11 @@ CASES = {
 }
 
 
-@pytest.mark.parametrize("case", list(CASES))
+# the slow tier: the stabilised case stays in make test (and the coupled contact case at -n 2)
+SLOW_CASES = ("plain", "interpolated", "symmetry+interp", "prescribed motion", "prescribed motion, plain, anti")
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in SLOW_CASES else []) for c in CASES])
 def test_blocked_equals_per_step(tmp_path, case):
     """Blocks of 5 steps, blocks of 7 in sub-blocks of 3 (3, 3 and 1 steps: the last one cut by the
     block's end) and the automatic sizes against step by step, one rank."""

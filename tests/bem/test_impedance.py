@@ -13,6 +13,8 @@ from helpers import cli
 from petsc_ssi.histories import History
 from petsc_ssi.bem.impedance import spectrum
 
+pytestmark = pytest.mark.mpi
+
 CASE = ["-ssi_problem", "bem", "-ssi_mesh_size", "8,8", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "1,1",
         "-ssi_disp_group", "load", "-ssi_dt", "6e-4", "-ssi_t_end", "0.1", "-ssi_output_stride", "0",
         "-ssi_warn_beta", "0"]
@@ -90,6 +92,8 @@ DISK = ["-ssi_problem", "bem", "-ssi_cp", "632", "-ssi_cs", "316", "-ssi_rho", "
         "-ssi_warn_beta", "0"]
 
 
+# slow tier: the disk's impedance against Veletsos & Verbic (the square's against Pais & Kausel stays)
+@pytest.mark.slow
 def test_disk_against_veletsos_and_verbic(tmp_path):
     """A rigid disk (R = 1 m, meshes/disk_soil.geo with 0.5 m elements, nu = 1/3) against Veletsos and
     Verbic's curves for a0 in [0.5, 1.5]: k within 0.04 (rocking) and 0.06 (vertical, horizontal), c
@@ -148,6 +152,9 @@ def _table(path):
     return {k: np.array(v) for k, v in out.items()}
 
 
+# slow tier: impedance: symmetry-reduced == full and -n 2 (11 s; the off-centre footing's planes stay), the
+#  requested band's warning (8 s) and the meshed surface's low-frequency limit (6 s)
+@pytest.mark.slow
 def test_symmetry_reduced_runs_equal_full_runs_and_two_ranks_equal_one(tmp_path):
     """Every mode and both coupling terms: the quarter models (each mode's own planes) give the
     full model's K(omega), and -n 2 gives -n 1's, to 1e-6 of the largest |K| of each term."""
@@ -164,6 +171,9 @@ def test_symmetry_reduced_runs_equal_full_runs_and_two_ranks_equal_one(tmp_path)
         assert np.abs(q[mode] - q2[mode]).max() <= 1e-8 * scale, (mode, np.abs(q[mode] - q2[mode]).max() / scale)
 
 
+# slow tier: impedance: symmetry-reduced == full and -n 2 (11 s; the off-centre footing's planes stay), the
+#  requested band's warning (8 s) and the meshed surface's low-frequency limit (6 s)
+@pytest.mark.slow
 def test_requested_band_outside_the_trusted_one_warns(tmp_path):
     """The band of a 4 m surface around the 2 m square, dt = 0.8 ms: a0 >= 1.44 (one Rayleigh
     wavelength across the surface; the 0.04 s record alone would allow 0.99) but a0 <= 1.19
@@ -188,6 +198,9 @@ def test_requested_band_outside_the_trusted_one_warns(tmp_path):
     assert p.returncode == 2 and "a0_min < a0_max" in p.stdout
 
 
+# slow tier: impedance: symmetry-reduced == full and -n 2 (11 s; the off-centre footing's planes stay), the
+#  requested band's warning (8 s) and the meshed surface's low-frequency limit (6 s)
+@pytest.mark.slow
 def test_the_meshed_surface_limits_the_low_frequencies(tmp_path):
     """The band's lower limit from the mesh's extent (one Rayleigh wavelength across the surface,
     a0 >= 2 pi B c_R / (c_s L)): the vertical impedance of the 2 m square on 4 m and 8 m surfaces

@@ -34,6 +34,8 @@ import pytest
 
 from helpers import run_bem, cli, resolve_error
 
+pytestmark = pytest.mark.mpi
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 B = 0.5                                   # the footing's half-width [m]
 

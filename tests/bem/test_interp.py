@@ -9,6 +9,8 @@ import pytest
 from helpers import run_bem
 from petsc_ssi.bem import interp
 
+pytestmark = pytest.mark.run
+
 
 @pytest.mark.parametrize("k", [2, 3, 5, 8])
 def test_chebyshev_reproduces_polynomials_of_degree_k_minus_1(k):

@@ -5,6 +5,8 @@ import pytest
 from petsc_ssi.bem import kernels as K
 from petsc_ssi.bem.reference import f1_numeric, t2_numeric
 
+pytestmark = pytest.mark.unit
+
 CP, CS, RHO = 548.0, 316.0, 2000.0
 MU = RHO * CS ** 2
 NU = (CP ** 2 - 2 * CS ** 2) / (2 * (CP ** 2 - CS ** 2))

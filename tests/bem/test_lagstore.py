@@ -9,6 +9,9 @@ import h5py
 import numpy as np
 
 from helpers import cli
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 BEM = ["-ssi_problem", "bem", "-ssi_mesh_size", "12,12", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
        "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
@@ -66,6 +69,9 @@ def test_a_coupled_study_reuses_the_soil(tmp_path):
     assert not np.array_equal(A["interface/uf"], B["interface/uf"])     # the structure did change
 
 
+# slow tier: the options of a lag file's key changed in turn, each refused (27 s; the checkpoint key's
+#  refusals stay in make test)
+@pytest.mark.slow
 def test_a_changed_key_is_refused(tmp_path):
     """What the matrices depend on may not change: dt, the mesh, the symmetry, the scheme, the
     interpolation, the material; a file without its .json (a save cut short), saving and loading

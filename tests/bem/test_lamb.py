@@ -13,6 +13,8 @@ from helpers import run_bem
 from petsc_ssi.verify import lamb_errors
 from petsc_ssi.analytic.pekeris import boussinesq_rectangle
 
+pytestmark = pytest.mark.run
+
 CASE = dict(cp=548, cs=316, rho=2000, mesh_size="10,10", mesh_patch="1,1", load_group="load",
             load_p0=1000, symmetry="x=sym,y=sym", receivers="2,0,0;3,0,0", t_end=2.5 * 3 / 316,
             output_stride=0, warn_beta=0)

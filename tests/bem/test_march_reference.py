@@ -8,6 +8,8 @@ import pytest
 
 from helpers import petsc, run_bem
 
+pytestmark = pytest.mark.run
+
 
 def _dense_lags(mesh_size, dt, L):
     PETSc = petsc()

@@ -7,6 +7,9 @@ import json
 import time
 
 from helpers import cli
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 
 def test_cgroup_limits_are_read(tmp_path):

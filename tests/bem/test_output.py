@@ -8,6 +8,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from helpers import cli, read_h5, ROOT
+import pytest
+
+pytestmark = pytest.mark.run
 
 
 def test_hdf5_xdmf_json_and_post_csv(tmp_path):

@@ -6,6 +6,8 @@ import pytest
 
 from helpers import cli, read_h5, relmax
 
+pytestmark = pytest.mark.mpi
+
 ARGS = ["-ssi_mesh_size", "8,8", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load",
         "-ssi_load_p0", "1000", "-ssi_symmetry", "x=sym", "-ssi_t_end", "0.0075", "-ssi_dt", "7.5e-4",
         "-ssi_receivers", "3,0,0;-2,2,0", "-ssi_output_stride", "5"]

@@ -11,6 +11,8 @@ import pytest
 from helpers import PY, ROOT, cli, petsc, read_h5, relmax
 from petsc_ssi.bem import partition
 
+pytestmark = pytest.mark.mpi
+
 ARGS = ["-ssi_mesh_size", "16,16", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load",
         "-ssi_load_p0", "1000", "-ssi_symmetry", "x=sym,y=sym", "-ssi_t_end", "0.03", "-ssi_dt", "7.5e-4",
         "-ssi_receivers", "3,0,0;2,2,0", "-ssi_output_stride", "5"]
@@ -87,6 +89,9 @@ def test_node_work_is_the_memory_estimate_count():
     assert abs(q2[0] - (np.dot(lw2, e0) + 3 * lw2.sum())) < 1e-9 * q2[0]
 
 
+# slow tier: the balanced partition evens the assembled work: a speed property (jobscripts measure it);
+#  balanced == equal partitions at -n 2 stays
+@pytest.mark.slow
 def test_balanced_evens_the_assembled_work():
     """The medium Lamb case (625 nodes, 107 lags, 106 steps) assembled on one process
     (jobscripts/partition_balance.py --one medium): cut for 2, 4, 8 and 16 ranks from the estimate,

@@ -12,6 +12,8 @@ import pytest
 from petsc_ssi.bem.bsr import positions
 from petsc_ssi.bem.quadrature import integrate_pair, integrate_plane, plane_points
 
+pytestmark = pytest.mark.unit
+
 CP, CS, RHO, NU = 400.0, 200.0, 2000.0, 1.0 / 3.0
 DT = 2e-3
 

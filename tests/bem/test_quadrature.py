@@ -6,6 +6,8 @@ from petsc_ssi.bem.quadrature import singular_static, integrate_pair
 from petsc_ssi.mesh import quad9
 from petsc_ssi.mesh.surface import grid
 
+pytestmark = pytest.mark.run
+
 NU, MU = 0.25, 1.0
 
 

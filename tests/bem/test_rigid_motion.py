@@ -5,6 +5,9 @@ import h5py
 import numpy as np
 
 from helpers import cli
+import pytest
+
+pytestmark = pytest.mark.mpi
 
 # a 2 m x 2 m footing (B = 1 m) on an 8 m x 8 m surface of 0.5 m elements, the paper's soil
 BASE = ["-ssi_problem", "bem", "-ssi_mesh_size", "8,8", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "1,1",
@@ -19,6 +22,9 @@ def resultants(path):
         return {k: g[k][()] for k in g}
 
 
+# slow tier: the folded quarter model of a rigid motion (30 s; the symmetry-reduced impedance runs == full
+#  runs and the half model on a graded gmsh mesh stay)
+@pytest.mark.slow
 def test_folded_quarter_model_equals_the_full_model(tmp_path):
     """Vertical translation: the quarter model (two symmetry planes, images folded into F and M)
     gives the full model's force to 1e-6 and zero horizontal force and moment; a reference point
@@ -56,6 +62,8 @@ def test_static_stiffness_of_the_square_footing(tmp_path):
         assert 1.0 < k[-1] / ref < 1.0 + tol, k[-1] / ref
 
 
+# slow tier: a rigid motion's resultants at -n 2 and through a restart (9 s; the square's stiffness stays)
+@pytest.mark.slow
 def test_two_ranks_equal_one_and_a_restart_keeps_the_resultants(tmp_path):
     """Rocking about y through x_ref on the x = 0 plane: -n 2 equals -n 1 to 1e-10, and a run
     restarted from a checkpoint writes the same resultants bit for bit."""

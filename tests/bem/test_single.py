@@ -16,6 +16,8 @@ import pytest
 from helpers import cli, resolve_error
 from test_history_block import BEM, INTERP, SSI, fields, same, log_line
 
+pytestmark = pytest.mark.mpi
+
 
 def stored_gb(out):
     """(estimated, stored) GB of lag matrices from the run's log."""
@@ -85,6 +87,9 @@ def test_single_lags_change_the_run_by_rounding_only(tmp_path):
     same(sgl, blk)
 
 
+# slow tier: single-precision lags interpolated, coupled and at -n 2 (30 s; single == double by rounding and
+#  the lag file's bitwise reload stay)
+@pytest.mark.slow
 def test_single_lags_interpolated_coupled_and_parallel(tmp_path):
     """With the far lags interpolated (the interpolating matrices single too), in a coupled run
     with unilateral contact, and on 2 ranks: within 1e-6 of the double run, and the 2-rank run the
@@ -103,6 +108,8 @@ def test_single_lags_interpolated_coupled_and_parallel(tmp_path):
         same(sgl, par, rtol=rtol)
 
 
+# slow tier: single lags' file reload (6 s; the double lag file's bitwise reload stays)
+@pytest.mark.slow
 def test_single_lag_file_reloads_bitwise(tmp_path):
     """-ssi_lags_save of a single-precision run (written as double MPIBAIJ) and -ssi_lags_load in the
     same set-up: bitwise the run that assembled; a double run refuses the file, naming why."""

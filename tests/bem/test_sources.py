@@ -17,6 +17,8 @@ import pytest
 
 from helpers import petsc
 
+pytestmark = pytest.mark.run
+
 V = 200.0                       # the load's speed [m/s] (below c_s = 316 m/s)
 X_START, X_END = -3.0, 3.0      # where the load runs [m]
 LENGTH = 1.0                    # the load's length along x [m]: a box of duration LENGTH / V

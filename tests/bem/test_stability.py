@@ -13,6 +13,8 @@ import pytest
 from helpers import run_bem
 from petsc_ssi.analytic.pekeris import boussinesq_rectangle
 
+pytestmark = pytest.mark.run
+
 CP, CS, RHO = 548.0, 316.0, 2000.0
 L_NODE = 0.5   # node spacing of 1 m nine-node elements
 

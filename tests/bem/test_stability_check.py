@@ -10,6 +10,8 @@ import pytest
 from helpers import run_bem, resolve_error
 from petsc_ssi.bem import stability as st
 
+pytestmark = pytest.mark.run
+
 CS = 316.0
 L_NODE = 0.5
 

@@ -4,6 +4,9 @@ import os
 import numpy as np
 
 from helpers import ROOT, run_bem, relmax
+import pytest
+
+pytestmark = pytest.mark.run
 
 COMMON = dict(mesh_size="6,6", mesh_h=1.0, mesh_patch="1,1", dt=7.5e-4, t_end=0.006,
               receivers="2,1,0;-2,-1.5,0;0.5,-2.5,0;0,0,0", output_stride=0)

@@ -19,6 +19,8 @@ import pytest
 
 from helpers import cli, run_bem
 
+pytestmark = pytest.mark.mpi
+
 CP, CS, RHO = 208.0, 100.0, 1800.0
 SOIL = dict(cp=CP, cs=CS, rho=RHO, mesh_h=1.0, mesh_patch="1,1", load_p0=1000.0, dt=2.5e-3, warn_beta=0,
             output_stride=0)

@@ -12,6 +12,8 @@ import pytest
 
 from helpers import run_ssi
 
+pytestmark = pytest.mark.run
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 G = RHO * CS ** 2
 NU = ((CP / CS) ** 2 - 2) / (2 * ((CP / CS) ** 2 - 1))

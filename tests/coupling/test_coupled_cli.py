@@ -7,6 +7,8 @@ import pytest
 
 from helpers import cli
 
+pytestmark = pytest.mark.mpi
+
 CASE = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800",
         "-ssi_mesh_size", "2,2", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "0.5,0.5",
         "-ssi_fem_box_cells", "4,4,2", "-ssi_fem_box_size", "1,1,0.5", "-ssi_fem_load_group", "top_left,top_right:-1",

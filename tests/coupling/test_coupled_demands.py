@@ -25,6 +25,8 @@ import pytest
 
 from helpers import petsc
 
+pytestmark = pytest.mark.run
+
 
 @pytest.fixture(scope="module")
 def record(tmp_path_factory):

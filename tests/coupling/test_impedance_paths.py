@@ -15,6 +15,9 @@ import numpy as np
 
 from helpers import run_bem, run_ssi
 from petsc_ssi.bem.impedance import rigid_fit, spectrum, step_spectrum
+import pytest
+
+pytestmark = pytest.mark.run
 
 CP, CS, RHO, B = 42.0, 20.0, 1800.0, 0.5
 DT, T_END, RISE, AMP = 0.0125, 1.0, 0.05, 1e-6

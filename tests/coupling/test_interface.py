@@ -9,6 +9,8 @@ from petsc_ssi.fem.mesh import structured_box
 from petsc_ssi.coupling.interface import build_interface, fem_symmetry_dofs
 from petsc_ssi.coupling.contact import ContactLaw, StaggeredSolve, ImplicitSolve, Capacitance
 
+pytestmark = pytest.mark.mpi
+
 
 def meshes(cells=4, h=0.5):
     be = surface.grid(2.0, 2.0, h, patch=(0.5, 0.5))

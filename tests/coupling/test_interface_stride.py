@@ -6,6 +6,9 @@ import h5py
 import numpy as np
 
 from helpers import run_ssi
+import pytest
+
+pytestmark = pytest.mark.run
 
 CASE = dict(cp=42.0, cs=20.0, rho=1800.0, mesh_size="2,2", mesh_h=0.5, mesh_patch="0.5,0.5",
             fem_box_cells="4,4,1", fem_box_size="1,1,0.25", fem_box_origin="-0.5,-0.5,0", fem_E=300e9,

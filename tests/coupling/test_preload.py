@@ -35,6 +35,8 @@ import pytest
 
 from helpers import cli, run_ssi
 
+pytestmark = pytest.mark.mpi
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 G_N = 9.81
 DT = 0.0125
@@ -238,6 +240,11 @@ def series(path):
 STAGGERED = ["-ssi_coupling", "staggered", "-ssi_fem_rho", "8000", "-ssi_fem_load_p0", "-32000"]
 
 
+# slow tier: restart and -n 2 == -n 1 with a contact preload, both couplings (three mpirun launches each: 13 s
+#  for both on the idle machine, 25 s each under load): the preload is a constant recomputed from the options;
+#  the contact state's restart is test_checkpoint's coupled contact restart, and test_preload's in-process
+#  checks and its -n 2 refusal stay
+@pytest.mark.slow
 @pytest.mark.parametrize("coupling, extra, mass, landed", [("implicit", [], 50.0, slice(18, 24)),
                                                            ("staggered", STAGGERED, 2000.0, slice(12, 19))])
 def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):

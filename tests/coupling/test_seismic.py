@@ -20,6 +20,8 @@ import pytest
 
 from helpers import run_ssi
 
+pytestmark = pytest.mark.mpi
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 
 
@@ -138,6 +140,9 @@ def test_fixed_base_limit(tmp_path, record):
     assert tower_difference(tmp_path, record, 500.0, 6e-4) < 0.03
 
 
+# slow tier: the fixed-base limit's convergence in the soil's stiffness (three soils; the light-block, Newton
+#  and -n 2 checks of the seismic input stay)
+@pytest.mark.slow
 def test_fixed_base_limit_converges_in_the_soil_stiffness(tmp_path, record):
     """The difference to the fixed base scales as the soil's compliance, 1 / c_s^2: on c_s 200 m/s
     it is (500/200)^2 times that on 500 m/s within 30 %; on the paper's soil (c_s 20 m/s) SSI

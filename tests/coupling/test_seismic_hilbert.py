@@ -24,6 +24,8 @@ from scipy.special import dawsn
 
 from helpers import cli, run_ssi
 
+pytestmark = pytest.mark.mpi
+
 
 def test_the_taper_starts_where_the_precursor_falls_below_the_tolerance():
     from petsc_ssi.analytic.free_field import PlaneWave, hilbert_of

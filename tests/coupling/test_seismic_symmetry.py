@@ -20,6 +20,8 @@ import pytest
 
 from helpers import run_ssi
 
+pytestmark = pytest.mark.run
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 
 

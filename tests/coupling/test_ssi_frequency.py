@@ -79,6 +79,8 @@ import pytest
 
 from helpers import cli, run_ssi
 
+pytestmark = pytest.mark.run
+
 CP, CS, RHO = 208.0, 100.0, 1800.0
 G = RHO * CS ** 2
 NU_S = ((CP / CS) ** 2 - 2) / (2 * ((CP / CS) ** 2 - 1))

@@ -16,6 +16,8 @@ import pytest
 from helpers import run_bem, run_ssi
 from petsc_ssi.bem.impedance import spectrum, step_spectrum
 
+pytestmark = pytest.mark.run
+
 CP, CS, RHO = 42.0, 20.0, 1800.0
 DT, T_END, M = 0.0125, 2.0, 5000.0
 

@@ -22,6 +22,8 @@ import pytest
 
 from fem_helpers import run_cli
 
+pytestmark = pytest.mark.mpi
+
 E, NU, B, H, L = 30e9, 0.2, 0.2, 3.0, 12.0
 LEVELS = (0.0, 3.0, 6.0)
 

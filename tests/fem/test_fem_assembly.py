@@ -10,6 +10,8 @@ from petsc_ssi.fem import assembly as asm
 from petsc_ssi.fem.mesh import structured_box, read_gmsh, renumber_rcm, boundary_faces
 from petsc_ssi.fem.loads import quad_pressure_forces, fixed_dofs
 
+pytestmark = pytest.mark.unit
+
 
 def distorted_bricks(n=5, seed=1):
     rng = np.random.default_rng(seed)

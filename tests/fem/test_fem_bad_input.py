@@ -4,6 +4,8 @@ import pytest
 
 from fem_helpers import run_cli
 
+pytestmark = pytest.mark.mpi
+
 FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_t_end", "0.01", "-ssi_dt", "0.005",
        "-ssi_output", ""]
 

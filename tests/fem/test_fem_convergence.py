@@ -25,6 +25,8 @@ from fem_helpers import chain_mats, vec_from
 from petsc_ssi.fem.integrators import GreenIntegrator, NewmarkIntegrator
 from petsc_ssi.fem.loads import History
 
+pytestmark = pytest.mark.unit
+
 NS = (60, 120, 240, 480)        # steps over the interval T
 ORDER_TOL = 0.2                 # observed order must be 2 +- 0.2
 

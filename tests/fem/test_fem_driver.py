@@ -14,6 +14,8 @@ from petsc_ssi.fem.loads import fixed_dofs, nodal_load
 from petsc_ssi.fem.mesh import read_gmsh, snap_points
 from petsc_ssi.fem.static import static_solve
 
+pytestmark = pytest.mark.mpi
+
 OPTS = os.path.join("runs", "foundation", "block-fixed.opts")
 SHORT = ["-ssi_t_end", "0.05"]          # 8 steps of the paper's dt (the file runs to 0.2 s)
 

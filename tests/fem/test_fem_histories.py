@@ -7,6 +7,8 @@ from petsc_ssi.petsc import SSIError
 from petsc_ssi.histories import History
 from petsc_ssi.bem import histories as bem_histories
 
+pytestmark = pytest.mark.unit
+
 TABLE = np.array([[0.01, 2.0], [0.02, -1.0], [0.035, 0.5], [0.05, 0.5]])   # jumps 0 -> 2 at t = 0.01
 
 

@@ -9,6 +9,8 @@ from petsc_ssi.fem.loads import fixed_dofs
 from petsc_ssi.fem.mesh import structured_box
 from petsc_ssi.fem.static import static_solve
 
+pytestmark = pytest.mark.unit
+
 RTOL = 1e-10    # "to round-off" for ~30-step recurrences on ~100 dofs
 
 

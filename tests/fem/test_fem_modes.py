@@ -8,6 +8,8 @@ from petsc_ssi.fem.loads import fixed_dofs
 from petsc_ssi.fem.mesh import structured_box
 from petsc_ssi.fem.modes import compute_modes
 
+pytestmark = pytest.mark.unit
+
 
 def dense_modes(K, m, fixed, k):
     Kd, md = dense(K), m.getArray().copy()

@@ -9,6 +9,8 @@ import pytest
 
 from fem_helpers import ROOT, PY, run_cli
 
+pytestmark = pytest.mark.mpi
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 

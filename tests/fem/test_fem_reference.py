@@ -27,6 +27,8 @@ from petsc_ssi.fem.integrators import GreenIntegrator
 from petsc_ssi.fem.loads import History, fixed_dofs, nodal_load
 from petsc_ssi.fem.mesh import structured_box, renumber_rcm
 
+pytestmark = pytest.mark.unit
+
 E, NU, RHO, AM, P0, T0, T = 300e6, 0.2, 2000.0, 30.0, 1000.0, 7.55e-3, 0.03
 RECEIVERS = np.array([[0.0, 0.0, 0.5], [0.5, 0.5, 0.5]])
 DTS = (1e-4, 5e-5)

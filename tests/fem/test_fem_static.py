@@ -10,6 +10,8 @@ from petsc_ssi.fem.loads import History, fixed_dofs, nodal_load
 from petsc_ssi.fem.mesh import structured_box
 from petsc_ssi.fem.static import static_solve
 
+pytestmark = pytest.mark.unit
+
 
 def settle(cls, solver, prefix):
     """The paper's block (4x4x2 bricks), base fixed, top pressure ramped over 0.05 s, then held;

@@ -25,6 +25,8 @@ from petsc_ssi.fem.elements.frame import FRAME, rect_section, _geometry  # noqa:
 from petsc_ssi.fem.elements.shell import SHELL, resultants, local_frame  # noqa: E402
 from petsc_ssi.fem import obstacle as ob  # noqa: E402
 
+pytestmark = pytest.mark.mpi
+
 
 def element_dofs(cells):
     return (6 * np.asarray(cells)[:, :, None] + np.arange(6)).reshape(len(cells), -1)

@@ -7,6 +7,8 @@ from fem_helpers import sdof_mats
 from petsc_ssi.fem import integrator_response as ir
 from petsc_ssi.fem.integrators import make_integrator
 
+pytestmark = pytest.mark.run
+
 DT, MASS = 5e-3, 2.0
 
 

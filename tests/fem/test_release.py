@@ -13,6 +13,8 @@ import pytest
 from fem_helpers import run_cli
 from test_structures import ok, receivers, relmax
 
+pytestmark = pytest.mark.mpi
+
 E, NU = 30e9, 0.3
 
 

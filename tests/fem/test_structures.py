@@ -18,6 +18,8 @@ from fem_helpers import ROOT, run_cli
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "elements"))
 from np_assembly import assemble as np_assemble, solve_static  # noqa: E402
 
+pytestmark = pytest.mark.mpi
+
 SLAB = os.path.join("runs", "structures", "slab-on-columns.opts")
 REF = os.path.join(os.path.dirname(__file__), "data", "hex8_before_dofmap.npz")
 

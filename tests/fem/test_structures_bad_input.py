@@ -8,6 +8,8 @@ import pytest
 
 from fem_helpers import run_cli
 
+pytestmark = pytest.mark.mpi
+
 BASE = ["-ssi_problem", "fem", "-ssi_fem_mesh", "meshes/slab_on_columns.geo", "-ssi_t_end", "0.004",
         "-ssi_dt", "0.002", "-ssi_output", ""]
 SLAB = {"slab_element": "shell", "slab_E": "30e9", "slab_nu": "0.2", "slab_rho": "2500", "slab_thickness": "0.2",

@@ -8,6 +8,8 @@ import pytest
 
 from helpers import cli
 
+pytestmark = pytest.mark.mpi
+
 FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_box_size", "1,1,1", "-ssi_fem_box_origin",
        "-0.5,-0.5,0", "-ssi_fem_E", "3e7", "-ssi_fem_rho", "2000", "-ssi_fem_fixed", "base", "-ssi_dt", "0.01",
        "-ssi_t_end", "0.2", "-ssi_receivers", "0,0,1", "-ssi_seismic", "vertical", "-ssi_seismic_units", "m/s2",

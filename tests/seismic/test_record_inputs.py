@@ -9,6 +9,8 @@ from helpers import cli
 from petsc_ssi.seismic import records as R
 from petsc_ssi.seismic.records import RecordError
 
+pytestmark = pytest.mark.mpi
+
 AT2 = ("PEER NGA STRONG MOTION DATABASE RECORD\nTEST 1999, STATION, 0\n"
        "ACCELERATION TIME SERIES IN UNITS OF G\nNPTS=    4, DT=   .0100 SEC,\n{}\n")
 

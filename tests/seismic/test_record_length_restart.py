@@ -12,6 +12,8 @@ import pytest
 from helpers import cli
 from test_checkpoint import run_and_restart, assert_same_files
 
+pytestmark = pytest.mark.mpi
+
 BASE = ["-ssi_seismic", "vertical", "-ssi_seismic_units", "m/s2", "-ssi_seismic_taper", "0",
         "-ssi_seismic_baseline", "none", "-ssi_output_stride", "10", "-ssi_reproducible"]
 FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_box_size", "1,1,1", "-ssi_fem_box_origin",

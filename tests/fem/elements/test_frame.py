@@ -16,6 +16,8 @@ from petsc_ssi.fem.elements import Props, REGISTRY  # noqa: E402
 from petsc_ssi.fem.elements.frame import FRAME, Frame, rect_section  # noqa: E402
 from petsc_ssi.petsc import SSIError  # noqa: E402
 
+pytestmark = pytest.mark.unit
+
 # Euler-Bernoulli cantilever eigenvalues beta_n L (Blevins, "Formulas for natural frequency and mode shape")
 BETA_L = np.array([1.87510407, 4.69409113, 7.85475744])
 

@@ -14,6 +14,8 @@ from petsc_ssi.fem import obstacle as ob
 from petsc_ssi.fem.elements import Props
 from petsc_ssi.fem.elements.shell import SHELL, pressure_forces, local_frame
 
+pytestmark = pytest.mark.unit
+
 PROPS = Props(E=30e9, nu=0.2, rho=2500.0, thickness=0.3)
 
 
