@@ -200,15 +200,9 @@ class HalfSpace:
     def _seismic_lines(self):
         """The seismic input's log lines and notes, and a warning when the run ends before the wave's
         lead and pads are over."""
-        for line in self.seismic.summary_lines():
-            printf(line)
-        for note in self.seismic.notes:
-            warn(note, self.comm)
-        from ..seismic.input import late_end
-        late = late_end(self.grid.t_end, self.seismic.motions, self.seismic.t0,
-                        "the wave's lead and any high-pass pad, see the seismic input lines")
-        if late:
-            warn(late, self.comm)
+        from ..seismic.input import report
+        report(self.seismic, self.grid.t_end, self.comm,
+               "the wave's lead and any high-pass pad, see the seismic input lines")
 
     def _seismic_symmetry(self, s):
         """A symmetry plane must hold for the free field ``s``: a uniform (vertical) wave moving along

@@ -17,7 +17,7 @@ import os
 
 import numpy as np
 
-from ..petsc import printf, warn
+from ..petsc import printf
 from ..monitor import event, staged
 from ..io.output import Output, provenance
 from .forces import add_force_recorder
@@ -49,15 +49,9 @@ class FEMTransient(TransientProblem):
         # without -ssi_t_end a run under a record lasts the record (nothing is written into the options)
         self.grid = timegrid.TimeGrid.of_run(cfg, [self.support.duration] if self.support is not None else [])
         if self.support is not None:
-            for line in self.support.summary_lines():
-                printf(line)
-            for note in self.support.notes:
-                warn(note, self.comm)
-            from ..seismic.input import late_end
-            late = late_end(self.grid.t_end, self.support.motions, self.support.t0,
-                            "the start and any high-pass pad, see the support motion lines")
-            if late:
-                warn(late, self.comm)
+            from ..seismic.input import report
+            report(self.support, self.grid.t_end, self.comm,
+                   "the start and any high-pass pad, see the support motion lines")
         self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None
         self.check_disk()

@@ -21,7 +21,7 @@ import warnings
 
 import numpy as np
 
-from ..petsc import SSIError, collective
+from ..petsc import SSIError, collective, printf, warn
 from ..analytic.free_field import PlaneWave, FreeFieldError, critical_angle
 from .records import read_record, process, parse_window, RecordError, RecordWarning
 
@@ -95,6 +95,19 @@ def late_end(t_end, motions, t0, lead):
         return None
     return (f"-ssi_t_end {t_end:g} s ends before the record starts (at {start:.6g} s of run time: {lead}): the run "
             f"sees none of it; give a later -ssi_t_end or leave it out (the run then lasts the record)")
+
+
+def report(source, t_end, comm, lead):
+    """Collective: a seismic source's (``SeismicInput`` or ``SupportMotion``) log lines and notes,
+    and ``late_end``'s warning for a run that ends at ``t_end`` [s] (``lead``: what precedes the
+    record, for the message)."""
+    for line in source.summary_lines():
+        printf(line)
+    for note in source.notes:
+        warn(note, comm)
+    late = late_end(t_end, source.motions, source.t0, lead)
+    if late:
+        warn(late, comm)
 
 
 def _records(cfg):

@@ -185,10 +185,9 @@ def test_refusals(tmp_path):
     assert p.returncode == 2 and "input-motion needs a seismic input" in p.stdout
 
 
-@pytest.mark.parametrize("wave,angle,azimuth", [("sh", 60.0, 30.0), ("p", 30.0, -20.0), ("sv", 20.0, 0.0)])
-def test_free_surface_rotation_is_half_the_curl(wave, angle, azimuth, tmp_path):
-    """SeismicInput.rotation against 1/2 curl u_ff by finite differences of the free field in x, y
-    (centred) and z (one-sided, second order, below the surface), at a few surface points and times."""
+def seismic_input(tmp_path, wave, angle, azimuth, pts):
+    """The SeismicInput of a 0.2 s pulse under ``wave`` at ``angle``, ``azimuth`` [deg] on this file's
+    soil, at rest at ``pts`` for t <= 0."""
     from helpers import petsc
     PETSc = petsc()
     from petsc_ssi import options
@@ -202,11 +201,18 @@ def test_free_surface_rotation_is_half_the_curl(wave, angle, azimuth, tmp_path):
         db.setValue("ssi_" + k, str(v))
     try:
         cfg = options.resolve(("common", "bem", "seismic"))
-        pts = np.array([[0.3, -0.2, 0.0], [-0.7, 0.4, 0.0], [0.0, 0.0, 0.0]])
-        s = SeismicInput(cfg, PETSc.COMM_WORLD, CS, CP, RHO, pts, np.zeros(3), 0.006)
+        return SeismicInput(cfg, PETSc.COMM_WORLD, CS, CP, RHO, pts, np.zeros(3), 0.006)
     finally:
         for k in opts:
             db.delValue("ssi_" + k)
+
+
+@pytest.mark.parametrize("wave,angle,azimuth", [("sh", 60.0, 30.0), ("p", 30.0, -20.0), ("sv", 20.0, 0.0)])
+def test_free_surface_rotation_is_half_the_curl(wave, angle, azimuth, tmp_path):
+    """SeismicInput.rotation against 1/2 curl u_ff by finite differences of the free field in x, y
+    (centred) and z (one-sided, second order, below the surface), at a few surface points and times."""
+    pts = np.array([[0.3, -0.2, 0.0], [-0.7, 0.4, 0.0], [0.0, 0.0, 0.0]])
+    s = seismic_input(tmp_path, wave, angle, azimuth, pts)
     d = 1e-4
     t = np.linspace(0.05, 0.5, 7)
 
@@ -229,24 +235,8 @@ def test_free_field_traction_on_faces_of_any_orientation(wave, angle, azimuth, t
     orientation, what an excavation's walls and bottom need) against Hooke's law on strains from
     centred finite differences of the free-field displacement, at points below the surface on faces
     with oblique normals; and zero on the free surface (n = +z)."""
-    from helpers import petsc
-    PETSc = petsc()
-    from petsc_ssi import options
-    import petsc_ssi.app.kinds  # noqa: F401
-    from petsc_ssi.seismic.input import SeismicInput
-    rec = pulse(tmp_path / "p.txt", 0.2)
-    opts = dict(seismic=wave, seismic_angle=angle, seismic_azimuth=azimuth, seismic_record=rec,
-                seismic_units="m/s2", seismic_taper=0, seismic_baseline="none", cp=CP, cs=CS, rho=RHO)
-    db = PETSc.Options()
-    for k, v in opts.items():
-        db.setValue("ssi_" + k, str(v))
-    try:
-        cfg = options.resolve(("common", "bem", "seismic"))
-        pts = np.array([[0.3, -0.2, -1.0], [-0.7, 0.4, -2.5], [1.0, 0.5, -0.6], [0.2, 0.1, 0.0]])
-        s = SeismicInput(cfg, PETSc.COMM_WORLD, CS, CP, RHO, pts, np.zeros(3), 0.006)
-    finally:
-        for k in opts:
-            db.delValue("ssi_" + k)
+    pts = np.array([[0.3, -0.2, -1.0], [-0.7, 0.4, -2.5], [1.0, 0.5, -0.6], [0.2, 0.1, 0.0]])
+    s = seismic_input(tmp_path, wave, angle, azimuth, pts)
     mu = RHO * CS ** 2
     lam = RHO * CP ** 2 - 2 * mu
     normals = np.array([[1.0, 0.0, 0.0], [0.0, -0.6, 0.8], [0.48, 0.6, -0.64], [0.0, 0.0, 1.0]])
