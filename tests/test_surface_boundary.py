@@ -53,3 +53,52 @@ def test_a_step_knows_its_normals_and_its_edge():
     with pytest.raises(SSIError, match=r"-ssi_mesh pit: the surface mesh must lie in the plane z = 0 \(the free "
                                        r"surface of the half-space z < 0: a reason\); node \d+ is at z = -1 m"):
         m.require_plane("-ssi_mesh pit", "a reason")
+
+
+def test_a_pit_is_a_closed_conforming_surface_with_normals_out_of_the_soil():
+    """surface.pit: the ground with a rectangular excavation (issue 42's basement): every element edge
+    inside the mesh is shared by exactly two elements and the free ones lie on the outer rectangle;
+    the area is Lx Ly + 4 (a + b) d; normals point out of the soil (+z on the ground and the bottom,
+    into the pit on the walls); the pit's rim, its bottom edges and its vertical corners are edges of
+    90 degrees; the plane's refusal names the pit."""
+    from petsc_ssi.mesh.surface import pit
+    from petsc_ssi.mesh import quad9
+    Lx, Ly, h, a, b, d = 8.0, 6.0, 1.0, 2.0, 1.5, 2.0
+    m = pit(Lx, Ly, h, a, b, d)
+    m.check()
+    assert not m.in_plane()
+    edges = {}
+    for e, c in enumerate(m.cells):
+        for tri in ((0, 4, 1), (1, 5, 2), (2, 6, 3), (3, 7, 0)):
+            edges.setdefault(tuple(sorted(c[list(tri)])), []).append(e)
+    free = [k for k, v in edges.items() if len(v) == 1]
+    assert all(len(v) in (1, 2) for v in edges.values())
+    xf = m.nodes[np.array(free).ravel()]
+    assert np.all(xf[:, 2] == 0.0) and np.all((np.abs(np.abs(xf[:, 0]) - Lx / 2) < 1e-12) |
+                                              (np.abs(np.abs(xf[:, 1]) - Ly / 2) < 1e-12))
+    gq, gw = quad9.gauss_legendre(3)
+    XI, ETA = np.meshgrid(gq, gq, indexing="ij")
+    _, jn = quad9.geometry(m.cell_coords(), XI.ravel(), ETA.ravel())
+    area = (np.linalg.norm(jn, axis=-1) * np.outer(gw, gw).ravel()).sum()
+    assert area == pytest.approx(Lx * Ly + 4 * (a + b) * d, rel=1e-12)
+    _, jc = quad9.geometry(m.cell_coords(), np.array([0.0]), np.array([0.0]))
+    n = jc[:, 0] / np.linalg.norm(jc[:, 0], axis=1, keepdims=True)
+    c = m.centres()
+    for g in ("ground", "bottom"):
+        assert np.allclose(n[m.groups[g]], [0, 0, 1], atol=1e-14)
+    w = m.groups["walls"]
+    into_pit = -c[w, :2] / np.linalg.norm(c[w, :2], axis=1, keepdims=True)
+    assert np.all(np.abs(n[w, 2]) < 1e-14) and np.all(np.einsum("ij,ij->i", n[w, :2], into_pit) > 0.5)
+    nodes, ang = m.edges_and_corners()
+    x = m.nodes[nodes]
+    rim_or_bottom = (x[:, 2] == 0.0) | (x[:, 2] == -d)
+    on_pit = (np.abs(x[:, 0]) <= a + 1e-12) & (np.abs(x[:, 1]) <= b + 1e-12)
+    on_wall_edge = (np.abs(np.abs(x[:, 0]) - a) < 1e-12) | (np.abs(np.abs(x[:, 1]) - b) < 1e-12)
+    assert np.all(on_pit & on_wall_edge) and np.all(ang > 89.0)
+    ring = 2 * (2 * a + 2 * b) / (h / 2)                   # nodes around the pit at h/2
+    assert rim_or_bottom.sum() == 2 * ring                  # the rim and the bottom's edge
+    assert len(nodes) == 2 * ring + 4 * (d / (h / 2) - 1)   # and the four vertical corners between
+    with pytest.raises(SSIError, match="must lie in the plane z = 0"):
+        m.require_plane("-ssi_mesh pit", "a reason")
+    with pytest.raises(SSIError, match="pit: need 0 < a < Lx/2"):
+        pit(Lx, Ly, h, Lx, b, d)

@@ -191,6 +191,57 @@ def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
     return SurfaceMesh(nodes, cells, groups, name="grid")
 
 
+def _quad9(corner, du, dv):
+    """The nine nodes (9, 3) of x = corner + (1 + xi)/2 du + (1 + eta)/2 dv (gmsh order; normal du x dv)."""
+    c, du, dv = (np.asarray(v, float) for v in (corner, du, dv))
+    return c + 0.5 * (1 + quad9.NODE_XI[:, :1]) * du + 0.5 * (1 + quad9.NODE_XI[:, 1:]) * dv
+
+
+def pit(Lx, Ly, h, a, b, d):
+    """Structured nine-node mesh of the ground [-Lx/2, Lx/2] x [-Ly/2, Ly/2] (z = 0) with a rectangular
+    excavation [-a, a] x [-b, b] of depth d (a basement's pit, a trench with b = Ly/2 is not this:
+    the pit stays inside the ground): its four vertical walls and its bottom z = -d. Normals point
+    out of the soil: +z on the ground and the bottom, into the pit on the walls (-x on x = a, +x on
+    x = -a, -y on y = b, +y on y = -b). Grid lines pass through x = +-a, y = +-b; the walls take about
+    d/h elements down. Groups: 'ground', 'walls', 'bottom', 'pit' (walls and bottom), 'surface'."""
+    if not (0 < a < Lx / 2 and 0 < b < Ly / 2 and d > 0 and h > 0):
+        raise SSIError(f"pit: need 0 < a < Lx/2, 0 < b < Ly/2, d > 0, h > 0 (got Lx {Lx:g}, Ly {Ly:g}, a {a:g}, "
+                       f"b {b:g}, d {d:g}, h {h:g})")
+    xs, ys, zs = _lines(-Lx / 2, Lx / 2, h, (-a, a)), _lines(-Ly / 2, Ly / 2, h, (-b, b)), _lines(-d, 0.0, h, ())
+    X, kind = [], []
+    for x0, x1 in zip(xs[:-1], xs[1:]):
+        for y0, y1 in zip(ys[:-1], ys[1:]):
+            inside = abs(0.5 * (x0 + x1)) < a and abs(0.5 * (y0 + y1)) < b
+            X.append(_quad9([x0, y0, -d if inside else 0.0], [x1 - x0, 0, 0], [0, y1 - y0, 0]))
+            kind.append("bottom" if inside else "ground")
+    for z0, z1 in zip(zs[:-1], zs[1:]):
+        dz = z1 - z0
+        for y0, y1 in zip(ys[:-1], ys[1:]):
+            if abs(0.5 * (y0 + y1)) < b:
+                X.append(_quad9([a, y0, z0], [0, 0, dz], [0, y1 - y0, 0]))      # -x
+                X.append(_quad9([-a, y0, z0], [0, y1 - y0, 0], [0, 0, dz]))     # +x
+                kind += ["walls", "walls"]
+        for x0, x1 in zip(xs[:-1], xs[1:]):
+            if abs(0.5 * (x0 + x1)) < a:
+                X.append(_quad9([x0, b, z0], [x1 - x0, 0, 0], [0, 0, dz]))      # -y
+                X.append(_quad9([x0, -b, z0], [0, 0, dz], [x1 - x0, 0, 0]))     # +y
+                kind += ["walls", "walls"]
+    X = np.array(X)
+    scale = max(Lx, Ly, d)
+    nodes, inv = np.unique(np.round(X.reshape(-1, 3) / (1e-9 * scale)), axis=0, return_inverse=True)
+    coords = nodes * (1e-9 * scale)
+    for k, lines in enumerate((xs, ys, zs)):        # exactly on the grid's node lines (mid-points too)
+        ln = np.r_[lines, 0.5 * (lines[:-1] + lines[1:])]
+        j = np.abs(coords[:, k, None] - ln[None, :]).argmin(1)
+        on = np.abs(coords[:, k] - ln[j]) <= 1e-8 * scale
+        coords[on, k] = ln[j[on]]
+    kind = np.array(kind)
+    groups = {k: np.nonzero(kind == k)[0] for k in ("ground", "walls", "bottom")}
+    groups["pit"] = np.nonzero(kind != "ground")[0]
+    groups["surface"] = np.arange(len(X))
+    return SurfaceMesh(coords, inv.reshape(-1, 9), groups, name="pit")
+
+
 def read_gmsh(path, params=None, user=()):
     """Read nine-node quads (gmsh type 10) from a .msh, or mesh a .geo first
     (order 2), through the one gmsh reader (``mesh/gmsh.py``).
