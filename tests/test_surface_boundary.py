@@ -102,3 +102,46 @@ def test_a_pit_is_a_closed_conforming_surface_with_normals_out_of_the_soil():
         m.require_plane("-ssi_mesh pit", "a reason")
     with pytest.raises(SSIError, match="pit: need 0 < a < Lx/2"):
         pit(Lx, Ly, h, Lx, b, d)
+
+
+def _normals_by_centre(m):
+    from petsc_ssi.mesh import quad9
+    _, jn = quad9.geometry(m.cell_coords(), np.array([0.0]), np.array([0.0]))
+    n = jn[:, 0] / np.linalg.norm(jn[:, 0], axis=1, keepdims=True)
+    order = np.lexsort(np.round(m.centres(), 9).T)
+    return m.centres()[order], n[order]
+
+
+def test_orientation_out_of_the_soil_is_restored_from_any_element_order():
+    """orient_out_of_soil: a pit whose elements were flipped at random, or all of them, comes back
+    with every normal out of the soil (the grid generator's)."""
+    from petsc_ssi.mesh.surface import pit, orient_out_of_soil, FLIP
+    ref = pit(6.0, 6.0, 1.0, 1.0, 1.5, 1.0)
+    c0, n0 = _normals_by_centre(ref)
+    rng = np.random.default_rng(5)
+    for flip in (rng.random(ref.n_cells) < 0.5, np.ones(ref.n_cells, bool)):
+        m = pit(6.0, 6.0, 1.0, 1.0, 1.5, 1.0)
+        m.cells[flip] = m.cells[flip][:, FLIP]
+        assert not np.allclose(_normals_by_centre(m)[1], n0)
+        orient_out_of_soil(m)
+        c, n = _normals_by_centre(m)
+        assert np.allclose(c, c0) and np.allclose(n, n0, atol=1e-14)
+
+
+def test_the_pit_geo_is_the_grid_generators_pit():
+    """meshes/pit.geo read through gmsh (orientation out of the soil) against surface.pit: the same
+    nodes, the same elements with the same normals, the same groups' sizes."""
+    pytest.importorskip("gmsh")
+    import os
+    from petsc_ssi.mesh.surface import pit, read_gmsh
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    p = dict(Lx=8.0, Ly=6.0, a=2.0, b=1.5, d=2.0, h=1.0)
+    g = read_gmsh(os.path.join(root, "meshes", "pit.geo"), p)
+    ref = pit(p["Lx"], p["Ly"], p["h"], p["a"], p["b"], p["d"])
+    assert (g.n_cells, g.n_nodes) == (ref.n_cells, ref.n_nodes)
+    assert np.allclose(np.unique(np.round(g.nodes, 9), axis=0), np.unique(np.round(ref.nodes, 9), axis=0))
+    cg, ng = _normals_by_centre(g)
+    cr, nr = _normals_by_centre(ref)
+    assert np.allclose(cg, cr, atol=1e-9) and np.allclose(ng, nr, atol=1e-9)
+    assert {k: len(g.groups[k]) for k in ("ground", "walls", "bottom", "pit")} == \
+        {k: len(ref.groups[k]) for k in ("ground", "walls", "bottom", "pit")}

@@ -270,11 +270,66 @@ def read_gmsh(path, params=None, user=()):
     remap = -np.ones(len(coords), np.int64)
     remap[used] = np.arange(len(used))
     mesh = SurfaceMesh(coords[used], remap[conn], groups, name=path)
+    if not mesh.in_plane():
+        return orient_out_of_soil(mesh)
     # gmsh may orient surfaces with normal -z; the half-space needs +z
     X = mesh.cell_coords()
     _, jn = quad9.geometry(X, np.array([0.0]), np.array([0.0]))
     flip = jn[:, 0, 2] < 0
     if flip.any():
-        perm = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])
-        mesh.cells[flip] = mesh.cells[flip][:, perm]
+        mesh.cells[flip] = mesh.cells[flip][:, FLIP]
+    return mesh
+
+
+FLIP = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])      # a nine-node element's nodes with its normal reversed
+
+
+def orient_out_of_soil(mesh):
+    """Orient every element of a surface that is not a plane (an excavation's walls and bottom) out
+    of the soil: consistently across shared edges (two neighbours run their shared edge in opposite
+    directions; breadth-first from each element not yet reached), then each connected piece so that
+    its highest elements (the ground) face +z. SSIError for a surface that cannot be oriented (a
+    Moebius strip, an edge of three elements). Returns the mesh, its cells reordered in place."""
+    cells = mesh.cells
+    owners = {}
+    for e, c in enumerate(cells):
+        for k in range(4):
+            p, q = int(c[k]), int(c[(k + 1) % 4])
+            owners.setdefault((min(p, q), max(p, q)), []).append(e)
+    if any(len(v) > 2 for v in owners.values()):
+        raise SSIError(f"{mesh.name}: an element edge is shared by more than two elements: not a surface")
+
+    def runs(e, p, q):           # whether element e runs its edge p -> q
+        c = [int(v) for v in cells[e, :4]]
+        k = c.index(p)
+        return c[(k + 1) % 4] == q
+
+    seen = np.zeros(len(cells), bool)
+    z = mesh.centres()[:, 2]
+    for start in range(len(cells)):
+        if seen[start]:
+            continue
+        seen[start] = True
+        piece, todo = [start], [start]
+        while todo:
+            e = todo.pop()
+            c = cells[e]
+            for k in range(4):
+                p, q = int(c[k]), int(c[(k + 1) % 4])
+                for f in owners[(min(p, q), max(p, q))]:
+                    if f == e:
+                        continue
+                    if not seen[f]:
+                        if runs(f, p, q):
+                            cells[f] = cells[f][FLIP]
+                        seen[f] = True
+                        piece.append(f)
+                        todo.append(f)
+                    elif runs(f, p, q):
+                        raise SSIError(f"{mesh.name}: the surface cannot be oriented (elements {e} and {f})")
+        piece = np.array(piece)
+        _, jn = quad9.geometry(mesh.cell_coords()[piece], np.array([0.0]), np.array([0.0]))
+        top = z[piece] >= z[piece].max() - 1e-9 * max(1.0, float(np.abs(z).max()))
+        if jn[top, 0, 2].sum() < 0:
+            cells[piece] = cells[piece][:, FLIP]
     return mesh
