@@ -75,10 +75,22 @@ def _pair_window(xc, X, c, R, h, reach, alpha, beta, dt, L, lag_lo, toff, tol, n
 
 
 @njit(cache=True)
-def _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u, toff, h_ref,
-               Ub, Pb, Us, Ps):
-    """Element integrals of one pair into Ub, Pb[:hi-lo+1] (the static singular part added at the
-    first lag of a singular pair); returns the kernel evaluations."""
+def buffers(L, sP, sU):
+    """The scratch of a pair's integrals (``bufs`` of ``_pair_integrals``): full blocks of L lags Ub,
+    Pb (L, 9, 3, 3), the static singular parts Us, Ps (9, 3, 3), compacted Pc (L sP), Uc (L sU)."""
+    return (np.zeros((L, 9, 3, 3)), np.zeros((L, 9, 3, 3)), np.zeros((9, 3, 3)), np.zeros((9, 3, 3)),
+            np.zeros(L * sP), np.zeros(L * sU))
+
+
+@njit(cache=True)
+def _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quadr, bufs):
+    """Element integrals of one pair into Ub, Pb[:hi-lo+1] of ``bufs`` (the static singular part
+    added at the first lag of a singular pair); returns the kernel evaluations. Packs: ``phys`` =
+    (dt, alpha, beta, rho, nu, mu, toff) (the step and the material), ``quadr`` = (ns_base, gq, gw,
+    gr, gwr, h_ref) (the quadrature), ``bufs`` from ``buffers``."""
+    dt, alpha, beta, rho, nu, mu, toff = phys
+    _, gq, gw, gr, gwr, h_ref = quadr
+    Ub, Pb, Us, Ps, _, _ = bufs
     nl = hi - lo + 1
     Ub[:nl] = 0.0
     Pb[:nl] = 0.0
@@ -120,13 +132,16 @@ def plane(flat, VX, ns, gq, gw, ns_max):
 
 
 @njit(cache=True)
-def _pair_integrals(xc, v, X, sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u,
-                    toff, h_ref, Ub, Pb, Us, Ps, plane, pattern, dH, dG, Pc, Uc):
+def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quadr, bufs, plane, pattern, dH, dG):
     """A pair's integrals of lags lo..hi in the patterns' layout (``_compact``): Pc[:9 m_H nl] and, with
     ``want_u``, Uc[:9 m_G nl]. A regular pair of the plane z = 0 (``plane``'s flag) by
     ``integrate_plane`` (the pattern's entries only; the element's geometry from ``plane`` at the base
     subdivisions, else computed into its scratch), any other by ``_integrate`` (the full blocks, the
-    entries a flat pattern drops checked into dH, dG, then compacted). Returns the kernel evaluations."""
+    entries a flat pattern drops checked into dH, dG, then compacted). Returns the kernel evaluations.
+    Packs as ``_integrate``'s; Pc, Uc are ``bufs``' last two."""
+    dt, alpha, beta, rho, _, _, toff = phys
+    ns_base, gq, gw, _, _, _ = quadr
+    Ub, Pb, _, _, Pc, Uc = bufs
     hp, hq, gp, gq_, hkeep, gkeep = pattern
     mH, mG = hp.shape[0], gp.shape[0]
     nl = hi - lo + 1
@@ -144,8 +159,7 @@ def _pair_integrals(xc, v, X, sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, al
         plane_points(X, ns, gq, gw, ssub[:m], spts[:m * ng2], sN[:m * ng2])
         return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, dt, alpha, beta, rho, P, U,
                                want_u, toff)
-    nev = _integrate(xc, X, sing, ns, gq, gw, gr, gwr, lo, hi, dt, alpha, beta, rho, nu, mu, want_u, toff, h_ref,
-                     Ub, Pb, Us, Ps)
+    nev = _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quadr, bufs)
     if mH < 9:
         _check_dropped(Pb, nl, hkeep, dH)
     _compact(Pc, 0, Pb, nl, hp, hq)
@@ -472,23 +486,16 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     hp, hq, gp, gq_, hkeep, gkeep = pattern
     mH, mG = hp.shape[0], gp.shape[0]
     sP, sU = 9 * mH, 9 * mG                    # doubles a lag slot of the P (H) and U (G) pools
-    smax = max(sP, sU)
     pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG = work
-    dH = dropped[0:1]
-    dG = dropped[1:2]
-    mu = rho * beta * beta
-    nv = VX.shape[0]
-    Ub = np.zeros((L, 9, 3, 3))
-    Pb = np.zeros((L, 9, 3, 3))
-    Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
-    Pc = np.zeros(L * sP)
-    Uc = np.zeros(L * sU)
+    phys = (dt, alpha, beta, rho, nu, rho * beta * beta, toff)
+    quadr = (ns_base, gq, gw, gr, gwr, h_ref)
+    bufs = buffers(L, sP, sU)
     nev = 0
     hits = 0
     ncache = len(cidx)
     pool_n, upool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
-    reach = alpha * (dt * L + toff)
+    nv = VX.shape[0]
     sgH = np.empty((nv, mH))                    # an element's image sign of each pattern entry's column
     sgG = np.empty((nv, mG))
     for v in range(nv):
@@ -498,109 +505,149 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
             sgG[v, j] = Vsign[v, gq_[j]]
     for ii in range(rows.shape[0]):
         i = rows[ii]
-        xc = xnodes[i]
-        npair = 0
-        sc_n = 0
-        # the row's pairs: pairs[k] = (element, lo, hi, want_u, where (0: cache pools, 1: scratch), P slot,
-        # U slot)
-        for v in range(nv):
-            lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
-                                            toff, tol, ns_base, ns_max, near_factor)
-            if lo > hi:
-                continue
-            want_u = False
-            for a in range(9):
-                if Vtcol[v, a] >= 0:
-                    want_u = True
-            nl = hi - lo + 1
-            found, fill_u, hsh = _cached(use_cache, cidx, ckeys, cmeta, VX[v], xc, qinv, key, lo, hi, want_u)
-            where = 0
-            offU = 0
-            if found >= 0:
-                off = cmeta[found, 2]
-                offU = cmeta[found, 4]
-                hits += 1
-            else:
-                nev += _pair_integrals(xc, v, VX[v], sing, ns, ns_base, gq, gw, gr, gwr, lo, hi, dt, alpha, beta,
-                                       rho, nu, mu, want_u, toff, h_ref, Ub, Pb, Us, Ps, plane, pattern, dH, dG, Pc,
-                                       Uc)
-                if fill_u >= 0:                 # complete the entry with its U blocks
-                    off = cmeta[fill_u, 2]
-                    while (upool_n + nl) * sU > cpoolU.shape[0]:
-                        cpoolU = _grow(cpoolU, cpoolU.shape[0])
-                    cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
-                    cmeta[fill_u, 3] = 1
-                    cmeta[fill_u, 4] = upool_n
-                    offU = upool_n
-                    upool_n += nl
-                elif use_cache and hsh not in cidx and 8 * (pool_n + nl) * smax <= cache_max:
-                    c = ncache
-                    ckeys = _grow(ckeys, c)
-                    cmeta = _grow(cmeta, c)
-                    while (pool_n + nl) * sP > cpoolP.shape[0]:
-                        cpoolP = _grow(cpoolP, cpoolP.shape[0])
-                    ckeys[c] = key
-                    cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
-                    cmeta[c, 3] = 1 if want_u else 0
-                    cpoolP[pool_n * sP:(pool_n + nl) * sP] = Pc[:nl * sP]
-                    if want_u:
-                        while (upool_n + nl) * sU > cpoolU.shape[0]:
-                            cpoolU = _grow(cpoolU, cpoolU.shape[0])
-                        cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
-                        cmeta[c, 4] = upool_n
-                        offU = upool_n
-                        upool_n += nl
-                    off = pool_n
-                    pool_n += nl
-                    cidx[hsh] = c
-                    ncache += 1
-                else:                           # no cache (or full): the row's scratch
-                    while (sc_n + nl) * sP > scP.shape[0]:
-                        scP = _grow(scP, scP.shape[0])
-                    while (sc_n + nl) * sU > scU.shape[0]:
-                        scU = _grow(scU, scU.shape[0])
-                    scP[sc_n * sP:(sc_n + nl) * sP] = Pc[:nl * sP]
-                    if want_u:
-                        scU[sc_n * sU:(sc_n + nl) * sU] = Uc[:nl * sU]
-                    where = 1
-                    off = sc_n
-                    offU = sc_n
-                    sc_n += nl
-            pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
-            pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
-            pairs[npair, 6] = offU
-            npair += 1
-        # lag by lag: the row's blocks summed by column, then written where they are kept
-        li = loc[i]
-        for lag in range(lag_lo, L + 1):
-            nH = 0
-            nG = 0
-            for k in range(npair):
-                lo = pairs[k, 1]
-                if lag < lo or lag > pairs[k, 2]:
-                    continue
-                v = pairs[k, 0]
-                slot = pairs[k, 5] + (lag - lo)
-                srcP = scP if pairs[k, 4] == 1 else cpoolP
-                if mH == 4:                     # the flat pattern: a constant width, loops unrolled
-                    nH = _accumulate(srcP, slot * sP, 4, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
-                else:
-                    nH = _accumulate(srcP, slot * sP, mH, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
-                if pairs[k, 3] == 1:
-                    srcU = scU if pairs[k, 4] == 1 else cpoolU
-                    if mG == 5:
-                        nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, 5, Vtcol[v], sgG[v], bufG,
-                                         touchG, lstG, nG, False)
-                    else:
-                        nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], sgG[v], bufG,
-                                         touchG, lstG, nG, False)
-            if nH:
-                cl = _ordered(lstH, nH, touchH)
-                _emit_lag(lag, nH, cl, bufH, li, hout)
-            if nG:
-                cl = _ordered(lstG, nG, touchG)
-                _emit_lag(lag, nG, cl, bufG, li, gout)
+        store = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, 0)
+        npair, n_ev, n_hit, store = _row_pairs(xnodes[i], mesh, wave, quad, pattern, plane, use_cache, cidx, qinv,
+                                               key, dropped, phys, quadr, bufs, cache_max, pairs, store)
+        ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, _ = store
+        nev += n_ev
+        hits += n_hit
+        _row_blocks(loc[i], npair, pairs, lag_lo, L, Vnode, Vtcol, sgH, sgG, mH, mG, scP, scU, cpoolP, cpoolU,
+                    (bufH, bufG, touchH, touchG, lstH, lstG), hout, gout)
     return ((pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG), nev, hits, ckeys, cmeta, cpoolP, cpoolU)
+
+
+@njit(cache=True)
+def _row_pairs(xc, mesh, wave, quad, pattern, plane, use_cache, cidx, qinv, key, dropped, phys, quadr, bufs,
+               cache_max, pairs, store):
+    """The pairs (collocation point xc, virtual element) of one row whose wave window reaches lags
+    lag_lo..L, listed in ``pairs`` (element, lo, hi, want_u, where (0: cache pools, 1: scratch), P slot,
+    U slot) with their integrals found in the cache or integrated now and stored (``_store_pair``).
+    Returns (pairs listed, kernel evaluations, cache hits, ``store`` updated)."""
+    _, VX, _, _, Vtcol, Vc, VR, Vh = mesh
+    L, dt, alpha, beta, _, _, lag_lo, toff = wave
+    ns_base, near_factor, ns_max, _, _, _, _, tol, _ = quad
+    sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]
+    Pc, Uc = bufs[4], bufs[5]
+    reach = alpha * (dt * L + toff)
+    npair = nev = hits = 0
+    for v in range(VX.shape[0]):
+        lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
+                                        toff, tol, ns_base, ns_max, near_factor)
+        if lo > hi:
+            continue
+        want_u = False
+        for a in range(9):
+            if Vtcol[v, a] >= 0:
+                want_u = True
+        nl = hi - lo + 1
+        found, fill_u, hsh = _cached(use_cache, cidx, store[0], store[1], VX[v], xc, qinv, key, lo, hi, want_u)
+        where = 0
+        if found >= 0:
+            off = store[1][found, 2]
+            offU = store[1][found, 4]
+            hits += 1
+        else:
+            nev += _pair_integrals(xc, v, VX[v], sing, ns, lo, hi, want_u, phys, quadr, bufs, plane, pattern,
+                                   dropped[0:1], dropped[1:2])
+            store, where, off, offU = _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc,
+                                                  sP, sU, cache_max, store)
+        pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
+        pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
+        pairs[npair, 6] = offU
+        npair += 1
+    return npair, nev, hits, store
+
+
+@njit(cache=True)
+def _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc, sP, sU, cache_max, store):
+    """Where a pair's freshly integrated blocks (Pc, Uc) go: into the cache entry ``fill_u`` (its U
+    blocks), a new cache entry while the pools stay under ``cache_max`` bytes, or else the row's
+    scratch. ``store`` = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, sc_n).
+    Returns (``store`` updated, where (0: cache pools, 1: scratch), P slot, U slot)."""
+    ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, sc_n = store
+    where = 0
+    offU = 0
+    if fill_u >= 0:                         # complete the entry with its U blocks
+        off = cmeta[fill_u, 2]
+        while (upool_n + nl) * sU > cpoolU.shape[0]:
+            cpoolU = _grow(cpoolU, cpoolU.shape[0])
+        cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
+        cmeta[fill_u, 3] = 1
+        cmeta[fill_u, 4] = upool_n
+        offU = upool_n
+        upool_n += nl
+    elif use_cache and hsh not in cidx and 8 * (pool_n + nl) * max(sP, sU) <= cache_max:
+        c = ncache
+        ckeys = _grow(ckeys, c)
+        cmeta = _grow(cmeta, c)
+        while (pool_n + nl) * sP > cpoolP.shape[0]:
+            cpoolP = _grow(cpoolP, cpoolP.shape[0])
+        ckeys[c] = key
+        cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
+        cmeta[c, 3] = 1 if want_u else 0
+        cpoolP[pool_n * sP:(pool_n + nl) * sP] = Pc[:nl * sP]
+        if want_u:
+            while (upool_n + nl) * sU > cpoolU.shape[0]:
+                cpoolU = _grow(cpoolU, cpoolU.shape[0])
+            cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
+            cmeta[c, 4] = upool_n
+            offU = upool_n
+            upool_n += nl
+        off = pool_n
+        pool_n += nl
+        cidx[hsh] = c
+        ncache += 1
+    else:                                   # no cache (or full): the row's scratch
+        while (sc_n + nl) * sP > scP.shape[0]:
+            scP = _grow(scP, scP.shape[0])
+        while (sc_n + nl) * sU > scU.shape[0]:
+            scU = _grow(scU, scU.shape[0])
+        scP[sc_n * sP:(sc_n + nl) * sP] = Pc[:nl * sP]
+        if want_u:
+            scU[sc_n * sU:(sc_n + nl) * sU] = Uc[:nl * sU]
+        where = 1
+        off = sc_n
+        offU = sc_n
+        sc_n += nl
+    return (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, sc_n), where, off, offU
+
+
+@njit(cache=True)
+def _row_blocks(li, npair, pairs, lag_lo, L, Vnode, Vtcol, sgH, sgG, mH, mG, scP, scU, cpoolP, cpoolU, rowbuf,
+                hout, gout):
+    """Lag by lag, one row's blocks summed by column from its ``pairs`` (in element order: the sums
+    of a block are those of the literal loop, bit for bit) and written where they are kept (row
+    ``li`` of the rank's rows); ``rowbuf`` = (bufH, bufG, touchH, touchG, lstH, lstG)."""
+    bufH, bufG, touchH, touchG, lstH, lstG = rowbuf
+    sP, sU = 9 * mH, 9 * mG
+    for lag in range(lag_lo, L + 1):
+        nH = 0
+        nG = 0
+        for k in range(npair):
+            lo = pairs[k, 1]
+            if lag < lo or lag > pairs[k, 2]:
+                continue
+            v = pairs[k, 0]
+            slot = pairs[k, 5] + (lag - lo)
+            srcP = scP if pairs[k, 4] == 1 else cpoolP
+            if mH == 4:                     # the flat pattern: a constant width, loops unrolled
+                nH = _accumulate(srcP, slot * sP, 4, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
+            else:
+                nH = _accumulate(srcP, slot * sP, mH, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
+            if pairs[k, 3] == 1:
+                srcU = scU if pairs[k, 4] == 1 else cpoolU
+                if mG == 5:
+                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, 5, Vtcol[v], sgG[v], bufG,
+                                     touchG, lstG, nG, False)
+                else:
+                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], sgG[v], bufG,
+                                     touchG, lstG, nG, False)
+        if nH:
+            cl = _ordered(lstH, nH, touchH)
+            _emit_lag(lag, nH, cl, bufH, li, hout)
+        if nG:
+            cl = _ordered(lstG, nG, touchG)
+            _emit_lag(lag, nG, cl, bufG, li, gout)
 
 
 # ---------------------------------------------------------------------------
@@ -679,20 +726,17 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
         uoff[r + 1] = uoff[r] + (nl * sU if meta[r, 4] == 1 else 0)
     P = np.zeros(off[m])
     U = np.zeros(uoff[m])
-    mu = rho * beta * beta
-    Ub = np.zeros((L, 9, 3, 3))
-    Pb = np.zeros((L, 9, 3, 3))
-    Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
-    Pc = np.zeros(L * sP)
-    Uc = np.zeros(L * sU)
+    phys = (dt, alpha, beta, rho, nu, rho * beta * beta, toff)
+    quadr = (ns_base, gq, gw, gr, gwr, h_ref)
+    bufs = buffers(L, sP, sU)
+    Pc, Uc = bufs[4], bufs[5]
     nev = 0
     for r in range(m):
         lo, hi = meta[r, 0], meta[r, 1]
         nl = hi - lo + 1
         v = meta[r, 5]
-        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], ns_base, gq, gw, gr, gwr, lo, hi, dt,
-                               alpha, beta, rho, nu, mu, meta[r, 4] == 1, toff, h_ref, Ub, Pb, Us, Ps, plane,
-                               pattern, dropped[0:1], dropped[1:2], Pc, Uc)
+        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], lo, hi, meta[r, 4] == 1, phys, quadr,
+                               bufs, plane, pattern, dropped[0:1], dropped[1:2])
         P[off[r]:off[r] + nl * sP] = Pc[:nl * sP]
         if meta[r, 4] == 1:
             U[uoff[r]:uoff[r] + nl * sU] = Uc[:nl * sU]

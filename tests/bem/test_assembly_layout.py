@@ -43,6 +43,7 @@ def _literal(ls):
     H = np.zeros((L + 1, N, N, 3, 3)); G = np.zeros((L + 1, N, nt, 3, 3))
     hm = np.zeros((L + 1, N, N), bool); gm = np.zeros((L + 1, N, nt), bool)
     Ub = np.zeros((L, 9, 3, 3)); Pb = np.zeros((L, 9, 3, 3)); Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
+    Pc = Uc = np.zeros(0)                                   # (the compacted blocks: not used here)
     reach = m.cp * ls.dt * L
     for i in ls.rows:
         xc = ls.mesh.nodes[i]
@@ -53,8 +54,8 @@ def _literal(ls):
             if lo > hi:
                 continue
             want_u = bool((ls.VT[v] >= 0).any())
-            _integrate(xc, ls.VX[v], sing, ns, gq, gw, gr, gwr, lo, hi, ls.dt, m.cp, m.cs, m.rho, m.nu, m.mu, want_u,
-                       0.0, float(ls.Vh.min()), Ub, Pb, Us, Ps)
+            _integrate(xc, ls.VX[v], sing, ns, lo, hi, want_u, (ls.dt, m.cp, m.cs, m.rho, m.nu, m.mu, 0.0),
+                       (o["subdivisions"], gq, gw, gr, gwr, float(ls.Vh.min())), (Ub, Pb, Us, Ps, Pc, Uc))
             for li in range(hi - lo + 1):
                 for a in range(9):
                     if np.any(Pb[li, a] != 0.0):
