@@ -29,6 +29,13 @@ def main():
 
 def _damping_note(cfg, freqs):
     flex = freqs[freqs > 1e-6 * max(freqs.max(), 1e-300)]
+    from ..fem.options import damping, rayleigh_zeta
+    a0, a1, note = damping(cfg)
+    if (a0 > 0 or a1 > 0) and flex.size:            # every mode's ratio of the damping a run would take
+        printf(f"[modes] {note}: damping ratio of each flexible mode: "
+               + ", ".join(f"{k + 1}: {float(z):.4g}" for k, z in
+                           zip(range(len(freqs)), rayleigh_zeta(a0, a1, np.where(freqs > 0, freqs, np.inf)))
+                           if freqs[k] in flex))
     if cfg.fem_damping_ratio > 0 and flex.size:
         f1 = flex[0]
         printf(f"[modes] zeta = {cfg.fem_damping_ratio:g} at the first flexible mode f = {f1:.6g} Hz: "

@@ -213,7 +213,8 @@ class SSITransient(TransientProblem):
         res = self.results()
         res["_outputs"] = (self.out, self.sout)
         res["stats"] = {"steps_done": self.n}
-        write_results(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False)
+        write_results(self.cfg, self.comm, self.prob, self.model, self.iface, res, self.am, status=status, final=False,
+                      a1=self.integ.a1)
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
@@ -231,7 +232,8 @@ class SSITransient(TransientProblem):
                  "capacitance_factor_s": coupler.solver_cap().t_factor, "contact_algebra_s": law.t_algebra,
                  "cycled_steps": law.cycled_steps, "interface_nodes": self.iface.n, "lags": prob.L,
                  "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
-                 "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am}
+                 "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am,
+                 "rayleigh_a1": self.integ.a1}
         from ..sysmem import peak_rss
         stats["peak_rss_max_rank_bytes"], stats["peak_rss_sum_bytes"] = peak_rss(comm)
         res["stats"] = stats
@@ -242,7 +244,8 @@ class SSITransient(TransientProblem):
                    f"({fmt_time(coupler.solver_cap().t_factor)}), active-set algebra {fmt_time(law.t_algebra)} in "
                    f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
                    "factorisation of the BEM step matrix")
-        write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status())
+        write_results(cfg, comm, prob, self.model, self.iface, res, self.am, status=self.final_status(),
+                      a1=self.integ.a1)
         self.integ.destroy()
         self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
@@ -250,14 +253,21 @@ class SSITransient(TransientProblem):
         return res
 
 
+def damping_attrs(am, a1):
+    """The structure's damping as output attributes (the glance reports it)."""
+    from ..fem.problem import damping_attrs as da
+    return da(am, a1)
+
+
 def structure_output_path(path):
     stem, ext = os.path.splitext(path)
     return stem + "_structure" + (ext or ".h5")
 
 
-def write_results(cfg, comm, prob, model, iface, res, am, status="completed", final=True):
+def write_results(cfg, comm, prob, model, iface, res, am, status="completed", final=True, a1=0.0):
     """Collective: both outputs (soil with the interface series, structure) with receivers,
-    attributes and the run record; ``final``: close them (else flush: readable, still open)."""
+    attributes and the run record; ``final``: close them (else flush: readable, still open).
+    ``am``, ``a1``: the structure's damping C = am M + a1 K."""
     out, sout = res.pop("_outputs")
     attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
              "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
@@ -280,8 +290,8 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
         sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
-        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "alpha_m": am,
-                                                                      "dt": cfg.dt}, record=None, status=status,
+        (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "dt": cfg.dt,
+                                                                      **damping_attrs(am, a1)}, record=None, status=status,
                                               groups=sgroups)
 
 

@@ -130,7 +130,8 @@ class FEMTransient(TransientProblem):
             from ..io.demands import Demands
             sup = self.support                    # the base moves with the ground: its inertia m a_g
             ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
-            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
+            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground,
+                                                a1=self.integ.a1))
         self.integ.start(f0=self.load(0))
         if rd is None:
             self.rec.structure.record(self.time(0), self.integ.u, self.integ.velocity(self.vel),
@@ -202,7 +203,7 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
         return
     t, u = srec.rec.arrays()
     receivers = srec.receivers() if comm.getRank() == 0 else None
-    groups, attrs = {}, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+    groups, attrs = {}, {"problem": "fem", "dt": cfg.dt, **damping_attrs(am, integ.a1)}
     if demands is not None and comm.getRank() == 0:
         groups["demands"] = demands.group()
     if support is not None:
@@ -212,12 +213,12 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
         if receivers is not None and "acceleration" in receivers:
             receivers["ground_acceleration"] = ground(receivers["t"])
             receivers["absolute_acceleration"] = receivers["acceleration"] + receivers["ground_acceleration"][:, None, :]
-    extra = {"fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
+    extra = {"fem": {"alpha_m": am, "rayleigh_a1": integ.a1, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                      "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
                      "elements": model.mesh.element_counts(),
                      "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
     if cfg.fem_integrator == "green":
-        extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
+        extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta, integ.a1)
     with event("FEM_io"):
         (out.close if final else out.flush)(receivers=receivers, attrs=attrs, groups=groups or None,
                                             record=provenance(cfg, comm, extra), status=status)
@@ -226,6 +227,13 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
     if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
         _plot(cfg.output, t, u)
     printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
+
+
+def damping_attrs(am, a1):
+    """Output attributes of the structure's damping C = alpha_m M + rayleigh_a1 K."""
+    return {"alpha_m": float(am), "rayleigh_a1": float(a1),
+            "damping": "C = alpha_m M + rayleigh_a1 K (Rayleigh; alpha_m in 1/s, rayleigh_a1 in s); damping ratio "
+                       "of a mode of frequency f: alpha_m/(2 omega) + rayleigh_a1 omega/2, omega = 2 pi f"}
 
 
 def _plot(path, t, u):
