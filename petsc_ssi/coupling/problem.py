@@ -259,6 +259,11 @@ def damping_attrs(am, a1):
     return da(am, a1)
 
 
+def _mass(model, comm):
+    from ..fem.problem import structure_mass
+    return structure_mass(model, comm)
+
+
 def structure_output_path(path):
     stem, ext = os.path.splitext(path)
     return stem + "_structure" + (ext or ".h5")
@@ -291,7 +296,8 @@ def write_results(cfg, comm, prob, model, iface, res, am, status="completed", fi
             srecd = receiver_record(model, res["structure"])
         sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
         (sout.close if final else sout.flush)(receivers=srecd, attrs={"problem": "ssi-structure", "dt": cfg.dt,
-                                                                      **damping_attrs(am, a1)}, record=None, status=status,
+                                                                      **damping_attrs(am, a1),
+                                                                      "structure_mass": _mass(model, comm)}, record=None, status=status,
                                               groups=sgroups)
 
 

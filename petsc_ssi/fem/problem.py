@@ -203,7 +203,8 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
         return
     t, u = srec.rec.arrays()
     receivers = srec.receivers() if comm.getRank() == 0 else None
-    groups, attrs = {}, {"problem": "fem", "dt": cfg.dt, **damping_attrs(am, integ.a1)}
+    groups, attrs = {}, {"problem": "fem", "dt": cfg.dt, **damping_attrs(am, integ.a1),
+                         "structure_mass": structure_mass(model, comm)}
     if demands is not None and comm.getRank() == 0:
         groups["demands"] = demands.group()
     if support is not None:
@@ -227,6 +228,16 @@ def _close_output(cfg, out, model, srec, comm, am, n_steps, integ, status="compl
     if cfg.plot and comm.getRank() == 0 and len(model.receiver_nodes):
         _plot(cfg.output, t, u)
     printf(f"[fem] wrote {cfg.output} (+ .xmf, .json)")
+
+
+def structure_mass(model, comm):
+    """Collective: the structure's mass [kg] (the lumped masses of the x translations of every node, the
+    base's included; of the modelled part of a half model): W = m g is the weight of post --demands' V/W."""
+    dm = model.dofmap
+    d = dm.translation_dofs(np.arange(model.mesh.n_nodes))[:, 0]
+    r0, r1 = model.m.getOwnershipRange()
+    d = d[(d >= r0) & (d < r1)] - r0
+    return float(comm.tompi4py().allreduce(float(model.m.getArray(readonly=True)[d].sum())))
 
 
 def damping_attrs(am, a1):
