@@ -187,7 +187,8 @@ FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "1,1,3", "-ssi_fem_box_size"
 
 def test_coefficients_and_frequencies_give_the_same_run(tmp_path):
     """-ssi_fem_rayleigh a0,a1 (the formulas' values written with repr) == -ssi_fem_rayleigh_freqs/_ratios,
-    bit for bit; the log line names the damping; the output records it (alpha_m, rayleigh_a1)."""
+    bit for bit; the log line names the damping; the output records it (alpha_m, rayleigh_a1); -n 2 == -n 1
+    to 1e-10."""
     import h5py
     from petsc_ssi.fem.options import rayleigh_from_ratios
     a0, a1 = rayleigh_from_ratios(2.0, 10.0, 0.05, 0.04)
@@ -197,7 +198,12 @@ def test_coefficients_and_frequencies_give_the_same_run(tmp_path):
     assert "Rayleigh damping C = a0 M + a1 K, zeta 0.05 at 2 Hz and 0.04 at 10 Hz" in r1.stdout
     r2 = run_cli(FEM + ["-ssi_fem_rayleigh", f"{a0!r},{a1!r}", "-ssi_output", str(tmp_path / "c.h5")])
     assert r2.returncode == 0, r2.stdout + r2.stderr
-    with h5py.File(tmp_path / "f.h5", "r") as f, h5py.File(tmp_path / "c.h5", "r") as g:
+    r3 = run_cli(FEM + ["-ssi_fem_rayleigh", f"{a0!r},{a1!r}", "-ssi_output", str(tmp_path / "n2.h5")], n=2)
+    assert r3.returncode == 0, r3.stdout + r3.stderr
+    with h5py.File(tmp_path / "f.h5", "r") as f, h5py.File(tmp_path / "c.h5", "r") as g, \
+            h5py.File(tmp_path / "n2.h5", "r") as h:
         assert np.array_equal(f["receivers/u"][()], g["receivers/u"][()])
         assert f.attrs["alpha_m"] == a0 and f.attrs["rayleigh_a1"] == a1
-        assert np.abs(f["receivers/u"][()]).max() > 0
+        u = f["receivers/u"][()]
+        assert np.abs(u).max() > 0
+        assert np.abs(h["receivers/u"][()] - u).max() <= 1e-10 * np.abs(u).max()          # -n 2 == -n 1
