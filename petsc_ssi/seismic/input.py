@@ -132,8 +132,15 @@ def read_motions(cfg):
     def proc(rec, scale):
         return process(rec, scale=scale, window=_window(c.seismic_window), taper=c.seismic_taper,
                        baseline=c.seismic_baseline, highpass=c.seismic_highpass)
+    from .scaling import check_units, parse_target, target_factor         # issue 43: units, target
+    target = parse_target(c.get("seismic_target", "none"))
     for axis, rec in recs.items():
-        m = proc(rec, c.seismic_scale)
+        if target is None:
+            m = proc(rec, c.seismic_scale)
+        else:                          # processed again with the target's factor: its warnings then
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RecordWarning)
+                m = proc(rec, c.seismic_scale)
         if m.duration < c.dt:
             raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
                            f"dt = {c.dt:g} s")
@@ -142,10 +149,8 @@ def read_motions(cfg):
         srcs = sorted({str(m.source) for m in out.values()})
         raise SSIError(f"record '{', '.join(srcs)}': its acceleration is zero everywhere after processing: no motion "
                        "to apply")
-    from .scaling import check_units, parse_target, target_factor         # issue 43: units, target
     if c.get("seismic_units_check", True):
         check_units(out, c.seismic_units)
-    target = parse_target(c.get("seismic_target", "none"))
     if target is not None:
         f, line = target_factor(out, target, c.seismic_target_damping)
         out = {axis: proc(rec, c.seismic_scale * f) for axis, rec in recs.items()}
