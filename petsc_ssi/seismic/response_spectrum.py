@@ -572,8 +572,11 @@ def _exact_rotd(t, acc2, omega, zeta, cs, oversample=1):
     min(E_i, E_i+1) + h max |a_g| beats the smallest angle's running peak; then for each angle whose
     peak it can beat, the zeros of the projected velocity in the step's quarter-period pieces are found
     by bisection on the two components' closed forms."""
-    P, n = omega.size, cs.shape[1]
-    peak = np.zeros((P, n))                                    # |omega y0_theta| = |omega^2 u_theta|
+    P, n_ang = omega.size, cs.shape[1]
+    if not np.allclose(cs, [np.cos(np.arange(n_ang) * np.pi / n_ang), np.sin(np.arange(n_ang) * np.pi / n_ang)],
+                       rtol=0, atol=1e-14):
+        raise SpectrumInputError("_exact_rotd needs the angles j pi / n (rotd's grid)")
+    peak = np.zeros((P, n_ang))                                # |omega y0_theta| = |omega^2 u_theta|
     prev0, prev1 = np.zeros((2, P)), np.zeros((2, P))
     n0, k = 0, oversample
     for y0, y1 in _march(t, acc2, omega, zeta, k):
@@ -603,7 +606,6 @@ def _exact_rotd(t, acc2, omega, zeta, cs, oversample=1):
             continue
         st = [_at_pieces(s0[r, c, p], s1[r, c, p], g0[r, c], g1[r, c], h[r], omega[p], zeta[p]) for c in (0, 1)]
         S = st[0][0]                                                             # (N, M + 1)
-        vel = np.stack([st[0][2], st[1][2]], axis=-1) @ cs                       # (N, M + 1, n): the sign of q'
         E2 = np.sqrt(st[0][1] ** 2 + st[0][2] ** 2 + st[1][1] ** 2 + st[1][2] ** 2)     # (N, M + 1)
         gp = np.maximum(np.hypot(st[0][3], st[1][3])[:, :-1], np.hypot(st[0][3], st[1][3])[:, 1:])
         hg = np.diff(S, axis=1) * gp
@@ -615,11 +617,28 @@ def _exact_rotd(t, acc2, omega, zeta, cs, oversample=1):
         ds_ = np.diff(S, axis=1)
         Emax = np.maximum(E2[:, :-1], E2[:, 1:]) + ds_ * gp
         rise = 0.5 * w_ ** 2 * (gp + w_ * (1 + 2 * zeta[p][:, None]) * Emax) * (0.5 * ds_) ** 2       # (N, M)
-        proj = np.abs(np.stack([st[0][1], st[1][1]], axis=-1) @ cs) * w_[:, :, None]                 # (N, M + 1, n)
-        reach = np.maximum(proj[:, :-1], proj[:, 1:]) + rise[:, :, None]
-        cand = (vel[:, :-1] * vel[:, 1:] < 0) & (penv[:, :, None] > peak[p][:, None, :]) & \
-            (reach > peak[p][:, None, :])
-        nn_, jx, aa = np.nonzero(cand)
+        # the angles whose projected velocity changes sign in a piece: (V_s . e)(V_e . e) < 0 with
+        # e = (cos t, sin t) is cos(2t - phi_s - phi_e) < -cos(phi_s - phi_e), an arc of width pi - alpha,
+        # alpha = arccos(-cos(phi_s - phi_e)): only the grid angles of that arc (and one more each side,
+        # then the sign test itself) are looked at, not all n
+        vsx, vsy, vex, vey = st[0][2][:, :-1], st[1][2][:, :-1], st[0][2][:, 1:], st[1][2][:, 1:]
+        ps_, pe_ = np.arctan2(vsy, vsx), np.arctan2(vey, vex)
+        alpha = np.arccos(np.clip(-np.cos(ps_ - pe_), -1.0, 1.0))
+        lo = (alpha + ps_ + pe_) / 2
+        jlo = np.floor(lo * n_ang / np.pi).astype(np.int64) - 1
+        cnt = np.minimum(np.ceil((np.pi - alpha) * n_ang / np.pi).astype(np.int64) + 3, n_ang)      # (N, M)
+        pi_, pj_ = np.nonzero(cnt > 0)
+        cc = cnt[pi_, pj_]
+        nn_, jx = np.repeat(pi_, cc), np.repeat(pj_, cc)
+        start = np.repeat(np.cumsum(cc) - cc, cc)
+        aa = (np.repeat(jlo[pi_, pj_], cc) + np.arange(cc.sum()) - start) % n_ang
+        c, sn = cs[0, aa], cs[1, aa]
+        keep = (c * vsx[nn_, jx] + sn * vsy[nn_, jx]) * (c * vex[nn_, jx] + sn * vey[nn_, jx]) < 0
+        pk = peak[p[nn_], aa]
+        keep &= penv[nn_, jx] > pk
+        pr = lambda k: np.abs(c * st[0][1][nn_, jx + k] + sn * st[1][1][nn_, jx + k]) * omega[p[nn_]]   # noqa: E731
+        keep &= np.maximum(pr(0), pr(1)) + rise[nn_, jx] > pk
+        nn_, jx, aa = nn_[keep], jx[keep], aa[keep]
         if not nn_.size:
             continue
         rr, pp = r[nn_], p[nn_]
