@@ -91,7 +91,7 @@ register("structure_moment_ref", "str", "auto", "m", "reference point 'x,y,z' of
 CONV_SHEAR = ("force the structure exerts on the ground through its base (the foundation's inertia included), "
               "x and y; = the sum of the lateral loads in a static case, minus the sum of the nodal inertia forces "
               "(absolute accelerations) dynamically; fixed base: minus the base's support reactions (K u + m a_g "
-              "at the base's fixed dofs) at t_n; coupled: minus the interface force of the step (the soil's force "
+              "at the base's fixed dofs, + a1 K v with Rayleigh's stiffness-proportional damping a1 K) at t_n; coupled: minus the interface force of the step (the soil's force "
               "on the structure)")
 CONV_MOMENT = ("moment vector (right-hand rule) about x and y of the forces the structure exerts on its base, "
                "about the reference point x_ref: M = sum (x - x_ref) x F; a lateral load F_x at height h gives "
