@@ -291,3 +291,31 @@ def test_an_undamped_fixed_base_has_no_damping_ratio(tmp_path, capsys):
     assert cells[3] == "< 1e-06 (undamped)" and cells[4] == "", line
     z = read_csv(tmp_path / "g.csv")["damping ratio zeta (SDOF fit)"]
     assert z[2] < 1e-6 and math.isnan(z[3])
+
+
+def test_given_damping_beside_the_identified(tmp_path, capsys):
+    """Issue 43: with the structure outputs' damping attributes (alpha_m, rayleigh_a1: what a run writes),
+    the row 'damping ratio given ...' is alpha_m/(2 w) + a1 w/2 at each identified f0 (1e-12): Rayleigh
+    damping of 3 % at 2 and 8 Hz is 3 % at the SSI's f0 (2 Hz) and 2.4 % at the fixed base's (4 Hz), within
+    the fit's error on f0; without the attributes the row says 'not recorded'."""
+    import h5py
+    from petsc_ssi.fem.options import rayleigh_from_ratios
+    s, fx = write_ssi(str(tmp_path)), write_fixed(str(tmp_path))
+    status, out, err = run([s, "--glance", fx], capsys)
+    assert status == 0, err
+    q = "damping ratio given to the structure at that f0 (C = alpha_m M + a1 K)"
+    assert f"| {q} | - | not recorded | not recorded |  |" in out
+    a0, a1 = rayleigh_from_ratios(2.0, 8.0, 0.03, 0.03)               # 3 % at 2 and 8 Hz: 2.4 % at 4 Hz
+    for p in (s[:-3] + "_structure.h5", fx):
+        with h5py.File(p, "r+") as f:
+            f.attrs["alpha_m"], f.attrs["rayleigh_a1"] = a0, a1
+    status, out, err = run([s, "--glance", fx, "--csv", tmp_path / "g.csv"], capsys)
+    assert status == 0, err
+    rows = read_csv(tmp_path / "g.csv")
+    f0 = rows["first frequency f0 (SDOF fit)"]
+    given = rows[q]
+    for k in (1, 2):
+        w = 2 * math.pi * f0[k]
+        assert given[k] == pytest.approx(a0 / (2 * w) + a1 * w / 2, rel=1e-12)
+    assert given[1] == pytest.approx(0.03, rel=0.02)                   # SSI f0 = 2 Hz: 3 %
+    assert given[2] == pytest.approx(0.024, rel=0.02)                  # fixed f0 = 4 Hz: 2.4 %

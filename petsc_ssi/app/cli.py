@@ -9,6 +9,8 @@ Commands:
   impedance       dynamic stiffness K(a0) of a surface footing (-ssi_disp_group), one run per mode
   input-motion    foundation input motion of a rigid massless footing (-ssi_disp_group) under the
                   seismic wave (-ssi_seismic): its translations and rotations, free field beside
+  record FILE     read and process an earthquake record as a run would (-ssi_seismic_* options):
+                  the report, the units' check, a target's factor; -ssi_record_csv the motion
   estimate        predicted time per stage and memory of the run, per rank count, and
                   whether it fits the nodes (no assembly; -ssi_estimate_* options)
   help            list every -ssi_ option with default, unit and meaning (also -help, --help)
@@ -19,7 +21,7 @@ and exit status 2 on every rank.
 """
 import sys
 
-COMMANDS = ("run", "post", "modes", "static", "help", "estimate", "impedance", "input-motion")
+COMMANDS = ("run", "post", "modes", "static", "help", "estimate", "impedance", "input-motion", "record")
 
 
 def _split(argv):
@@ -162,7 +164,7 @@ def main(argv=None):
     from ..petsc import init, SSIError
     PETSc = init(rest)
     from .. import options
-    from . import kinds, estimate, impedance  # noqa: F401  (every option declared, also for -help)
+    from . import kinds, estimate, impedance, record  # noqa: F401  (every option declared, also for -help)
     if cmd == "help" or "-help" in rest or "--help" in rest:
         PETSc.Sys.Print(__doc__.split("Errors in the input")[0].rstrip() + "\n")
         PETSc.Sys.Print(options.help_text())
@@ -181,6 +183,8 @@ def main(argv=None):
             estimate.main()
         elif cmd == "impedance":
             impedance.main()
+        elif cmd == "record":
+            record.main(rest[1:])
         elif cmd == "input-motion":
             from .input_motion import main as input_motion_main
             input_motion_main()

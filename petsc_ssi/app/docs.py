@@ -8,7 +8,7 @@ BEGIN, END = "<!-- options:begin -->", "<!-- options:end -->"
 
 def table():
     from .. import options
-    from . import kinds, estimate, impedance  # noqa: F401  (every option declared)
+    from . import kinds, estimate, impedance, record  # noqa: F401  (every option declared)
     return options.markdown_table()
 
 

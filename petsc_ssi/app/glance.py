@@ -412,6 +412,18 @@ def demands(path, component):
     return out
 
 
+def given_damping(path, f0):
+    """The damping ratio the structure of ``path`` was given at the frequency f0 [Hz]: C = alpha_m M +
+    rayleigh_a1 K (file attributes; issue 43), zeta = alpha_m/(2 w) + rayleigh_a1 w/2; None when the
+    file does not record it."""
+    at = _attrs(path)
+    if "alpha_m" not in at:
+        return None
+    a0, a1 = float(at["alpha_m"]), float(at.get("rayleigh_a1", 0.0))
+    w = 2 * math.pi * f0
+    return a0 / (2 * w) + a1 * w / 2
+
+
 # ---------------------------------------------------------------- report
 
 def analyse(pair, b=KO_B, band=None):
@@ -432,6 +444,11 @@ def table(S, F):
     rows = [row("first frequency f0 (SDOF fit)", "Hz", S["fit"].f0, F["fit"].f0),
             # (a damping ratio under UNDAMPED is the fit's round-off of an undamped structure: no ratio)
             row("damping ratio zeta (SDOF fit)", "-", zs, zf, ratio=zf >= UNDAMPED),
+            # what the structure was given (C = alpha_m M + a1 K of its output's attributes) at the identified f0:
+            # the fixed base's identified zeta should equal it; with SSI the soil's radiation adds to it
+            row("damping ratio given to the structure at that f0 (C = alpha_m M + a1 K)", "-",
+                given_damping(S["pair"].structure_path, S["fit"].f0),
+                given_damping(F["pair"].structure_path, F["fit"].f0), ratio=False),
             row("period T0 = 1/f0 (ratio: period lengthening)", "s", 1 / S["fit"].f0, 1 / F["fit"].f0),
             row(f"peak of the smoothed spectral ratio (Konno-Ohmachi b = {S['b']:g}) at", "Hz",
                 S["ratio"].f_peak, F["ratio"].f_peak),

@@ -5,7 +5,7 @@ import math
 import numpy as np
 
 from ..petsc import printf
-from ..fem.modes import compute_modes, default_target
+from ..fem.modes import compute_modes, default_target, participation, modes_for, modal_participation_group
 
 
 def main():
@@ -22,13 +22,42 @@ def main():
     for k, f in enumerate(freqs, 1):
         printf(f"{k},{f:.8g}")
     _damping_note(cfg, freqs)
+    part = participation(shapes, model, comm)
+    _participation_lines(part, freqs)
     if cfg.output:
-        _write(cfg, model, freqs, shapes, comm)
+        _write(cfg, model, freqs, shapes, comm, part)
     return freqs
+
+
+def _participation_lines(p, freqs):
+    """The log's table of effective modal masses (share of the total, cumulative) and heights."""
+    b = p["base_point"]
+    tot = p["total_mass"]
+    printf(f"[modes] modal participation (shapes of the table above; base point ({b[0]:g}, {b[1]:g}, {b[2]:g}) m; "
+           f"total mass moving with the base x {tot[0]:.6g} kg, y {tot[1]:.6g} kg, z {tot[2]:.6g} kg)")
+    printf("mode,frequency_hz,meff_x_kg,meff_y_kg,meff_z_kg,ratio_x,ratio_y,ratio_z,cum_x,cum_y,cum_z,"
+           "height_x_m,height_y_m")
+    for k, f in enumerate(freqs):
+        me, r, c, h = p["effective_mass"][k], p["effective_mass_ratio"][k], p["cumulative_mass_ratio"][k], \
+            p["effective_height"][k]
+        printf(f"{k + 1},{f:.8g}," + ",".join(f"{v:.6g}" for v in me[:3]) + "," + ",".join(f"{v:.4f}" for v in r[:3])
+               + "," + ",".join(f"{v:.4f}" for v in c[:3]) + "," + ",".join(f"{v:.6g}" for v in h))
+    need = modes_for(p["cumulative_mass_ratio"])
+    cum = p["cumulative_mass_ratio"][-1]
+    printf("[modes] modes for 90 % of the mass: " + ", ".join(
+        f"{d} {n}" if n else f"{d} not reached with {len(freqs)} ({100 * cum[i]:.1f} %; -ssi_modes_n more)"
+        for i, (d, n) in enumerate(zip("xyz", need[:3]))))
 
 
 def _damping_note(cfg, freqs):
     flex = freqs[freqs > 1e-6 * max(freqs.max(), 1e-300)]
+    from ..fem.options import damping, rayleigh_zeta
+    a0, a1, note = damping(cfg)
+    if (a0 > 0 or a1 > 0) and flex.size:            # every mode's ratio of the damping a run would take
+        printf(f"[modes] {note}: damping ratio of each flexible mode: "
+               + ", ".join(f"{k + 1}: {float(z):.4g}" for k, z in
+                           zip(range(len(freqs)), rayleigh_zeta(a0, a1, np.where(freqs > 0, freqs, np.inf)))
+                           if freqs[k] in flex))
     if cfg.fem_damping_ratio > 0 and flex.size:
         f1 = flex[0]
         printf(f"[modes] zeta = {cfg.fem_damping_ratio:g} at the first flexible mode f = {f1:.6g} Hz: "
@@ -37,13 +66,16 @@ def _damping_note(cfg, freqs):
                f"{2 * cfg.fem_damping_ratio * 2 * math.pi * cfg.fem_damping_freq:.6g} 1/s)")
 
 
-def _write(cfg, model, freqs, shapes, comm):
+def _write(cfg, model, freqs, shapes, comm, part=None):
     from ..io.output import Output, provenance
     from ..io.structure import FieldWriter
     out = Output(cfg.output, comm)
     fw = FieldWriter(out, model, comm)
     for k, s in enumerate(shapes, 1):
         fw.write(float(k), s, names=("mode_shape", "mode_shape_rotation", None))
+    groups = {"modal_participation": modal_participation_group(part, freqs)} if part is not None and \
+        comm.getRank() == 0 else None
     out.close(attrs={"problem": "modes", "frequencies_hz": np.asarray(freqs), "time_is": "mode number"},
+              groups=groups,
               record=provenance(cfg, comm, {"modes": {"frequencies_hz": [float(f) for f in freqs]}}))
     printf(f"[modes] wrote {cfg.output} (+ .xmf, .json)")

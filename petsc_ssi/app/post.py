@@ -7,6 +7,18 @@ Reads an output file with h5py (serial; no PETSc needed):
   --plot PNG          receiver time histories (with the Pekeris patch solution
                       when the run was a Lamb problem)
   --info              what the file holds
+  --series G/NAME --csv [OUT.csv]
+                      (without --receivers, --spectrum, --transfer) any time series of the
+                      file as columns: t [s], then one column per component, named
+                      NAME_x [unit] (the unit from the dataset's attribute), e.g.
+                      demands/base_shear, demands/drift_ratio (a column per storey),
+                      interface/force_fe, resultants/force, input_motion/..., seismic/x_acceleration;
+                      '#' lines first: file, series, unit, convention
+  --demands --csv [OUT.csv]
+                      the storey demands' summary of a structure output (group demands):
+                      peak drift ratio per storey, peak base shear, V/W (W = m g of the
+                      structure's mass attribute), peak overturning moment, each with its
+                      time; columns quantity,storey,component,value,unit,time_s
 
 Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
   --spectrum          one-sided amplitude spectrum |X(f)| of a series, scaled so
@@ -211,6 +223,130 @@ def info(path, out=None):
         for k, v in f.attrs.items():
             out.write(f"{k}: {v}\n")
         out.write("datasets: " + ", ".join(sorted(f.keys())[:12]) + (" ..." if len(f.keys()) > 12 else "") + "\n")
+
+
+# ---------------------------------------------------------------- any series as CSV (issue 43)
+
+G_STANDARD = 9.80665          # m/s^2: the weight W = m g of post --demands
+
+
+def _time_key(f, grp, name):
+    """The time grid of GROUP/NAME: the sibling GROUP/t, or GROUP/<c>_t for GROUP/<c>_<what> (the
+    seismic group's per-component records)."""
+    base = (grp + "/") if grp else ""
+    for key in (base + "t", base + name.split("_")[0] + "_t"):
+        if key in f and key != base + name:
+            return key
+    return None
+
+
+def _unit(d):
+    u = d.attrs.get("unit")
+    return (u.decode() if isinstance(u, bytes) else str(u)) if u is not None else "unit not recorded"
+
+
+def series_csv(path, series, out=None):
+    """Any time series GROUP/NAME of an output file as CSV: '#' lines (file, series, unit, convention),
+    then t [s] and a column per component (the dataset's trailing axes flattened: x, y, z for a last
+    axis of 2 or 3; the middle axis of (K, S, C) as storey1.. for demands' drift ratios, r0.. otherwise),
+    each named with the dataset's unit."""
+    out = sys.stdout if out is None else out
+    series = series.strip("/")
+    grp, _, name = series.rpartition("/")
+    with open_h5(path) as f:
+        if series not in f or not hasattr(f[series], "shape"):
+            have = [k for k in (f[grp].keys() if grp in f else []) if not k.endswith("t")]
+            raise PostError(f"{path} holds no series {series}" + (f" (the group {grp} holds: {', '.join(sorted(have))})"
+                                                                   if have else f" (no group {grp})" if grp else ""))
+        tkey = _time_key(f, grp, name)
+        d = f[series]
+        if tkey is None:
+            raise PostError(f"{path}: {series} has no time grid ({grp + '/' if grp else ''}t): not a time series")
+        t = np.asarray(f[tkey][()], float)
+        x = np.asarray(d[()], float)
+        unit, tunit = _unit(d), _unit(f[tkey])
+        conv = d.attrs.get("convention", "")
+        conv = conv.decode() if isinstance(conv, bytes) else str(conv)
+        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+    if x.ndim == 0 or x.shape[0] != t.size:
+        raise PostError(f"{path}: {series} has shape {x.shape}, its time grid {tkey} {t.size} samples: "
+                        "not a time series")
+    if x.ndim > 3:
+        raise PostError(f"{path}: {series} has shape {x.shape}: more axes than a time series of points")
+    comp = lambda n: list("xyz"[:n]) if n in (2, 3) else [str(j) for j in range(n)]   # noqa: E731
+    if x.ndim == 1:
+        names, cols = [name], [x]
+    elif x.ndim == 2:
+        names = [f"{name}_{c}" for c in comp(x.shape[1])]
+        cols = [x[:, j] for j in range(x.shape[1])]
+    else:
+        tag = (lambda k: f"storey{k + 1}") if grp == "demands" else (lambda k: f"r{k}")
+        names, cols = [], []
+        for k in range(x.shape[1]):
+            for j, c in enumerate(comp(x.shape[2])):
+                names.append(f"{name}_{tag(k)}_{c}")
+                cols.append(x[:, k, j])
+    hdr = _header([f"petsc-ssi post --series {series} --csv: the time series as stored",
+                   f"file: {os.path.abspath(path)} (problem {attrs.get('problem', '?')}, run_status "
+                   f"{attrs.get('run_status', '?')})",
+                   f"series: {series}, shape {tuple(x.shape)}, unit {unit}; time {tkey} [{tunit}]"]
+                  + ([f"convention: {' '.join(conv.split())}"] if conv else []))
+    _write_table(out, hdr, [f"t [{tunit}]"] + [f"{n} [{unit}]" for n in names], [t] + cols)
+    return t, x
+
+
+def demands_summary(path):
+    """[(quantity, storey, component, value, unit, time_s)] of the group demands of a structure output."""
+    rows = []
+    with open_h5(path) as f:
+        d = f.get("demands")
+        if d is None or not hasattr(d, "keys"):
+            what = f.attrs.get("problem", "?")
+            raise PostError(f"{path}: no group demands (problem {what}: the storey demands are in a structure "
+                            "output, FILE.h5 of -ssi_problem fem or FILE_structure.h5 of a coupled run)")
+        mass = f.attrs.get("structure_mass")
+
+        def get(k):
+            return np.asarray(d[k][()], float) if k in d else None
+        for name, label, unit in (("drift_ratio", "peak inter-storey drift ratio", "m/m"),
+                                  ("drift_ratio_deformation", "peak drift ratio without the base's rocking", "m/m")):
+            pk, pt = get("peak_" + name), get("peak_" + name + "_time")
+            if pk is None:
+                continue
+            pk, pt = pk.reshape(-1, 2), pt.reshape(-1, 2)
+            for s in range(pk.shape[0]):
+                for j, c in enumerate("xy"):
+                    rows.append((label, s + 1, c, pk[s, j], unit, pt[s, j]))
+        V, Vt = get("peak_base_shear"), get("peak_base_shear_time")
+        if V is not None:
+            for j, c in enumerate("xy"):
+                rows.append(("peak base shear", "", c, V[j], "N", Vt[j]))
+            if mass is not None and float(mass) > 0:
+                W = float(mass) * G_STANDARD
+                for j, c in enumerate("xy"):
+                    rows.append(("peak base shear / weight V/W", "", c, V[j] / W, "1", Vt[j]))
+                rows.append((f"weight W = m g (m = {float(mass):.6g} kg, g = {G_STANDARD} m/s^2)", "", "", W, "N",
+                             float("nan")))
+        Mo, Mt = get("peak_overturning_moment"), get("peak_overturning_moment_time")
+        if Mo is not None:
+            for j, c in enumerate("xy"):
+                rows.append((f"peak overturning moment (about {c})", "", c, Mo[j], "N m", Mt[j]))
+    if not rows:
+        raise PostError(f"{path}: the group demands holds no peaks (no base and no storeys recorded)")
+    return rows, mass
+
+
+def demands_csv(path, out=None):
+    out = sys.stdout if out is None else out
+    rows, mass = demands_summary(path)
+    out.write(_header([f"petsc-ssi post --demands: storey demands' peaks of {os.path.abspath(path)} (group demands)",
+                       "value: max over the steps of |series| per component; time_s: the first time of that peak",
+                       "V/W: " + ("base shear over the weight of the structure's mass attribute (the modelled part)"
+                                  if mass is not None else "not given: the file records no structure_mass")]))
+    out.write("quantity,storey,component,value,unit,time_s\n")
+    for q, st, c, v, u, tt in rows:
+        out.write(f'"{q}",{st},{c},{v:.9g},{u},{tt:.9g}\n')
+    return rows
 
 
 # ---------------------------------------------------------------- series selection
@@ -477,6 +613,7 @@ def main(argv=None):
                          "--quantity or --series; spectrum, transfer)")
     ap.add_argument("--plot", metavar="PNG", help="plot receiver histories to PNG")
     ap.add_argument("--info", action="store_true")
+    ap.add_argument("--demands", action="store_true", help="storey demands' summary (with --csv)")
     ap.add_argument("--spectrum", action="store_true", help="amplitude spectrum of a series")
     ap.add_argument("--transfer", nargs=2, metavar=("A", "B"), help="transfer function B/A")
     ap.add_argument("--quantity", choices=QUANTITIES, default="u")
@@ -502,6 +639,7 @@ def main(argv=None):
         a.file, a.csv = a.csv, True
     if a.file is None:
         ap.error("the following arguments are required: file")
+    a.series_given = a.series is not None
     a.series = a.series or f"receivers/{a.quantity}"
     from ..spectrum import SpectrumError
     if world_rank() > 0:            # serial: rank 0 does the work and reports; the others agree on the status
@@ -513,7 +651,9 @@ def main(argv=None):
     try:
         _check_numbers(a)
         inputs = [a.file] + [_parse_ref(r, a.file, a.series)[0] for r in (a.transfer or ())]
-        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer) else None), ("--png", a.png),
+        plain_series = bool(a.series_given and a.csv and not (a.receivers or a.spectrum or a.transfer))
+        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer or plain_series or a.demands) else None),
+                       ("--png", a.png),
                        ("--plot", a.plot)], inputs, a.overwrite)
         if a.spectrum and a.transfer:
             raise PostError("give either --spectrum or --transfer, not both")
@@ -526,6 +666,23 @@ def main(argv=None):
         open_h5(a.file).close()
         if a.info:
             info(a.file)
+        if plain_series or (a.demands and a.csv):
+            fh, close = _open_out(a.csv)
+            try:
+                if plain_series:
+                    series_csv(a.file, a.series, fh)
+                else:
+                    demands_csv(a.file, fh)
+            except BaseException:
+                if close:
+                    fh.close()
+                    os.remove(a.csv)                # no half-written file after an error
+                raise
+            if close:
+                fh.close()
+            return 0
+        if a.demands:
+            raise PostError("--demands writes a CSV: give --csv [OUT.csv]")
         if a.receivers and a.csv:
             fh, close = _open_out(a.csv)            # --csv OUT.csv: that file; --csv alone: standard output
             try:
@@ -538,7 +695,8 @@ def main(argv=None):
             read_series(a.file, a.series)          # a missing series: one line, not a traceback
             receiver_plot(a.file, png=a.plot, series=a.series)
         if not (a.info or (a.receivers and a.csv) or a.plot):
-            ap.error("nothing to do: give --receivers --csv, --plot PNG, --info, --spectrum or --transfer A B")
+            ap.error("nothing to do: give --receivers --csv, --series G/NAME --csv, --demands --csv, --plot PNG, "
+                     "--info, --spectrum or --transfer A B")
     except (OSError, PostError, SpectrumError) as exc:
         msg = " ".join(str(exc).split())
         print(f"petsc-ssi post: error: {msg}", file=sys.stderr)

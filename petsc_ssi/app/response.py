@@ -37,10 +37,18 @@ Options
   --periods SPEC        T1:T2:N (N log-spaced periods from T1 to T2 s) | T,T,... (sorted,
                         0 allowed: the rigid limit PGA) | standard (default:
                         standard_periods(): 100 log-spaced 0.01 .. 10 s and NGA-West2's 21)
-  --oversample N|auto   sub-steps per time step (default auto: ceil(10 dt / T_min), the
-                        numerics' advice: at least 10 nodes per period, so a peak between
-                        nodes is missed by at most 1 - cos(pi / 10) = 4.9 %, typically far
-                        less; the summary states the bound; 20 dt / T_min gives 1.2 %)
+  --peaks exact|nodes   exact (default): each peak found WITHIN its step from the closed form
+                        of the exactly integrated oscillator (the extremum of the closed form
+                        in the step, seismic/response_spectrum.py _exact_peaks): no sub-steps
+                        needed; what remains is round-off (1e-12 of the peak against closed
+                        forms and 200-fold oversampling in tests/seismic/test_response_spectrum.py)
+                        and, in principle, a pair of extrema inside one quarter period of the
+                        oscillator, which sampling misses as well.  nodes: the largest value at
+                        the samples and sub-steps (the earlier method)
+  --oversample N|auto   sub-steps per time step (default auto: 1 with --peaks exact;
+                        ceil(10 dt / T_min) with --peaks nodes, the numerics' advice: a peak
+                        between nodes is then missed by at most 1 - cos(pi / 10) = 4.9 %; the
+                        summary states the bound; 20 dt / T_min gives 1.2 %)
   --ratio B.h5          spectral ratio A / B (e.g. SSI over fixed base) of every quantity,
   --ratio-receiver K    with B's receiver K (default: --receiver), same component(s),
   --ratio-table FILE    or of a table; nan where B is 0
@@ -298,11 +306,11 @@ def _miss_bound(t, periods, k):
 
 # ---------------------------------------------------------------- spectra
 
-def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, oversample="auto"):
+def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, oversample="auto", peaks="exact"):
     """([(label, ResponseSpectrum)], sub-steps): a spectrum per component (labels x, y, z or
     a), or RotD50, RotD100 (``rotd``) and/or GM (``geomean``) of the components x, y."""
     periods = rs.standard_periods() if periods is None else periods
-    k = auto_oversample(series.t, periods) if oversample == "auto" else int(oversample)
+    k = (1 if peaks == "exact" else auto_oversample(series.t, periods)) if oversample == "auto" else int(oversample)
     out = []
     if rotd or geomean:
         if series.components[:2] != ("x", "y"):
@@ -315,16 +323,16 @@ def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, ov
                          f"{min(px, py):.3g} m/s^2 against {max(px, py):.3g}: it carries no motion (a one-component "
                          f"run), and the geometric mean would be 0 at every period; take the components alone")
         if rotd:
-            for s in rs.rotd(series.t, ax, ay, periods, damping, oversample=k).values():
+            for s in rs.rotd(series.t, ax, ay, periods, damping, oversample=k, peaks=peaks).values():
                 out.append((s.label, s))
         if geomean:
-            sx = rs.response_spectrum(series.t, ax, periods, damping, oversample=k)
-            sy = rs.response_spectrum(series.t, ay, periods, damping, oversample=k)
+            sx = rs.response_spectrum(series.t, ax, periods, damping, oversample=k, peaks=peaks)
+            sy = rs.response_spectrum(series.t, ay, periods, damping, oversample=k, peaks=peaks)
             out.append(("GM", rs.geometric_mean(sx, sy)))
     else:
         for j, c in enumerate(series.components):
             out.append((c, rs.response_spectrum(series.t, series.a[:, j], periods, damping,
-                                                oversample=k)))
+                                                oversample=k, peaks=peaks)))
     return out, k
 
 
@@ -447,6 +455,7 @@ def _parser():
     ap.add_argument("--damping", type=parse_damping, default=np.array([0.05]), metavar="Z[,Z...]")
     ap.add_argument("--periods", type=parse_periods, default=None, metavar="SPEC")
     ap.add_argument("--oversample", type=_oversample_arg, default="auto", metavar="N|auto")
+    ap.add_argument("--peaks", choices=("exact", "nodes"), default="exact")
     ap.add_argument("--ratio", metavar="B.h5", help="spectral ratio A / B")
     ap.add_argument("--ratio-receiver", type=int, default=None, metavar="K")
     ap.add_argument("--ratio-table", metavar="FILE", help="spectral ratio A / (the table's)")
@@ -509,7 +518,7 @@ def main(argv=None, out=None):
         inputs = [p for p in (a.file, a.table, a.ratio, a.ratio_table) if p]
         _post.check_outputs([("--csv", a.csv), ("--png", a.png)], inputs, a.overwrite)
         A = _load(a.file, a.table, a.receiver, comps, a, "--table" if a.table else "--receiver")
-        specs, k = spectra(A, periods, a.damping, a.rotd, a.geomean, a.oversample)
+        specs, k = spectra(A, periods, a.damping, a.rotd, a.geomean, a.oversample, a.peaks)
         B = None
         if a.ratio or a.ratio_table:
             rrec = a.receiver if a.ratio_receiver is None else a.ratio_receiver
@@ -518,7 +527,7 @@ def main(argv=None, out=None):
             if len(B.components) != len(A.components):
                 raise _error(f"--ratio: A has the components {', '.join(A.components)}, "
                              f"B {', '.join(B.components)}")
-            specs_b, kb = spectra(B, periods, a.damping, a.rotd, a.geomean, a.oversample)
+            specs_b, kb = spectra(B, periods, a.damping, a.rotd, a.geomean, a.oversample, a.peaks)
             specs = ratios(specs, specs_b)
         header = _summary(A, B, specs, ptext, periods, a, k, kb if B is not None else None)
         if not (a.rotd or a.geomean):
@@ -568,9 +577,13 @@ def _summary(A, B, specs, ptext, periods, a, k, kb):
         if s is None:
             continue
         miss, tmin = _miss_bound(s.t, periods, kk)
-        lines.append(f"{tag if B is not None else ''}sub-steps per time step: {kk}"
-                     + (f" (a peak between nodes is missed by at most {100 * miss:.2g} % at "
-                        f"T = {tmin:g} s)" if tmin else ""))
+        if a.peaks == "exact":
+            lines.append(f"{tag if B is not None else ''}sub-steps per time step: {kk}; peaks exact: each found within "
+                         "its step from the closed form of the exactly integrated oscillator (round-off remains)")
+        else:
+            lines.append(f"{tag if B is not None else ''}sub-steps per time step: {kk}"
+                         + (f" (a peak between nodes is missed by at most {100 * miss:.2g} % at "
+                            f"T = {tmin:g} s)" if tmin else ""))
     lines.append("columns: period [s], damping [-], then per spectrum "
                  + (f"{', '.join(specs[0][1].quantities)} ratio [-]" if B is not None else quants)
                  + "; one row per (damping, period)")

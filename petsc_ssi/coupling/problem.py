@@ -24,6 +24,7 @@ from ..io.structure import receiver_record
 from ..bem.build import build_marcher
 from ..fem.integrators import make_model_integrator
 from ..fem.loads import load_history
+from ..fem.problem import damping_attrs, structure_mass
 from . import options as _options  # noqa: F401  (declares the coupling's options, and the soil's and structure's)
 from .model import build_coupled, interface_bytes
 from .step import Coupler
@@ -233,7 +234,8 @@ class SSITransient(TransientProblem):
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
         sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
-        sattrs = {"problem": "ssi-structure", "alpha_m": self.am, "dt": cfg.dt}
+        sattrs = {"problem": "ssi-structure", "dt": cfg.dt, **damping_attrs(self.am, self.integ.a1),
+                  "structure_mass": structure_mass(model, comm)}
         return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups}),
                 (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups})]
 
@@ -252,7 +254,8 @@ class SSITransient(TransientProblem):
                  "capacitance_factor_s": coupler.solver_cap().t_factor, "contact_algebra_s": law.t_algebra,
                  "cycled_steps": law.cycled_steps, "interface_nodes": self.iface.n, "lags": prob.L,
                  "exact_lags": plan.Lx, "interp_k": plan.k if plan.active else 0,
-                 "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am}
+                 "beta_min": prob.beta[0], "beta_max": prob.beta[1], "alpha_m": self.am,
+                 "rayleigh_a1": self.integ.a1}
         from ..sysmem import peak_rss
         stats["peak_rss_max_rank_bytes"], stats["peak_rss_sum_bytes"] = peak_rss(comm)
         res["stats"] = stats

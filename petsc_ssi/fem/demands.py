@@ -36,6 +36,8 @@ Where the forces come from:
       planes, lateral supports) are not the base and are left out. The support's force on the
       structure at a fixed dof c is (K u)_c + m_c a_g(t) (u = 0 there, and the node moves with the
       ground: relative-motion form), so V = -sum_c [(K u^n)_c + m_c a_g(t_n)] over the base's x (y)
+      (with Rayleigh's stiffness-proportional damping a1 K, whose dashpots act across the members,
+      (K u^n)_c becomes (K (u^n + a1 v^n))_c)
       dofs and M = -R_c^T [K u^n + m a_g(t_n)], R_c the rigid rotation about x_ref restricted to
       the base's fixed dofs, a_g(t_n) the record's acceleration at t_n. With K symmetric the
       stiffness part is one linear functional g . u^n, g = -K e (formed once): exact at t_n for any
@@ -89,7 +91,7 @@ register("structure_moment_ref", "str", "auto", "m", "reference point 'x,y,z' of
 CONV_SHEAR = ("force the structure exerts on the ground through its base (the foundation's inertia included), "
               "x and y; = the sum of the lateral loads in a static case, minus the sum of the nodal inertia forces "
               "(absolute accelerations) dynamically; fixed base: minus the base's support reactions (K u + m a_g "
-              "at the base's fixed dofs) at t_n; coupled: minus the interface force of the step (the soil's force "
+              "at the base's fixed dofs, + a1 K v with Rayleigh's stiffness-proportional damping a1 K) at t_n; coupled: minus the interface force of the step (the soil's force "
               "on the structure)")
 CONV_MOMENT = ("moment vector (right-hand rule) about x and y of the forces the structure exerts on its base, "
                "about the reference point x_ref: M = sum (x - x_ref) x F; a lateral load F_x at height h gives "
@@ -216,10 +218,13 @@ class DemandSpec:
 class Demands:
     """Collective: the observer of the recorder that keeps the demands of every step (module
     docstring). ``spec``: a DemandSpec; ``model``: the assembled model (K for the reactions);
-    ``what``: '[fem]' or '[ssi]' for the start-up line."""
+    ``what``: '[fem]' or '[ssi]' for the start-up line; ``a1``: the stiffness-proportional damping
+    (C = alpha_m M + a1 K, -ssi_fem_rayleigh*): its dashpots act across the members, so at the base
+    the support also takes a1 (K v)_c, added to the reactions (g . (u + a1 v))."""
 
-    def __init__(self, spec, model, comm, what="[fem]", ground=None):
+    def __init__(self, spec, model, comm, what="[fem]", ground=None, a1=0.0):
         self.spec, self.comm, self.rank = spec, comm, comm.getRank()
+        self.a1 = float(a1)
         self.ground = ground                      # t -> (3,) the base's acceleration [m/s^2] (support motion)
         self.Cg = np.zeros((4, 3))
         dm = model.dofmap
@@ -306,15 +311,20 @@ class Demands:
         s = step.get("structure")
         if s is None:
             return
-        self.record(t, s[0], step.get("interface"))
+        self.record(t, s[0], step.get("interface"), v=s[1] if len(s) > 1 else None)
 
-    def record(self, t, u, interface=None):
-        """Collective: the demands of the state u at time t (``interface``: the coupled step's record
+    def record(self, t, u, interface=None, v=None):
+        """Collective: the demands of the state u (velocity v: the stiffness-proportional dashpots'
+        share of the reactions, with a1 > 0) at time t (``interface``: the coupled step's record
         with force_fe, moment_fe; None at t = 0 or in a fixed-base run)."""
         vals = np.zeros(self.G.shape[0])
         if vals.size:                             # one small reduction (no field is gathered)
             from mpi4py import MPI
-            self.mpi.Allreduce(self.G @ u.getArray(readonly=True), vals, op=MPI.SUM)
+            x = u.getArray(readonly=True)
+            loc = self.G @ x
+            if self.a1 and v is not None and self.G.shape[0] > self.n_drift_funcs:
+                loc[self.n_drift_funcs:] += self.a1 * (self.G[self.n_drift_funcs:] @ v.getArray(readonly=True))
+            self.mpi.Allreduce(loc, vals, op=MPI.SUM)
         if self.ground is not None and self.spec.base == "reactions" and self.spec.base_dofs.size:
             vals[self.n_drift_funcs:] += self.Cg @ np.asarray(self.ground(t), float)
         if self.spec.base == "interface":

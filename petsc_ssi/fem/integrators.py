@@ -1,4 +1,5 @@
-r"""Time integrators of M a + C v + K u = f with C = alpha_m M (lumped M).
+r"""Time integrators of M a + C v + K u = f with Rayleigh damping C = alpha_m M + a1 K (lumped M;
+alpha_m is Rayleigh's a0).
 
 GreenIntegrator: implicit Green's functions (Soares & Mansur 2005; paper
 Section 3, eqs. 13-24). NewmarkIntegrator: plain Newmark, for comparison.
@@ -83,6 +84,23 @@ f^n. Both are second order; they agree exactly only in free vibration.
 Newmark with loads (NewmarkIntegrator): the usual form with the same cell-mean
 samples f^n, a^0 = M^{-1}(f^0 - C v^0 - K u^0).
 
+Stiffness-proportional damping (a1 > 0, issue 43). D = (1 + a1 delta/(alpha dt)) K
++ (1/(alpha dt^2) + delta alpha_m/(alpha dt)) M is still factorised once (K scaled, the same
+sparsity). Newmark adds a1 K (delta/(alpha dt) u + (delta/alpha - 1) v + dt (delta/(2 alpha) - 1) a)
+to its right-hand side (one product with K per step) and a^0 = M^{-1}(f^0 - C v^0 - K u^0). The
+midpoint form: D u^n = (4M/dt^2 + 2C/dt - K) u^{n-1} + (4/dt) M v^{n-1} + 2 fbar^n, i.e. its K u^{n-1}
+term (already formed) gets the factor (2 a1/dt - 1). The Green scheme with a1 > 0 is taken for the
+trapezoidal rule only (alpha 1/4, delta 1/2), where its free step IS the trapezoidal free step (above):
+with kappa = 2 a1/dt, c = 4/dt^2 + 2 alpha_m/dt and D = (1 + kappa) K + c M,
+    K u = (D u - c M u)/(1 + kappa),   so   D^{-1}[(c M + (kappa - 1) K) u + (4/dt) M v]
+        = r u + D^{-1} M (c (1 - r) u + (4/dt) v),   r = (kappa - 1)/(kappa + 1),
+which is eq. 13's form u^n = D^{-1} M (b4 u + b1 v) + b2 u with b2 = r, b4 = c (1 - r), b1 = 4/dt, and
+v^n = 2 (u^n - u^{n-1})/dt - v^{n-1} = b7 w + b6 u + bv v with b7 = 2/dt, b6 = 2 (r - 1)/dt, bv = -1
+(kappa = 0: r = -1, the constants above; bv = b2 in general without a1). The cost is nil: the same
+one solve with D per step, no product with K (the K term is folded into D and r). Other Green
+constants (delta^2 = alpha != 1/4) with a1 > 0 are refused with the options (-ssi_fem_integrator newmark
+takes them).
+
 Constraints: fixed dofs have zero rows and columns in D (the mean diagonal on
 the diagonal, ``assembly.eliminate_dofs``) and are masked in every impulse
 and right-hand side, so u = v = 0 stays exact there. A load on a fixed dof is
@@ -96,11 +114,22 @@ from ..petsc import init, SSIError, check, collective_error, set_default_options
     direct_solver_defaults, printf, warn, check_reproducible_solver
 from ..monitor import event
 from .assembly import check_mass, owned_dofs, eliminate_dofs
-from .options import alpha_m
+from .options import damping
 
 
-def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5):
-    """b0..b7 of paper eqs. 17-24 (derived in the module docstring)."""
+def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5, a1=0.0):
+    """b0..b7 of paper eqs. 17-24 (derived in the module docstring) and bv, the velocity's own factor
+    in v^n = b7 w + b6 u + bv v (= b2 without stiffness-proportional damping); with a1 > 0 (trapezoidal
+    only) the constants of the trapezoidal free step with C = alpha_m M + a1 K (module docstring)."""
+    if a1:
+        if abs(alpha - 0.25) > 1e-12 or abs(delta - 0.5) > 1e-12:
+            raise SSIError(f"the Green's-function integrator takes stiffness-proportional damping (a1 = {a1:g} s) "
+                           f"with the trapezoidal rule only (alpha 1/4, delta 1/2; got {alpha:g}, {delta:g}); "
+                           "-ssi_fem_integrator newmark takes any")
+        kappa = 2.0 * a1 / dt
+        c = 4.0 / dt ** 2 + 2.0 * alpha_m / dt
+        r = (kappa - 1.0) / (kappa + 1.0)
+        return dict(b1=4.0 / dt, b2=r, b4=c * (1.0 - r), b6=2.0 * (r - 1.0) / dt, b7=2.0 / dt, bv=-1.0, a1=a1)
     b0 = (1 / (2 * alpha) - 1) * alpha_m - 1 / (alpha * dt)
     b1 = (delta / alpha - 1) * alpha_m - 0.5 * dt * (delta / alpha - 2) * alpha_m ** 2 - b0
     b2 = 1 - dt * (1 - delta) * alpha_m + delta * dt * b0
@@ -109,12 +138,17 @@ def green_constants(dt, alpha_m=0.0, alpha=0.25, delta=0.5):
     b5 = alpha_m * b3 + b1 / (alpha * dt ** 2)
     b6 = alpha_m * b2 + b0
     b7 = b3 / b1
-    return dict(b0=b0, b1=b1, b2=b2, b3=b3, b4=b4, b5=b5, b6=b6, b7=b7)
+    return dict(b0=b0, b1=b1, b2=b2, b3=b3, b4=b4, b5=b5, b6=b6, b7=b7, bv=b2)
 
 
 def d_mass_coefficient(dt, alpha_m, alpha, delta):
-    """c with D = K + c M (eq. 15 with C = alpha_m M)."""
+    """c with D = k K + c M (eq. 15 with C = alpha_m M + a1 K)."""
     return 1.0 / (alpha * dt ** 2) + delta * alpha_m / (alpha * dt)
+
+
+def d_stiffness_coefficient(dt, a1, alpha, delta):
+    """k with D = k K + c M (eq. 15 with C = alpha_m M + a1 K): 1 + a1 delta/(alpha dt)."""
+    return 1.0 + delta * a1 / (alpha * dt)
 
 
 # CG + BoomerAMG with the settings hypre's documentation advises for 3D elasticity
@@ -195,14 +229,16 @@ def fixed_load_message(count, where):
 
 
 class _Dynamic:
-    """Shared set-up: D = K + c M, the mask of free dofs, M^{-1} on free dofs."""
+    """Shared set-up: D = k K + c M, the mask of free dofs, M^{-1} on free dofs. C = alpha_m M + a1 K."""
 
     def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5,
-                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf, near_null=None):
+                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf, near_null=None, a1=0.0):
         comm = K.getComm()
         check(dt > 0, f"time step dt = {dt} must be > 0", comm)
+        check(a1 >= 0 and alpha_m >= 0, f"damping C = a0 M + a1 K needs a0, a1 >= 0 (got {alpha_m:g}, {a1:g})", comm)
         self.comm, self.K, self.m, self.dt = comm, K, m, float(dt)
         self.alpha_m, self.alpha, self.delta = float(alpha_m), float(alpha), float(delta)
+        self.a1 = float(a1)
         self._masks(fixed)
         check_mass(m, self.mask, comm)
         with event("FEM_assembly"):
@@ -251,10 +287,12 @@ class _Dynamic:
         self.minv.getArray()[:] = self.mask.getArray(readonly=True) / np.where(mm > 0, mm, 1.0)
 
     def _assemble_D(self):
-        """Collective: D = K + (1/(alpha dt^2) + delta alpha_m/(alpha dt)) M (eq. 15), fixed dofs
-        eliminated (``assembly.eliminate_dofs``)."""
+        """Collective: D = (1 + delta a1/(alpha dt)) K + (1/(alpha dt^2) + delta alpha_m/(alpha dt)) M
+        (eq. 15), fixed dofs eliminated (``assembly.eliminate_dofs``)."""
         PETSc = init()
         D = self.K.copy()
+        if self.a1:
+            D.scale(d_stiffness_coefficient(self.dt, self.a1, self.alpha, self.delta))
         cm = self.m.copy()
         cm.scale(d_mass_coefficient(self.dt, self.alpha_m, self.alpha, self.delta))
         D.setDiagonal(cm, addv=PETSc.InsertMode.ADD_VALUES)
@@ -320,8 +358,13 @@ class GreenIntegrator(_Dynamic):
     def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5, **kw):
         check(abs(delta * delta - alpha) < 1e-12, f"Green's-function integrator needs delta^2 = alpha "
               f"(paper eq. 24); got alpha {alpha}, delta {delta}", K.getComm())
+        a1 = float(kw.get("a1", 0.0))
+        check(not a1 or (abs(alpha - 0.25) < 1e-12 and abs(delta - 0.5) < 1e-12),
+              f"the Green's-function integrator takes stiffness-proportional damping (a1 = {a1:g} s) with the "
+              f"trapezoidal rule only (alpha 1/4, delta 1/2; got {alpha:g}, {delta:g}); -ssi_fem_integrator "
+              "newmark takes any", K.getComm())
         super().__init__(K, m, dt, alpha_m, fixed, alpha, delta, **kw)
-        self.b = green_constants(dt, alpha_m, alpha, delta)
+        self.b = green_constants(dt, alpha_m, alpha, delta, self.a1)
         self.vhalf = m.duplicate()            # M^{-1} f dt/2 of the last impulse
         self.vhalf.zeroEntries()
         self._predicted = False
@@ -357,7 +400,7 @@ class GreenIntegrator(_Dynamic):
         self.rhs.pointwiseMult(self.rhs, self.m)
         self.rhs.pointwiseMult(self.rhs, self.mask)
         self.solve(self.rhs, self.w)                              # w = D^-1 M (b4 u + b1 v)
-        self.v.scale(b["b2"])                                     # eq. 14 without f*
+        self.v.scale(b["bv"])                                     # eq. 14 without f* (bv = b2 without a1)
         self.v.axpy(b["b6"], self.u)
         self.v.axpy(b["b7"], self.w)
         self.u.scale(b["b2"])                                     # eq. 13
@@ -414,6 +457,9 @@ class NewmarkIntegrator(_Dynamic):
         self.c_u = 1 / (a * dt ** 2) + am * d / (a * dt)
         self.c_v = 1 / (a * dt) + am * (d / a - 1)
         self.c_a = (1 / (2 * a) - 1) + am * dt * (d / (2 * a) - 1)
+        # the stiffness-proportional part a1 K (d/(a dt) u + (d/a - 1) v + dt (d/(2a) - 1) a)
+        self.k_u, self.k_v, self.k_a = d / (a * dt), d / a - 1, dt * (d / (2 * a) - 1)
+        self.kx = (m.duplicate(), m.duplicate()) if self.a1 else None      # (work, K work) with a1 > 0
 
     _STATE = (("u", "u"), ("v", "v"), ("a", "a"))
 
@@ -425,6 +471,9 @@ class NewmarkIntegrator(_Dynamic):
         self.w.scale(-1.0)
         if f0 is not None:
             self.w.axpy(1.0, f0)
+        if self.a1:                                               # - a1 K v^0
+            self.K.mult(self.v, self.rhs)
+            self.w.axpy(-self.a1, self.rhs)
         self.w.pointwiseMult(self.w, self.minv)
         self.w.axpy(-self.alpha_m, self.v)
         self.w.pointwiseMult(self.w, self.mask)
@@ -444,6 +493,14 @@ class NewmarkIntegrator(_Dynamic):
         self.rhs.axpy(self.c_v, self.v)
         self.rhs.axpy(self.c_a, self.a)
         self.rhs.pointwiseMult(self.rhs, self.m)
+        if self.a1:                                               # + a1 K (k_u u + k_v v + k_a a)
+            kx, kk = self.kx
+            kx.zeroEntries()
+            kx.axpy(self.k_u, self.u)
+            kx.axpy(self.k_v, self.v)
+            kx.axpy(self.k_a, self.a)
+            self.K.mult(kx, kk)
+            self.rhs.axpy(self.a1, kk)
         if f is not None:
             self.rhs.axpy(1.0, f)
         self.rhs.pointwiseMult(self.rhs, self.mask)
@@ -473,6 +530,8 @@ class NewmarkIntegrator(_Dynamic):
 
     def destroy(self):
         self.a.destroy()
+        for x in self.kx or ():
+            x.destroy()
         super().destroy()
 
 
@@ -515,7 +574,7 @@ class MidpointIntegrator(NewmarkIntegrator):
         self.rhs.axpy(4.0 / dt, self.v)
         self.rhs.pointwiseMult(self.rhs, self.m)
         self.K.mult(self.u, self.ku)
-        self.rhs.axpy(-1.0, self.ku)
+        self.rhs.axpy(2.0 * self.a1 / dt - 1.0, self.ku)          # (2C/dt - K) u: a1 K's part with -K
         if f is not None:
             self.rhs.axpy(2.0, f)
         self.rhs.pointwiseMult(self.rhs, self.mask)
@@ -554,14 +613,15 @@ def near_null_args(solver, model):
 
 
 def make_model_integrator(cfg, comm, model=None):
-    """Collective: (model, integrator, alpha_m) for the options ``cfg``."""
+    """Collective: (model, integrator, alpha_m) for the options ``cfg`` (the integrator's ``a1``:
+    the stiffness-proportional part of Rayleigh damping, -ssi_fem_rayleigh*)."""
     if model is None:
         from .model import build_model
         model = build_model(cfg, comm)
-    am, note = alpha_m(cfg)
+    am, a1, note = damping(cfg)
     printf(f"[fem] {note}; integrator {cfg.fem_integrator}, solver {cfg.fem_solver}")
     coords, near = near_null_args(cfg.fem_solver, model)
     integ = make_integrator(cfg.fem_integrator, model.K, model.m, cfg.dt, am, model.fixed,
                             cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
-                            coords_vec=coords, near_null=near)
+                            coords_vec=coords, near_null=near, a1=a1)
     return model, integ, am

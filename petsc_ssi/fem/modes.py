@@ -19,7 +19,9 @@ sigma; if SLEPc found fewer, it solves again with twice the nev.
 
 Output: a table ``mode,frequency_hz`` on stdout (rank 0), the mode shapes
 (max |u| = 1) as snapshots ``mode_shape_<k>`` of -ssi_output with "time" =
-mode number and attribute ``frequencies_hz``. With -ssi_fem_damping_ratio
+mode number and attribute ``frequencies_hz``; the modal participation (``participation``:
+effective masses per direction, their cumulative share, effective heights) in the group
+``modal_participation`` and the log. With -ssi_fem_damping_ratio
 zeta, alpha_m = 2 zeta omega is printed for the first flexible mode.
 """
 import math
@@ -168,3 +170,105 @@ def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_", max_attempt
     return np.array(freqs), shapes
 
 
+
+
+DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def participation(shapes, model, comm):
+    """Collective: modal participation of the mode shapes (issue 43, item 2), a dict of arrays (every
+    rank; ``modal_participation_group`` gives them units):
+
+      influence vectors   r_d (d = x, y, z: unit translations; rx, ry, rz: unit rotations about the
+                          base point x_b, rotation dofs included), zero on the fixed dofs;
+      L[k, d] = phi_k^T M r_d,  Mn[k] = phi_k^T M phi_k (the shapes as written, max |u| = 1),
+      participation_factor Gamma = L / Mn, effective_mass M*_kd = L^2 / Mn, and its share of the
+      total M_d = r_d^T M r_d (the mass that moves with the base: the free dofs' mass; for rotations
+      the mass moment of inertia about x_b). sum_k M*_kd = M_d over ALL modes (M-orthogonality).
+      effective_height h*_k (x, y) = the height above the base of the resultant of mode k's inertia
+      forces under that ground motion: the overturning moment about the base over the base shear,
+      h*_x = L[k, ry] / L[k, x], h*_y = -L[k, rx] / L[k, y] (Chopra's L^theta / L^h for a shear
+      building; NaN where the mode has no share along that direction).
+    x_b: the centroid of the fixed nodes at their lowest level (the lowest node's level for a free
+    structure)."""
+    from mpi4py import MPI
+    dm, coords = model.dofmap, model.mesh.coords
+    fixed = np.asarray(model.fixed, np.int64)
+    fnodes = None
+    if fixed.size:                                 # the node of each fixed dof (offsets: each node's first dof)
+        off = np.asarray(dm.offset[:dm.n_nodes], np.int64)
+        order = np.argsort(off, kind="stable")
+        fnodes = np.unique(order[np.searchsorted(off[order], fixed, side="right") - 1])
+    zb = float(coords[fnodes, 2].min()) if fnodes is not None and fnodes.size else float(coords[:, 2].min())
+    base = coords[fnodes] if fnodes is not None and fnodes.size else coords
+    at = np.abs(base[:, 2] - zb) <= 1e-9 * max(float(np.ptp(coords)), 1.0)
+    xb = np.r_[base[at, :2].mean(axis=0), zb]
+    R = dm.rigid_body_modes(coords, centre=xb)
+    R[fixed] = 0.0
+    r0, r1 = dm.r0, dm.r1
+    Rl = R[r0:r1]
+    m = model.m.getArray(readonly=True)
+    mpi = comm.tompi4py()
+    loc = np.zeros((len(shapes) + 1, 6))
+    mn = np.zeros(len(shapes))
+    for k, s in enumerate(shapes):
+        phi = s.getArray(readonly=True)
+        loc[k] = (m * phi) @ Rl
+        mn[k] = float((m * phi) @ phi)
+    loc[-1] = ((m[:, None] * Rl) * Rl).sum(axis=0)
+    L = np.zeros_like(loc)
+    mpi.Allreduce(loc, L, op=MPI.SUM)
+    Mn = np.zeros_like(mn)
+    mpi.Allreduce(mn, Mn, op=MPI.SUM)
+    total = L[-1]
+    L = L[:-1]
+    Mn_safe = np.where(Mn > 0, Mn, np.inf)
+    gamma = L / Mn_safe[:, None]
+    meff = L ** 2 / Mn_safe[:, None]
+    share = np.where(total > 0, meff / np.where(total > 0, total, 1.0), np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        small = lambda a, d: np.abs(a) <= 1e-9 * np.sqrt(np.maximum(total[d], 1e-300) * Mn)   # noqa: E731
+        hx = np.where(small(L[:, 0], 0), np.nan, L[:, 4] / L[:, 0])
+        hy = np.where(small(L[:, 1], 1), np.nan, -L[:, 3] / L[:, 1])
+    return {"L": L, "modal_mass": Mn, "participation_factor": gamma, "effective_mass": meff,
+            "total_mass": total, "effective_mass_ratio": share, "cumulative_mass_ratio": np.cumsum(share, axis=0),
+            "effective_height": np.c_[hx, hy], "base_point": xb}
+
+
+def modes_for(cum, share=0.9):
+    """Per direction: the number of modes whose cumulative effective mass reaches ``share`` (0 when
+    the computed modes do not reach it)."""
+    out = []
+    for d in range(cum.shape[1]):
+        hit = np.flatnonzero(cum[:, d] >= share - 1e-12)
+        out.append(int(hit[0]) + 1 if hit.size else 0)
+    return np.array(out)
+
+
+def modal_participation_group(p, freqs):
+    """The output group 'modal_participation' {name: (array, unit, attrs)} of ``participation``."""
+    dirs = ", ".join(DIRECTIONS)
+    units6 = "kg (x, y, z), kg m^2 (rx, ry, rz)"
+    return {
+        "frequency": (np.asarray(freqs, float), "Hz", {"convention": "natural frequency of each mode"}),
+        "directions": (np.array([d.encode() for d in DIRECTIONS]), "1", {"convention": "the columns of the "
+                       "(modes, 6) datasets: translations x, y, z and rotations about the base point"}),
+        "modal_mass": (p["modal_mass"], "kg (shapes with max |u| = 1)", {"convention": "phi^T M phi"}),
+        "participation_factor": (p["participation_factor"], "1 (x, y, z), m (rx, ry, rz)",
+                                 {"convention": "Gamma = phi^T M r / phi^T M phi, columns " + dirs}),
+        "effective_mass": (p["effective_mass"], units6, {"convention": "effective modal mass (phi^T M r)^2 / "
+                           "phi^T M phi per direction " + dirs + "; summed over all modes it is total_mass"}),
+        "total_mass": (p["total_mass"], units6, {"convention": "r^T M r: the mass (moment of inertia about the "
+                       "base point) that moves with the base: the free dofs'"}),
+        "effective_mass_ratio": (p["effective_mass_ratio"], "1", {"convention": "effective_mass / total_mass"}),
+        "cumulative_mass_ratio": (p["cumulative_mass_ratio"], "1", {"convention": "sum of effective_mass_ratio "
+                                  "over modes 1..k"}),
+        "modes_for_90_percent": (modes_for(p["cumulative_mass_ratio"]), "1", {"convention": "the number of modes "
+                                 "whose cumulative effective mass reaches 90 % per direction (0: not reached "
+                                 "with the modes computed; ask for more with -ssi_modes_n)"}),
+        "effective_height": (p["effective_height"], "m", {"convention": "height above the base of the resultant "
+                             "of the mode's inertia forces under ground motion along x, y: base overturning moment "
+                             "/ base shear (Chopra's h*_n = L^theta / L^h); NaN without a share along it"}),
+        "base_point": (p["base_point"], "m", {"convention": "the base point (the fixed nodes' centroid at their "
+                       "lowest level) of the rotations and heights"}),
+    }

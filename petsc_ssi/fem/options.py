@@ -21,6 +21,36 @@ def _nu_range(v):
     return None if -1.0 < v < 0.5 else "Poisson's ratio must lie in (-1, 0.5)"
 
 
+def parse_pair(text):
+    """'a,b' -> (a, b) floats; SSIError otherwise."""
+    try:
+        vals = [float(x) for x in str(text).replace(";", ",").split(",") if x.strip()]
+    except ValueError:
+        vals = []
+    if len(vals) != 2:
+        raise SSIError("expected two comma-separated numbers")
+    return vals[0], vals[1]
+
+
+def _pair(what, nonneg=False, positive=False):
+    def check(text):
+        if not str(text).strip():
+            return None
+        try:
+            a, b = parse_pair(text)
+        except SSIError:
+            return f"must be two comma-separated numbers '{what}'"
+        import math
+        if not (math.isfinite(a) and math.isfinite(b)):
+            return f"must be two finite numbers '{what}'"
+        if nonneg and min(a, b) < 0:
+            return f"'{what}' must be >= 0 (a negative value is negative damping)"
+        if positive and min(a, b) <= 0:
+            return f"'{what}' must be > 0"
+        return None
+    return check
+
+
 def _triple(kind):
     def check(text):
         try:
@@ -54,6 +84,15 @@ register("fem_damping_ratio", "real", 0.0, "", "damping ratio zeta at -ssi_fem_d
          "omega (instead of -ssi_fem_alpha_m)", G, validator=nonnegative)
 register("fem_damping_freq", "real", 0.0, "Hz", "reference frequency of -ssi_fem_damping_ratio", G,
          validator=nonnegative)
+register("fem_rayleigh", "str", "", "1/s, s", "Rayleigh damping C = a0 M + a1 K by its coefficients 'a0,a1' "
+         "(zeta(f) = a0/(2 omega) + a1 omega/2, omega = 2 pi f); instead of -ssi_fem_alpha_m, "
+         "-ssi_fem_damping_ratio and -ssi_fem_rayleigh_freqs", G, validator=_pair("a0,a1", nonneg=True))
+register("fem_rayleigh_freqs", "str", "", "Hz", "Rayleigh damping C = a0 M + a1 K from two frequencies 'f1,f2' "
+         "(f1 < f2) and the ratios -ssi_fem_rayleigh_ratios there: a0 = 2 w1 w2 (z1 w2 - z2 w1)/(w2^2 - w1^2), "
+         "a1 = 2 (z2 w2 - z1 w1)/(w2^2 - w1^2); between them zeta is below the targets, outside above",
+         G, validator=_pair("f1,f2", positive=True))
+register("fem_rayleigh_ratios", "str", "", "1", "damping ratios 'z1,z2' at -ssi_fem_rayleigh_freqs (e.g. "
+         "0.05,0.05)", G, validator=_pair("z1,z2", nonneg=True))
 register("fem_integrator", "enum", "green", "", "time integrator: green (implicit Green's functions, paper "
          "eqs. 13-24) or newmark (plain Newmark)", G, choices=("green", "newmark"))
 register("fem_newmark_alpha", "real", 0.25, "", "Newmark alpha (beta in most texts); green needs "
@@ -96,6 +135,9 @@ def _fem_checks(cfg):
         return f"-ssi_fem_mesh {cfg.fem_mesh}: no such file (relative to {os.getcwd()})"
     if cfg.user_set("fem_alpha_m") and cfg.fem_damping_ratio > 0:
         return "give either -ssi_fem_alpha_m or -ssi_fem_damping_ratio, not both"
+    msg = _rayleigh_check(cfg)
+    if msg:
+        return msg
     if cfg.fem_damping_ratio > 0 and cfg.fem_damping_freq <= 0:
         return "-ssi_fem_damping_ratio needs a reference frequency -ssi_fem_damping_freq > 0"
     if cfg.fem_load_p0 != 0 and not cfg.fem_load_group.strip():
@@ -139,6 +181,92 @@ def _forces_check(cfg):
 
 
 register_check((G,), _forces_check)
+
+
+def rayleigh_from_ratios(f1, f2, z1, z2):
+    """(a0 [1/s], a1 [s]) of C = a0 M + a1 K with damping ratios z1 at f1 and z2 at f2 [Hz]:
+    zeta(w) = a0/(2 w) + a1 w/2 solved at w1 = 2 pi f1, w2 = 2 pi f2."""
+    import math
+    w1, w2 = 2 * math.pi * f1, 2 * math.pi * f2
+    den = w2 * w2 - w1 * w1
+    return 2 * w1 * w2 * (z1 * w2 - z2 * w1) / den, 2 * (z2 * w2 - z1 * w1) / den
+
+
+def rayleigh_zeta(a0, a1, f):
+    """Damping ratio of C = a0 M + a1 K at the frequency f [Hz] (an undamped mode of K, M)."""
+    import numpy as np
+    w = 2 * np.pi * np.asarray(f, float)
+    return a0 / (2 * w) + a1 * w / 2
+
+
+def _rayleigh_check(cfg):
+    """One line when the Rayleigh options are given wrongly (None otherwise)."""
+    coef = str(cfg.get("fem_rayleigh", "") or "").strip()
+    freqs = str(cfg.get("fem_rayleigh_freqs", "") or "").strip()
+    ratios = str(cfg.get("fem_rayleigh_ratios", "") or "").strip()
+    if not (coef or freqs or ratios):
+        return None
+    others = [o for o in ("fem_alpha_m", "fem_damping_ratio") if cfg.user_set(o)]
+    if coef and (freqs or ratios):
+        return ("give Rayleigh damping either by its coefficients -ssi_fem_rayleigh a0,a1 or by "
+                "-ssi_fem_rayleigh_freqs f1,f2 with -ssi_fem_rayleigh_ratios z1,z2, not both")
+    if others:
+        return (f"-ssi_{others[0]} and Rayleigh damping (-ssi_fem_rayleigh*) both set the damping: give one "
+                "(a0 of -ssi_fem_rayleigh is the mass-proportional alpha_m)")
+    if bool(freqs) != bool(ratios):
+        return ("-ssi_fem_rayleigh_freqs f1,f2 and -ssi_fem_rayleigh_ratios z1,z2 go together: give both (or the "
+                "coefficients -ssi_fem_rayleigh a0,a1)")
+    if freqs:
+        f1, f2 = parse_pair(freqs)
+        z1, z2 = parse_pair(ratios)
+        if not f1 < f2 or (f2 - f1) <= 1e-9 * f2:
+            return (f"-ssi_fem_rayleigh_freqs {freqs}: give two different frequencies f1 < f2 (a Rayleigh "
+                    "damping is fixed by its ratios at two frequencies)")
+        a0, a1 = rayleigh_from_ratios(f1, f2, z1, z2)
+        if a0 < -1e-12 * abs(a1) * (2 * 3.141592653589793 * f2) ** 2:
+            return (f"-ssi_fem_rayleigh_ratios {ratios} at {freqs} Hz gives a0 = {a0:.4g} 1/s < 0: negative "
+                    f"damping below {f1:g} Hz (need z2/z1 <= f2/f1)")
+        if a1 < -1e-12 * abs(a0) / (2 * 3.141592653589793 * f1) ** 2:
+            return (f"-ssi_fem_rayleigh_ratios {ratios} at {freqs} Hz gives a1 = {a1:.4g} s < 0: negative "
+                    f"damping above {f2:g} Hz (need z2/z1 >= f1/f2)")
+    a0, a1 = damping(cfg)[:2]
+    if a1 > 0:
+        a, d = cfg.fem_newmark_alpha, cfg.fem_newmark_delta
+        integ = cfg.get("fem_integrator", "green")
+        if integ == "green" and (abs(a - 0.25) > 1e-12 or abs(d - 0.5) > 1e-12):
+            return (f"stiffness-proportional damping (a1 = {a1:.4g} s) with -ssi_fem_integrator green needs the "
+                    f"trapezoidal rule (Newmark alpha 1/4, delta 1/2; got {a:g}, {d:g}); -ssi_fem_integrator "
+                    "newmark takes any alpha, delta")
+    return None
+
+
+def damping(cfg):
+    """(a0 [1/s], a1 [s], note): C = a0 M + a1 K from -ssi_fem_rayleigh, -ssi_fem_rayleigh_freqs/_ratios,
+    -ssi_fem_damping_ratio/_freq or -ssi_fem_alpha_m (a1 = 0 for the last two), and a one-line note."""
+    coef = str(cfg.get("fem_rayleigh", "") or "").strip()
+    freqs = str(cfg.get("fem_rayleigh_freqs", "") or "").strip()
+    if coef:
+        a0, a1 = parse_pair(coef)
+        return a0, a1, (f"Rayleigh damping C = a0 M + a1 K, a0 = {a0:.6g} 1/s, a1 = {a1:.6g} s (-ssi_fem_rayleigh)"
+                        + _zeta_note(a0, a1))
+    if freqs:
+        f1, f2 = parse_pair(freqs)
+        z1, z2 = parse_pair(cfg.fem_rayleigh_ratios)
+        a0, a1 = rayleigh_from_ratios(f1, f2, z1, z2)
+        return a0, a1, (f"Rayleigh damping C = a0 M + a1 K, zeta {z1:g} at {f1:g} Hz and {z2:g} at {f2:g} Hz: "
+                        f"a0 = {a0:.6g} 1/s, a1 = {a1:.6g} s" + _zeta_note(a0, a1))
+    am, note = alpha_m(cfg)
+    return am, 0.0, note
+
+
+def _zeta_note(a0, a1):
+    """'; zeta ... at ... Hz' at a few frequencies, and the frequency of least damping."""
+    import math
+    out = ""
+    if a0 > 0 and a1 > 0:
+        fmin = math.sqrt(a0 / a1) / (2 * math.pi)
+        out += f"; least zeta {float(rayleigh_zeta(a0, a1, fmin)):.4g} at {fmin:.4g} Hz"
+    return out
 
 
 def alpha_m(cfg):

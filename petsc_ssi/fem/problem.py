@@ -125,7 +125,8 @@ class FEMTransient(TransientProblem):
             from .demands import Demands
             sup = self.support                    # the base moves with the ground: its inertia m a_g
             ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
-            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground))
+            self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground,
+                                                a1=self.integ.a1))
         self.integ.start(f0=self.load(0))
         if rd is None:                            # the records of t = 0 (series, fields, forces, demands)
             self.rec.initial(self.time(0), write=self.grid.writes(0),
@@ -169,7 +170,8 @@ class FEMTransient(TransientProblem):
         if self.out is None:
             return []
         receivers = self.rec.structure.receivers() if comm.getRank() == 0 else None
-        groups, attrs = {}, {"problem": "fem", "alpha_m": am, "dt": cfg.dt}
+        groups, attrs = {}, {"problem": "fem", "dt": cfg.dt, **damping_attrs(am, self.integ.a1),
+                             "structure_mass": structure_mass(model, comm)}
         if self.demands is not None and comm.getRank() == 0:
             groups["demands"] = self.demands.group()
         if self.support is not None:
@@ -180,12 +182,12 @@ class FEMTransient(TransientProblem):
                 receivers["absolute_acceleration"] = (receivers["acceleration"]
                                                       + receivers["ground_acceleration"][:, None, :])
         extra = {"time_grid": {"dt_s": cfg.dt, "t_end_s": n_steps * cfg.dt, "n_steps": n_steps},
-                 "fem": {"alpha_m": am, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
+                 "fem": {"alpha_m": am, "rayleigh_a1": self.integ.a1, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                          "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
                          "elements": model.mesh.element_counts(),
                          "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
         if cfg.fem_integrator == "green":
-            extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta)
+            extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta, self.integ.a1)
         return [(self.out, {"receivers": receivers, "attrs": attrs, "groups": groups or None,
                             "record": provenance(cfg, comm, extra)})]
 
@@ -212,6 +214,23 @@ class FEMTransient(TransientProblem):
             self.demands.destroy()
         self.release_locks()                    # the run is done: its files are free again
         return out
+
+
+def structure_mass(model, comm):
+    """Collective: the structure's mass [kg] (the lumped masses of the x translations of every node, the
+    base's included; of the modelled part of a half model): W = m g is the weight of post --demands' V/W."""
+    dm = model.dofmap
+    d = dm.translation_dofs(np.arange(model.mesh.n_nodes))[:, 0]
+    r0, r1 = model.m.getOwnershipRange()
+    d = d[(d >= r0) & (d < r1)] - r0
+    return float(comm.tompi4py().allreduce(float(model.m.getArray(readonly=True)[d].sum())))
+
+
+def damping_attrs(am, a1):
+    """Output attributes of the structure's damping C = alpha_m M + rayleigh_a1 K."""
+    return {"alpha_m": float(am), "rayleigh_a1": float(a1),
+            "damping": "C = alpha_m M + rayleigh_a1 K (Rayleigh; alpha_m in 1/s, rayleigh_a1 in s); damping ratio "
+                       "of a mode of frequency f: alpha_m/(2 omega) + rayleigh_a1 omega/2, omega = 2 pi f"}
 
 
 def _plot(path, t, u):

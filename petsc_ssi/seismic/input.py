@@ -141,9 +141,20 @@ def read_motions(cfg):
     work (RecordError, SSIError on a defect)."""
     c = cfg
     out = {}
-    for axis, rec in _records(cfg).items():
-        m = process(rec, scale=c.seismic_scale, window=_window(c.seismic_window), taper=c.seismic_taper,
-                    baseline=c.seismic_baseline, highpass=c.seismic_highpass)
+    recs = _records(cfg)
+
+    def proc(rec, scale):
+        return process(rec, scale=scale, window=_window(c.seismic_window), taper=c.seismic_taper,
+                       baseline=c.seismic_baseline, highpass=c.seismic_highpass)
+    from .scaling import check_units, parse_target, target_factor         # issue 43: units, target
+    target = parse_target(c.get("seismic_target", "none"))
+    for axis, rec in recs.items():
+        if target is None:
+            m = proc(rec, c.seismic_scale)
+        else:                          # processed again with the target's factor: its warnings then
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RecordWarning)
+                m = proc(rec, c.seismic_scale)
         if m.duration < c.dt:
             raise SSIError(f"record '{rec.source}': it lasts {m.duration:.4g} s, less than one step "
                            f"dt = {c.dt:g} s")
@@ -152,6 +163,13 @@ def read_motions(cfg):
         srcs = sorted({str(m.source) for m in out.values()})
         raise SSIError(f"record '{', '.join(srcs)}': its acceleration is zero everywhere after processing: no motion "
                        "to apply")
+    if c.get("seismic_units_check", True):
+        check_units(out, c.seismic_units)
+    if target is not None:
+        f, line = target_factor(out, target, c.seismic_target_damping)
+        out = {axis: proc(rec, c.seismic_scale * f) for axis, rec in recs.items()}
+        for m in out.values():
+            m.processing["target"] = line
     return out
 
 
@@ -229,7 +247,8 @@ def collective_motions(cfg, comm):
                     motions = read_motions(cfg)
                 except RecordError as exc:
                     raise SSIError(str(exc)) from None
-            notes += [str(w.message) for w in caught if issubclass(w.category, RecordWarning)]
+            notes += list(dict.fromkeys(str(w.message) for w in caught        # (once: a target processes twice)
+                                        if issubclass(w.category, RecordWarning)))
             notes += _nyquist_notes(motions, cfg.dt)
             notes += _scheme_notes(motions, cfg)
     return comm.tompi4py().bcast((motions, notes), root=0)

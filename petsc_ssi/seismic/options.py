@@ -5,6 +5,11 @@ from ..options import register, register_check
 from .. import common_options  # noqa: F401
 
 G = "seismic"
+
+
+def _target_ok(text):
+    from .scaling import target_validator
+    return target_validator(text)
 WAVES = ("none", "vertical", "sh", "sv", "p", "rayleigh")
 
 register("seismic", "enum", "none", "", "plane-wave earthquake input in the scattered-field form: none, vertical "
@@ -29,6 +34,16 @@ register("seismic_traces", "str", "", "", "-ssi_seismic vertical with multi-trac
          "code, its suffix or the trace's index; '-' leaves an axis out); with one file in -ssi_seismic_record "
          "each listed trace drives its axis, with -ssi_seismic_record_x/_y/_z each file gives its axis's trace", G)
 register("seismic_scale", "real", 1.0, "", "amplitude factor after unit conversion", G)
+register("seismic_units_check", "bool", True, "", "refuse a record whose PGA as read (in its -ssi_seismic_units, "
+         "before -ssi_seismic_scale) is above 5 g or below 1e-6 g, implausible for an earthquake: most likely wrong "
+         "units (0: run it anyway)", G)
+register("seismic_target", "str", "none", "m/s^2, s", "scale the processed record(s) to a target: none, 'pga:A' "
+         "(PGA A), 'psa:T:A' (pseudo-spectral acceleration at the period T [s] with -ssi_seismic_target_damping, "
+         "ASCE 7 amplitude scaling) or 'sa:T:A' (spectral acceleration); A in m/s^2, or in g with a suffix g "
+         "('pga:0.4g'); one factor for every component, set by the horizontal ones (larger PGA, RotD100 of x and "
+         "y); seismic/scaling.py", G, validator=_target_ok)
+register("seismic_target_damping", "real", 0.05, "1", "damping ratio of -ssi_seismic_target psa/sa", G,
+         validator=lambda v: None if 0.0 <= v < 1.0 else "must lie in [0, 1)")
 register("seismic_control", "enum", "surface", "", "surface: the record is the free-field surface (outcrop) "
          "motion at the control point; incident: the record is the incident wave (the surface motion is twice "
          "it at vertical incidence)", G, choices=("surface", "incident"))

@@ -729,6 +729,8 @@ class Motion:
         for key, name in names.items():
             lines.append(f"{name + ' [' + STAT_UNITS[key] + ']':16s}{_fmt(self.stats_raw[key]):>24s}"
                          f"{_fmt(self.stats[key]):>24s}")
+        if p.get("target"):                       # -ssi_seismic_target (seismic/scaling.py)
+            lines.append(p["target"])
         if p.get("baseline") == "poly6":
             lines.append(f"poly6 baseline PGA change: {_fmt(np.multiply(self.baseline_pga_change, 100), '+.2f')} %")
         return lines

@@ -153,20 +153,28 @@ def test_fixed_base_limit_converges_in_the_soil_stiffness(tmp_path, record):
     assert tower_difference(tmp_path, record, 20.0, 0.0125) > 0.5
 
 
-def test_glance_on_the_tower(tmp_path, record, capsys):
+@pytest.mark.parametrize("damping", ["mass", "rayleigh"])
+def test_glance_on_the_tower(tmp_path, record, capsys, damping):
     """petsc-ssi post SSI.h5 --glance FIXED.h5 on the tower (3 s, 240 steps of 12.5 ms) on the paper's
     soil (c_s 20 m/s) and on a fixed base, both with mass-proportional damping alpha_m = 2 0.05 2 pi
     3 Hz: the free field the glance takes from the coupled run's seismic group equals the fixed-base
     run's ground acceleration (the same step means) to rounding; the fixed base's identified damping
     is alpha_m / (2 omega_0) at its identified f0 within 3 % (measured 0.4 %: the only damping of the
     fixed base, the midpoint rule adding none); the soft soil lengthens the period (measured T_ssi /
-    T_fixed 1.93) and adds damping."""
+    T_fixed 1.93) and adds damping. Issue 43: the same with Rayleigh damping of 5 % at 2 and 8 Hz (a0, a1): the
+    fixed base's identified zeta is a0/(2 omega_0) + a1 omega_0/2 at its f0 within 3 %, and the glance's row of the
+    given damping says so."""
     import csv
     import math
     from helpers import cli
     from petsc_ssi.app import glance, post
-    common = TOWER + ["-ssi_seismic_record", record, "-ssi_t_end", "3", "-ssi_dt", "0.0125",
-                      "-ssi_fem_damping_ratio", "0.05", "-ssi_fem_damping_freq", "3"]
+    from petsc_ssi.fem.options import rayleigh_from_ratios
+    alpha_m, a1 = 2 * 0.05 * 2 * math.pi * 3.0, 0.0
+    damp = ["-ssi_fem_damping_ratio", "0.05", "-ssi_fem_damping_freq", "3"]
+    if damping == "rayleigh":
+        alpha_m, a1 = rayleigh_from_ratios(2.0, 8.0, 0.05, 0.05)
+        damp = ["-ssi_fem_rayleigh_freqs", "2,8", "-ssi_fem_rayleigh_ratios", "0.05,0.05"]
+    common = TOWER + ["-ssi_seismic_record", record, "-ssi_t_end", "3", "-ssi_dt", "0.0125"] + damp
     fixed, ssi = tmp_path / "fixed.h5", tmp_path / "ssi.h5"
     cli(["-ssi_problem", "fem", "-ssi_fem_fixed", "base", "-ssi_receivers", "0,0,2", "-ssi_output", str(fixed)]
         + _fem_only(common))
@@ -181,8 +189,14 @@ def test_glance_on_the_tower(tmp_path, record, capsys):
     rows = {r[0]: r for r in csv.reader(open(out)) if r and not r[0].startswith("#")}
     f_ssi, f_fix = (float(v) for v in rows["first frequency f0 (SDOF fit)"][2:4])
     z_ssi, z_fix = (float(v) for v in rows["damping ratio zeta (SDOF fit)"][2:4])
-    alpha_m = 2 * 0.05 * 2 * math.pi * 3.0
-    assert abs(z_fix / (alpha_m / (4 * math.pi * f_fix)) - 1) < 0.03, (z_fix, f_fix)
+    zeta = lambda f: alpha_m / (4 * math.pi * f) + a1 * math.pi * f       # noqa: E731  (a0/(2 w) + a1 w/2)
+    assert abs(z_fix / zeta(f_fix) - 1) < 0.03, (z_fix, f_fix, zeta(f_fix))
+    print(f"{damping}: identified zeta {z_fix:.5f} at f0 {f_fix:.4f} Hz, given {zeta(f_fix):.5f} "
+          f"({z_fix / zeta(f_fix) - 1:+.2%})")
+    # issue 43: the glance reports the damping the structure was given (its output's attributes) at each f0
+    given = rows["damping ratio given to the structure at that f0 (C = alpha_m M + a1 K)"]
+    assert float(given[3]) == pytest.approx(zeta(f_fix), rel=1e-12)
+    assert float(given[2]) == pytest.approx(zeta(f_ssi), rel=1e-12)
     assert float(rows["fit R^2 in the band"][3]) > 0.99
     assert f_ssi < 0.8 * f_fix and z_ssi > z_fix
     assert float(rows["period T0 = 1/f0 (ratio: period lengthening)"][4]) == pytest.approx(f_fix / f_ssi, rel=1e-12)
