@@ -33,7 +33,7 @@ def parse_ranks(text):
 
 def count_run(cfg, comm, ranks, node_mem, coupled=None):
     """Collective: the BEM set-up of a run without assembly, and its counts. ``coupled``: the
-    (prob, model, iface, fe_cfg) of ``coupling.model.build_coupled`` for -ssi_problem ssi (the
+    (prob, model, iface, integrator) of ``coupling.model.build_coupled`` for -ssi_problem ssi (the
     soil with the interface as its traction region, as the coupled run assembles it)."""
     from ..bem.halfspace import HalfSpace
     from ..sysmem import machine_memory

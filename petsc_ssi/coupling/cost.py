@@ -30,10 +30,10 @@ FALLBACK = {"r_cpl": 2.0e9, "c_cstep": 4.0e-3, "n_fs": 2}
 
 class CoupledCounts:
     """Collective: the structure's measured costs and the interface's counts of a coupled run
-    (from ``build_coupled``'s (prob, model, iface, fe_cfg); assembles and factorises the structure,
+    (from ``build_coupled``'s (prob, model, iface, integrator); assembles and factorises the structure,
     nothing of the soil)."""
 
-    def __init__(self, cfg, comm, prob, model, iface, fe_cfg, n_solves=5):
+    def __init__(self, cfg, comm, prob, model, iface, integrator, n_solves=5):
         from ..fem.integrators import make_model_integrator
         mpi = comm.tompi4py()
         self.nI, self.N, self.steps = iface.n, prob.mesh.n_nodes, prob.n_steps
@@ -43,7 +43,7 @@ class CoupledCounts:
         r0 = process_rss()
         t0 = time.perf_counter()
         model.assemble()
-        _, integ, _ = make_model_integrator(fe_cfg, comm, model)
+        _, integ, _ = make_model_integrator(cfg, comm, model, integrator=integrator)
         mpi.Barrier()
         self.fem_setup_s = time.perf_counter() - t0
         b, x = integ.u.duplicate(), integ.u.duplicate()

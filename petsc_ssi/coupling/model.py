@@ -5,19 +5,11 @@ memory check (``interface_bytes``). Collective."""
 import numpy as np
 
 from ..petsc import SSIError, collective, printf
-from ..options import Config
 from ..bem.halfspace import HalfSpace, read_soil_surface
 from ..bem import symmetry
 from ..fem.model import build_model
 from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces, interface_offsets
 from .step import STRATEGIES
-
-
-def _view(cfg, **changes):
-    """A copy of the options with some values replaced."""
-    vals = cfg.as_dict()
-    vals.update(changes)
-    return Config(vals, cfg.sources())
 
 
 def check_on_surface(mesh, groups):
@@ -34,7 +26,8 @@ def check_on_surface(mesh, groups):
 
 def build_coupled(cfg, comm):
     """Collective: the soil problem, the structure's model (not assembled) and the
-    interface, all checked. Returns (prob, model, iface, fe_cfg)."""
+    interface, all checked. Returns (prob, model, iface, integrator): the last, the structure's time
+    integrator that the coupling strategy takes (``step.STRATEGIES``)."""
     from .options import ignored_contact_options
     from ..petsc import warn
     ignored = ignored_contact_options(cfg)
@@ -43,8 +36,8 @@ def build_coupled(cfg, comm):
              f"ignored (the interface is {cfg.contact})", comm)
     planes = symmetry.parse(cfg.symmetry)
     mesh = read_soil_surface(cfg, comm, planes)
-    fe_cfg = _view(cfg, receivers=cfg.structure_receivers, fem_integrator=STRATEGIES[cfg.coupling].integrator)
-    model = build_model(fe_cfg, comm, assemble_matrices=False, receivers_what="-ssi_structure_receivers",
+    model = build_model(cfg, comm, assemble_matrices=False, receivers=cfg.structure_receivers,
+                        receivers_what="-ssi_structure_receivers",
                         check_mesh=lambda mesh: check_on_surface(mesh, cfg.fem_interface))
     iface = sym = None
     with collective(comm, "matching the interface"):
@@ -59,7 +52,7 @@ def build_coupled(cfg, comm):
     prob = HalfSpace(cfg, comm, log=printf, mesh=mesh, interface=iface)
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
     model.dofmap.set_fixed(model.fixed)
-    return prob, model, iface, fe_cfg
+    return prob, model, iface, STRATEGIES[cfg.coupling].integrator
 
 
 def interface_bytes(cfg, prob, model, iface, ranks):

@@ -46,7 +46,7 @@ class SSITransient(TransientProblem):
         comm = self.comm
         with staged("SSI setup"):
             self.hist = load_history(cfg, comm)
-            self.prob, self.model, self.iface, self.fe_cfg = build_coupled(cfg, comm)
+            self.prob, self.model, self.iface, self.integrator = build_coupled(cfg, comm)
             iface = self.iface
             from ..fem.demands import DemandSpec
             from ..petsc import collective
@@ -83,12 +83,12 @@ class SSITransient(TransientProblem):
         cfg, comm, prob = self.cfg, self.comm, self.prob
         with staged("SSI FEM assembly"):
             self.model.assemble()
-            _, self.integ, self.am = make_model_integrator(self.fe_cfg, comm, self.model)
+            _, self.integ, self.am = make_model_integrator(cfg, comm, self.model, integrator=self.integrator)
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
             self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
             printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
-                   f"{self.fe_cfg.fem_integrator}): {3 * self.iface.n} BEM"
+                   f"{self.integrator}): {3 * self.iface.n} BEM"
                    + (" and FEM" if cfg.coupling == "implicit" else "")
                    + f" solves in {fmt_time(self.coupler.t_capacitance)} "
                    f"(BEM step matrix factorised once in {fmt_time(self.march.t_factor)})")

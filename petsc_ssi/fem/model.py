@@ -70,11 +70,11 @@ def structure_receivers(mesh, text, what="-ssi_receivers"):
     return np.concatenate(pts), np.concatenate(nodes).astype(np.int64), np.concatenate(dist)
 
 
-def _inputs(mesh, cfg, dofmap, receivers_what="-ssi_receivers"):
+def _inputs(mesh, cfg, dofmap, receivers_what="-ssi_receivers", receivers=None):
     fixed = fixed_dofs(mesh, cfg.fem_fixed, dofmap)
     F, pdist = nodal_load(mesh, cfg, dofmap)
     pm, mdist = point_masses(mesh, cfg.get("fem_point_mass", ""), dofmap)
-    pts, nodes, dist = structure_receivers(mesh, cfg.receivers, receivers_what)
+    pts, nodes, dist = structure_receivers(mesh, cfg.receivers if receivers is None else receivers, receivers_what)
     return fixed, F, pts, nodes, dist, np.r_[pdist, mdist], pm
 
 
@@ -89,10 +89,12 @@ def describe_parts(mesh, material=None, log=printf):
     return parts, total
 
 
-def build_model(cfg, comm, assemble_matrices=True, log=printf, receivers_what="-ssi_receivers", check_mesh=None):
+def build_model(cfg, comm, assemble_matrices=True, log=printf, receivers_what="-ssi_receivers", check_mesh=None,
+                receivers=None):
     """Collective: parse the parts, read the mesh, check the inputs, then assemble K and M.
 
-    ``receivers_what``: the option that named ``cfg.receivers`` (for its errors);
+    ``receivers``: the structure's receivers ('x,y,z;...'; None: ``cfg.receivers``);
+    ``receivers_what``: the option that named them (for its errors);
     ``check_mesh(mesh)``: the caller's own check of the mesh (raises SSIError), run before
     the inputs are checked against it (a structure placed wrong is then named as such, not
     as a receiver outside it)."""
@@ -105,7 +107,7 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf, receivers_what="-
     with collective(comm, "checking the structure's inputs"):
         if check_mesh is not None:
             check_mesh(mesh)
-        fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap, receivers_what)
+        fixed, F, pts, nodes, dist, pdist, pm = _inputs(mesh, cfg, dofmap, receivers_what, receivers)
     dofmap.set_fixed(fixed)
     fixed = dofmap.fixed                  # the section's constraints are the record of the supports
     counts = ", ".join(f"{n} {k}" for k, n in mesh.element_counts().items())
