@@ -24,6 +24,7 @@ from ..io.structure import receiver_record
 from ..bem.build import build_marcher
 from ..fem.integrators import make_model_integrator
 from ..fem.loads import load_history
+from ..sources.nodal import NodalLoad
 from ..fem.problem import damping_attrs, structure_mass
 from . import options as _options  # noqa: F401  (declares the coupling's options, and the soil's and structure's)
 from .model import build_coupled, interface_bytes
@@ -92,18 +93,21 @@ class SSITransient(TransientProblem):
                    + (" and FEM" if cfg.coupling == "implicit" else "")
                    + f" solves in {fmt_time(self.coupler.t_capacitance)} "
                    f"(BEM step matrix factorised once in {fmt_time(self.march.t_factor)})")
-        self.F, self.fn = self.model.load_vec(), self.model.load_vec()
+        self.fn = self.model.load_vec()
+        self.load_source = NodalLoad(self.model.load_vec(), self.hist)      # F a(t) (sources/nodal.py)
         self.vel = self.integ.u.duplicate()
+
+    @property
+    def F(self):
+        """The structure's spatial load Vec (the load source's F, after ``setup``): a script may
+        change it between steps."""
+        return self.load_source.F
 
     def load(self, k):
         """The structure's load of step k: at t_k as the cell mean (Green, staggered), or the mean
         over (t_{k-1}, t_k] (midpoint form, implicit)."""
-        self.F.copy(self.fn)
-        if self.cfg.coupling == "staggered" or k == 0:
-            self.fn.scale(self.hist.cell_mean(k, self.grid.dt))
-        else:
-            self.fn.scale(self.hist.step_mean(k, self.grid.dt))
-        return self.fn
+        rule = "cell" if self.cfg.coupling == "staggered" or k == 0 else "step"
+        return self.load_source.sample(self.fn, k, self.grid.dt, rule)
 
     def start(self):
         self._advance("set up", "started")

@@ -26,6 +26,7 @@ from .. import timegrid
 from . import options as _options  # noqa: F401  (declares the structure's -ssi_fem_ options)
 from .model import build_model
 from .loads import load_history
+from ..sources.nodal import NodalLoad
 from .integrators import make_model_integrator, green_constants
 
 
@@ -64,7 +65,8 @@ class FEMTransient(TransientProblem):
         with staged("FEM assembly"):
             self.model.assemble()
             _, self.integ, self.am = make_model_integrator(self.cfg, self.comm, self.model)
-        self.F, self.fn = self.model.load_vec(), self.model.load_vec()
+        self.fn = self.model.load_vec()
+        self.load_source = NodalLoad(self.model.load_vec(), self.hist)      # F a(t) (sources/nodal.py)
         self.vel = self.integ.u.duplicate()
         self.inertia = self._inertia() if self.support is not None else {}
 
@@ -89,12 +91,17 @@ class FEMTransient(TransientProblem):
             out[axis] = v
         return out
 
+    @property
+    def F(self):
+        """The structure's spatial load Vec (the load source's F, after ``setup``): a script may
+        change it between steps."""
+        return self.load_source.F
+
     def load(self, n):
         """The load sample of step n: the spatial load times the mean of the history over the
         step's cell [t_n - dt/2, t_n + dt/2]; with a support motion also -M iota times the mean
         ground acceleration over the same cell (exact for the piecewise-linear record)."""
-        self.F.copy(self.fn)
-        self.fn.scale(self.hist.cell_mean(n, self.grid.dt))
+        self.load_source.sample(self.fn, n, self.grid.dt, "cell")
         t, h = self.time(n), 0.5 * self.grid.dt
         for axis, v in self.inertia.items():
             self.fn.axpy(float(self.support.mean_acceleration(axis, t - h, t + h)), v)

@@ -20,7 +20,12 @@ of surface load is a class with these members, or plain data given to ``SurfaceT
                              those its symmetry planes contradict (``bem.symmetry.check_compatible``)
     describe()               one line for the run's log
 
+The structure's load (``nodal.NodalLoad``): F a(t) with F the nodal forces of the options' pressures
+and point loads, sampled per step by the integrator's rule ('cell' or 'step'); the fixed base and
+the coupled run both take it (their load() methods had each written the sampling).
+
 Where a new excitation goes: a new kind of source is a module here; the domains take it through
 their ``sources`` argument (``bem.problem.BEMTransient(cfg, comm, sources=[...])``).
 """
 from .traction import SurfaceTraction, uniform_patch, soil_sources  # noqa: F401
+from .nodal import NodalLoad  # noqa: F401
