@@ -185,6 +185,23 @@ def check_restart(cfg, comm, kind, outputs=()):
     return head
 
 
+def not_ours(path, comm, run_id, overwrite=False):
+    """Collective: a phrase if ``path`` exists and is not a checkpoint of the run ``run_id`` (another
+    run's, or another file), which a checkpoint write would replace (unless ``overwrite``), else None."""
+    why = None
+    if comm.getRank() == 0 and not overwrite and os.path.lexists(path):
+        rid = None
+        try:
+            with _h5(path, "r") as f:
+                v = f.attrs.get("run_id", "")
+                rid = v.decode() if isinstance(v, bytes) else str(v)
+        except Exception:  # noqa: BLE001 -- not an HDF5 file: not ours
+            pass
+        if not run_id or rid != run_id:
+            why = f"{path} exists and is not this run's checkpoint (add -ssi_output_overwrite to replace it)"
+    return comm.tompi4py().bcast(why, root=0)
+
+
 def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
     """Collective: a checkpoint at ``path``, atomically (``path``.tmp, then renamed). ``vecs``:
     {name: Vec}, written by the PETSc HDF5 viewer; ``serial``: {name: array} of rank 0; every

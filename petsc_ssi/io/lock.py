@@ -99,7 +99,8 @@ def _create(lockfile, holder):
 def acquire(paths, comm, holder, what="-ssi_output"):
     """Collective: a lock on each of ``paths`` (rank 0); SSIError in one line on every rank if
     another run holds one (the locks made are given back); the list of lock files held."""
-    files = [lock_path(os.path.abspath(p)) for p in dict.fromkeys(paths)]
+    # the real path: two names of one file (a symbolic link, a linked directory) take one lock
+    files = list(dict.fromkeys(lock_path(os.path.realpath(p)) for p in paths))
     err, notes, made = None, [], []
     if comm.getRank() == 0:
         for f in files:

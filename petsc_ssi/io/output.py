@@ -89,6 +89,24 @@ def output_files(path):
     return [path] + [stem + s for s in SIDECARS]
 
 
+def file_keys(path):
+    """What the file ``path`` is, to compare two names of files (never by ``os.path.abspath``, which
+    sees two names of one file through a symbolic link, a linked directory or a hard link as two
+    files): its real path (links and '..' resolved) and, when it exists, its device and inode."""
+    keys = {("path", os.path.realpath(path))}
+    try:
+        st = os.stat(path)
+        keys.add(("inode", st.st_dev, st.st_ino))
+    except OSError:
+        pass
+    return keys
+
+
+def same_file(a, b):
+    """Whether the names ``a`` and ``b`` are one file (``file_keys``)."""
+    return bool(file_keys(a) & file_keys(b))
+
+
 def remove_output(path):
     """Rank 0: a scratch run's output gone: FILE.h5, its sidecars and its parts directory."""
     import shutil
