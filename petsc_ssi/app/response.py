@@ -298,11 +298,24 @@ def _miss_bound(t, periods, k):
 
 # ---------------------------------------------------------------- spectra
 
+MAX_SUBSTEPS = 10 ** 7     # sub-steps of the oscillators' march (a few minutes) beyond which a spectrum is refused
+
+
 def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, oversample="auto"):
     """([(label, ResponseSpectrum)], sub-steps): a spectrum per component (labels x, y, z or
     a), or RotD50, RotD100 (``rotd``) and/or GM (``geomean``) of the components x, y."""
     periods = rs.standard_periods() if periods is None else periods
     k = auto_oversample(series.t, periods) if oversample == "auto" else int(oversample)
+    steps = k * (len(series.t) - 1)
+    if steps > MAX_SUBSTEPS:
+        # each sub-step is one pass of the recurrence over every oscillator (about 20 us in Python):
+        # 1e8 sub-steps per sample ran for days
+        pos = np.asarray(periods)[np.asarray(periods) > 0]
+        why = (f"--oversample {oversample}" if oversample != "auto" else
+               f"--oversample auto (10 dt / T_min with the shortest period {float(pos.min()):g} s in --periods)")
+        raise _error(f"{why}: {k} sub-steps per time step over {len(series.t) - 1} steps are {steps:.3g} sub-steps, "
+                     f"more than {MAX_SUBSTEPS:.0e} (about {steps * 2e-5 / 3600:.2g} h); give a smaller --oversample "
+                     f"(auto gives {auto_oversample(series.t, periods)}) or a longer shortest period in --periods")
     out = []
     if rotd or geomean:
         if series.components[:2] != ("x", "y"):

@@ -12,7 +12,9 @@ A checkpoint of a run after step n holds
       ``step``, ``n_steps``, ``problem``, ``ranks``, ``format``, the package version, ``key``:
       the options that define the run (``run_key``) as JSON, with a SHA-256 of every input file
       they name (meshes, load tables), and ``run_id``: the id the run wrote into its output too
-      (a restart continues only an output of the same run)
+      (a restart continues only an output of the same run); ``attrs_sha256``: the SHA-256 of
+      these attributes and of every dataset's CRC32 list (``attrs_digest``), so an edited
+      attribute is refused like damaged data
   on every dataset, attribute ``crc32``
       the CRC32 of each 8 MiB piece of its data (``io.integrity``: the ranks sum the pieces in
       turn, no gather); a restart verifies them before any heavy work and refuses a damaged file
@@ -39,7 +41,20 @@ import numpy as np
 
 from ..petsc import init, collective, collective_error, collective_io, ensure_space, SSIError
 
-FORMAT = 2          # 2: with run_id and the CRC32 of every dataset's data (1: refused)
+FORMAT = 3          # 3: with the SHA-256 of the attributes; 2: run_id and the CRC32 of every dataset's data (1, 2: refused)
+ATTRS = ("format", "step", "n_steps", "problem", "ranks", "petsc_ssi_version", "key", "run_id")
+
+
+def attrs_digest(attrs, crcs):
+    """SHA-256 of the attributes a restart trusts (``ATTRS``: the step it resumes after, the run's
+    options, its id, ...) and of every dataset's CRC32 list: an attribute edited by hand or damaged
+    is refused like a damaged dataset."""
+    def text(v):
+        v = v.item() if hasattr(v, "item") else v
+        return v.decode() if isinstance(v, bytes) else str(v)
+    blob = json.dumps({"attrs": {k: text(attrs.get(k, "")) for k in ATTRS},
+                       "crc32": {k: [int(c) for c in v] for k, v in sorted(crcs.items())}}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
 
 # Options that steer how a run is carried out, watched or written, not what it computes: a restart
 # may change them. Every other -ssi_ option defines the run and must be the same on restart.
@@ -48,7 +63,7 @@ RUN_CONTROL = frozenset((
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
     "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
-    "huge_pages", "disk_check"))
+    "huge_pages", "disk_check", "debug"))
 
 
 def _file_digest(path):
@@ -126,16 +141,30 @@ def read_header(path, comm):
                 raise SSIError(f"-ssi_restart {path}: no such file")
             import h5py
             with _h5(path, "r") as f:
-                if int(f.attrs.get("format", -1)) == 1:
+                fmt = f.attrs.get("format", -1)
+                fmt = int(fmt) if np.ndim(fmt) == 0 and np.issubdtype(np.asarray(fmt).dtype, np.number) else -1
+                if fmt in (1, 2):
                     raise SSIError(f"-ssi_restart {path}: a checkpoint of an older petsc-ssi without checksums "
-                                   "of its content (format 1); run again from the start")
-                if int(f.attrs.get("format", -1)) != FORMAT or "key" not in f.attrs:
+                                   f"of its {'content' if fmt == 1 else 'attributes'} (format {fmt}); run again "
+                                   "from the start")
+                if fmt != FORMAT or "key" not in f.attrs:
                     raise SSIError(f"-ssi_restart {path}: not a petsc-ssi checkpoint (format {FORMAT})")
-                head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
-                head["key"] = json.loads(str(head["key"]))
                 crc = {}
                 f.visititems(lambda name, obj: crc.__setitem__(name, [int(c) for c in obj.attrs["crc32"]])
                              if isinstance(obj, h5py.Dataset) and "crc32" in obj.attrs else None)
+                saved = f.attrs.get("attrs_sha256", "")
+                saved = saved.decode() if isinstance(saved, bytes) else str(saved)
+                if saved != attrs_digest(f.attrs, crc):
+                    raise SSIError(f"-ssi_restart {path}: its attributes (step, options, run id, checksums) differ "
+                                   "from their SHA-256 (attrs_sha256): a damaged or edited checkpoint; restart from "
+                                   "an earlier one or run again from the start")
+                head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+                head = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in head.items()}
+                try:
+                    head["key"] = json.loads(str(head["key"]))
+                    int(head["step"]), int(head["n_steps"])
+                except (ValueError, TypeError) as exc:
+                    raise SSIError(f"-ssi_restart {path}: unreadable attributes ({exc})") from None
                 head["crc32"] = crc
     return comm.tompi4py().bcast(head, root=0)
 
@@ -236,6 +265,7 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
                 f.attrs.update({"format": FORMAT, "step": int(step), "n_steps": int(n_steps), "problem": kind,
                                 "ranks": comm.getSize(), "petsc_ssi_version": __version__,
                                 "key": json.dumps(key, sort_keys=True), "run_id": run_id})
+                f.attrs["attrs_sha256"] = attrs_digest(f.attrs, crcs)
             fd = os.open(tmp, os.O_RDONLY)
             try:
                 os.fsync(fd)

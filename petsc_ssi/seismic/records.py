@@ -523,11 +523,30 @@ def _highpass(path, t, a, fc):
     if not fc < nyq:
         _refuse(path, f"high-pass corner {fc:g} Hz is not below the Nyquist frequency {nyq:g} Hz")
     npad = int(np.ceil(0.75 * HIGHPASS_ORDER / fc / dt))
+    _check_pad_memory(path, fc, dt, npad, a.shape)
     ap = np.vstack([np.zeros((npad, a.shape[1])), a, np.zeros((npad, a.shape[1]))])
     sos = butter(HIGHPASS_ORDER // 2, fc / nyq, btype="highpass", output="sos")
     af = sosfiltfilt(sos, ap, axis=0, padtype=None)
     tp = t[0] + dt * (np.arange(len(ap)) - npad)
     return tp, af, npad
+
+
+PAD_COPIES = 8          # arrays of the padded record's size alive at once (filter, integration, motion)
+
+
+def _check_pad_memory(path, fc, dt, npad, shape):
+    """Refuse a high-pass whose padded record (2 npad zeros more, ``PAD_COPIES`` arrays of it) would
+    not fit in half the memory of the machine (or its cgroup): f_c = 1e-7 Hz padded 6e9 samples, a
+    44.7 GiB allocation that ended in MemoryError after the set-up."""
+    from ..sysmem import machine_memory
+    need = PAD_COPIES * 8.0 * (2 * npad + shape[0]) * shape[1]
+    room = 0.5 * machine_memory()
+    if need > room:
+        fc_min = 0.75 * HIGHPASS_ORDER / dt / max(1.0, (room / (PAD_COPIES * 8.0 * shape[1]) - shape[0]) / 2)
+        _refuse(path, f"-ssi_seismic_highpass {fc:g} Hz pads the record with 2 x {npad:.3g} zeros "
+                      f"({2 * npad * dt:.3g} s): about {need / 1e9:.3g} GB, more than half the memory "
+                      f"({room / 1e9:.3g} GB); give a corner of at least {fc_min:.2g} Hz (a corner below "
+                      f"1 / the record's length removes nothing the baseline does not)")
 
 
 def _check_args(path, scale, taper, baseline, pad_start):
