@@ -53,9 +53,12 @@ def _start(cfg):
     if text == "auto":
         return None
     try:
-        return float(text)
+        t0 = float(text)
     except ValueError:
         raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+    if not np.isfinite(t0):                 # nan ran to the end with NaN in every dataset
+        raise SSIError(f"-ssi_seismic_start '{text}': expected auto or a finite number of seconds")
+    return t0
 
 
 def record_lines(motions, tag):
@@ -207,6 +210,9 @@ class SupportMotion:
         self.factor = 2.0 if cfg.seismic_control == "incident" else 1.0
         self.motions, self.notes = collective_motions(cfg, comm)
         t0 = _start(cfg)
+        if t0 is not None and t0 < 0:
+            raise SSIError(f"-ssi_seismic_start {t0:g}: a negative shift drops the first {-t0:g} s of the record (the "
+                           "fixed base starts at t = 0); give a shift >= 0, or auto (one step)")
         self.t0 = cfg.dt if t0 is None else t0
         self.duration = self.t0 + max(m.t[-1] for m in self.motions.values())
 

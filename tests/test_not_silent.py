@@ -1,0 +1,60 @@
+"""Nothing lost, nothing silent, round three (issue 44): silent wrong answers, each now refused in
+one line naming the option (or said in a note).
+
+  * ``--glance`` against a "twin" that ran another record (its SHA-256) or another scale (the
+    processed record): refused (before: a table of SSI effects that were the records' difference);
+  * ``-ssi_seismic_start nan`` (before: NaN in every dataset, exit 0) and ``-1`` on a fixed base
+    (before: the first second of the record dropped): refused.
+"""
+import numpy as np
+import pytest
+
+from test_post_glance import write_ssi, write_fixed, run as glance
+
+
+@pytest.mark.unit
+def test_glance_refuses_a_twin_of_another_record_or_scale(tmp_path, capsys):
+    import h5py
+    s = write_ssi(str(tmp_path))
+    fx = write_fixed(str(tmp_path))
+    assert glance([s, "--glance", fx], capsys)[0] == 0
+    with h5py.File(fx, "r+") as f:
+        f["seismic/x_acceleration"][...] = 2.0 * f["seismic/x_acceleration"][()]        # -ssi_seismic_scale 2
+    st, out, err = glance([s, "--glance", fx], capsys)
+    assert st == 2 and "processed x records differ" in err and "-ssi_seismic_scale" in err, err
+    assert len(err.strip().splitlines()) == 1
+    fx = write_fixed(str(tmp_path), name="fixed2.h5")
+    for path, sha in ((s, "a" * 64), (fx, "b" * 64)):
+        with h5py.File(path, "r+") as f:
+            f["seismic/x_sha256"] = np.bytes_(sha)
+    st, out, err = glance([s, "--glance", fx], capsys)
+    assert st == 2 and "the runs' records differ (x: SHA-256 aaaaaaaaaaaa..." in err, err
+
+
+def _fem_record(tmp_path, cols=1):
+    t = np.arange(0.0, 1.0, 0.005)
+    a = np.sin(2 * np.pi * 3 * t) * np.hanning(t.size)
+    path = str(tmp_path / "rec.txt")
+    np.savetxt(path, np.c_[t, np.outer(a, np.ones(cols))], header="units: m/s2")
+    return path
+
+
+FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_t_end", "0.02", "-ssi_dt", "0.005",
+       "-ssi_output", "", "-ssi_seismic", "vertical"]
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_fixed_base_start_that_is_not_a_shift_or_floats_is_refused(tmp_path, n):
+    from helpers import cli
+    from test_integrity import refused
+    one, three = _fem_record(tmp_path), _fem_record(tmp_path / "..", 3)
+    cases = [(["-ssi_fem_fixed", "base", "-ssi_seismic_record", one, "-ssi_seismic_start", "nan"],
+              "-ssi_seismic_start 'nan': expected auto or a finite number of seconds"),
+             (["-ssi_fem_fixed", "base", "-ssi_seismic_record", one, "-ssi_seismic_start", "-1"],
+              "-ssi_seismic_start -1: a negative shift drops the first 1 s of the record"),
+             (["-ssi_seismic_record", one], "drives x but no translation along x is fixed (-ssi_fem_fixed (none))"),
+             (["-ssi_fem_fixed", "base:x", "-ssi_seismic_record", three],
+              "drives y, z but no translation along y or z is fixed (-ssi_fem_fixed base:x)")]
+    for extra, msg in cases:
+        err = refused(cli(FEM + extra, nranks=n, check=False))
+        assert msg in err, (extra, err)
