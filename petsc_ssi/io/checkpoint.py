@@ -84,7 +84,37 @@ def run_key(cfg, exclude=RUN_CONTROL):
         key[name] = repr(val) if isinstance(val, float) else str(val)
         if isinstance(val, str) and val and os.path.isfile(val):
             key["file:" + name] = _file_digest(val)
+    seismic = str(cfg.get("seismic", "none") or "none") != "none"
+    if seismic and hasattr(cfg, "user_set") and "t_end" in key and not cfg.user_set("t_end"):
+        # the run lasts the record: t_end is derived (the record, the start and dt are in the key),
+        # the same on restart, where it is set only after this check (before: 0.04 here, 15.005 saved)
+        key["derived:t_end"] = key.pop("t_end")
+        key["t_end"] = DERIVED
+    if "seismic_format" in key:
+        key["seismic_format"] = _record_format(cfg)
     return key
+
+
+DERIVED = "(not given: the record's length)"
+
+
+def _record_format(cfg):
+    """-ssi_seismic_format as the record is read: 'auto' resolved to what it finds (peer, table or obspy),
+    so a restart that names the format auto found is the same run (before: refused as a change)."""
+    fmt = str(cfg.get("seismic_format", "auto") or "auto")
+    path = next((cfg.get(k) for k in ("seismic_record", "seismic_record_x", "seismic_record_y", "seismic_record_z")
+                 if cfg.get(k) and os.path.isfile(cfg.get(k))), None)
+    if path is None or str(cfg.get("seismic", "none")) == "none":
+        return fmt
+    from ..seismic.records import _detect
+    try:
+        with open(path, "rb") as fh:
+            kind = _detect(path, fh.read(1 << 16), fmt)
+    except OSError:
+        return fmt
+    if kind in ("peer", "table"):
+        return kind
+    return "obspy" if fmt.lower() in ("auto", "obspy") else fmt.upper()
 
 
 def key_difference(saved, now):
@@ -93,7 +123,19 @@ def key_difference(saved, now):
     option naming an input file compares by the file's SHA-256, not its path."""
     from ..options import _REGISTRY
     for name in sorted(set(saved) | set(now)):
+        if name.startswith("derived:"):
+            continue                             # a value the run derives, compared through ``name``
         a, b = saved.get(name), now.get(name)
+        if DERIVED in (a, b) and a != b:         # derived on one side, given on the other: the saved value
+            da = saved.get("derived:" + name, a)
+            try:
+                if a == DERIVED and float(b) == float(da):
+                    continue                     # given as the value the interrupted run derived
+            except (TypeError, ValueError):
+                pass
+            return (f"-ssi_{name} is {b} here and was {a if a != DERIVED else f'{da} {DERIVED}'}"
+                    + (f"; leave -ssi_{name} out, as the interrupted run did" if a == DERIVED else
+                       f"; give -ssi_{name} {a}, as the interrupted run did"))
         if a is None and name in _REGISTRY and not name.startswith("file:"):
             d = _REGISTRY[name].default
             a = repr(d) if isinstance(d, float) else str(d)
@@ -211,6 +253,15 @@ def check_restart(cfg, comm, kind, outputs=()):
             raise SSIError(f"-ssi_output {out}: exists and is not the output of the run that wrote -ssi_restart "
                            f"{path} (run id {rid or '(none)'} there, {head.get('run_id')} in the checkpoint); a "
                            "restart continues its own run's output: give that one, or a name that does not exist")
+        if rid is not None:                      # its parts, before the assembly (before: refused after it)
+            from .output import missing_part
+            gone = None
+            with collective(comm, f"-ssi_output {out}", "{what}: cannot read it ({error})"):
+                if comm.getRank() == 0:
+                    gone = missing_part(out)
+            gone = comm.tompi4py().bcast(gone, root=0)
+            if gone:
+                raise SSIError(f"-ssi_output {gone}; restore the part, or restart into a new -ssi_output name")
     return head
 
 
