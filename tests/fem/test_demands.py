@@ -235,6 +235,9 @@ def test_fixed_base_equilibrium_every_step(msh, record, tmp_path, alpha_m):
     ({"structure_drift_levels": "0,3,4.2"}, "no node of the structure within 0.01 m (-ssi_structure_level_tol) "
                                             "of z = 4.2 m (the nearest node levels: 4.5, 3, 6 m)"),
     ({"structure_drift_levels": "3,0"}, "increasing"),
+    # levels that share nodes (issue 44: a tolerance of metres gave drift 0 every step)
+    ({"structure_drift_levels": "0,3,6", "structure_level_tol": 3.5}, "the levels z = 0 and 3 m share"),
+    ({"structure_drift_levels": "3,3.001"}, "the levels z = 3 and 3.001 m share 4 node(s)"),
     ({"structure_drift_levels": "0,a"}, "expected levels"),
     ({"structure_drift_pairs": "0:7"}, "receiver 7 does not exist (-ssi_receivers gives 2 receiver(s)"),
     ({"structure_drift_pairs": "1:0"}, "must lie above"),
