@@ -58,3 +58,20 @@ def test_a_fixed_base_start_that_is_not_a_shift_or_floats_is_refused(tmp_path, n
     for extra, msg in cases:
         err = refused(cli(FEM + extra, nranks=n, check=False))
         assert msg in err, (extra, err)
+
+
+def test_a_ratio_against_a_component_without_motion_says_so(tmp_path, capsys):
+    import io
+    from petsc_ssi.app import response as rsp
+    t = np.arange(0.0, 2.0, 0.01)
+    a = np.sin(2 * np.pi * t)
+    for name, scale in (("a.txt", 1.0), ("b.txt", 0.5), ("z.txt", 1e-20)):
+        np.savetxt(str(tmp_path / name), np.c_[t, scale * a])
+    for b, noted in (("b.txt", False), ("z.txt", True)):
+        out = io.StringIO()
+        st = rsp.main(["--response-spectrum", "--table", str(tmp_path / "a.txt"), "--ratio-table",
+                       str(tmp_path / b), "--periods", "0.5,1"], out=out)
+        assert st == 0, capsys.readouterr().err
+        text = out.getvalue()
+        assert ("note: B's a component (z.txt) peaks at 1e-20 m/s^2 against A's 1: it carries no motion" in text) \
+            == noted, text

@@ -357,6 +357,21 @@ def noise_notes(*series):
     return out
 
 
+def ratio_notes(A, B):
+    """Notes for a ratio A / B whose B component carries no motion against A's (peaks below ROUNDOFF of
+    A's: round-off, a component the other run's record did not drive): every ratio is then about
+    1 / ROUNDOFF (1e16 seen), not an amplification."""
+    out = []
+    pa = np.atleast_1d(np.abs(np.asarray(A.a, float)).max(axis=0))
+    pb = np.atleast_1d(np.abs(np.asarray(B.a, float)).max(axis=0))
+    for c, x, y in zip(B.components, pa, pb):
+        if x > 0 and y <= ROUNDOFF * x:
+            out.append(f"note: B's {c} component ({os.path.basename(B.path)}) peaks at {y:.3g} m/s^2 against A's "
+                       f"{x:.3g}: it carries no motion, so its ratios ({x / y if y else float('inf'):.3g} at the peak) "
+                       f"are not amplifications; compare with a run whose record drives {c}")
+    return out
+
+
 def ratios(spec_a, spec_b):
     """[(label, a / b)] of two lists from ``spectra`` with the same labels."""
     return [(la, rs.spectral_ratio(sa, sb)) for (la, sa), (_, sb) in zip(spec_a, spec_b)]
@@ -536,6 +551,8 @@ def main(argv=None, out=None):
         header = _summary(A, B, specs, ptext, periods, a, k, kb if B is not None else None)
         if not (a.rotd or a.geomean):
             header += noise_notes(*([A] if B is None else [A, B]))
+        if B is not None:
+            header += ratio_notes(A, B)
         peaks = peak_lines(specs, a.plot_quantity, ratio=B is not None)
         if a.csv == "-":
             write_table(out, specs, header + peaks, ratio=B is not None)
