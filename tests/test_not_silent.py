@@ -75,3 +75,27 @@ def test_a_ratio_against_a_component_without_motion_says_so(tmp_path, capsys):
         text = out.getvalue()
         assert ("note: B's a component (z.txt) peaks at 1e-20 m/s^2 against A's 1: it carries no motion" in text) \
             == noted, text
+
+
+@pytest.mark.parametrize("text,words", [
+    ("PEER\nev, st, E\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=   4, DT= 100.0 SEC\n0 1 -1 0\n",
+     "DT = 100.0 s on line 4: a strong-motion record is sampled every 1 s or faster"),
+])
+def test_a_peer_record_sampled_implausibly_is_refused(tmp_path, text, words):
+    from petsc_ssi.seismic import records as R
+    path = tmp_path / "r.AT2"
+    path.write_text(text)
+    with pytest.raises(R.RecordError) as e:
+        R.read_record(str(path))
+    assert words in str(e.value), e.value
+
+
+def test_record_refusals_name_the_options(tmp_path):
+    from petsc_ssi.seismic import records as R
+    path = tmp_path / "t.txt"
+    path.write_text("0 1\n0.01 2\n0.02 0\n")
+    for kw, words in (({}, "give them with -ssi_seismic_units (post: --table-units)"),
+                      ({"units": "m/s2", "component": "x"}, "(-ssi_seismic_component or -ssi_seismic_traces)")):
+        with pytest.raises(R.RecordError) as e:
+            R.read_record(str(path), **kw)
+        assert words in str(e.value) and "units=" not in str(e.value) and "component=" not in str(e.value), e.value

@@ -111,10 +111,10 @@ def _records(cfg):
     traces = [x.strip() for x in c.seismic_traces.split(",")] if c.get("seismic_traces") else [None] * 3
     traces = [int(x) if x is not None and x.isdigit() else x for x in traces]     # an index, or a channel
     if not c.seismic_record:
-        return {a: read(c.get(f"seismic_record_{a}"), tr) for a, tr in zip(AXES, traces)
-                if c.get(f"seismic_record_{a}") and tr != "-"}
+        return _distinct({a: read(c.get(f"seismic_record_{a}"), tr) for a, tr in zip(AXES, traces)
+                          if c.get(f"seismic_record_{a}") and tr != "-"}, c)
     if c.get("seismic_traces"):                                    # one multi-trace file, a trace per axis
-        return {a: read(c.seismic_record, tr) for a, tr in zip(AXES, traces) if tr != "-"}
+        return _distinct({a: read(c.seismic_record, tr) for a, tr in zip(AXES, traces) if tr != "-"}, c)
     rec = read(c.seismic_record)
     if np.ndim(rec.values) == 2:                                   # a 't ax ay az' table
         return {a: dataclasses.replace(rec, values=rec.values[:, k]) for k, a in enumerate(AXES)}
@@ -123,6 +123,22 @@ def _records(cfg):
         raise SSIError(f"-ssi_seismic_component {c.seismic_component}: with -ssi_seismic vertical and a "
                        "one-component record, the component it drives: x, y or z")
     return {axis: rec}
+
+
+def _distinct(recs, cfg):
+    """SSIError if one trace of one multi-trace file drives two axes (-ssi_seismic_traces E,E,E drove x,
+    y and z with the east component: a diagonal motion nobody recorded)."""
+    seen = {}
+    for axis, r in recs.items():
+        m = r.metadata
+        if "obspy_format" not in m:
+            continue
+        k = (r.sha256, m.get("station"), m.get("component"), m.get("starttime"))
+        if k in seen:
+            raise SSIError(f"-ssi_seismic_traces {cfg.get('seismic_traces') or '(none)'}: the trace {m.get('component')} "
+                           f"of {r.source} drives both {seen[k]} and {axis}; give each axis its own trace (e.g. E,N,Z)")
+        seen[k] = axis
+    return recs
 
 
 def read_motions(cfg):
