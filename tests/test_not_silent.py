@@ -99,3 +99,21 @@ def test_record_refusals_name_the_options(tmp_path):
         with pytest.raises(R.RecordError) as e:
             R.read_record(str(path), **kw)
         assert words in str(e.value) and "units=" not in str(e.value) and "component=" not in str(e.value), e.value
+
+
+def test_input_motion_keeps_the_control_point_where_disp_ref_moves(tmp_path):
+    """-ssi_disp_ref says about which point the footing's motion is told, not where the wave is
+    controlled: the wave's start t0 (and so every series) is the same with and without it (before:
+    the control point moved to x_ref and an oblique wave's series shifted in time)."""
+    import h5py
+    from helpers import run_bem
+    sys_path = __import__("sys").path
+    sys_path.insert(0, str(__import__("pathlib").Path(__file__).parent / "bem"))
+    from test_input_motion import pulse, base
+    rec = pulse(tmp_path / "p.txt", 0.1)
+    t0 = []
+    for name, extra in (("a.h5", {}), ("b.h5", {"disp_ref": "0.5,0,0"})):
+        run_bem(**base(tmp_path, name, rec, symmetry="y=anti", t_end=0.03, **extra))
+        with h5py.File(tmp_path / name, "r") as f:
+            t0.append(float(f["seismic/t0"][()]))
+    assert t0[0] == t0[1], t0

@@ -119,8 +119,12 @@ class HalfSpace:
         self._lags()
         self._warnings(h)
         self.seismic = None
-        if cfg.get("seismic", "none") != "none" and self.massless:     # the control point: x_ref by default
-            self.attach_seismic(self.motion.xref)
+        if cfg.get("seismic", "none") != "none" and self.massless:
+            # the control point: the footing's centroid, as -ssi_seismic_ref auto says, whatever -ssi_disp_ref
+            # (which only says about which point the motion is told: before, it moved the wave's control
+            # point too, and every series shifted in time against the run without it)
+            from .input_motion import region_centroid
+            self.attach_seismic(region_centroid(self.mesh, self.regions, self.planes))
         elif cfg.get("seismic", "none") != "none" and len(disp):
             self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
         elif cfg.get("seismic", "none") != "none" and not defer_seismic:
