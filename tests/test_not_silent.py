@@ -117,3 +117,56 @@ def test_input_motion_keeps_the_control_point_where_disp_ref_moves(tmp_path):
         with h5py.File(tmp_path / name, "r") as f:
             t0.append(float(f["seismic/t0"][()]))
     assert t0[0] == t0[1], t0
+
+
+def test_a_wave_needs_a_scatterer_and_a_footing_soil_around_it(tmp_path):
+    """Refused before the assembly: a massless footing that is the whole meshed surface or reaches
+    its edge (before: input-motion ran it), and a wave on the half-space with nothing in it (before:
+    a zero scattered field was marched)."""
+    import sys
+    import pathlib
+    sys.path.insert(0, str(pathlib.Path(__file__).parent / "bem"))
+    from helpers import resolve_error
+    from test_input_motion import pulse, base
+    rec = pulse(tmp_path / "p.txt", 0.1)
+    o = base(tmp_path, "r.h5", rec)
+    o.pop("output")
+    groups = ("common", "bem", "seismic")
+    err = resolve_error(groups, **dict(o, disp_group="box:-1,1,-1,1"))
+    assert "the footing is the whole meshed surface; a massless footing (input-motion) needs" in err, err
+    err = resolve_error(groups, **dict(o, disp_group="box:-0.5,1,-0.5,0.5"))
+    assert "the footing reaches the edge of the meshed surface" in err, err
+    nothing = {k: v for k, v in o.items() if not k.startswith("disp")}
+    err = resolve_error(groups, **nothing)
+    assert "-ssi_seismic sh on the half-space alone with nothing in it" in err, err
+    assert resolve_error(groups, **o) is None
+
+
+def test_a_wave_with_a_zero_soil_load_is_not_called_load_free(tmp_path, capfd):
+    """runs/seismic/building.opts zeroes the demo's soil load (-ssi_load_p0 0) under the wave of a
+    coupled run: no warning that the run is load-free (the wave loads it); without a wave it stays."""
+    import sys
+    import pathlib
+    sys.path.insert(0, str(pathlib.Path(__file__).parent / "bem"))
+    from helpers import petsc
+    from test_input_motion import pulse, base
+    from petsc_ssi import options
+    import petsc_ssi.app.kinds  # noqa: F401
+    from petsc_ssi.bem.halfspace import HalfSpace
+    PETSc = petsc()
+    o = {k: v for k, v in base(tmp_path, "r.h5", pulse(tmp_path / "p.txt", 0.1)).items()
+         if not k.startswith("disp") and k != "output"}
+    o.update(load_group="load", load_p0=0)
+    db = PETSc.Options()
+    for wave, said in ((True, False), (False, True)):
+        opts = o if wave else {k: v for k, v in o.items() if not k.startswith("seismic")}
+        for k, v in opts.items():
+            db.setValue("ssi_" + k, str(v))
+        try:
+            capfd.readouterr()
+            cfg = options.resolve(("common", "bem", "seismic"))
+            HalfSpace(cfg, PETSc.COMM_WORLD, log=lambda m: None, defer_seismic=True)
+            assert ("the run is load-free" in capfd.readouterr().out) == said, wave
+        finally:
+            for k in opts:
+                db.delValue("ssi_" + k)

@@ -84,14 +84,14 @@ def _mirror_equal(pts, ax, tol):
     return bool(d.max() <= tol)
 
 
-def _check_soil_around(mesh, elems, group, tol):
+def _check_soil_around(mesh, elems, group, tol, who="petsc-ssi impedance"):
     """SSIError unless the footing ``elems`` is a part of the meshed surface with soil all around it:
     not the whole surface, and touching the surface's outer edge nowhere (edges on a plane x = 0 or
     y = 0 of a half model excepted: the soil continues in the mirror image). An impedance of a
     footing without soil around it is not the footing's, and its comparison with the published
     curves meaningless."""
     if len(elems) == mesh.n_cells:
-        raise SSIError(f"-ssi_disp_group {group}: the footing is the whole meshed surface; petsc-ssi impedance "
+        raise SSIError(f"-ssi_disp_group {group}: the footing is the whole meshed surface; {who} "
                        "needs the footing as a part of the surface with soil around it (mesh a larger surface or "
                        "name a smaller group)")
     corners = mesh.cells[:, :4]
@@ -107,7 +107,7 @@ def _check_soil_around(mesh, elems, group, tol):
     if touch.size:
         p = X[touch[0]]
         raise SSIError(f"-ssi_disp_group {group}: the footing reaches the edge of the meshed surface (at "
-                       f"x = {p[0]:.4g}, y = {p[1]:.4g} m); petsc-ssi impedance needs soil around the footing "
+                       f"x = {p[0]:.4g}, y = {p[1]:.4g} m); {who} needs soil around the footing "
                        "(mesh a larger surface)")
 
 

@@ -93,7 +93,8 @@ class HalfSpace:
         self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
         load = self.mesh.select(cfg.load_group) if cfg.load_group else ()
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
-        if cfg.load_group and cfg.load_p0 == 0.0:
+        wave = cfg.get("seismic", "none") != "none"
+        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         if cfg.user_set("load_p0") and not cfg.load_group:
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
@@ -108,6 +109,9 @@ class HalfSpace:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
         symmetry.check_compatible(self.planes, np.array([0.0, 0.0, -cfg.load_p0]) if len(load) else None, None)
         self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and len(disp) > 0
+        if self.massless:                 # a footing with no soil around it is not a footing (issue 44: it ran)
+            from ..app.impedance import _check_soil_around
+            _check_soil_around(self.mesh, disp, cfg.disp_group, 1e-6 * h, who="a massless footing (input-motion)")
         xref = self._massless_reference() if self.massless else None
         self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if len(disp) else None
         self.receivers = rec.parse(cfg.receivers)
@@ -128,6 +132,13 @@ class HalfSpace:
         elif cfg.get("seismic", "none") != "none" and len(disp):
             self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
         elif cfg.get("seismic", "none") != "none" and not defer_seismic:
+            if not (len(load) and cfg.load_p0 != 0.0):
+                # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
+                # marched, assembly and all, and the output held zeros beside the closed-form free field)
+                raise SSIError(f"-ssi_seismic {cfg.seismic} on the half-space alone with nothing in it (no "
+                               "-ssi_disp_group footing, no loaded -ssi_load_group): the scattered field would be "
+                               "zero at every step; give a footing (petsc-ssi input-motion) or a structure "
+                               "(-ssi_problem ssi)")
             self.attach_seismic(np.zeros(3))
 
     def _massless_reference(self):
