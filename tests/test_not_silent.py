@@ -170,3 +170,15 @@ def test_a_wave_with_a_zero_soil_load_is_not_called_load_free(tmp_path, capfd):
         finally:
             for k in opts:
                 db.delValue("ssi_" + k)
+
+
+@pytest.mark.parametrize("opts,words", [
+    ({"cp": 1e7}, "-ssi_cp 1e+07 m/s is faster than any soil or rock"),
+    ({"mesh_size": "4,4", "mesh_h": 10, "mesh_patch": ""}, "-ssi_mesh_h 10 m is larger than the mesh (-ssi_mesh_size 4,4)"),
+])
+def test_soil_numbers_out_of_range_are_refused(opts, words):
+    from helpers import resolve_error
+    o = dict(mesh_size="4,4", mesh_h=1, mesh_patch="1,1", load_group="load", load_p0=1000, dt=0.005, t_end=0.01)
+    o.update(opts)
+    err = resolve_error(("common", "bem"), **o)
+    assert err is not None and words in err, err
