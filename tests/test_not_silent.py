@@ -182,3 +182,42 @@ def test_soil_numbers_out_of_range_are_refused(opts, words):
     o.update(opts)
     err = resolve_error(("common", "bem"), **o)
     assert err is not None and words in err, err
+
+
+def test_record_processing_refusals_name_the_options():
+    from petsc_ssi.seismic import records as R
+    t = np.arange(0.0, 1.0, 0.01)
+    rec = R.Record(t=t, values=np.sin(2 * np.pi * t) * np.hanning(t.size), quantity="acceleration", units_in="m/s2",
+                   source="rec.txt", sha256="0", dt=0.01)
+    for kw, words in (({"scale": 0.0}, "-ssi_seismic_scale 0.0: must be finite"),
+                      ({"taper": 0.7}, "-ssi_seismic_taper 0.7:"), ({"highpass": -1.0}, "-ssi_seismic_highpass -1.0 Hz")):
+        with pytest.raises(R.RecordError) as e:
+            R.process(rec, **kw)
+        assert words in str(e.value), e.value
+
+
+def test_obspy_warnings_reach_the_run_and_a_corrupt_record_is_refused(tmp_path, monkeypatch):
+    """ObsPy's warnings while reading (e.g. a corrupt miniSEED record, whose samples it skips) were
+    swallowed: now a RecordWarning (a run note), and one about corrupt data refuses the file."""
+    import warnings
+    obspy = pytest.importorskip("obspy")
+    from petsc_ssi.seismic import records as R
+    tr = obspy.Trace(np.sin(np.arange(200) * 0.1), header={"channel": "HNZ", "sampling_rate": 100.0})
+    path = str(tmp_path / "one.mseed")
+    obspy.Stream([tr]).write(path, format="MSEED")
+    real = obspy.read
+    for said, refused in (("a gap of 2 samples was filled", False), ("corrupt record at 512 (skipped)", True)):
+        def read(*a, _said=said, **k):
+            warnings.warn(_said, UserWarning)
+            return real(*a, **k)
+        monkeypatch.setattr(obspy, "read", read)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            if refused:
+                with pytest.raises(R.RecordError) as e:
+                    R.read_record(path, units="m/s2")
+                assert "a warning that data are corrupt (corrupt record at 512" in str(e.value), e.value
+            else:
+                R.read_record(path, units="m/s2")
+                assert any(issubclass(w.category, R.RecordWarning) and "ObsPy: a gap of 2 samples" in str(w.message)
+                           for w in caught), [str(w.message) for w in caught]

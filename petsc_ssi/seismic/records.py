@@ -574,11 +574,11 @@ def _check_pad_memory(path, fc, dt, npad, shape):
 
 def _check_args(path, scale, taper, baseline, pad_start):
     if not (np.isfinite(scale) and scale != 0):
-        _refuse(path, f"scale = {scale} (must be finite and non-zero)")
+        _refuse(path, f"-ssi_seismic_scale {scale}: must be finite and non-zero")
     if not 0 <= taper <= 0.5:
-        _refuse(path, f"taper = {taper} (a fraction at each end, 0 <= taper <= 0.5)")
+        _refuse(path, f"-ssi_seismic_taper {taper}: a fraction at each end, 0 <= taper <= 0.5")
     if baseline not in BASELINES:
-        _refuse(path, f"baseline '{baseline}' (one of {', '.join(BASELINES)})")
+        _refuse(path, f"-ssi_seismic_baseline {baseline}: one of {', '.join(BASELINES)}")
     if not (np.isfinite(pad_start) and pad_start >= 0):
         _refuse(path, f"pad_start = {pad_start} (must be finite and >= 0)")
 
@@ -609,7 +609,7 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
     path = record.source
     _check_args(path, scale, taper, baseline, pad_start)
     if not (np.isfinite(highpass) and highpass >= 0):
-        _refuse(path, f"highpass = {highpass} Hz (must be finite and >= 0)")
+        _refuse(path, f"-ssi_seismic_highpass {highpass} Hz: must be finite and >= 0")
     t, x = np.asarray(record.t, float), _as2d(record.values) * scale
     raw = _kinematics(t, x, record.quantity)
     i0, i1 = _window(path, t, raw[0], window)
