@@ -225,8 +225,9 @@ def collective(comm, what, template="{what} failed on rank {rank}: {error}"):
     it) and raise the same SSIError on every rank if it failed on any (``collective_error``: the lowest
     failing rank's message; the allgather is also the barrier). An SSIError passes its message
     unchanged; any other exception (a bug, an unreadable file, MemoryError) is told as
-    ``template`` (``what``, the failing ``rank``, ``error`` = ``one_line(exc)``) after its
-    traceback is printed on that rank's stderr, so nothing is lost and mpirun never hangs:
+    ``template`` (``what``, the failing ``rank``, ``error`` = ``one_line(exc)``), and a bug's
+    traceback is printed on that rank's stderr (a file or memory error's, ``USER_ERRORS``, only
+    with -ssi_debug: its line says it all), so nothing is lost and mpirun never hangs:
 
         with collective(comm, "reading the mesh"):
             mesh = read(path)          # may fail on some ranks only
