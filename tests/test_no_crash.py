@@ -107,3 +107,14 @@ def test_a_highpass_whose_pads_do_not_fit_is_refused():
     assert "-ssi_seismic_highpass 1e-07 Hz pads the record" in str(e.value) and "give a corner of at least" \
         in str(e.value), e.value
     R.process(rec, highpass=0.1, taper=0.05)          # a usual corner passes
+
+
+def test_a_spectrum_pad_beyond_the_memory_is_refused():
+    """``post --spectrum --pad 1e12``: refused by the memory its FFT would take (before: MemoryError
+    and a traceback)."""
+    from petsc_ssi.spectrum import amplitude_spectrum, SpectrumError
+    t = np.arange(0.0, 1.0, 0.01)
+    with pytest.raises(SpectrumError) as e:
+        amplitude_spectrum(t, np.sin(2 * np.pi * t), pad=1e12)
+    assert "--pad 1e+12:" in str(e.value) and "more than half the memory" in str(e.value), e.value
+    amplitude_spectrum(t, np.sin(2 * np.pi * t), pad=4)
