@@ -78,27 +78,28 @@ def run_key(cfg, exclude=RUN_CONTROL):
     """{option: value as text} of the options that define the run (estimate_* and the run-control
     ones left out), plus ``file:<option>`` the SHA-256 of an input file an option names."""
     key = {}
-    for name, val in sorted(cfg.as_dict().items()):
+    values = cfg.as_dict()
+    for name, val in sorted(values.items()):
         if name in exclude or name.startswith("estimate_"):
             continue
         key[name] = repr(val) if isinstance(val, float) else str(val)
         if isinstance(val, str) and val and os.path.isfile(val):
             key["file:" + name] = _file_digest(val)
-    seismic = str(cfg.get("seismic", "none") or "none") != "none"
+    seismic = str(values.get("seismic", "none") or "none") != "none"
     if seismic and hasattr(cfg, "user_set") and "t_end" in key and not cfg.user_set("t_end"):
         # the run lasts the record: t_end is derived (the record, the start and dt are in the key),
         # the same on restart, where it is set only after this check (before: 0.04 here, 15.005 saved)
         key["derived:t_end"] = key.pop("t_end")
         key["t_end"] = DERIVED
     if "seismic_format" in key:
-        key["seismic_format"] = _record_format(cfg)
+        key["seismic_format"] = _record_format(values)
     return key
 
 
 DERIVED = "(not given: the record's length)"
 
 
-def _record_format(cfg):
+def _record_format(cfg):          # cfg: the options' values (a dict)
     """-ssi_seismic_format as the record is read: 'auto' resolved to what it finds (peer, table or obspy),
     so a restart that names the format auto found is the same run (before: refused as a change)."""
     fmt = str(cfg.get("seismic_format", "auto") or "auto")
