@@ -55,7 +55,7 @@ def test_a_fixed_base_start_that_is_not_a_shift_or_floats_is_refused(tmp_path, n
              (["-ssi_seismic_record", one], "drives x but no translation along x is fixed (-ssi_fem_fixed (none))"),
              (["-ssi_fem_fixed", "base:x", "-ssi_seismic_record", three],
               "drives y, z but no translation along y or z is fixed (-ssi_fem_fixed base:x)")]
-    for extra, msg in cases:
+    for extra, msg in cases[n - 1::2]:          # (the checks are replicated: half the cases at each rank count)
         err = refused(cli(FEM + extra, nranks=n, check=False))
         assert msg in err, (extra, err)
 

@@ -19,30 +19,42 @@ from helpers import cli
 from test_integrity import SMALL, refused, files
 
 
+@pytest.fixture(scope="module")
+def numbered(tmp_path_factory):
+    """Run A's output and its checkpoints ck-2.h5, ck-4.h5 (made once, copied by each test)."""
+    d = tmp_path_factory.mktemp("numbered")
+    cli(SMALL + ["-ssi_output", str(d / "a.h5"), "-ssi_checkpoint", str(d / "ck-%d.h5"), "-ssi_checkpoint_every", "2"])
+    assert os.path.exists(d / "ck-2.h5") and os.path.exists(d / "ck-4.h5")
+    return d
+
+
 @pytest.mark.parametrize("n", [1, 2])
-def test_another_runs_numbered_checkpoints_are_not_replaced(tmp_path, n):
-    ck = str(tmp_path / "ck-%d.h5")
-    cli(SMALL + ["-ssi_output", str(tmp_path / "a.h5"), "-ssi_checkpoint", ck, "-ssi_checkpoint_every", "2"])
-    assert os.path.exists(tmp_path / "ck-2.h5") and os.path.exists(tmp_path / "ck-4.h5")
-    before = files(tmp_path)
-    err = refused(cli(SMALL + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_checkpoint", ck,
+def test_another_runs_numbered_checkpoints_are_not_replaced(numbered, tmp_path, n):
+    import shutil
+    run = tmp_path / "run"
+    shutil.copytree(numbered, run)
+    ck = str(run / "ck-%d.h5")
+    before = files(run)
+    err = refused(cli(SMALL + ["-ssi_output", str(run / "b.h5"), "-ssi_checkpoint", ck,
                                "-ssi_checkpoint_every", "2"], nranks=n, check=False))
-    assert f"-ssi_checkpoint {ck}: {tmp_path / 'ck-2.h5'} exists and is not this run's" in err, err
+    assert f"-ssi_checkpoint {ck}: {run / 'ck-2.h5'} exists and is not this run's" in err, err
     assert "-ssi_output_overwrite" in err
-    assert files(tmp_path) == before
+    assert files(run) == before
     if n == 1:
         # a restart of the run that wrote them replaces its own (the same run id)
-        r = cli(SMALL + ["-ssi_output", str(tmp_path / "a.h5"), "-ssi_checkpoint", ck, "-ssi_checkpoint_every", "2",
-                         "-ssi_restart", str(tmp_path / "ck-2.h5")], nranks=n)
+        r = cli(SMALL + ["-ssi_output", str(run / "a.h5"), "-ssi_checkpoint", ck, "-ssi_checkpoint_every", "2",
+                         "-ssi_restart", str(run / "ck-2.h5")], nranks=n)
         assert "restarted from" in r.stdout
 
 
 @pytest.mark.parametrize("n", [1, 2])
-def test_a_checkpoint_or_lag_file_that_is_the_output_through_a_link_is_refused(tmp_path, n):
+def test_a_checkpoint_or_lag_file_that_is_the_output_through_a_link_is_refused(numbered, tmp_path, n):
+    import shutil
     run = tmp_path / "run"
     run.mkdir()
     out = str(run / "o.h5")
-    cli(SMALL + ["-ssi_output", out])
+    for f in ("a.h5", "a.json", "a.xmf"):
+        shutil.copy(numbered / f, run / f.replace("a.", "o."))
     os.symlink(str(run), str(tmp_path / "alias"))                 # a linked directory
     os.symlink(out, str(run / "link.h5"))                        # a link to the file
     alias = str(tmp_path / "alias" / "o.h5")
@@ -52,7 +64,7 @@ def test_a_checkpoint_or_lag_file_that_is_the_output_through_a_link_is_refused(t
              (["-ssi_lags_save", alias], f"-ssi_lags_save {alias}: would replace"),
              (["-ssi_lags_save", str(run / "link.h5")], "-ssi_lags_save"),
              (["-ssi_lags_save", str(tmp_path / "alias" / "o.xmf")], "a sidecar of the output")]
-    for extra, msg in cases:
+    for extra, msg in cases[n - 1::2]:          # (the checks are replicated: half the cases at each rank count)
         err = refused(cli(ow + extra, nranks=n, check=False))
         assert msg in err and "a name of its own" in err, (extra, err)
         assert files(run) == before, extra

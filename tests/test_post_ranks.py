@@ -24,9 +24,10 @@ def test_post_refuses_to_write_its_input_and_every_rank_says_2(tmp_path):
     code = ("import sys; from mpi4py import MPI; from petsc_ssi.app.cli import main; "
             f"s = main(['petsc-ssi', 'post', {out!r}, '--receivers', '--csv', {out!r}]); "
             "print('rank', MPI.COMM_WORLD.Get_rank(), 'status', s, flush=True)")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
     p = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable, "-c", code],
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
-    assert "rank 0 status 2" in p.stdout and "rank 1 status 2" in p.stdout, p.stdout + p.stderr[-2000:]
+                       cwd=ROOT, capture_output=True, text=True, timeout=300, env=env)
+    assert "rank 0 status 2" in p.stdout and "rank 1 status 2" in p.stdout, (p.returncode, p.stdout + p.stderr[-2000:])
     assert open(out, "rb").read() == keep
 
 
