@@ -132,6 +132,7 @@ class HalfSpace:
         elif cfg.get("seismic", "none") != "none" and len(disp):
             self.attach_seismic(self.mesh.nodes[self.regions.disp_nodes].mean(0))
         elif cfg.get("seismic", "none") != "none" and not defer_seismic:
+            self.attach_seismic(np.zeros(3))          # (the record and the wave checked first: cheap)
             if not (len(load) and cfg.load_p0 != 0.0):
                 # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
                 # marched, assembly and all, and the output held zeros beside the closed-form free field)
@@ -139,7 +140,6 @@ class HalfSpace:
                                "-ssi_disp_group footing, no loaded -ssi_load_group): the scattered field would be "
                                "zero at every step; give a footing (petsc-ssi input-motion) or a structure "
                                "(-ssi_problem ssi)")
-            self.attach_seismic(np.zeros(3))
 
     def _massless_reference(self):
         """-ssi_disp_rigid massless: the footing's reference point x_ref [m], -ssi_disp_ref or by
