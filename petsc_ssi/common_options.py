@@ -49,6 +49,9 @@ register("checkpoint_interval", "real", 0.0, "s", "write a checkpoint when this 
          "the last one (0: never)", "common", validator=lambda v: None if v >= 0 else "must be >= 0")
 register("restart", "str", "", "", "resume the run from this checkpoint (same options, any rank count; the "
          "output of the interrupted run is continued)", "common")
+register("debug", "bool", False, "", "print the Python traceback of a file or memory error (an unreadable or "
+         "damaged file, a failed allocation) beside its one-line message; a bug's traceback is printed always",
+         "common")
 register("plot", "bool", False, "", "write a PNG of the receiver histories beside the output", "common")
 register("disk_check", "bool", True, "", "before the assembly, compare the free space of the output's file system "
          "with the run's estimated output (fields x snapshots x nodes x 8 B, receiver and interface series) and "

@@ -202,14 +202,32 @@ def one_line(exc):
     return f"{type(exc).__name__}: {lines[0] if lines else ''}".rstrip(": ")
 
 
+# Errors of the input or of the machine, not of the code: a file that cannot be read or is damaged
+# (OSError, h5py's too; bytes that do not decode; a truncated file), a failed allocation. Their
+# one line says it all: no traceback unless -ssi_debug (anything else is a bug: its traceback).
+USER_ERRORS = (OSError, UnicodeError, EOFError, MemoryError)
+
+
+def debug():
+    """Whether -ssi_debug is set (tracebacks of file and memory errors too)."""
+    if not _INITIALISED:
+        return False
+    from petsc4py import PETSc
+    try:
+        return bool(PETSc.Options().getBool("ssi_debug", False))
+    except Exception:  # noqa: BLE001 -- a malformed value: not debugging
+        return False
+
+
 @contextlib.contextmanager
 def collective(comm, what, template="{what} failed on rank {rank}: {error}"):
     """Collective: run the block on every rank (work for one rank only goes under an ``if`` inside
     it) and raise the same SSIError on every rank if it failed on any (``collective_error``: the lowest
     failing rank's message; the allgather is also the barrier). An SSIError passes its message
     unchanged; any other exception (a bug, an unreadable file, MemoryError) is told as
-    ``template`` (``what``, the failing ``rank``, ``error`` = ``one_line(exc)``) after its
-    traceback is printed on that rank's stderr, so nothing is lost and mpirun never hangs:
+    ``template`` (``what``, the failing ``rank``, ``error`` = ``one_line(exc)``), and a bug's
+    traceback is printed on that rank's stderr (a file or memory error's, ``USER_ERRORS``, only
+    with -ssi_debug: its line says it all), so nothing is lost and mpirun never hangs:
 
         with collective(comm, "reading the mesh"):
             mesh = read(path)          # may fail on some ranks only
@@ -221,8 +239,9 @@ def collective(comm, what, template="{what} failed on rank {rank}: {error}"):
     except SSIError as exc:
         err = str(exc)
     except Exception as exc:  # noqa: BLE001 -- reaches every rank, with the traceback on stderr
-        traceback.print_exc(file=sys.stderr)
-        sys.stderr.flush()
+        if debug() or not isinstance(exc, USER_ERRORS):
+            traceback.print_exc(file=sys.stderr)        # a bug: the traceback is what to report
+            sys.stderr.flush()
         err = template.format(what=what, rank=comm.getRank(), error=one_line(exc))
     collective_error(err, comm)
 

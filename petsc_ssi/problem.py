@@ -39,7 +39,7 @@ import time
 
 import numpy as np
 
-from .petsc import init, SSIError, printf
+from .petsc import init, SSIError, printf, collective_error
 
 SIGNALS = ("SIGTERM", "SIGINT", "SIGUSR1")
 
@@ -101,31 +101,82 @@ class CheckpointObserver:
 def check_names(cfg, outputs):
     """SSIError (the same on every rank: names only) if the checkpoint (-ssi_checkpoint, '%d' any
     step) or -ssi_lags_save's files would replace an output of the run or its sidecars, or each
-    other: a file written by one part of the run must not be another's."""
+    other: a file written by one part of the run must not be another's. Files are compared by what
+    they are (``io.output.file_keys``: the real path and the inode), so a name that reaches an
+    output through a symbolic link, a linked directory or a hard link is that output."""
     import re
-    from .io.output import output_files
+    from .io.output import output_files, file_keys
     from .io import checkpoint
     from .io.lock import lock_path
-    ab = os.path.abspath
-    owned = {}                                    # file -> what writes it
+    owned = {}                                    # key of a file -> (its name, what writes it)
+
+    def owner(f):
+        for k in file_keys(f):
+            if k in owned:
+                return owned[k]
+        return None
+
     for o in outputs:
         for f in output_files(o) + [lock_path(o)]:
-            owned[ab(f)] = f"the output {o}" if ab(f) == ab(o) else f"a sidecar of the output {o}"
+            who = f"the output {o}" if f == o else f"a sidecar of the output {o}"
+            for k in file_keys(f):
+                owned.setdefault(k, (f, who))
     lags = cfg.get("lags_save") or ""
     if lags:
         for f in (lags, lags + ".json", lags + ".tmp", lags + ".json.tmp", lock_path(lags)):
-            if ab(f) in owned:
-                raise SSIError(f"-ssi_lags_save {lags}: would replace {f}, {owned[ab(f)]}; give the lag file "
+            hit = owner(f)
+            if hit:
+                raise SSIError(f"-ssi_lags_save {lags}: would replace {hit[0]}, {hit[1]}; give the lag file "
                                "a name of its own")
-            owned[ab(f)] = f"-ssi_lags_save's {f}"
+            for k in file_keys(f):
+                owned[k] = (f, f"-ssi_lags_save's {f}")
     ck = cfg.get("checkpoint") or ""
     if ck or outputs:
-        pattern = ab(checkpoint.checkpoint_path(cfg) or "")
+        pattern = os.path.realpath(checkpoint.checkpoint_path(cfg) or "")
         rx = re.compile("^" + "[0-9]+".join(re.escape(part) for part in pattern.split("%d")) + r"(\.tmp)?$")
-        for f, who in owned.items():
-            if rx.match(f):
+        for key, (f, who) in owned.items():
+            if key[0] == "path" and rx.match(key[1]):
                 raise SSIError(f"-ssi_checkpoint {ck or pattern}: would replace {f}, {who}; a checkpoint needs "
                                "a name of its own")
+        if "%d" not in pattern:
+            hit = owner(pattern) or owner(pattern + ".tmp")
+            if hit:
+                raise SSIError(f"-ssi_checkpoint {ck or pattern}: would replace {hit[0]}, {hit[1]}; a checkpoint "
+                               "needs a name of its own")
+
+
+def foreign_checkpoints(cfg, comm, run_id, overwrite):
+    """Collective: SSIError in one line if the checkpoint pattern of -ssi_checkpoint ('%d' in the
+    name: one file per step) matches files that exist and are not this run's (another run with the
+    same pattern, or a restart's other run): the run would replace them one by one without a word.
+    A restart may replace its own run's (the same run id); -ssi_output_overwrite any."""
+    import re
+    ck = cfg.get("checkpoint") or ""
+    if "%d" not in ck or overwrite:
+        return
+    err = None
+    if comm.getRank() == 0:
+        d = os.path.dirname(os.path.abspath(ck)) or "."
+        base = os.path.basename(ck)
+        rx = re.compile("^" + "[0-9]+".join(re.escape(part) for part in base.split("%d")) + "$")
+        found = sorted(f for f in (os.listdir(d) if os.path.isdir(d) else ()) if rx.match(f))
+        for f in found:
+            path = os.path.join(d, f)
+            rid = None
+            if run_id:
+                try:
+                    import h5py
+                    with h5py.File(path, "r") as h:
+                        v = h.attrs.get("run_id", "")
+                        rid = v.decode() if isinstance(v, bytes) else str(v)
+                except Exception:  # noqa: BLE001 -- unreadable: not this run's
+                    rid = None
+            if rid is None or rid != run_id:
+                err = (f"-ssi_checkpoint {ck}: {path} exists and is not this run's ({len(found)} file(s) of this "
+                       "pattern: another run's checkpoints, which this run would replace step by step); add "
+                       "-ssi_output_overwrite to replace them, or choose another -ssi_checkpoint")
+                break
+    collective_error(err, comm)
 
 
 def _size(b):
@@ -189,10 +240,12 @@ class TransientProblem:
             check_output(cfg.output, self.comm, overwrite or self.restart is not None, also=also)
         ck = checkpoint.checkpoint_path(cfg, 0)
         if ck and (cfg.get("checkpoint") or cfg.get("checkpoint_every") or cfg.get("checkpoint_interval")):
-            same = self.restart is not None and os.path.abspath(ck) == os.path.abspath(cfg.restart)
+            from .io.output import same_file
+            same = self.restart is not None and same_file(ck, cfg.restart)
             check_output(ck, self.comm, overwrite or same or "%d" in (cfg.get("checkpoint") or ""),
                          what="-ssi_checkpoint")
         check_names(cfg, outputs)
+        foreign_checkpoints(cfg, self.comm, self.run_id if self.restart is not None else "", overwrite)
         from .io import lock
         paths = list(outputs)
         if cfg.get("checkpoint"):
@@ -267,7 +320,7 @@ class TransientProblem:
         if path is None:
             return None
         if self._key is None:
-            self._key = checkpoint.run_key(self.cfg)
+            self._key = checkpoint.run_key(self.cfg, grid=self.grid)   # (a record-long run: the end it derived)
         with staged("SSI checkpoint"):
             if flush and self.cfg.get("output") and not self._flush():
                 # the output holds every snapshot a checkpoint lists, even after SIGKILL: without that
@@ -275,6 +328,13 @@ class TransientProblem:
                 from .petsc import warn
                 warn(f"no checkpoint after step {self.n}: the output could not be updated first", self.comm)
                 self._last_ckpt = time.perf_counter()          # tried: the next one at the next interval
+                return None
+            why = checkpoint.not_ours(path, self.comm, getattr(self, "run_id", ""),
+                                      bool(self.cfg.get("output_overwrite")))
+            if why:                                    # never replace a file this run did not write
+                from .petsc import warn
+                warn(f"no checkpoint after step {self.n}: {why}", self.comm)
+                self._last_ckpt = time.perf_counter()
                 return None
             vecs, serial = self.checkpoint_state()
             checkpoint.write(path, self.comm, self.n, self.n_steps, self.kind, self._key, vecs, serial,

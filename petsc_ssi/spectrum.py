@@ -75,7 +75,14 @@ def _nfft(n, pad):
     if not pad >= 1:
         raise SpectrumError(f"pad must be >= 1 (a multiple of the record length), got {pad:g}")
     target = int(np.ceil(pad * n - 1e-9))
-    return 1 << max(0, int(target - 1).bit_length())
+    nfft = 1 << max(0, int(target - 1).bit_length())
+    from .sysmem import machine_memory
+    need, room = 48.0 * nfft, 0.5 * machine_memory()     # the padded series and its complex FFT, a few copies
+    if need > room:       # (issue 44: a pad of 1e12 asked for terabytes and ended in MemoryError)
+        raise SpectrumError(f"--pad {pad:g}: {nfft:.3g} FFT points need about {need / 1e9:.3g} GB per component, "
+                            f"more than half the memory ({room / 1e9:.3g} GB); give a pad below about "
+                            f"{room / 48.0 / n:.3g}")
+    return nfft
 
 
 def _detrend(t, x, how):

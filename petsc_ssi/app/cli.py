@@ -136,6 +136,46 @@ def _solver_help(PETSc):
             db.delValue(k)
 
 
+def _post(rest):
+    if "--response-spectrum" in rest:          # earthquake-engineering response spectra
+        from .response import main as response_main
+        return response_main(rest[1:])
+    if "--glance" in rest:                     # SSI at a glance: coupled run vs fixed-base twin
+        from .glance import main as glance_main
+        return glance_main(rest[1:])
+    from .post import main as post_main
+    return post_main(rest[1:])
+
+
+def _serial_status(run):
+    """``run()`` (a serial command: post) on rank 0 only under mpirun, every rank exiting with rank 0's
+    status (before: the other ranks only opened the file and exited 0 when rank 0 refused an argument).
+    Rank 0 sends its status whatever happens (an exception too: status 1), so no rank waits for ever."""
+    import os
+    size = next((int(os.environ[k]) for k in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MV2_COMM_WORLD_SIZE")
+                 if os.environ.get(k, "").isdigit()), 1)
+    if size <= 1:
+        return run()
+    from mpi4py import MPI
+    comm = MPI.COMM_WORLD
+    if comm.Get_size() == 1:
+        return run()
+    if comm.Get_rank() == 0:
+        status = 1
+        try:
+            status = run()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            comm.bcast(status, root=0)
+        return status
+    status = comm.bcast(None, root=0)
+    if status:
+        import time
+        time.sleep(0.3)                          # rank 0's error line first (mpirun ends at the first non-zero exit)
+    return status
+
+
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
     bad = _bad_command(argv) or _bad_options_file(argv)
@@ -153,14 +193,7 @@ def main(argv=None):
         return 0
     cmd, rest = _split(argv)
     if cmd == "post":
-        if "--response-spectrum" in rest:          # earthquake-engineering response spectra
-            from .response import main as response_main
-            return response_main(rest[1:])
-        if "--glance" in rest:                     # SSI at a glance: coupled run vs fixed-base twin
-            from .glance import main as glance_main
-            return glance_main(rest[1:])
-        from .post import main as post_main
-        return post_main(rest[1:])
+        return _serial_status(lambda: _post(rest))
     from ..petsc import init, SSIError
     PETSc = init(rest)
     from .. import options

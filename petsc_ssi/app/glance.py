@@ -158,6 +158,44 @@ def _same_control(ssi, fixed):
                      f"base moved as the record instead of twice it (the free surface); rerun it")
 
 
+def _same_record(ssi, fixed):
+    """Refuse a pair that did not run the same motion (not twins): the records' SHA-256 (``<axis>_sha256``
+    of the seismic groups) differ, the axes the records drive differ, or the processed accelerations
+    (``<axis>_acceleration``: the scale, units, window, taper, baseline and high-pass applied) differ.
+    A file without them (an earlier petsc-ssi) is not judged on what it lacks."""
+    import h5py
+
+    def motions(path):
+        out = {}
+        with h5py.File(path, "r") as f:
+            s = f.get("seismic")
+            if not isinstance(s, h5py.Group):
+                return out
+            for k in s:
+                if k.endswith("_acceleration") and not k.startswith("raw_"):
+                    ax = k[:-len("_acceleration")]
+                    sha = s[ax + "_sha256"][()] if ax + "_sha256" in s else None
+                    sha = sha.decode() if isinstance(sha, bytes) else sha
+                    out[ax] = (sha, np.asarray(s[k][()], float))
+        return out
+    ms, mf = motions(ssi), motions(fixed)
+    if not ms or not mf:
+        return
+    if set(ms) != set(mf):
+        raise _error(f"the runs' records drive different axes: {', '.join(sorted(ms))} in {ssi}, "
+                     f"{', '.join(sorted(mf))} in {fixed}: not twins; rerun one with the other's -ssi_seismic_record*")
+    for ax in sorted(ms):
+        (hs, a_s), (hf, a_f) = ms[ax], mf[ax]
+        if hs and hf and hs != hf:
+            raise _error(f"the runs' records differ ({ax}: SHA-256 {hs[:12]}... in {ssi}, {hf[:12]}... in {fixed}): "
+                         f"not twins; rerun one with the other's -ssi_seismic_record")
+        if a_s.shape != a_f.shape or not np.allclose(a_s, a_f, rtol=1e-9, atol=1e-12 * max(np.abs(a_s).max(), 1e-300)):
+            pk_s, pk_f = float(np.abs(a_s).max()), float(np.abs(a_f).max())
+            raise _error(f"the runs' processed {ax} records differ (peak {pk_s:.6g} m/s^2 in {ssi}, {pk_f:.6g} in "
+                         f"{fixed}): another -ssi_seismic_scale, units, window, taper, baseline or high-pass; not "
+                         f"twins: rerun one with the other's -ssi_seismic_* options")
+
+
 def free_field(path, times, component):
     """(step means (n,) [m/s^2] of the free-field surface acceleration along ``component`` at the
     run times ``times`` (0 at the first), one line saying what it is) from the seismic group of
@@ -593,6 +631,7 @@ def main(argv=None, out=None):
         ps = load_ssi(a.file, a.receiver, a.component)
         pf = load_fixed(a.glance, a.receiver, a.component)
         _same_control(a.file, a.glance)
+        _same_record(a.file, a.glance)
         S, F = ({"pair": p, "b": a.ko_b} for p in (ps, pf))
         for X in (S, F):
             X["ratio"], X["fit"] = analyse(X["pair"], a.ko_b, a.band)

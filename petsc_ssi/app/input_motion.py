@@ -130,9 +130,20 @@ def main():
     if not db.getString("ssi_disp_group", "").strip():
         raise SSIError("petsc-ssi input-motion needs the footing as -ssi_disp_group (a group or 'box:x0,x1,y0,y1')")
     db.setValue("ssi_disp_rigid", "massless")
+    if db.hasName("ssi_output") and not (db.getString("ssi_output", "") or "").strip():
+        raise SSIError("-ssi_output '': petsc-ssi input-motion keeps its results in files (<stem>.h5, "
+                       "<stem>-input-motion.csv and .png); give -ssi_output FILE.h5, or leave it out for "
+                       "out/input-motion.h5")
     if not db.getString("ssi_output", "").strip():
         db.setValue("ssi_output", "out/input-motion.h5")
     cfg = options.resolve(("common", "bem", "seismic"))
+    from ..io.output import replace_error
+    from ..petsc import collective_error
+    stem = os.path.splitext(cfg.output)[0]
+    err = None
+    for f in (stem + "-input-motion.csv", stem + "-input-motion.png"):
+        err = err or replace_error(f, f"-ssi_output {cfg.output}", overwrite=bool(cfg.get("output_overwrite")))
+    collective_error(err, comm)              # before the run: the user's files are never replaced unasked
     res = BEMTransient(cfg, comm).run()
     if comm.getRank() == 0:
         g = res["input_motion"]

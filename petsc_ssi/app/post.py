@@ -219,6 +219,11 @@ def write_csv(path, out=None, series="receivers/u"):
 
 def info(path, out=None):
     out = sys.stdout if out is None else out
+    from ..io.output import missing_part
+    gone = missing_part(path)
+    if gone:                 # its snapshots there cannot be read: not reported as if they could
+        raise PostError(f"{gone}; restore the part (the output of a running or stopped run links its snapshots "
+                        "to the files of <stem>.parts/)")
     with open_h5(path) as f:
         for k, v in f.attrs.items():
             out.write(f"{k}: {v}\n")
@@ -652,7 +657,10 @@ def main(argv=None):
         _check_numbers(a)
         inputs = [a.file] + [_parse_ref(r, a.file, a.series)[0] for r in (a.transfer or ())]
         plain_series = bool(a.series_given and a.csv and not (a.receivers or a.spectrum or a.transfer))
-        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer or plain_series or a.demands) else None),
+        # every file post writes, --receivers --csv's too (before: 'post X.h5 --receivers --csv X.h5' cut X.h5
+        # to 0 bytes)
+        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer or plain_series or a.demands or a.receivers)
+                        else None),
                        ("--png", a.png),
                        ("--plot", a.plot)], inputs, a.overwrite)
         if a.spectrum and a.transfer:

@@ -306,11 +306,24 @@ def _miss_bound(t, periods, k):
 
 # ---------------------------------------------------------------- spectra
 
+MAX_SUBSTEPS = 10 ** 7     # sub-steps of the oscillators' march (a few minutes) beyond which a spectrum is refused
+
+
 def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, oversample="auto", peaks="exact"):
     """([(label, ResponseSpectrum)], sub-steps): a spectrum per component (labels x, y, z or
     a), or RotD50, RotD100 (``rotd``) and/or GM (``geomean``) of the components x, y."""
     periods = rs.standard_periods() if periods is None else periods
     k = (1 if peaks == "exact" else auto_oversample(series.t, periods)) if oversample == "auto" else int(oversample)
+    steps = k * (len(series.t) - 1)
+    if steps > MAX_SUBSTEPS:
+        # each sub-step is one pass of the recurrence over every oscillator (about 20 us in Python):
+        # 1e8 sub-steps per sample ran for days
+        pos = np.asarray(periods)[np.asarray(periods) > 0]
+        why = (f"--oversample {oversample}" if oversample != "auto" else
+               f"--oversample auto (10 dt / T_min with the shortest period {float(pos.min()):g} s in --periods)")
+        raise _error(f"{why}: {k} sub-steps per time step over {len(series.t) - 1} steps are {steps:.3g} sub-steps, "
+                     f"more than {MAX_SUBSTEPS:.0e} (about {steps * 2e-5 / 3600:.2g} h); give a smaller --oversample "
+                     f"(auto gives {auto_oversample(series.t, periods)}) or a longer shortest period in --periods")
     out = []
     if rotd or geomean:
         if series.components[:2] != ("x", "y"):
@@ -349,6 +362,21 @@ def noise_notes(*series):
             if pk <= ROUNDOFF * float(np.max(peaks)):
                 out.append(f"note: {os.path.basename(s.path)}'s {c} component peaks at {pk:.3g} m/s^2 against "
                            f"{float(np.max(peaks)):.3g}: round-off, not motion; its spectra and ratios are noise")
+    return out
+
+
+def ratio_notes(A, B):
+    """Notes for a ratio A / B whose B component carries no motion against A's (peaks below ROUNDOFF of
+    A's: round-off, a component the other run's record did not drive): every ratio is then about
+    1 / ROUNDOFF (1e16 seen), not an amplification."""
+    out = []
+    pa = np.atleast_1d(np.abs(np.asarray(A.a, float)).max(axis=0))
+    pb = np.atleast_1d(np.abs(np.asarray(B.a, float)).max(axis=0))
+    for c, x, y in zip(B.components, pa, pb):
+        if x > 0 and y <= ROUNDOFF * x:
+            out.append(f"note: B's {c} component ({os.path.basename(B.path)}) peaks at {y:.3g} m/s^2 against A's "
+                       f"{x:.3g}: it carries no motion, so its ratios ({x / y if y else float('inf'):.3g} at the peak) "
+                       f"are not amplifications; compare with a run whose record drives {c}")
     return out
 
 
@@ -532,6 +560,8 @@ def main(argv=None, out=None):
         header = _summary(A, B, specs, ptext, periods, a, k, kb if B is not None else None)
         if not (a.rotd or a.geomean):
             header += noise_notes(*([A] if B is None else [A, B]))
+        if B is not None:
+            header += ratio_notes(A, B)
         peaks = peak_lines(specs, a.plot_quantity, ratio=B is not None)
         if a.csv == "-":
             write_table(out, specs, header + peaks, ratio=B is not None)

@@ -104,7 +104,8 @@ class HalfSpace:
         disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
         if interface is not None:
             disp = interface.be_elems
-        if cfg.load_group and cfg.load_p0 == 0.0:
+        wave = cfg.get("seismic", "none") != "none"
+        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         if cfg.user_set("load_p0") and not cfg.load_group:
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
@@ -129,6 +130,9 @@ class HalfSpace:
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
         prescribed = len(disp) > 0 and interface is None
         self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and prescribed
+        if self.massless:                 # a footing with no soil around it is not a footing (issue 44: it ran)
+            from .input_motion import check_soil_around
+            check_soil_around(self.mesh, disp, cfg.disp_group, 1e-6 * h, who="a massless footing (input-motion)")
         xref = self._massless_reference() if self.massless else None
         self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if prescribed else None
         self.receivers = rec.parse(cfg.receivers)
@@ -141,7 +145,15 @@ class HalfSpace:
         self.sites = interface.x if interface is not None else np.zeros((0, 3))
         self.seismic = None
         if cfg.get("seismic", "none") != "none":
-            self.seismic = self._seismic_input(self._control_point(interface))
+            self.seismic = self._seismic_input(self._control_point(interface))   # (record and wave checked first)
+            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources)
+            if interface is None and self.motion is None and not loaded:
+                # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
+                # marched, assembly and all, and the output held zeros beside the closed-form free field)
+                raise SSIError(f"-ssi_seismic {cfg.seismic} on the half-space alone with nothing in it (no "
+                               "-ssi_disp_group footing, no loaded -ssi_load_group): the scattered field would be "
+                               "zero at every step; give a footing (petsc-ssi input-motion) or a structure "
+                               "(-ssi_problem ssi)")
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
         self.grid = timegrid.TimeGrid.of_run(cfg, [self.seismic.duration] if self.seismic is not None else [])
         self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
@@ -165,7 +177,11 @@ class HalfSpace:
         if interface is not None:
             return interface.x.mean(0)
         if self.massless:
-            return self.motion.xref
+            # the footing's centroid, as -ssi_seismic_ref auto says, whatever -ssi_disp_ref (which only
+            # says about which point the motion is told: it moved the wave's control point too, and every
+            # series shifted in time against the run without it; issue 44)
+            from .input_motion import region_centroid
+            return region_centroid(self.mesh, self.regions, self.planes)
         if self.motion is not None:
             return self.mesh.nodes[self.regions.disp_nodes].mean(0)
         return np.zeros(3)

@@ -205,3 +205,30 @@ class MasslessFooting:
             "step_stiffness": (self.W, "rows F_x, F_y, F_z [N], M_x, M_y, M_z [N m]; columns per unit u [m] and "
                                        "theta [rad]: the resultant of one step's response from rest"),
         }
+
+
+def check_soil_around(mesh, elems, group, tol, who="petsc-ssi impedance"):
+    """SSIError unless the footing ``elems`` is a part of the meshed surface with soil all around it:
+    not the whole surface, and touching the surface's outer edge nowhere (edges on a plane x = 0 or
+    y = 0 of a half model excepted: the soil continues in the mirror image). An impedance of a
+    footing without soil around it is not the footing's, and its comparison with the published
+    curves meaningless."""
+    if len(elems) == mesh.n_cells:
+        raise SSIError(f"-ssi_disp_group {group}: the footing is the whole meshed surface; {who} "
+                       "needs the footing as a part of the surface with soil around it (mesh a larger surface or "
+                       "name a smaller group)")
+    corners = mesh.cells[:, :4]
+    edges = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    outer = np.unique(uniq[count == 1])
+    X = mesh.nodes
+    for ax in (0, 1):                          # a half model's edge on its plane is not an edge of the soil
+        if X[:, ax].min() > -tol and np.abs(X[:, ax]).min() < tol:
+            outer = outer[np.abs(X[outer, ax]) > tol]
+    foot = np.unique(mesh.cells[elems])
+    touch = np.intersect1d(foot, outer)
+    if touch.size:
+        p = X[touch[0]]
+        raise SSIError(f"-ssi_disp_group {group}: the footing reaches the edge of the meshed surface (at "
+                       f"x = {p[0]:.4g}, y = {p[1]:.4g} m); {who} needs soil around the footing "
+                       "(mesh a larger surface)")

@@ -110,14 +110,30 @@ register("warn_beta", "bool", True, "", "warn when beta_s = c_s dt / l leaves wh
          "found stable for the scheme in use", "bem")
 
 
+MAX_CP = 1.0e4           # m/s: beyond any soil or rock (a P-wave speed of 1e7 m/s ran: nu -> 0.5, dt c_p / h huge)
+
+
 def _bem_checks(cfg):
     if cfg.cs >= cfg.cp:
         return f"-ssi_cs {cfg.cs} must be smaller than -ssi_cp {cfg.cp}"
     if cfg.cp < cfg.cs * 2 ** 0.5 * 0.999999:
         return (f"-ssi_cp/-ssi_cs = {cfg.cp / cfg.cs:.4f} < sqrt(2): Poisson's ratio would be negative "
                 "(not supported)")
+    if cfg.cp > MAX_CP:
+        r2 = (cfg.cp / cfg.cs) ** 2
+        return (f"-ssi_cp {cfg.cp:g} m/s is faster than any soil or rock (granite about 6000 m/s; Poisson's ratio "
+                f"{(r2 - 2) / (2 * (r2 - 1)):.9f}): check the units (m/s) or give a P-wave speed <= {MAX_CP:g} m/s")
     if cfg.t_end < cfg.dt:
         return f"-ssi_t_end {cfg.t_end} is shorter than one step -ssi_dt {cfg.dt}"
+    if cfg.mesh == "grid":
+        try:
+            lx, ly = (float(v) for v in str(cfg.mesh_size).split(","))
+        except ValueError:
+            lx = ly = None                   # the mesh generator reports the format
+        if lx is not None and cfg.mesh_h > min(lx, ly):
+            return (f"-ssi_mesh_h {cfg.mesh_h:g} m is larger than the mesh (-ssi_mesh_size {cfg.mesh_size}): the grid "
+                    f"would have elements of {min(lx, ly):g} m, not the size asked; give -ssi_mesh_h <= "
+                    f"{min(lx, ly):g} m or a larger -ssi_mesh_size")
     if cfg.mesh != "grid" and not os.path.isfile(cfg.mesh):
         return f"-ssi_mesh {cfg.mesh}: no such file"
     if cfg.interp in ("chebyshev", "linear") and (cfg.interp_k < 1 or cfg.interp_tl <= 0):

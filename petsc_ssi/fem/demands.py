@@ -175,6 +175,13 @@ class DemandSpec:
                                f"{self.tol:g} m (-ssi_structure_level_tol) of z = {zl:g} m (the nearest node "
                                f"levels: {', '.join(f'{v:g}' for v in near)} m)")
             self.level_nodes.append(nodes)
+        for k in range(len(self.level_nodes) - 1):
+            both = np.intersect1d(self.level_nodes[k], self.level_nodes[k + 1])
+            if both.size:                 # the storey's two means share nodes: its drift is 0 or too small
+                raise SSIError(f"-ssi_structure_drift_levels: the levels z = {self.levels[k]:g} and "
+                               f"{self.levels[k + 1]:g} m share {both.size} node(s) within -ssi_structure_level_tol "
+                               f"{self.tol:g} m (e.g. z = {z[both[0]]:g} m): their drift would be 0 every step; give "
+                               f"levels more than 2 x the tolerance apart, or a smaller -ssi_structure_level_tol")
         self.pairs = parse_pairs(cfg.get("structure_drift_pairs", ""), len(model.receiver_nodes), receivers_option)
         self.pair_nodes = model.receiver_nodes[self.pairs] if len(self.pairs) else np.zeros((0, 2), np.int64)
         for (i, j), (a, b) in zip(self.pairs, self.pair_nodes):

@@ -17,7 +17,7 @@ import os
 
 import numpy as np
 
-from ..petsc import printf
+from ..petsc import printf, SSIError
 from ..monitor import event, staged
 from ..io.output import Output, provenance
 from .forces import add_force_recorder
@@ -47,6 +47,7 @@ class FEMTransient(TransientProblem):
             if cfg.get("seismic", "none") != "none":        # a fixed base moving with the record
                 from ..seismic.input import SupportMotion
                 self.support = SupportMotion(cfg, self.comm)
+                self._check_supported_axes()
         # without -ssi_t_end a run under a record lasts the record (nothing is written into the options)
         self.grid = timegrid.TimeGrid.of_run(cfg, [self.support.duration] if self.support is not None else [])
         if self.support is not None:
@@ -56,6 +57,21 @@ class FEMTransient(TransientProblem):
         self.integ = self.rec = self.out = self.forces = self.demands = None
         self.state = None
         self.check_disk()
+
+    def _check_supported_axes(self):
+        """SSIError (every rank: the fixed dofs are replicated) unless every axis the support motion
+        drives has a fixed translation along it: the ground moves the structure only through its
+        supports, so a structure with none along an axis floats on it and the relative-motion
+        form's answer along that axis (-M iota a_g on free masses) is a rigid drift, not a response."""
+        dm = self.model.dofmap
+        tdofs = dm.translation_dofs(np.arange(self.model.mesh.n_nodes))
+        fixed = np.asarray(self.model.fixed, np.int64)
+        loose = [a for k, a in enumerate("xyz") if a in self.support.motions and not np.isin(tdofs[:, k], fixed).any()]
+        if loose:
+            raise SSIError(f"-ssi_seismic vertical drives {', '.join(loose)} but no translation along "
+                           f"{' or '.join(loose)} is fixed (-ssi_fem_fixed {self.cfg.get('fem_fixed') or '(none)'}): the "
+                           f"base moves the structure only through its supports, so it would float; fix the base "
+                           f"along {', '.join(loose)} (e.g. -ssi_fem_fixed base) or leave those records out")
 
     def output_bytes(self):
         return structure_bytes(self.model, self.grid)

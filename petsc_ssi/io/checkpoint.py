@@ -12,7 +12,9 @@ A checkpoint of a run after step n holds
       ``step``, ``n_steps``, ``problem``, ``ranks``, ``format``, the package version, ``key``:
       the options that define the run (``run_key``) as JSON, with a SHA-256 of every input file
       they name (meshes, load tables), and ``run_id``: the id the run wrote into its output too
-      (a restart continues only an output of the same run)
+      (a restart continues only an output of the same run); ``attrs_sha256``: the SHA-256 of
+      these attributes and of every dataset's CRC32 list (``attrs_digest``), so an edited
+      attribute is refused like damaged data
   on every dataset, attribute ``crc32``
       the CRC32 of each 8 MiB piece of its data (``io.integrity``: the ranks sum the pieces in
       turn, no gather); a restart verifies them before any heavy work and refuses a damaged file
@@ -39,7 +41,20 @@ import numpy as np
 
 from ..petsc import init, collective, collective_error, collective_io, ensure_space, SSIError
 
-FORMAT = 2          # 2: with run_id and the CRC32 of every dataset's data (1: refused)
+FORMAT = 3          # 3: with the SHA-256 of the attributes; 2: run_id and the CRC32 of every dataset's data (1, 2: refused)
+ATTRS = ("format", "step", "n_steps", "problem", "ranks", "petsc_ssi_version", "key", "run_id")
+
+
+def attrs_digest(attrs, crcs):
+    """SHA-256 of the attributes a restart trusts (``ATTRS``: the step it resumes after, the run's
+    options, its id, ...) and of every dataset's CRC32 list: an attribute edited by hand or damaged
+    is refused like a damaged dataset."""
+    def text(v):
+        v = v.item() if hasattr(v, "item") else v
+        return v.decode() if isinstance(v, bytes) else str(v)
+    blob = json.dumps({"attrs": {k: text(attrs.get(k, "")) for k in ATTRS},
+                       "crc32": {k: [int(c) for c in v] for k, v in sorted(crcs.items())}}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
 
 # Options that steer how a run is carried out, watched or written, not what it computes: a restart
 # may change them. Every other -ssi_ option defines the run and must be the same on restart.
@@ -48,7 +63,7 @@ RUN_CONTROL = frozenset((
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
     "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
-    "huge_pages", "disk_check"))
+    "huge_pages", "disk_check", "debug"))
 
 
 def _file_digest(path):
@@ -59,17 +74,50 @@ def _file_digest(path):
     return h.hexdigest()
 
 
-def run_key(cfg, exclude=RUN_CONTROL):
+def run_key(cfg, exclude=RUN_CONTROL, grid=None):
     """{option: value as text} of the options that define the run (estimate_* and the run-control
-    ones left out), plus ``file:<option>`` the SHA-256 of an input file an option names."""
+    ones left out), plus ``file:<option>`` the SHA-256 of an input file an option names. A run under
+    a record without -ssi_t_end lasts the record: its t_end is ``DERIVED``, and ``grid`` (the run's
+    time grid, when known) gives the end it derived under 'derived:t_end'."""
     key = {}
-    for name, val in sorted(cfg.as_dict().items()):
+    values = cfg.as_dict()
+    for name, val in sorted(values.items()):
         if name in exclude or name.startswith("estimate_"):
             continue
         key[name] = repr(val) if isinstance(val, float) else str(val)
         if isinstance(val, str) and val and os.path.isfile(val):
             key["file:" + name] = _file_digest(val)
+    seismic = str(values.get("seismic", "none") or "none") != "none"
+    if seismic and hasattr(cfg, "user_set") and "t_end" in key and not cfg.user_set("t_end"):
+        # the run lasts the record: t_end is derived (the record, the start and dt are in the key),
+        # the same on restart, where it is set only after this check (before: 0.04 here, 15.005 saved)
+        key["derived:t_end"] = key.pop("t_end") if grid is None else repr(float(grid.t_end))
+        key["t_end"] = DERIVED
+    if "seismic_format" in key:
+        key["seismic_format"] = _record_format(values)
     return key
+
+
+DERIVED = "(not given: the record's length)"
+
+
+def _record_format(cfg):          # cfg: the options' values (a dict)
+    """-ssi_seismic_format as the record is read: 'auto' resolved to what it finds (peer, table or obspy),
+    so a restart that names the format auto found is the same run (before: refused as a change)."""
+    fmt = str(cfg.get("seismic_format", "auto") or "auto")
+    path = next((cfg.get(k) for k in ("seismic_record", "seismic_record_x", "seismic_record_y", "seismic_record_z")
+                 if cfg.get(k) and os.path.isfile(cfg.get(k))), None)
+    if path is None or str(cfg.get("seismic", "none")) == "none":
+        return fmt
+    from ..seismic.records import _detect
+    try:
+        with open(path, "rb") as fh:
+            kind = _detect(path, fh.read(1 << 16), fmt)
+    except OSError:
+        return fmt
+    if kind in ("peer", "table"):
+        return kind
+    return "obspy" if fmt.lower() in ("auto", "obspy") else fmt.upper()
 
 
 def key_difference(saved, now):
@@ -79,7 +127,19 @@ def key_difference(saved, now):
     from ..options import options
     registry = options()
     for name in sorted(set(saved) | set(now)):
+        if name.startswith("derived:"):
+            continue                             # a value the run derives, compared through ``name``
         a, b = saved.get(name), now.get(name)
+        if DERIVED in (a, b) and a != b:         # derived on one side, given on the other: the saved value
+            da = saved.get("derived:" + name, a)
+            try:
+                if a == DERIVED and float(b) == float(da):
+                    continue                     # given as the value the interrupted run derived
+            except (TypeError, ValueError):
+                pass
+            return (f"-ssi_{name} is {b} here and was {a if a != DERIVED else f'{da} {DERIVED}'}"
+                    + (f"; leave -ssi_{name} out, as the interrupted run did" if a == DERIVED else
+                       f"; give -ssi_{name} {a}, as the interrupted run did"))
         if a is None and name in registry and not name.startswith("file:"):
             d = registry[name].default
             a = repr(d) if isinstance(d, float) else str(d)
@@ -127,16 +187,30 @@ def read_header(path, comm):
                 raise SSIError(f"-ssi_restart {path}: no such file")
             import h5py
             with _h5(path, "r") as f:
-                if int(f.attrs.get("format", -1)) == 1:
+                fmt = f.attrs.get("format", -1)
+                fmt = int(fmt) if np.ndim(fmt) == 0 and np.issubdtype(np.asarray(fmt).dtype, np.number) else -1
+                if fmt in (1, 2):
                     raise SSIError(f"-ssi_restart {path}: a checkpoint of an older petsc-ssi without checksums "
-                                   "of its content (format 1); run again from the start")
-                if int(f.attrs.get("format", -1)) != FORMAT or "key" not in f.attrs:
+                                   f"of its {'content' if fmt == 1 else 'attributes'} (format {fmt}); run again "
+                                   "from the start")
+                if fmt != FORMAT or "key" not in f.attrs:
                     raise SSIError(f"-ssi_restart {path}: not a petsc-ssi checkpoint (format {FORMAT})")
-                head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
-                head["key"] = json.loads(str(head["key"]))
                 crc = {}
                 f.visititems(lambda name, obj: crc.__setitem__(name, [int(c) for c in obj.attrs["crc32"]])
                              if isinstance(obj, h5py.Dataset) and "crc32" in obj.attrs else None)
+                saved = f.attrs.get("attrs_sha256", "")
+                saved = saved.decode() if isinstance(saved, bytes) else str(saved)
+                if saved != attrs_digest(f.attrs, crc):
+                    raise SSIError(f"-ssi_restart {path}: its attributes (step, options, run id, checksums) differ "
+                                   "from their SHA-256 (attrs_sha256): a damaged or edited checkpoint; restart from "
+                                   "an earlier one or run again from the start")
+                head = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+                head = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in head.items()}
+                try:
+                    head["key"] = json.loads(str(head["key"]))
+                    int(head["step"]), int(head["n_steps"])
+                except (ValueError, TypeError) as exc:
+                    raise SSIError(f"-ssi_restart {path}: unreadable attributes ({exc})") from None
                 head["crc32"] = crc
     return comm.tompi4py().bcast(head, root=0)
 
@@ -183,7 +257,33 @@ def check_restart(cfg, comm, kind, outputs=()):
             raise SSIError(f"-ssi_output {out}: exists and is not the output of the run that wrote -ssi_restart "
                            f"{path} (run id {rid or '(none)'} there, {head.get('run_id')} in the checkpoint); a "
                            "restart continues its own run's output: give that one, or a name that does not exist")
+        if rid is not None:                      # its parts, before the assembly (before: refused after it)
+            from .output import missing_part
+            gone = None
+            with collective(comm, f"-ssi_output {out}", "{what}: cannot read it ({error})"):
+                if comm.getRank() == 0:
+                    gone = missing_part(out)
+            gone = comm.tompi4py().bcast(gone, root=0)
+            if gone:
+                raise SSIError(f"-ssi_output {gone}; restore the part, or restart into a new -ssi_output name")
     return head
+
+
+def not_ours(path, comm, run_id, overwrite=False):
+    """Collective: a phrase if ``path`` exists and is not a checkpoint of the run ``run_id`` (another
+    run's, or another file), which a checkpoint write would replace (unless ``overwrite``), else None."""
+    why = None
+    if comm.getRank() == 0 and not overwrite and os.path.lexists(path):
+        rid = None
+        try:
+            with _h5(path, "r") as f:
+                v = f.attrs.get("run_id", "")
+                rid = v.decode() if isinstance(v, bytes) else str(v)
+        except Exception:  # noqa: BLE001 -- not an HDF5 file: not ours
+            pass
+        if not run_id or rid != run_id:
+            why = f"{path} exists and is not this run's checkpoint (add -ssi_output_overwrite to replace it)"
+    return comm.tompi4py().bcast(why, root=0)
 
 
 def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
@@ -220,6 +320,7 @@ def write(path, comm, step, n_steps, kind, key, vecs, serial, run_id=""):
                 f.attrs.update({"format": FORMAT, "step": int(step), "n_steps": int(n_steps), "problem": kind,
                                 "ranks": comm.getSize(), "petsc_ssi_version": __version__,
                                 "key": json.dumps(key, sort_keys=True), "run_id": run_id})
+                f.attrs["attrs_sha256"] = attrs_digest(f.attrs, crcs)
             fd = os.open(tmp, os.O_RDONLY)
             try:
                 os.fsync(fd)

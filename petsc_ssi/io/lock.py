@@ -44,12 +44,14 @@ def _read(lockfile):
     """{host, pid, started} of a lock file ({} if unreadable)."""
     info = {}
     try:
-        with open(lockfile) as fh:
-            for line in fh:
-                k, _, v = line.partition(" ")
-                info[k] = v.strip()
+        with open(lockfile, "rb") as fh:
+            text = fh.read(4096).decode("utf-8", errors="replace")      # any bytes: never a crash
     except OSError:
-        pass
+        return info
+    for line in text.splitlines():
+        k, _, v = line.partition(" ")
+        if k in ("host", "pid", "started"):
+            info[k] = v.strip()
     return info
 
 
@@ -75,6 +77,9 @@ def _create(lockfile, holder):
                 stale = True                       # left by a problem of this process that is gone
             else:
                 stale = info.get("host") == host and opid > 0 and not _alive(opid)
+            if not stale and not mine and ("host" not in info or opid <= 0):
+                return (f"{lockfile} exists and is not a petsc-ssi lock (no host and pid in it): "
+                        f"{lockfile[:-len(SUFFIX)]} may be in use; remove {lockfile} if no run writes it", None)
             if not stale:
                 return (f"{lockfile[:-len(SUFFIX)]} is being written by another run (host {info.get('host', '?')}, "
                         f"pid {info.get('pid', '?')}, started {info.get('started', '?')}; its lock {lockfile}); "
@@ -99,7 +104,8 @@ def _create(lockfile, holder):
 def acquire(paths, comm, holder, what="-ssi_output"):
     """Collective: a lock on each of ``paths`` (rank 0); SSIError in one line on every rank if
     another run holds one (the locks made are given back); the list of lock files held."""
-    files = [lock_path(os.path.abspath(p)) for p in dict.fromkeys(paths)]
+    # the real path: two names of one file (a symbolic link, a linked directory) take one lock
+    files = list(dict.fromkeys(lock_path(os.path.realpath(p)) for p in paths))
     err, notes, made = None, [], []
     if comm.getRank() == 0:
         for f in files:

@@ -89,6 +89,41 @@ def output_files(path):
     return [path] + [stem + s for s in SIDECARS]
 
 
+def file_keys(path):
+    """What the file ``path`` is, to compare two names of files (never by ``os.path.abspath``, which
+    sees two names of one file through a symbolic link, a linked directory or a hard link as two
+    files): its real path (links and '..' resolved) and, when it exists, its device and inode."""
+    keys = {("path", os.path.realpath(path))}
+    try:
+        st = os.stat(path)
+        keys.add(("inode", st.st_dev, st.st_ino))
+    except OSError:
+        pass
+    return keys
+
+
+def missing_part(path):
+    """Rank 0's phrase for the first dataset of the output ``path`` that links (HDF5 external link) to
+    a part that is not there (a running or stopped run's output whose parts directory lost a file), or
+    None (also when ``path`` does not exist or holds its datasets itself)."""
+    import h5py
+    if not os.path.isfile(path):
+        return None
+    d = os.path.dirname(os.path.abspath(path))
+    with _h5(path, "r") as f:
+        for name in f:
+            ln = f.get(name, getlink=True)
+            if isinstance(ln, h5py.ExternalLink) and not os.path.isfile(os.path.join(d, ln.filename)):
+                return (f"{path} links its dataset {name} to {ln.filename}, which is missing: the file and its "
+                        "parts directory go together")
+    return None
+
+
+def same_file(a, b):
+    """Whether the names ``a`` and ``b`` are one file (``file_keys``)."""
+    return bool(file_keys(a) & file_keys(b))
+
+
 def remove_output(path):
     """Rank 0: a scratch run's output gone: FILE.h5, its sidecars and its parts directory."""
     import shutil

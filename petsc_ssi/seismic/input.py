@@ -54,9 +54,12 @@ def _start(cfg):
     if text == "auto":
         return None
     try:
-        return float(text)
+        t0 = float(text)
     except ValueError:
         raise SSIError(f"-ssi_seismic_start '{text}': expected auto or seconds") from None
+    if not np.isfinite(t0):                 # nan ran to the end with NaN in every dataset
+        raise SSIError(f"-ssi_seismic_start '{text}': expected auto or a finite number of seconds")
+    return t0
 
 
 def record_lines(motions, tag):
@@ -122,10 +125,10 @@ def _records(cfg):
     traces = [x.strip() for x in c.seismic_traces.split(",")] if c.get("seismic_traces") else [None] * 3
     traces = [int(x) if x is not None and x.isdigit() else x for x in traces]     # an index, or a channel
     if not c.seismic_record:
-        return {a: read(c.get(f"seismic_record_{a}"), tr) for a, tr in zip(AXES, traces)
-                if c.get(f"seismic_record_{a}") and tr != "-"}
+        return _distinct({a: read(c.get(f"seismic_record_{a}"), tr) for a, tr in zip(AXES, traces)
+                          if c.get(f"seismic_record_{a}") and tr != "-"}, c)
     if c.get("seismic_traces"):                                    # one multi-trace file, a trace per axis
-        return {a: read(c.seismic_record, tr) for a, tr in zip(AXES, traces) if tr != "-"}
+        return _distinct({a: read(c.seismic_record, tr) for a, tr in zip(AXES, traces) if tr != "-"}, c)
     rec = read(c.seismic_record)
     if np.ndim(rec.values) == 2:                                   # a 't ax ay az' table
         return {a: dataclasses.replace(rec, values=rec.values[:, k]) for k, a in enumerate(AXES)}
@@ -134,6 +137,22 @@ def _records(cfg):
         raise SSIError(f"-ssi_seismic_component {c.seismic_component}: with -ssi_seismic vertical and a "
                        "one-component record, the component it drives: x, y or z")
     return {axis: rec}
+
+
+def _distinct(recs, cfg):
+    """SSIError if one trace of one multi-trace file drives two axes (-ssi_seismic_traces E,E,E drove x,
+    y and z with the east component: a diagonal motion nobody recorded)."""
+    seen = {}
+    for axis, r in recs.items():
+        m = r.metadata
+        if "obspy_format" not in m:
+            continue
+        k = (r.sha256, m.get("station"), m.get("component"), m.get("starttime"))
+        if k in seen:
+            raise SSIError(f"-ssi_seismic_traces {cfg.get('seismic_traces') or '(none)'}: the trace {m.get('component')} "
+                           f"of {r.source} drives both {seen[k]} and {axis}; give each axis its own trace (e.g. E,N,Z)")
+        seen[k] = axis
+    return recs
 
 
 def read_motions(cfg):
@@ -271,6 +290,9 @@ class SupportMotion:
         self.factor = 2.0 if cfg.seismic_control == "incident" else 1.0
         self.motions, self.notes = collective_motions(cfg, comm)
         t0 = _start(cfg)
+        if t0 is not None and t0 < 0:
+            raise SSIError(f"-ssi_seismic_start {t0:g}: a negative shift drops the first {-t0:g} s of the record (the "
+                           "fixed base starts at t = 0); give a shift >= 0, or auto (one step)")
         self.t0 = cfg.dt if t0 is None else t0
         self.duration = self.t0 + max(m.t[-1] for m in self.motions.values())
 

@@ -198,7 +198,8 @@ def _npts_match(line):
 def _read_peer(path, raw, fmt, component):
     lines = raw.decode("latin-1").splitlines()
     if component is not None:
-        _refuse(path, f"a PEER file holds one component (component={component!r} given)")
+        _refuse(path, f"a PEER file holds one component, and a trace or column {component!r} is asked for "
+                      f"(-ssi_seismic_component or -ssi_seismic_traces): leave it out")
     if len(lines) < 4:
         _refuse(path, f"PEER header needs 4 lines, the file has {len(lines)}")
     qty, unit = _peer_line3(path, lines[2])
@@ -234,6 +235,9 @@ def _peer_line3(path, line):
     return qty, unit
 
 
+MAX_DT = 1.0         # s: the coarsest sampling of a record taken as plausible (PEER's DT)
+
+
 def _peer_line4(path, line):
     m = _npts_match(line)
     if m is None:
@@ -244,6 +248,9 @@ def _peer_line4(path, line):
         _refuse(path, f"line 4: NPTS '{m.group(1)}' or DT '{m.group(2)}' is not a number")
     if not (np.isfinite(dt) and dt > 0):
         _refuse(path, f"DT = {m.group(2)} on line 4 (must be finite and > 0)")
+    if dt > MAX_DT:             # a strong-motion record samples at 1 Hz or faster: DT = 100 is not seconds
+        _refuse(path, f"DT = {m.group(2)} s on line 4: a strong-motion record is sampled every {MAX_DT:g} s or "
+                      f"faster; check that line 4 gives DT in seconds")
     if npts < 2:
         _refuse(path, f"NPTS = {npts} on line 4 (need at least 2 samples)")
     return npts, dt
@@ -297,7 +304,8 @@ def _read_table(path, raw, fmt, component):
 def _table_column(path, data, component):
     if data.shape[1] == 2:
         if component is not None:
-            _refuse(path, f"a 't a' table holds one component (component={component!r} given)")
+            _refuse(path, f"a 't a' table holds one component, and a column {component!r} is asked for "
+                          f"(-ssi_seismic_component or -ssi_seismic_traces): leave it out")
         return data[:, 1].copy(), ""
     if component is None:
         return data[:, 1:].copy(), "x,y,z"
@@ -314,13 +322,26 @@ def _read_obspy(path, raw, fmt, component):
         _refuse(path, "not a PEER file or a table, and ObsPy (needed for seismological formats) is not installed")
     f = None if str(fmt).lower() in ("auto", "obspy") else str(fmt).upper()
     try:
-        st = obspy.read(io.BytesIO(raw), format=f)
+        with warnings.catch_warnings(record=True) as said:      # ObsPy's own warnings are not swallowed
+            warnings.simplefilter("always")
+            st = obspy.read(io.BytesIO(raw), format=f)
     except Exception as exc:                               # ObsPy raises many kinds
         msg = re.sub(r"\S*obspy-\S*\.tmp", path, str(exc))   # (ObsPy names its temporary copy, not this file)
         if "Unknown format" in msg:
             msg = "ObsPy does not recognise its format"
         _refuse(path, f"not a PEER file, a table of numbers (optionally under one row of column names) or a "
                       f"format ObsPy reads ({type(exc).__name__}: {msg})")
+    for w in said:
+        text = " ".join(re.sub(r"\S*obspy-\S*\.tmp", path, str(w.message)).split())
+        if "corrupt" in text.lower():                      # samples skipped: the motion has a hole
+            _refuse(path, f"ObsPy read it with a warning that data are corrupt ({text}); repair or replace the file")
+        warnings.warn(f"record '{path}': ObsPy: {text}", RecordWarning, stacklevel=3)
+    ids = [tr.id for tr in st]
+    split = sorted({i for i in ids if ids.count(i) > 1})
+    if split:                                              # gaps or overlaps: one channel in several segments
+        _refuse(path, f"the trace {split[0]} is in {ids.count(split[0])} segments (gaps or overlaps in the "
+                      f"recording): they are not one motion; fill or cut the gaps first (ObsPy's Stream.merge, "
+                      f"or keep one segment with Stream.slice)")
     tr = _pick_trace(path, st, component)
     form = tr.stats.get("_format", f or "")
     vals = np.asarray(tr.data, dtype=float)
@@ -372,9 +393,11 @@ def _resolve(path, file_units, units, quantity):
     if units != "auto" and given is None:
         _refuse(path, f"unknown units '{units}' (one of auto, {', '.join(UNITS)})")
     if file_units is None and given is None:
-        _refuse(path, f"the file does not state its units: give units= (one of {', '.join(UNITS)})")
+        _refuse(path, f"the file does not state its units: give them with -ssi_seismic_units (post: --table-units), "
+                      f"one of {', '.join(UNITS)}")
     if file_units and given and UNITS[file_units] != UNITS[given]:
-        _refuse(path, f"the file is in {file_units}, units='{units}' given")
+        _refuse(path, f"the file is in {file_units}, and -ssi_seismic_units (post: --table-units) says {units}: "
+                      f"leave it auto or give {file_units}")
     unit = file_units or given
     if quantity != "auto" and quantity != UNITS[unit][0]:
         _refuse(path, f"quantity mismatch: the file holds {UNITS[unit][0]} ({unit}), {quantity} requested")
@@ -524,6 +547,7 @@ def _highpass(path, t, a, fc):
     if not fc < nyq:
         _refuse(path, f"high-pass corner {fc:g} Hz is not below the Nyquist frequency {nyq:g} Hz")
     npad = int(np.ceil(0.75 * HIGHPASS_ORDER / fc / dt))
+    _check_pad_memory(path, fc, dt, npad, a.shape)
     ap = np.vstack([np.zeros((npad, a.shape[1])), a, np.zeros((npad, a.shape[1]))])
     sos = butter(HIGHPASS_ORDER // 2, fc / nyq, btype="highpass", output="sos")
     af = sosfiltfilt(sos, ap, axis=0, padtype=None)
@@ -531,13 +555,31 @@ def _highpass(path, t, a, fc):
     return tp, af, npad
 
 
+PAD_COPIES = 8          # arrays of the padded record's size alive at once (filter, integration, motion)
+
+
+def _check_pad_memory(path, fc, dt, npad, shape):
+    """Refuse a high-pass whose padded record (2 npad zeros more, ``PAD_COPIES`` arrays of it) would
+    not fit in half the memory of the machine (or its cgroup): f_c = 1e-7 Hz padded 6e9 samples, a
+    44.7 GiB allocation that ended in MemoryError after the set-up."""
+    from ..sysmem import machine_memory
+    need = PAD_COPIES * 8.0 * (2 * npad + shape[0]) * shape[1]
+    room = 0.5 * machine_memory()
+    if need > room:
+        fc_min = 0.75 * HIGHPASS_ORDER / dt / max(1.0, (room / (PAD_COPIES * 8.0 * shape[1]) - shape[0]) / 2)
+        _refuse(path, f"-ssi_seismic_highpass {fc:g} Hz pads the record with 2 x {npad:.3g} zeros "
+                      f"({2 * npad * dt:.3g} s): about {need / 1e9:.3g} GB, more than half the memory "
+                      f"({room / 1e9:.3g} GB); give a corner of at least {fc_min:.2g} Hz (a corner below "
+                      f"1 / the record's length removes nothing the baseline does not)")
+
+
 def _check_args(path, scale, taper, baseline, pad_start):
     if not (np.isfinite(scale) and scale != 0):
-        _refuse(path, f"scale = {scale} (must be finite and non-zero)")
+        _refuse(path, f"-ssi_seismic_scale {scale}: must be finite and non-zero")
     if not 0 <= taper <= 0.5:
-        _refuse(path, f"taper = {taper} (a fraction at each end, 0 <= taper <= 0.5)")
+        _refuse(path, f"-ssi_seismic_taper {taper}: a fraction at each end, 0 <= taper <= 0.5")
     if baseline not in BASELINES:
-        _refuse(path, f"baseline '{baseline}' (one of {', '.join(BASELINES)})")
+        _refuse(path, f"-ssi_seismic_baseline {baseline}: one of {', '.join(BASELINES)}")
     if not (np.isfinite(pad_start) and pad_start >= 0):
         _refuse(path, f"pad_start = {pad_start} (must be finite and >= 0)")
 
@@ -568,7 +610,7 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
     path = record.source
     _check_args(path, scale, taper, baseline, pad_start)
     if not (np.isfinite(highpass) and highpass >= 0):
-        _refuse(path, f"highpass = {highpass} Hz (must be finite and >= 0)")
+        _refuse(path, f"-ssi_seismic_highpass {highpass} Hz: must be finite and >= 0")
     t, x = np.asarray(record.t, float), _as2d(record.values) * scale
     raw = _kinematics(t, x, record.quantity)
     i0, i1 = _window(path, t, raw[0], window)

@@ -199,6 +199,8 @@ def _march(t, acc, omega, zeta, oversample=1):
     (samples and sub-steps) for the c ground accelerations acc (c, n).  The buffers are
     reused: consume a block before asking for the next."""
     c, P, k = acc.shape[0], omega.size, oversample
+    if c * P == 0:                  # only T = 0 asked (the rigid limit, the PGA): no oscillator to march
+        return
     rows = max(1, _BLOCK_VALUES // (c * P))
     buf0, buf1 = np.empty((rows, c, P)), np.empty((rows, c, P))
     y0, y1 = np.zeros((c, P)), np.zeros((c, P))

@@ -4,6 +4,9 @@ roof acceleration with and without SSI, the period of the spectral peak, the fre
 and a PNG of the roof's absolute acceleration with SSI and on a fixed base beside the free field.
 
     python runs/seismic/report.py out/seismic      (prints the README tables, writes roof.png)
+
+The PNGs go into the run's directory (out/seismic/roof.png, oblique.png), never over the ones kept
+in the repository beside this script (copy them there to refresh the README's figures).
 """
 import csv
 import glob
@@ -84,8 +87,8 @@ def main(d):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(os.path.join(HERE, "roof.png"), dpi=120)
-    print(f"wrote {os.path.join(HERE, 'roof.png')}")
+    fig.savefig(os.path.join(d, "roof.png"), dpi=120)
+    print(f"wrote {os.path.join(d, 'roof.png')}")
 
 
 def _accel(t, u):
@@ -140,8 +143,8 @@ def oblique(d):
         ax.legend(fontsize=7, ncol=2)
     axs[-1].set_xlabel("t [s]")
     fig.tight_layout()
-    fig.savefig(os.path.join(HERE, "oblique.png"), dpi=120)
-    print(f"wrote {os.path.join(HERE, 'oblique.png')}")
+    fig.savefig(os.path.join(d, "oblique.png"), dpi=120)
+    print(f"wrote {os.path.join(d, 'oblique.png')}")
 
 
 if __name__ == "__main__":

@@ -117,7 +117,10 @@ def test_a_run_ending_before_the_record_is_warned(tmp_path, dpulse):
     args = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "0.5", "-ssi_cp", "42", "-ssi_cs", "20",
             "-ssi_dt", "0.006", "-ssi_t_end", "0.06", "-ssi_seismic", "rayleigh", "-ssi_seismic_record", dpulse,
             "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none", "-ssi_output", str(tmp_path / "o.h5"),
-            "-ssi_warn_beta", "0"]
+            "-ssi_warn_beta", "0",
+            # something in the half-space (a half-space with nothing in it is refused since issue 44)
+            "-ssi_mesh_patch", "0.5,0.5", "-ssi_load_group", "load", "-ssi_load_p0", "1",
+            "-ssi_seismic_combine", "superpose"]
     p = cli(args)
     said = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning:") and "before the record" in ln]
     assert len(said) == 1 and "-ssi_t_end 0.06 s" in said[0], p.stdout

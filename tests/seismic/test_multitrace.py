@@ -54,6 +54,9 @@ def test_each_axis_takes_its_trace(tmp_path, three, form, expect):
     ([], "-ssi_seismic_traces X,Y,Z"),
     (["-ssi_seismic_traces", "E,N"], "give three traces"),
     (["-ssi_seismic_traces", "E,N,Q"], "'Q' matches 0 of the traces"),
+    # one trace driving three axes (issue 44: E,E,E ran as a diagonal motion)
+    (["-ssi_seismic_traces", "E,E,E"], "the trace HNE of"),
+    (["-ssi_seismic_traces", "HNE,1,-"], "drives both x and y"),
 ])
 def test_a_multi_trace_file_without_its_traces_is_refused_in_one_line(tmp_path, three, extra, words):
     p = cli(FEM + ["-ssi_output", str(tmp_path / "o.h5"), "-ssi_seismic_record", three] + extra, nranks=2,
@@ -61,3 +64,22 @@ def test_a_multi_trace_file_without_its_traces_is_refused_in_one_line(tmp_path, 
     errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert words in errors[0], errors[0]
+
+
+def test_a_record_with_gaps_is_refused(tmp_path):
+    """A miniSEED whose channel is in three segments (gaps): refused whatever the trace asked for
+    (issue 44: the index 0 ran the first segment; three segments could drive three axes)."""
+    obspy = pytest.importorskip("obspy")
+    from petsc_ssi.seismic import records as R
+    t0 = obspy.UTCDateTime(2020, 1, 1)
+    segs = []
+    for off in (0, 10, 25):
+        tr = obspy.Trace(np.sin(np.arange(500) * 0.1), header={"channel": "HNZ", "station": "ST", "sampling_rate": 100.0,
+                                                               "starttime": t0 + off})
+        segs.append(tr)
+    path = str(tmp_path / "gaps.mseed")
+    obspy.Stream(segs).write(path, format="MSEED")
+    for comp in (None, "Z", 0):
+        with pytest.raises(R.RecordError) as e:
+            R.read_record(path, component=comp, units="m/s2")
+        assert "the trace .ST..HNZ is in 3 segments (gaps or overlaps" in str(e.value), e.value

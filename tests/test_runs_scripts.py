@@ -1,0 +1,37 @@
+"""runs/seismic/report.py writes its figures into the run's directory, never over the PNGs kept in
+the repository beside it (issue 44: run.sh's report replaced runs/seismic/roof.png)."""
+import hashlib
+import importlib.util
+import os
+
+import h5py
+import numpy as np
+
+from helpers import ROOT
+import pytest
+
+pytestmark = pytest.mark.run
+
+
+def _digest(path):
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+def test_seismic_report_writes_into_the_run_directory(tmp_path, capsys):
+    t = np.linspace(0.0, 1.0, 101)
+    a = np.zeros((t.size, 1, 3))
+    a[:, 0, 0] = np.sin(2 * np.pi * 2 * t)
+    for name, key in (("building_structure.h5", "acceleration"), ("fixed-base.h5", "absolute_acceleration"),
+                      ("building.h5", "u")):
+        with h5py.File(tmp_path / name, "w") as f:
+            f["receivers/t"], f[f"receivers/{key}"] = t, a
+            if name == "building.h5":
+                f["seismic/x_pga"] = 1.0
+    kept = os.path.join(ROOT, "runs", "seismic", "roof.png")
+    before = _digest(kept)
+    spec = importlib.util.spec_from_file_location("seismic_report", os.path.join(ROOT, "runs", "seismic", "report.py"))
+    report = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(report)
+    report.main(str(tmp_path))
+    assert os.path.getsize(tmp_path / "roof.png") > 1000
+    assert _digest(kept) == before
