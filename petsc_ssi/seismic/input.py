@@ -189,6 +189,9 @@ def read_motions(cfg):
         out = {axis: proc(rec, c.seismic_scale * f) for axis, rec in recs.items()}
         for m in out.values():
             m.processing["target"] = line
+    if c.get("seismic_units_check", True):
+        from .scaling import check_scaled
+        check_scaled(out, c)
     return out
 
 

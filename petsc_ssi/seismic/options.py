@@ -36,7 +36,7 @@ register("seismic_traces", "str", "", "", "-ssi_seismic vertical with multi-trac
 register("seismic_scale", "real", 1.0, "", "amplitude factor after unit conversion", G)
 register("seismic_units_check", "bool", True, "", "refuse a record whose PGA as read (in its -ssi_seismic_units, "
          "before -ssi_seismic_scale) is above 5 g or below 1e-6 g, implausible for an earthquake: most likely wrong "
-         "units (0: run it anyway)", G)
+         "units; and a run whose PGA after -ssi_seismic_scale or -ssi_seismic_target is (0: run it anyway)", G)
 register("seismic_target", "str", "none", "m/s^2, s", "scale the processed record(s) to a target: none, 'pga:A' "
          "(PGA A), 'psa:T:A' (pseudo-spectral acceleration at the period T [s] with -ssi_seismic_target_damping, "
          "ASCE 7 amplitude scaling) or 'sa:T:A' (spectral acceleration); A in m/s^2, or in g with a suffix g "

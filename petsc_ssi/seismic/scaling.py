@@ -93,6 +93,22 @@ def check_units(motions, units_option):
                        + "; -ssi_seismic_units_check 0 runs it anyway")
 
 
+def check_scaled(motions, cfg):
+    """SSIError (one line) when the motion a run applies, after -ssi_seismic_scale and
+    -ssi_seismic_target, peaks outside [1e-6 g, 5 g]: a plausible record made implausible by its
+    scale (issue 44: -ssi_seismic_scale 1e12 ran), naming the option that did it."""
+    for axis, m in motions.items():
+        pga = float(np.max(m.stats["pga"]))
+        if PGA_MIN_G * G0 <= pga <= PGA_MAX_G * G0:
+            continue
+        why = "above 5 g" if pga > PGA_MAX_G * G0 else "below 1e-6 g"
+        by = ("-ssi_seismic_target " + str(cfg.get("seismic_target")) if m.processing.get("target")
+              else f"-ssi_seismic_scale {cfg.get('seismic_scale', 1.0):g}")
+        raise SSIError(f"record '{m.source}'" + (f" ({axis})" if axis else "") + f": the run's PGA {pga / G0:.4g} g "
+                       f"({pga:.4g} m/s^2) after {by} is {why}: implausible for an earthquake; check {by.split()[0]}"
+                       "; -ssi_seismic_units_check 0 runs it anyway")
+
+
 def _horizontal(motions):
     h = [a for a in motions if a in ("x", "y")]
     return h if h else list(motions)

@@ -52,3 +52,19 @@ def test_refusals_one_line_every_rank(rec, which, extra, words):
     p = cli(["record", str(rec[which])] + extra, nranks=2, check=False, timeout=300)
     errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1 and words in errors[0], p.stdout + p.stderr
+
+
+def test_a_plausible_record_scaled_to_an_implausible_run_is_refused(rec):
+    """Issue 44's 'record scaled by 1e12': the units check reads the record before its scale, so the
+    run's PGA (after -ssi_seismic_scale or -ssi_seismic_target) is checked too, naming the option
+    that made it implausible; -ssi_seismic_units_check 0 runs it anyway."""
+    for extra, opt in ((["-ssi_seismic_scale", "1e12"], "-ssi_seismic_scale"),
+                       (["-ssi_seismic_target", "pga:1e12"], "-ssi_seismic_target"),
+                       (["-ssi_seismic_scale", "1e-9"], "-ssi_seismic_scale")):
+        p = cli(["record", str(rec[0]), "-ssi_seismic_baseline", "none"] + extra, check=False)
+        lines = [ln for ln in p.stdout.splitlines() + p.stderr.splitlines() if "error" in ln]
+        assert p.returncode == 2 and len(lines) == 1, p.stdout + p.stderr
+        assert "the run's PGA" in lines[0] and f"check {opt}" in lines[0], lines[0]
+    p = cli(["record", str(rec[0]), "-ssi_seismic_baseline", "none", "-ssi_seismic_scale", "1e12",
+             "-ssi_seismic_units_check", "0"])
+    assert "PGA [m/s2]" in p.stdout
