@@ -49,7 +49,8 @@ def test_period_zero_alone_is_the_pga(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra,msg", [(["--oversample", "100000000"], "--oversample 100000000: "),
-                                       (["--periods", "1e-7,1"], "--oversample auto (10 dt / T_min")])
+                                       (["--periods", "1e-7,1", "--peaks", "nodes"], "--oversample auto (10 dt / T_min"),
+                                       (["--periods", "1e-7,1"], "--periods: the shortest period 1e-07 s needs")])
 def test_oversampling_beyond_the_work_bound_is_refused(tmp_path, capsys, extra, msg):
     st, out, err = _rsp(["--response-spectrum", "--table", _table(tmp_path)] + extra, capsys)
     assert st == 2 and msg in err and "sub-steps" in err and len(err.strip().splitlines()) == 1, err

@@ -324,6 +324,16 @@ def spectra(series, periods=None, damping=(0.05,), rotd=False, geomean=False, ov
         raise _error(f"{why}: {k} sub-steps per time step over {len(series.t) - 1} steps are {steps:.3g} sub-steps, "
                      f"more than {MAX_SUBSTEPS:.0e} (about {steps * 2e-5 / 3600:.2g} h); give a smaller --oversample "
                      f"(auto gives {auto_oversample(series.t, periods)}) or a longer shortest period in --periods")
+    pos = np.asarray(periods)[np.asarray(periods) > 0]
+    if peaks == "exact" and len(pos) and len(series.t) > 1:
+        # exact peaks search each step in pieces of at most a quarter period: 4 dt / T pieces a step
+        # for the shortest period (--periods 1e-7 asked 4e5 a step and took the machine's memory)
+        pieces = int(np.ceil(4.0 * float(np.max(np.diff(series.t))) / (k * float(pos.min()))))
+        if pieces * steps > MAX_SUBSTEPS:
+            raise _error(f"--periods: the shortest period {float(pos.min()):g} s needs {pieces} quarter-period pieces "
+                         f"in each of the {steps} (sub-)steps for its exact peaks, {pieces * steps:.3g} sub-steps in "
+                         f"all, more than {MAX_SUBSTEPS:.0e}; give a longer shortest period (at least "
+                         f"{4.0 * float(np.max(np.diff(series.t))) * steps / MAX_SUBSTEPS / k:.3g} s)")
     out = []
     if rotd or geomean:
         if series.components[:2] != ("x", "y"):

@@ -303,6 +303,24 @@ def _pieces(h, omega):
     return h[:, None] * jj / m[:, None]
 
 
+MAX_PIECES = 10 ** 8         # quarter-period pieces of all steps beyond which exact peaks are refused
+
+
+def _check_pieces(t, omega, oversample):
+    """SpectrumInputError when the exact peaks' quarter-period pieces over the whole record exceed
+    ``MAX_PIECES`` (a period far below the sampling step: 4 dt / T pieces a step; a period of 1e-7 s
+    under a 5 ms record took the machine's memory)."""
+    if omega.size == 0 or t.size < 2:
+        return
+    h = float(np.max(np.diff(t))) / oversample
+    pieces = int(np.ceil(float(omega.max()) * h / QUARTER - 1e-9))
+    total = pieces * (t.size - 1) * oversample
+    if total > MAX_PIECES:
+        raise SpectrumInputError(f"exact peaks of the period {2 * np.pi / float(omega.max()):.3g} s need {pieces} "
+                                 f"pieces in each of {(t.size - 1) * oversample} steps ({total:.3g} in all, more than "
+                                 f"{MAX_PIECES:.0e}); give longer periods or peaks='nodes'")
+
+
 def _at_pieces(y0, y1, g0, g1, h, omega, zeta):
     """(S, a, b, g) (N, M + 1): the states y = (a, b) and the ground g at the pieces' points S of each
     candidate step; the step matrices are formed once per distinct (h, omega, zeta) (a uniform record
@@ -493,6 +511,7 @@ def response_spectrum(t, acc, periods=None, damping=(0.05,), quantity="all", ove
     omega, zeta, pos = _pairs(periods, damping)
     pd, pv, pa = np.zeros(omega.size), np.zeros(omega.size), np.zeros(omega.size)
     if peaks == "exact":
+        _check_pieces(t, omega, k)
         pd, pv, pa = _exact_peaks(t, acc, omega, zeta, k)
     else:
         for y0, y1 in _march(t, acc[None, :], omega, zeta, k):
@@ -546,6 +565,7 @@ def rotd(t, ax, ay, periods=None, damping=(0.05,), percentiles=(50, 100), n_angl
     if peaks not in ("exact", "nodes"):
         raise SpectrumInputError(f"peaks must be 'exact' or 'nodes', got {peaks!r}")
     if peaks == "exact":                                          # each angle's peak within its step
+        _check_pieces(t, omega, k)
         peak = _exact_rotd(t, np.stack([ax, ay]), omega, zeta, cs, k)
     else:
         peak = np.zeros((omega.size, n))                          # peak |omega^2 u_theta| at the nodes

@@ -86,3 +86,17 @@ def test_rotd_exact_against_dense(record):
     single = rs.response_spectrum(t, a, P, [0.05])
     r = rs.rotd(t, a, np.zeros_like(a), P, [0.05])[100]["PSA"]
     assert np.allclose(r, single["PSA"], rtol=1e-11)                      # one component: RotD100 = its PSA
+
+
+def test_a_period_far_below_the_step_is_refused_not_allocated():
+    """Exact peaks search each step in quarter-period pieces: 4 dt / T of them. A period of 1e-8 s under a
+    5 ms record would take 2e6 pieces a step (a merged run of make test lost a worker to the kernel's OOM
+    killer on --periods 1e-7): refused before anything is allocated, for the spectra and RotD."""
+    from petsc_ssi.seismic import response_spectrum as rs
+    t = np.arange(0.0, 10.0, 0.005)
+    a = np.sin(2 * np.pi * t)
+    with pytest.raises(rs.SpectrumInputError, match="pieces in each of 1999 steps"):
+        rs.response_spectrum(t, a, [1e-8, 1.0])
+    with pytest.raises(rs.SpectrumInputError, match="pieces"):
+        rs.rotd(t, a, a, [1e-8, 1.0])
+    assert rs.response_spectrum(t, a, [1e-8, 1.0], peaks="nodes").values["PSA"].shape == (1, 2)
