@@ -77,8 +77,8 @@ def check_units(motions, units_option):
     for axis, m in motions.items():
         scale = abs(float(m.processing["scale"]))
         pga = float(np.max(m.stats_raw["pga"])) / scale           # as read, in SI (before the scale)
-        if PGA_MIN_G * G0 <= pga <= PGA_MAX_G * G0:
-            continue
+        if PGA_MIN_G * G0 <= pga <= PGA_MAX_G * G0 or pga == 0.0:
+            continue          # (a zero column of 't ax ay az' driving the other axes: a record of zeros is refused apart)
         unit = m.record_info.get("units_in", "?")
         from .records import UNITS
         factor = UNITS[unit][1] if unit in UNITS else 1.0
@@ -99,7 +99,7 @@ def check_scaled(motions, cfg):
     scale (issue 44: -ssi_seismic_scale 1e12 ran), naming the option that did it."""
     for axis, m in motions.items():
         pga = float(np.max(m.stats["pga"]))
-        if PGA_MIN_G * G0 <= pga <= PGA_MAX_G * G0:
+        if PGA_MIN_G * G0 <= pga <= PGA_MAX_G * G0 or pga == 0.0:
             continue
         why = "above 5 g" if pga > PGA_MAX_G * G0 else "below 1e-6 g"
         by = ("-ssi_seismic_target " + str(cfg.get("seismic_target")) if m.processing.get("target")
