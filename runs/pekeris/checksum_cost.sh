@@ -9,7 +9,7 @@ set -e
 BEFORE=${1:-7d75961}
 REPS=${2:-3}
 PY=${PY:-.venv/bin/python}
-[ -x "$PY" ] || PY=/work/main/.venv/bin/python
+[ -x "$PY" ] || { echo "checksum_cost.sh: no $PY (run make deps, or set PY)"; exit 1; }
 HERE=$(pwd)
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT

@@ -1,7 +1,8 @@
 """Checks of the plane-wave free field of a half-space (petsc_ssi.analytic.free_field).
 
 Conventions: soil z < 0, e_z up, u_v positive up, angles in degrees, e^{-i omega t} for complex
-coefficients.  Reference values: /work/shared/notes/seismic-input.md sec. 2.5, 2.7, 2.8.
+coefficients.  Reference values: Aki & Richards (2002), sec. 5.2 (free-surface reflection
+coefficients) and Achenbach (1973), ch. 5 (Rayleigh waves), as cited in the module.
 The free-surface conditions are re-solved here independently (a 2x2 complex system built from
 the stress of one plane-wave term), not through the module's closed forms.
 """
