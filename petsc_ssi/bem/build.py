@@ -48,11 +48,13 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     PETSc = init()
     from .. import numba_cache_warm
     if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
-        from .model import announce_compile
+        from .lagset import announce_compile
         announce_compile()
     t0 = time.perf_counter()
     if cfg.get("lags_load"):
         return _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
+    if getattr(prob, "lattice", None) is not None:
+        return _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
     single = int(cfg.lag_single_from)
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx, single_from=single)
     N = prob.mesh.n_nodes
@@ -157,3 +159,69 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     ls.H = ls.G = None
     return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
                    "nbaij": nbaij, "nsingle": nsingle, "fill": float("nan"), "mem": mem_exact + mem_interp}
+
+
+def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0):
+    """Collective: the G lags lag_lo..lag_hi (at kernel times l dt + toff) as the dense path stores
+    them, from an assembly over the elements that carry traction columns only (the others add
+    nothing to G; the same elements in the same order: the same bits)."""
+    nt = prob.regions.n_t
+    tl = ls.restricted(np.any(ls.VT >= 0, axis=1))
+    PETSc = init()
+    pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+    tcol_loc = pl.getLocalSize() // 3
+    pl.destroy()
+    _, gb = tl.assemble(monitor=False, lag_lo=lag_lo, lag_hi=lag_hi, toff=toff, quiet=True)
+    N = prob.mesh.n_nodes
+    if lag_lo == lag_hi and lag_lo > 1:
+        return [lagmats.build_one(comm, gb, lag_lo, ls.node_range, N, nt, tcol_loc, "dense")[0]], tl
+    return lagmats.build(comm, gb, lag_hi, ls.node_range, N, nt, tcol_loc, "dense")[0], tl
+
+
+def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
+    """Collective: build_marcher on a uniform flat grid (-ssi_lag_store toeplitz, ``bem.toeplitz``):
+    lags 1 and 2 assembled as always (the step matrix), the H lags of the history sum as FFT
+    kernels on the grid, G (traction columns only) as the dense path stores it."""
+    from .toeplitz import ToeplitzHistory
+    N = prob.mesh.n_nodes
+    r0, r1 = ls.node_range
+    ls.assemble(monitor=cfg.monitor, lag_hi=2)
+    nev = ls.kernel_evaluations
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))
+    with event("SSI_BEM_LagMats"):
+        H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
+        H = list(H) + [None] * (plan.Lx - 2)
+        k = plan.k if plan.active else 0
+        HI, GI = [None] * k, []
+        if prob.regions.n_t:
+            G, tl = _traction_g(comm, prob, plan, ls, plan.Lx)
+            nev += tl.kernel_evaluations
+            for j in range(k):
+                lag, toff = plan.kernel_time(j)
+                g, tl = _traction_g(comm, prob, plan, ls, lag, lag, toff)
+                GI.append(g[0])
+                nev += tl.kernel_evaluations
+        else:
+            G = [None] * plan.Lx
+    ls.H = ls.G = None
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    with event("SSI_BEM_Toeplitz"):
+        th = ToeplitzHistory(comm, ls, prob.lattice, log).build(march, plan, monitor=cfg.monitor)
+    march.toeplitz = th
+    ls.kernel_evaluations = nev + th.nev
+    t_asm = time.perf_counter() - t0
+    mem_g = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in [M for M in H + G + GI if M is not None]))
+    mem = mem_g + th.bytes
+    printf(f"[ssi] assembly {fmt_time(t_asm)}: lag store toeplitz on the {prob.lattice.describe()}: "
+           f"{th.D} history kernels K'_d in Fourier space ({th.bytes / 1e9:.3g} GB with the kept states' "
+           f"transforms; kernels {th.t_build:.3g} s), step matrix and G lags {mem_g / 1e9:.3g} GB, "
+           f"{ls.kernel_evaluations:.3g} kernel evaluations")
+    _say_block(march)
+    if cfg.get("lags_save"):
+        from ..petsc import SSIError
+        raise SSIError("-ssi_lags_save: not available with -ssi_lag_store toeplitz (its kernels are built in "
+                       "seconds); use -ssi_lag_store dense")
+    return march, {"t_asm": t_asm, "mem_exact": mem, "mem_interp": 0.0, "ndense": 0, "nbaij": 0, "nsingle": 0,
+                   "fill": float("nan"), "mem": mem}

@@ -371,16 +371,66 @@ class HalfSpace:
         plan = self.interp_plan()
         printf("[ssi] " + plan.describe())
         ls = self.lagset(plan)
+        self.lattice = self._lattice(ls)
         if ls.balance is not None:
             n = [b - a for a, b in ls.ranges]
             printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, -ssi_partition "
                    f"{self.cfg.partition} (estimated work max/mean {ls.balance[0]:.3f}; equal node counts "
                    f"{ls.balance[1]:.3f})")
-        self.check_memory(ls, plan, extra_bytes, extra_what)
+        if self.lattice is None:
+            self.check_memory(ls, plan, extra_bytes, extra_what)
+        else:
+            self.check_toeplitz_memory(ls, plan, extra_bytes)
         from . import lagstore
         with collective(self.comm, "checking -ssi_lags_load"):
             self.lags_manifest = lagstore.check(self.cfg, self.comm, self, plan)
         return plan, ls
+
+    def _lattice(self, ls):
+        """Collective: the uniform grid of -ssi_lag_store toeplitz (or auto, where it exists), or None
+        (the dense lag matrices). Refused in one line, on every rank, before any assembly: a forced
+        toeplitz store on a surface that is not a uniform flat grid, or with what it does not do."""
+        from .toeplitz import detect
+        store = self.cfg.get("lag_store", "dense")
+        if store == "dense":
+            return None
+        why = None
+        if self.cfg.get("lags_load") or self.cfg.get("lags_save"):
+            why = "-ssi_lags_save/-ssi_lags_load store lag matrices"
+        elif int(self.cfg.lag_single_from):
+            why = "-ssi_lag_single_from keeps lag matrices in single precision"
+        elif not ls.flat:
+            why = "the surface is not flat (or -ssi_lag_pattern full)"
+        if why is None:
+            try:
+                lat = detect(ls.VX, self.mesh.nodes)
+            except SSIError as e:
+                why = str(e).split(": ", 1)[-1]
+                lat = None
+        if why is not None:
+            if store == "toeplitz":
+                raise SSIError(f"-ssi_lag_store toeplitz: {why}")
+            printf(f"[ssi] lag store: dense lag matrices ({why})")
+            return None
+        printf(f"[ssi] lag store: toeplitz, {lat.describe()}")
+        return lat
+
+    def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
+        """Collective: refuse a toeplitz run whose kernels and kept transforms (complex, D of each:
+        4 x 9 x 4 and 9 x 3 fields of the FFT grid's half spectrum) would not fit the node."""
+        c = self.cfg
+        lat = self.lattice
+        self.lag_fill = c.lag_fill
+        limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
+        D = self.L
+        est = 16.0 * lat.F * (D * 144 + (D + 1) * 27) + float(extra_bytes)
+        self.mem_estimate = est
+        self.mem_peak_estimate = est + 2 * 8.0 * 144 * lat.Mx * lat.My * min(D, 8) * self.comm.getSize()
+        if self.mem_peak_estimate > limit:
+            raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {est / 1e9:.3g} GB, more than "
+                           f"the {limit / 1e9:.3g} GB available (-ssi_memory_limit); use -ssi_interp, a shorter "
+                           "-ssi_t_end or a coarser grid")
+        self.loop_estimate = None
 
     def quad_options(self):
         c = self.cfg

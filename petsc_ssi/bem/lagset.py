@@ -382,6 +382,18 @@ class LagSet:
         peak = peak_bytes(mats, trip, g, asm, rss, n_exact=lags, asm_interp=asm_i)
         return float(mats.sum() + g.sum()), float(peak), int(dense.sum())
 
+    def restricted(self, keep):
+        """A LagSet of the same rows over the virtual elements ``keep`` (a mask), for an assembly
+        of their contributions only (``build._traction_g``: the elements with traction columns)."""
+        import copy
+        o = copy.copy(self)
+        for a in ("VX", "VN", "VS", "VT", "Vc", "VR", "Vh"):
+            setattr(o, a, np.ascontiguousarray(getattr(self, a)[keep]))
+        o._plane = None
+        o.n_images = 1              # (the capacity estimate: each kept element apart, an upper bound)
+        o.__dict__.pop("_cache_est", None)
+        return o
+
     CACHE_MAX = CACHE_MAX        # bytes per cache pool (P and U): 1 GiB per rank at most
 
     def pattern(self):
@@ -503,7 +515,7 @@ class LagSet:
         rows = self.rows
         chunk = chunk or self.chunk_rows(lag_hi - lag_lo + 1)
         prog = Progress(what, max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
-        nimg = len(self.Vc) // self.mesh.n_cells
+        nimg = getattr(self, "n_images", None) or len(self.Vc) // self.mesh.n_cells
         est = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg)
         est[:lag_lo - 1] = 0
         cap = 1.15 * est

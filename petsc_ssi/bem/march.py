@@ -151,6 +151,7 @@ class Marcher:
         self.norm_prefix_max = []   # the divergence guard's running max of |u| (bem/stability.py guard)
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
+        self.toeplitz = None        # bem/toeplitz.ToeplitzHistory: the H lags >= 2 as FFT kernels
 
     def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
@@ -277,8 +278,14 @@ class Marcher:
         """out = sum_{j>=2} [G_j q_j(p) - H_j q_j(u)] for step n: time-blocked
         (``_blocked_history``) when ``block`` > 1, else step by step (``history_step``)."""
         if self.block > 1:
-            return self._blocked_history(n, out_u)
-        return self.history_step(n, out_u)
+            self._blocked_history(n, out_u)
+        else:
+            self.history_step(n, out_u)
+        if self.toeplitz is not None:       # the H lags of a uniform grid in Fourier space (bem/toeplitz.py)
+            ev = event("SSI_BEM_HistFFT")
+            ev.begin()
+            self.toeplitz.add(n, self, out_u)
+            ev.end()
 
     def history_step(self, n, out_u):
         """The per-step history sum (the reference): one product per lag; lags beyond

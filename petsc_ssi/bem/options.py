@@ -33,6 +33,12 @@ register("partition", "enum", "balanced", "", "soil nodes per rank: contiguous r
          "products (bem/partition.py) or PETSc's equal node counts", "bem",
          choices=("balanced", "equal"))
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
+register("lag_store", "enum", "dense", "", "how the lags of the history sum are stored: dense (the lag matrices, "
+         "-ssi_lag_storage) or toeplitz (a uniform flat grid of equal elements, with or without symmetry planes: the H "
+         "lags as block-Toeplitz kernels in Fourier space, O(N) a lag instead of O(N^2), the history sum by FFTs: "
+         "bem/toeplitz.py; the same answer to round-off; refused in one line naming the first element off the grid); "
+         "auto: toeplitz where the grid allows it, else dense (said in one log line)", "bem",
+         choices=("dense", "toeplitz", "auto"))
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))
 register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "

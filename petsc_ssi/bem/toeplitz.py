@@ -1,0 +1,375 @@
+r"""Lag matrices of a uniform flat grid as block-Toeplitz convolutions, the history sum in Fourier space
+(issue 41; ``-ssi_lag_store toeplitz``).
+
+On a surface whose elements (and their symmetry images) are equal axis-aligned squares or rectangles
+hx x hy on a lattice of centres c = o + (i hx, j hy), with their nodes at c + delta_a (the nine
+positions {-h/2, 0, h/2}^2, ``SLOTS``), every entry of a lag matrix is a sum over elements e and
+their local nodes a of one element's integral that depends only on the offset x_i - c_e and on a:
+
+    (H_l u)(x) = sum_a sum_e K_{l,a}(x - c_e) v_a(e),    v_a(e) = S_e u(node of e at c_e + delta_a)
+
+(S_e the image's sign, ``symmetry``). A collocation point is a node, x = c + ((2k + t_x) hx/2,
+(2k' + t_y) hy/2) with parity class t = (t_x, t_y) (corner, two edge and centre nodes), so per class
+the sum over e is a discrete 2-D convolution on the lattice: nine convolutions (one per a) for each
+of four classes, each a 3x3 block with the flat surface's H pattern (4 entries, ``bsr.H4``). A lag is
+stored as the 2-D real FFTs of its kernels on a zero-padded grid Mx x My >= 2 nx x 2 ny (so the
+circular convolution is the linear one on the lattice), O(N) numbers instead of O(N^2). The kernels
+are the same integrals the dense path computes (``assemble.integrate_records`` on one element of the
+grid at every offset), so the answer is the dense path's to round-off.
+
+The history sum of the marching scheme (``march``) over the exact lags 2..Lx and the interpolating
+matrices is one stationary convolution in time, sum_d K'_d u^{n-d}, whose kernel K'_d (d = 1..D) is the
+linear combination of lag kernels the scheme's terms give (``Marcher._step_terms``: plain, stabilised,
+multi-linear or Chebyshev interpolation beyond T_L alike). Each state u^m is transformed once (27
+real FFTs: nine node slots, three components) and kept while a kernel reads it; per step the
+products sum over d in Fourier space and four classes x three components go back by inverse FFTs.
+
+Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
+and of every kept state's transform: memory divided by the ranks); each rank transforms the new state
+(gathered: the data a dense MatMult gathers anyway) and keeps its slab; the summed slabs are gathered
+and transformed back. A frequency's products are summed in the same order on any number of ranks, so
+``-n 2`` gives ``-n 1``'s bits.
+
+G (traction columns) stays as the dense path stores it (N x n_t, small when the tractions live on a
+footprint or a load patch); the step matrix (lags 1 and 2) is assembled and factorised as before.
+"""
+import math
+import time
+
+import numpy as np
+from numba import njit
+
+from ..petsc import SSIError, printf
+
+# the nine node positions of an element relative to its centre, in half element sizes
+SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
+CLASSES = ((0, 0), (0, 1), (1, 0), (1, 1))      # node parity (t_x, t_y): 0 on a centre line, 1 on an edge
+
+
+class Lattice:
+    """The uniform grid of a surface: lattice of element centres, node slots, parity classes of the
+    nodes (``detect``)."""
+
+    def __init__(self, o, h, nx, ny, cell, perm, node_fine, code0):
+        self.o, self.h, self.nx, self.ny = o, h, nx, ny
+        self.cell = cell                # (nv,) flat lattice index ix * ny + iy of each virtual element
+        self.perm = perm                # (nv, 9): local node of element v at slot a (SLOTS)
+        self.node_fine = node_fine      # (N, 2): a node's position in half element sizes from o
+        self.code0 = code0              # (9,): the slot of each local node of element 0 (the kernels')
+        from scipy.fft import next_fast_len
+        self.Mx = next_fast_len(2 * nx, real=True)
+        self.My = next_fast_len(2 * ny, real=True)
+        self.F = self.Mx * (self.My // 2 + 1)
+
+    def describe(self):
+        return (f"{self.nx} x {self.ny} lattice of {self.h[0]:g} x {self.h[1]:g} m elements (FFT grid "
+                f"{self.Mx} x {self.My})")
+
+
+def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
+    """The Lattice of virtual elements VX (nv, 9, 3) and nodes (N, 3), or SSIError naming the first
+    element that is not on it (a surface not in the plane z = 0, elements of another size or shape,
+    off the lattice, overlapping or turned over)."""
+    VX = np.asarray(VX, float)
+    nodes = np.asarray(nodes, float)
+    if VX.shape[0] == 0:
+        raise SSIError(f"{what}: the surface has no elements")
+    X0 = VX[0]
+    h = np.array([np.ptp(X0[:, 0]), np.ptp(X0[:, 1])])
+    if h.min() <= 0:
+        raise SSIError(f"{what}: element 0 is not a rectangle in the plane z = 0")
+    tol = 1e-9 * float(h.max())
+    if np.abs(VX[..., 2]).max() > tol or (nodes.size and np.abs(nodes[:, 2]).max() > tol):
+        v = int(np.argmax(np.abs(VX[..., 2]).max(axis=1)))
+        raise SSIError(f"{what}: the surface is not the plane z = 0 (element {v} at z = "
+                       f"{VX[v, :, 2].min():.6g} m); a grid of FFT lags needs a flat surface")
+    c = 0.25 * (VX[:, 0] + VX[:, 1] + VX[:, 2] + VX[:, 3])           # centre of the corners
+    rel = (VX[..., :2] - c[:, None, :2]) / (0.5 * h)
+    fine = np.rint(rel)
+    bad = np.abs(rel - fine).max(axis=(1, 2)) > 1e-9 * 2
+    bad |= np.abs(fine).max(axis=(1, 2)) > 1
+    code = ((fine[..., 0] + 1) * 3 + (fine[..., 1] + 1)).astype(np.int64)
+    bad |= np.any(np.sort(code, axis=1) != np.arange(9)[None, :], axis=1)
+    # orientation: the signed area of the corners (images keep the outward normal: symmetry.FLIP)
+    P = VX[:, :4, :2]
+    area = 0.5 * np.sum(P[:, :, 0] * np.roll(P[:, :, 1], -1, axis=1) - np.roll(P[:, :, 0], -1, axis=1) * P[:, :, 1],
+                        axis=1)
+    bad |= np.sign(area) != np.sign(area[0])
+    if np.any(bad):
+        v = int(np.argmax(bad))
+        raise SSIError(f"{what}: element {v} (centre {c[v, 0]:.6g}, {c[v, 1]:.6g} m) is not a "
+                       f"{h[0]:g} x {h[1]:g} m nine-node rectangle like element 0 (same size, straight sides, "
+                       "mid-side nodes, the same orientation); use -ssi_lag_store dense")
+    o = c[:, :2].min(axis=0)
+    g = (c[:, :2] - o) / h
+    gi = np.rint(g)
+    off = np.abs(g - gi).max(axis=1) > 1e-9
+    if np.any(off):
+        v = int(np.argmax(off))
+        raise SSIError(f"{what}: element {v} (centre {c[v, 0]:.6g}, {c[v, 1]:.6g} m) is off the grid of "
+                       f"element 0 ({h[0]:g} x {h[1]:g} m); use -ssi_lag_store dense")
+    gi = gi.astype(np.int64)
+    nx, ny = int(gi[:, 0].max()) + 1, int(gi[:, 1].max()) + 1
+    cell = gi[:, 0] * ny + gi[:, 1]
+    u, first, cnt = np.unique(cell, return_index=True, return_counts=True)
+    if np.any(cnt > 1):
+        dup = u[cnt > 1][0]
+        v = int(np.nonzero(cell == dup)[0][1])
+        raise SSIError(f"{what}: element {v} (centre {c[v, 0]:.6g}, {c[v, 1]:.6g} m) overlaps element "
+                       f"{int(np.nonzero(cell == dup)[0][0])}")
+    perm = np.argsort(code, axis=1)          # slot a (code a) -> local node
+    nf = (nodes[:, :2] - o) / (0.5 * h) if nodes.size else np.zeros((0, 2))
+    nfi = np.rint(nf)
+    if nodes.size and np.abs(nf - nfi).max() > 1e-9 * 2:
+        i = int(np.argmax(np.abs(nf - nfi).max(axis=1)))
+        raise SSIError(f"{what}: node {i} is off the grid's half-element positions")
+    return Lattice(o, h, nx, ny, cell, perm, nfi.astype(np.int64), code[0].copy())
+
+
+def kernel_offsets(lat):
+    """The collocation points of the kernels relative to the lattice origin's element: per class t and
+    lattice offset (k, k') in [-nx, nx) x [-ny, ny): (points (n, 2) in half element sizes, class, kx, ky)."""
+    kx = np.arange(-lat.nx, lat.nx)
+    ky = np.arange(-lat.ny, lat.ny)
+    out = []
+    for t, (tx, ty) in enumerate(CLASSES):
+        KX, KY = np.meshgrid(kx, ky, indexing="ij")
+        out.append(np.c_[2 * KX.ravel() + tx, 2 * KY.ravel() + ty, np.full(KX.size, t), KX.ravel(), KY.ravel()])
+    return np.concatenate(out)
+
+
+@njit(cache=True)
+def spectral_products(K, V, slots, pp, pq, out):
+    """out[t, c, f] += sum_d sum_a sum_e K[d, t, a, e, f] V[slots[d], a, pq[e], f] with c = pp[e]
+    (slots[d] < 0: no state): the history sum in Fourier space, one frequency slab. Array inputs
+    only: the one function a GPU array module would take over."""
+    D = K.shape[0]
+    F = K.shape[4]
+    m = pp.shape[0]
+    for d in range(D):
+        s = slots[d]
+        if s < 0:
+            continue
+        for t in range(4):
+            for a in range(9):
+                for e in range(m):
+                    k = K[d, t, a, e]
+                    v = V[s, a, pq[e]]
+                    o = out[t, pp[e]]
+                    for f in range(F):
+                        o[f] += k[f] * v[f]
+
+
+class ToeplitzHistory:
+    """Collective: the H part of the history sum of a uniform flat grid in Fourier space (module
+    docstring). ``build`` computes the kernels; ``add(n, march, out_u)`` subtracts the H terms of step
+    n's history sum from ``out_u``."""
+
+    def __init__(self, comm, ls, lat, log=printf):
+        self.comm, self.ls, self.lat, self.log = comm, ls, lat, log
+        mpi = comm.tompi4py()
+        p, r = mpi.Get_size(), mpi.Get_rank()
+        F = lat.F
+        self.f0, self.f1 = (F * r) // p, (F * (r + 1)) // p
+        self.counts = np.array([(F * (q + 1)) // p - (F * q) // p for q in range(p)], np.int64)
+        from .bsr import positions, H4
+        self.pp, self.pq = positions(H4)
+        self.upto = 0
+
+    # ---------------------------------------------------------------- kernels
+    def _integrate(self, lag_lo, c_lo, c_hi, toff, L, sel):
+        """The element integrals of the offsets ``sel`` (indices into kernel_offsets) for lags
+        c_lo..c_hi at kernel time l dt + toff, with the windows, subdivisions and singular treatment
+        of the dense assembly of lags lag_lo..L (``_pair_window``); a singular pair (its point a node
+        of the element) from lag_lo on, as that assembly integrates it. Returns (offsets kept, meta,
+        P pool offsets, P pool)."""
+        from .assemble import _pair_window, integrate_records, SING_TOL, plane
+        ls, lat = self.ls, self.lat
+        o = ls.opts
+        v0 = 0
+        X = ls.VX[v0:v0 + 1]
+        c0, R0, h0 = ls.Vc[v0], ls.VR[v0], ls.Vh[v0]
+        gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
+        gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
+        mat, dt = ls.mat, ls.dt
+        reach = mat.cp * (dt * L + toff)
+        pts = np.zeros((len(sel), 3))
+        off = self.offsets[sel]
+        pts[:, 0] = c0[0] + off[:, 0] * 0.5 * lat.h[0]
+        pts[:, 1] = c0[1] + off[:, 1] * 0.5 * lat.h[1]
+        pts[:, 2] = c0[2]
+        meta = np.zeros((len(sel), 6), np.int64)
+        keep = np.zeros(len(sel), bool)
+        for i in range(len(sel)):
+            lo, hi, sing, ns = _pair_window(pts[i], X[0], c0, R0, h0, reach, mat.cp, mat.cs, dt, L, lag_lo, toff,
+                                            SING_TOL, int(o["subdivisions"]), int(o["max_subdivisions"]),
+                                            float(o["near_factor"]))
+            if sing < 0:
+                lo = max(lo, c_lo)
+            hi = min(hi, c_hi)
+            if lo > hi or hi < c_lo:
+                continue
+            meta[i] = (lo, hi, sing, ns, 0, 0)
+            keep[i] = True
+        meta, pts, idx = meta[keep], pts[keep], np.asarray(sel)[keep]
+        if not hasattr(self, "_plane") or self._plane is None:
+            self._plane = plane(ls.in_plane, X, int(o["subdivisions"]), gq, gw, int(o["max_subdivisions"]))
+        dropped = np.zeros(2)
+        offP, P, _, _, nev = integrate_records(meta, pts, X, c_hi, dt, mat.cp, mat.cs, mat.rho, mat.nu, gq, gw, gr,
+                                               gwr, toff, float(ls.Vh.min()), ls.pattern(), dropped,
+                                               int(o["subdivisions"]), self._plane)
+        if dropped.max() != 0.0:
+            raise SSIError(f"-ssi_lag_store toeplitz: a flat-surface block entry outside its pattern is "
+                           f"{dropped.max():.3g}, not 0; report this with the mesh")
+        self.nev += int(nev)
+        return idx, meta, offP, P
+
+    def _spectra(self, lag_lo, lag_hi, toff, L):
+        """Yield (lag, this rank's slab of the lag's kernel spectra (4, 9, 4, slab) complex) for lags
+        lag_lo..lag_hi, integrated in chunks of lags (the integrals split over the ranks by offset,
+        summed: each offset is integrated by one rank, so the sum is exact)."""
+        from scipy.fft import rfft2
+        lat = self.lat
+        mpi = self.comm.tompi4py()
+        p, r = mpi.Get_size(), mpi.Get_rank()
+        n_off = len(self.offsets)
+        sel = np.arange(r, n_off, p)
+        per_lag = 4 * 9 * 4 * lat.Mx * lat.My * 8
+        chunk = max(1, min(lag_hi - lag_lo + 1, int(256e6 // per_lag)))
+        t = self.offsets[:, 2]
+        kx = np.mod(self.offsets[:, 3], lat.Mx)
+        ky = np.mod(self.offsets[:, 4], lat.My)
+        for c_lo in range(lag_lo, lag_hi + 1, chunk):
+            c_hi = min(lag_hi, c_lo + chunk - 1)
+            idx, meta, offP, P = self._integrate(lag_lo, c_lo, c_hi, toff, L, sel)
+            Kp = np.zeros((c_hi - c_lo + 1, 4, 9, 4, lat.Mx, lat.My))
+            _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, lat.code0)
+            mpi.Allreduce(mpi_in_place(), Kp)
+            S = rfft2(Kp, axes=(-2, -1), workers=1).reshape(Kp.shape[:4] + (-1,))
+            Kp = None
+            for i in range(c_hi - c_lo + 1):
+                yield c_lo + i, np.ascontiguousarray(S[i, ..., self.f0:self.f1])
+            S = None
+
+    def build(self, march, plan, monitor=False):
+        """Collective: the kernels K'_d (d = 1..D) of the march's history sum (its scheme and ``plan``)
+        in this rank's frequency slab."""
+        t0 = time.perf_counter()
+        lat, ls = self.lat, self.ls
+        self.offsets = kernel_offsets(lat)
+        self.nev = 0
+        nbig = ls.L + 8
+        terms = march._step_terms(nbig)
+        by_key = {}
+        for key, m, c in terms:
+            if march._mat(key, "u") is not None:        # (lag 2: the step matrix's Mat takes its terms)
+                continue
+            by_key.setdefault(key, []).append((nbig - m, c))
+        D = max([d for v in by_key.values() for d, _ in v] + [0])
+        self.D = D
+        slab = self.f1 - self.f0
+        self.K = np.zeros((D, 4, 9, 4, slab), np.complex128)
+        exact = sorted(j for kind, j in by_key if kind == "x")
+        if exact:
+            for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
+                for d, c in by_key.get(("x", lag), ()):
+                    self.K[d - 1] += c * S
+        if plan is not None and plan.active:
+            for i in range(plan.k):
+                if ("i", i) not in by_key:
+                    continue
+                lag, toff = plan.kernel_time(i)
+                for _, S in self._spectra(lag, lag, toff, lag):
+                    for d, c in by_key[("i", i)]:
+                        self.K[d - 1] += c * S
+        # the kept states' transforms: states n-1 .. n-D (slot m mod R)
+        self.R = D + 1
+        self.V = np.zeros((self.R, 9, 3, slab), np.complex128)
+        self._setup_state_maps(march)
+        self.t_build = time.perf_counter() - t0
+        mpi = self.comm.tompi4py()
+        self.nev = mpi.allreduce(self.nev)
+        self.bytes = mpi.allreduce(self.K.nbytes + self.V.nbytes)
+        return self
+
+    def _setup_state_maps(self, march):
+        lat, ls = self.lat, self.ls
+        PETSc = march.PETSc
+        self.sc, self.seq = PETSc.Scatter.toAll(march.u_tmpl)
+        # v_a(cell) = S_v u(VN[v, perm[v, a]]): for every virtual element and slot
+        self.vnode = ls.VN[np.arange(len(ls.VN))[:, None], lat.perm]      # (nv, 9)
+        self.vsign = ls.VS                                                 # (nv, 3)
+        ix, iy = lat.cell // lat.ny, lat.cell % lat.ny
+        self.vpos = (ix, iy)
+        r0, r1 = march.u_tmpl.getOwnershipRange()
+        rows = np.arange(r0 // 3, r1 // 3)
+        nf = lat.node_fine[rows]
+        tx, ty = nf[:, 0] & 1, nf[:, 1] & 1
+        self.row_t = (2 * tx + ty).astype(np.int64)
+        self.row_x = np.mod((nf[:, 0] - tx) // 2, lat.Mx)
+        self.row_y = np.mod((nf[:, 1] - ty) // 2, lat.My)
+
+    # ---------------------------------------------------------------- per step
+    def _transform(self, u_all, slot):
+        from scipy.fft import rfft2
+        lat = self.lat
+        U = u_all.reshape(-1, 3)
+        f = np.zeros((9, 3, lat.Mx, lat.My))
+        ix, iy = self.vpos
+        for a in range(9):
+            for c in range(3):
+                f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
+        S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)
+        self.V[slot] = S[..., self.f0:self.f1]
+
+    def _catch_up(self, n, march):
+        """Collective: the transforms of the states up to n (final) not yet kept."""
+        PETSc = march.PETSc
+        for m in range(max(self.upto + 1, n - self.D + 1, 1), n + 1):
+            self.sc.scatter(march.ubuf[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
+            self._transform(self.seq.getArray(readonly=True), m % self.R)
+        self.upto = max(self.upto, n)
+
+    def add(self, n, march, out_u):
+        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows)."""
+        from scipy.fft import irfft2
+        lat = self.lat
+        self._catch_up(n - 1, march)
+        slab = self.f1 - self.f0
+        acc = np.zeros((4, 3, slab), np.complex128)
+        d = np.arange(1, self.D + 1)
+        m = n - d
+        slots = np.where(m >= 1, np.mod(m, self.R), -1).astype(np.int64)
+        spectral_products(self.K, self.V, slots, self.pp, self.pq, acc)
+        march.PETSc.Log.logFlops(8.0 * int(np.count_nonzero(slots >= 0)) * 4 * 9 * 4 * slab)
+        full = np.empty((lat.F, 12), np.complex128)
+        send = np.ascontiguousarray(acc.reshape(12, slab).T)
+        mpi = self.comm.tompi4py()
+        from mpi4py import MPI
+        mpi.Allgatherv(send, [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12, MPI.C_DOUBLE_COMPLEX])
+        phys = irfft2(full.T.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
+        vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
+        arr = out_u.getArray()
+        arr -= vals.ravel()
+
+
+def mpi_in_place():
+    from mpi4py import MPI
+    return MPI.IN_PLACE
+
+
+@njit(cache=True)
+def _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, code0):
+    """Kp[l - c_lo, t, code0[a], e, kx, ky] = the integrals of lag l of offset idx[r] (pool layout of
+    ``assemble._compact``: lag slot, local node a of the reference element, entry e), for lags of the
+    chunk (slot code0[a]: the node's position)."""
+    nl_c = Kp.shape[0]
+    for r in range(idx.shape[0]):
+        o = idx[r]
+        lo, hi = meta[r, 0], meta[r, 1]
+        base = offP[r]
+        for l in range(max(lo, c_lo), min(hi, c_lo + nl_c - 1) + 1):
+            s = base + (l - lo) * 36
+            for a in range(9):
+                for e in range(4):
+                    Kp[l - c_lo, t[o], code0[a], e, kx[o], ky[o]] = P[s + 4 * a + e]
