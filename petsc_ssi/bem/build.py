@@ -219,9 +219,5 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            f"transforms; kernels {th.t_build:.3g} s), step matrix and G lags {mem_g / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations")
     _say_block(march)
-    if cfg.get("lags_save"):
-        from ..petsc import SSIError
-        raise SSIError("-ssi_lags_save: not available with -ssi_lag_store toeplitz (its kernels are built in "
-                       "seconds); use -ssi_lag_store dense")
     return march, {"t_asm": t_asm, "mem_exact": mem, "mem_interp": 0.0, "ndense": 0, "nbaij": 0, "nsingle": 0,
                    "fill": float("nan"), "mem": mem}

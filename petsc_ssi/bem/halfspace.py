@@ -396,11 +396,12 @@ class HalfSpace:
             return None
         why = None
         if self.cfg.get("lags_load") or self.cfg.get("lags_save"):
-            why = "-ssi_lags_save/-ssi_lags_load store lag matrices"
+            why = ("-ssi_lags_save/-ssi_lags_load store lag matrices, which this store does not keep (its kernels "
+                   "are built in seconds); use -ssi_lag_store dense")
         elif int(self.cfg.lag_single_from):
-            why = "-ssi_lag_single_from keeps lag matrices in single precision"
+            why = "-ssi_lag_single_from keeps lag matrices in single precision; use -ssi_lag_store dense"
         elif not ls.flat:
-            why = "the surface is not flat (or -ssi_lag_pattern full)"
+            why = "the surface is not flat (or -ssi_lag_pattern full); use -ssi_lag_store dense"
         if why is None:
             try:
                 lat = detect(ls.VX, self.mesh.nodes)

@@ -1,0 +1,121 @@
+"""The toeplitz lag store (issue 41; bem/toeplitz.py): on a uniform flat grid the H lags of the history
+sum are block-Toeplitz kernels applied in Fourier space. It is exact, not an approximation: every
+recorded field equals the dense path's to 1e-12 of the run's largest value of its kind
+(``test_history_block.same``; observed 4e-16 on the stabilised case), for the plain and stabilised
+schemes, the interpolation of the far lags, symmetry planes, prescribed motion, the coupled run with
+unilateral contact, at -n 1 and -n 2, and through a restart (bit for bit: the kept transforms are
+made again from the checkpoint's states). A surface that is not a uniform grid is refused in one
+line naming the first element off it."""
+import os
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import cli
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from test_history_block import BEM, INTERP, DISP, SSI, same  # noqa: E402
+
+pytestmark = pytest.mark.mpi
+
+TZ = ["-ssi_lag_store", "toeplitz"]
+
+CASES = {
+    "stabilised": BEM,
+    "plain": BEM + ["-ssi_scheme", "plain"],
+    "symmetry+interp": BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"],
+    "chebyshev, plain": BEM + ["-ssi_interp", "chebyshev", "-ssi_interp_tl", "0.01", "-ssi_interp_k", "4",
+                               "-ssi_scheme", "plain"],
+    "prescribed motion": DISP,
+    "prescribed motion, plain, anti": DISP + ["-ssi_scheme", "plain", "-ssi_disp_value", "1e-6,0,0",
+                                              "-ssi_symmetry", "x=anti,y=sym"],
+}
+SLOW = ("plain", "chebyshev, plain", "prescribed motion, plain, anti")   # slow tier: siblings of the others
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in SLOW else []) for c in CASES])
+def test_toeplitz_equals_dense(tmp_path, case):
+    args = CASES[case]
+    ref, tz = str(tmp_path / "dense.h5"), str(tmp_path / "tz.h5")
+    cli(args + ["-ssi_output", ref])
+    out = cli(args + TZ + ["-ssi_output", tz]).stdout
+    assert "lag store: toeplitz" in out and "history kernels K'_d in Fourier space" in out
+    same(ref, tz)
+
+
+def test_toeplitz_coupled_contact_two_ranks(tmp_path):
+    """The coupled box with unilateral contact (it lifts off) on 2 ranks: toeplitz against dense (both
+    -ssi_reproducible), 1e-10 as the block test allows for the free flight's round-off; and -n 2
+    against -n 1 on the toeplitz path."""
+    ref, tz, one = (str(tmp_path / f"{k}.h5") for k in ("ref", "tz", "one"))
+    cli(SSI + ["-ssi_output", ref, "-ssi_reproducible"], nranks=2)
+    cli(SSI + TZ + ["-ssi_output", tz, "-ssi_reproducible"], nranks=2)
+    A = same(ref, tz, rtol=1e-10)
+    assert any(k.startswith("interface/") for k in A)
+    with h5py.File(tz) as f:
+        closed = f["interface/closed"][...]
+    assert closed.any() and not closed.all()        # contact is active: it lifts off
+    cli(SSI + TZ + ["-ssi_output", one])
+    same(one, tz, rtol=1e-10)
+
+
+def test_toeplitz_two_ranks_equal_one(tmp_path):
+    """The frequency slabs over 2 ranks: -n 2 equals -n 1 (symmetry planes and interpolation)."""
+    args = BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"] + TZ
+    one, two = str(tmp_path / "one.h5"), str(tmp_path / "two.h5")
+    cli(args + ["-ssi_output", one])
+    cli(args + ["-ssi_output", two, "-ssi_reproducible"], nranks=2)
+    same(one, two)
+
+
+def test_toeplitz_restart_is_bitwise(tmp_path):
+    """A checkpoint after step 10 of 60: the restart makes the kept transforms again from the
+    checkpoint's states, and every dataset is the uninterrupted run's bit for bit."""
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    from test_checkpoint import run_and_restart, assert_same_files
+    (ref, rs), = run_and_restart(BEM + TZ, tmp_path, 1, 5, 10)
+    assert_same_files(ref, rs)
+
+
+def test_toeplitz_refusals_and_auto(tmp_path):
+    """A grid whose patch edges cut the elements (0.75 m and 1 m columns) is refused in one line naming an
+    element; auto falls back to the dense matrices and says why; -ssi_lags_save is refused."""
+    bad = ["-ssi_problem", "bem", "-ssi_mesh_size", "6,6", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "0.75,0.75",
+           "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025", "-ssi_t_end", "0.01",
+           "-ssi_warn_beta", "0"]
+    r = cli(bad + TZ + ["-ssi_output", str(tmp_path / "a.h5")], check=False)
+    assert r.returncode != 0
+    err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
+    assert err and "-ssi_lag_store toeplitz" in err[0] and "element" in err[0], r.stderr[-2000:]
+    assert "Traceback" not in r.stderr
+    r = cli(bad + ["-ssi_lag_store", "auto", "-ssi_output", str(tmp_path / "b.h5")])
+    assert "lag store: dense lag matrices (" in r.stdout
+    r = cli(BEM + TZ + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_lags_save", str(tmp_path / "lags")],
+            check=False)
+    assert r.returncode != 0 and "-ssi_lags_save" in r.stdout + r.stderr and "Traceback" not in r.stderr
+
+
+def test_detect_names_the_element():
+    """The lattice detection on made elements: a uniform grid is found (size, extent, FFT grid); a
+    moved, a resized and a turned-over element are each refused naming that element."""
+    from petsc_ssi.bem.toeplitz import detect
+    from petsc_ssi.petsc import SSIError
+    corners = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1), (0, -1), (1, 0), (0, 1), (-1, 0), (0, 0)], float)
+
+    def elem(cx, cy, hx=1.0, hy=2.0, flip=False):
+        X = np.zeros((9, 3))
+        X[:, 0] = cx + 0.5 * hx * corners[:, 0]
+        X[:, 1] = cy + 0.5 * hy * corners[:, 1]
+        return X[[0, 3, 2, 1, 7, 6, 5, 4, 8]] if flip else X
+
+    VX = np.array([elem(i + 0.5, 2 * j + 1.0) for i in range(3) for j in range(2)])
+    nodes = np.unique(VX.reshape(-1, 3), axis=0)
+    lat = detect(VX, nodes)
+    assert (lat.nx, lat.ny) == (3, 2) and np.allclose(lat.h, (1.0, 2.0)) and lat.Mx >= 6 and lat.My >= 4
+    for k, X in ((2, elem(2.5 + 0.1, 1.0)), (3, elem(2.5, 3.0, hx=0.5)), (4, elem(1.5, 1.0, flip=True))):
+        V = VX.copy()
+        V[k] = X
+        with pytest.raises(SSIError, match=f"element {k} "):
+            detect(V, np.unique(V.reshape(-1, 3), axis=0))
