@@ -13,6 +13,7 @@ from .. import common_options  # noqa: F401  (the common options every problem r
 from . import parts as _parts  # noqa: F401  (-help lists the per-part options)
 from ..seismic import options as _seismic_options  # noqa: F401  (a fixed base moving with a record)
 from . import demands as _demands  # noqa: F401  (-ssi_structure_drift_*: the storey demands' options)
+from . import gravity as _gravity  # noqa: F401  (-ssi_fem_gravity: the self-weight case)
 
 G = "fem"
 
