@@ -50,6 +50,11 @@ from .elements.frame import END_FORCES, END_FORCE_UNITS
 from .elements.shell import RESULTANTS, RESULTANT_UNITS, resultant_operator
 
 KINDS = ("frame", "shell")
+COMBINATION = ("G + max_t E(t) and G + min_t E(t), component by component: G the static self-weight case "
+               "(-ssi_fem_gravity, K u_G = -g M e_z with the fixed dofs held), E(t) the run's dynamic response "
+               "(increments from the unloaded state; every step, t = 0 at rest included); linear superposition, "
+               "factors 1")
+
 FRAME_CONVENTION = ("end forces the nodes exert on the element, local axes (x' node 0 -> node 1, z' the "
                     "orientation vector normal to x', y' = z' x x'), f = k_local T u_e, no member inertia "
                     "(OpenSees localForce); stress resultants: -f_i at node 0, +f_j at node 1 (N > 0 tension, "
@@ -332,7 +337,6 @@ class ForceRecorder:
 
 def _gravity_datasets(f, g, p, E):
     """Rank 0: forces/<part>_gravity, _max, _min, _gravity_plus_max, _gravity_plus_min (fem/gravity.py)."""
-    from .gravity import COMBINATION
     val = {w: f[f"forces_{w}_{p.name}"][()].reshape(E, p.c) for w in ("gravity", "max", "min")}
     what = {"gravity": "the static self-weight case G (-ssi_fem_gravity)",
             "max": "signed max over every time step of the run's value E(t) (t = 0 at rest included)",

@@ -30,42 +30,9 @@ pressure at the interface.
 """
 import numpy as np
 
-from ..options import register, register_check
 from ..petsc import printf
 
-G = "fem"
-G_MAX = 100.0                 # m/s^2: above it the value is taken for cm/s^2 or a typo
-
-COMBINATION = ("G + max_t E(t) and G + min_t E(t), component by component: G the static self-weight case "
-               "(-ssi_fem_gravity, K u_G = -g M e_z with the fixed dofs held), E(t) the run's dynamic response "
-               "(increments from the unloaded state; every step, t = 0 at rest included); linear superposition, "
-               "factors 1")
-
-
-def _gravity_ok(v):
-    if not v >= 0:
-        return "must be >= 0 m/s^2 (the acceleration of gravity, acting along -z; 0: no gravity case)"
-    if v > G_MAX:
-        return (f"{v:g} m/s^2 is not a gravity in m/s^2 (9.81 on Earth; {v:g} looks like cm/s^2); "
-                f"give it in m/s^2, at most {G_MAX:g}")
-    return None
-
-
-register("fem_gravity", "real", 0.0, "m/s^2", "gravity g acting along -z: the structure's self-weight (its lumped "
-         "masses: elements, added and point masses) as a static case solved once (fixed base and petsc-ssi static); "
-         "its member forces and support reactions are written beside the earthquake's, with the combined envelopes "
-         "G + max E and G + min E (petsc_ssi/fem/gravity.py); 0: none", G, validator=_gravity_ok)
-
-
-def _coupled_check(cfg):
-    if cfg.get("problem", "fem") == "ssi" and float(cfg.get("fem_gravity", 0.0) or 0.0) > 0:
-        return ("-ssi_fem_gravity is built for the fixed base (-ssi_problem fem) and petsc-ssi static: the soil's "
-                "static response to the weight is not modelled in a coupled run; leave it out there "
-                "(-ssi_contact_preload weight gives the weight's contact pressure)")
-    return None
-
-
-register_check(("fem", "ssi"), _coupled_check)
+from .forces import COMBINATION  # noqa: F401  (the rule, stated with the member forces; the option: fem/options.py)
 
 
 def gravity_load(model, g):
