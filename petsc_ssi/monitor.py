@@ -88,6 +88,14 @@ class Progress:
         self.unit = unit
         self.t0 = time.perf_counter()
         self.first = 0                   # items done before t0 (a restarted run)
+        self.model = None                # k -> predicted seconds of items 1..k (``expect``)
+        self.warned = False
+
+    def expect(self, model, ranks_here=1, what="the run's prediction"):
+        """Compare the measured time with ``model`` (k -> predicted seconds of items 1..k) at every
+        report, and warn once when it runs more than SLOW times above it (``slow_warning``);
+        ``ranks_here``: the ranks sharing this node's cores."""
+        self.model, self.ranks_here, self.model_what = model, int(ranks_here), what
 
     def update(self, k, extra=""):
         """Report after item ``k`` (1-based) when due."""
@@ -97,9 +105,49 @@ class Progress:
         eta = el / max(k - self.first, 1) * (self.total - k)
         printf(f"[ssi] {self.what}: {self.unit} {k}/{self.total} ({100.0 * k / self.total:5.1f}%) "
                f"elapsed {fmt_time(el)} eta {fmt_time(eta)}{(' ' + extra) if extra else ''}", self.comm)
+        if self.model is not None and not self.warned:
+            pred = self.model(k) - self.model(self.first)
+            msg = slow_warning(el, pred, k - self.first, self.ranks_here, self.model_what, self.unit)
+            if msg:
+                self.warned = True
+                from .petsc import warn
+                warn(msg, self.comm)
 
     def elapsed(self):
         return time.perf_counter() - self.t0
+
+
+SLOW = 3.0            # measured / predicted above which the progress line warns
+SLOW_MIN_S = 2.0      # ... once the loop has run this long (start-up noise) and over 5 items
+
+
+def slow_warning(elapsed, predicted, items, ranks_here, what="the run's prediction", unit="step", load=None,
+                 cores=None):
+    """The warning (one line) when ``elapsed`` seconds for ``items`` items run more than SLOW times
+    above ``predicted``, naming the likely cause and what to try, or None. ``ranks_here``: the
+    ranks sharing this node's cores; ``load``: the 1-minute load average and ``cores`` this machine's
+    (read here when None)."""
+    import os
+    if items < 5 or elapsed < SLOW_MIN_S or not predicted > 0 or elapsed <= SLOW * predicted:
+        return None
+    cores = cores or os.cpu_count() or 1
+    if load is None:
+        try:
+            load = os.getloadavg()[0]
+        except OSError:
+            load = float("nan")
+    head = (f"the {unit}s run {elapsed / predicted:.1f} times slower than {what} ({fmt_time(elapsed)} for {items} "
+            f"{unit}s, predicted {fmt_time(predicted)}): ")
+    if ranks_here > cores:
+        return head + (f"{ranks_here} ranks share {cores} cores (oversubscribed); run with at most {cores} ranks per "
+                       "node (mpirun -n)")
+    if load > 1.25 * cores:
+        return head + (f"the machine is loaded (load average {load:.1f} on {cores} cores: other work shares the cores, "
+                       f"and {ranks_here} rank(s) of this run wait for them); run it when the machine is idle, or with "
+                       "fewer ranks (-n 1 may then be the faster)")
+    return head + (f"the machine is not visibly loaded (load average {load:.1f} on {cores} cores), so the cost model's "
+                   "constants may not fit it or this case: check petsc-ssi estimate, and fit the constants with "
+                   "jobscripts/calibrate.py (-ssi_estimate_constants)")
 
 
 def fmt_time(s):

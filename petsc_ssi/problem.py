@@ -500,6 +500,18 @@ class TransientProblem:
         est = getattr(prob, "loop_estimate", None)
         return None if est is None else (est[0], est[1], "the soil's BEM")
 
+    def expect_progress(self):
+        """The progress line (-ssi_monitor) compares the measured time of the steps with the run's
+        own prediction (``loop_estimate``'s model for the first k steps) and warns once when it runs
+        far above it (``monitor.slow_warning``: a loaded machine, oversubscribed ranks)."""
+        prob = getattr(self, "prob", None)
+        model = getattr(prob, "loop_model", None)
+        rec = getattr(self, "rec", None)
+        if model is None or rec is None:
+            return
+        rec.progress.progress.expect(model, getattr(prob, "ranks_here", 1),
+                                     "the run's prediction (the soil's BEM, bem/cost.py)")
+
     def announce_loop(self):
         """Collective, before the set-up: one line with the number of steps and, where a model
         exists, the predicted time of the loop; SSIError beyond -ssi_max_steps (a run whose t_end
@@ -541,6 +553,7 @@ class TransientProblem:
         self.announce_loop()
         self.setup()
         self.start()
+        self.expect_progress()
         with _Signals() as sig:                      # kept through finish: a signal there waits for the end
             ck = self.rec.add(CheckpointObserver(self, sig))
             try:

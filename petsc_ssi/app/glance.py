@@ -70,7 +70,6 @@ Options
 Errors end with one line ``petsc-ssi post: error: ...`` on stderr and exit status 2.
 """
 import argparse
-import json
 import math
 import os
 import sys
@@ -80,6 +79,7 @@ import numpy as np
 
 from . import post as _post
 from . import response as _rsp
+from . import twins as _twins
 from ..seismic import response_spectrum as rs
 
 PROG = "petsc-ssi post"
@@ -124,78 +124,6 @@ def _attrs(path):
         return {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
 
 
-def _control(path):
-    """-ssi_seismic_control of the run of the soil output ``path``: its seismic/control, else its
-    JSON record's options, else 'surface' (the default) and a note."""
-    import h5py
-    with h5py.File(path, "r") as f:
-        if "seismic/control" in f:
-            v = f["seismic/control"][()]
-            return (v.decode() if isinstance(v, bytes) else str(v)), "seismic/control"
-    js = os.path.splitext(path)[0] + ".json"
-    try:
-        with open(js) as fh:
-            return str(json.load(fh)["options"]["seismic_control"]), os.path.basename(js)
-    except (OSError, ValueError, KeyError, TypeError):
-        return "surface", "assumed: the default (neither seismic/control nor the JSON record says)"
-
-
-def _same_control(ssi, fixed):
-    """Refuse a pair of runs whose records drive different motions: -ssi_seismic_control differs, or
-    the fixed base took 'incident' before its base moved as twice the record (its output has no
-    seismic/control then: until 2026-11-26 a fixed base moved as the record itself). A file that says
-    nothing of its control (neither seismic/control nor a JSON record) is not judged."""
-    import h5py
-    c_s, said_s = _control(ssi)
-    c_f, said = _control(fixed)
-    if c_s != c_f and not said.startswith("assumed") and not said_s.startswith("assumed"):
-        raise _error(f"the runs' -ssi_seismic_control differ: {c_s} in {ssi}, {c_f} in {fixed} ({said}): the "
-                     f"bases would not move alike; rerun one of them")
-    with h5py.File(fixed, "r") as f:
-        old = "seismic" in f and "seismic/control" not in f
-    if c_f == "incident" and old:
-        raise _error(f"{fixed}: a fixed base run with -ssi_seismic_control incident by an earlier petsc-ssi, whose "
-                     f"base moved as the record instead of twice it (the free surface); rerun it")
-
-
-def _same_record(ssi, fixed):
-    """Refuse a pair that did not run the same motion (not twins): the records' SHA-256 (``<axis>_sha256``
-    of the seismic groups) differ, the axes the records drive differ, or the processed accelerations
-    (``<axis>_acceleration``: the scale, units, window, taper, baseline and high-pass applied) differ.
-    A file without them (an earlier petsc-ssi) is not judged on what it lacks."""
-    import h5py
-
-    def motions(path):
-        out = {}
-        with h5py.File(path, "r") as f:
-            s = f.get("seismic")
-            if not isinstance(s, h5py.Group):
-                return out
-            for k in s:
-                if k.endswith("_acceleration") and not k.startswith("raw_"):
-                    ax = k[:-len("_acceleration")]
-                    sha = s[ax + "_sha256"][()] if ax + "_sha256" in s else None
-                    sha = sha.decode() if isinstance(sha, bytes) else sha
-                    out[ax] = (sha, np.asarray(s[k][()], float))
-        return out
-    ms, mf = motions(ssi), motions(fixed)
-    if not ms or not mf:
-        return
-    if set(ms) != set(mf):
-        raise _error(f"the runs' records drive different axes: {', '.join(sorted(ms))} in {ssi}, "
-                     f"{', '.join(sorted(mf))} in {fixed}: not twins; rerun one with the other's -ssi_seismic_record*")
-    for ax in sorted(ms):
-        (hs, a_s), (hf, a_f) = ms[ax], mf[ax]
-        if hs and hf and hs != hf:
-            raise _error(f"the runs' records differ ({ax}: SHA-256 {hs[:12]}... in {ssi}, {hf[:12]}... in {fixed}): "
-                         f"not twins; rerun one with the other's -ssi_seismic_record")
-        if a_s.shape != a_f.shape or not np.allclose(a_s, a_f, rtol=1e-9, atol=1e-12 * max(np.abs(a_s).max(), 1e-300)):
-            pk_s, pk_f = float(np.abs(a_s).max()), float(np.abs(a_f).max())
-            raise _error(f"the runs' processed {ax} records differ (peak {pk_s:.6g} m/s^2 in {ssi}, {pk_f:.6g} in "
-                         f"{fixed}): another -ssi_seismic_scale, units, window, taper, baseline or high-pass; not "
-                         f"twins: rerun one with the other's -ssi_seismic_* options")
-
-
 def free_field(path, times, component):
     """(step means (n,) [m/s^2] of the free-field surface acceleration along ``component`` at the
     run times ``times`` (0 at the first), one line saying what it is) from the seismic group of
@@ -212,7 +140,7 @@ def free_field(path, times, component):
                          f"{' or '.join(have) or 'x'}")
         tk, a, v = (np.asarray(s[pre + k][()], float) for k in ("t", "acceleration", "velocity"))
         t0 = float(s["t0"][()])
-    control, said = _control(path)
+    control, said = _twins.control(path)
     factor = 2.0 if control == "incident" else 1.0
     m = Motion(tk, a, v, np.zeros_like(a), {}, {}, 0.0, 0.0, path, "", {}, {})
     t = np.asarray(times, float)
@@ -630,8 +558,8 @@ def main(argv=None, out=None):
             raise _error(f"--glance {a.glance}: the same file as SSI.h5")
         ps = load_ssi(a.file, a.receiver, a.component)
         pf = load_fixed(a.glance, a.receiver, a.component)
-        _same_control(a.file, a.glance)
-        _same_record(a.file, a.glance)
+        _twins.same_control(a.file, a.glance, _error)
+        _twins.same_record(a.file, a.glance, _error)
         S, F = ({"pair": p, "b": a.ko_b} for p in (ps, pf))
         for X in (S, F):
             X["ratio"], X["fit"] = analyse(X["pair"], a.ko_b, a.band)

@@ -555,6 +555,11 @@ def main(argv=None, out=None):
         periods, ptext = a.periods if a.periods is not None else parse_periods("standard")
         inputs = [p for p in (a.file, a.table, a.ratio, a.ratio_table) if p]
         _post.check_outputs([("--csv", a.csv), ("--png", a.png)], inputs, a.overwrite)
+        if a.ratio and a.file:                   # twins: the same record, scale, control and axes (app/twins.py)
+            from . import twins
+            for p in (a.file, a.ratio):
+                _post.open_h5(p).close()         # (its own one-line refusal for a missing or foreign file)
+            twins.check(a.file, a.ratio, _error)
         A = _load(a.file, a.table, a.receiver, comps, a, "--table" if a.table else "--receiver")
         specs, k = spectra(A, periods, a.damping, a.rotd, a.geomean, a.oversample, a.peaks)
         B = None

@@ -50,6 +50,11 @@ def main():
         u = static_solve(model.K, f, model.fixed, model.mesh.coords, solver=cfg.fem_solver,
                          dofmap=model.dofmap, near_null=near if coords is None else
                          PETSc.NullSpace().createRigidBody(coords))
+    from ..fem.gravity import gravity_case            # -ssi_fem_gravity: the self-weight added to the loads
+    grav = gravity_case(cfg, model, comm)
+    if grav is not None:
+        u.axpy(1.0, grav.u)
+        printf("[static] the solution is the options' loads plus the self-weight (-ssi_fem_gravity)")
     rec = ReceiverSeries(model.dofmap, model.receiver_nodes, comm)
     rec.record(1.0, u)
     umax = u.norm(PETSc.NormType.INFINITY)
@@ -69,7 +74,11 @@ def main():
         if forces is not None:
             forces.record(1.0, u, write=True)
         receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
-        out.close(receivers=receivers, attrs={"problem": "static", "time_is": "load factor"},
+        attrs = {"problem": "static", "time_is": "load factor"}
+        if grav is not None:
+            attrs["gravity"] = grav.g
+        out.close(receivers=receivers, attrs=attrs, groups={"gravity": grav.group()} if grav is not None and
+                  comm.getRank() == 0 else None,
                   record=provenance(cfg, comm, {"static": {"n_dofs": model.dofmap.size,
                                                            "max_abs_u": float(umax)}}))
         printf(f"[static] wrote {cfg.output} (+ .xmf, .json)")

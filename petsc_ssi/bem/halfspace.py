@@ -503,9 +503,14 @@ class HalfSpace:
         self.mem_peak_estimate = peak
         from .cost import loop_seconds
         stride = self.grid.stride
-        self.loop_estimate = loop_seconds(est, self.mesh.n_nodes, lags, self.n_steps, mpi.Get_size(),
-                                          int(round(share * mpi.Get_size())), self.n_steps // stride if stride else 0,
-                                          dense=2 * nd >= lags)
+        here = int(round(share * mpi.Get_size()))
+        self.loop_estimate = loop_seconds(est, self.mesh.n_nodes, lags, self.n_steps, mpi.Get_size(), here,
+                                          self.n_steps // stride if stride else 0, dense=2 * nd >= lags)
+        # the same model for the first k steps: the progress line compares the measured time with it
+        n_nodes_, ranks_, dense_ = self.mesh.n_nodes, mpi.Get_size(), 2 * nd >= lags
+        self.loop_model = (lambda k: loop_seconds(est, n_nodes_, lags, k, ranks_, here,
+                                                  k // stride if stride else 0, dense=dense_)[0])
+        self.ranks_here = here
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "

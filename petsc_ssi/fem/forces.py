@@ -26,6 +26,10 @@ Output (the structure's file: ``-ssi_output`` of a fem run, ``<stem>_structure.h
                                          per component, comma-separated), components,
                                          convention, element, part
   forces/<part>_envelope    (E, c)       the envelope, with the same attributes
+  forces/<part>_gravity, _max, _min, _gravity_plus_max, _gravity_plus_min   (E, c)
+                                         with -ssi_fem_gravity (``fem/gravity.py``): the self-weight
+                                         case G, the signed max and min over every step of the run's
+                                         E(t), and G + max E, G + min E (attribute ``combination``)
   forces/<part>_cells       (E,)         each element's index in the XDMF topology
   forces/<part>_nodes       (E, n)       its nodes (0-based, the ``coordinates`` rows)
   forces/snapshots, forces/time          the snapshot indices k of the K rows and their times
@@ -46,6 +50,11 @@ from .elements.frame import END_FORCES, END_FORCE_UNITS
 from .elements.shell import RESULTANTS, RESULTANT_UNITS, resultant_operator
 
 KINDS = ("frame", "shell")
+COMBINATION = ("G + max_t E(t) and G + min_t E(t), component by component: G the static self-weight case "
+               "(-ssi_fem_gravity, K u_G = -g M e_z with the fixed dofs held), E(t) the run's dynamic response "
+               "(increments from the unloaded state; every step, t = 0 at rest included); linear superposition, "
+               "factors 1")
+
 FRAME_CONVENTION = ("end forces the nodes exert on the element, local axes (x' node 0 -> node 1, z' the "
                     "orientation vector normal to x', y' = z' x x'), f = k_local T u_e, no member inertia "
                     "(OpenSees localForce); stress resultants: -f_i at node 0, +f_j at node 1 (N > 0 tension, "
@@ -124,6 +133,7 @@ class _Part:
         self.env_vec = self.vec.duplicate()          # the envelope's Vec, filled when written or saved
         self.env = np.zeros((self.e1 - self.e0, self.c))
         self.value = np.zeros((self.e1 - self.e0, self.c))
+        self.gravity = self.smax = self.smin = None          # with a gravity case (``ForceRecorder.set_gravity``)
 
     def attrs(self):
         return {"unit": ",".join(self.units),
@@ -196,6 +206,30 @@ class ForceRecorder:
         self.snapshots = [int(k) for k in s["forces_snapshots"]]
         self.times = [float(t) for t in s["forces_times"]]
 
+    def set_gravity(self, u):
+        """Collective: the gravity case's displacement Vec ``u`` (``fem.gravity``): its forces G are
+        kept, and from now on the signed max and min of every step's forces (combined with G at the
+        output: G + max, G + min)."""
+        self.scatter.scatter(u, self.seq)
+        a = self.seq.getArray(readonly=True)
+        for p in self.parts:
+            p.gravity = np.einsum("ecd,ed->ec", p.G, a[p.pos])
+            p.smax = np.full_like(p.env, -np.inf)
+            p.smin = np.full_like(p.env, np.inf)
+            p.ext_vecs = {w: p.env_vec.duplicate() for w in ("max", "min", "gravity")}
+
+    def _extreme_vecs(self, with_gravity=True):
+        """{name: Vec} of the signed extremes (and the gravity forces), the Vecs filled."""
+        out = {}
+        for p in self.parts:
+            if p.gravity is None:
+                continue
+            for what, arr in (("max", p.smax), ("min", p.smin)) + ((("gravity", p.gravity),) if with_gravity else ()):
+                v = p.ext_vecs[what]
+                v.getArray()[:] = arr.ravel()
+                out[f"forces_{what}_{p.name}"] = v
+        return out
+
     def _envelope_vecs(self):
         """{name: Vec} of the envelopes, the Vecs filled (no view into a Vec's array is kept: a
         load may replace it)."""
@@ -204,13 +238,21 @@ class ForceRecorder:
         return {f"forces_envelope_{p.name}": p.env_vec for p in self.parts}
 
     def checkpoint_vecs(self):
-        """{name: Vec}: the envelopes (saved by the checkpoint globally: any rank count restarts)."""
-        return self._envelope_vecs()
+        """{name: Vec}: the envelopes (saved by the checkpoint globally: any rank count restarts),
+        and with a gravity case the signed extremes (G itself is solved again on a restart)."""
+        out = self._envelope_vecs()
+        out.update(self._extreme_vecs(with_gravity=False))
+        return out
 
     def restore_vecs(self, reader):
         for p in self.parts:
             reader.load(f"forces_envelope_{p.name}", p.env_vec)
             p.env[:] = p.env_vec.getArray(readonly=True).reshape(-1, p.c)
+            if p.gravity is not None:
+                for what, arr in (("max", p.smax), ("min", p.smin)):
+                    v = p.ext_vecs[what]
+                    reader.load(f"forces_{what}_{p.name}", v)
+                    arr[:] = v.getArray(readonly=True).reshape(-1, p.c)
 
     # ------------------------------------------------------------ work
     def compute(self, u):
@@ -220,6 +262,9 @@ class ForceRecorder:
         for p in self.parts:
             np.einsum("ecd,ed->ec", p.G, a[p.pos], out=p.value)
             np.maximum(p.env, np.abs(p.value), out=p.env)
+            if p.gravity is not None:
+                np.maximum(p.smax, p.value, out=p.smax)
+                np.minimum(p.smin, p.value, out=p.smin)
 
     def write(self, t):
         """Collective: the last computed forces as the snapshot the structure's output just wrote
@@ -240,8 +285,12 @@ class ForceRecorder:
 
     # ------------------------------------------------------------ Output's call-backs
     def write_collective(self, out):
-        """Collective, before the output closes its viewer: the envelopes."""
+        """Collective, before the output closes its viewer: the envelopes (and the gravity case's
+        forces and the signed extremes)."""
         out.write_vecs(self._envelope_vecs(), "member force envelopes")
+        ext = self._extreme_vecs()
+        if ext:
+            out.write_vecs(ext, "member forces of gravity and the signed extremes")
 
     def write_serial(self, f):
         """Rank 0, the file open (h5py): the 'forces' group and the cell fields; returns the XDMF
@@ -270,6 +319,8 @@ class ForceRecorder:
                 for key, val in p.attrs().items():
                     a.attrs[key] = val
             de.attrs["what"] = "max over every time step of |value|"
+            if p.gravity is not None:
+                _gravity_datasets(f, g, p, E)
             g.create_dataset(f"{p.name}_cells", data=p.cell_index, track_times=False)
             g.create_dataset(f"{p.name}_nodes", data=p.cells, track_times=False)
             for comp, unit, val, where in p.peaks(env):
@@ -282,6 +333,23 @@ class ForceRecorder:
             d.attrs["what"] = f"peak |{comp}| over every time step{where}; NaN on cells without it"
             cells.append((f"peak_{comp}", f"cell_peak_{comp}", unit))
         return cells
+
+
+def _gravity_datasets(f, g, p, E):
+    """Rank 0: forces/<part>_gravity, _max, _min, _gravity_plus_max, _gravity_plus_min (fem/gravity.py)."""
+    val = {w: f[f"forces_{w}_{p.name}"][()].reshape(E, p.c) for w in ("gravity", "max", "min")}
+    what = {"gravity": "the static self-weight case G (-ssi_fem_gravity)",
+            "max": "signed max over every time step of the run's value E(t) (t = 0 at rest included)",
+            "min": "signed min over every time step of the run's value E(t) (t = 0 at rest included)",
+            "gravity_plus_max": "G + max_t E(t)", "gravity_plus_min": "G + min_t E(t)"}
+    val["gravity_plus_max"] = val["gravity"] + val["max"]
+    val["gravity_plus_min"] = val["gravity"] + val["min"]
+    for w, arr in val.items():
+        d = g.create_dataset(f"{p.name}_{w}", data=arr, track_times=False)
+        for key, v in p.attrs().items():
+            d.attrs[key] = v
+        d.attrs["what"] = what[w]
+        d.attrs["combination"] = COMBINATION
 
 
 def _virtual(g, name, layout, fill):

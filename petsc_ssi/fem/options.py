@@ -125,6 +125,35 @@ register("structure_forces", "str", "", "", "member forces of frame and shell pa
          "axes) and shell stress resultants (N11, N22, N12, M11, M22, M12, Q1, Q2 at the centre, local frame) with "
          "every structure snapshot, their peak over all steps, and the peaks as XDMF cell fields "
          "(petsc_ssi/fem/forces.py)", G)
+# -ssi_fem_gravity: the self-weight as a static case (fem/gravity.py)
+G_MAX = 100.0                 # m/s^2: above it the value is taken for cm/s^2 or a typo
+
+def _gravity_ok(v):
+    if not v >= 0:
+        return "must be >= 0 m/s^2 (the acceleration of gravity, acting along -z; 0: no gravity case)"
+    if v > G_MAX:
+        return (f"{v:g} m/s^2 is not a gravity in m/s^2 (9.81 on Earth; {v:g} looks like cm/s^2); "
+                f"give it in m/s^2, at most {G_MAX:g}")
+    return None
+
+
+register("fem_gravity", "real", 0.0, "m/s^2", "gravity g acting along -z: the structure's self-weight (its lumped "
+         "masses: elements, added and point masses) as a static case solved once (fixed base and petsc-ssi static); "
+         "its member forces and support reactions are written beside the earthquake's, with the combined envelopes "
+         "G + max E and G + min E (petsc_ssi/fem/gravity.py); 0: none", G, validator=_gravity_ok)
+
+
+def _coupled_check(cfg):
+    if cfg.get("problem", "fem") == "ssi" and float(cfg.get("fem_gravity", 0.0) or 0.0) > 0:
+        return ("-ssi_fem_gravity is built for the fixed base (-ssi_problem fem) and petsc-ssi static: the soil's "
+                "static response to the weight is not modelled in a coupled run; leave it out there "
+                "(-ssi_contact_preload weight gives the weight's contact pressure)")
+    return None
+
+
+register_check(("fem", "ssi"), _coupled_check)
+
+
 register("modes_n", "int", 6, "", "petsc-ssi modes: number of natural modes", G, validator=at_least(1))
 
 

@@ -54,7 +54,7 @@ class FEMTransient(TransientProblem):
             from ..seismic.input import report
             report(self.support, self.grid.t_end, self.comm,
                    "the start and any high-pass pad, see the support motion lines")
-        self.integ = self.rec = self.out = self.forces = self.demands = None
+        self.integ = self.rec = self.out = self.forces = self.demands = self.gravity = None
         self.state = None
         self.check_disk()
 
@@ -85,6 +85,10 @@ class FEMTransient(TransientProblem):
         self.load_source = NodalLoad(self.model.load_vec(), self.hist)      # F a(t) (sources/nodal.py)
         self.vel = self.integ.u.duplicate()
         self.inertia = self._inertia() if self.support is not None else {}
+        from .gravity import gravity_case               # -ssi_fem_gravity: the static self-weight case
+        with staged("FEM gravity"):
+            self.gravity = gravity_case(self.cfg, self.model, self.comm,
+                                        ref=self.demand_spec.ref if self.demand_spec.has_base else None)
 
     def _inertia(self):
         """{axis: -M iota_axis}: the effective earthquake load per unit ground acceleration along
@@ -144,6 +148,8 @@ class FEMTransient(TransientProblem):
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
                                 structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
             self.forces = add_force_recorder(cfg, self.out, self.model, comm, self.rec)
+            if self.forces is not None and self.gravity is not None:
+                self.forces.set_gravity(self.gravity.u)      # G, and the signed extremes of E(t) from t = 0
         if self.demand_spec.any:                  # base shear, overturning moment, drifts (fem/demands.py)
             from .demands import Demands
             sup = self.support                    # the base moves with the ground: its inertia m a_g
@@ -197,6 +203,11 @@ class FEMTransient(TransientProblem):
                              "structure_mass": structure_mass(model, comm)}
         if self.demands is not None and comm.getRank() == 0:
             groups["demands"] = self.demands.group()
+        if self.gravity is not None:
+            attrs["gravity"] = self.gravity.g
+            if comm.getRank() == 0:
+                dem = dict(self.demands.arrays(), reference_point=self.demand_spec.ref) if self.demands else None
+                groups["gravity"] = self.gravity.group(dem)
         if self.support is not None:
             groups["seismic"] = self.support.arrays()
             attrs["seismic"] = "support motion (relative-motion form: u, velocity, acceleration relative to the base)"
@@ -231,6 +242,8 @@ class FEMTransient(TransientProblem):
             printf(f"[fem] receiver 0 at t = {t[-1]:.5g} s: u = ({u[-1, 0, 0]:.6e}, {u[-1, 0, 1]:.6e}, "
                    f"{u[-1, 0, 2]:.6e}) m")
         self.integ.destroy()
+        if self.gravity is not None:
+            self.gravity.destroy()
         out = {"t": t, "u": u, "n_steps": self.n_steps, "alpha_m": self.am, "model": model}
         if self.demands is not None:
             out["demands"] = self.demands.arrays() if comm.getRank() == 0 else None

@@ -68,8 +68,10 @@ register("seismic_window", "str", "all", "", "part of the record: all, 't0,t1' (
          "'arias:p0,p1' (fractions of the Arias intensity)", G)
 register("seismic_taper", "real", 0.05, "", "Hann taper fraction at both ends (0: none)", G,
          validator=lambda v: None if 0.0 <= v <= 0.5 else "must lie in [0, 0.5]")
-register("seismic_baseline", "enum", "poly6", "", "baseline correction: poly6 (sixth-order displacement fit, "
-         "PEER/USGS), mean, none", G, choices=("poly6", "mean", "none"))
+register("seismic_baseline", "enum", "auto", "", "baseline correction: auto (none when the tapered record ends at "
+         "rest, |v_end| <= 1 % PGV and |d_end| <= 10 % PGD, else whichever of mean and poly6 leaves it nearest rest; "
+         "the log says which and why), poly6 (sixth-order displacement fit, PEER/USGS), mean (pre-event mean), none", G,
+         choices=("auto", "poly6", "mean", "none"))
 register("seismic_highpass", "real", 0.0, "Hz", "corner frequency of an acausal (zero-phase) Butterworth "
          "high-pass of order 4 applied to the tapered, zero-padded acceleration (pads of 1.5 n / f_c in all, "
          "half at each end, kept: the motion lasts that much longer; PEER's processing; e.g. 0.1): removes the "

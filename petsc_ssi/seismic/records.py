@@ -68,7 +68,14 @@ Processing (``process``), in this order
        the velocity and displacement of its exact integration return to about zero (what PEER's
        processing does; a record's long-period content below f_c is lost). With a velocity or
        displacement record the filter acts on the acceleration of step 5.
-    Warnings (RecordWarning): the poly6 correction changes PGA by more than 5 %; |v_end| > 1 % PGV.
+    Baseline "auto" (the option's default, issue 43: processing that does no harm by default): none
+       when the tapered record already ends at rest (|v_end| <= 1 % PGV and |d_end| <= 10 % PGD on
+       every component: a record corrected by its agency is left as it is), else whichever of mean and
+       poly6 leaves it nearest rest (``choose_baseline``); the choice and why are in
+       ``Motion.processing`` ('baseline', 'baseline_reason') and the summary.
+    Warnings (RecordWarning): the poly6 correction changes PGA by more than 5 %; a correction given
+    explicitly leaves the motion further from rest than none would (naming -ssi_seismic_baseline);
+    |v_end| > 1 % PGV (naming -ssi_seismic_highpass).
 
 Stats (``Motion.stats_raw``: the scaled record as read, integrated whole; ``Motion.stats``: processed):
 PGA, PGV, PGD (peaks over the samples), v_end, d_end, Arias intensity pi/(2 g) int a^2 dt (exact for
@@ -92,7 +99,7 @@ UNITS = {"g": ("acceleration", G), "m/s2": ("acceleration", 1.0), "cm/s2": ("acc
          "m": ("displacement", 1.0), "cm": ("displacement", 0.01), "mm": ("displacement", 0.001)}
 PEER_EXT = {".at2": "acceleration", ".vt2": "velocity", ".dt2": "displacement"}
 OBSPY_CALIBRATED = ("KNET", "KINEMETRICS_EVT")      # samples x stats.calib are m/s^2
-BASELINES = ("poly6", "mean", "none")
+BASELINES = ("auto", "poly6", "mean", "none")
 STAT_UNITS = {"pga": "m/s2", "pgv": "m/s", "pgd": "m", "v_end": "m/s", "d_end": "m", "arias": "m/s",
               "d5_95": "s"}
 _NPTS_NEW = re.compile(r"NPTS\s*=\s*([^,\s]+)\s*,?\s*DT\s*=\s*([^,\s]+)", re.I)
@@ -597,15 +604,17 @@ def _ratio(x, y):
     return np.divide(x, y, out=np.zeros_like(np.asarray(x, float)), where=np.asarray(y) != 0)
 
 
-def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_start=0.0, highpass=0.0):
+def process(record, scale=1.0, window="all", taper=0.05, baseline="auto", pad_start=0.0, highpass=0.0):
     """Motion from a Record: scale, window, pre-event mean, Hann taper, acceleration, exact integration
     and baseline (module docstring, steps 1-8).  RecordError on bad arguments, RecordWarning on a large
-    baseline change or final velocity.
+    baseline change, a final velocity left, or a correction that leaves the motion further from rest
+    than none would.
 
     scale: factor after the conversion to SI (finite, non-zero).  window: "all" | (t0, t1) | ("arias",
     p0, p1) (``parse_window`` reads the option syntax).  taper: Hann fraction at each end, 0..0.5.
-    baseline: "poly6" | "mean" | "none".  pad_start: time of the first kept sample in the motion [s].
-    highpass: corner frequency f_c of the acausal Butterworth high-pass [Hz] (0: none; step 4b).
+    baseline: "auto" | "poly6" | "mean" | "none" ("auto": ``choose_baseline``).  pad_start: time of the
+    first kept sample in the motion [s].  highpass: corner frequency f_c of the acausal Butterworth
+    high-pass [Hz] (0: none; step 4b).
     """
     path = record.source
     _check_args(path, scale, taper, baseline, pad_start)
@@ -614,13 +623,48 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
     t, x = np.asarray(record.t, float), _as2d(record.values) * scale
     raw = _kinematics(t, x, record.quantity)
     i0, i1 = _window(path, t, raw[0], window)
+    if taper == 0:                               # (the values less the pre-event mean a correction removes)
+        xw = x[i0:i1 + 1]
+        xw = xw if baseline == "none" else xw - (x[:i0] if i0 >= 2 else xw).mean(0)
+        _check_start_at_rest(path, t[i0:i1 + 1] - t[i0] + pad_start, xw, record.quantity)
+
+    def run(how):
+        return _corrected(path, t, x, i0, i1, record.quantity, taper, how, pad_start, highpass)
+
+    runs = {"none": run("none")} if baseline in ("auto", "none") else {}
+    choice = None
+    if baseline == "auto":
+        choice = choose_baseline(runs, run)
+        how = choice["chosen"]
+        tm, a, v, d, change, npad = choice["result"]
+    else:
+        how = baseline
+        if how not in runs:
+            runs[how] = run(how)
+        tm, a, v, d, change, npad = runs[how]
+    proc = dict(scale=float(scale), window=window, taper=float(taper), baseline=how,
+                baseline_option=baseline, pad_start=float(pad_start), window_samples=(i0, i1),
+                highpass=float(highpass), highpass_pad_s=float(npad * (tm[1] - tm[0])) if npad else 0.0)
+    if choice is not None:
+        proc["baseline_reason"] = choice["reason"]
+    elif how != "none":                          # an explicit correction: how far from rest without it
+        proc["drift_without"] = drift(run("none"))
+    t_rec0 = float(t[i0]) - proc["highpass_pad_s"]
+    motion = Motion(t=tm, a=a, v=v, d=d, stats_raw=motion_stats(t, *raw), stats=motion_stats(tm, a, v, d),
+                    baseline_pga_change=change, record_t0=t_rec0, source=path, sha256=record.sha256,
+                    record_info=_record_info(record), processing=proc, ndim=np.ndim(record.values))
+    motion.warn()
+    return motion
+
+
+def _corrected(path, t, x, i0, i1, quantity, taper, baseline, pad_start, highpass):
+    """(t, a, v, d, PGA change, pad samples) of the window [i0, i1] of the samples x processed with
+    ``baseline`` (none, mean or poly6): steps 3-8 of the module docstring."""
     xw = x[i0:i1 + 1]
     if baseline != "none":
         xw = xw - (x[:i0] if i0 >= 2 else xw).mean(0)
     tm = t[i0:i1 + 1] - t[i0] + pad_start
-    if taper == 0:
-        _check_start_at_rest(path, tm, xw, record.quantity)
-    a, v0, d0 = to_acceleration(tm, xw * hann_taper(tm, taper)[:, None], record.quantity)
+    a, v0, d0 = to_acceleration(tm, xw * hann_taper(tm, taper)[:, None], quantity)
     npad = 0
     if highpass > 0:
         tm, a, npad = _highpass(path, tm, a, float(highpass))
@@ -633,15 +677,49 @@ def process(record, scale=1.0, window="all", taper=0.05, baseline="poly6", pad_s
         change = _ratio(np.abs(a_new).max(0), np.abs(a).max(0)) - 1
         a = a_new
         v, d = integrate(tm, a, v0, d0)
-    proc = dict(scale=float(scale), window=window, taper=float(taper), baseline=baseline,
-                pad_start=float(pad_start), window_samples=(i0, i1), highpass=float(highpass),
-                highpass_pad_s=float(npad * (tm[1] - tm[0])) if npad else 0.0)
-    t_rec0 = float(t[i0]) - proc["highpass_pad_s"]
-    motion = Motion(t=tm, a=a, v=v, d=d, stats_raw=motion_stats(t, *raw), stats=motion_stats(tm, a, v, d),
-                    baseline_pga_change=change, record_t0=t_rec0, source=path, sha256=record.sha256,
-                    record_info=_record_info(record), processing=proc, ndim=np.ndim(record.values))
-    motion.warn()
-    return motion
+    return tm, a, v, d, change, npad
+
+
+REST_V, REST_D = 0.01, 0.1      # at rest: |v_end| <= 1 % of PGV and |d_end| <= 10 % of PGD (every component)
+
+
+def drift(result):
+    """(|v_end| / PGV, |d_end| / PGD) per component of a ``_corrected`` result: how far the processed
+    motion ends from rest."""
+    _, a, v, d, _, _ = result
+    return _ratio(np.abs(v[-1]), np.abs(v).max(0)), _ratio(np.abs(d[-1]), np.abs(d).max(0))
+
+
+def _score(dr):
+    """Per component, one number for 'how far from rest' (<= 1: at rest; the velocity counts ten
+    times more than the displacement: a permanent displacement may be real)."""
+    return np.maximum(np.asarray(dr[0]) / REST_V, np.asarray(dr[1]) / REST_D)
+
+
+def choose_baseline(runs, run):
+    """The baseline of ``-ssi_seismic_baseline auto``, per component: none when the tapered record
+    already ends at rest (``REST_V``, ``REST_D``: a corrected record is left as it is), else the one of
+    none, mean and poly6 that leaves it nearest rest (ties: the first). ``runs``: {baseline: result} holding 'none';
+    ``run(baseline)``: a result. {'chosen' (one name, or 'x/y/z' names per component), 'reason',
+    'result'}."""
+    d0 = drift(runs["none"])
+    words = (f"without a correction the tapered motion ends at a final velocity of {_fmt(100 * d0[0], '.3g')} % of PGV "
+             f"and a final displacement of {_fmt(100 * d0[1], '.3g')} % of PGD")
+    if np.all(_score(d0) <= 1.0):
+        return {"chosen": "none", "reason": words + " (at rest: nothing to correct)", "result": runs["none"]}
+    names = ("none", "mean", "poly6")
+    for how in names[1:]:
+        runs[how] = run(how)
+    scores = np.array([_score(drift(runs[k])) for k in names])        # (3, components)
+    pick = np.where(scores[0] <= 1.0, 0, np.argmin(scores, axis=0))   # a component at rest keeps its record
+    tm, _, _, _, _, npad = runs["none"]
+    cols = [np.stack([runs[names[k]][i][:, j] for j, k in enumerate(pick)], axis=1) for i in (1, 2, 3)]
+    change = np.array([runs[names[k]][4][j] for j, k in enumerate(pick)])
+    result = (tm, cols[0], cols[1], cols[2], change, npad)
+    chosen = "/".join(names[k] for k in pick) if len(set(pick.tolist())) > 1 else names[pick[0]]
+    db = drift(result)
+    return {"chosen": chosen, "result": result,
+            "reason": words + f"; {chosen} leaves {_fmt(100 * db[0], '.3g')} % and {_fmt(100 * db[1], '.3g')} %"}
 
 
 def _check_start_at_rest(path, t, x, quantity):
@@ -742,15 +820,28 @@ class Motion:
         return out[:, 0].reshape(tq.shape)[()] if self.ndim == 1 else out.reshape(tq.shape + out.shape[1:])
 
     def warn(self):
-        """RecordWarning if poly6 changed PGA by more than 5 % or |v_end| > 1 % PGV."""
-        s = self.stats
+        """RecordWarning if the baseline changed PGA by more than 5 %, if |v_end| > 1 % PGV, or if an
+        explicit correction left the motion further from rest than none would (each names the option)."""
+        s, p = self.stats, self.processing
         if np.any(np.abs(self.baseline_pga_change) > 0.05):
             warnings.warn(f"record '{self.source}': the poly6 baseline changes PGA by "
-                          f"{_fmt(np.multiply(self.baseline_pga_change, 100), '+.1f')} % (> 5 %)",
-                          RecordWarning, stacklevel=3)
-        if np.any(np.abs(s["v_end"]) > 0.01 * np.asarray(s["pgv"])):
+                          f"{_fmt(np.multiply(self.baseline_pga_change, 100), '+.1f')} % (> 5 %): the polynomial "
+                          "fits part of the motion itself (long periods); -ssi_seismic_baseline none or mean keeps "
+                          "them", RecordWarning, stacklevel=3)
+        worse = p.get("drift_without")
+        now = drift((None, _as2d(self.a), _as2d(self.v), _as2d(self.d), None, None))
+        if worse is not None and np.any(_score(now) > np.maximum(_score(worse), 1.0)):
+            warnings.warn(f"record '{self.source}': the {p['baseline']} baseline leaves the motion further from rest "
+                          f"than no correction (final velocity {_fmt(100 * now[0], '.3g')} % of PGV, final displacement "
+                          f"{_fmt(100 * now[1], '.3g')} % of PGD; without it {_fmt(100 * worse[0], '.3g')} % and "
+                          f"{_fmt(100 * worse[1], '.3g')} %): "
+                          f"the record looks corrected already; give -ssi_seismic_baseline none (or auto, the default, "
+                          "which chooses)", RecordWarning, stacklevel=3)
+        elif np.any(np.abs(s["v_end"]) > 0.01 * np.asarray(s["pgv"])):
             warnings.warn(f"record '{self.source}': final velocity {_fmt(s['v_end'])} m/s is more than "
-                          f"1 % of PGV {_fmt(s['pgv'])} m/s", RecordWarning, stacklevel=3)
+                          f"1 % of PGV {_fmt(s['pgv'])} m/s after the {p.get('baseline', '?')} baseline"
+                          + ("" if p.get("highpass") else "; a high-pass filter (-ssi_seismic_highpass, e.g. 0.1 Hz) "
+                             "removes the drift a baseline leaves"), RecordWarning, stacklevel=3)
 
     def summary_lines(self):
         """Human-readable report (units stated), one string per line."""
@@ -773,6 +864,8 @@ class Motion:
                          f"{_fmt(self.stats[key]):>24s}")
         if p.get("target"):                       # -ssi_seismic_target (seismic/scaling.py)
             lines.append(p["target"])
+        if p.get("baseline_option") == "auto":
+            lines.append(f"baseline auto -> {p['baseline']}: {p.get('baseline_reason', '')}")
         if p.get("baseline") == "poly6":
             lines.append(f"poly6 baseline PGA change: {_fmt(np.multiply(self.baseline_pga_change, 100), '+.2f')} %")
         return lines

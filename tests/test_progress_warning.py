@@ -1,0 +1,41 @@
+"""The progress line warns when the steps run far above the run's own prediction (issue 43: 'an
+estimate you can trust'; issue 44: '-n 2 slower than -n 1 on shared cores with no word'):
+``monitor.slow_warning`` names the cause it can see (ranks above the cores, a load average above
+them, else the model's constants) and what to try; ``Progress.expect`` warns once, on rank 0, from
+the -ssi_monitor line. No timing of the machine: the measured times are given."""
+import pytest
+
+from petsc_ssi import monitor
+
+pytestmark = pytest.mark.unit
+
+
+def test_no_warning_within_the_factor_or_too_early():
+    assert monitor.slow_warning(2.9 * 10, 10.0, 50, 1, load=0.1, cores=2) is None       # under SLOW x
+    assert monitor.slow_warning(1.5, 0.01, 50, 1, load=9.0, cores=2) is None            # start-up noise
+    assert monitor.slow_warning(100.0, 1.0, 3, 1, load=9.0, cores=2) is None            # too few steps
+
+
+@pytest.mark.parametrize("ranks, load, words", [
+    (4, 0.5, ["4 ranks share 2 cores (oversubscribed)", "mpirun -n"]),
+    (2, 10.0, ["load average 10.0 on 2 cores", "-n 1 may then be the faster"]),
+    (1, 0.2, ["not visibly loaded", "jobscripts/calibrate.py", "-ssi_estimate_constants"])])
+def test_warning_names_the_cause_and_what_to_try(ranks, load, words):
+    msg = monitor.slow_warning(40.0, 10.0, 100, ranks, load=load, cores=2)
+    assert msg is not None and "4.0 times slower" in msg and "\n" not in msg
+    for w in words:
+        assert w in msg, msg
+
+
+def test_progress_warns_once_against_its_model(monkeypatch, capfd):
+    """A Progress whose model predicts 1 ms a step, measured at 10 s a step (a clock that advances
+    10 s per call): the first due report warns, later ones do not repeat it."""
+    clock = iter(range(0, 10_000, 10))
+    monkeypatch.setattr(monitor.time, "perf_counter", lambda: float(next(clock)))
+    p = monitor.Progress("time loop", 40, every=10)
+    p.expect(lambda k: 1e-3 * k, ranks_here=1)
+    for k in range(1, 41):
+        p.update(k)
+    out = capfd.readouterr().out
+    assert out.count("times slower than the run's prediction") == 1
+    assert "for 10 steps" in out
