@@ -136,6 +136,10 @@ class HalfSpace:
             warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
+        self._excavation = None
+        if wave and not self.mesh.flat:       # the scattered field's -t_ff on the excavation's free faces
+            self._excavation = self._free_field_source(disp)
+            self.sources += [self._excavation] if self._excavation is not None else []
         check_sources(self.mesh, self.sources)
         load = (np.unique(np.concatenate([s.elements for s in self.sources])) if self.sources
                 else np.zeros(0, np.int64))
@@ -146,7 +150,7 @@ class HalfSpace:
         if interface is not None and not np.array_equal(self.regions.disp_nodes, interface.be_nodes):
             raise SSIError("interface: internal error, node order of the soil regions differs")
         self.bind_sources()
-        for src in self.sources if sources is not None else ():
+        for src in self.sources if sources is not None else [self._excavation] if self._excavation else ():
             printf(f"[ssi] source: {src.describe()}")
         for name in ("disp_rotation", "disp_ref"):
             if cfg.user_set(name) and not cfg.disp_group:
@@ -169,7 +173,9 @@ class HalfSpace:
         self.seismic = None
         if cfg.get("seismic", "none") != "none":
             self.seismic = self._seismic_input(self._control_point(interface))   # (record and wave checked first)
-            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources)
+            if self._excavation is not None:
+                self._excavation.attach(self.seismic)
+            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
             if interface is None and self.motion is None and not loaded:
                 # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
                 # marched, assembly and all, and the output held zeros beside the closed-form free field)
@@ -193,9 +199,16 @@ class HalfSpace:
         if interface is not None:
             raise SSIError(f"-ssi_mesh {cfg.mesh}: a structure coupled to a soil surface with an excavation is not "
                            "supported yet (issue 42, item 2); use a plane surface")
-        if cfg.get("seismic", "none") != "none":
-            raise SSIError(f"-ssi_seismic {cfg.seismic} on a soil surface with an excavation (-ssi_mesh {cfg.mesh}) "
-                           "needs the free field's traction on its walls and bottom: not supported yet")
+
+    def _free_field_source(self, disp):
+        """The free field's traction -t_ff on the excavation's faces (every element below the ground but
+        the prescribed region's): ``sources.free_field.FreeFieldTraction``, its wave attached later."""
+        from ..sources.free_field import FreeFieldTraction
+        X = self.mesh.cell_coords()
+        tol = 1e-9 * max(float(np.ptp(self.mesh.nodes, axis=0).max()), 1.0)
+        below = np.nonzero(X[..., 2].min(1) < -tol)[0]
+        faces = np.setdiff1d(below, np.asarray(disp, np.int64))
+        return FreeFieldTraction(faces) if faces.size else None
 
     def _check_interface(self, load, interface):
         both = np.intersect1d(load, interface.be_elems)
