@@ -122,15 +122,20 @@ PIT = ["-ssi_problem", "bem", "-ssi_mesh", "pit", "-ssi_mesh_params", "a=1,b=1,d
        "-ssi_warn_beta", "0"]
 
 
-def test_two_ranks_equal_one_and_bad_geometry_is_refused_on_every_rank(tmp_path):
-    """-n 2 gives -n 1's displacements, tractions and receivers to 1e-12 of their scale; the .geo's pit
-    turned upside down (d < 0: walls and bottom above the ground) is refused in one line at -n 2 before
-    any assembly."""
+# slow tier: a pit run at -n 1 and -n 2 (25 s; the -n 2 refusal below stays)
+@pytest.mark.slow
+def test_two_ranks_equal_one(tmp_path):
+    """-n 2 gives -n 1's displacements, tractions and receivers to 1e-12 of their scale."""
     a, b = str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
     cli(PIT + ["-ssi_output", a])
     cli(PIT + ["-ssi_output", b], nranks=2)
     same(a, b, 1e-12)
     assert np.abs(receivers(a)).max() > 0
+
+
+def test_bad_geometry_is_refused_on_every_rank(tmp_path):
+    """The .geo's pit turned upside down (d < 0: walls and bottom above the ground) is refused in one line
+    at -n 2 before any assembly."""
     r = cli(["-ssi_problem", "bem", "-ssi_mesh", "meshes/pit.geo", "-ssi_mesh_params", "a=1,b=1,d=-1",
              "-ssi_mesh_size", "6,6", "-ssi_mesh_h", "1", "-ssi_load_group", "pit", "-ssi_load_p0", "1000",
              "-ssi_t_end", "0.01", "-ssi_output", str(tmp_path / "c.h5")], nranks=2, check=False)

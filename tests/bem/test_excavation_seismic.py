@@ -134,6 +134,8 @@ def test_the_scattered_motion_converges_with_the_mesh(tmp_path):
     assert np.all(np.abs(peak_a[big] / peak_b[big] - 1) < 0.25), (peak_a[big], peak_b[big])
 
 
+# slow tier: the seismic pit at -n 1 and -n 2 (13 s; the pit's other runs stay in the default tier)
+@pytest.mark.slow
 def test_two_ranks_equal_one(tmp_path):
     rec = pulse(tmp_path / "p.txt", 0.02)
     args = ["-ssi_problem", "bem", "-ssi_mesh", "pit", "-ssi_mesh_params", "a=1,b=1,d=1", "-ssi_mesh_size", "6,6",
