@@ -706,6 +706,16 @@ class PlaneWave:
 
     def stress(self, points, t):
         """Cauchy stress (Pa if SI), shape (n, 3, 3) or (nt, n, 3, 3); needs rho."""
+        return self._stress(points, t, 1)
+
+    def stress_integral(self, points, t):
+        """The stress's running time integral int_{-inf}^t sigma dt' (Pa s if SI), shape as ``stress``: the
+        stress is linear in the strain, which carries one time derivative of the signal (a plane wave is a
+        function of t - s.x), so its integral is the same sum over the signal itself. The exact mean over
+        a step is the difference of two values over the step (a source's piecewise-constant traction)."""
+        return self._stress(points, t, 0)
+
+    def _stress(self, points, t, deriv):
         if self.rho is None:
             raise FreeFieldError("stress needs the density: PlaneWave(..., rho=...)")
         X, z, _ = self._points(points)
@@ -713,7 +723,7 @@ class PlaneWave:
         base = self._base(X, tt)
         out = np.zeros(base.shape + (3, 3))
         for S, q in zip(self._S, self._q):
-            out += self._term(S, base - q.real * z, q.imag * z + 0 * base, 1)
+            out += self._term(S, base - q.real * z, q.imag * z + 0 * base, deriv)
         return out[0] if scalar else out
 
     # --- evaluation

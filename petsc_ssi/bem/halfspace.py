@@ -45,6 +45,8 @@ def read_surface_mesh(cfg, comm, planes):
                                "the DefineConstant parameters of a .geo given as -ssi_mesh")
             if cfg.mesh == "grid":
                 mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
+            elif cfg.mesh == "pit":
+                mesh = _pit(cfg, Lx, Ly, patch, planes)
             else:
                 params = {"Lx": Lx, "Ly": Ly, "h": cfg.mesh_h,
                           "xmin": -Lx / 2 if xmin is None else 0.0,
@@ -56,12 +58,31 @@ def read_surface_mesh(cfg, comm, planes):
                 params.update(user)
                 mesh = surface.read_gmsh(cfg.mesh, params, tuple(user))
             mesh.check()
-            # on the plane, exactly (the lag blocks' flat pattern, bem/bsr.py, holds); the kernels
-            # have a general path, but these still assume the plane:
-            mesh.require_plane(f"-ssi_mesh {cfg.mesh}", "receivers are located in plan, the seismic input's "
-                               "scattered form takes t_ff = 0 on the surface, symmetry images and the "
-                               "diffraction warning take a flat edge")
+            if mesh.in_plane():
+                # on the plane, exactly (the lag blocks' flat pattern, bem/bsr.py, holds)
+                mesh.require_plane(f"-ssi_mesh {cfg.mesh}", "")
+            else:
+                # an excavation: the ground z = 0 closed by walls and bottoms, normals out of the soil
+                # (refused in one line before any assembly); the general 3x3 block pattern
+                surface.check_excavation(mesh, f"-ssi_mesh {cfg.mesh}")
+                if planes:
+                    raise SSIError(f"-ssi_symmetry {cfg.symmetry}: symmetry planes on a surface with an excavation "
+                                   "(-ssi_mesh " + cfg.mesh + ") are not supported yet; mesh the whole surface")
     return mpi.bcast(mesh)
+
+
+def _pit(cfg, Lx, Ly, patch, planes):
+    """-ssi_mesh pit: the grid generator's ground with a rectangular excavation (``surface.pit``) of
+    -ssi_mesh_params a=,b=,d= (half-widths and depth, m)."""
+    from ..fem.mesh import parse_mesh_params
+    p = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
+    if patch or planes:
+        raise SSIError(f"-ssi_mesh pit: {'-ssi_mesh_patch' if patch else '-ssi_symmetry'} is not taken (the pit's "
+                       "groups are ground, walls, bottom and pit; it is meshed whole)")
+    if set(p) != {"a", "b", "d"}:
+        raise SSIError(f"-ssi_mesh pit: -ssi_mesh_params must give a, b and d (the pit's half-widths and depth, m), "
+                       f"got '{cfg.get('mesh_params', '')}'")
+    return surface.pit(Lx, Ly, cfg.mesh_h, p["a"], p["b"], p["d"])
 
 
 def read_soil_surface(cfg, comm, planes):
@@ -97,6 +118,8 @@ class HalfSpace:
         self.mesh = mesh if mesh is not None else read_soil_surface(cfg, comm, self.planes)
         h = float(self.mesh.element_sizes().max())
         self.h = h
+        if not self.mesh.flat:
+            self._check_excavation_run(interface)
         bad, ang = surface.kinks(self.mesh, self.planes)
         if len(bad):
             printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
@@ -113,6 +136,10 @@ class HalfSpace:
             warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
+        self._excavation = None
+        if wave and not self.mesh.flat:       # the scattered field's -t_ff on the excavation's free faces
+            self._excavation = self._free_field_source(disp)
+            self.sources += [self._excavation] if self._excavation is not None else []
         check_sources(self.mesh, self.sources)
         load = (np.unique(np.concatenate([s.elements for s in self.sources])) if self.sources
                 else np.zeros(0, np.int64))
@@ -123,7 +150,7 @@ class HalfSpace:
         if interface is not None and not np.array_equal(self.regions.disp_nodes, interface.be_nodes):
             raise SSIError("interface: internal error, node order of the soil regions differs")
         self.bind_sources()
-        for src in self.sources if sources is not None else ():
+        for src in self.sources if sources is not None else [self._excavation] if self._excavation else ():
             printf(f"[ssi] source: {src.describe()}")
         for name in ("disp_rotation", "disp_ref"):
             if cfg.user_set(name) and not cfg.disp_group:
@@ -139,14 +166,16 @@ class HalfSpace:
         for p in self.receivers:
             q, _ = symmetry.map_point(p, self.planes)
             rec.locate(self.mesh, q)
-            if abs(p[2]) > 1e-6 * max(h, 1.0):
+            if self.mesh.flat and abs(p[2]) > 1e-6 * max(h, 1.0):
                 raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
         # a coupled run's structure: points of interest (the interpolation rule, the diffraction warning)
         self.sites = interface.x if interface is not None else np.zeros((0, 3))
         self.seismic = None
         if cfg.get("seismic", "none") != "none":
             self.seismic = self._seismic_input(self._control_point(interface))   # (record and wave checked first)
-            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources)
+            if self._excavation is not None:
+                self._excavation.attach(self.seismic)
+            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
             if interface is None and self.motion is None and not loaded:
                 # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
                 # marched, assembly and all, and the output held zeros beside the closed-form free field)
@@ -163,6 +192,23 @@ class HalfSpace:
             self._seismic_lines()
         if interface is not None:
             self.diffraction_warning(interface.x, "the structure (interface nodes)")
+
+    def _check_excavation_run(self, interface):
+        """What a surface with an excavation does not take yet (one line, before any assembly)."""
+        cfg = self.cfg
+        if interface is not None:
+            raise SSIError(f"-ssi_mesh {cfg.mesh}: a structure coupled to a soil surface with an excavation is not "
+                           "supported yet (issue 42, item 2); use a plane surface")
+
+    def _free_field_source(self, disp):
+        """The free field's traction -t_ff on the excavation's faces (every element below the ground but
+        the prescribed region's): ``sources.free_field.FreeFieldTraction``, its wave attached later."""
+        from ..sources.free_field import FreeFieldTraction
+        X = self.mesh.cell_coords()
+        tol = 1e-9 * max(float(np.ptp(self.mesh.nodes, axis=0).max()), 1.0)
+        below = np.nonzero(X[..., 2].min(1) < -tol)[0]
+        faces = np.setdiff1d(below, np.asarray(disp, np.int64))
+        return FreeFieldTraction(faces) if faces.size else None
 
     def _check_interface(self, load, interface):
         both = np.intersect1d(load, interface.be_elems)

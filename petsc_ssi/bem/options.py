@@ -10,7 +10,9 @@ from ..seismic import options as _seismic_options  # noqa: F401  (the soil takes
 register("cp", "real", 548.0, "m/s", "P-wave speed of the half-space", "bem", validator=positive)
 register("cs", "real", 316.0, "m/s", "S-wave speed of the half-space", "bem", validator=positive)
 register("rho", "real", 2000.0, "kg/m^3", "density of the half-space", "bem", validator=positive)
-register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator) or a gmsh .geo/.msh file of nine-node quads", "bem")
+register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator), 'pit' (the grid's ground with a "
+         "rectangular excavation of -ssi_mesh_params a=,b=,d=: half-widths and depth in m; groups ground, walls, "
+         "bottom, pit) or a gmsh .geo/.msh file of nine-node quads", "bem")
 register("mesh_size", "str", "16,16", "m", "grid/.geo: full extent 'Lx,Ly' of the surface, centred at the origin", "bem")
 register("mesh_h", "real", 1.0, "m", "grid/.geo: element size (node spacing is h/2)", "bem", validator=positive)
 register("mesh_patch", "str", "", "m", "grid/.geo: half-widths 'a,b' of a central patch named 'load' whose edges the mesh follows", "bem")
@@ -131,7 +133,7 @@ def _bem_checks(cfg):
                 f"{(r2 - 2) / (2 * (r2 - 1)):.9f}): check the units (m/s) or give a P-wave speed <= {MAX_CP:g} m/s")
     if cfg.t_end < cfg.dt:
         return f"-ssi_t_end {cfg.t_end} is shorter than one step -ssi_dt {cfg.dt}"
-    if cfg.mesh == "grid":
+    if cfg.mesh in ("grid", "pit"):
         try:
             lx, ly = (float(v) for v in str(cfg.mesh_size).split(","))
         except ValueError:
@@ -140,7 +142,7 @@ def _bem_checks(cfg):
             return (f"-ssi_mesh_h {cfg.mesh_h:g} m is larger than the mesh (-ssi_mesh_size {cfg.mesh_size}): the grid "
                     f"would have elements of {min(lx, ly):g} m, not the size asked; give -ssi_mesh_h <= "
                     f"{min(lx, ly):g} m or a larger -ssi_mesh_size")
-    if cfg.mesh != "grid" and not os.path.isfile(cfg.mesh):
+    if cfg.mesh not in ("grid", "pit") and not os.path.isfile(cfg.mesh):
         return f"-ssi_mesh {cfg.mesh}: no such file"
     if cfg.interp in ("chebyshev", "linear") and (cfg.interp_k < 1 or cfg.interp_tl <= 0):
         return f"-ssi_interp {cfg.interp} needs -ssi_interp_tl > 0 and -ssi_interp_k >= 1 (or use -ssi_interp auto)"

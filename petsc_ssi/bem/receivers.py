@@ -14,8 +14,11 @@ def parse(spec):
 
 
 def locate(mesh, p, tol=1e-8):
-    """(element, xi, eta) of the surface point nearest to p in plan (x, y).
+    """(element, xi, eta) of the surface point nearest to p in plan (x, y) on a plane surface, the
+    surface point at p on one that is not (``locate_3d``: a wall, the bottom of an excavation).
     Raises SSIError if p lies off the mesh."""
+    if not mesh.flat:
+        return locate_3d(mesh, p, tol)
     X = mesh.cell_coords()
     lo = X[:, :, :2].min(1) - 1e-9
     hi = X[:, :, :2].max(1) + 1e-9
@@ -34,6 +37,33 @@ def locate(mesh, p, tol=1e-8):
         if np.all(np.abs(xi) <= 1 + tol):
             return int(e), float(xi[0]), float(xi[1])
     raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) lies off the surface mesh")
+
+
+def locate_3d(mesh, p, tol=1e-8):
+    """(element, xi, eta) of the point p on a surface that is not a plane: the first element (in
+    element order) whose point nearest to p (Gauss-Newton on |x(xi, eta) - p|) lies inside it and
+    within 1e-6 of the mesh's size of p. A point on an edge shared by a wall and the ground is on
+    either; its shape functions give the same (continuous) value. SSIError if none holds p."""
+    X = mesh.cell_coords()
+    h = float(mesh.element_sizes().max())
+    near = 1e-6 * max(h, 1.0)
+    lo = X.min(1) - near
+    hi = X.max(1) + near
+    cand = np.where(np.all((p >= lo) & (p <= hi), axis=1))[0]
+    for e in cand:
+        xi = np.zeros(2)
+        for _ in range(50):
+            N = quad9.shape(xi[0], xi[1])
+            d1, d2 = quad9.shape_grad(xi[0], xi[1])
+            J = np.array([d1 @ X[e], d2 @ X[e]]).T            # (3, 2)
+            dx = np.linalg.lstsq(J, p - N @ X[e], rcond=None)[0]
+            xi = np.clip(xi + dx, -1.5, 1.5)
+            if np.abs(dx).max() < 1e-13:
+                break
+        if np.all(np.abs(xi) <= 1 + tol) and np.linalg.norm(quad9.shape(xi[0], xi[1]) @ X[e] - p) <= near:
+            return int(e), float(xi[0]), float(xi[1])
+    raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) lies off the surface mesh (not on the ground, a wall "
+                   "or a bottom)")
 
 
 def operator(comm, mesh, points, planes, ncol_loc):

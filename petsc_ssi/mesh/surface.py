@@ -117,6 +117,95 @@ class SurfaceMesh:
             raise SSIError(f"the surface mesh has {int((~used).sum())} nodes in no element")
 
 
+_EDGE_MID = (4, 5, 6, 7)          # mid-side node of element edge k (corner k -> corner k + 1)
+
+
+def element_edges(cells):
+    """{(min(p, q), max(p, q)): [(element, p, q, mid), ...]} of every element edge (corners p -> q in
+    the element's own direction, ``mid`` its mid-side node)."""
+    owners = {}
+    for e, c in enumerate(np.asarray(cells)):
+        for k in range(4):
+            p, q = int(c[k]), int(c[(k + 1) % 4])
+            owners.setdefault((min(p, q), max(p, q)), []).append((e, p, q, int(c[_EDGE_MID[k]])))
+    return owners
+
+
+def _loops(edges):
+    """Connected pieces of a set of edges (p, q): the number of boundary loops."""
+    parent = {}
+
+    def find(a):
+        while parent.setdefault(a, a) != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+    for p, q in edges:
+        parent[find(p)] = find(q)
+    return len({find(a) for a in parent})
+
+
+def check_excavation(mesh, what):
+    """SSIError in one line unless a surface that is not a plane is one the half-space can take: the
+    ground z = 0 with excavations below it (walls and bottoms), a conforming surface (an element edge
+    shared by two elements, or by one on the mesh's outer edge), whose free edges form one loop on the
+    ground z = 0 (an excavation that does not close on the ground leaves a hole: a second loop; walls
+    that meet the mesh's edge leave free edges below z = 0), and whose normals point out of the soil
+    (neighbours run their shared edge in opposite directions; the ground faces +z). ``what``: the
+    input named in the error. ``read_gmsh`` orients a .geo/.msh surface first (``orient_out_of_soil``);
+    a mesh made otherwise must come oriented."""
+    x = mesh.nodes
+    ext = float(np.ptp(x, axis=0).max()) if mesh.n_nodes else 1.0
+    tol = 1e-9 * max(ext, 1.0)
+    k = int(x[:, 2].argmax())
+    if x[k, 2] > tol:
+        raise SSIError(f"{what}: node {k} at ({x[k, 0]:.6g}, {x[k, 1]:.6g}, {x[k, 2]:.6g}) m lies above the ground "
+                       "z = 0 (the soil is z < 0 with excavations below the ground; a hill is not supported)")
+    owners = element_edges(mesh.cells)
+    for key, own in owners.items():
+        if len(own) > 2:
+            raise SSIError(f"{what}: an element edge (nodes {key[0]}, {key[1]}) is shared by {len(own)} elements: "
+                           "not a surface")
+    free = []
+    for key, own in owners.items():
+        if len(own) == 1:
+            free.append(own[0])
+            continue
+        (e, p, q, _), (f, p2, q2, _) = own
+        if p == p2:                    # the same direction: one of the two faces the wrong way
+            raise SSIError(f"{what}: the normals of elements {e} and {f} disagree across their shared edge (one "
+                           "points into the soil); orient every element out of the soil")
+    lo, hi = x[:, :2].min(0), x[:, :2].max(0)
+    for e, p, q, m in free:
+        for a in (p, m, q):
+            if x[a, 2] >= -tol:
+                continue
+            where = f"({x[a, 0]:.6g}, {x[a, 1]:.6g}, {x[a, 2]:.6g}) m"
+            if np.any(np.abs(x[a, :2] - lo) <= tol) or np.any(np.abs(x[a, :2] - hi) <= tol):
+                raise SSIError(f"{what}: the excavation meets the mesh's edge: element {e} has a free edge at {where} "
+                               "below the ground; keep the walls inside the ground (an excavation closed on every "
+                               "side)")
+            raise SSIError(f"{what}: the surface does not close: element {e} has a free edge at {where} below the "
+                           "ground (a wall or bottom missing)")
+    n_loops = _loops([(p, q) for _, p, q, _ in free])
+    if n_loops != 1:
+        e, p, q, m = free[0]
+        raise SSIError(f"{what}: the surface does not close: its free element edges form {n_loops} loops, not the "
+                       "one outer edge of the ground (a hole in the ground, or walls and bottom that do not meet it)")
+    from . import quad9 as q9
+    _, jn = q9.geometry(mesh.cell_coords(), np.array([0.0]), np.array([0.0]))
+    n = jn[:, 0] / np.linalg.norm(jn[:, 0], axis=1, keepdims=True)
+    ground = np.abs(mesh.cell_coords()[..., 2]).max(1) <= tol
+    bad = np.nonzero(ground & (n[:, 2] < 0))[0]
+    if len(bad):
+        c = mesh.centres()[bad[0]]
+        raise SSIError(f"{what}: the normals point into the soil ({len(bad)} ground elements face -z, element "
+                       f"{bad[0]} at ({c[0]:.6g}, {c[1]:.6g}, 0) m); the soil's normals point out of it (+z on the "
+                       "ground)")
+    if not ground.any():
+        raise SSIError(f"{what}: no element lies on the ground z = 0")
+
+
 def kinks(mesh, planes=(), max_angle_deg=1.0):
     """Nodes where the surface is not smooth: the unit normals of the elements
     sharing the node differ by more than ``max_angle_deg`` (an edge or a

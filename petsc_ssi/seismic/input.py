@@ -432,6 +432,14 @@ class SeismicInput:
         n = np.asarray(normals, float).reshape(-1, 3)
         return np.einsum("pij,pj->pi", self.stress(points, t), n)
 
+    def traction_integral(self, points, normals, t):
+        """int_{-inf}^t sigma_ff n dt' at ``points`` (n, 3) for the (not necessarily unit) ``normals`` (n, 3)
+        [Pa s]: the difference of two values over a step is the step's exact mean traction times dt
+        (``sources.free_field.FreeFieldTraction``)."""
+        pts = np.asarray(points, float).reshape(-1, 3)
+        S = sum((w.stress_integral(pts, t) for w in self.waves), np.zeros((len(pts), 3, 3)))
+        return np.einsum("pij,pj->pi", S, np.asarray(normals, float).reshape(-1, 3))
+
     def rotation(self, points, t):
         """The rotation of the free surface at surface ``points`` (n, 3) at time t (scalar or 1-D):
         1/2 curl u_ff = (du_z/dy, -du_z/dx, (du_y/dx - du_x/dy)/2) [rad], (n, 3) or (nt, n, 3). Each

@@ -1,0 +1,93 @@
+"""The free field's traction on the faces of an excavation, as a source of the scattered field (issue 42,
+item 3).
+
+The soil carries the scattered field u_sc = u - u_ff (``seismic.input``). On the flat free surface the
+free field is traction-free, t_ff = sigma_ff n = 0, so a plane surface needs no source. On an
+excavation's walls and bottom it is not: the total traction there is zero (a free face), so the
+scattered field's traction is
+
+    t_sc = -t_ff = -sigma_ff(x, t) n(x),
+
+a known traction on those faces. Its step mean over ((m-1) dt, m dt] is exact: the free field's stress
+has a running time integral in closed form (``SeismicInput.traction_integral``), and the mean is the
+difference of two values over dt.
+
+The soil's tractions are nodal values, continuous over the loaded region (``bem.lagset.Regions``); at an
+edge of the excavation (a wall meeting the bottom, two walls meeting) the faces' normals differ and so
+does t_ff. A node takes the traction of its tributary faces' summed vector area,
+
+    n_a = sum_e int_e N_a n dGamma / sum_e int_e N_a dGamma,
+
+which keeps the node's consistent force (int N_a t dGamma over its elements) for a stress uniform
+near it; its length is below 1 at an edge (1/sqrt(2) where two faces meet at a right angle). The
+traction jumps there in truth, which this continuous interpolation smears over one element: the
+error falls with the element size.
+"""
+import numpy as np
+
+from ..mesh import quad9
+
+
+def vector_areas(mesh, elements, nodes, order=4):
+    """(n_a (k, 3), w_a (k,)): sum over ``elements`` of int N_a n dGamma and int N_a dGamma [m^2] at each
+    of ``nodes`` (sorted ids); Gauss rule of ``order`` points a direction."""
+    g, w = np.polynomial.legendre.leggauss(order)
+    XI, ETA = np.meshgrid(g, g, indexing="ij")
+    W = np.outer(w, w).ravel()
+    X = mesh.cell_coords()[elements]                                  # (e, 9, 3)
+    _, jn = quad9.geometry(X, XI.ravel(), ETA.ravel())                # (e, q, 3)
+    N = np.array([quad9.shape(a, b) for a, b in zip(XI.ravel(), ETA.ravel())])    # (q, 9)
+    vec = np.einsum("q,qa,eqd->ead", W, N, jn)
+    area = np.einsum("q,qa,eq->ea", W, N, np.linalg.norm(jn, axis=-1))
+    idx = np.searchsorted(nodes, mesh.cells[elements])
+    nv, na = np.zeros((len(nodes), 3)), np.zeros(len(nodes))
+    np.add.at(nv, idx.ravel(), vec.reshape(-1, 3))
+    np.add.at(na, idx.ravel(), area.ravel())
+    return nv, na
+
+
+class FreeFieldTraction:
+    """-t_ff = -sigma_ff n on ``elements`` (an excavation's free faces): the surface-traction protocol
+    (``petsc_ssi.sources``), its wave given by ``attach`` once the seismic input is made (before the
+    first step)."""
+
+    def __init__(self, elements, name="free-field traction on the excavation"):
+        self.elements = np.unique(np.asarray(elements, np.int64))
+        self.name = name
+        self.seismic = None
+        self.idx = self._x = self._n = None
+
+    def nodes(self, mesh):
+        return np.unique(mesh.cells[self.elements]) if self.elements.size else np.zeros(0, np.int64)
+
+    def bind(self, mesh, region_nodes):
+        own = self.nodes(mesh)
+        self.idx = np.searchsorted(region_nodes, own)
+        nv, na = vector_areas(mesh, self.elements, own)
+        self._x = mesh.nodes[own].copy()
+        self._n = nv / na[:, None]
+        return self.idx
+
+    def attach(self, seismic):
+        """The seismic input (``seismic.input.SeismicInput``) whose free field this source cancels."""
+        self.seismic = seismic
+
+    def normals(self):
+        """The nodes' effective normals (k, 3) (module docstring; unit on a face, shorter at an edge)."""
+        return self._n
+
+    def step_mean(self, m, dt):
+        """-t_ff (k, 3) [Pa] at this source's nodes, the exact mean over ((m-1) dt, m dt]."""
+        if self.seismic is None:
+            raise RuntimeError("FreeFieldTraction: no seismic input attached")
+        I = self.seismic.traction_integral
+        return -(I(self._x, self._n, m * dt) - I(self._x, self._n, (m - 1) * dt)) / dt
+
+    def amplitudes(self):
+        """None given ahead (the wave sets them): no distinct vectors to check against symmetry planes
+        (a surface with an excavation takes none)."""
+        return np.zeros((0, 3))
+
+    def describe(self):
+        return (f"{self.name}: {self.elements.size} elements (walls and bottoms), traction -sigma_ff n of the "
+                "seismic input")
