@@ -208,7 +208,8 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     b, sub = _block_of(cfg, comm, H, G, HI, GI)
     march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
     with event("SSI_BEM_Toeplitz"):
-        th = ToeplitzHistory(comm, ls, prob.lattice, log).build(march, plan, monitor=cfg.monitor)
+        th = ToeplitzHistory(comm, ls, prob.lattice, log, block=int(cfg.history_block) or 8).build(march, plan,
+                                                                                            monitor=cfg.monitor)
     march.toeplitz = th
     ls.kernel_evaluations = nev + th.nev
     t_asm = time.perf_counter() - t0

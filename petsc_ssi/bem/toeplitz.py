@@ -40,6 +40,8 @@ import numpy as np
 from numba import njit
 
 from ..petsc import SSIError, printf
+from ..monitor import event
+from .assemble import _pair_window
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -127,15 +129,47 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 
 
 def kernel_offsets(lat):
-    """The collocation points of the kernels relative to the lattice origin's element: per class t and
-    lattice offset (k, k') in [-nx, nx) x [-ny, ny): (points (n, 2) in half element sizes, class, kx, ky)."""
-    kx = np.arange(-lat.nx, lat.nx)
-    ky = np.arange(-lat.ny, lat.ny)
+    """The collocation points of the kernels relative to an element of the lattice: per class t the
+    lattice offsets k = i' - i a node of that class (at i') and an element (at i) can have, (points (n, 2)
+    in half element sizes, class, kx, ky); offsets no node reads are left out (their kernel is zero:
+    the outputs they reach are no node's)."""
     out = []
+    nf = lat.node_fine
     for t, (tx, ty) in enumerate(CLASSES):
+        sel = ((nf[:, 0] & 1) == tx) & ((nf[:, 1] & 1) == ty)
+        if not np.any(sel):
+            continue
+        ix = (nf[sel, 0] - tx) // 2
+        iy = (nf[sel, 1] - ty) // 2
+        kx = np.arange(ix.min() - (lat.nx - 1), ix.max() + 1)
+        ky = np.arange(iy.min() - (lat.ny - 1), iy.max() + 1)
         KX, KY = np.meshgrid(kx, ky, indexing="ij")
         out.append(np.c_[2 * KX.ravel() + tx, 2 * KY.ravel() + ty, np.full(KX.size, t), KX.ravel(), KY.ravel()])
     return np.concatenate(out)
+
+
+@njit(cache=True)
+def _windows(pts, X, c0, R0, h0, reach, alpha, beta, dt, L, lag_lo, toff, tol, ns_base, ns_max, near, c_lo, c_hi):
+    """meta rows (lo, hi, sing, ns, 0, 0) of ``integrate_records`` for the points ``pts`` against
+    element X, the lags c_lo..c_hi of the windows of an assembly of lags lag_lo..L (a singular pair
+    from its first lag: its subdivisions are those of that assembly); keep[i] False: no lag."""
+    n = pts.shape[0]
+    meta = np.zeros((n, 6), np.int64)
+    keep = np.zeros(n, np.bool_)
+    for i in range(n):
+        lo, hi, sing, ns = _pair_window(pts[i], X, c0, R0, h0, reach, alpha, beta, dt, L, lag_lo, toff, tol,
+                                        ns_base, ns_max, near)
+        if sing < 0:
+            lo = max(lo, c_lo)
+        hi = min(hi, c_hi)
+        if lo > hi or hi < c_lo:
+            continue
+        meta[i, 0] = lo
+        meta[i, 1] = hi
+        meta[i, 2] = sing
+        meta[i, 3] = ns
+        keep[i] = True
+    return meta, keep
 
 
 @njit(cache=True)
@@ -160,13 +194,43 @@ def spectral_products(K, V, slots, pp, pq, out):
                         o[f] += k[f] * v[f]
 
 
+@njit(cache=True)
+def blocked_products(K, V, slots, pp, pq, acc, fchunk=32):
+    """acc[k, t, c, f] += sum_d sum_a sum_e K[d, t, a, e, f] V[slots[k, d], a, pq[e], f] (c = pp[e];
+    slots[k, d] < 0: no state) for the b rows k of a block of steps: the frequencies in chunks of
+    ``fchunk``, so that a kernel's chunk is read from memory once for the b steps (in cache for the
+    others) and the states' chunks stay in cache: the kernels' memory traffic divided by b. The
+    same sums per (k, frequency) in the same order (d ascending) as ``spectral_products``."""
+    D = K.shape[0]
+    F = K.shape[4]
+    b = slots.shape[0]
+    m = pp.shape[0]
+    for f0 in range(0, F, fchunk):
+        f1 = min(F, f0 + fchunk)
+        for d in range(D):
+            for k in range(b):
+                s = slots[k, d]
+                if s < 0:
+                    continue
+                for t in range(4):
+                    for a in range(9):
+                        for e in range(m):
+                            kk = K[d, t, a, e]
+                            vv = V[s, a, pq[e]]
+                            oo = acc[k, t, pp[e]]
+                            for f in range(f0, f1):
+                                oo[f] += kk[f] * vv[f]
+
+
 class ToeplitzHistory:
     """Collective: the H part of the history sum of a uniform flat grid in Fourier space (module
     docstring). ``build`` computes the kernels; ``add(n, march, out_u)`` subtracts the H terms of step
     n's history sum from ``out_u``."""
 
-    def __init__(self, comm, ls, lat, log=printf):
+    def __init__(self, comm, ls, lat, log=printf, block=8):
         self.comm, self.ls, self.lat, self.log = comm, ls, lat, log
+        self.block = max(1, int(block))     # steps whose known-state products share one pass over the kernels
+        self._blk = None
         mpi = comm.tompi4py()
         p, r = mpi.Get_size(), mpi.Get_rank()
         F = lat.F
@@ -183,7 +247,7 @@ class ToeplitzHistory:
         of the dense assembly of lags lag_lo..L (``_pair_window``); a singular pair (its point a node
         of the element) from lag_lo on, as that assembly integrates it. Returns (offsets kept, meta,
         P pool offsets, P pool)."""
-        from .assemble import _pair_window, integrate_records, SING_TOL, plane
+        from .assemble import integrate_records, SING_TOL, plane
         ls, lat = self.ls, self.lat
         o = ls.opts
         v0 = 0
@@ -198,19 +262,8 @@ class ToeplitzHistory:
         pts[:, 0] = c0[0] + off[:, 0] * 0.5 * lat.h[0]
         pts[:, 1] = c0[1] + off[:, 1] * 0.5 * lat.h[1]
         pts[:, 2] = c0[2]
-        meta = np.zeros((len(sel), 6), np.int64)
-        keep = np.zeros(len(sel), bool)
-        for i in range(len(sel)):
-            lo, hi, sing, ns = _pair_window(pts[i], X[0], c0, R0, h0, reach, mat.cp, mat.cs, dt, L, lag_lo, toff,
-                                            SING_TOL, int(o["subdivisions"]), int(o["max_subdivisions"]),
-                                            float(o["near_factor"]))
-            if sing < 0:
-                lo = max(lo, c_lo)
-            hi = min(hi, c_hi)
-            if lo > hi or hi < c_lo:
-                continue
-            meta[i] = (lo, hi, sing, ns, 0, 0)
-            keep[i] = True
+        meta, keep = _windows(pts, X[0], c0, R0, h0, reach, mat.cp, mat.cs, dt, L, lag_lo, toff, SING_TOL,
+                              int(o["subdivisions"]), int(o["max_subdivisions"]), float(o["near_factor"]), c_lo, c_hi)
         meta, pts, idx = meta[keep], pts[keep], np.asarray(sel)[keep]
         if not hasattr(self, "_plane") or self._plane is None:
             self._plane = plane(ls.in_plane, X, int(o["subdivisions"]), gq, gw, int(o["max_subdivisions"]))
@@ -331,17 +384,34 @@ class ToeplitzHistory:
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
-        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows)."""
+        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows). Time-blocked:
+        at the first step of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart)
+        the terms of the states m <= n0 for all b steps in one pass over the kernels
+        (``blocked_products``); each step adds those of the block's states before it (d <= b - 1)."""
         from scipy.fft import irfft2
-        lat = self.lat
-        self._catch_up(n - 1, march)
+        lat, b = self.lat, self.block
         slab = self.f1 - self.f0
-        acc = np.zeros((4, 3, slab), np.complex128)
+        n0 = b * ((n - 1) // b)
         d = np.arange(1, self.D + 1)
-        m = n - d
-        slots = np.where(m >= 1, np.mod(m, self.R), -1).astype(np.int64)
-        spectral_products(self.K, self.V, slots, self.pp, self.pq, acc)
-        march.PETSc.Log.logFlops(8.0 * int(np.count_nonzero(slots >= 0)) * 4 * 9 * 4 * slab)
+        if self._blk is None or self._blk[0] != n0:
+            self._catch_up(n0, march)
+            ev = event("SSI_BEM_HistFFTBlock")
+            ev.begin()
+            m = n0 + 1 + np.arange(b)[:, None] - d[None, :]
+            slots = np.where((m >= 1) & (m <= n0), np.mod(m, self.R), -1).astype(np.int64)
+            acc_b = np.zeros((b, 4, 3, slab), np.complex128)
+            blocked_products(self.K, self.V, slots, self.pp, self.pq, acc_b)
+            march.PETSc.Log.logFlops(8.0 * int(np.count_nonzero(slots >= 0)) * 4 * 9 * 4 * slab)
+            ev.end()
+            self._blk = (n0, acc_b)
+        self._catch_up(n - 1, march)
+        acc = self._blk[1][n - n0 - 1].copy()
+        k = min(n - n0 - 1, self.D)
+        if k:
+            m = n - d[:k]
+            slots = np.mod(m, self.R).astype(np.int64)
+            spectral_products(self.K[:k], self.V, slots, self.pp, self.pq, acc)
+            march.PETSc.Log.logFlops(8.0 * k * 4 * 9 * 4 * slab)
         full = np.empty((lat.F, 12), np.complex128)
         send = np.ascontiguousarray(acc.reshape(12, slab).T)
         mpi = self.comm.tompi4py()
