@@ -46,6 +46,7 @@ def count_run(cfg, comm, ranks, node_mem, coupled=None):
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * (node_mem or machine_memory())
     cnt = Counts(prob, plan, ls, ranks, limit, comm)
     cnt.setup_s = time.perf_counter() - t0
+    cnt.lagset = ls
     return prob, plan, cnt
 
 
@@ -122,10 +123,32 @@ def report(cfg, comm, out=None):
     else:
         lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
                      f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    lines += _toeplitz_lines(cfg, prob, cnt, ranks)
     lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
                  f"-log_view times; the model's measured error: jobscripts/README.md)")
     out("\n".join(lines))
     return {"counts": cnt, "rows": rows}
+
+
+def _toeplitz_lines(cfg, prob, cnt, ranks):
+    """The toeplitz lag store's estimate (bem/toeplitz.py) per rank count, where -ssi_lag_store asks for it
+    and the surface is a uniform flat grid (else the reason, one line)."""
+    if cfg.get("lag_store", "dense") == "dense":
+        return []
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets
+    from ..petsc import SSIError
+    try:
+        if not cnt.lagset.flat:
+            raise SSIError("the surface is not flat")
+        lat = detect(cnt.lagset.VX, prob.mesh.nodes)
+    except SSIError as e:
+        return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
+    lat.n_offsets = len(kernel_offsets(lat))
+    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks"]
+    for p in ranks:
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8)
+        out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")
+    return out
 
 
 def _refuses(cnt, p, q):

@@ -17,7 +17,7 @@ from .resultants import RigidMotion
 from .lagset import Material, Regions, LagSet
 from .windows import causal_lags
 from . import interp
-from ..sysmem import machine_memory
+from ..sysmem import machine_memory, process_rss
 
 
 def _pair(text, name):
@@ -463,21 +463,29 @@ class HalfSpace:
         return lat
 
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
-        """Collective: refuse a toeplitz run whose kernels and kept transforms (complex, D of each:
-        4 x 9 x 4 and 9 x 3 fields of the FFT grid's half spectrum) would not fit the node."""
+        """Collective: refuse a toeplitz run whose kernels and kept transforms would not fit the node
+        (``toeplitz.estimate``), and predict its time loop (``loop_estimate``)."""
+        from .toeplitz import estimate, kernel_offsets
+        from mpi4py import MPI
         c = self.cfg
         lat = self.lattice
         self.lag_fill = c.lag_fill
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
-        D = self.L
-        est = 16.0 * lat.F * (D * 144 + (D + 1) * 27) + float(extra_bytes)
-        self.mem_estimate = est
-        self.mem_peak_estimate = est + 2 * 8.0 * 144 * lat.Mx * lat.My * min(D, 8) * self.comm.getSize()
-        if self.mem_peak_estimate > limit:
+        lat.n_offsets = len(kernel_offsets(lat))
+        p = self.comm.getSize()
+        block = int(c.history_block) or 8
+        est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block)
+        rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)
+        est += float(extra_bytes) + rss
+        self.mem_estimate = self.mem_peak_estimate = est
+        printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels and kept transforms "
+               f"{(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
+               f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
+        if est > limit:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {est / 1e9:.3g} GB, more than "
                            f"the {limit / 1e9:.3g} GB available (-ssi_memory_limit); use -ssi_interp, a shorter "
                            "-ssi_t_end or a coarser grid")
-        self.loop_estimate = None
+        self.loop_estimate = (t_hist, t_hist / max(self.n_steps, 1))
 
     def quad_options(self):
         c = self.cfg

@@ -128,6 +128,34 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
     return Lattice(o, h, nx, ny, cell, perm, nfi.astype(np.int64), code[0].copy())
 
 
+# cost model (``estimate``): the rates measured by jobscripts/toeplitz_bench.sh on the development machine
+# (2 cores; jobscripts/README.md): complex matrix products of the history sum per rank, seconds per
+# (offset, lag) pair of the kernels' integration, seconds per point of a 2-D real FFT and log2 of its size
+RATES = {"r_products": 6.0e9, "t_pair_lag": 2.0e-6, "t_fft_point": 1.0e-8}
+
+
+def estimate(lat, L, n_steps, ranks=1, block=8, rates=None):
+    """(bytes over all ranks, seconds of the kernels' build, seconds of the history sum) of a toeplitz
+    run: kernels 144 complex per frequency and history lag, kept transforms 27 per frequency and kept
+    state (D + 2 b + 64), the build's chunk of kernels per rank (2 x 256 MB at most); the history's
+    complex products 8 x 144 flops per frequency and (step, lag) pair, at ``r_products`` per rank, and
+    per step the 27 forward and 12 inverse FFTs of every rank."""
+    r = dict(RATES, **(rates or {}))
+    D = int(L)
+    W = D + 2 * block + 64
+    F = lat.F
+    per_lag = 144 * lat.Mx * lat.My * 8.0
+    build = ranks * 2 * min(256e6, per_lag * max(1, min(D, int(256e6 // per_lag))))
+    nbytes = 16.0 * F * (144 * D + 27 * W) + build
+    pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
+    t_build = r["t_pair_lag"] * pairs * D / ranks
+    n = np.arange(1, n_steps + 1)
+    flops = 8.0 * 144 * F * float(np.minimum(np.maximum(n - 1, 0), D).sum())
+    pts = lat.Mx * lat.My
+    t_hist = flops / (ranks * r["r_products"]) + n_steps * 39 * r["t_fft_point"] * pts * math.log2(pts)
+    return nbytes, t_build, t_hist
+
+
 def kernel_offsets(lat):
     """The collocation points of the kernels relative to an element of the lattice: per class t the
     lattice offsets k = i' - i a node of that class (at i') and an element (at i) can have, (points (n, 2)
@@ -170,56 +198,6 @@ def _windows(pts, X, c0, R0, h0, reach, alpha, beta, dt, L, lag_lo, toff, tol, n
         meta[i, 3] = ns
         keep[i] = True
     return meta, keep
-
-
-@njit(cache=True)
-def spectral_products(K, V, slots, pp, pq, out):
-    """out[t, c, f] += sum_d sum_a sum_e K[d, t, a, e, f] V[slots[d], a, pq[e], f] with c = pp[e]
-    (slots[d] < 0: no state): the history sum in Fourier space, one frequency slab. Array inputs
-    only: the one function a GPU array module would take over."""
-    D = K.shape[0]
-    F = K.shape[4]
-    m = pp.shape[0]
-    for d in range(D):
-        s = slots[d]
-        if s < 0:
-            continue
-        for t in range(4):
-            for a in range(9):
-                for e in range(m):
-                    k = K[d, t, a, e]
-                    v = V[s, a, pq[e]]
-                    o = out[t, pp[e]]
-                    for f in range(F):
-                        o[f] += k[f] * v[f]
-
-
-@njit(cache=True)
-def blocked_products(K, V, slots, pp, pq, acc, fchunk=32):
-    """acc[k, t, c, f] += sum_d sum_a sum_e K[d, t, a, e, f] V[slots[k, d], a, pq[e], f] (c = pp[e];
-    slots[k, d] < 0: no state) for the b rows k of a block of steps: the frequencies in chunks of
-    ``fchunk``, so that a kernel's chunk is read from memory once for the b steps (in cache for the
-    others) and the states' chunks stay in cache: the kernels' memory traffic divided by b. The
-    same sums per (k, frequency) in the same order (d ascending) as ``spectral_products``."""
-    D = K.shape[0]
-    F = K.shape[4]
-    b = slots.shape[0]
-    m = pp.shape[0]
-    for f0 in range(0, F, fchunk):
-        f1 = min(F, f0 + fchunk)
-        for d in range(D):
-            for k in range(b):
-                s = slots[k, d]
-                if s < 0:
-                    continue
-                for t in range(4):
-                    for a in range(9):
-                        for e in range(m):
-                            kk = K[d, t, a, e]
-                            vv = V[s, a, pq[e]]
-                            oo = acc[k, t, pp[e]]
-                            for f in range(f0, f1):
-                                oo[f] += kk[f] * vv[f]
 
 
 class ToeplitzHistory:
@@ -310,6 +288,7 @@ class ToeplitzHistory:
         t0 = time.perf_counter()
         lat, ls = self.lat, self.ls
         self.offsets = kernel_offsets(lat)
+        lat.n_offsets = len(self.offsets)
         self.nev = 0
         nbig = ls.L + 8
         terms = march._step_terms(nbig)
@@ -321,12 +300,16 @@ class ToeplitzHistory:
         D = max([d for v in by_key.values() for d, _ in v] + [0])
         self.D = D
         slab = self.f1 - self.f0
-        self.K = np.zeros((D, 4, 9, 4, slab), np.complex128)
+        # per frequency two dense matrices, rows (d descending, slot, input component), columns (class,
+        # output component): Kxy (x, y out of z in: entries xz, yz), Kz (z out of x, y in: zx, zy): the
+        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy)
+        self.Kxy = np.zeros((slab, D * 9, 8), np.complex128)
+        self.Kz = np.zeros((slab, D * 18, 4), np.complex128)
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 for d, c in by_key.get(("x", lag), ()):
-                    self.K[d - 1] += c * S
+                    self._add_kernel(d, c, S)
         if plan is not None and plan.active:
             for i in range(plan.k):
                 if ("i", i) not in by_key:
@@ -334,16 +317,26 @@ class ToeplitzHistory:
                 lag, toff = plan.kernel_time(i)
                 for _, S in self._spectra(lag, lag, toff, lag):
                     for d, c in by_key[("i", i)]:
-                        self.K[d - 1] += c * S
-        # the kept states' transforms: states n-1 .. n-D (slot m mod R)
-        self.R = D + 1
-        self.V = np.zeros((self.R, 9, 3, slab), np.complex128)
+                        self._add_kernel(d, c, S)
+        # the kept states' transforms, in time order (state m at m - base): z (slab, W, 9), x and y
+        # (slab, W, 18); states before the first are zeros, as are those not yet made
+        self.W = D + 2 * self.block + 64
+        self.Vz = np.zeros((slab, self.W, 9), np.complex128)
+        self.Vxy = np.zeros((slab, self.W, 18), np.complex128)
+        self.base = -D
         self._setup_state_maps(march)
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
-        self.bytes = mpi.allreduce(self.K.nbytes + self.V.nbytes)
+        self.bytes = mpi.allreduce(self.Kxy.nbytes + self.Kz.nbytes + self.Vz.nbytes + self.Vxy.nbytes)
         return self
+
+    def _add_kernel(self, d, c, S):
+        """K'_d += c S: S (4, 9, 4, slab) one lag's kernel spectra (class, slot, H4 entry, frequency)."""
+        D, slab = self.D, S.shape[-1]
+        r = D - d
+        self.Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
+        self.Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
 
     def _setup_state_maps(self, march):
         lat, ls = self.lat, self.ls
@@ -363,7 +356,7 @@ class ToeplitzHistory:
         self.row_y = np.mod((nf[:, 1] - ty) // 2, lat.My)
 
     # ---------------------------------------------------------------- per step
-    def _transform(self, u_all, slot):
+    def _transform(self, u_all, m):
         from scipy.fft import rfft2
         lat = self.lat
         U = u_all.reshape(-1, 3)
@@ -372,55 +365,91 @@ class ToeplitzHistory:
         for a in range(9):
             for c in range(3):
                 f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
-        S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)
-        self.V[slot] = S[..., self.f0:self.f1]
+        S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
+        i = m - self.base
+        self.Vz[:, i, :] = S[:, 2, :].T
+        self.Vxy[:, i, :] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
+
+    def _room(self, n0):
+        """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - D .. n0 + b;
+        when they would run past the end, the kept ones move to the start and the rest is zeroed."""
+        if n0 + self.block - self.base < self.W:
+            return
+        lo = n0 + 1 - self.D
+        keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
+        k = keep.stop - keep.start
+        for B in (self.Vz, self.Vxy):
+            B[:, :k] = B[:, keep]
+            B[:, k:] = 0.0
+        self.base = lo
 
     def _catch_up(self, n, march):
         """Collective: the transforms of the states up to n (final) not yet kept."""
         PETSc = march.PETSc
         for m in range(max(self.upto + 1, n - self.D + 1, 1), n + 1):
             self.sc.scatter(march.ubuf[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
-            self._transform(self.seq.getArray(readonly=True), m % self.R)
+            self._transform(self.seq.getArray(readonly=True), m)
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
         """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows). Time-blocked:
         at the first step of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart)
-        the terms of the states m <= n0 for all b steps in one pass over the kernels
-        (``blocked_products``); each step adds those of the block's states before it (d <= b - 1)."""
+        the terms of the states m <= n0 for all b steps at once (``history_products``: the kernels
+        read once for the b steps); each step adds those of the block's states before it (d < b)."""
         from scipy.fft import irfft2
-        lat, b = self.lat, self.block
-        slab = self.f1 - self.f0
+        lat, b, D = self.lat, self.block, self.D
         n0 = b * ((n - 1) // b)
-        d = np.arange(1, self.D + 1)
         if self._blk is None or self._blk[0] != n0:
+            self._room(n0)
             self._catch_up(n0, march)
             ev = event("SSI_BEM_HistFFTBlock")
             ev.begin()
-            m = n0 + 1 + np.arange(b)[:, None] - d[None, :]
-            slots = np.where((m >= 1) & (m <= n0), np.mod(m, self.R), -1).astype(np.int64)
-            acc_b = np.zeros((b, 4, 3, slab), np.complex128)
-            blocked_products(self.K, self.V, slots, self.pp, self.pq, acc_b)
-            march.PETSc.Log.logFlops(8.0 * int(np.count_nonzero(slots >= 0)) * 4 * 9 * 4 * slab)
+            p0 = n0 + 1 - D - self.base              # the first state row 0 reads (d = D)
+            acc_b = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, p0, b, D)
+            march.PETSc.Log.logFlops(8.0 * b * D * 144 * (self.f1 - self.f0))
             ev.end()
             self._blk = (n0, acc_b)
         self._catch_up(n - 1, march)
-        acc = self._blk[1][n - n0 - 1].copy()
-        k = min(n - n0 - 1, self.D)
-        if k:
-            m = n - d[:k]
-            slots = np.mod(m, self.R).astype(np.int64)
-            spectral_products(self.K[:k], self.V, slots, self.pp, self.pq, acc)
-            march.PETSc.Log.logFlops(8.0 * k * 4 * 9 * 4 * slab)
+        acc = self._blk[1][:, n - n0 - 1].copy()            # (slab, 12)
+        k = min(n - n0 - 1, D)
+        if k:                                               # the block's states n0 + 1 .. n - 1: d = k .. 1
+            acc += history_products(self.Kxy[:, 9 * (D - k):], self.Kz[:, 18 * (D - k):], self.Vz, self.Vxy,
+                                    n0 + 1 - self.base, 1, k)[:, 0]
+            march.PETSc.Log.logFlops(8.0 * k * 144 * (self.f1 - self.f0))
         full = np.empty((lat.F, 12), np.complex128)
-        send = np.ascontiguousarray(acc.reshape(12, slab).T)
         mpi = self.comm.tompi4py()
         from mpi4py import MPI
-        mpi.Allgatherv(send, [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12, MPI.C_DOUBLE_COMPLEX])
-        phys = irfft2(full.T.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
+        mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
+                                                   MPI.C_DOUBLE_COMPLEX])
+        # columns: (class t, x or y) for 0..7, then z of class t at 8 + t -> (t, component)
+        out = np.empty((4, 3, lat.F), np.complex128)
+        out[:, 0:2, :] = full[:, :8].T.reshape(4, 2, lat.F)
+        out[:, 2, :] = full[:, 8:].T
+        phys = irfft2(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
         vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
         arr = out_u.getArray()
         arr -= vals.ravel()
+
+
+def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
+    """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
+    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers, as two
+    matrix products per frequency, (b x 9D) (b x 9D)-windows of Vz times Kxy (9D x 8) and (b x 18D)
+    of Vxy times Kz (18D x 4): (slab, b, 12) complex, columns (class, x or y) then z by class. Array
+    inputs and ``matmul`` only (the one function a GPU array module would take over); frequencies in
+    chunks so the windows' copies stay small."""
+    from numpy.lib.stride_tricks import sliding_window_view
+    slab = Kxy.shape[0]
+    out = np.empty((slab, b, 12), np.complex128)
+    for f0 in range(0, slab, fchunk):
+        f1 = min(slab, f0 + fchunk)
+        wz = sliding_window_view(Vz[f0:f1, p0:p0 + b - 1 + D], D, axis=1)      # (fc, b, 9, D)
+        wxy = sliding_window_view(Vxy[f0:f1, p0:p0 + b - 1 + D], D, axis=1)    # (fc, b, 18, D)
+        az = np.ascontiguousarray(wz.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 9 * D)
+        axy = np.ascontiguousarray(wxy.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 18 * D)
+        np.matmul(az, Kxy[f0:f1], out=out[f0:f1, :, :8])
+        np.matmul(axy, Kz[f0:f1], out=out[f0:f1, :, 8:])
+    return out
 
 
 def mpi_in_place():

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Benchmark of the toeplitz lag store (issue 41; petsc_ssi/bem/toeplitz.py) against the dense lag
+# matrices, on RANKS ranks (default 2), with -log_view and -memory_view:
+#   - the paper's Lamb case as it is (quarter model: runs/pekeris/paper.opts), dense and toeplitz;
+#   - the paper's case meshed whole (-ssi_symmetry none): dense (refused on a 24 GB node: its log
+#     keeps the refusal) and toeplitz; its receivers against the quarter model's;
+#   - whole grids of SIZES metres (1 m elements, the paper's soil and dt, T_END seconds): the cost per
+#     step against N, and the run's own estimate beside each.
+# Then jobscripts/toeplitz_table.py writes the table into runs/pekeris/README.md, the CSV
+# runs/pekeris/toeplitz_bench.csv and the plot runs/pekeris/toeplitz_cost_per_step.png.
+#   bash jobscripts/toeplitz_bench.sh            (RANKS=1 SIZES="24 36" T_END=0.05 to change)
+set -euo pipefail
+source "$(dirname "$0")/bench_env.sh"
+RANKS=${RANKS:-2}
+SIZES=${SIZES:-"24 36 48 64"}
+T_END=${T_END:-0.06}
+OUT=${OUT:-out/bench/toeplitz}
+mkdir -p "$OUT"
+"$PY" -m petsc_ssi.app.warmup > /dev/null
+run() {
+  local name=$1
+  shift
+  echo "[bench] $name on $RANKS rank(s) -> $OUT/$name.log"
+  mpirun --allow-run-as-root --oversubscribe -n "$RANKS" "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" \
+    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view > "$OUT/$name.log" 2>&1 || true
+}
+P=(-options_file runs/pekeris/paper.opts)
+run paper-quarter-dense "${P[@]}"
+run paper-quarter-toeplitz "${P[@]}" -ssi_lag_store toeplitz
+run paper-whole-dense "${P[@]}" -ssi_symmetry none
+run paper-whole-toeplitz "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz
+for L in $SIZES; do
+  run "grid-$L" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_mesh_size "$L,$L" -ssi_t_end "$T_END"
+done
+"$PY" jobscripts/toeplitz_table.py "$OUT" runs/pekeris/README.md runs/pekeris/toeplitz_bench.csv \
+  runs/pekeris/toeplitz_cost_per_step.png

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Table, CSV and plot of jobscripts/toeplitz_bench.sh from its logs (-log_view, -memory_view and the
+run's own lines): per run the lag store, dofs, steps, stored GB, build and history seconds, the
+history's cost per step, the wall, the peak memory over the ranks, and the run's own estimate; the
+whole model's receivers against the quarter model's.
+
+    python jobscripts/toeplitz_table.py OUTDIR README CSV PNG
+"""
+import csv
+import glob
+import os
+import re
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from logview import parse  # noqa: E402
+
+BEGIN, END = "<!-- toeplitz:begin -->", "<!-- toeplitz:end -->"
+COLS = ["run", "store", "ranks", "dofs", "steps", "stored_GB", "kernels_s", "history_s", "history_ms_per_step",
+        "total_s", "peak_GB", "est_GB", "est_kernels_s", "est_history_s", "note"]
+
+
+def row(log):
+    text = open(log).read()
+    lv = parse(text)
+    name = os.path.basename(log)[:-4]
+    r = {"run": name, "store": "toeplitz" if "lag store: toeplitz" in text else "dense", "ranks": lv["ranks"] or ""}
+    m = re.search(r"(\d+) DOFs", text)
+    r["dofs"] = int(m.group(1)) if m else ""
+    m = re.search(r"dt \S+ s, (\d+) steps", text)
+    r["steps"] = int(m.group(1)) if m else ""
+    m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s\)", text)
+    if m:
+        r["stored_GB"], r["kernels_s"] = float(m.group(1)), float(m.group(2))
+    else:
+        m = re.search(r"stored (\S+) GB", text)
+        r["stored_GB"] = float(m.group(1)) if m else ""
+        r["kernels_s"] = round(lv["stages"].get("SSI BEM assembly", float("nan")), 2) if lv["stages"] else ""
+    ev = lv["events"]
+    h = ev.get("SSI_BEM_History", (0, float("nan")))[1]
+    r["history_s"] = round(h, 2)
+    r["history_ms_per_step"] = round(1e3 * h / r["steps"], 2) if r["steps"] and h == h else ""
+    r["total_s"] = round(lv["total_s"], 2) if lv["total_s"] else ""
+    r["peak_GB"] = round(lv["peak_rss_bytes"] / 1e9, 2) if lv["peak_rss_bytes"] else ""
+    m = re.search(r"toeplitz estimate: (\S+) GB over the ranks .*kernels (\S+) s, history sum (\S+) s", text)
+    if m:
+        r["est_GB"], r["est_kernels_s"], r["est_history_s"] = (float(m.group(i)) for i in (1, 2, 3))
+    m = re.search(r"error: (.*)", text)
+    r["note"] = ("refused: " + m.group(1)[:160]) if m else ""
+    return r
+
+
+def receivers_agree(outdir):
+    """Largest difference of the whole model's receivers from the quarter model's, relative to their peak."""
+    import h5py
+    import numpy as np
+    try:
+        with h5py.File(os.path.join(outdir, "paper-whole-toeplitz.h5")) as a, \
+                h5py.File(os.path.join(outdir, "paper-quarter-toeplitz.h5")) as b:
+            ua, ub = a["receivers/u"][...], b["receivers/u"][...]
+        return float(np.abs(ua - ub).max() / np.abs(ub).max())
+    except (OSError, KeyError):
+        return None
+
+
+def main(outdir, readme, csvpath, png):
+    rows = [row(p) for p in sorted(glob.glob(os.path.join(outdir, "*.log")))]
+    with open(csvpath, "w", newline="") as f:
+        w = csv.DictWriter(f, COLS)
+        w.writerow({c: c + {"stored_GB": " [GB]", "kernels_s": " [s]", "history_s": " [s]",
+                            "history_ms_per_step": " [ms]", "total_s": " [s]", "peak_GB": " [GB]",
+                            "est_GB": " [GB]", "est_kernels_s": " [s]", "est_history_s": " [s]"}.get(c, "")
+                    for c in COLS})
+        for r in rows:
+            w.writerow({c: r.get(c, "") for c in COLS})
+    agree = receivers_agree(outdir)
+    md = ["| " + " | ".join(COLS) + " |", "|" + "---|" * len(COLS)]
+    md += ["| " + " | ".join(str(r.get(c, "")) for c in COLS) + " |" for r in rows]
+    if agree is not None:
+        md.append("")
+        md.append(f"Whole model's receivers against the quarter model's (toeplitz both): largest difference "
+                  f"{agree:.3g} of their peak.")
+    grid = [r for r in rows if r["run"].startswith("grid-") and r.get("history_ms_per_step") not in ("", None)]
+    if grid:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        import numpy as np
+        N = np.array([r["dofs"] for r in grid], float)
+        t = np.array([r["history_ms_per_step"] for r in grid], float)
+        est = np.array([1e3 * r.get("est_history_s", np.nan) / r["steps"] for r in grid], float)
+        fig, ax = plt.subplots(figsize=(6, 4))
+        ax.loglog(N, t, "o-", label="measured (-log_view SSI_BEM_History / steps)")
+        ax.loglog(N, est, "s--", label="run's estimate (bem/toeplitz.py)")
+        ref = t[0] * (N * np.log(N)) / (N[0] * np.log(N[0]))
+        ax.loglog(N, ref, ":", label="N log N through the first point")
+        ax.set_xlabel("soil DOFs N [-]")
+        ax.set_ylabel("history sum per step [ms]")
+        ax.set_title("toeplitz lag store: cost per step (whole grids, 1 m elements)")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(png, dpi=120)
+    text = open(readme).read()
+    block = BEGIN + "\n" + "\n".join(md) + "\n" + END
+    if BEGIN in text:
+        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
+    else:
+        text += "\n" + block + "\n"
+    open(readme, "w").write(text)
+    print("\n".join(md))
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:5])
