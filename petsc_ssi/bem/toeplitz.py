@@ -58,9 +58,17 @@ class Lattice:
         self.perm = perm                # (nv, 9): local node of element v at slot a (SLOTS)
         self.node_fine = node_fine      # (N, 2): a node's position in half element sizes from o
         self.code0 = code0              # (9,): the slot of each local node of element 0 (the kernels')
+        # the FFT grid: a circular convolution of size M gives the linear one on the outputs of lattice
+        # indices r0..r1 (the nodes' span) from inputs 0..n-1 when M >= r1 - r0 + n (their offsets then
+        # differ modulo M): 2 n for a whole grid, less for a symmetric model's rows in one quarter
         from scipy.fft import next_fast_len
-        self.Mx = next_fast_len(2 * nx, real=True)
-        self.My = next_fast_len(2 * ny, real=True)
+        span = [2 * nx, 2 * ny]
+        if len(node_fine):
+            for ax, n in ((0, nx), (1, ny)):
+                i = (node_fine[:, ax] - (node_fine[:, ax] & 1)) // 2
+                span[ax] = int(i.max() - i.min() + n)
+        self.Mx = next_fast_len(span[0], real=True)
+        self.My = next_fast_len(span[1], real=True)
         self.F = self.Mx * (self.My // 2 + 1)
 
     def describe(self):
@@ -142,7 +150,7 @@ def estimate(lat, L, n_steps, ranks=1, block=8, rates=None):
     per step the 27 forward and 12 inverse FFTs of every rank."""
     r = dict(RATES, **(rates or {}))
     D = int(L)
-    W = D + 2 * block + 64
+    W = D + 3 * block + 8
     F = lat.F
     per_lag = 144 * lat.Mx * lat.My * 8.0
     build = ranks * 2 * min(256e6, per_lag * max(1, min(D, int(256e6 // per_lag))))
@@ -320,7 +328,7 @@ class ToeplitzHistory:
                         self._add_kernel(d, c, S)
         # the kept states' transforms, in time order (state m at m - base): z (slab, W, 9), x and y
         # (slab, W, 18); states before the first are zeros, as are those not yet made
-        self.W = D + 2 * self.block + 64
+        self.W = D + 3 * self.block + 8
         self.Vz = np.zeros((slab, self.W, 9), np.complex128)
         self.Vxy = np.zeros((slab, self.W, 18), np.complex128)
         self.base = -D
