@@ -102,7 +102,7 @@ def boussinesq():
         out.append(("boussinesq", f"patch [-1,1]^2 at ({x:g}, {y:g}) m, tau = 200 vs static rectangle: relative "
                     "difference, vertical", abs(uz[0] - sz) / abs(sz), "",
                     "tests/analytic/test_pekeris.py::test_patch_late_time_is_boussinesq"))
-        out.append(("boussinesq", f"the same, horizontal (|u_h - u_h,static| / |u_h,static|)",
+        out.append(("boussinesq", "the same, horizontal (|u_h - u_h,static| / |u_h,static|)",
                     math.hypot(ux[0] - sx, uy[0] - sy) / math.hypot(sx, sy), "",
                     "tests/analytic/test_pekeris.py::test_patch_late_time_is_boussinesq"))
     return out
@@ -145,7 +145,7 @@ def lamb(out_dir):
             e1, e2 = errs[levels[0]][k][c], errs[levels[1]][k][c]
             out.append(("lamb", f"Heaviside patch, r = {r:g} m, {name}: relative L2, tau <= 2.5, h = 1 m", e1, "",
                         "tests/bem/test_lamb.py"))
-            out.append(("lamb", f"the same at h = 0.5 m (dt halved)", e2, math.log(e1 / e2) / math.log(2.0),
+            out.append(("lamb", "the same at h = 0.5 m (dt halved)", e2, math.log(e1 / e2) / math.log(2.0),
                         "tests/bem/test_lamb.py"))
     return out
 
