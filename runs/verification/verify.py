@@ -15,6 +15,10 @@ verification page (runs/verification/README.md) carries numbers this script obta
   lamb         the BEM under the Heaviside patch load against the Pekeris patch solution
                (tests/bem/test_lamb.py's case: 10 m surface, receivers at 2 m and 3 m, h = 1 and
                0.5 m with dt = 7.5e-4 h / 1 m; relative L2 over tau <= 2.5, petsc_ssi.verify)
+  disk         the independent welded-disk solver (petsc_ssi.analytic.disk_static) against the
+               bonded punch's vertical closed form, at 8 and 12 rings (tests/analytic/test_disk_static.py);
+               the BEM disk's coupling K_hr, K_rh against that solver's at 18 rings
+               (runs/impedance/disk_coupling_static.csv, written by disk_coupling_static.py)
   smooth       the smooth-pulse study's rows (runs/pekeris/convergence_smooth.csv, written by
                runs/pekeris/convergence_smooth.py)
 
@@ -150,6 +154,25 @@ def lamb(out_dir):
     return out
 
 
+def disk():
+    from petsc_ssi.analytic.disk_static import k_z_bonded, stiffness
+    nu = 1.0 / 3.0
+    out, prev = [], None
+    for nr in (8, 12):
+        e = abs(stiffness(nr, 4 * nr, 1.0, nu)[1, 1] / k_z_bonded(1.0, nu) - 1)
+        order = math.log(prev / e) / math.log(nr / 8) if prev else ""
+        out.append(("disk", f"welded disk, nu = 1/3, {nr} rings: K_z vs 4 G R ln(3 - 4 nu) / (1 - 2 nu)", e, order,
+                    "tests/analytic/test_disk_static.py"))
+        prev = e
+    rows = list(csv.DictReader(open(os.path.join(ROOT, "runs", "impedance", "disk_coupling_static.csv"))))
+    ind = next(r for r in rows if r["rings"] == "18")
+    bem = next(r for r in rows if r["rings"].startswith("BEM"))
+    for key in ("K_hr / (R K_x) [-]", "K_rh / (R K_x) [-]"):
+        out.append(("disk", f"BEM disk (0.25 m elements) coupling {key.split(' [')[0]} vs the welded solver's (18 rings)",
+                    abs(float(bem[key]) / float(ind[key]) - 1), "", "runs/impedance/disk_coupling_static.py"))
+    return out
+
+
 def smooth():
     path = os.path.join(ROOT, "runs", "pekeris", "convergence_smooth.csv")
     out = []
@@ -175,7 +198,7 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     jobs = {"kelvin": kelvin, "pekeris": pekeris, "static": static, "boussinesq": boussinesq, "pulse": pulse,
-            "lamb": lambda: lamb(a.out), "smooth": smooth}
+            "lamb": lambda: lamb(a.out), "disk": disk, "smooth": smooth}
     names = [n for n in jobs if not a.only or n in a.only.split(",")]
     rows = []
     for n in names:
