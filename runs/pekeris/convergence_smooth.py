@@ -287,6 +287,11 @@ def main():
             lines.append(f"- truncation at h = {h:g} m, r = {key[0]:g} m, {key[1]}: |u(D = {D:g} m) - u(D = {half:g} m)| "
                          f"/ |u_ref| = {100 * tr[key]:.3f} % (error on D = {half:g} m: {100 * eb[key]:.3f} %, on "
                          f"D = {D:g} m: {100 * errs[h][key]:.3f} %)")
+    if (3.0, 48.0) in trunc and (1.5, 36.0) in trunc:
+        e3, e15 = trunc[(3.0, 48.0)][1], trunc[(1.5, 36.0)][1]
+        lines.append("- the first pair without the mesh edge's diffraction in the window (h = 3 m on D = 48 m, h = 1.5 m "
+                     "on D = 36 m): observed orders " + ", ".join(
+                         f"r = {k[0]:g} m {k[1]} {math.log(e3[k] / e15[k]) / math.log(2.0):.2f}" for k in e3))
     for h in levels:
         note = ", with the first run's numba compilation" if runs[h][4] else ""
         lines.append(f"- h = {h:g} m, dt = {BETA * h / CS:.4g} s: {runs[h][2]:.0f} s wall{note}, peak {runs[h][3]:.1f} GB "
