@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Static stiffness of the rigid square footing on grids graded toward its edges (issue 46: the
+rocking stiffness within 5 % at h = B/4?). static_stiffness.py's runs (2B x 2B footing, B = 1 m, on
+a 6 m x 6 m surface, each mode held from the first step with the symmetry planes it allows, beta =
+c_s dt / h = 0.5, K from the settled last step) with -ssi_mesh_grade g: the grid lines cluster
+toward the footing's edges at the same number of elements (petsc_ssi/mesh/surface.py).
+
+    .venv/bin/python runs/impedance/graded_static.py        (16 runs, a few minutes on 2 cores)
+
+writes runs/impedance/graded_static.csv (K [N/m or N m/rad] and K / Pais-Kausel [-]) and the table
+between <!-- graded:begin/end --> in runs/impedance/README.md, with, per mode, the limit h -> 0 of
+the uniform grids (Richardson at order 1/2, the d^(-1/2) edge tractions', as static_stiffness.py),
+the observed order of the graded (grade 1) grids' excess over that limit, and the element size at
+which each kind of grid would come within 5 % of Pais and Kausel at its observed order.
+"""
+import math
+import csv
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from static_stiffness import MODES, OUT  # noqa: E402
+
+CASES = [(0.5, 0.0), (0.5, 1.0), (0.25, 0.0), (0.25, 0.5), (0.25, 1.0)]     # (h [m], grade)
+L = 6.0
+
+
+def run(mode, h, grade):
+    opt, val, sym, what, comp, ref, amp = MODES[mode]
+    dt = 0.5 * h / 316.0
+    out = os.path.join(OUT, f"graded-{mode}-h{h:g}-g{grade:g}.h5")
+    if not os.path.exists(out):
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable, "-m", "petsc_ssi",
+               "-ssi_problem", "bem", "-ssi_mesh_size", f"{L:g},{L:g}", "-ssi_mesh_h", f"{h:g}", "-ssi_mesh_patch",
+               "1,1", "-ssi_mesh_grade", f"{grade:g}", "-ssi_disp_group", "load", opt, val, "-ssi_symmetry", sym,
+               "-ssi_dt", repr(dt), "-ssi_t_end", repr(max(0.1, 3.0 * L / 316.0)), "-ssi_output_stride", "0",
+               "-ssi_warn_beta", "0", "-ssi_output", out, "-ssi_output_overwrite"]
+        subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    import h5py
+    with h5py.File(out) as f:
+        x = f["resultants"][what][:, comp] / amp
+    wall = json.load(open(out[:-3] + ".json"))["stats"]["wall_s"]
+    return float(x[-1]), float(np.ptp(x[-30:]) / abs(x[-1])), wall
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    rows = []
+    for mode, spec in MODES.items():
+        for h, g in CASES:
+            K, settled, wall = run(mode, h, g)
+            rows.append({"mode": mode, "h [m]": h, "grade [-]": g, "K [N/m or N m/rad]": K,
+                         "K / Pais-Kausel [-]": K / spec[5], "settled (last 30 steps, relative) [-]": settled,
+                         "wall [s]": wall})
+            print(f"{mode:10s} h {h:g} grade {g:g}: K/K_ref = {K / spec[5]:.4f} (settled {settled:.1e}, {wall:.1f} s)",
+                  flush=True)
+    with open(os.path.join(HERE, "graded_static.csv"), "w", newline="") as fh:
+        w = csv.DictWriter(fh, list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    head = " | ".join(f"h {h:g} m, grade {g:g}" for h, g in CASES)
+    table = [f"| mode | {head} |", "|---" * (len(CASES) + 1) + "|"]
+    for mode in MODES:
+        r = {(x["h [m]"], x["grade [-]"]): x["K / Pais-Kausel [-]"] for x in rows if x["mode"] == mode}
+        table.append(f"| {mode} | " + " | ".join(f"{r[c]:.3f}" for c in CASES) + " |")
+    table.append("")
+    for mode, spec in MODES.items():
+        r = {(x["h [m]"], x["grade [-]"]): x["K [N/m or N m/rad]"] for x in rows if x["mode"] == mode}
+        lim = r[(0.25, 0.0)] + (r[(0.25, 0.0)] - r[(0.5, 0.0)]) / (math.sqrt(2.0) - 1.0)
+        line = f"- {mode}: uniform grids' limit h -> 0 = {lim / spec[5]:.3f} of Pais-Kausel"
+        for g in (0.0, 1.0):
+            e1, e2 = r[(0.5, g)] - lim, r[(0.25, g)] - lim
+            if not (e1 > e2 > 0):
+                line += f"; grade {g:g}: no monotone excess to extrapolate"
+                continue
+            p = math.log(e1 / e2) / math.log(2.0)
+            line += f"; grade {g:g}: excess falls at order {p:.2f}"
+            need = 1.05 * spec[5] - lim
+            if r[(0.25, g)] <= 1.05 * spec[5]:
+                line += ", within 5 % already at h = 0.25 m"
+            elif need > 0:
+                h5 = 0.25 * (need / e2) ** (1.0 / p)
+                line += f", within 5 % at h = {h5:.3g} m ({(0.25 / h5) ** 2:.3g} x the elements of h = 0.25 m)"
+        table.append(line)
+    readme = os.path.join(HERE, "README.md")
+    text = open(readme).read()
+    b, e = "<!-- graded:begin -->", "<!-- graded:end -->"
+    if b in text:
+        i, j = text.index(b) + len(b), text.index(e)
+        open(readme, "w").write(text[:i] + "\n" + "\n".join(table) + "\n" + text[j:])
+    print("\n".join(table))
+
+
+if __name__ == "__main__":
+    main()
