@@ -25,13 +25,20 @@ extrapolation at the observed order). Checks of the solver: K_z against the bond
 form 4 G R ln(3 - 4 nu) / (1 - 2 nu) (k_z_bonded) and K_r against the frictionless
 punch's 8 G R^3 / (3 (1 - nu)) (the bonded value is slightly larger).
 
-Used by runs/impedance/disk_coupling_static.py (the study) and tests/analytic/test_disk_static.py.
+The same kernel, rules and collocation on an n x n grid of rectangles graded toward the edges
+give the welded rigid square (``square_stiffness``), and the torsion theta_z ((u_x, u_y) =
+theta (-y, x), M_z) is the fourth motion of both. Checks of the machinery against exact values
+(tests/analytic/test_disk_static.py): the frictionless disk (``frictionless_disk``: vertical and
+rocking), the disk's torsion 16 G R^3 / 3 (welded = frictionless there), the bonded disk's vertical
+closed form, and nu = 1/2, where the coupling vanishes.
+
+Used by runs/impedance/disk_coupling_static.py, runs/impedance/graded_static.py (the study) and tests/analytic/test_disk_static.py.
 """
 import math
 
 import numpy as np
 
-__all__ = ["stiffness", "k_z_bonded", "cells", "green_up"]
+__all__ = ["stiffness", "square_stiffness", "frictionless_disk", "k_z_bonded", "cells", "green_up"]
 
 
 def cells(nr, nt, R=1.0):
@@ -117,18 +124,42 @@ def self_integral(c, x, G, nu, nth=4096):
     return (g * best[:, None, None]).sum(0) * (2 * np.pi / nth)
 
 
-def assemble(nr, nt, G, nu):
-    C = cells(nr, nt)
-    X, A = centroids(C)
-    n = len(C)
+def _ray_to_rectangle(c, x, e):
+    """Distance from x (inside the rectangle c = (x0, x1, y0, y1)) to its boundary along the unit
+    directions e (m, 2)."""
+    x0, x1, y0, y1 = c
+    with np.errstate(divide="ignore"):
+        tx = np.where(e[:, 0] > 0, (x1 - x[0]) / e[:, 0], np.where(e[:, 0] < 0, (x0 - x[0]) / e[:, 0], np.inf))
+        ty = np.where(e[:, 1] > 0, (y1 - x[1]) / e[:, 1], np.where(e[:, 1] < 0, (y0 - x[1]) / e[:, 1], np.inf))
+    return np.minimum(tx, ty)
+
+
+def _self_rectangle(c, x, G, nu, nth=4096):
+    th = 2 * np.pi * (np.arange(nth) + 0.5) / nth
+    e = np.column_stack([np.cos(th), np.sin(th)])
+    g = green_up(-e[:, 0], -e[:, 1], G, nu)
+    return (g * _ray_to_rectangle(c, x, e)[:, None, None]).sum(0) * (2 * np.pi / nth)
+
+
+def _gauss_rectangle(C, m):
+    s, w = np.polynomial.legendre.leggauss(m)
+    s, w = 0.5 * (s + 1), 0.5 * w
+    x0, x1, y0, y1 = (C[:, k][:, None, None] for k in range(4))
+    X = x0 + (x1 - x0) * s[None, :, None]
+    Y = y0 + (y1 - y0) * s[None, None, :]
+    W = (x1 - x0) * (y1 - y0) * w[None, :, None] * w[None, None, :]
+    X, Y, W = np.broadcast_arrays(X, Y, W)
+    return np.stack([X, Y], axis=-1).reshape(len(C), m * m, 2), W.reshape(len(C), m * m)
+
+
+def _assemble(X, A, far, near, self_term, G, nu):
+    n = len(A)
     M = np.zeros((n, 3, n, 3))
     size = np.sqrt(A)
-    far_p, far_w = gauss_cell(C, 3)
-    near_p, near_w = gauss_cell(C, 10)
     for i in range(n):
         d = np.linalg.norm(X[None, i] - X, axis=1)
-        near = d < 3 * np.maximum(size, size[i])
-        for sel, P, W in ((~near, far_p, far_w), (near, near_p, near_w)):
+        is_near = d < 3 * np.maximum(size, size[i])
+        for sel, (P, W) in ((~is_near, far), (is_near, near)):
             idx = np.nonzero(sel)[0]
             idx = idx[idx != i]
             if not len(idx):
@@ -136,22 +167,62 @@ def assemble(nr, nt, G, nu):
             dd = X[i][None, None, :] - P[idx]
             g = green_up(dd[..., 0], dd[..., 1], G, nu)
             M[i, :, idx, :] = np.einsum("kq,kqab->kab", W[idx], g)
-        M[i, :, i, :] = self_integral(C[i], X[i], G, nu)
-    return M.reshape(3 * n, 3 * n), X, A
+        M[i, :, i, :] = self_term(i)
+    return M.reshape(3 * n, 3 * n)
+
+
+def assemble(nr, nt, G, nu):
+    C = cells(nr, nt)
+    X, A = centroids(C)
+    M = _assemble(X, A, gauss_cell(C, 3), gauss_cell(C, 10), lambda i: self_integral(C[i], X[i], G, nu), G, nu)
+    return M, X, A
+
+
+def _solve_rigid(M, X, A):
+    """K (4 x 4) of (F_x, F_z, M_y, M_z) against (u_x, u_z, theta_y, theta_z), moments about the
+    origin on the surface (z up, right-handed: theta_y gives u_z = -theta x, theta_z gives
+    (u_x, u_y) = theta (-y, x))."""
+    n = len(A)
+    U = np.zeros((3 * n, 4))
+    U[0::3, 0] = 1.0                 # u_x
+    U[2::3, 1] = 1.0                 # u_z
+    U[2::3, 2] = -X[:, 0]            # theta_y
+    U[0::3, 3] = -X[:, 1]            # theta_z
+    U[1::3, 3] = X[:, 0]
+    T = np.linalg.solve(M, U).reshape(n, 3, 4)       # tractions [Pa] of each motion
+    F = np.einsum("n,nam->am", A, T)                  # forces (3, motions)
+    My = -np.einsum("n,n,nm->m", A, X[:, 0], T[:, 2, :])
+    Mz = np.einsum("n,n,nm->m", A, X[:, 0], T[:, 1, :]) - np.einsum("n,n,nm->m", A, X[:, 1], T[:, 0, :])
+    return np.array([F[0], F[2], My, Mz])
 
 
 def stiffness(nr, nt, G, nu):
-    """3 x 3 K of (F_x, F_z, M_y) against (u_x, u_z, theta_y) [N/m, N, N m]."""
+    """K of (F_x, F_z, M_y, M_z) against (u_x, u_z, theta_y, theta_z) [N/m, N, N m] of the disk
+    (R = 1; _solve_rigid)."""
     M, X, A = assemble(nr, nt, G, nu)
-    n = len(A)
-    U = np.zeros((3 * n, 3))
-    U[0::3, 0] = 1.0                 # u_x
-    U[2::3, 1] = 1.0                 # u_z
-    U[2::3, 2] = -X[:, 0]            # theta_y: u_z = -theta x
-    T = np.linalg.solve(M, U).reshape(n, 3, 3)       # tractions [Pa] of each motion
-    F = np.einsum("n,nam->am", A, T)                  # forces (3, motions)
-    My = -np.einsum("n,n,nm->m", A, X[:, 0], T[:, 2, :])
-    return np.array([F[0], F[2], My])
+    return _solve_rigid(M, X, A)
+
+
+def frictionless_disk(nr, nt, G, nu):
+    """(K_z, K_r) [N/m, N m] of the rigid disk (R = 1) in frictionless contact: only the normal
+    tractions, the u_z-t_z block of the kernel; the exact values are 4 G R / (1 - nu) and
+    8 G R^3 / (3 (1 - nu)) (Boussinesq; the checks of this module's rules and lever arms)."""
+    M, X, A = assemble(nr, nt, G, nu)
+    Mzz = M[2::3, 2::3]
+    tz = np.linalg.solve(Mzz, np.column_stack([np.ones(len(A)), -X[:, 0]]))
+    return float(A @ tz[:, 0]), float(-(A * X[:, 0]) @ tz[:, 1])
+
+
+def square_stiffness(n, G, nu, B=1.0):
+    """The same 4 x 4 K of a welded rigid square [-B, B]^2: n x n rectangular cells on lines
+    -B cos(pi k / n) (finer toward the edges), the same kernel, rules and collocation."""
+    xs = -B * np.cos(np.pi * np.arange(n + 1) / n)
+    C = np.array([(xs[i], xs[i + 1], xs[j], xs[j + 1]) for i in range(n) for j in range(n)])
+    X = np.column_stack([0.5 * (C[:, 0] + C[:, 1]), 0.5 * (C[:, 2] + C[:, 3])])
+    A = (C[:, 1] - C[:, 0]) * (C[:, 3] - C[:, 2])
+    M = _assemble(X, A, _gauss_rectangle(C, 3), _gauss_rectangle(C, 10),
+                  lambda i: _self_rectangle(C[i], X[i], G, nu), G, nu)
+    return _solve_rigid(M, X, A)
 
 
 def k_z_bonded(G, nu, R=1.0):

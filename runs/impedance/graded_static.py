@@ -11,7 +11,11 @@ writes runs/impedance/graded_static.csv (K [N/m or N m/rad] and K / Pais-Kausel 
 between <!-- graded:begin/end --> in runs/impedance/README.md, with, per mode, the limit h -> 0 of
 the uniform grids (Richardson at order 1/2, the d^(-1/2) edge tractions', as static_stiffness.py),
 the observed order of the graded (grade 1) grids' excess over that limit, and the element size at
-which each kind of grid would come within 5 % of Pais and Kausel at its observed order.
+which each kind of grid would come within 5 % of Pais and Kausel at its observed order; and the
+same runs against an independent reference of the welded (bonded) square, the footing this code
+models: petsc_ssi/analytic/disk_static.square_stiffness (Boussinesq-Cerruti, only the footing
+meshed, n x n cells graded toward its edges) at n = 18, 27, 36 with Richardson's limit at the
+observed order, each BEM case's excess over it and the observed order of that excess.
 """
 import math
 import csv
@@ -47,6 +51,31 @@ def run(mode, h, grade):
         x = f["resultants"][what][:, comp] / amp
     wall = json.load(open(out[:-3] + ".json"))["stats"]["wall_s"]
     return float(x[-1]), float(np.ptp(x[-30:]) / abs(x[-1])), wall
+
+
+def limit(ns, ks):
+    """Richardson's limit of k(n) = L + C n^-p through three levels (p solved from their ratios)."""
+    from scipy.optimize import brentq
+    (n1, n2, n3), (k1, k2, k3) = ns, ks
+    ratio = (k2 - k1) / (k3 - k2)
+    f = lambda p: (n1 ** -p - n2 ** -p) / (n2 ** -p - n3 ** -p) - ratio
+    p = brentq(f, 0.05, 8.0)
+    return k3 + (k3 - k2) * n3 ** -p / (n2 ** -p - n3 ** -p), p
+
+
+def welded_square(ns=(18, 27, 36)):
+    """{mode: ((K at each n), Richardson's limit, its order)} [N/m or N m/rad] of the welded rigid
+    square (B = 1 m) on this soil, from petsc_ssi.analytic.disk_static.square_stiffness."""
+    sys.path.insert(0, ROOT)
+    from petsc_ssi.analytic.disk_static import square_stiffness
+    G = 2000.0 * 316.0 ** 2
+    nu = ((548 / 316) ** 2 - 2) / (2 * ((548 / 316) ** 2 - 1))
+    Ks = [square_stiffness(n, G, nu) for n in ns]
+    out = {}
+    for mode, i in {"vertical": 1, "horizontal": 0, "rocking": 2, "torsion": 3}.items():
+        ks = tuple(K[i, i] for K in Ks)
+        out[mode] = (ks,) + limit(ns, ks)
+    return out
 
 
 def main():
@@ -88,6 +117,22 @@ def main():
                 h5 = 0.25 * (need / e2) ** (1.0 / p)
                 line += f", within 5 % at h = {h5:.3g} m ({(0.25 / h5) ** 2:.3g} x the elements of h = 0.25 m)"
         table.append(line)
+    table += ["", "Against the independent welded square (its limit n -> infinity, in units of Pais and Kausel; "
+              "the BEM's excess over it in %, h = 0.5 / 0.25 m, and the excess's observed order):", "",
+              "| mode | welded square / Pais-Kausel (n = 18, 27, 36; limit) | uniform grid: excess %, order | "
+              "graded (1): excess %, order | graded (0.5) at h = 0.25 m: excess % |", "|---|---|---|---|---|"]
+    welded = welded_square()
+    for mode, spec in MODES.items():
+        r = {(x["h [m]"], x["grade [-]"]): x["K [N/m or N m/rad]"] for x in rows if x["mode"] == mode}
+        levels, lim, p_lim = welded[mode]
+        cells = [f"{v / spec[5]:.4f}" for v in levels] + [f"{lim / spec[5]:.4f} (order {p_lim:.2f})"]
+        out = []
+        for g in (0.0, 1.0):
+            e1, e2 = r[(0.5, g)] / lim - 1, r[(0.25, g)] / lim - 1
+            order = f"{math.log(e1 / e2) / math.log(2.0):.2f}" if e1 > e2 > 0 else "-"
+            out.append(f"{100 * e1:.1f} / {100 * e2:.1f}, {order}")
+        table.append(f"| {mode} | {', '.join(cells[:3])}; {cells[3]} | {out[0]} | {out[1]} | "
+                     f"{100 * (r[(0.25, 0.5)] / lim - 1):.1f} |")
     readme = os.path.join(HERE, "README.md")
     text = open(readme).read()
     b, e = "<!-- graded:begin -->", "<!-- graded:end -->"

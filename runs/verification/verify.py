@@ -164,6 +164,14 @@ def disk():
         out.append(("disk", f"welded disk, nu = 1/3, {nr} rings: K_z vs 4 G R ln(3 - 4 nu) / (1 - 2 nu)", e, order,
                     "tests/analytic/test_disk_static.py"))
         prev = e
+    from petsc_ssi.analytic.disk_static import frictionless_disk
+    prev = None
+    for nr in (8, 12):
+        kz, kr = frictionless_disk(nr, 4 * nr, 1.0, nu)
+        e = abs(kr / (8 / (3 * (1 - nu))) - 1)
+        out.append(("disk", f"frictionless disk, {nr} rings: K_r vs 8 G R^3 / (3 (1 - nu))", e,
+                    math.log(prev / e) / math.log(nr / 8) if prev else "", "tests/analytic/test_disk_static.py"))
+        prev = e
     rows = list(csv.DictReader(open(os.path.join(ROOT, "runs", "impedance", "disk_coupling_static.csv"))))
     ind = next(r for r in rows if r["rings"] == "18")
     bem = next(r for r in rows if r["rings"].startswith("BEM"))
