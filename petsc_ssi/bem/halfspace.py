@@ -44,7 +44,7 @@ def read_surface_mesh(cfg, comm, planes):
                 raise SSIError("-ssi_mesh_params: the grid generator (-ssi_mesh grid) has no parameters; they set "
                                "the DefineConstant parameters of a .geo given as -ssi_mesh")
             if cfg.mesh == "grid":
-                mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin)
+                mesh = surface.grid(Lx, Ly, cfg.mesh_h, patch, xmin, ymin, cfg.get("mesh_grade", 0.0))
             elif cfg.mesh == "pit":
                 mesh = _pit(cfg, Lx, Ly, patch, planes)
             else:

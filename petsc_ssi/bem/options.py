@@ -16,6 +16,9 @@ register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator)
 register("mesh_size", "str", "16,16", "m", "grid/.geo: full extent 'Lx,Ly' of the surface, centred at the origin", "bem")
 register("mesh_h", "real", 1.0, "m", "grid/.geo: element size (node spacing is h/2)", "bem", validator=positive)
 register("mesh_patch", "str", "", "m", "grid/.geo: half-widths 'a,b' of a central patch named 'load' whose edges the mesh follows", "bem")
+register("mesh_grade", "real", 0.0, "", "grid: clustering of the grid lines toward the patch's edges at the same number "
+         "of elements, 0 (uniform) to 1 (cosine); a rigid footing's tractions are singular there", "bem",
+         validator=lambda v: None if 0.0 <= v <= 1.0 else "must be in [0, 1]")
 register("mesh_params", "str", "", "", ".geo soil mesh: more parameters 'name=value,...' (gmsh ONELAB 'Parameters/name'), "
          "beside Lx, Ly, xmin, ymin, h, a, b", "bem")
 register("scheme", "enum", "stabilized", "", "time marching: plain (paper eq. 6) or stabilized (eq. 7)", "bem",
@@ -142,6 +145,9 @@ def _bem_checks(cfg):
             return (f"-ssi_mesh_h {cfg.mesh_h:g} m is larger than the mesh (-ssi_mesh_size {cfg.mesh_size}): the grid "
                     f"would have elements of {min(lx, ly):g} m, not the size asked; give -ssi_mesh_h <= "
                     f"{min(lx, ly):g} m or a larger -ssi_mesh_size")
+    if cfg.mesh_grade and (cfg.mesh != "grid" or not cfg.mesh_patch):
+        return ("-ssi_mesh_grade: only the grid generator (-ssi_mesh grid) grades its lines, toward the edges of "
+                "-ssi_mesh_patch; give both, or leave -ssi_mesh_grade out")
     if cfg.mesh not in ("grid", "pit") and not os.path.isfile(cfg.mesh):
         return f"-ssi_mesh {cfg.mesh}: no such file"
     if cfg.interp in ("chebyshev", "linear") and (cfg.interp_k < 1 or cfg.interp_tl <= 0):

@@ -234,21 +234,45 @@ def kinks(mesh, planes=(), max_angle_deg=1.0):
     return nodes[first][bad], ang[bad]
 
 
-def _lines(lo, hi, h, cuts):
-    """Grid lines from lo to hi of spacing about h, passing through cuts."""
-    pts = sorted({lo, hi, *[c for c in cuts if lo < c < hi]})
+def _graded(s, at_start, at_end, grade):
+    """Positions in [0, 1] of the uniform parameters s, clustered toward the ends that are cuts:
+    (1 - grade) s + grade phi(s), phi the cosine map that clusters at those ends (phi'(end) = 0)."""
+    if at_start and at_end:
+        phi = 0.5 * (1.0 - np.cos(np.pi * s))
+    elif at_start:
+        phi = 1.0 - np.cos(0.5 * np.pi * s)
+    elif at_end:
+        phi = np.sin(0.5 * np.pi * s)
+    else:
+        return s
+    return (1.0 - grade) * s + grade * phi
+
+
+def _lines(lo, hi, h, cuts, grade=0.0):
+    """Grid lines from lo to hi of spacing about h, passing through cuts; ``grade`` in [0, 1]
+    clusters them toward the cuts at the same number of lines (0: uniform, 1: cosine)."""
+    inner = {c for c in cuts if lo < c < hi}
+    pts = sorted({lo, hi, *inner})
     out = [pts[0]]
     for a, b in zip(pts[:-1], pts[1:]):
         n = max(1, int(round((b - a) / h)))
-        out += list(np.linspace(a, b, n + 1)[1:])
+        s = np.linspace(0.0, 1.0, n + 1)[1:]
+        if grade > 0.0:
+            s = _graded(s, a in inner, b in inner, grade)
+            s[-1] = 1.0
+        out += list(a + (b - a) * s)
     return np.array(out)
 
 
-def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
+def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None, grade=0.0):
     """Structured nine-node mesh of [xmin, Lx/2] x [ymin, Ly/2] (z = 0).
 
     Defaults: centred at the origin. With ``patch=(a, b)`` the grid lines
     pass through x = +-a, y = +-b and the elements inside form group 'load'.
+    ``grade`` (0 to 1, -ssi_mesh_grade) clusters the grid lines toward the patch's edges at the
+    same number of elements (a rigid footing's tractions are singular there): on each stretch
+    between grid ends and patch edges, the lines sit at (1 - grade) s + grade phi(s) of it, s
+    uniform and phi the cosine map that clusters at the stretch's ends that are patch edges.
     Outward normal +z (soil below).
     """
     x0 = -Lx / 2 if xmin is None else xmin
@@ -256,8 +280,10 @@ def grid(Lx, Ly, h, patch=None, xmin=None, ymin=None):
     cx = cy = ()
     if patch is not None:
         cx, cy = (-patch[0], patch[0]), (-patch[1], patch[1])
-    xs = _lines(x0, Lx / 2, h, cx)
-    ys = _lines(y0, Ly / 2, h, cy)
+    if grade and patch is None:
+        raise ValueError("grid: grading (-ssi_mesh_grade) needs a patch (-ssi_mesh_patch) whose edges it refines")
+    xs = _lines(x0, Lx / 2, h, cx, grade)
+    ys = _lines(y0, Ly / 2, h, cy, grade)
     nx, ny = len(xs) - 1, len(ys) - 1
     # node lines including mid-points
     xn = np.empty(2 * nx + 1); xn[0::2] = xs; xn[1::2] = 0.5 * (xs[:-1] + xs[1:])

@@ -25,6 +25,8 @@ SMALL = dict(mesh_size="4,4", mesh_h=1.0, t_end=0.003)
     (dict(memory_limit=1e-6, t_end=0.01), "more than the"),
     (dict(scheme="explicit"), "is not one of"),
     (dict(dtt=1e-3), "did you mean -ssi_dt"),
+    (dict(mesh_grade=0.5), "-ssi_mesh_grade: only the grid generator"),
+    (dict(mesh_grade=1.5, mesh_patch="1,1"), "-ssi_mesh_grade 1.5: must be in [0, 1]"),
 ])
 def test_bad_input_one_line_error(opts, expect):
     msg = resolve_error(**{**SMALL, **opts})
