@@ -6,8 +6,10 @@
 #     keeps the refusal) and toeplitz; its receivers against the quarter model's;
 #   - whole grids of SIZES metres (1 m elements, the paper's soil and dt, T_END seconds): the cost per
 #     step against N, and the run's own estimate beside each.
+#   - the paper's whole case at 1, 2 and 4 ranks (SCALE_RANKS): the scaling table.
 # Then jobscripts/toeplitz_table.py writes the table into runs/pekeris/README.md, the CSV
-# runs/pekeris/toeplitz_bench.csv and the plot runs/pekeris/toeplitz_cost_per_step.png.
+# runs/pekeris/toeplitz_bench.csv, the plot runs/pekeris/toeplitz_cost_per_step.png and the scaling
+# table into jobscripts/README.md.
 #   bash jobscripts/toeplitz_bench.sh            (RANKS=1 SIZES="24 36" T_END=0.05 to change)
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
@@ -32,5 +34,11 @@ run paper-whole-toeplitz "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz
 for L in $SIZES; do
   run "grid-$L" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_mesh_size "$L,$L" -ssi_t_end "$T_END"
 done
+# scaling of the paper's whole case at SCALE_RANKS ranks (4 oversubscribed on a 2-core machine)
+R0=$RANKS
+for n in ${SCALE_RANKS:-"1 2 4"}; do
+  RANKS=$n run "scale-n$n" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz
+done
+RANKS=$R0
 "$PY" jobscripts/toeplitz_table.py "$OUT" runs/pekeris/README.md runs/pekeris/toeplitz_bench.csv \
-  runs/pekeris/toeplitz_cost_per_step.png
+  runs/pekeris/toeplitz_cost_per_step.png jobscripts/README.md

@@ -4,7 +4,7 @@ run's own lines): per run the lag store, dofs, steps, stored GB, build and histo
 history's cost per step, the wall, the peak memory over the ranks, and the run's own estimate; the
 whole model's receivers against the quarter model's.
 
-    python jobscripts/toeplitz_table.py OUTDIR README CSV PNG
+    python jobscripts/toeplitz_table.py OUTDIR README CSV PNG [SCALING_README]
 """
 import csv
 import glob
@@ -63,8 +63,35 @@ def receivers_agree(outdir):
         return None
 
 
-def main(outdir, readme, csvpath, png):
+def put(path, begin, end, lines):
+    text = open(path).read()
+    block = begin + "\n" + "\n".join(lines) + "\n" + end
+    if begin in text:
+        text = text[:text.index(begin)] + block + text[text.index(end) + len(end):]
+    else:
+        text += "\n" + block + "\n"
+    open(path, "w").write(text)
+
+
+def scaling(rows, path):
+    """The paper's whole case at 1, 2, 4 ranks: wall, kernels, history, speed-up of the history sum."""
+    sc = sorted((r for r in rows if r["run"].startswith("scale-n")), key=lambda r: r["ranks"] or 0)
+    if not sc:
+        return
+    h1 = sc[0]["history_s"]
+    lines = ["| ranks | kernels [s] | history sum [s] | history speed-up [-] | total [s] | peak over the ranks [GB] |",
+             "|---|---|---|---|---|---|"]
+    for r in sc:
+        sp = round(h1 / r["history_s"], 2) if r["history_s"] else ""
+        lines.append(f"| {r['ranks']} | {r.get('kernels_s', '')} | {r['history_s']} | {sp} | {r['total_s']} | "
+                     f"{r['peak_GB']} |")
+    put(path, "<!-- toeplitz-scaling:begin -->", "<!-- toeplitz-scaling:end -->", lines)
+
+
+def main(outdir, readme, csvpath, png, scaling_readme=None):
     rows = [row(p) for p in sorted(glob.glob(os.path.join(outdir, "*.log")))]
+    if scaling_readme:
+        scaling(rows, scaling_readme)
     with open(csvpath, "w", newline="") as f:
         w = csv.DictWriter(f, COLS)
         w.writerow({c: c + {"stored_GB": " [GB]", "kernels_s": " [s]", "history_s": " [s]",
@@ -100,15 +127,9 @@ def main(outdir, readme, csvpath, png):
         ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(png, dpi=120)
-    text = open(readme).read()
-    block = BEGIN + "\n" + "\n".join(md) + "\n" + END
-    if BEGIN in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text += "\n" + block + "\n"
-    open(readme, "w").write(text)
+    put(readme, BEGIN, END, md)
     print("\n".join(md))
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:5])
+    main(*sys.argv[1:6])
