@@ -31,7 +31,9 @@ solve). Set-up costs one step solve per mode. With symmetry planes only the mode
 are unknown (the others vanish with the symmetric free field): e.g. y=anti (a wave along x
 polarised along y) leaves u_y, th_x, th_z.
 
-Output group ``input_motion`` (``arrays``): per step the footing's translation [m], rotation [rad]
+Output group ``input_motion`` (``arrays``; an embedded footing's also ``free_field_resultant``, the free
+field's share of the condition, which the group ``resultants`` (the scattered traction's) does not hold):
+per step the footing's translation [m], rotation [rad]
 and their accelerations [m/s^2, rad/s^2] (second central differences of the step series), and the
 free field at x_ref beside them: its displacement and its rotation, the rotation of the free
 surface, 1/2 curl u_ff = (du_z/dy, -du_z/dx, (du_y/dx - du_x/dy)/2) at z = 0
@@ -221,7 +223,13 @@ class MasslessFooting:
         acc = second_difference(q, dt)
         aff = second_difference(np.c_[uff, rff], dt)
         diff = "(second central difference of the step series; backward at the last step)"
-        return {
+        extra = {}
+        if self._ff is not None:          # an embedded footing: the output's 'resultants' are the scattered part
+            extra["free_field_resultant"] = (
+                np.array([self.free_field_resultant(n) for n in range(1, len(q) + 1)]).reshape(-1, 6),
+                "F_x, F_y, F_z [N], M_x, M_y, M_z [N m] about x_ref: the free field's traction sigma_ff n on the "
+                "footing, each step's mean; plus the group 'resultants' (the scattered traction's) it is zero")
+        return extra | {
             "t": (np.asarray(times, float), "s"),
             "translation": (q[:, :3], "m (displacement of x_ref: x, y, z)"),
             "rotation": (q[:, 3:], "rad (small rotation about the axes through x_ref: x, y, z)"),

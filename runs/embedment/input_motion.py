@@ -77,6 +77,19 @@ def run(D, h, L, dt, t_end, T, out):
     return t, a, al, second_difference(us, dt)[:, None] * np.array([1.0, 0.0, 0.0])
 
 
+def residual(out):
+    """max |F_scattered + F_ff| / max |W q| over the steps, forces and moments apart (the larger): the
+    footing's condition, the total traction's resultant zero, as the output ``out`` holds it."""
+    import h5py
+    with h5py.File(out) as f:
+        g = f["input_motion"]
+        q = np.c_[g["translation"][:], g["rotation"][:]]
+        total = np.c_[f["resultants/force"][:], f["resultants/moment"][:]] + g["free_field_resultant"][:]
+        wq = q @ g["step_stiffness"][:].T
+    return max(np.abs(total[:, :3]).max() / np.abs(wq[:, :3]).max(),
+               np.abs(total[:, 3:]).max() / np.abs(wq[:, 3:]).max())
+
+
 def nist(f, D):
     """(H_u, H_theta) of NIST GCR 12-917-21 as recalled (module docstring) at frequencies f [Hz]."""
     x = 2 * np.pi * np.asarray(f, float) * D / SOIL["cs"]
