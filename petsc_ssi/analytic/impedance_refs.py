@@ -301,6 +301,45 @@ def pais_kausel(mode, a0, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
     return K0, _out(alpha, a), _out(c, a)
 
 
+def pais_kausel_embedment(mode, D_B, LB=1.0):
+    """Pais & Kausel's static embedment factor eta = K_emb / K_sur of a rectangle 2L x 2B embedded D deep
+    with its side walls in contact (NIST GCR 12-917-21 Table 2-2b; runs/embedment/static_stiffness.py).
+    Vertical and horizontal (either direction: the table gives one factor for both)."""
+    r = _check_rect(mode, LB)
+    if mode == "vertical":
+        return 1.0 + (0.25 + 0.25 / r) * D_B ** 0.8
+    if mode in ("horizontal", "horizontal_y"):
+        return 1.0 + (0.33 + 1.34 / (1.0 + r)) * D_B ** 0.8
+    raise NotImplementedError(f"embedment factor of {mode!r}: only vertical and horizontal here")
+
+
+def pais_kausel_embedded(mode, a0, D_B, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
+    """Impedance of a rigid rectangular footing 2L x 2B embedded D = ``D_B`` B deep (side walls in
+    contact), Pais & Kausel (1988) via NIST GCR 12-917-21 Table 2-3b, in the form of
+    :func:`pais_kausel`: (K0, k, c) with K0 = eta K_sur (Table 2-2b), k = alpha_j (Table 2-3b takes the
+    surface modifiers) and c the bracket of the embedded beta_j over K0 / (G B):
+
+        vertical      c = 4 (psi L/B + D/B (1 + L/B)) / (K0 / (G B))
+        horizontal    c = 4 (L/B + D/B (psi + L/B)) / (K0 / (G B))          (along the long side, x)
+        horizontal_y  c = 4 (L/B + D/B (1 + psi L/B)) / (K0 / (G B))        (along the short side, y)
+
+    Source: the only transcription of Table 2-3b found, eng-tools/geofound's
+    geofound/damping/pais_1988.py ([T3] of the module docstring). Each bracket is the sum of the
+    plane-wave dashpots of the base and of the four walls (rho c_p on the faces the motion pushes,
+    rho c_s on those it shears, psi for c_p/c_s): that independent reading gives the same terms.
+    Vertical and horizontal only (the embedded rocking and torsion are not transcribed here)."""
+    r = _check_rect(mode, LB)
+    nu = _check_nu(nu)
+    a = _a0_array(a0)
+    eta = pais_kausel_embedment(mode, D_B, r)
+    Kn = eta * pais_kausel_static(mode, r, nu)                 # K_emb / (G B)
+    alpha, _ = _pk_alpha_c(mode, a, r, nu)
+    p = psi(nu)
+    bracket = {"vertical": 4.0 * (p * r + D_B * (1.0 + r)), "horizontal": 4.0 * (r + D_B * (p + r)),
+               "horizontal_y": 4.0 * (r + D_B * (1.0 + p * r))}[mode]
+    return Kn * G * B, _out(alpha, a), _out(bracket / Kn * np.ones_like(a), a)
+
+
 def rect_dashpot_limit(mode, LB=1.0, nu=1.0 / 3.0):
     """Exact high-frequency (plane-wave) dashpot of the rectangle in the project's normalisation,
     c_inf = (c_wave/c_s) G X/(B K0) with K0 = :func:`pais_kausel_static`, X = A = 4 B L, I_y =

@@ -1,5 +1,6 @@
 """``petsc-ssi input-motion``: the foundation input motion of a rigid massless surface footing under a
-seismic wave (kinematic interaction; issue 27), beside ``petsc-ssi impedance``.
+seismic wave (kinematic interaction; issue 27), beside ``petsc-ssi impedance``; also of an embedded one,
+the walls and bottom of an excavation (``-ssi_mesh pit -ssi_disp_group pit``; runs/embedment/input_motion.py).
 
 The footing is the -ssi_disp_group region (a group or 'box:x0,x1,y0,y1'), the wave -ssi_seismic with
 its record (-ssi_seismic_record ...). One BEM run (-ssi_problem bem with -ssi_disp_rigid massless,

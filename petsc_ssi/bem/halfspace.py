@@ -73,16 +73,17 @@ def read_surface_mesh(cfg, comm, planes):
 
 def _pit(cfg, Lx, Ly, patch, planes):
     """-ssi_mesh pit: the grid generator's ground with a rectangular excavation (``surface.pit``) of
-    -ssi_mesh_params a=,b=,d= (half-widths and depth, m)."""
+    -ssi_mesh_params a=,b=,d= (half-widths and depth, m), centred at x=,y= (m; default 0, 0: a long
+    narrow excavation off the centre is a trench, runs/trench)."""
     from ..fem.mesh import parse_mesh_params
     p = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
     if patch or planes:
         raise SSIError(f"-ssi_mesh pit: {'-ssi_mesh_patch' if patch else '-ssi_symmetry'} is not taken (the pit's "
                        "groups are ground, walls, bottom and pit; it is meshed whole)")
-    if set(p) != {"a", "b", "d"}:
-        raise SSIError(f"-ssi_mesh pit: -ssi_mesh_params must give a, b and d (the pit's half-widths and depth, m), "
-                       f"got '{cfg.get('mesh_params', '')}'")
-    return surface.pit(Lx, Ly, cfg.mesh_h, p["a"], p["b"], p["d"])
+    if not {"a", "b", "d"} <= set(p) <= {"a", "b", "d", "x", "y"}:
+        raise SSIError(f"-ssi_mesh pit: -ssi_mesh_params must give a, b and d (the pit's half-widths and depth, m) "
+                       f"and may give x and y (its centre, m), got '{cfg.get('mesh_params', '')}'")
+    return surface.pit(Lx, Ly, cfg.mesh_h, p["a"], p["b"], p["d"], p.get("x", 0.0), p.get("y", 0.0))
 
 
 def read_soil_surface(cfg, comm, planes):

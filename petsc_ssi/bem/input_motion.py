@@ -10,7 +10,9 @@ no mass, the soil's traction on the region has zero resultant force and moment e
 
     W p_n = 0,    W: the region's resultant operator (``resultants.Resultants``, 6 x 3 n_t).
 
-The BEM carries the scattered field (u_sc = u - u_ff on the region, t_ff = 0 on the flat surface).
+The BEM carries the scattered field (u_sc = u - u_ff on the region, t_ff = 0 on the flat surface;
+on an excavation's walls and bottom, an embedded footing, the total traction is t_sc + t_ff and the
+condition below carries the free field's resultant W_ff(n), ``free_field_resultant``).
 A step of the march (``march.Marcher``) solves A x_n = b_n(history) - H_s kv_n, linear in the
 known displacement kv_n of the region's DOFs. With kv_n = -u_ff(t_n) + R q_n,
 
@@ -21,7 +23,7 @@ so far) and X_k the response of one step to a unit rigid mode k from rest (the s
 the step matrix and its known-value terms do not change). The tractions follow, p_n = p_n^(0) +
 sum_k q_k P_k, and the condition W p_n = 0 is the small system
 
-    (W P) q_n = -W p_n^(0)       (6 x 6: the footing's instantaneous step stiffness),
+    (W P) q_n = -W p_n^(0) - W_ff(n)       (6 x 6: the footing's instantaneous step stiffness),
 
 solved every step; x_n and kv_n are then set to the q-solution before the march stores them, so
 the history the next steps read is that of the massless footing (exact by linearity: no second
@@ -29,7 +31,9 @@ solve). Set-up costs one step solve per mode. With symmetry planes only the mode
 are unknown (the others vanish with the symmetric free field): e.g. y=anti (a wave along x
 polarised along y) leaves u_y, th_x, th_z.
 
-Output group ``input_motion`` (``arrays``): per step the footing's translation [m], rotation [rad]
+Output group ``input_motion`` (``arrays``; an embedded footing's also ``free_field_resultant``, the free
+field's share of the condition, which the group ``resultants`` (the scattered traction's) does not hold):
+per step the footing's translation [m], rotation [rad]
 and their accelerations [m/s^2, rad/s^2] (second central differences of the step series), and the
 free field at x_ref beside them: its displacement and its rotation, the rotation of the free
 surface, 1/2 curl u_ff = (du_z/dy, -du_z/dx, (du_y/dx - du_x/dy)/2) at z = 0
@@ -139,6 +143,7 @@ class MasslessFooting:
             raise SSIError(f"-ssi_disp_rigid massless: the footing's step stiffness is singular (condition "
                            f"{cond:.3g}); is the -ssi_disp_group region a surface patch of several elements?")
         self.q = []
+        self._ff = self._free_field_traction()
         printf(f"[ssi] massless rigid footing: unknown rigid motion {', '.join(NAMES[k] for k in m)} about "
                f"x_ref = ({', '.join(f'{v:.6g}' for v in self.xref)}) m, zero resultant force and moment each step "
                f"(step stiffness condition {cond:.3g})")
@@ -151,10 +156,39 @@ class MasslessFooting:
         out[r0:r1] = self.res.y.getArray()
         return self.comm.tompi4py().allreduce(out)
 
+    def _free_field_traction(self):
+        """None on a flat surface (t_ff = 0 there); on an excavation's faces (an embedded footing) the
+        free field's traction on the region's nodes (``sources.free_field.FreeFieldTraction``, the
+        nodal normals of its tributary faces) with the region's area moments, for
+        ``free_field_resultant``."""
+        prob = self.prob
+        if prob.seismic is None or prob.mesh.flat:
+            return None
+        if prob.planes:
+            raise SSIError("-ssi_disp_rigid massless on a surface with an excavation takes no symmetry planes")
+        from ..sources.free_field import FreeFieldTraction
+        from .resultants import area_moments
+        reg = prob.regions
+        src = FreeFieldTraction(reg.disp_elems, name="free-field traction on the footing")
+        idx = src.bind(prob.mesh, reg.disp_nodes)
+        src.attach(prob.seismic)
+        a, b = area_moments(prob.mesh, reg.disp_elems, reg.disp_nodes)
+        return src, a[idx], b[idx] - a[idx, None] * self.xref
+
+    def free_field_resultant(self, n):
+        """(6,) the resultant force [N] and moment about x_ref [N m] of the free field's traction
+        t_ff = sigma_ff n on the footing, its exact mean over step n (0 on a flat surface): the total
+        traction on an embedded footing is t_sc + t_ff."""
+        if self._ff is None:
+            return np.zeros(6)
+        src, a, r = self._ff
+        t = -src.step_mean(n, self.prob.dt)                  # (the source's step mean is -t_ff)
+        return np.r_[a @ t, np.cross(r, t).sum(0)]
+
     def correct(self, n, x):
         """Collective: the step's q from the zero-resultant condition; x and the march's known
         displacement kv_u set to the q-solution (``Marcher.step``)."""
-        f0 = self._resultant(self.march.traction_of(x, self.P))
+        f0 = self._resultant(self.march.traction_of(x, self.P)) + self.free_field_resultant(n)
         m = self.modes
         qm = -self._d * np.linalg.solve(self._Ws, self._d * f0[m])
         x.maxpy(list(qm), self.X)
@@ -189,7 +223,13 @@ class MasslessFooting:
         acc = second_difference(q, dt)
         aff = second_difference(np.c_[uff, rff], dt)
         diff = "(second central difference of the step series; backward at the last step)"
-        return {
+        extra = {}
+        if self._ff is not None:          # an embedded footing: the output's 'resultants' are the scattered part
+            extra["free_field_resultant"] = (
+                np.array([self.free_field_resultant(n) for n in range(1, len(q) + 1)]).reshape(-1, 6),
+                "F_x, F_y, F_z [N], M_x, M_y, M_z [N m] about x_ref: the free field's traction sigma_ff n on the "
+                "footing, each step's mean; plus the group 'resultants' (the scattered traction's) it is zero")
+        return extra | {
             "t": (np.asarray(times, float), "s"),
             "translation": (q[:, :3], "m (displacement of x_ref: x, y, z)"),
             "rotation": (q[:, 3:], "rad (small rotation about the axes through x_ref: x, y, z)"),

@@ -11,8 +11,8 @@ register("cp", "real", 548.0, "m/s", "P-wave speed of the half-space", "bem", va
 register("cs", "real", 316.0, "m/s", "S-wave speed of the half-space", "bem", validator=positive)
 register("rho", "real", 2000.0, "kg/m^3", "density of the half-space", "bem", validator=positive)
 register("mesh", "str", "grid", "", "surface mesh: 'grid' (structured generator), 'pit' (the grid's ground with a "
-         "rectangular excavation of -ssi_mesh_params a=,b=,d=: half-widths and depth in m; groups ground, walls, "
-         "bottom, pit) or a gmsh .geo/.msh file of nine-node quads", "bem")
+         "rectangular excavation of -ssi_mesh_params a=,b=,d=: half-widths and depth in m, and x=,y=: its centre in m, "
+         "default 0,0, so a long narrow one off the centre is a trench; groups ground, walls, bottom, pit) or a gmsh .geo/.msh file of nine-node quads", "bem")
 register("mesh_size", "str", "16,16", "m", "grid/.geo: full extent 'Lx,Ly' of the surface, centred at the origin", "bem")
 register("mesh_h", "real", 1.0, "m", "grid/.geo: element size (node spacing is h/2)", "bem", validator=positive)
 register("mesh_patch", "str", "", "m", "grid/.geo: half-widths 'a,b' of a central patch named 'load' whose edges the mesh follows", "bem")

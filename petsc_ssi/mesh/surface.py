@@ -312,34 +312,39 @@ def _quad9(corner, du, dv):
     return c + 0.5 * (1 + quad9.NODE_XI[:, :1]) * du + 0.5 * (1 + quad9.NODE_XI[:, 1:]) * dv
 
 
-def pit(Lx, Ly, h, a, b, d):
+def pit(Lx, Ly, h, a, b, d, xc=0.0, yc=0.0):
     """Structured nine-node mesh of the ground [-Lx/2, Lx/2] x [-Ly/2, Ly/2] (z = 0) with a rectangular
-    excavation [-a, a] x [-b, b] of depth d (a basement's pit, a trench with b = Ly/2 is not this:
-    the pit stays inside the ground): its four vertical walls and its bottom z = -d. Normals point
-    out of the soil: +z on the ground and the bottom, into the pit on the walls (-x on x = a, +x on
-    x = -a, -y on y = b, +y on y = -b). Grid lines pass through x = +-a, y = +-b; the walls take about
-    d/h elements down. Groups: 'ground', 'walls', 'bottom', 'pit' (walls and bottom), 'surface'."""
-    if not (0 < a < Lx / 2 and 0 < b < Ly / 2 and d > 0 and h > 0):
-        raise SSIError(f"pit: need 0 < a < Lx/2, 0 < b < Ly/2, d > 0, h > 0 (got Lx {Lx:g}, Ly {Ly:g}, a {a:g}, "
-                       f"b {b:g}, d {d:g}, h {h:g})")
-    xs, ys, zs = _lines(-Lx / 2, Lx / 2, h, (-a, a)), _lines(-Ly / 2, Ly / 2, h, (-b, b)), _lines(-d, 0.0, h, ())
+    excavation [xc - a, xc + a] x [yc - b, yc + b] of depth d (a basement's pit; a long narrow one, a
+    << b, off the centre, is an open trench: runs/trench): its four vertical walls and its bottom
+    z = -d. The excavation stays inside the ground (a trench across the whole ground is not this).
+    Normals point out of the soil: +z on the ground and the bottom, into the pit on the walls (-x on
+    x = xc + a, +x on x = xc - a, -y on y = yc + b, +y on y = yc - b). Grid lines pass through
+    x = xc +- a, y = yc +- b; the walls take about d/h elements down. Groups: 'ground', 'walls',
+    'bottom', 'pit' (walls and bottom), 'surface'."""
+    if not (0 < a and 0 < b and d > 0 and h > 0 and -Lx / 2 < xc - a and xc + a < Lx / 2
+            and -Ly / 2 < yc - b and yc + b < Ly / 2):
+        raise SSIError(f"pit: need a, b, d, h > 0 and the opening [x - a, x + a] x [y - b, y + b] inside the ground "
+                       f"[-Lx/2, Lx/2] x [-Ly/2, Ly/2] (got Lx {Lx:g}, Ly {Ly:g}, a {a:g}, b {b:g}, d {d:g}, h {h:g}, "
+                       f"x {xc:g}, y {yc:g})")
+    xa, xb, ya, yb = xc - a, xc + a, yc - b, yc + b
+    xs, ys, zs = _lines(-Lx / 2, Lx / 2, h, (xa, xb)), _lines(-Ly / 2, Ly / 2, h, (ya, yb)), _lines(-d, 0.0, h, ())
     X, kind = [], []
     for x0, x1 in zip(xs[:-1], xs[1:]):
         for y0, y1 in zip(ys[:-1], ys[1:]):
-            inside = abs(0.5 * (x0 + x1)) < a and abs(0.5 * (y0 + y1)) < b
+            inside = xa < 0.5 * (x0 + x1) < xb and ya < 0.5 * (y0 + y1) < yb
             X.append(_quad9([x0, y0, -d if inside else 0.0], [x1 - x0, 0, 0], [0, y1 - y0, 0]))
             kind.append("bottom" if inside else "ground")
     for z0, z1 in zip(zs[:-1], zs[1:]):
         dz = z1 - z0
         for y0, y1 in zip(ys[:-1], ys[1:]):
-            if abs(0.5 * (y0 + y1)) < b:
-                X.append(_quad9([a, y0, z0], [0, 0, dz], [0, y1 - y0, 0]))      # -x
-                X.append(_quad9([-a, y0, z0], [0, y1 - y0, 0], [0, 0, dz]))     # +x
+            if ya < 0.5 * (y0 + y1) < yb:
+                X.append(_quad9([xb, y0, z0], [0, 0, dz], [0, y1 - y0, 0]))      # -x
+                X.append(_quad9([xa, y0, z0], [0, y1 - y0, 0], [0, 0, dz]))     # +x
                 kind += ["walls", "walls"]
         for x0, x1 in zip(xs[:-1], xs[1:]):
-            if abs(0.5 * (x0 + x1)) < a:
-                X.append(_quad9([x0, b, z0], [x1 - x0, 0, 0], [0, 0, dz]))      # -y
-                X.append(_quad9([x0, -b, z0], [0, 0, dz], [x1 - x0, 0, 0]))     # +y
+            if xa < 0.5 * (x0 + x1) < xb:
+                X.append(_quad9([x0, yb, z0], [x1 - x0, 0, 0], [0, 0, dz]))      # -y
+                X.append(_quad9([x0, ya, z0], [0, 0, dz], [x1 - x0, 0, 0]))     # +y
                 kind += ["walls", "walls"]
     X = np.array(X)
     scale = max(Lx, Ly, d)
