@@ -32,11 +32,12 @@ run paper-quarter-toeplitz "${P[@]}" -ssi_lag_store toeplitz
 run paper-whole-dense "${P[@]}" -ssi_symmetry none
 run paper-whole-toeplitz "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz
 for L in $SIZES; do
-  run "grid-$L" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_mesh_size "$L,$L" -ssi_t_end "$T_END"
+  run "grid-$L" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_mesh_size "$L,$L" -ssi_t_end "$T_END" \
+    -ssi_receivers "5,0,0"
 done
 # scaling of the paper's whole case at SCALE_RANKS ranks (4 oversubscribed on a 2-core machine)
 R0=$RANKS
-for n in ${SCALE_RANKS:-"1 2 4"}; do
+for n in ${SCALE_RANKS:-1 2 4}; do
   RANKS=$n run "scale-n$n" "${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz
 done
 RANKS=$R0

@@ -144,9 +144,12 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     except SSIError as e:
         return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
     lat.n_offsets = len(kernel_offsets(lat))
-    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks"]
+    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks "
+           "beside the processes"]
     for p in ranks:
-        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8)
+        lags = cnt.Lx + cnt.k
+        g = 8.0 * 5 * prob.mesh.n_nodes * prob.regions.n_t * lags
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g)
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")
     return out
 

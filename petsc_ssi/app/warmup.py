@@ -46,6 +46,11 @@ def main():
         for k, v in opts.items():
             db.setValue("ssi_" + k, str(v))
         run_bem(options.resolve(("common", "bem")))
+        db.setValue("ssi_lag_store", "toeplitz")              # the toeplitz store's kernels (bem/toeplitz.py)
+        db.setValue("ssi_output_overwrite", "1")
+        run_bem(options.resolve(("common", "bem")))
+        db.delValue("ssi_lag_store")
+        db.delValue("ssi_output_overwrite")
         _shared_cache_kernels(PETSc)
         _single_kernels()
     os.makedirs(d, exist_ok=True)

@@ -342,8 +342,9 @@ def _emit_lag(lag, n, cl, buf, li, out):
     """Append the blocks buf[cl[k]] (k < n, columns ascending) of one row to lag ``lag`` of ``out`` =
     (columns, values, float32 values, fill, counts, single_from): typed Lists of per-lag arrays (values
     from ``single_from`` > 0 on in float32, rounded as they are written), fill[l] the blocks lag l
-    holds, counts[l, li] += the row's (li: its place among the rank's rows)."""
-    if n == 0:
+    holds, counts[l, li] += the row's (li: its place among the rank's rows); single_from < 0: a matrix
+    not kept (the G-only assembly of ``build._traction_g``), nothing written."""
+    if n == 0 or out[5] < 0:
         return
     _room(out, lag, n)
     cols, vals, vals32, fill, counts, single_from = out

@@ -171,7 +171,7 @@ def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0):
     pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
     tcol_loc = pl.getLocalSize() // 3
     pl.destroy()
-    _, gb = tl.assemble(monitor=False, lag_lo=lag_lo, lag_hi=lag_hi, toff=toff, quiet=True)
+    _, gb = tl.assemble(monitor=False, lag_lo=lag_lo, lag_hi=lag_hi, toff=toff, quiet=True, keep_h=False)
     N = prob.mesh.n_nodes
     if lag_lo == lag_hi and lag_lo > 1:
         return [lagmats.build_one(comm, gb, lag_lo, ls.node_range, N, nt, tcol_loc, "dense")[0]], tl

@@ -475,12 +475,16 @@ class HalfSpace:
         lat.n_offsets = len(kernel_offsets(lat))
         p = self.comm.getSize()
         block = int(c.history_block) or 8
-        est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block)
+        lags = plan.Lx + (plan.k if plan.active else 0)
+        g = 8.0 * 5 * self.mesh.n_nodes * self.regions.n_t * lags          # G dense: N x n_t blocks of 5
+        est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g)
+        from .lagset import load_kernels
+        load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)
         est += float(extra_bytes) + rss
         self.mem_estimate = self.mem_peak_estimate = est
-        printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels and kept transforms "
-               f"{(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
+        printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
+               f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
                f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
         if est > limit:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {est / 1e9:.3g} GB, more than "

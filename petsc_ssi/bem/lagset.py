@@ -504,10 +504,11 @@ class LagSet:
         return ckeys, cmeta, cpP, cpU, int(nev)
 
     def assemble(self, monitor=False, chunk=None, lag_lo=1, lag_hi=None, toff=0.0, what="BEM assembly",
-                 single_from=0, quiet=False):
+                 single_from=0, quiet=False, keep_h=True):
         """Lags lag_lo..lag_hi (default 1..L) at kernel times l dt + toff,
         each rank its rows; sets and returns (H, G) Buckets (lags >= ``single_from`` > 0 kept in
-        float32: -ssi_lag_single_from). ``quiet``: no -log_view event (``load_kernels``)."""
+        float32: -ssi_lag_single_from). ``quiet``: no -log_view event (``load_kernels``); ``keep_h`` False:
+        G only, H's blocks not written (``build._traction_g``)."""
         o = self.opts
         lag_hi = self.L if lag_hi is None else lag_hi
         gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
@@ -518,7 +519,7 @@ class LagSet:
         nimg = getattr(self, "n_images", None) or len(self.Vc) // self.mesh.n_cells
         est = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg)
         est[:lag_lo - 1] = 0
-        cap = 1.15 * est
+        cap = 1.15 * est if keep_h else np.zeros_like(est)
         mH, mG = self.mH, self.mG
         small = bool(self.opts.get("small_pages", False))      # -ssi_huge_pages (petsc.lag_small_pages)
         H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=mH,
@@ -553,7 +554,8 @@ class LagSet:
         for s in range(0, len(rows), chunk):
             work, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
                 rows[s:s + chunk], mesh, wave, quad, pattern, bool(o.get("cache", True)), cidx, ckeys, cmeta,
-                cpP, cpU, qinv, work, dropped, H.out(), G.out(), H.loc, self.plane(gq, gw), self.CACHE_MAX)
+                cpP, cpU, qinv, work, dropped, H.out() if keep_h else H.out()[:5] + (-1,), G.out(), H.loc,
+                self.plane(gq, gw), self.CACHE_MAX)
             nev += n_ev
             hits += n_hit
             prog.update(min(s + chunk, len(rows)))

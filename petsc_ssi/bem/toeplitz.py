@@ -136,31 +136,34 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
     return Lattice(o, h, nx, ny, cell, perm, nfi.astype(np.int64), code[0].copy())
 
 
-# cost model (``estimate``): the rates measured by jobscripts/toeplitz_bench.sh on the development machine
-# (2 cores; jobscripts/README.md): complex matrix products of the history sum per rank, seconds per
-# (offset, lag) pair of the kernels' integration, seconds per point of a 2-D real FFT and log2 of its size
-RATES = {"r_products": 6.0e9, "t_pair_lag": 2.0e-6, "t_fft_point": 1.0e-8}
+# cost model (``estimate``), fitted to jobscripts/toeplitz_bench.sh's logs on the development machine (2
+# cores, idle; runs/pekeris/README.md "The toeplitz lag store"): the history's complex products per rank
+# (the block products' flops over this rate), the per-step work that grows with the soil's DOFs and is
+# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), and
+# seconds per (kernel offset, lag) of the kernels' integration
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6}
+CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
-def estimate(lat, L, n_steps, ranks=1, block=8, rates=None):
-    """(bytes over all ranks, seconds of the kernels' build, seconds of the history sum) of a toeplitz
-    run: kernels 144 complex per frequency and history lag, kept transforms 27 per frequency and kept
-    state (D + 2 b + 64), the build's chunk of kernels per rank (2 x 256 MB at most); the history's
-    complex products 8 x 144 flops per frequency and (step, lag) pair, at ``r_products`` per rank, and
-    per step the 27 forward and 12 inverse FFTs of every rank."""
+def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None):
+    """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
+    the history sum) of a toeplitz run: kernels 144 complex per frequency and history lag, kept
+    transforms 27 per frequency and kept state (D + 3 b + 8), the build's transients per rank (a chunk of
+    kernels, its spectra, its integrals), ``g_bytes`` of G and the step matrix; the history's complex
+    products, 8 x 144 flops per frequency and (step, lag) pair at ``r_products`` per rank, and
+    ``t_step_dof`` per step and DOF."""
     r = dict(RATES, **(rates or {}))
     D = int(L)
     W = D + 3 * block + 8
     F = lat.F
     per_lag = 144 * lat.Mx * lat.My * 8.0
-    build = ranks * 2 * min(256e6, per_lag * max(1, min(D, int(256e6 // per_lag))))
-    nbytes = 16.0 * F * (144 * D + 27 * W) + build
+    build = ranks * 3 * per_lag * max(1, min(D, int(CHUNK_BYTES // per_lag)))
+    nbytes = 16.0 * F * (144 * D + 27 * W) + build + float(g_bytes)
     pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
     t_build = r["t_pair_lag"] * pairs * D / ranks
     n = np.arange(1, n_steps + 1)
     flops = 8.0 * 144 * F * float(np.minimum(np.maximum(n - 1, 0), D).sum())
-    pts = lat.Mx * lat.My
-    t_hist = flops / (ranks * r["r_products"]) + n_steps * 39 * r["t_fft_point"] * pts * math.log2(pts)
+    t_hist = flops / (ranks * r["r_products"]) + n_steps * n_dofs * r["t_step_dof"]
     return nbytes, t_build, t_hist
 
 
@@ -274,7 +277,7 @@ class ToeplitzHistory:
         n_off = len(self.offsets)
         sel = np.arange(r, n_off, p)
         per_lag = 4 * 9 * 4 * lat.Mx * lat.My * 8
-        chunk = max(1, min(lag_hi - lag_lo + 1, int(256e6 // per_lag)))
+        chunk = max(1, min(lag_hi - lag_lo + 1, int(CHUNK_BYTES // per_lag)))
         t = self.offsets[:, 2]
         kx = np.mod(self.offsets[:, 3], lat.Mx)
         ky = np.mod(self.offsets[:, 4], lat.My)

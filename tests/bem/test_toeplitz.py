@@ -32,7 +32,9 @@ CASES = {
     "prescribed motion, plain, anti": DISP + ["-ssi_scheme", "plain", "-ssi_disp_value", "1e-6,0,0",
                                               "-ssi_symmetry", "x=anti,y=sym"],
 }
-SLOW = ("plain", "chebyshev, plain", "prescribed motion, plain, anti")   # slow tier: siblings of the others
+# slow tier: the plain scheme, Chebyshev, the antisymmetric prescribed motion and the symmetry planes with
+# interpolation against dense (test_toeplitz_two_ranks_equal_one compares that case with dense at -n 1)
+SLOW = ("plain", "chebyshev, plain", "prescribed motion, plain, anti", "symmetry+interp")
 
 
 @pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in SLOW else []) for c in CASES])
@@ -45,6 +47,21 @@ def test_toeplitz_equals_dense(tmp_path, case):
     same(ref, tz)
 
 
+def test_toeplitz_coupled_contact(tmp_path):
+    """The coupled box with unilateral contact (it lifts off), one rank: toeplitz against dense to 1e-10
+    (the block test's bound for the free flight's round-off)."""
+    ref, tz = str(tmp_path / "ref.h5"), str(tmp_path / "tz.h5")
+    cli(SSI + ["-ssi_output", ref])
+    cli(SSI + TZ + ["-ssi_output", tz])
+    A = same(ref, tz, rtol=1e-10)
+    assert any(k.startswith("interface/") for k in A)
+    with h5py.File(tz) as f:
+        closed = f["interface/closed"][...]
+    assert closed.any() and not closed.all()        # contact is active: it lifts off
+
+
+# slow tier: the coupled contact case at -n 2 (test_toeplitz_coupled_contact is its one-rank sibling)
+@pytest.mark.slow
 def test_toeplitz_coupled_contact_two_ranks(tmp_path):
     """The coupled box with unilateral contact (it lifts off) on 2 ranks: toeplitz against dense (both
     -ssi_reproducible), 1e-10 as the block test allows for the free flight's round-off; and -n 2
@@ -62,11 +79,14 @@ def test_toeplitz_coupled_contact_two_ranks(tmp_path):
 
 
 def test_toeplitz_two_ranks_equal_one(tmp_path):
-    """The frequency slabs over 2 ranks: -n 2 equals -n 1 (symmetry planes and interpolation)."""
-    args = BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"] + TZ
-    one, two = str(tmp_path / "one.h5"), str(tmp_path / "two.h5")
-    cli(args + ["-ssi_output", one])
-    cli(args + ["-ssi_output", two, "-ssi_reproducible"], nranks=2)
+    """The frequency slabs over 2 ranks: -n 2 equals -n 1, and -n 1 the dense store (symmetry planes and
+    interpolation)."""
+    args = BEM + INTERP + ["-ssi_symmetry", "x=sym,y=sym"]
+    ref, one, two = (str(tmp_path / f"{k}.h5") for k in ("dense", "one", "two"))
+    cli(args + ["-ssi_output", ref])
+    cli(args + TZ + ["-ssi_output", one])
+    cli(args + TZ + ["-ssi_output", two, "-ssi_reproducible"], nranks=2)
+    same(ref, one)
     same(one, two)
 
 
@@ -141,6 +161,8 @@ def test_toeplitz_seismic_massless_footing(tmp_path):
     same(ref, tz)
 
 
+# slow tier: impedance (28 s; prescribed motion is its sibling in test_toeplitz_equals_dense)
+@pytest.mark.slow
 def test_toeplitz_impedance_equals_dense(tmp_path):
     """`petsc-ssi impedance` (every mode, each on its own symmetry planes, prescribed rigid motion) on
     the toeplitz store: K(omega) of every term equals the dense store's to 1e-10 of its largest |K|."""
