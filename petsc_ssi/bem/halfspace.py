@@ -477,6 +477,13 @@ class HalfSpace:
         block = int(c.history_block) or 8
         lags = plan.Lx + (plan.k if plan.active else 0)
         g = 8.0 * 5 * self.mesh.n_nodes * self.regions.n_t * lags          # G dense: N x n_t blocks of 5
+        # lags 1 and 2 as Mats (block-sparse: their wave reaches a few elements) and the step matrix's
+        # factors: counted from the blocks of the lag-2 window, 36 B a block, three times over
+        from .windows import estimate_blocks
+        rows = ls.rows[::max(1, len(ls.rows) // 256)]          # (a sample of rows: O(rows x elements))
+        nb = estimate_blocks(self.mesh.nodes, rows, ls.Vc, ls.VR, 2, self.mat, self.dt,
+                             len(ls.Vc) // self.mesh.n_cells) * (len(ls.rows) / max(len(rows), 1))
+        g += 3 * 36.0 * self.comm.tompi4py().allreduce(float(nb.sum()))
         est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g)
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
@@ -486,10 +493,16 @@ class HalfSpace:
         printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
                f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
                f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
-        if est > limit:
-            raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {est / 1e9:.3g} GB, more than "
-                           f"the {limit / 1e9:.3g} GB available (-ssi_memory_limit); use -ssi_interp, a shorter "
-                           "-ssi_t_end or a coarser grid")
+        # the limit holds per node: the run's memory is shared by its ranks, ``share`` of them on the most
+        # loaded node (all of them on one machine), as in check_memory
+        mpi = self.comm.tompi4py()
+        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
+        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
+        node.Free()
+        if share * est > limit:
+            raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "
+                           f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
+                           "per node); use -ssi_interp, a shorter -ssi_t_end, a coarser grid or more nodes")
         self.loop_estimate = (t_hist, t_hist / max(self.n_steps, 1))
 
     def quad_options(self):

@@ -681,6 +681,8 @@ class Marcher:
         of an older version holds one dataset per step, ``bem_u_000123``)."""
         self.n = int(n)
         self._blk = self._rep = None
+        if self.toeplitz is not None:
+            self.toeplitz.reset()           # its kept transforms are made again from the restored states
         steps = list(self._kept_steps())
         for name, buf, tmpl in (("u", self.ubuf, self.u_tmpl), ("p", self.pbuf, self.p_tmpl)):
             if not tmpl.getSize():

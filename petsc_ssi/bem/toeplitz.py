@@ -260,9 +260,11 @@ class ToeplitzHistory:
         offP, P, _, _, nev = integrate_records(meta, pts, X, c_hi, dt, mat.cp, mat.cs, mat.rho, mat.nu, gq, gw, gr,
                                                gwr, toff, float(ls.Vh.min()), ls.pattern(), dropped,
                                                int(o["subdivisions"]), self._plane)
-        if dropped.max() != 0.0:
+        from mpi4py import MPI
+        lost = self.comm.tompi4py().allreduce(float(dropped.max()), op=MPI.MAX)    # (every rank: no hang)
+        if lost != 0.0:
             raise SSIError(f"-ssi_lag_store toeplitz: a flat-surface block entry outside its pattern is "
-                           f"{dropped.max():.3g}, not 0; report this with the mesh")
+                           f"{lost:.3g}, not 0; report this with the mesh")
         self.nev += int(nev)
         return idx, meta, offP, P
 
@@ -381,6 +383,12 @@ class ToeplitzHistory:
         self.Vz[:, i, :] = S[:, 2, :].T
         self.Vxy[:, i, :] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
 
+    def reset(self):
+        """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
+        self.upto, self.base, self._blk = 0, -self.D, None
+        self.Vz[...] = 0.0
+        self.Vxy[...] = 0.0
+
     def _room(self, n0):
         """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - D .. n0 + b;
         when they would run past the end, the kept ones move to the start and the rest is zeroed."""
@@ -423,9 +431,9 @@ class ToeplitzHistory:
         self._catch_up(n - 1, march)
         acc = self._blk[1][:, n - n0 - 1].copy()            # (slab, 12)
         k = min(n - n0 - 1, D)
-        if k:                                               # the block's states n0 + 1 .. n - 1: d = k .. 1
+        if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
             acc += history_products(self.Kxy[:, 9 * (D - k):], self.Kz[:, 18 * (D - k):], self.Vz, self.Vxy,
-                                    n0 + 1 - self.base, 1, k)[:, 0]
+                                    n - k - self.base, 1, k)[:, 0]
             march.PETSc.Log.logFlops(8.0 * k * 144 * (self.f1 - self.f0))
         full = np.empty((lat.F, 12), np.complex128)
         mpi = self.comm.tompi4py()

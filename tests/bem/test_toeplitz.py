@@ -181,3 +181,15 @@ def test_toeplitz_impedance_equals_dense(tmp_path):
     assert set(runs["dense"]) == set(runs["tz"]) and len(runs["dense"]) >= 4
     for mode, K in runs["dense"].items():
         assert np.abs(K - runs["tz"][mode]).max() <= 1e-10 * np.abs(K).max(), mode
+
+
+def test_toeplitz_block_longer_than_the_lags(tmp_path):
+    """Blocks of 16 steps on a grid whose history has 9 lags (D < b - 1: the steps late in a block read
+    only states inside it): toeplitz equals dense (a review found the in-block window started at the
+    block's first state instead of n - D)."""
+    args = BEM[:] + ["-ssi_mesh_size", "4,4", "-ssi_t_end", "0.1", "-ssi_receivers", "1,0,0"]
+    ref, tz = str(tmp_path / "dense.h5"), str(tmp_path / "tz.h5")
+    cli(args + ["-ssi_output", ref])
+    out = cli(args + TZ + ["-ssi_history_block", "16", "-ssi_output", tz]).stdout
+    assert "lags stored 9 " in out
+    same(ref, tz)
