@@ -100,7 +100,7 @@ def test_a_pit_is_a_closed_conforming_surface_with_normals_out_of_the_soil():
     assert len(nodes) == 2 * ring + 4 * (d / (h / 2) - 1)   # and the four vertical corners between
     with pytest.raises(SSIError, match="must lie in the plane z = 0"):
         m.require_plane("-ssi_mesh pit", "a reason")
-    with pytest.raises(SSIError, match="pit: need 0 < a < Lx/2"):
+    with pytest.raises(SSIError, match=r"pit: need a, b, d, h > 0 and the opening \[x - a, x \+ a\]"):
         pit(Lx, Ly, h, Lx, b, d)
 
 
