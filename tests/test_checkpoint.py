@@ -121,6 +121,9 @@ def test_coupled_contact_restart_is_bitwise(coupling, tmp_path):
     assert not closed[30:].all() and not closed[:30].all()      # open before and after the checkpoint
 
 
+# slow tier: a signal's checkpoint of a coupled contact run restarted (86 s; siblings in make test:
+# test_coupled_contact_restart_is_bitwise for the restart, test_output_survives's coupled contact signal)
+@pytest.mark.slow
 def test_a_signal_writes_a_checkpoint_that_restarts_a_coupled_contact_run(tmp_path):
     """SIGTERM to both ranks (as a scheduler sends it to every task; mpirun forwards its own SIGTERM
     only after odls_base_sigkill_timeout and kills soon after: test_sigterm_to_mpirun_...) in the

@@ -118,6 +118,9 @@ def test_blocked_equals_per_step(tmp_path, case):
     same(ref, auto)
 
 
+# slow tier: the coupled contact case blocked at -n 1 and -n 2 (33 s; siblings in make test: the stabilised
+# case blocked and test_blocked_two_ranks_and_a_block_longer_than_the_lags)
+@pytest.mark.slow
 def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
     """The block on the half-space with unilateral contact (uplift: the contact iterations change the
     current step's state only): blocks of 6 against step by step at -n 1, and blocks of 6 in

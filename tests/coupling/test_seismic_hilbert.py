@@ -81,8 +81,10 @@ def dpulse(tmp_path_factory):
     return str(p)
 
 
+# slow tier: the post-critical SV case (34 s); the Rayleigh wave stays in make test
 @pytest.mark.parametrize("wave,extra", [("rayleigh", {}),
-                                        ("sv", dict(seismic_angle=40.0, seismic_postcritical=1))])
+                                        pytest.param("sv", dict(seismic_angle=40.0, seismic_postcritical=1),
+                                                     marks=[pytest.mark.slow])])
 def test_a_block_under_a_hilbert_wave_does_not_depend_on_the_start(tmp_path, dpulse, wave, extra):
     """The roof's acceleration (m/s^2, x and z) with the default tolerance (0.01: the wave starts
     about 4 s before the record) and with 0.003 (about 14 s before), on the record's time axis from

@@ -246,6 +246,9 @@ def test_mixed_model_K_M_against_independent_assembly(slab_model):
     assert total == pytest.approx(7200.0 + 2700.0, rel=1e-12)
 
 
+# slow tier: the mixed model's statics, modes, dynamics and two ranks (67 s; siblings in make test: the
+# building's fixed-base modes at two ranks and the element tests of tests/fem/elements)
+@pytest.mark.slow
 def test_mixed_model_static_modes_dynamics_and_two_ranks(slab_model, tmp_path):
     """runs/structures/slab-on-columns.opts as static, modes and dynamics:
     static receivers equal the independent assembly's solution (1e-9); `-n 2` equals `-n 1`
