@@ -144,7 +144,8 @@ def _wait_for(log, text, p, timeout=240):
     raise AssertionError(f"no '{text}' in the log:\n" + open(log).read()[-2000:])
 
 
-@pytest.mark.parametrize("nranks", [1, 2])
+# slow tier: the two-rank kill (15 s); the one-rank kill stays in make test
+@pytest.mark.parametrize("nranks", [1, pytest.param(2, marks=[pytest.mark.slow])])
 def test_a_kill_at_random_moments_keeps_the_flushed_steps(nranks, tmp_path):
     """SIGKILL without warning (a lost node; mpirun's kill when the stop outlasts its timeout) to the
     whole job (mpirun and every rank: helpers.kill_session), at 3 moments drawn at random (seeded)

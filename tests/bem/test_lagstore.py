@@ -54,6 +54,9 @@ def test_loaded_lags_give_the_assembled_run_bitwise(tmp_path):
         assert np.abs(D[k] - A[k]).max() <= 1e-12 * np.abs(A[k]).max(), k
 
 
+# slow tier: a coupled study reusing the soil's lags (14 s; sibling in make test:
+# test_loaded_lags_give_the_assembled_run_bitwise)
+@pytest.mark.slow
 def test_a_coupled_study_reuses_the_soil(tmp_path):
     """The block on the half-space with contact: the soil's matrices saved once, loaded by a run
     with a softer, heavier block (the structure is not in the key): bitwise the assembled run."""

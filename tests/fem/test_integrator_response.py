@@ -166,6 +166,9 @@ BOX = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "1,1,2", "-ssi_fem_box_size"
        "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none", "-ssi_receivers", "0.5,0.5,1"]
 
 
+# slow tier: the 70 Hz record under a stiff structure run twice (20 s; siblings in make test:
+# test_safe_band_and_record_note and test_which_runs_check_their_record)
+@pytest.mark.slow
 def test_a_stiff_structure_under_a_record_at_70_hz_is_warned_and_the_named_dt_resolves_it(tmp_path):
     """A stiff block (first mode ~ 600 Hz) on a fixed base under 5 Hz + 70 Hz (a third of the peak):
     at dt = 5 ms green's roof peak absolute acceleration exceeds newmark's by over 30 % and the run
