@@ -56,6 +56,17 @@ def resolve_error(groups=("common", "bem"), **opts):
             db.delValue("ssi_" + k)
 
 
+def run_script(*parts):
+    """The module of a study script under runs/ (``run_script("runs", "trench", "trench.py")``): tests
+    run its functions, as the README's numbers come from them."""
+    import importlib.util
+    path = os.path.join(ROOT, *parts)
+    spec = importlib.util.spec_from_file_location(os.path.splitext(parts[-1])[0] + "_study", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
 def cli(args, nranks=1, timeout=900, check=True):
     """Run ``petsc-ssi`` (python -m petsc_ssi) in a subprocess, optionally under mpirun."""
     cmd = [PY, "-m", "petsc_ssi"] + list(args)

@@ -9,22 +9,16 @@ Measured (runs/embedment/README.md), eta_BEM / eta_PK - 1 at h = 1 m and 0.5 m:
     torsion   -18.2 %, -20.1 % ->  -9.2 %, -11.5 %
     rocking    -10.5 %, -15.8 % ->  -1.8 %, -8.1 %   (about the base's centre)
 every one closer to the table on the finer mesh (about halving)."""
-import importlib.util
-import os
 
 import pytest
 
-from helpers import ROOT
+from helpers import run_script
 
 pytestmark = pytest.mark.run
 
 
 def script():
-    path = os.path.join(ROOT, "runs", "embedment", "static_stiffness.py")
-    spec = importlib.util.spec_from_file_location("static_stiffness", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return run_script("runs", "embedment", "static_stiffness.py")
 
 
 def test_embedment_factors_on_one_metre_elements(tmp_path):

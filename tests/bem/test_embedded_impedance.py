@@ -8,23 +8,17 @@ What a wrong embedded footing would fail: walls that did not radiate leave the n
 the surface footing's (the walls' dashpots are what Table 2-3b adds: +50 % horizontally at D/B = 0.5),
 and a wrong time or space integration on the walls bends k and c away from the table.
 Measured (runs/embedment/README.md)."""
-import importlib.util
-import os
 
 import numpy as np
 import pytest
 
-from helpers import ROOT
+from helpers import run_script
 
 pytestmark = pytest.mark.run
 
 
 def script():
-    path = os.path.join(ROOT, "runs", "embedment", "dynamic_stiffness.py")
-    spec = importlib.util.spec_from_file_location("dynamic_stiffness", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return run_script("runs", "embedment", "dynamic_stiffness.py")
 
 
 def test_pais_kausel_embedded_brackets_are_the_plane_wave_dashpots():

@@ -57,14 +57,8 @@ def test_smooth_pulse_second_order_at_5m(tmp_path):
 
 
 def _study_module():
-    import importlib.util
-    import os
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    spec = importlib.util.spec_from_file_location("convergence_smooth",
-                                                  os.path.join(root, "runs", "pekeris", "convergence_smooth.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    from helpers import run_script
+    return run_script("runs", "pekeris", "convergence_smooth.py")
 
 
 # slow tier: the full study's three levels at r = 5 m and 15 m on the 48 m surface (about 6 min on

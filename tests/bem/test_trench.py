@@ -8,23 +8,17 @@ What a wrong trench would fail: a trench that did not scatter (normals, free ter
 leaves ARF near 1; the published trend (Woods 1968; Segol, Lee & Abel 1978) is ARF well below 1/2
 once d / lambda_R exceeds about 0.6, and a reduction that grows with the depth.
 Measured (runs/trench/README.md)."""
-import importlib.util
-import os
 
 import numpy as np
 import pytest
 
-from helpers import ROOT
+from helpers import run_script
 
 pytestmark = pytest.mark.run
 
 
 def script():
-    path = os.path.join(ROOT, "runs", "trench", "trench.py")
-    spec = importlib.util.spec_from_file_location("trench", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return run_script("runs", "trench", "trench.py")
 
 
 def test_the_generator_places_a_trench_off_the_centre():
