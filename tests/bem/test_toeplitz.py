@@ -1,7 +1,7 @@
 """The toeplitz lag store (issue 41; bem/toeplitz.py): on a uniform flat grid the H lags of the history
 sum are block-Toeplitz kernels applied in Fourier space. It is exact, not an approximation: every
 recorded field equals the dense path's to 1e-12 of the run's largest value of its kind
-(``test_history_block.same``; observed 4e-16 on the stabilised case), for the plain and stabilised
+(``test_history_block.same``), for the plain and stabilised
 schemes, the interpolation of the far lags, symmetry planes, prescribed motion, the coupled run with
 unilateral contact, at -n 1 and -n 2, and through a restart (bit for bit: the kept transforms are
 made again from the checkpoint's states). A surface that is not a uniform grid is refused in one
