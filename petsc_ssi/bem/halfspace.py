@@ -119,8 +119,6 @@ class HalfSpace:
         self.mesh = mesh if mesh is not None else read_soil_surface(cfg, comm, self.planes)
         h = float(self.mesh.element_sizes().max())
         self.h = h
-        if not self.mesh.flat:
-            self._check_excavation_run(interface)
         bad, ang = surface.kinks(self.mesh, self.planes)
         if len(bad):
             printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
@@ -137,7 +135,12 @@ class HalfSpace:
             warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
-        self._excavation = None
+        self._excavation = self._interface_ff = None
+        if wave and interface is not None and not self.mesh.flat:
+            # the free field's traction on the structure's faces below the ground (walls, bottom): the
+            # structure takes the total traction t_sc + t_ff there (``interface_free_field``)
+            from ..sources.free_field import InterfaceFreeField
+            self._interface_ff = InterfaceFreeField(self.mesh, interface.be_elems, interface.be_nodes, interface.M)
         if wave and not self.mesh.flat:       # the scattered field's -t_ff on the excavation's free faces
             self._excavation = self._free_field_source(disp)
             self.sources += [self._excavation] if self._excavation is not None else []
@@ -176,6 +179,8 @@ class HalfSpace:
             self.seismic = self._seismic_input(self._control_point(interface))   # (record and wave checked first)
             if self._excavation is not None:
                 self._excavation.attach(self.seismic)
+            if self._interface_ff is not None:
+                self._interface_ff.attach(self.seismic)
             loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
             if interface is None and self.motion is None and not loaded:
                 # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
@@ -193,13 +198,6 @@ class HalfSpace:
             self._seismic_lines()
         if interface is not None:
             self.diffraction_warning(interface.x, "the structure (interface nodes)")
-
-    def _check_excavation_run(self, interface):
-        """What a surface with an excavation does not take yet (one line, before any assembly)."""
-        cfg = self.cfg
-        if interface is not None:
-            raise SSIError(f"-ssi_mesh {cfg.mesh}: a structure coupled to a soil surface with an excavation is not "
-                           "supported yet (issue 42, item 2); use a plane surface")
 
     def _free_field_source(self, disp):
         """The free field's traction -t_ff on the excavation's faces (every element below the ground but
@@ -299,6 +297,15 @@ class HalfSpace:
         r0, r1 = out.getOwnershipRange()
         out.getArray()[:] += self.free_field_owned(t, r0, r1)
         return out
+
+    def interface_free_field(self, m):
+        """The free field's traction t_ff = sigma_ff n_b (n_I, 3) [Pa] on a coupled structure's interface,
+        the exact mean over ((m-1) dt, m dt], n_b the soil's outward normal, as the nodal field whose
+        consistent force is that of t_ff face by face (``sources.free_field.InterfaceFreeField``); None
+        where it vanishes (no wave, or a plane surface: the free field is traction-free on z = 0)."""
+        if self._interface_ff is None:
+            return None
+        return self._interface_ff.step_mean(m, self.dt)
 
     def free_field_at(self, nodes, t):
         """The free-field displacement (3 n,) of soil ``nodes`` at time t [m] (0 without a wave)."""

@@ -23,6 +23,10 @@ broadcast (n_I booleans per iteration): ranks whose BLAS differ in the last
 bit (heterogeneous nodes, run-time-dispatched kernels) could otherwise take
 different active sets and deadlock or diverge.
 
+Under a wave on a surface with an excavation the soil carries the scattered field and the free field has
+a traction t_ff = sigma_ff n_b on the structure's faces below the ground (``offset``, per step): p_N and
+the open nodes' target are taken on the total traction p + t_ff; on a plane surface t_ff = 0.
+
 Kuhn-Tucker conditions (paper eq. 25), per node, n_b the soil's outward normal:
   gap     g = (u_b - u_f) . n_f = -delta . n_b        (g >= 0)
   traction p_N = p_b . n_b (tension positive)         (p_N <= p_C)
@@ -110,6 +114,7 @@ class ContactLaw:
         self.preload = float(preload)                # p_w: the static compression [N/m^2], >= 0
         self.tol = float(tol)
         self.max_iter = int(max_iter)
+        self.offset = None                           # the step's free-field traction t_ff (3 n_I) or None
         self.closed = np.ones(self.nI, bool)
         self.ub_prev = np.zeros(3 * self.nI)
         self.total_changes = 0
@@ -131,7 +136,14 @@ class ContactLaw:
             tt = ((p_open + self.preload) * self.n_b) * (~closed)[:, None]
             t[:] = tt.ravel()
             t[self.zero.ravel()] = 0.0
+        if self.offset is not None:                  # the soil carries t - t_ff: the total is the target
+            t -= np.repeat(~closed, 3) * self.offset * ~self.zero.ravel()
         return t
+
+    def total(self, p):
+        """The total traction p + t_ff of the soil's (scattered) traction p: the free field's share on
+        faces below the ground (``offset``; none on a plane surface)."""
+        return p if self.offset is None else p + self.offset
 
     def _agree(self, obj):
         """Collective (with a comm): rank 0's decision on every rank."""
@@ -162,7 +174,7 @@ class ContactLaw:
             while True:
                 its += 1
                 O, ub, uf, p = solve(closed)
-                pN = self._normal(p)
+                pN = self._normal(self.total(p))
                 gap = -self._normal(ub - uf)
                 # violations relative to their own scales (tractions and displacements)
                 sp = max(np.abs(p).max(), self.p_C, self.preload, 1e-300)
@@ -186,7 +198,7 @@ class ContactLaw:
                 changes += int((new != closed).sum())
                 closed = new
                 seen.add(closed.tobytes())
-        pN = self._normal(p)
+        pN = self._normal(self.total(p))
         gap = -self._normal(ub - uf)
         self.closed = closed
         self.ub_prev = ub

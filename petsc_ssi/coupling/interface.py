@@ -29,10 +29,13 @@ def _fmt(points, k=3):
         (f"; ... ({len(points)} in all)" if len(points) > k else "")
 
 
-def fe_interface_faces(fe_mesh, groups):
+def fe_interface_faces(fe_mesh, groups, excavated=False):
     """Quads of the comma-separated FE groups that rest on the soil, ordered so that their
     normal points out of the structure (into the soil): brick faces as they are (outward),
-    shell cells reversed (shells are oriented up: the soil is under a foundation slab)."""
+    shell cells reversed (shells are oriented up: the soil is under a foundation slab).
+    ``excavated``: the soil's surface has an excavation, and the groups' faces above the ground
+    z = 0 (a basement's walls continuing up as the storey's) are left out: the soil touches only
+    the faces below it."""
     out = []
     for name in [g.strip() for g in str(groups).split(",") if g.strip()]:
         if name in fe_mesh.shells and name not in fe_mesh.faces:
@@ -40,9 +43,20 @@ def fe_interface_faces(fe_mesh, groups):
         else:
             out.append(group_faces(fe_mesh, name, "-ssi_fem_interface"))
     quads = np.concatenate(out) if out else np.zeros((0, 4), np.int64)
+    if excavated and len(quads):
+        quads = quads[fe_mesh.coords[quads, 2].max(axis=1) <= ground_tol(fe_mesh)]
+        if len(quads) == 0:
+            raise SSIError(f"-ssi_fem_interface {groups}: none of these faces lies below the ground z = 0 (on a "
+                           "surface with an excavation the soil touches the structure's faces in it)")
     if len(quads) == 0:
         raise SSIError("-ssi_fem_interface names no faces of the structure")
     return quads
+
+
+def ground_tol(fe_mesh):
+    """The tolerance [m] for a structure's node to lie on or below the ground z = 0: 1e-6 of the mesh's
+    largest extent."""
+    return 1e-6 * (float(np.ptp(fe_mesh.coords, axis=0).max()) or 1.0)
 
 
 def interface_offsets(fe_mesh, iface, groups):
@@ -165,9 +179,10 @@ def build_interface(be_mesh, fe_mesh, spec, fe_groups, tol_rel, planes=(), h=1.0
     """Match the meshes (SSIError listing unmatched nodes); normals; M.
 
     ``spec``: 'auto', a BE group name or 'box:...'. ``planes``: symmetry planes
-    (the DOFs they force to zero are flagged in ``zero``, shape (n_I, 3))."""
+    (the DOFs they force to zero are flagged in ``zero``, shape (n_I, 3)). On a soil surface with
+    an excavation the structure's faces below the ground are matched (walls and bottom)."""
     from scipy.spatial import cKDTree
-    quads = fe_interface_faces(fe_mesh, fe_groups)
+    quads = fe_interface_faces(fe_mesh, fe_groups, excavated=not be_mesh.flat)
     fnodes = np.unique(quads)
     xf = fe_mesh.coords[fnodes]
     edges = np.concatenate([quads[:, [0, 1]], quads[:, [1, 2]]])

@@ -8,16 +8,20 @@ from ..petsc import SSIError, collective, printf
 from ..bem.halfspace import HalfSpace, read_soil_surface
 from ..bem import symmetry
 from ..fem.model import build_model
-from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces, interface_offsets
+from .interface import build_interface, fem_symmetry_dofs, fe_interface_faces, ground_tol, interface_offsets
 from .step import STRATEGIES
 
 
-def check_on_surface(mesh, groups):
+def check_on_surface(mesh, groups, soil=None):
     """SSIError when the structure's interface faces (-ssi_fem_interface) do not lie on the soil's
-    surface z = 0 (a structure placed above or below the soil), naming their heights."""
-    z = mesh.coords[np.unique(fe_interface_faces(mesh, groups)), 2]
-    ext = float(np.ptp(mesh.coords, axis=0).max()) or 1.0
-    if np.abs(z).max() > 1e-6 * ext:
+    surface z = 0 (a structure placed above or below the soil), naming their heights. On a ``soil``
+    surface with an excavation the faces below the ground are the interface (walls and bottom: the
+    matching names any that miss the soil's nodes); a structure wholly above the ground is refused."""
+    excavated = soil is not None and not soil.flat
+    z = mesh.coords[np.unique(fe_interface_faces(mesh, groups, excavated)), 2]
+    if excavated:
+        return
+    if np.abs(z).max() > ground_tol(mesh):
         where = "above" if z.min() > 0 else "below" if z.max() < 0 else "off"
         raise SSIError(f"-ssi_fem_interface {groups}: the structure's interface faces lie at z = {z.min():.6g} .. "
                        f"{z.max():.6g} m, {where} the soil's surface z = 0 (they must rest on it: move the "
@@ -38,7 +42,7 @@ def build_coupled(cfg, comm):
     mesh = read_soil_surface(cfg, comm, planes)
     model = build_model(cfg, comm, assemble_matrices=False, receivers=cfg.structure_receivers,
                         receivers_what="-ssi_structure_receivers",
-                        check_mesh=lambda mesh: check_on_surface(mesh, cfg.fem_interface))
+                        check_mesh=lambda fe: check_on_surface(fe, cfg.fem_interface, mesh))
     iface = sym = None
     with collective(comm, "matching the interface"):
         iface = build_interface(mesh, model.mesh, cfg.interface, cfg.fem_interface, cfg.interface_tol,

@@ -33,7 +33,7 @@ from .step import Coupler
 INTERFACE_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "iterations", "changes", "force_fe", "force_be",
                   "moment_fe", "moment_be", "bem_residual", "force_map_error", "n_open")
 # the keys with a value per interface dof or node: kept every -ssi_interface_stride steps
-NODAL_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "uf_check", "uff")
+NODAL_KEYS = ("uf", "ub", "p", "gap", "pN", "closed", "uf_check", "uff", "pff")
 
 
 class SSITransient(TransientProblem):
@@ -116,7 +116,8 @@ class SSITransient(TransientProblem):
         from ..fem.recorder import StructureRecorder
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
-            (("uff",) if self.prob.seismic is not None else ())
+            (("uff",) if self.prob.seismic is not None else ()) + \
+            (("pff",) if self.prob.interface_free_field(1) is not None else ())
         rd = self._open_restart()
         self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None,
@@ -170,7 +171,7 @@ class SSITransient(TransientProblem):
         coupler, integ = self.coupler, self.integ
         with staged("SSI time loop"):
             uffI = self.prob.free_field_at(self.iface.be_nodes, self.time(n)) if self.prob.seismic is not None else None
-            u, p, res = coupler.step(self.load(n), uffI)
+            u, p, res = coupler.step(self.load(n), uffI, self.prob.interface_free_field(n))
             t = self.time(n)
             if res["cycled"]:
                 coupler.law.cycled_steps.append(n)
@@ -194,7 +195,7 @@ class SSITransient(TransientProblem):
         nI = self.coupler.nI
         inter = rec.interface_arrays()
         nodal = inter.pop("nodal_steps")
-        for k in ("uf", "ub", "p") + tuple(k for k in ("uf_check", "uff") if k in inter):
+        for k in ("uf", "ub", "p") + tuple(k for k in ("uf_check", "uff", "pff") if k in inter):
             inter[k] = inter[k].reshape(len(nodal), nI, 3)
         inter["n_open"] = np.asarray(inter["n_open"], np.int64)
         inter["t"] = np.asarray(times)

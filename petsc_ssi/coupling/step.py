@@ -106,7 +106,9 @@ class ImplicitStep:
         # totals (which loses the digits of p where the structure follows the free field); the
         # gap (u_b - u_f) . n_f is the same; u_b and u_f are handed back as totals
         uff = self.cp.uffI
-        res = self.cp.law.step(self.solver(yI, wI - uff, np.zeros_like(yI)), None)
+        # the free field's traction t_ff on faces below the ground: the structure takes p + t_ff (r)
+        r = self.cp.law.offset if self.cp.law.offset is not None else np.zeros_like(yI)
+        res = self.cp.law.step(self.solver(yI, wI - uff, r), None)
         if uff.any():
             res["ub"], res["uf"] = res["ub"] + uff, res["uf"] + uff
         return res
@@ -255,13 +257,16 @@ class Coupler:
         solve_columns(integ.ksp, integ.u, 3 * self.nI, fill, take)
         return out, C
 
-    def step(self, f_ext, uffI=None):
+    def step(self, f_ext, uffI=None, pffI=None):
         """Collective: one coupled step; ``uffI``: the free-field displacement of the interface
         nodes at t_n (3 n_I, every rank; a seismic input in the scattered-field form: the BEM
-        carries u_sc = u - u_ff, the interface and contact work with total u_b). Returns
-        (u_soil scattered, p_soil, info)."""
+        carries u_sc = u - u_ff, the interface and contact work with total u_b); ``pffI``: the free
+        field's traction t_ff on the interface, the step's mean (3 n_I; None on a plane surface,
+        where it vanishes): the structure and the contact law take p_sc + t_ff. Returns
+        (u_soil scattered, p_soil scattered, info: its "p" the total traction)."""
         m, st = self.march, self.strategy
         self.uffI = np.zeros(3 * self.nI) if uffI is None else np.asarray(uffI, float)
+        self.law.offset = None if pffI is None else np.asarray(pffI, float).ravel()
         with event("SSI_FEM_Step"):
             uf = st.predict(f_ext)                                 # B.1
         wI = self.Top.gather(uf)
@@ -287,6 +292,8 @@ class Coupler:
         res["bem_residual"] = self._bem_residual(b)
         fI = self._handover(res)
         res["force_map_error"] = self._force_map_error(p, res["p"])
+        if self.law.offset is not None:         # recorded: the total traction, and the free field's share
+            res["p"], res["pff"] = res["p"] + self.law.offset, self.law.offset
         with event("SSI_FEM_Step"):
             st.finish(f_ext, fI, res)
         return u, p, res
@@ -300,6 +307,7 @@ class Coupler:
             tr = np.where(same, self.c_new * res["p"] - self.c_old * self.pI_prev, res["p"])
         self.closed_prev = res["closed"].copy()
         self.pI_prev = res["p"].copy()
+        tr = self.law.total(tr)                 # + t_ff below the ground (exact step mean: not extrapolated)
         f_all = -self._m3(tr)
         fI = f_all.copy()
         fI[self.fixed_I] = 0.0                  # supports (symmetry planes) take these

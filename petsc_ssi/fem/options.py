@@ -79,6 +79,11 @@ register("fem_E", "real", 300e6, "N/m^2", "Young's modulus of the structure (pap
          validator=positive)
 register("fem_nu", "real", 0.2, "", "Poisson's ratio of the structure, in (-1, 0.5)", G, validator=_nu_range)
 register("fem_rho", "real", 2000.0, "kg/m^3", "density of the structure (lumped mass)", G, validator=positive)
+register("fem_cp", "real", 0.0, "m/s", "P-wave speed of the structure's single hex8 part, with -ssi_fem_cs and "
+         "-ssi_fem_rho instead of -ssi_fem_E and -ssi_fem_nu (a soil region filling an excavation); 0: unused", G,
+         validator=nonnegative)
+register("fem_cs", "real", 0.0, "m/s", "S-wave speed of the structure's single hex8 part (with -ssi_fem_cp)", G,
+         validator=nonnegative)
 register("fem_alpha_m", "real", 0.0, "1/s", "mass-proportional damping C = alpha_m M", G, validator=nonnegative)
 register("fem_damping_ratio", "real", 0.0, "", "damping ratio zeta at -ssi_fem_damping_freq: alpha_m = 2 zeta "
          "omega (instead of -ssi_fem_alpha_m)", G, validator=nonnegative)

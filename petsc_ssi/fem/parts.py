@@ -6,6 +6,7 @@ that carry elements. Each part takes its element and properties from
 
   element       hex8 | frame | shell            (required)
   E, nu, rho    Young's modulus [N/m^2], Poisson's ratio, density [kg/m^3]   (required)
+  cp, cs        hex8: P- and S-wave speeds [m/s] instead of E and nu (a soil region: with rho)
   thickness     shell thickness [m]                                           (shell, required)
   mass_per_area shell: mass per area [kg/m^2] used instead of rho * thickness
   section b,h   frame: rectangle of width b and depth h [m] (h along the orientation
@@ -27,7 +28,8 @@ that carry elements. Each part takes its element and properties from
                 mechanism the static solve refuses): fix its torsion at one end
 
 Without ``-ssi_fem_parts`` the structure is one hex8 part made of every brick
-of the mesh with ``-ssi_fem_E/_nu/_rho`` (the behaviour before parts existed).
+of the mesh with ``-ssi_fem_E/_nu/_rho`` or ``-ssi_fem_cp/_cs/_rho`` (the behaviour before parts
+existed).
 A part name may contain underscores; a misspelt part or property is an error
 with a suggestion. Parsing is replicated (every rank reads the same database)
 and raises SSIError before any mesh is read.
@@ -49,6 +51,8 @@ PROPERTIES = {
     "E": ("real", "N/m^2", "Young's modulus"),
     "nu": ("real", "", "Poisson's ratio, in (-1, 0.5)"),
     "rho": ("real", "kg/m^3", "density"),
+    "cp": ("real", "m/s", "hex8: P-wave speed, with cs instead of E and nu (a soil region)"),
+    "cs": ("real", "m/s", "hex8: S-wave speed, with cp instead of E and nu (a soil region)"),
     "thickness": ("real", "m", "shell thickness"),
     "mass_per_area": ("real", "kg/m^2", "shell: mass per area used instead of rho * thickness"),
     "section": ("b,h", "m", "frame: rectangle of width b and depth h (h along the orientation vector)"),
@@ -64,7 +68,7 @@ PROPERTIES = {
                 "(translations tied, rotations released; default none: monolithic)"),
 }
 ALLOWED = {
-    "hex8": ("element", "E", "nu", "rho"),
+    "hex8": ("element", "E", "nu", "rho", "cp", "cs"),
     "shell": ("element", "E", "nu", "rho", "thickness", "mass_per_area", "shear_factor", "added_mass", "drilling",
               "release"),
     "frame": ("element", "E", "nu", "rho", "section", "area", "Iy", "Iz", "J", "orientation", "shear_factor",
@@ -141,6 +145,41 @@ def _split_key(rest, names):
     return best, rest[len(best) + 1:]
 
 
+def elastic_from_wave_speeds(cp, cs, rho, what):
+    """(E [N/m^2], nu) of an isotropic solid of wave speeds cp, cs [m/s] and density rho [kg/m^3]:
+    nu = (cp^2 - 2 cs^2) / (2 (cp^2 - cs^2)), E = 2 rho cs^2 (1 + nu). SSIError naming ``what`` unless
+    0 < cs and cp / cs > 2 / sqrt(3) (nu > -1 needs only cp > cs; nu < 0.5 any finite cp)."""
+    if not (cs > 0 and cp > cs * np.sqrt(4.0 / 3.0) and rho > 0):
+        raise SSIError(f"{what}: wave speeds cp {cp:g}, cs {cs:g} m/s and density {rho:g} kg/m^3 must have cs > 0, "
+                       "cp > 2 cs / sqrt(3) (Poisson's ratio above -1 with a positive bulk modulus) and rho > 0")
+    nu = (cp * cp - 2.0 * cs * cs) / (2.0 * (cp * cp - cs * cs))
+    return 2.0 * rho * cs * cs * (1.0 + nu), nu
+
+
+def _from_wave_speeds(g, opt):
+    """A hex8 part given by cp, cs (and rho) as one given by E, nu (a soil region)."""
+    both = [p for p in ("E", "nu") if p in g]
+    if both or not ("cp" in g and "cs" in g and "rho" in g):
+        raise SSIError(f"{opt('cp')}/{opt('cs')}: a part given by its wave speeds takes cp, cs and rho together "
+                       f"and not E or nu" + (f" (also given: {', '.join(opt(p) for p in both)})" if both else ""))
+    cp, cs, rho = (_real(g[p], opt(p)) for p in ("cp", "cs", "rho"))
+    E, nu = elastic_from_wave_speeds(cp, cs, rho, f"part {opt('cp')[:-3]}")
+    return {**{k: v for k, v in g.items() if k not in ("cp", "cs")}, "E": repr(E), "nu": repr(nu)}
+
+
+def _legacy_props(cfg):
+    """The box's single hex8 part: -ssi_fem_E/_nu/_rho, or -ssi_fem_cp/_cs/_rho (a soil region)."""
+    cp, cs = float(cfg.get("fem_cp", 0.0) or 0.0), float(cfg.get("fem_cs", 0.0) or 0.0)
+    if cp or cs:
+        user = getattr(cfg, "user_set", lambda name: False)
+        given = [f"-ssi_fem_{p}" for p in ("E", "nu") if user("fem_" + p)]
+        if given:
+            raise SSIError(f"-ssi_fem_cp/-ssi_fem_cs give the structure's E and nu: drop {' and '.join(given)}")
+        E, nu = elastic_from_wave_speeds(cp, cs, cfg.fem_rho, "-ssi_fem_cp/-ssi_fem_cs")
+        return Props(E=E, nu=nu, rho=cfg.fem_rho)
+    return Props(E=cfg.fem_E, nu=cfg.fem_nu, rho=cfg.fem_rho)
+
+
 def parse_parts(cfg, raw=None):
     """Replicated: [PartSpec] of the options (SSIError on any bad or missing property)."""
     names = part_names(cfg)
@@ -149,7 +188,7 @@ def parse_parts(cfg, raw=None):
         if raw:
             key = sorted(raw)[0]
             raise SSIError(f"-{KEY}{key} is set but -ssi_fem_parts names no part")
-        return [PartSpec("structure", "hex8", Props(E=cfg.fem_E, nu=cfg.fem_nu, rho=cfg.fem_rho), legacy=True)]
+        return [PartSpec("structure", "hex8", _legacy_props(cfg), legacy=True)]
     if len(set(names)) != len(names):
         raise SSIError(f"-ssi_fem_parts '{cfg.fem_parts}': a part is named twice")
     given = {n: {} for n in names}
@@ -177,6 +216,8 @@ def _spec(name, g):
         if p not in ALLOWED[el]:
             raise SSIError(f"{opt(p)}: a {el} part has no property '{p}' (its properties: "
                            f"{', '.join(q for q in ALLOWED[el] if q != 'element')})")
+    if "cp" in g or "cs" in g:
+        g = _from_wave_speeds(g, opt)
     missing = [p for p in REQUIRED[el] if p not in g]
     if missing:
         raise SSIError(f"part '{name}' ({el}) needs {', '.join(opt(p) for p in missing)}")

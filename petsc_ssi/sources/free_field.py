@@ -91,3 +91,54 @@ class FreeFieldTraction:
     def describe(self):
         return (f"{self.name}: {self.elements.size} elements (walls and bottoms), traction -sigma_ff n of the "
                 "seismic input")
+
+
+class InterfaceFreeField:
+    """The free field's traction t_ff = sigma_ff n on a coupled structure's faces below the ground (walls and
+    bottom of an excavation), for the structure's side of the interface.
+
+    The structure takes the consistent force of the total traction, f_a = -int N_a (t_sc + t_ff) dGamma. The
+    free field's share is integrated element by element with each face's own normal,
+
+        b_a = sum_e int_e N_a sigma_ff(x) n_e dGamma     (Gauss rule of ``order`` points a direction),
+
+    so that the jump of t_ff at an edge (a wall meeting the bottom) stays where it is; its nodal
+    traction is the L2 projection p_ff = M^-1 b on the interface's continuous nine-node field (M the
+    interface's consistent mass matrix, ``coupling.interface``), for which M p_ff = b exactly. (The
+    nodal values at the nodes' mean normals, as ``FreeFieldTraction`` takes on free faces, would give
+    M p_ff != b near an edge: the soil's scattered traction then makes up the difference, a
+    self-equilibrated traction near the edges as large as t_ff that does not fall with the mesh.)
+    Step means over ((m-1) dt, m dt] are exact, from the free field's running stress integral."""
+
+    def __init__(self, mesh, elements, nodes, M, order=4):
+        import scipy.sparse.linalg as sla
+        g, w = np.polynomial.legendre.leggauss(order)
+        XI, ETA = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+        X = mesh.cell_coords()[np.asarray(elements, np.int64)]           # (e, 9, 3)
+        x, jn = quad9.geometry(X, XI, ETA)                                # (e, q, 3) each
+        N = quad9.shape(XI, ETA)                                          # (q, 9)
+        self._x = x.reshape(-1, 3)
+        self._jw = (jn * np.outer(w, w).ravel()[None, :, None]).reshape(-1, 3)   # n J w at each point
+        # b_a = sum over points of N_a(q) (traction integral with the weighted normal at q)
+        rows = np.searchsorted(nodes, mesh.cells[np.asarray(elements, np.int64)])          # (e, 9)
+        e, q = X.shape[0], len(XI)
+        import scipy.sparse as sp
+        self._P = sp.csr_matrix((np.tile(N, (e, 1)).ravel(),
+                                 (np.repeat(rows, q, axis=0).ravel(),
+                                  np.repeat(np.arange(e * q), 9))), shape=(len(nodes), e * q))
+        self._lu = sla.splu(sp.csc_matrix(M))
+        self.seismic = None
+
+    def attach(self, seismic):
+        """The seismic input (``seismic.input.SeismicInput``) whose free field this is."""
+        self.seismic = seismic
+
+    def force(self, m, dt):
+        """b (k, 3) [N]: int N_a t_ff dGamma at the interface nodes, the exact mean over ((m-1) dt, m dt]."""
+        I = self.seismic.traction_integral
+        T = (I(self._x, self._jw, m * dt) - I(self._x, self._jw, (m - 1) * dt)) / dt
+        return np.asarray(self._P @ T)
+
+    def step_mean(self, m, dt):
+        """p_ff = M^-1 b (k, 3) [Pa]: the nodal traction whose consistent force is b."""
+        return self._lu.solve(self.force(m, dt))

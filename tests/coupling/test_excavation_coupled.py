@@ -1,0 +1,169 @@
+"""A structure in an excavation (issue 42, items 2 and 4): the coupled FEM-BEM run on a soil surface with a
+pit, the structure's faces below the ground (walls and bottom) matched to the soil's, and under a wave
+the free field's traction t_ff = sigma_ff n on them handed to the structure with the soil's scattered
+traction (``sources.free_field.InterfaceFreeField``; the contact law takes the total).
+
+The check that needs no reference solution: a pit filled with finite elements of the same soil
+(-ssi_fem_cp/-ssi_fem_cs/-ssi_fem_rho: a soil region) scatters nothing, so the coupled run must
+reproduce the free field, in the region and in the soil around it:
+  * vertically incident S (a sin^4 pulse of 40 ms, wavelength 12.6 m), pit 2 x 2 x 1 m, soil elements
+    1 m, bricks 0.5 m: the region's top centre and a node inside it follow the closed-form free field
+    within 5e-4 of its peak (measured 1.9e-4 and 1.3e-4), the interface nodes within 3e-3 (1.35e-3),
+    the soil's surface 1 m from the pit within 5e-4 (1.8e-4); the force of the soil on the region is
+    the region's inertia int rho u_ff'' dV = rho A (c_s / 2) [v(t - t0 + d/c_s) - v(t - t0 - d/c_s)]
+    within 2 % of its peak (measured 1.0 %);
+  * oblique SV at 30 degrees: the interface nodes within 1.5e-2 of the free field's peak (8.4e-3);
+  * with 0.5 m elements and 0.25 m bricks (slow tier) the errors fall: interface 1.35e-3 -> 6.9e-4
+    (vertical), 8.4e-3 -> 4.4e-3 (SV); the region's top 1.9e-4 -> 1.0e-4;
+  * the free field's traction on the interface is needed: scaled by 0 (the soil's scattered traction
+    alone, what a plane surface needs) the interface nodes are off by 9.0e-3 of the peak, by 8.9e-3 with
+    twice it and 1.7e-2 with its opposite, against 1.1e-3 with it (measured once by scaling the term in a
+    scratch copy, with the nodal tractions at the nodes' mean normals that preceded the consistent
+    force; not kept as a test);
+  * -n 2 equals -n 1; refusals in one line.
+Known and not fixed: the interface's nodal scattered traction (the output's interface/p minus
+interface/pff) is a self-equilibrated field near the pit's edges of the size of t_ff (0.7-0.9 of its
+peak at bottom nodes at both meshes), though its resultant is 1 % of the free field's: the nodal
+traction is continuous across the wall-bottom edge where the true traction jumps, and its error there
+does not fall with the mesh; displacements and resultants do.
+"""
+import h5py
+import numpy as np
+import pytest
+
+from helpers import cli
+
+pytestmark = pytest.mark.mpi
+
+CS, CP, RHO = 316.0, 548.0, 2000.0
+
+
+def pulse(path, T):
+    """A sin^4 acceleration pulse of length T then the reversed one, 1 m/s^2 (zero net velocity)."""
+    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
+    a = sum(sg * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
+            for k, sg in enumerate((1, -1)))
+    np.savetxt(path, np.c_[t, a], header="units: m/s2")
+    return str(path)
+
+
+def args(tmp, name, h=1.0, wave="vertical", angle=0.0, T=0.04, extra=()):
+    n, nz = int(round(4 / h)), int(round(2 / h))
+    return ["run", "-ssi_problem", "ssi", "-ssi_mesh", "pit", "-ssi_mesh_params", "a=1,b=1,d=1",
+            "-ssi_mesh_size", "6,6", "-ssi_mesh_h", str(h), "-ssi_dt", str(0.0025 * h), "-ssi_t_end", "0.14",
+            "-ssi_seismic", wave, "-ssi_seismic_angle", str(angle),
+            "-ssi_seismic_record", pulse(tmp / f"p{T}.txt", T), "-ssi_seismic_units", "m/s2",
+            "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none",
+            "-ssi_fem_mesh", "box", "-ssi_fem_box_cells", f"{n},{n},{nz}", "-ssi_fem_box_size", "2,2,1",
+            "-ssi_fem_box_origin", "-1,-1,-1", "-ssi_fem_interface", "xmin,xmax,ymin,ymax,base",
+            "-ssi_fem_cp", str(CP), "-ssi_fem_cs", str(CS), "-ssi_fem_rho", str(RHO),
+            "-ssi_receivers", "2,0,0", "-ssi_structure_receivers", "0,0,0;0,0,-0.5",
+            "-ssi_output", str(tmp / name), "-ssi_output_overwrite", "1", "-ssi_warn_beta", "0", *extra]
+
+
+def free_field_x(f, P, t):
+    """Vertical S: u_x(z, t) = [D(t - t0 - z/c_s) + D(t - t0 + z/c_s)] / 2 at points P, times t [m]."""
+    D, td, t0 = f["seismic/x_displacement"][:], f["seismic/x_t"][:], float(f["seismic/t0"][()])
+    return np.stack([0.5 * (np.interp(t - t0 - p[2] / CS, td, D, left=0.0) +
+                            np.interp(t - t0 + p[2] / CS, td, D, left=0.0)) for p in P], axis=1)
+
+
+def interface_error(path):
+    """max |u_f - u_ff| over the interface nodes and steps / max |u_ff|."""
+    with h5py.File(path) as f:
+        g = f["interface"]
+        uf, uff = g["uf"][:], g["uff"][:]
+    return np.abs(uf - uff).max() / np.abs(uff).max()
+
+
+def region_errors(tmp, name):
+    """(region's receivers' error, soil receiver's error, force error), each / its free-field peak."""
+    path = str(tmp / name)
+    with h5py.File(path.replace(".h5", "_structure.h5")) as fs, h5py.File(path) as f:
+        ts, Ps, us = fs["receivers/t"][:], fs["receivers/points"][:], fs["receivers/u"][:]
+        uffs = free_field_x(f, Ps, ts)
+        t, P, u = f["receivers/t"][:], f["receivers/points"][:], f["receivers/u"][:]
+        uff = free_field_x(f, P, t)
+        ti, F = f["interface/t"][:], f["interface/force_fe"][:, 0]
+        D, td, t0 = f["seismic/x_displacement"][:], f["seismic/x_t"][:], float(f["seismic/t0"][()])
+    pk = np.abs(uffs).max()
+    e_region = np.abs(us[:, :, 0] - uffs).max() / pk
+    e_soil = max(np.abs(u[:, 0, 0] - uff[:, 0]).max(), np.abs(u[:, 0, 1:]).max()) / pk
+    # the region's inertia, the step's mean: (rho A c_s / 2) [v(t + d/c_s) - v(t - d/c_s)] averaged over
+    # (t_{n-1}, t_n] is a difference of displacements over dt (A = 4 m^2, d = 1 m)
+    dt, d = ti[1] - ti[0], 1.0
+
+    def vmean(s):
+        return (np.interp(ti - t0 + s, td, D, left=0.0) - np.interp(ti - dt - t0 + s, td, D, left=0.0)) / dt
+    F_ref = RHO * 4.0 * CS / 2.0 * (vmean(d / CS) - vmean(-d / CS))
+    e_force = np.abs(F - F_ref).max() / np.abs(F_ref).max()
+    return e_region, e_soil, e_force
+
+
+def test_a_pit_filled_with_the_same_soil_moves_with_the_free_field(tmp_path):
+    cli(args(tmp_path, "v.h5"))
+    e_region, e_soil, e_force = region_errors(tmp_path, "v.h5")
+    assert e_region < 5e-4, e_region
+    assert e_soil < 5e-4, e_soil
+    assert e_force < 0.02, e_force
+    assert interface_error(tmp_path / "v.h5") < 3e-3
+    with h5py.File(tmp_path / "v.h5") as f:
+        g = f["interface"]
+        x, pff = g["x"][:], g["pff"][:]
+        assert g["pff"].attrs["unit"] == "N/m^2"
+    # the walls and the bottom are the interface (57 nodes of 12 elements), and the free field's traction
+    # is there and not zero (sigma_xz on the bottom, a vertical shear on the x walls)
+    assert len(x) == 57 and x[:, 2].min() == -1.0 and np.abs(pff).max() > 1e3
+
+
+def test_an_oblique_sv_wave_too(tmp_path):
+    cli(args(tmp_path, "sv.h5", wave="sv", angle=30.0))
+    assert interface_error(tmp_path / "sv.h5") < 1.5e-2
+
+
+# slow tier: 0.5 m elements and 0.25 m bricks (25 s each); the default-tier siblings above run 1 m
+@pytest.mark.slow
+@pytest.mark.parametrize("wave,angle,coarse", [("vertical", 0.0, 1.35e-3), ("sv", 30.0, 8.38e-3)])
+def test_the_filled_pit_converges_with_the_mesh(tmp_path, wave, angle, coarse):
+    cli(args(tmp_path, "f.h5", h=0.5, wave=wave, angle=angle))
+    e = interface_error(tmp_path / "f.h5")
+    assert e < 0.6 * coarse, (e, coarse)            # measured 0.51 and 0.52 of the 1 m mesh's error
+    if wave == "vertical":
+        e_region, _, _ = region_errors(tmp_path, "f.h5")
+        assert e_region < 1.5e-4, e_region          # 1.0e-4 (1.9e-4 on the 1 m mesh)
+
+
+# slow tier: two runs, 10-20 s; the default tier's siblings: the refusals below at -n 2, and the filled pit
+# at -n 1
+@pytest.mark.slow
+def test_two_ranks_equal_one(tmp_path):
+    cli(args(tmp_path, "a.h5", T=0.02))
+    cli(args(tmp_path, "b.h5", T=0.02), nranks=2)
+    compared = 0
+    for stem in ("", "_structure"):
+        with h5py.File(tmp_path / f"a{stem}.h5") as fa, h5py.File(tmp_path / f"b{stem}.h5") as fb:
+            names = []
+            fa.visititems(lambda k, o: names.append(k) if isinstance(o, h5py.Dataset) and o.dtype.kind == "f"
+                          and ("displacement" in k or "interface/" in k or "receivers/u" in k) else None)
+            for k in names:
+                if "residual" in k or "error" in k:          # round-off diagnostics
+                    continue
+                a, b = fa[k][...], fb[k][...]
+                assert np.abs(a - b).max() <= 1e-9 * max(np.abs(a).max(), 1e-300), k
+                compared += np.abs(a).max() > 0
+    assert compared >= 8                      # fields that move, soil and structure
+
+
+@pytest.mark.parametrize("extra,msg", [
+    (("-ssi_fem_box_origin", "-1,-1,0.5"), "none of these faces lies below the ground z = 0"),
+    (("-ssi_fem_box_origin", "-1,-1,0"), "no soil element has all nine nodes on the structure"),
+    (("-ssi_fem_cp", "300"), "cp > 2 cs / sqrt(3)"),
+    (("-ssi_fem_E", "3e8"), "drop -ssi_fem_E"),
+])
+def test_bad_input_is_refused_in_one_line_on_every_rank(tmp_path, extra, msg):
+    ranks = 2 if "-ssi_fem_box_origin" in extra else 1        # (two at -n 2: the make-test budget)
+    p = cli(args(tmp_path, "r.h5", T=0.02, extra=extra), nranks=ranks, check=False)
+    assert p.returncode != 0
+    lines = [ln for ln in (p.stdout + p.stderr).splitlines() if "error" in ln]
+    assert lines and all(msg in ln for ln in lines), p.stdout + p.stderr
+    assert len(lines) == 1 or len(set(lines)) == 1
