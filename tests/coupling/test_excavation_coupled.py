@@ -167,3 +167,22 @@ def test_bad_input_is_refused_in_one_line_on_every_rank(tmp_path, extra, msg):
     lines = [ln for ln in (p.stdout + p.stderr).splitlines() if "error" in ln]
     assert lines and all(msg in ln for ln in lines), p.stdout + p.stderr
     assert len(lines) == 1 or len(set(lines)) == 1
+
+
+# slow tier: the soft layer in a 6 m box (a minute); the default tier's sibling: the filled pit above
+@pytest.mark.slow
+def test_a_soft_layer_in_a_narrow_box_resonates_as_a_box(tmp_path, monkeypatch):
+    """runs/soil_region/soft_layer.py at W = 6 m, H = 2 m: the surface centre's transfer function peaks
+    near the rigid-walled box's first mode f0 sqrt(1 + 2 (2H/W)^2) = 27.1 Hz (measured 27.3 Hz), well
+    above the 1D layer's c_s1/4H = 19.75 Hz, and amplifies more than the 1D layer's 1/alpha = 2.22
+    (measured 4.76): the box's width matters at W/H = 3."""
+    from helpers import run_script
+    m = run_script("runs", "soil_region", "soft_layer.py")
+    out = str(tmp_path / "W6.h5")
+    m.run(6.0, 1, out)
+    f, tf = m.transfer(out)
+    keep = f <= 40.0
+    k = int(np.argmax(tf[keep]))
+    fr = m.F0 * np.sqrt(1 + 2 * (2 * m.H / 6.0) ** 2)
+    assert abs(f[keep][k] - fr) < 0.05 * fr, (f[keep][k], fr)
+    assert tf[keep][k] > 1.5 / m.ALPHA
