@@ -64,10 +64,7 @@ def read_surface_mesh(cfg, comm, planes):
             else:
                 # an excavation: the ground z = 0 closed by walls and bottoms, normals out of the soil
                 # (refused in one line before any assembly); the general 3x3 block pattern
-                surface.check_excavation(mesh, f"-ssi_mesh {cfg.mesh}")
-                if planes:
-                    raise SSIError(f"-ssi_symmetry {cfg.symmetry}: symmetry planes on a surface with an excavation "
-                                   "(-ssi_mesh " + cfg.mesh + ") are not supported yet; mesh the whole surface")
+                surface.check_excavation(mesh, f"-ssi_mesh {cfg.mesh}", planes)
     return mpi.bcast(mesh)
 
 
@@ -77,13 +74,13 @@ def _pit(cfg, Lx, Ly, patch, planes):
     narrow excavation off the centre is a trench, runs/trench)."""
     from ..fem.mesh import parse_mesh_params
     p = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
-    if patch or planes:
-        raise SSIError(f"-ssi_mesh pit: {'-ssi_mesh_patch' if patch else '-ssi_symmetry'} is not taken (the pit's "
-                       "groups are ground, walls, bottom and pit; it is meshed whole)")
+    if patch:
+        raise SSIError("-ssi_mesh pit: -ssi_mesh_patch is not taken (the pit's groups are ground, walls, bottom and "
+                       "pit)")
     if not {"a", "b", "d"} <= set(p) <= {"a", "b", "d", "x", "y"}:
         raise SSIError(f"-ssi_mesh pit: -ssi_mesh_params must give a, b and d (the pit's half-widths and depth, m) "
                        f"and may give x and y (its centre, m), got '{cfg.get('mesh_params', '')}'")
-    return surface.pit(Lx, Ly, cfg.mesh_h, p["a"], p["b"], p["d"], p.get("x", 0.0), p.get("y", 0.0))
+    return surface.pit(Lx, Ly, cfg.mesh_h, p["a"], p["b"], p["d"], p.get("x", 0.0), p.get("y", 0.0), planes)
 
 
 def read_soil_surface(cfg, comm, planes):
@@ -140,7 +137,8 @@ class HalfSpace:
             # the free field's traction on the structure's faces below the ground (walls, bottom): the
             # structure takes the total traction t_sc + t_ff there (``interface_free_field``)
             from ..sources.free_field import InterfaceFreeField
-            self._interface_ff = InterfaceFreeField(self.mesh, interface.be_elems, interface.be_nodes, interface.M)
+            self._interface_ff = InterfaceFreeField(self.mesh, interface.be_elems, interface.be_nodes, interface.M,
+                                                    interface.zero)
         if wave and not self.mesh.flat:       # the scattered field's -t_ff on the excavation's free faces
             self._excavation = self._free_field_source(disp)
             self.sources += [self._excavation] if self._excavation is not None else []

@@ -145,7 +145,7 @@ def _loops(edges):
     return len({find(a) for a in parent})
 
 
-def check_excavation(mesh, what):
+def check_excavation(mesh, what, planes=()):
     """SSIError in one line unless a surface that is not a plane is one the half-space can take: the
     ground z = 0 with excavations below it (walls and bottoms), a conforming surface (an element edge
     shared by two elements, or by one on the mesh's outer edge), whose free edges form one loop on the
@@ -153,7 +153,8 @@ def check_excavation(mesh, what):
     that meet the mesh's edge leave free edges below z = 0), and whose normals point out of the soil
     (neighbours run their shared edge in opposite directions; the ground faces +z). ``what``: the
     input named in the error. ``read_gmsh`` orients a .geo/.msh surface first (``orient_out_of_soil``);
-    a mesh made otherwise must come oriented."""
+    a mesh made otherwise must come oriented. ``planes``: symmetry planes ((axis, kind), ...): the part
+    modelled is cut there, and its free edges on a plane (below the ground too) are the cut, not a hole."""
     x = mesh.nodes
     ext = float(np.ptp(x, axis=0).max()) if mesh.n_nodes else 1.0
     tol = 1e-9 * max(ext, 1.0)
@@ -178,7 +179,7 @@ def check_excavation(mesh, what):
     lo, hi = x[:, :2].min(0), x[:, :2].max(0)
     for e, p, q, m in free:
         for a in (p, m, q):
-            if x[a, 2] >= -tol:
+            if x[a, 2] >= -tol or any(abs(x[a, ax]) <= tol for ax, _ in planes):
                 continue
             where = f"({x[a, 0]:.6g}, {x[a, 1]:.6g}, {x[a, 2]:.6g}) m"
             if np.any(np.abs(x[a, :2] - lo) <= tol) or np.any(np.abs(x[a, :2] - hi) <= tol):
@@ -312,7 +313,7 @@ def _quad9(corner, du, dv):
     return c + 0.5 * (1 + quad9.NODE_XI[:, :1]) * du + 0.5 * (1 + quad9.NODE_XI[:, 1:]) * dv
 
 
-def pit(Lx, Ly, h, a, b, d, xc=0.0, yc=0.0):
+def pit(Lx, Ly, h, a, b, d, xc=0.0, yc=0.0, planes=()):
     """Structured nine-node mesh of the ground [-Lx/2, Lx/2] x [-Ly/2, Ly/2] (z = 0) with a rectangular
     excavation [xc - a, xc + a] x [yc - b, yc + b] of depth d (a basement's pit; a long narrow one, a
     << b, off the centre, is an open trench: runs/trench): its four vertical walls and its bottom
@@ -320,14 +321,20 @@ def pit(Lx, Ly, h, a, b, d, xc=0.0, yc=0.0):
     Normals point out of the soil: +z on the ground and the bottom, into the pit on the walls (-x on
     x = xc + a, +x on x = xc - a, -y on y = yc + b, +y on y = yc - b). Grid lines pass through
     x = xc +- a, y = yc +- b; the walls take about d/h elements down. Groups: 'ground', 'walls',
-    'bottom', 'pit' (walls and bottom), 'surface'."""
+    'bottom', 'pit' (walls and bottom), 'surface'. ``planes``: symmetry planes ((axis, kind), ...) through the
+    opening's centre: only the part x >= 0 (y >= 0) is meshed, the grid's lines passing through the plane."""
     if not (0 < a and 0 < b and d > 0 and h > 0 and -Lx / 2 < xc - a and xc + a < Lx / 2
             and -Ly / 2 < yc - b and yc + b < Ly / 2):
         raise SSIError(f"pit: need a, b, d, h > 0 and the opening [x - a, x + a] x [y - b, y + b] inside the ground "
                        f"[-Lx/2, Lx/2] x [-Ly/2, Ly/2] (got Lx {Lx:g}, Ly {Ly:g}, a {a:g}, b {b:g}, d {d:g}, h {h:g}, "
                        f"x {xc:g}, y {yc:g})")
     xa, xb, ya, yb = xc - a, xc + a, yc - b, yc + b
-    xs, ys, zs = _lines(-Lx / 2, Lx / 2, h, (xa, xb)), _lines(-Ly / 2, Ly / 2, h, (ya, yb)), _lines(-d, 0.0, h, ())
+    axes = [ax for ax, _ in planes]
+    if (0 in axes and xc != 0.0) or (1 in axes and yc != 0.0):
+        raise SSIError(f"pit: a symmetry plane must pass through the opening's centre (x {xc:g}, y {yc:g})")
+    xs = _lines(0.0 if 0 in axes else -Lx / 2, Lx / 2, h, (xa, xb))
+    ys = _lines(0.0 if 1 in axes else -Ly / 2, Ly / 2, h, (ya, yb))
+    zs = _lines(-d, 0.0, h, ())
     X, kind = [], []
     for x0, x1 in zip(xs[:-1], xs[1:]):
         for y0, y1 in zip(ys[:-1], ys[1:]):
@@ -339,13 +346,17 @@ def pit(Lx, Ly, h, a, b, d, xc=0.0, yc=0.0):
         for y0, y1 in zip(ys[:-1], ys[1:]):
             if ya < 0.5 * (y0 + y1) < yb:
                 X.append(_quad9([xb, y0, z0], [0, 0, dz], [0, y1 - y0, 0]))      # -x
-                X.append(_quad9([xa, y0, z0], [0, y1 - y0, 0], [0, 0, dz]))     # +x
-                kind += ["walls", "walls"]
+                kind.append("walls")
+                if 0 not in axes:
+                    X.append(_quad9([xa, y0, z0], [0, y1 - y0, 0], [0, 0, dz]))     # +x
+                    kind.append("walls")
         for x0, x1 in zip(xs[:-1], xs[1:]):
             if xa < 0.5 * (x0 + x1) < xb:
                 X.append(_quad9([x0, yb, z0], [x1 - x0, 0, 0], [0, 0, dz]))      # -y
-                X.append(_quad9([x0, ya, z0], [0, 0, dz], [x1 - x0, 0, 0]))     # +y
-                kind += ["walls", "walls"]
+                kind.append("walls")
+                if 1 not in axes:
+                    X.append(_quad9([x0, ya, z0], [0, 0, dz], [x1 - x0, 0, 0]))     # +y
+                    kind.append("walls")
     X = np.array(X)
     scale = max(Lx, Ly, d)
     nodes, inv = np.unique(np.round(X.reshape(-1, 3) / (1e-9 * scale)), axis=0, return_inverse=True)

@@ -104,13 +104,14 @@ class InterfaceFreeField:
 
     so that the jump of t_ff at an edge (a wall meeting the bottom) stays where it is; its nodal
     traction is the L2 projection p_ff = M^-1 b on the interface's continuous nine-node field (M the
-    interface's consistent mass matrix, ``coupling.interface``), for which M p_ff = b exactly. (The
+    interface's consistent mass matrix, ``coupling.interface``), for which M p_ff = b exactly (with symmetry
+    planes: on the dofs they leave free, those they fix held at zero). (The
     nodal values at the nodes' mean normals, as ``FreeFieldTraction`` takes on free faces, would give
     M p_ff != b near an edge: the soil's scattered traction then makes up the difference, a
     self-equilibrated traction near the edges as large as t_ff that does not fall with the mesh.)
     Step means over ((m-1) dt, m dt] are exact, from the free field's running stress integral."""
 
-    def __init__(self, mesh, elements, nodes, M, order=4):
+    def __init__(self, mesh, elements, nodes, M, zero=None, order=4):
         import scipy.sparse.linalg as sla
         g, w = np.polynomial.legendre.leggauss(order)
         XI, ETA = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
@@ -126,7 +127,15 @@ class InterfaceFreeField:
         self._P = sp.csr_matrix((np.tile(N, (e, 1)).ravel(),
                                  (np.repeat(rows, q, axis=0).ravel(),
                                   np.repeat(np.arange(e * q), 9))), shape=(len(nodes), e * q))
-        self._lu = sla.splu(sp.csc_matrix(M))
+        # per component, the projection on the dofs a symmetry plane leaves free (``zero``: (k, 3), the
+        # interface's; the full model's p_ff vanishes on those by symmetry, and the modelled part's M p_ff = b
+        # holds on the others only with them held at zero)
+        self._zero = np.zeros((len(nodes), 3), bool) if zero is None else np.asarray(zero, bool)
+        M = sp.csr_matrix(M)
+        self._lu = []
+        for c in range(3):
+            free = np.flatnonzero(~self._zero[:, c])
+            self._lu.append((free, sla.splu(sp.csc_matrix(M[free][:, free])) if free.size else None))
         self.seismic = None
 
     def attach(self, seismic):
@@ -141,4 +150,9 @@ class InterfaceFreeField:
 
     def step_mean(self, m, dt):
         """p_ff = M^-1 b (k, 3) [Pa]: the nodal traction whose consistent force is b."""
-        return self._lu.solve(self.force(m, dt))
+        b = self.force(m, dt)
+        out = np.zeros_like(b)
+        for c, (free, lu) in enumerate(self._lu):
+            if lu is not None:
+                out[free, c] = lu.solve(np.ascontiguousarray(b[free, c]))
+        return out
