@@ -210,3 +210,12 @@ def test_a_soft_layer_in_a_narrow_box_resonates_as_a_box(tmp_path, monkeypatch):
     fr = m.F0 * np.sqrt(1 + 2 * (2 * m.H / 6.0) ** 2)
     assert abs(f[keep][k] - fr) < 0.05 * fr, (f[keep][k], fr)
     assert tf[keep][k] > 1.5 / m.ALPHA
+
+
+def test_unilateral_contact_in_a_pit_is_warned_about(tmp_path):
+    """The known limitation (README): unilateral contact in an excavation runs, with a set-up warning that its
+    active set does not settle there."""
+    a = args(tmp_path, "u.h5", T=0.02, extra=("-ssi_contact", "unilateral"))
+    a[a.index("-ssi_t_end") + 1] = "0.005"
+    p = cli(a)
+    assert "the contact's active set is known not to settle there" in p.stdout + p.stderr
