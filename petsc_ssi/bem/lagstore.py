@@ -41,7 +41,7 @@ def lag_key(cfg, prob, plan):
     """{name: text}: everything the lag matrices depend on (module docstring)."""
     reg = prob.regions
     key = {"mesh_nodes": _h(np.asarray(prob.mesh.nodes, float)), "mesh_cells": _h(np.asarray(prob.mesh.cells, np.int64)),
-           "cp": repr(float(cfg.cp)), "cs": repr(float(cfg.cs)), "rho": repr(float(cfg.rho)), "dt": repr(float(cfg.dt)),
+           "cp": repr(float(cfg.cp)), "cs": repr(float(cfg.cs)), "rho": repr(float(cfg.rho)), "dt": repr(float(prob.dt)),
            "scheme": str(cfg.scheme), "symmetry": str(cfg.symmetry), "lags": str(prob.L), "exact_lags": str(plan.Lx),
            "traction_nodes": _h(np.asarray(reg.tnode, np.int64)), "load_nodes": str(reg.n_load),
            "disp_nodes": _h(np.asarray(reg.disp_nodes, np.int64))}

@@ -112,7 +112,7 @@ class BEMTransient(TransientProblem):
         recd = None
         if res["u"] is not None:
             recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
-        attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt,
+        attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": prob.dt,
                  "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
         groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
         if getattr(prob, "seismic", None) is not None:

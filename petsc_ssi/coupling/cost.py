@@ -43,7 +43,7 @@ class CoupledCounts:
         r0 = process_rss()
         t0 = time.perf_counter()
         model.assemble()
-        _, integ, _ = make_model_integrator(cfg, comm, model, integrator=integrator)
+        _, integ, _ = make_model_integrator(cfg, comm, prob.dt, model, integrator=integrator)
         mpi.Barrier()
         self.fem_setup_s = time.perf_counter() - t0
         b, x = integ.u.duplicate(), integ.u.duplicate()

@@ -84,7 +84,7 @@ class SSITransient(TransientProblem):
         cfg, comm, prob = self.cfg, self.comm, self.prob
         with staged("SSI FEM assembly"):
             self.model.assemble()
-            _, self.integ, self.am = make_model_integrator(cfg, comm, self.model, integrator=self.integrator)
+            _, self.integ, self.am = make_model_integrator(cfg, comm, self.grid.dt, self.model, integrator=self.integrator)
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
             self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
@@ -221,7 +221,7 @@ class SSITransient(TransientProblem):
         times) and the structure's (receivers, demands), each with attributes; the run record in
         the soil's."""
         cfg, comm, prob, model = self.cfg, self.comm, self.prob, self.model
-        attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": cfg.dt, "scheme": cfg.scheme,
+        attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": self.grid.dt, "scheme": cfg.scheme,
                  "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
                  "contact_preload": float(res["interface"].get("preload", 0.0)),
                  "structure_output": os.path.basename(structure_output_path(cfg.output))}
@@ -239,7 +239,7 @@ class SSITransient(TransientProblem):
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
         sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
-        sattrs = {"problem": "ssi-structure", "dt": cfg.dt, **damping_attrs(self.am, self.integ.a1),
+        sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1),
                   "structure_mass": structure_mass(model, comm)}
         return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups}),
                 (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups})]

@@ -612,10 +612,11 @@ def near_null_args(solver, model):
     return None, model.dofmap.near_null_space(model.mesh.coords)
 
 
-def make_model_integrator(cfg, comm, model=None, integrator=None):
-    """Collective: (model, integrator, alpha_m) for the options ``cfg`` (the integrator's ``a1``:
-    the stiffness-proportional part of Rayleigh damping, -ssi_fem_rayleigh*); ``integrator``: the
-    scheme's name (None: -ssi_fem_integrator; a coupled run's strategy names its own)."""
+def make_model_integrator(cfg, comm, dt, model=None, integrator=None):
+    """Collective: (model, integrator, alpha_m) for the options ``cfg`` and the run's time step ``dt`` [s]
+    (its time grid's: ``timegrid.TimeGrid``) (the integrator's ``a1``: the stiffness-proportional part of
+    Rayleigh damping, -ssi_fem_rayleigh*); ``integrator``: the scheme's name (None: -ssi_fem_integrator; a
+    coupled run's strategy names its own)."""
     name = cfg.fem_integrator if integrator is None else integrator
     if model is None:
         from .model import build_model
@@ -623,7 +624,7 @@ def make_model_integrator(cfg, comm, model=None, integrator=None):
     am, a1, note = damping(cfg)
     printf(f"[fem] {note}; integrator {name}, solver {cfg.fem_solver}")
     coords, near = near_null_args(cfg.fem_solver, model)
-    integ = make_integrator(name, model.K, model.m, cfg.dt, am, model.fixed,
+    integ = make_integrator(name, model.K, model.m, dt, am, model.fixed,
                             cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
                             coords_vec=coords, near_null=near, a1=a1)
     return model, integ, am

@@ -80,7 +80,7 @@ class FEMTransient(TransientProblem):
         self._advance("created", "set up")
         with staged("FEM assembly"):
             self.model.assemble()
-            _, self.integ, self.am = make_model_integrator(self.cfg, self.comm, self.model)
+            _, self.integ, self.am = make_model_integrator(self.cfg, self.comm, self.grid.dt, self.model)
         self.fn = self.model.load_vec()
         self.load_source = NodalLoad(self.model.load_vec(), self.hist)      # F a(t) (sources/nodal.py)
         self.vel = self.integ.u.duplicate()
@@ -199,7 +199,8 @@ class FEMTransient(TransientProblem):
         if self.out is None:
             return []
         receivers = self.rec.structure.receivers() if comm.getRank() == 0 else None
-        groups, attrs = {}, {"problem": "fem", "dt": cfg.dt, **damping_attrs(am, self.integ.a1),
+        dt = self.grid.dt
+        groups, attrs = {}, {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1),
                              "structure_mass": structure_mass(model, comm)}
         if self.demands is not None and comm.getRank() == 0:
             groups["demands"] = self.demands.group()
@@ -215,13 +216,13 @@ class FEMTransient(TransientProblem):
                 receivers["ground_acceleration"] = self.ground_acceleration(receivers["t"])
                 receivers["absolute_acceleration"] = (receivers["acceleration"]
                                                       + receivers["ground_acceleration"][:, None, :])
-        extra = {"time_grid": {"dt_s": cfg.dt, "t_end_s": n_steps * cfg.dt, "n_steps": n_steps},
+        extra = {"time_grid": {"dt_s": dt, "t_end_s": n_steps * dt, "n_steps": n_steps},
                  "fem": {"alpha_m": am, "rayleigh_a1": self.integ.a1, "n_steps": n_steps, "n_nodes": model.mesh.n_nodes,
                          "n_cells": model.mesh.n_cells, "n_dofs": model.dofmap.size, "mesh": model.mesh.source,
                          "elements": model.mesh.element_counts(),
                          "receiver_snap_distance": [float(d) for d in model.receiver_dist]}}
         if cfg.fem_integrator == "green":
-            extra["fem"]["b"] = green_constants(cfg.dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta, self.integ.a1)
+            extra["fem"]["b"] = green_constants(dt, am, cfg.fem_newmark_alpha, cfg.fem_newmark_delta, self.integ.a1)
         return [(self.out, {"receivers": receivers, "attrs": attrs, "groups": groups or None,
                             "record": provenance(cfg, comm, extra)})]
 
