@@ -140,17 +140,21 @@ def _records(cfg):
 
 
 def _distinct(recs, cfg):
-    """SSIError if one trace of one multi-trace file drives two axes (-ssi_seismic_traces E,E,E drove x,
-    y and z with the east component: a diagonal motion nobody recorded)."""
+    """SSIError if one trace of one multi-trace file, or one column of a 't ax ay az' table, drives two axes
+    (-ssi_seismic_traces E,E,E drove x, y and z with the east component: a diagonal motion nobody
+    recorded; x,x,x did the same with a table's first column). One single-component file given for two
+    axes (-ssi_seismic_record_x and _y) is the user's explicit choice and runs."""
     seen = {}
     for axis, r in recs.items():
         m = r.metadata
-        if "obspy_format" not in m:
+        if "obspy_format" not in m and not m.get("component"):
             continue
         k = (r.sha256, m.get("station"), m.get("component"), m.get("starttime"))
         if k in seen:
-            raise SSIError(f"-ssi_seismic_traces {cfg.get('seismic_traces') or '(none)'}: the trace {m.get('component')} "
-                           f"of {r.source} drives both {seen[k]} and {axis}; give each axis its own trace (e.g. E,N,Z)")
+            what = "trace" if "obspy_format" in m else "column"
+            raise SSIError(f"-ssi_seismic_traces {cfg.get('seismic_traces') or '(none)'}: the {what} {m.get('component')} "
+                           f"of {r.source} drives both {seen[k]} and {axis}; give each axis its own {what} "
+                           f"(e.g. {'E,N,Z' if what == 'trace' else 'x,y,z'})")
         seen[k] = axis
     return recs
 

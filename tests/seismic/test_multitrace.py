@@ -83,3 +83,22 @@ def test_a_record_with_gaps_is_refused(tmp_path):
         with pytest.raises(R.RecordError) as e:
             R.read_record(path, component=comp, units="m/s2")
         assert "the trace .ST..HNZ is in 3 segments (gaps or overlaps" in str(e.value), e.value
+
+
+def test_one_column_of_a_table_cannot_drive_two_axes(tmp_path):
+    """A 't ax ay az' table read with -ssi_seismic_traces: each axis its column (z,y,x swaps them), and one
+    column for two axes is refused in one line on every rank (issue 44: x,x,x ran the first column as a
+    diagonal motion; only ObsPy files were checked)."""
+    t = np.arange(0.0, 0.5, 0.01)
+    p = np.where(t < 0.3, np.sin(np.pi * t / 0.3) ** 4, 0.0)
+    tab = tmp_path / "tab3.txt"
+    np.savetxt(tab, np.c_[t, p, 2 * p, 3 * p], header="units: m/s2")
+    out = tmp_path / "o.h5"
+    cli(FEM + ["-ssi_output", str(out), "-ssi_seismic_record", str(tab), "-ssi_seismic_traces", "z,y,x"])
+    got = _pga(out)
+    assert all(abs(got[a] - v) < 1e-12 for a, v in (("x", 3.0), ("y", 2.0), ("z", 1.0))), got
+    r = cli(FEM + ["-ssi_output", str(tmp_path / "r.h5"), "-ssi_seismic_record", str(tab), "-ssi_seismic_traces",
+                   "x,x,x"], nranks=2, check=False, timeout=300)
+    errors = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    assert r.returncode == 2 and len(errors) == 1, r.stdout[-2000:] + r.stderr[-2000:]
+    assert "the column x of" in errors[0] and "drives both x and y" in errors[0], errors[0]
