@@ -117,7 +117,13 @@ def _record_format(cfg):          # cfg: the options' values (a dict)
         return fmt
     if kind in ("peer", "table"):
         return kind
-    return "obspy" if fmt.lower() in ("auto", "obspy") else fmt.upper()
+    if fmt.lower() not in ("auto", "obspy"):
+        return fmt.upper()
+    try:                # the format ObsPy finds (MSEED, SAC, ...): -ssi_seismic_format mseed names the same
+        import obspy
+        return str(obspy.read(path, headonly=True)[0].stats._format).upper()
+    except Exception:   # (no ObsPy, or a file it cannot read: the run's reader says why, in one line)
+        return "obspy"
 
 
 def key_difference(saved, now):
@@ -145,6 +151,8 @@ def key_difference(saved, now):
             a = repr(d) if isinstance(d, float) else str(d)
         if a == b:
             continue
+        if name == "seismic_format" and a == "obspy" and b is not None and b.isupper():
+            continue            # a checkpoint written before the ObsPy format was resolved: the same reader
         fa, fb = saved.get("file:" + name), now.get("file:" + name)
         if fa is not None and fa == fb:
             continue            # the same input file at another path (moved, copied): the same run

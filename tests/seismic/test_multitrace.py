@@ -102,3 +102,17 @@ def test_one_column_of_a_table_cannot_drive_two_axes(tmp_path):
     errors = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert r.returncode == 2 and len(errors) == 1, r.stdout[-2000:] + r.stderr[-2000:]
     assert "the column x of" in errors[0] and "drives both x and y" in errors[0], errors[0]
+
+
+def test_a_restart_naming_the_obspy_format_auto_found_is_the_same_run(three):
+    """The restart key resolves -ssi_seismic_format auto to the format ObsPy finds, so naming it (mseed) on a
+    restart is no change of options (issue 44: refused as one), while another format (sac) still is; a
+    checkpoint written before the format was resolved ('obspy') matches any ObsPy format."""
+    from petsc_ssi.io.checkpoint import _record_format, key_difference
+    base = {"seismic": "vertical", "seismic_record": three}
+    auto, mseed, sac = (_record_format(dict(base, seismic_format=f)) for f in ("auto", "mseed", "sac"))
+    assert auto == mseed == "MSEED" and sac == "SAC"
+    assert key_difference({"seismic_format": auto}, {"seismic_format": mseed}) is None
+    assert "-ssi_seismic_format is SAC here and was MSEED" in key_difference({"seismic_format": auto},
+                                                                             {"seismic_format": sac})
+    assert key_difference({"seismic_format": "obspy"}, {"seismic_format": mseed}) is None
