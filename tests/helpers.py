@@ -226,3 +226,13 @@ def pvpython(body, xmf, tmp_path):
                        timeout=180, env=dict(os.environ, DISPLAY=""))
     assert p.returncode == 0, p.stdout + p.stderr
     return json.loads([ln for ln in p.stdout.splitlines() if ln[:1] in "{["][-1])
+
+
+def sin4_pulse(path, T):
+    """A record file 't a': a sin^4 acceleration pulse of length T then the reversed one, 1 m/s^2 (zero net
+    velocity), 80 samples a pulse; returns its path as a string."""
+    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
+    a = sum(sg * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
+            for k, sg in enumerate((1, -1)))
+    np.savetxt(path, np.c_[t, a], header="units: m/s2")
+    return str(path)

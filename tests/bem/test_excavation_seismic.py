@@ -22,7 +22,7 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import cli, run_bem
+from helpers import cli, run_bem, sin4_pulse
 from test_history_block import same
 
 pytestmark = pytest.mark.mpi
@@ -30,13 +30,7 @@ pytestmark = pytest.mark.mpi
 CS = 316.0
 
 
-def pulse(path, T):
-    """A sin^4 acceleration pulse of length T then the reversed one, 1 m/s^2 (zero net velocity)."""
-    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
-    a = sum(sg * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
-            for k, sg in enumerate((1, -1)))
-    np.savetxt(path, np.c_[t, a], header="units: m/s2")
-    return str(path)
+pulse = sin4_pulse          # (tests/helpers.py)
 
 
 def options(tmp, name, record, d, h=1.0, t_end=0.14):

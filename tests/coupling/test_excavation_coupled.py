@@ -32,20 +32,14 @@ import h5py
 import numpy as np
 import pytest
 
-from helpers import cli
+from helpers import cli, sin4_pulse
 
 pytestmark = pytest.mark.mpi
 
 CS, CP, RHO = 316.0, 548.0, 2000.0
 
 
-def pulse(path, T):
-    """A sin^4 acceleration pulse of length T then the reversed one, 1 m/s^2 (zero net velocity)."""
-    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
-    a = sum(sg * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
-            for k, sg in enumerate((1, -1)))
-    np.savetxt(path, np.c_[t, a], header="units: m/s2")
-    return str(path)
+pulse = sin4_pulse          # (tests/helpers.py)
 
 
 def args(tmp, name, h=1.0, wave="vertical", angle=0.0, T=0.04, extra=()):
