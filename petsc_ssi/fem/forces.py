@@ -296,8 +296,8 @@ class ForceRecorder:
         """Rank 0, the file open (h5py): the 'forces' group and the cell fields; returns the XDMF
         cell attributes [(name, dataset, unit)]."""
         import h5py
-        from ..io.output import _group
-        g = _group(f, "forces")
+        from ..io.output import new_group
+        g = new_group(f, "forces")
         g.create_dataset("snapshots", data=np.asarray(self.snapshots, np.int64), track_times=False)
         d = g.create_dataset("time", data=np.asarray(self.times, float), track_times=False)
         d.attrs["unit"] = "s"

@@ -109,10 +109,10 @@ def _record_format(cfg):          # cfg: the options' values (a dict)
                  if cfg.get(k) and os.path.isfile(cfg.get(k))), None)
     if path is None or str(cfg.get("seismic", "none")) == "none":
         return fmt
-    from ..seismic.records import _detect
+    from ..seismic.records import detect_format
     try:
         with open(path, "rb") as fh:
-            kind = _detect(path, fh.read(1 << 16), fmt)
+            kind = detect_format(path, fh.read(1 << 16), fmt)
     except OSError:
         return fmt
     if kind in ("peer", "table"):

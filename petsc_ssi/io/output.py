@@ -214,7 +214,7 @@ def check_output(path, comm, overwrite=False, what="-ssi_output", also=()):
     collective_error(err, comm)
 
 
-def _group(parent, name):
+def new_group(parent, name):
     """A new HDF5 group without modification times (h5py's create_group cannot say so)."""
     import h5py
     gcpl = h5py.h5p.create(h5py.h5p.GROUP_CREATE)
@@ -673,7 +673,7 @@ class Output:
             f.create_dataset("time", data=np.asarray(self.times), track_times=False)
             for gname, data in ((("receivers", receivers),) if receivers is not None else ()) + \
                     tuple((groups or {}).items()):
-                g = _group(f, gname)
+                g = new_group(f, gname)
                 for k, v in data.items():
                     unit, extra = UNITS.get(f"{gname}/{k}"), {}
                     if isinstance(v, tuple) and len(v) == 2 and isinstance(v[1], str):

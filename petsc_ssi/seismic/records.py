@@ -158,7 +158,7 @@ def read_record(path, fmt="auto", quantity="auto", units="auto", component=None)
         _refuse(path, f"cannot read: {exc.strerror or exc}")
     if not raw.strip():
         _refuse(path, "empty file")
-    kind = _detect(path, raw, fmt)
+    kind = detect_format(path, raw, fmt)
     reader = {"peer": _read_peer, "table": _read_table, "obspy": _read_obspy}[kind]
     t, vals, file_units, meta = reader(path, raw, fmt, component)
     unit, qty = _resolve(path, file_units, units, quantity)
@@ -170,7 +170,9 @@ def read_record(path, fmt="auto", quantity="auto", units="auto", component=None)
                   sha256=hashlib.sha256(raw).hexdigest(), dt=dt, metadata=dict(meta, format=kind))
 
 
-def _detect(path, raw, fmt):
+def detect_format(path, raw, fmt):
+    """The reader of a record file: 'peer', 'table' or 'obspy', from -ssi_seismic_format ``fmt`` (auto: from
+    the extension and the first bytes ``raw``)."""
     f = str(fmt).lower()
     if f != "auto":
         return {"peer": "peer", "at2": "peer", "table": "table"}.get(f, "obspy")
