@@ -101,7 +101,7 @@ def _history(cfg, which):
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
-    def __init__(self, cfg, comm, log=printf, sources=None, mesh=None, interface=None):
+    def __init__(self, cfg, comm, log=printf, sources=None, mesh=None, interface=None, record_scheme=None):
         """``sources``: the surface tractions that load the soil (``petsc_ssi.sources``); None: those
         of the options (-ssi_load_*). ``mesh``: the surface mesh when the caller has read it
         (``read_soil_surface``). ``interface``: a coupled run's interface
@@ -109,8 +109,11 @@ class HalfSpace:
         its centroid is the seismic input's default control point and its nodes are points of
         interest. The seismic input, a source with a duration, comes before the time grid: without
         -ssi_t_end the run lasts the record (``timegrid.TimeGrid.of_run``); nothing is written into
-        the options."""
+        the options. ``record_scheme``: a coupled structure's integrator when it takes the record as a
+        prescribed load (``coupling.step``'s strategies: the staggered coupling's Green scheme), whose
+        amplification near Nyquist the record's notes check."""
         self.cfg, self.comm, self.log = cfg, comm, log
+        self.record_scheme = record_scheme
         self.mat = Material(cfg.cp, cfg.cs, cfg.rho)
         self.planes = symmetry.parse(cfg.symmetry)
         self.mesh = mesh if mesh is not None else read_soil_surface(cfg, comm, self.planes)
@@ -252,7 +255,7 @@ class HalfSpace:
         the default control point. Refuses a symmetry plane the wave breaks."""
         from ..seismic.input import SeismicInput
         seismic = SeismicInput(self.cfg, self.comm, self.mat.cs, self.mat.cp, self.mat.rho, self.mesh.nodes,
-                               ref, self.cfg.dt)
+                               ref, self.cfg.dt, scheme=self.record_scheme)
         self._seismic_symmetry(seismic)
         return seismic
 

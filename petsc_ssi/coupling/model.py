@@ -58,7 +58,8 @@ def build_coupled(cfg, comm):
                            "shell slab nodes; the offset applies to a shell foundation slab only and does nothing "
                            "here: drop it")
     # the soil with its interface: the structure's tractions, the seismic control point, points of interest
-    prob = HalfSpace(cfg, comm, log=printf, mesh=mesh, interface=iface)
+    prob = HalfSpace(cfg, comm, log=printf, mesh=mesh, interface=iface,
+                     record_scheme=STRATEGIES[cfg.coupling].record_scheme)
     model.fixed = np.union1d(model.fixed, sym).astype(np.int64)
     model.dofmap.set_fixed(model.fixed)
     return prob, model, iface, STRATEGIES[cfg.coupling].integrator

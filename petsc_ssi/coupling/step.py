@@ -50,6 +50,7 @@ class StaggeredStep:
     with every interface node closed at u_b = u_f, the active-set corrections through the
     capacitance Z_OO, and the soil's force handed to the structure as an impulse (B.5-B.6)."""
     integrator = "green"
+    record_scheme = "green"          # the record reaches the structure as a prescribed impulse: checked
 
     def __init__(self, cp):
         self.cp = cp
@@ -87,6 +88,7 @@ class ImplicitStep:
     to the free field (s - u_ff, w - u_ff), the soil's own scattered-field unknowns; the contact law
     sees the same gap, and u_b, u_f come back as totals."""
     integrator = "midpoint"
+    record_scheme = None             # the interface force is solved with the soil: no prescribed load
 
     def __init__(self, cp):
         self.cp = cp

@@ -46,7 +46,7 @@ class FEMTransient(TransientProblem):
             self.support = None
             if cfg.get("seismic", "none") != "none":        # a fixed base moving with the record
                 from ..seismic.input import SupportMotion
-                self.support = SupportMotion(cfg, self.comm)
+                self.support = SupportMotion(cfg, self.comm, scheme=cfg.fem_integrator)
                 self._check_supported_axes()
         # without -ssi_t_end a run under a record lasts the record (nothing is written into the options)
         self.grid = timegrid.TimeGrid.of_run(cfg, [self.support.duration] if self.support is not None else [])

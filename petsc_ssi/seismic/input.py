@@ -231,26 +231,14 @@ def _nyquist_notes(motions, dt):
     return out
 
 
-def structure_scheme(cfg):
-    """The structure's time integrator whose answer to the record ``record_note`` checks: -ssi_fem_integrator
-    on a fixed base (-ssi_problem fem, the record is the support's prescribed motion), the Green scheme of
-    the staggered coupling (the soil's force handed over as a prescribed impulse); None for the implicit
-    coupling (the interface force is solved with the soil, not a prescribed load: the demo building
-    under a record with 50-90 Hz energy has its roof peak at 5 ms within 2.2 % of 2.5 ms,
+def _scheme_notes(motions, cfg, scheme):
+    """A note per record with energy where the structure's integrator ``scheme`` amplifies a load
+    (fem/integrator_response.py ``record_note``: the Green scheme's 1/cos^2(pi f dt)). The domain that
+    takes the record names the scheme: a fixed base its -ssi_fem_integrator, the staggered coupling its
+    Green scheme (``coupling.step.StaggeredStep.record_scheme``); None (no note) for the implicit
+    coupling (the interface force is solved with the soil, not a prescribed load: the demo building under a
+    record with 50-90 Hz energy has its roof peak at 5 ms within 2.2 % of 2.5 ms,
     runs/integrators/coupled.csv) and without a structure."""
-    problem = cfg.get("problem", "bem")
-    if problem == "fem":
-        return cfg.get("fem_integrator", "green")
-    if problem == "ssi" and cfg.get("coupling", "implicit") == "staggered":
-        from ..coupling.step import STRATEGIES
-        return STRATEGIES["staggered"].integrator
-    return None
-
-
-def _scheme_notes(motions, cfg):
-    """A note per record with energy where the structure's integrator amplifies a load
-    (fem/integrator_response.py ``record_note``: the Green scheme's 1/cos^2(pi f dt))."""
-    scheme = structure_scheme(cfg)
     if scheme is None:
         return []
     from ..fem.integrator_response import record_note
@@ -261,9 +249,10 @@ def _scheme_notes(motions, cfg):
     return [n for n in notes if n]
 
 
-def collective_motions(cfg, comm):
+def collective_motions(cfg, comm, scheme=None):
     """Collective: (motions, notes): ``read_motions`` on rank 0, broadcast; the processing's
-    warnings (``RecordWarning``) as one-line notes; one-line SSIError on every rank on a defect."""
+    warnings (``RecordWarning``) as one-line notes, and ``scheme``'s (the structure's integrator that
+    takes the record as a load, ``_scheme_notes``); one-line SSIError on every rank on a defect."""
     motions, notes = None, _unused_angle_notes(cfg)
     with collective(comm, "-ssi_seismic", "{what}: {error}"):
         if comm.getRank() == 0:
@@ -276,7 +265,7 @@ def collective_motions(cfg, comm):
             notes += list(dict.fromkeys(str(w.message) for w in caught        # (once: a target processes twice)
                                         if issubclass(w.category, RecordWarning)))
             notes += _nyquist_notes(motions, cfg.dt)
-            notes += _scheme_notes(motions, cfg)
+            notes += _scheme_notes(motions, cfg, scheme)
     return comm.tompi4py().bcast((motions, notes), root=0)
 
 
@@ -287,7 +276,7 @@ class SupportMotion:
     its fixed-base twin see the same times. ``mean_acceleration(axis, t0, t1)``: the mean of a_g over
     [t0, t1] (exact for the piecewise-linear record: the velocity difference over the length)."""
 
-    def __init__(self, cfg, comm):
+    def __init__(self, cfg, comm, scheme=None):
         if cfg.seismic != "vertical":
             raise SSIError(f"-ssi_seismic {cfg.seismic}: a fixed base moves as one: the structure alone (-ssi_problem "
                            "fem) takes -ssi_seismic vertical (one record per component)")
@@ -295,7 +284,7 @@ class SupportMotion:
         # the base moves as the free surface: the record itself (control surface), or twice the incident
         # wave it gives (control incident: at vertical incidence S and P double at the free surface)
         self.factor = 2.0 if cfg.seismic_control == "incident" else 1.0
-        self.motions, self.notes = collective_motions(cfg, comm)
+        self.motions, self.notes = collective_motions(cfg, comm, scheme)
         t0 = _start(cfg)
         if t0 is not None and t0 < 0:
             raise SSIError(f"-ssi_seismic_start {t0:g}: a negative shift drops the first {-t0:g} s of the record (the "
@@ -336,17 +325,18 @@ class SupportMotion:
 class SeismicInput:
     """Collective: the seismic input of ``cfg`` (group "seismic") on a soil of speeds ``cs``, ``cp``
     and density ``rho``; ``points``: every soil node the run touches (the automatic start keeps the
-    free field zero there for t <= 0); ``ref``: the default control point (x, y); ``dt``: the step.
+    free field zero there for t <= 0); ``ref``: the default control point (x, y); ``dt``: the step;
+    ``scheme``: the integrator of a structure that takes the record as a load (``_scheme_notes``).
 
     ``u(points, t)``: the free-field displacement (n, 3) [m] (sum of the waves); ``summary_lines``,
     ``arrays`` (the output group 'seismic', units in ``units``), ``key`` (the records' SHA-256, for
     checkpoints), ``duration`` (s, from t = 0 to the end of the shifted record)."""
 
-    def __init__(self, cfg, comm, cs, cp, rho, points, ref, dt):
+    def __init__(self, cfg, comm, cs, cp, rho, points, ref, dt, scheme=None):
         self.cfg, self.kind = cfg, cfg.seismic
         self.motions = None
         self.precursor = None           # (taper_before, width, tail level) of a tapered H[g] (free_field)
-        self.motions, self.notes = collective_motions(cfg, comm)
+        self.motions, self.notes = collective_motions(cfg, comm, scheme)
         with collective(comm, f"-ssi_seismic {self.kind}", "{what}: {error}"):
             self.waves = self._waves(cs, cp, rho, _ref_point(cfg.seismic_ref, ref))
             self._start(np.asarray(points, float), dt)

@@ -201,14 +201,9 @@ def test_a_stiff_structure_under_a_record_at_70_hz_is_warned_and_the_named_dt_re
 def test_which_runs_check_their_record():
     """The fixed base checks its -ssi_fem_integrator, the staggered coupling its Green scheme; the implicit
     coupling (interface force solved with the soil; runs/integrators/coupled.csv) and the soil alone none."""
-    from petsc_ssi.seismic.input import structure_scheme
+    import inspect
+    from petsc_ssi.coupling.step import STRATEGIES
+    from petsc_ssi.bem.halfspace import HalfSpace
+    assert STRATEGIES["staggered"].record_scheme == "green" and STRATEGIES["implicit"].record_scheme is None
+    assert inspect.signature(HalfSpace).parameters["record_scheme"].default is None      # the soil alone
 
-    class Cfg(dict):
-        def get(self, k, d=None):
-            return dict.get(self, k, d)
-    assert structure_scheme(Cfg(problem="fem", fem_integrator="green")) == "green"
-    assert structure_scheme(Cfg(problem="fem", fem_integrator="newmark")) == "newmark"
-    assert structure_scheme(Cfg(problem="ssi", coupling="staggered")) == "green"
-    assert structure_scheme(Cfg(problem="ssi", coupling="implicit")) is None
-    assert structure_scheme(Cfg(problem="ssi")) is None
-    assert structure_scheme(Cfg(problem="bem")) is None
