@@ -165,6 +165,10 @@ def read_record(path, fmt="auto", quantity="auto", units="auto", component=None)
     if not np.all(np.isfinite(vals)):
         _refuse(path, f"non-finite value (nan or inf) at sample {int(np.nonzero(~np.isfinite(vals))[0][0])}")
     step = np.diff(t)
+    if kind != "peer" and step.size and float(step.max()) > MAX_DT:     # (PEER: its DT line, checked as read)
+        k = int(np.argmax(step))
+        _refuse(path, f"the time step {step[k]:.6g} s between samples {k} and {k + 1} ({t[k]:.6g} s, {t[k + 1]:.6g} s): a "
+                      f"strong-motion record is sampled every {MAX_DT:g} s or faster; check that its times are seconds")
     dt = float(step.mean()) if np.allclose(step, step[0], rtol=1e-6, atol=0) else None
     return Record(t=t, values=vals * UNITS[unit][1], quantity=qty, units_in=unit, source=path,
                   sha256=hashlib.sha256(raw).hexdigest(), dt=dt, metadata=dict(meta, format=kind))

@@ -632,3 +632,21 @@ def test_real_knet_record_highpassed():
     assert abs(s["v_end"]) < 0.01 * s["pgv"] and abs(s["d_end"]) < 0.02 * s["pgd"]
     ref = _quiet_process(rec)
     assert s["pga"] == pytest.approx(ref.stats["pga"], rel=0.10)
+
+
+def test_a_table_or_trace_sampled_coarser_than_a_second_is_refused(tmp_path):
+    """Every format's sampling is checked as PEER's DT is (issue 44: only PEER headers were): a table whose
+    times are milliseconds, or an ObsPy trace at 0.5 Hz, is refused naming the step; a table non-uniform
+    only below 1 s reads."""
+    t = np.arange(0.0, 200.0, 10.0)                      # 'ms' written where seconds are read
+    np.savetxt(tmp_path / "ms.txt", np.c_[t, np.sin(t)], header="units: m/s2")
+    with pytest.raises(RecordError, match=r"the time step 10 s between samples 0 and 1 .* every 1 s or faster"):
+        R.read_record(str(tmp_path / "ms.txt"))
+    t2 = np.r_[0.0, 0.01, 0.5, 1.2, 1.21]
+    np.savetxt(tmp_path / "ok.txt", np.c_[t2, np.zeros(5)], header="units: m/s2")
+    assert R.read_record(str(tmp_path / "ok.txt")).t[-1] == pytest.approx(1.21)
+    obspy = pytest.importorskip("obspy")
+    tr = obspy.Trace(np.zeros(50), header={"channel": "LHZ", "station": "ST", "sampling_rate": 0.5})
+    obspy.Stream([tr]).write(str(tmp_path / "slow.mseed"), format="MSEED")
+    with pytest.raises(RecordError, match=r"the time step 2 s between samples 0 and 1"):
+        R.read_record(str(tmp_path / "slow.mseed"), units="m/s2")
