@@ -12,6 +12,7 @@ Quantities (x, the wave's polarisation; the full model's values):
   * the peak absolute acceleration of the roof centre (0, 0, 6), the first floor's (0, 0, 3) and the ground
     floor's (the foundation slab's centre, (0, 0, 0): with the basement, the basement's top);
   * the peak drift ratio of each storey, total (the base's rocking in it) and of deformation alone;
+  * the peak rocking theta_y of the ground floor (the rigid rotation fitted to the slab's u_z at z = 0);
   * the peak base shear and overturning moment about (0, 0, 0): the force the structure exerts on the soil
     through its interface (fem/demands.py), i.e. with the basement the force on the pit's walls and bottom,
     the basement's own inertia included.
@@ -36,6 +37,7 @@ def load(d, case):
         out["moment"] = g["overturning_moment"][:, 1]
         out["drift"] = g["drift_ratio"][:, :, 0]                     # (K, storeys) x
         out["drift_def"] = g["drift_ratio_deformation"][:, :, 0]
+        out["rot"] = g["base_rotation"][:, 1]                        # theta_y of the ground floor (z = 0)
     with h5py.File(os.path.join(d, f"{case}.h5")) as f:
         out["pga"] = float(f["seismic/x_pga"][()])
     return out
@@ -50,6 +52,7 @@ def table(r):
             ("peak drift ratio storey 2 [-]", lambda o: np.abs(o["drift"][:, 1]).max()),
             ("peak deformation drift ratio storey 1 [-]", lambda o: np.abs(o["drift_def"][:, 0]).max()),
             ("peak deformation drift ratio storey 2 [-]", lambda o: np.abs(o["drift_def"][:, 1]).max()),
+            ("peak rocking theta_y of the ground floor [rad]", lambda o: np.abs(o["rot"]).max()),
             ("peak base shear at the interface [N]", lambda o: np.abs(o["shear"]).max()),
             ("peak overturning moment about (0 0 0) [N m]", lambda o: np.abs(o["moment"]).max())]
     return [(name, fn(r["surface"]), fn(r["basement"])) for name, fn in rows]
