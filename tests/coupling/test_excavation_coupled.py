@@ -208,7 +208,7 @@ def test_the_pit_footing_mesh_puts_nodes_every_half_h_on_the_pit(tmp_path):
     assert r.returncode != 0 and len(lines) == 1 and "must be multiples of h/2" in lines[0], r.stdout + r.stderr
 
 
-# slow tier: four runs, 65 s on 1 rank; the default-tier siblings: the filled pit and the pit_footing mesh above
+# slow tier: four runs, 51-67 s on 1 rank; the default-tier siblings: the filled pit and the pit_footing mesh above
 @pytest.mark.slow
 def test_a_footing_on_the_filled_pit_responds_as_on_the_plain_half_space(tmp_path):
     """runs/soil_region/footing.py: a stiff 1 x 1 x 0.5 m block on a 2 x 2 x 1 m pit filled with the same soil
