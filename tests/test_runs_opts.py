@@ -26,6 +26,8 @@ SLOW = {
     "runs/foundation/anti-bonded.opts", "runs/foundation/anti-unilateral-cohesive.opts",
     # the paper's building under a record: the half building's file (same mesh) and the seismic building stay
     "runs/seismic/paper-building.opts",
+    # the building on a basement (the pit's BEM assembly, half a minute): runs/basement/surface.opts stays
+    "runs/basement/basement.opts",
 }
 PARAMS = [pytest.param(p, id=os.path.relpath(p, ROOT),
                        marks=[pytest.mark.slow] if os.path.relpath(p, ROOT) in SLOW else [])

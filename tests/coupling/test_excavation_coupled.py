@@ -213,3 +213,41 @@ def test_unilateral_contact_in_a_pit_is_warned_about(tmp_path):
     a[a.index("-ssi_t_end") + 1] = "0.005"
     p = cli(a)
     assert "the contact's active set is known not to settle there" in p.stdout + p.stderr
+
+
+def test_the_pit_footing_mesh_puts_nodes_every_half_h_on_the_pit(tmp_path):
+    """meshes/pit_footing.geo: the region's walls and bottom carry the pit's nine-node grid (nodes every h/2),
+    the footing's base is shared with the region's top; a footing half-width off the h/2 lattice is refused
+    in one line (run in a subprocess: a gmsh error in this process would fail its next .geo)."""
+    from helpers import run_script
+    from petsc_ssi.mesh import gmsh as reader
+    p = {"a": 1.0, "b": 1.0, "d": 1.0, "c": 0.5, "hf": 0.5, "h": 1.0, "fill": 1.0}
+    m = reader.read("meshes/pit_footing.geo", dim=3, params=p, user=tuple(p))
+    pit = m.coords[m.groups["pit"].nodes]
+    assert len(pit) == 57                      # the 12 nine-node soil elements' nodes of -ssi_mesh pit
+    assert np.allclose(np.round(pit * 2) / 2, pit)
+    assert len(set(m.groups["base"].nodes) & set(m.groups["soil"].nodes)) == 9
+    fp = run_script("runs", "soil_region", "footing.py")
+    a = [s.replace("c=0.5,", "c=0.3,") for s in fp.args("filled", 1.0, str(tmp_path / "r.h5"),
+                                                                fp.pulse_table(str(tmp_path / "p.txt")))]
+    r = cli(["run"] + a, check=False)
+    lines = [ln for ln in (r.stdout + r.stderr).splitlines() if "error" in ln]
+    assert r.returncode != 0 and len(lines) == 1 and "must be multiples of h/2" in lines[0], r.stdout + r.stderr
+
+
+# slow tier: four runs, 51-67 s on 1 rank; the default-tier siblings: the filled pit and the pit_footing mesh above
+@pytest.mark.slow
+def test_a_footing_on_the_filled_pit_responds_as_on_the_plain_half_space(tmp_path):
+    """runs/soil_region/footing.py: a stiff 1 x 1 x 0.5 m block on a 2 x 2 x 1 m pit filled with the same soil
+    against the block on the flat half-space, under a vertical and a horizontal force pulse (40 ms): the top
+    centre's max |u_filled - u_plain| / peak falls with the mesh, 4.1e-2 -> 1.4e-2 (u_z) and 8.2e-2 -> 4.6e-2
+    (u_x) from h = 1 m to 0.5 m (bricks h/2, dt 2.5 ms x h in both)."""
+    from helpers import run_script
+    m = run_script("runs", "soil_region", "footing.py")
+    err = {}
+    for h in (1.0, 0.5):
+        paths = {case: m.run(case, h, str(tmp_path))[0] for case in ("plain", "filled")}
+        err[h] = m.compare(paths["filled"], paths["plain"])[0]
+    assert err[1.0]["z"] < 0.05 and err[1.0]["x"] < 0.10, err            # 0.041, 0.082
+    assert err[0.5]["z"] < 0.02 and err[0.5]["x"] < 0.055, err           # 0.014, 0.046
+    assert err[0.5]["z"] < 0.5 * err[1.0]["z"] and err[0.5]["x"] < 0.7 * err[1.0]["x"], err   # 0.34, 0.55
