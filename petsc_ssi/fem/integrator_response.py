@@ -236,7 +236,7 @@ def record_note(kind, dt, t, a, source, axis="", tol=SAFE_TOL, advice=""):
     share of the record's energy above the scheme's safe band, the overstatement, the largest dt
     (a step 0.9 times the last, down to 1e-3 of dt) that keeps it within 1 + tol, then ``advice``."""
     x = safe_band(kind, tol)
-    if x >= 0.5:
+    if x >= 0.5 or not np.any(np.asarray(a, float)):          # (a record of zeros: nothing to overstate)
         return None
     ratio = stiff_peak_ratio(kind, dt, t, a)
     if ratio <= 1.0 + tol:
