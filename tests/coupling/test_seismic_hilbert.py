@@ -81,8 +81,9 @@ def dpulse(tmp_path_factory):
     return str(p)
 
 
-# slow tier: the post-critical SV case (34 s); the Rayleigh wave stays in make test
-@pytest.mark.parametrize("wave,extra", [("rayleigh", {}),
+# slow tier: both waves (two runs each, 20-34 s: the make-test budget); the default tier's siblings: the
+# taper against Dawson's closed form and its start (test_the_taper_starts_where_...), the refusal and the warning
+@pytest.mark.parametrize("wave,extra", [pytest.param("rayleigh", {}, marks=[pytest.mark.slow]),
                                         pytest.param("sv", dict(seismic_angle=40.0, seismic_postcritical=1),
                                                      marks=[pytest.mark.slow])])
 def test_a_block_under_a_hilbert_wave_does_not_depend_on_the_start(tmp_path, dpulse, wave, extra):
