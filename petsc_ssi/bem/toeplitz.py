@@ -296,60 +296,59 @@ class ToeplitzHistory:
             S = None
 
     def build(self, march, plan, monitor=False):
-        """Collective: the kernels K'_d (d = 1..D) of the march's history sum (its scheme and ``plan``)
-        in this rank's frequency slab."""
+        """Collective: the kernels K'_d (d = 1..D) of the march's exact lags and the kernels A_j of the
+        interpolating lags (``plan``: the far lags' matrices are sum_j w_j(l) H(T_j), so their part of the
+        history sum is sum_j A_j (sum_m c_j(n, m) v^m), the weights c of ``Marcher._interp_coef``, formed
+        per block over the kept transforms: only the exact and the anchors' kernels are stored), in this
+        rank's frequency slab."""
         t0 = time.perf_counter()
         lat, ls = self.lat, self.ls
         self.offsets = kernel_offsets(lat)
         lat.n_offsets = len(self.offsets)
         self.nev = 0
         nbig = ls.L + 8
-        terms = march._step_terms(nbig)
         by_key = {}
-        for key, m, c in terms:
+        for key, m, c in march._step_terms(nbig):
             if march._mat(key, "u") is not None:        # (lag 2: the step matrix's Mat takes its terms)
                 continue
             by_key.setdefault(key, []).append((nbig - m, c))
-        D = max([d for v in by_key.values() for d, _ in v] + [0])
+        D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
         self.D = D
+        # the history's reach: the oldest state a step reads (the interpolated lags' reach beyond D)
+        self.R = max([d for v in by_key.values() for d, _ in v] + [0])
+        self.k = plan.k if plan is not None and plan.active else 0
         slab = self.f1 - self.f0
         # per frequency two dense matrices, rows (d descending, slot, input component), columns (class,
         # output component): Kxy (x, y out of z in: entries xz, yz), Kz (z out of x, y in: zx, zy): the
-        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy)
+        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy); the
+        # anchors' Axy, Az the same with rows (anchor j, slot, input component)
         self.Kxy = np.zeros((slab, D * 9, 8), np.complex128)
         self.Kz = np.zeros((slab, D * 18, 4), np.complex128)
+        self.Axy = np.zeros((slab, self.k * 9, 8), np.complex128)
+        self.Az = np.zeros((slab, self.k * 18, 4), np.complex128)
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 for d, c in by_key.get(("x", lag), ()):
-                    self._add_kernel(d, c, S)
-        if plan is not None and plan.active:
-            for i in range(plan.k):
-                if ("i", i) not in by_key:
-                    continue
-                lag, toff = plan.kernel_time(i)
-                for _, S in self._spectra(lag, lag, toff, lag):
-                    for d, c in by_key[("i", i)]:
-                        self._add_kernel(d, c, S)
+                    _add_kernel(self.Kxy, self.Kz, D - d, c, S)
+        for i in range(self.k):
+            if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
+                continue
+            lag, toff = plan.kernel_time(i)
+            for _, S in self._spectra(lag, lag, toff, lag):
+                _add_kernel(self.Axy, self.Az, i, 1.0, S)
         # the kept states' transforms, in time order (state m at m - base): z (slab, W, 9), x and y
         # (slab, W, 18); states before the first are zeros, as are those not yet made
-        self.W = D + 3 * self.block + 8
+        self.W = self.R + 3 * self.block + 8
         self.Vz = np.zeros((slab, self.W, 9), np.complex128)
         self.Vxy = np.zeros((slab, self.W, 18), np.complex128)
-        self.base = -D
+        self.base = -self.R
         self._setup_state_maps(march)
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
-        self.bytes = mpi.allreduce(self.Kxy.nbytes + self.Kz.nbytes + self.Vz.nbytes + self.Vxy.nbytes)
+        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.Kxy, self.Kz, self.Axy, self.Az, self.Vz, self.Vxy)))
         return self
-
-    def _add_kernel(self, d, c, S):
-        """K'_d += c S: S (4, 9, 4, slab) one lag's kernel spectra (class, slot, H4 entry, frequency)."""
-        D, slab = self.D, S.shape[-1]
-        r = D - d
-        self.Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
-        self.Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
 
     def _setup_state_maps(self, march):
         lat, ls = self.lat, self.ls
@@ -385,16 +384,17 @@ class ToeplitzHistory:
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
-        self.upto, self.base, self._blk = 0, -self.D, None
+        self.upto, self.base, self._blk = 0, -self.R, None
         self.Vz[...] = 0.0
         self.Vxy[...] = 0.0
 
     def _room(self, n0):
-        """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - D .. n0 + b;
-        when they would run past the end, the kept ones move to the start and the rest is zeroed."""
+        """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - R .. n0 + b (R the
+        history's reach); when they would run past the end, the kept ones move to the start and the rest is
+        zeroed."""
         if n0 + self.block - self.base < self.W:
             return
-        lo = n0 + 1 - self.D
+        lo = n0 + 1 - self.R
         keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
         k = keep.stop - keep.start
         for B in (self.Vz, self.Vxy):
@@ -405,39 +405,77 @@ class ToeplitzHistory:
     def _catch_up(self, n, march):
         """Collective: the transforms of the states up to n (final) not yet kept."""
         PETSc = march.PETSc
-        for m in range(max(self.upto + 1, n - self.D + 1, 1), n + 1):
+        for m in range(max(self.upto + 1, n - self.R + 1, 1), n + 1):
             self.sc.scatter(march.ubuf[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
             self._transform(self.seq.getArray(readonly=True), m)
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
-        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows). Time-blocked:
-        at the first step of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart)
-        the terms of the states m <= n0 for all b steps at once (``history_products``: the kernels
-        read once for the b steps); each step adds those of the block's states before it (d < b)."""
-        from scipy.fft import irfft2
-        lat, b, D = self.lat, self.block, self.D
+        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} + sum_j A_j s_j^n (this rank's rows;
+        s_j^n = sum_m c_j(n, m) v^m the interpolated lags' weighted states). Time-blocked: at the first step
+        of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart) the terms of the states
+        m <= n0 for all b steps at once (``history_products``, ``interp_products``: the kernels read once
+        for the b steps); each step adds those of the block's states before it (m > n0)."""
+        b = self.block
         n0 = b * ((n - 1) // b)
         if self._blk is None or self._blk[0] != n0:
             self._room(n0)
             self._catch_up(n0, march)
             ev = event("SSI_BEM_HistFFTBlock")
             ev.begin()
-            p0 = n0 + 1 - D - self.base              # the first state row 0 reads (d = D)
-            acc_b = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, p0, b, D)
-            march.PETSc.Log.logFlops(8.0 * b * D * 144 * (self.f1 - self.f0))
+            self._blk = (n0, self._block_products(n0, march))
             ev.end()
-            self._blk = (n0, acc_b)
         self._catch_up(n - 1, march)
         acc = self._blk[1][:, n - n0 - 1].copy()            # (slab, 12)
+        self._step_products(n, n0, march, acc)
+        self._apply(acc, out_u)
+
+    def _block_products(self, n0, march):
+        """(slab, b, 12): the terms of the states m <= n0 in the history sums of steps n0 + 1 .. n0 + b."""
+        b, D, slab = self.block, self.D, self.f1 - self.f0
+        if D:
+            acc = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, n0 + 1 - D - self.base, b, D)
+            march.PETSc.Log.logFlops(8.0 * b * D * 144 * slab)
+        else:
+            acc = np.zeros((slab, b, 12), np.complex128)
+        if self.k:
+            lo = n0 + 1 - self.R                         # the oldest state the block reads
+            C = np.stack([self._weights(march, n0 + 1 + i, lo, n0) for i in range(b)])
+            acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, lo - self.base, march.PETSc.Log)
+        return acc
+
+    def _step_products(self, n, n0, march, acc):
+        """acc += the terms of the block's states n0 < m <= n - 1 in step n's history sum."""
+        D = self.D
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
             acc += history_products(self.Kxy[:, 9 * (D - k):], self.Kz[:, 18 * (D - k):], self.Vz, self.Vxy,
                                     n - k - self.base, 1, k)[:, 0]
             march.PETSc.Log.logFlops(8.0 * k * 144 * (self.f1 - self.f0))
+        if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
+            C = self._weights(march, n, n0 + 1, n - 1)[None]
+            if C.any():
+                acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, n0 + 1 - self.base,
+                                       march.PETSc.Log)[:, 0]
+
+    def _weights(self, march, n, m_lo, m_hi):
+        """(k, m_hi - m_lo + 1): the weight of state m_lo + i in the interpolated history s_j^n of step n
+        (``Marcher._interp_coef``, the dense path's weights), zero for states outside 1..n-1."""
+        C = np.zeros((self.k, m_hi - m_lo + 1))
+        coef = march._interp_coef(n)
+        if coef is not None:
+            a, e = max(m_lo, 1), min(m_hi, n - 1)
+            if e >= a:
+                C[:, a - m_lo:e - m_lo + 1] = coef[a:e + 1].T
+        return C
+
+    def _apply(self, acc, out_u):
+        """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows taken off out_u."""
+        from scipy.fft import irfft2
+        from mpi4py import MPI
+        lat = self.lat
         full = np.empty((lat.F, 12), np.complex128)
         mpi = self.comm.tompi4py()
-        from mpi4py import MPI
         mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
                                                    MPI.C_DOUBLE_COMPLEX])
         # columns: (class t, x or y) for 0..7, then z of class t at 8 + t -> (t, component)
@@ -448,6 +486,62 @@ class ToeplitzHistory:
         vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
         arr = out_u.getArray()
         arr -= vals.ravel()
+
+
+def _add_kernel(Kxy, Kz, r, c, S):
+    """Rows r of Kxy (9 a row) and Kz (18) += c S: S (4, 9, 4, slab) one lag's kernel spectra (class,
+    slot, H4 entry, frequency)."""
+    slab = S.shape[-1]
+    Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
+    Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
+
+
+def _spans(C):
+    """How ``interp_products`` forms the weighted states of C (b, k, ns): [(j0, j1, a, e)]: anchors j0..j1-1
+    from states a..e-1. One product over all anchors and their common span when that span is at most
+    twice their own spans' total (Chebyshev: every anchor weighs every state), else one per anchor
+    (multi-linear: an anchor weighs the states of its two intervals only)."""
+    nz = np.any(C != 0.0, axis=0)                       # (k, ns)
+    own = []
+    for j in range(C.shape[1]):
+        i = np.flatnonzero(nz[j])
+        if i.size:
+            own.append((j, j + 1, int(i[0]), int(i[-1]) + 1))
+    if not own:
+        return []
+    a, e = min(o[2] for o in own), max(o[3] for o in own)
+    if C.shape[1] * (e - a) <= 2 * sum(o[3] - o[2] for o in own):
+        return [(0, C.shape[1], a, e)]
+    return own
+
+
+def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=256):
+    """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
+    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m; real weights on the
+    real and imaginary parts: one real matrix product per span of ``_spans``), then (b x 9k)(9k x 8) and
+    (b x 18k)(18k x 4) products with the anchors' kernels: (slab, b, 12) complex, columns as
+    ``history_products``. Frequencies in chunks so the weighted states stay small."""
+    slab = Axy.shape[0]
+    b, k, _ = C.shape
+    out = np.zeros((slab, b, 12), np.complex128)
+    spans = _spans(C)
+    if not spans:
+        return out
+    for f0 in range(0, slab, fchunk):
+        f1 = min(slab, f0 + fchunk)
+        fc = f1 - f0
+        Sz = np.zeros((fc, b, k, 9), np.complex128)
+        Sxy = np.zeros((fc, b, k, 18), np.complex128)
+        for j0, j1, a, e in spans:
+            for V, S in ((Vz, Sz), (Vxy, Sxy)):
+                Vf = V[f0:f1, r0 + a:r0 + e].view(np.float64)                     # (fc, len, 2 c)
+                w = np.tensordot(C[:, j0:j1, a:e], Vf, axes=([2], [1]))         # (b, nj, fc, 2 c)
+                S[:, :, j0:j1, :] = w.view(np.complex128).transpose(2, 0, 1, 3)
+        np.matmul(Sz.reshape(fc, b, 9 * k), Axy[f0:f1], out=out[f0:f1, :, :8])
+        np.matmul(Sxy.reshape(fc, b, 18 * k), Az[f0:f1], out=out[f0:f1, :, 8:])
+    if log is not None:
+        log.logFlops(slab * (8.0 * b * k * 144 + 2.0 * 54 * b * sum((j1 - j0) * (e - a) for j0, j1, a, e in spans)))
+    return out
 
 
 def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
