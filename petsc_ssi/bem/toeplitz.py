@@ -139,31 +139,65 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # cost model (``estimate``), fitted to jobscripts/toeplitz_bench.sh's logs on the development machine (2
 # cores, idle; runs/pekeris/README.md "The toeplitz lag store"): the history's complex products per rank
 # (the block products' flops over this rate), the per-step work that grows with the soil's DOFs and is
-# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), and
-# seconds per (kernel offset, lag) of the kernels' integration
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6}
+# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), seconds
+# per (kernel offset, lag) of the kernels' integration, and the real flops per second of the interpolated
+# lags' weighted states (``interp_products``: real matrix products over the kept transforms)
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.0e9}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
-def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None):
+def interp_work(plan, n_steps, block=8, stabilized=True):
+    """(steps whose history reads an interpolating matrix, summed (anchors x states) of the weighted states
+    over the run's blocks) of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block:
+    the code's own choice); (0, 0) without interpolation. The terms of a block's own states (T_L within a
+    block) are left out (a few states a step)."""
+    if plan is None or not plan.active:
+        return 0, 0.0
+    from .interp import state_weights
+    steps, work = 0, 0.0
+    R = plan.L
+    for n0 in range(0, n_steps, block):
+        C = np.zeros((block, plan.k, R))
+        for i in range(block):
+            n = n0 + 1 + i
+            coef = state_weights(plan, n, stabilized)
+            if coef is None:
+                continue
+            if n <= n_steps:
+                steps += 1
+            lo = n0 + 1 - R
+            m = np.arange(max(lo, 1), min(n0, n - 1) + 1)
+            C[i][:, m - lo] = coef[m].T
+        work += block * sum((j1 - j0) * (e - a) for j0, j1, a, e in _spans(C))
+    return steps, work
+
+
+def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
-    the history sum) of a toeplitz run: kernels 144 complex per frequency and history lag, kept
-    transforms 27 per frequency and kept state (D + 3 b + 8), the build's transients per rank (a chunk of
-    kernels, its spectra, its integrals), ``g_bytes`` of G and the step matrix; the history's complex
-    products, 8 x 144 flops per frequency and (step, lag) pair at ``r_products`` per rank, and
+    the history sum) of a toeplitz run: kernels 144 complex per frequency for each exact lag (D: L, or the
+    ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept transforms 27 per frequency
+    and kept state (L + 3 b + 8), the build's transients per rank (a chunk of kernels, its spectra, its
+    integrals), ``g_bytes`` of G and the step matrix; the history's complex products, 8 x 144 flops per
+    frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
+    (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums``, and
     ``t_step_dof`` per step and DOF."""
     r = dict(RATES, **(rates or {}))
-    D = int(L)
-    W = D + 3 * block + 8
+    active = plan is not None and plan.active
+    D = int(plan.Lx) if active else int(L)
+    k = int(plan.k) if active else 0
+    W = int(L) + 3 * block + 8
     F = lat.F
     per_lag = 144 * lat.Mx * lat.My * 8.0
-    build = ranks * 3 * per_lag * max(1, min(D, int(CHUNK_BYTES // per_lag)))
-    nbytes = 16.0 * F * (144 * D + 27 * W) + build + float(g_bytes)
+    build = ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag)))
+    nbytes = 16.0 * F * (144 * (D + k) + 27 * W) + build + float(g_bytes)
     pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
-    t_build = r["t_pair_lag"] * pairs * D / ranks
+    t_build = r["t_pair_lag"] * pairs * (D + k) / ranks
     n = np.arange(1, n_steps + 1)
     flops = 8.0 * 144 * F * float(np.minimum(np.maximum(n - 1, 0), D).sum())
-    t_hist = flops / (ranks * r["r_products"]) + n_steps * n_dofs * r["t_step_dof"]
+    isteps, iwork = interp_work(plan, n_steps, block, stabilized)
+    flops += 8.0 * 144 * F * k * isteps
+    t_hist = (flops / (ranks * r["r_products"]) + 2.0 * 54 * F * iwork / (ranks * r["r_sums"])
+              + n_steps * n_dofs * r["t_step_dof"])
     return nbytes, t_build, t_hist
 
 
@@ -337,11 +371,12 @@ class ToeplitzHistory:
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
                 _add_kernel(self.Axy, self.Az, i, 1.0, S)
-        # the kept states' transforms, in time order (state m at m - base): z (slab, W, 9), x and y
-        # (slab, W, 18); states before the first are zeros, as are those not yet made
+        # the kept states' transforms, in time order (state m at m - base; time-major, so a run of states
+        # is one strided matrix for the weighted states' products): z (W, slab, 9), x and y (W, slab, 18);
+        # states before the first are zeros, as are those not yet made
         self.W = self.R + 3 * self.block + 8
-        self.Vz = np.zeros((slab, self.W, 9), np.complex128)
-        self.Vxy = np.zeros((slab, self.W, 18), np.complex128)
+        self.Vz = np.zeros((self.W, slab, 9), np.complex128)
+        self.Vxy = np.zeros((self.W, slab, 18), np.complex128)
         self.base = -self.R
         self._setup_state_maps(march)
         self.t_build = time.perf_counter() - t0
@@ -379,8 +414,8 @@ class ToeplitzHistory:
                 f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
         S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
         i = m - self.base
-        self.Vz[:, i, :] = S[:, 2, :].T
-        self.Vxy[:, i, :] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
+        self.Vz[i] = S[:, 2, :].T
+        self.Vxy[i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
@@ -398,8 +433,8 @@ class ToeplitzHistory:
         keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
         k = keep.stop - keep.start
         for B in (self.Vz, self.Vxy):
-            B[:, :k] = B[:, keep]
-            B[:, k:] = 0.0
+            B[:k] = B[keep]
+            B[k:] = 0.0
         self.base = lo
 
     def _catch_up(self, n, march):
@@ -441,7 +476,10 @@ class ToeplitzHistory:
         if self.k:
             lo = n0 + 1 - self.R                         # the oldest state the block reads
             C = np.stack([self._weights(march, n0 + 1 + i, lo, n0) for i in range(b)])
+            ev = event("SSI_BEM_HistInterp")
+            ev.begin()
             acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, lo - self.base, march.PETSc.Log)
+            ev.end()
         return acc
 
     def _step_products(self, n, n0, march, acc):
@@ -515,12 +553,13 @@ def _spans(C):
     return own
 
 
-def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=256):
+def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=64):
     """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
-    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m; real weights on the
-    real and imaginary parts: one real matrix product per span of ``_spans``), then (b x 9k)(9k x 8) and
-    (b x 18k)(18k x 4) products with the anchors' kernels: (slab, b, 12) complex, columns as
-    ``history_products``. Frequencies in chunks so the weighted states stay small."""
+    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
+    buffers; real weights on the real and imaginary parts: per span of ``_spans`` one real matrix product
+    of the weights with the span's states, read in place), then (b x 9k)(9k x 8) and (b x 18k)(18k x 4)
+    products with the anchors' kernels: (slab, b, 12) complex, columns as ``history_products``.
+    Frequencies in chunks so the weighted states stay small."""
     slab = Axy.shape[0]
     b, k, _ = C.shape
     out = np.zeros((slab, b, 12), np.complex128)
@@ -533,10 +572,12 @@ def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=256):
         Sz = np.zeros((fc, b, k, 9), np.complex128)
         Sxy = np.zeros((fc, b, k, 18), np.complex128)
         for j0, j1, a, e in spans:
+            Cj = C[:, j0:j1, a:e].reshape(-1, e - a)
             for V, S in ((Vz, Sz), (Vxy, Sxy)):
-                Vf = V[f0:f1, r0 + a:r0 + e].view(np.float64)                     # (fc, len, 2 c)
-                w = np.tensordot(C[:, j0:j1, a:e], Vf, axes=([2], [1]))         # (b, nj, fc, 2 c)
-                S[:, :, j0:j1, :] = w.view(np.complex128).transpose(2, 0, 1, 3)
+                c = V.shape[2]
+                Vf = V[r0 + a:r0 + e, f0:f1].view(np.float64).reshape(e - a, fc * 2 * c)     # (a view)
+                w = (Cj @ Vf).view(np.complex128).reshape(b, j1 - j0, fc, c)
+                S[:, :, j0:j1, :] = w.transpose(2, 0, 1, 3)
         np.matmul(Sz.reshape(fc, b, 9 * k), Axy[f0:f1], out=out[f0:f1, :, :8])
         np.matmul(Sxy.reshape(fc, b, 18 * k), Az[f0:f1], out=out[f0:f1, :, 8:])
     if log is not None:
@@ -546,7 +587,7 @@ def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=256):
 
 def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
     """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
-    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers, as two
+    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c), as two
     matrix products per frequency, (b x 9D) (b x 9D)-windows of Vz times Kxy (9D x 8) and (b x 18D)
     of Vxy times Kz (18D x 4): (slab, b, 12) complex, columns (class, x or y) then z by class. Array
     inputs and ``matmul`` only (the one function a GPU array module would take over); frequencies in
@@ -556,10 +597,10 @@ def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
     out = np.empty((slab, b, 12), np.complex128)
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
-        wz = sliding_window_view(Vz[f0:f1, p0:p0 + b - 1 + D], D, axis=1)      # (fc, b, 9, D)
-        wxy = sliding_window_view(Vxy[f0:f1, p0:p0 + b - 1 + D], D, axis=1)    # (fc, b, 18, D)
-        az = np.ascontiguousarray(wz.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 9 * D)
-        axy = np.ascontiguousarray(wxy.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 18 * D)
+        wz = sliding_window_view(Vz[p0:p0 + b - 1 + D, f0:f1], D, axis=0)      # (b, fc, 9, D)
+        wxy = sliding_window_view(Vxy[p0:p0 + b - 1 + D, f0:f1], D, axis=0)    # (b, fc, 18, D)
+        az = np.ascontiguousarray(wz.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 9 * D)
+        axy = np.ascontiguousarray(wxy.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 18 * D)
         np.matmul(az, Kxy[f0:f1], out=out[f0:f1, :, :8])
         np.matmul(axy, Kz[f0:f1], out=out[f0:f1, :, 8:])
     return out

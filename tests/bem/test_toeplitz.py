@@ -101,7 +101,7 @@ def test_toeplitz_restart_is_bitwise(tmp_path):
 
 # the far lags interpolated (-ssi_interp): the store keeps the exact lags' kernels and the k matrices'
 # kernels only, and sums each step's weighted states (bem/toeplitz.py interp_products). A small grid with
-# slow waves (23 lags; 12 exact, so a block of 8 steps reads only known states for the far lags), and T_L
+# slow waves (24 lags; 12 exact, so a block of 8 steps reads only known states for the far lags), and T_L
 # inside a block (Lx = 4 < b: the far lags' terms of the block's own states step by step)
 SLOW_SITE = ["-ssi_problem", "bem", "-ssi_cp", "200", "-ssi_cs", "100", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1",
              "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
@@ -134,6 +134,31 @@ def test_toeplitz_interp_equals_dense(tmp_path, case):
     same(ref, tz)
 
 
+def test_estimate_on_the_toeplitz_store(tmp_path):
+    """`petsc-ssi estimate -ssi_lag_store toeplitz` on a uniform grid prints the toeplitz block only (no
+    dense pair tables: O(N^2) on a whole grid) with the compressed kernels (exact lags + interpolating
+    matrices), and its bytes of kernels and kept transforms are the run's own (the ``bytes`` the run logs)."""
+    from petsc_ssi.bem import interp
+    from petsc_ssi.bem.toeplitz import estimate
+    args = SLOW_SITE + INTERP_CASES["linear"][0] + TZ
+    r = cli(["estimate"] + args + ["-ssi_estimate_ranks", "1,2"])
+    assert "estimate of this BEM run on the toeplitz lag store" in r.stdout
+    assert "kernels: 12 exact lags + 5 interpolating (of 24 the run reaches)" in r.stdout, r.stdout
+    assert "blocks assembled" not in r.stdout          # (the dense model's line)
+    out = cli(args + ["-ssi_output", str(tmp_path / "tz.h5")]).stdout
+    import re
+    stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
+
+    class Lat:
+        Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
+        F = 8 * 5
+        nx = ny = 4
+    plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
+    b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
+    build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes
+    assert abs((b - build) / 1e9 - stored) <= 0.01 * stored + 5e-6, (b - build, stored)
+
+
 def test_interp_products_match_the_sum():
     """``interp_products`` (weighted states by spans, then the anchors' products) against the plain sum
     over anchors, steps and states, for banded (per-anchor spans) and full (one span) weights."""
@@ -141,7 +166,7 @@ def test_interp_products_match_the_sum():
     rng = np.random.default_rng(3)
     slab, k, b, W = 37, 4, 3, 30
     cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
-    Axy, Az, Vz, Vxy = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4), cz(slab, W, 9), cz(slab, W, 18)
+    Axy, Az, Vz, Vxy = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4), cz(W, slab, 9), cz(W, slab, 18)
     banded = np.zeros((b, k, 20))
     for j in range(k):
         banded[:, j, 4 * j:4 * j + 6] = rng.standard_normal((b, 6))
@@ -149,8 +174,8 @@ def test_interp_products_match_the_sum():
     for C, n_spans in ((banded, k), (full, 1)):
         assert len(_spans(C)) == n_spans
         got = interp_products(Axy, Az, Vz, Vxy, C, 5, fchunk=16)
-        Sz = np.einsum("bjm,fmc->fbjc", C, Vz[:, 5:25]).reshape(slab, b, 9 * k)
-        Sxy = np.einsum("bjm,fmc->fbjc", C, Vxy[:, 5:25]).reshape(slab, b, 18 * k)
+        Sz = np.einsum("bjm,mfc->fbjc", C, Vz[5:25]).reshape(slab, b, 9 * k)
+        Sxy = np.einsum("bjm,mfc->fbjc", C, Vxy[5:25]).reshape(slab, b, 18 * k)
         ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)
         assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
 
