@@ -134,6 +134,18 @@ def test_toeplitz_interp_equals_dense(tmp_path, case):
     same(ref, tz)
 
 
+# slow tier: a restart with interpolated far lags (test_toeplitz_restart_is_bitwise is its sibling in make test)
+@pytest.mark.slow
+def test_toeplitz_interp_restart_is_bitwise(tmp_path):
+    """A checkpoint after step 10 of 32 (inside a block of 8) with the far lags interpolated: the restart
+    makes the kept transforms again back to the history's reach (24 states), and every dataset is the
+    uninterrupted run's bit for bit."""
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    from test_checkpoint import run_and_restart, assert_same_files
+    (ref, rs), = run_and_restart(SLOW_SITE + INTERP_CASES["linear"][0] + TZ, tmp_path, 1, 5, 10)
+    assert_same_files(ref, rs)
+
+
 def test_estimate_on_the_toeplitz_store(tmp_path):
     """`petsc-ssi estimate -ssi_lag_store toeplitz` on a uniform grid prints the toeplitz block only (no
     dense pair tables: O(N^2) on a whole grid) with the compressed kernels (exact lags + interpolating
