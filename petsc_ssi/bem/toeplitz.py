@@ -141,8 +141,13 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # (the block products' flops over this rate), the per-step work that grows with the soil's DOFs and is
 # not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), seconds
 # per (kernel offset, lag) of the kernels' integration, and the real flops per second of the interpolated
-# lags' weighted states (``interp_products``: real matrix products over the kept transforms)
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.0e9}
+# lags' weighted states (``interp_products``: real matrix products over the kept transforms; from the
+# 40, 60 and 80 m sites of jobscripts/toeplitz_bench.sh, run on the shared machine: each run's rate of the
+# weighted states over its rate of the exact products, times the idle r_products; median of 3.44, 6.67,
+# 4.69 GFlop/s), and the bytes of the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested
+# dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak
+# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
@@ -177,7 +182,8 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     the history sum) of a toeplitz run: kernels 144 complex per frequency for each exact lag (D: L, or the
     ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept transforms 27 per frequency
     and kept state (L + 3 b + 8), the build's transients per rank (a chunk of kernels, its spectra, its
-    integrals), ``g_bytes`` of G and the step matrix; the history's complex products, 8 x 144 flops per
+    integrals), ``g_bytes`` of G and the step matrix, the march's past states (the ring and every rank's
+    copy of it), the step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 x 144 flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
     (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums``, and
     ``t_step_dof`` per step and DOF."""
@@ -189,7 +195,11 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     F = lat.F
     per_lag = 144 * lat.Mx * lat.My * 8.0
     build = ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag)))
-    nbytes = 16.0 * F * (144 * (D + k) + 27 * W) + build + float(g_bytes)
+    # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
+    # rank's copies of them for the G lags' panel products (``_replicate``): 8 bytes a DOF and state
+    ring = 8.0 * n_dofs * (int(L) + 2 + 31) * (1 + ranks)
+    factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
+    nbytes = 16.0 * F * (144 * (D + k) + 27 * W) + build + float(g_bytes) + ring + factors
     pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
     t_build = r["t_pair_lag"] * pairs * (D + k) / ranks
     n = np.arange(1, n_steps + 1)
