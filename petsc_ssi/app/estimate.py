@@ -66,11 +66,10 @@ def report(cfg, comm, out=None):
         from ..coupling.cost import CoupledCounts
         coupled = build_coupled(cfg, comm)
         cc = CoupledCounts(cfg, comm, *coupled)
-    if coupled is None and cfg.get("lag_store", "dense") != "dense":
-        lines = _toeplitz_report(cfg, comm, ranks, cores, q, node_mem)
-        if lines is not None:          # a uniform flat grid: the run takes the toeplitz store
-            out("\n".join(lines))
-            return {"counts": None, "rows": []}
+    tz = None if coupled is not None else _toeplitz_report(cfg, comm, ranks, cores, q, node_mem)
+    if tz is not None:                  # a uniform flat grid: the run takes the toeplitz store
+        out("\n".join(tz))
+        return {"counts": None, "rows": []}
     prob, plan, cnt = count_run(cfg, comm, ranks, node_mem, coupled)
     nd = int(cnt.storage.sum())
     n1 = int(cnt.single.sum())
@@ -120,19 +119,22 @@ def report(cfg, comm, out=None):
                      + (f"{t['cpl_setup']:16.4g} {t['cpl_loop']:15.4g} " if cc is not None else "")
                      + f"{t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
                      f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
-    ok = [r for r in rows if r["fits"]]
-    if ok:
-        best = min(ok, key=lambda r: r["total"])
-        lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
-                     f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
-    else:
-        lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
-                     f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    lines.append(_verdict(rows, node_mem))
     lines += _toeplitz_lines(cfg, prob, cnt, ranks)
     lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
                  f"-log_view times; the model's measured error: jobscripts/README.md)")
     out("\n".join(lines))
     return {"counts": cnt, "rows": rows}
+
+
+def _verdict(rows, node_mem):
+    ok = [r for r in rows if r["fits"]]
+    if ok:
+        best = min(ok, key=lambda r: r["total"])
+        return (f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
+                f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
+    return (f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
+            f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
 
 
 def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
@@ -145,6 +147,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
     from ..bem.lagset import load_kernels
     from ..sysmem import process_rss
     from ..petsc import SSIError
+    if cfg.get("lag_store", "dense") == "dense":
+        return None
     t0 = time.perf_counter()
     prob = HalfSpace(cfg, comm, log=lambda m: None)
     prob.warn_diffraction()
