@@ -5,6 +5,11 @@ history's cost per step, the wall, the peak memory over the ranks, and the run's
 whole model's receivers against the quarter model's.
 
     python jobscripts/toeplitz_table.py OUTDIR README CSV PNG [SCALING_README]
+
+The sites (runs site-<L>, issue 41's 100 m item) get their own table (between <!-- toeplitz-site:begin/end -->
+in README and SCALING_README), with `petsc-ssi estimate`'s block (site-<L>.estimate) beside each run, the
+interpolation's effect on the receivers (site-<L> against site-<L>-exact), and the plot PNG with
+"_site" before its extension.
 """
 import csv
 import glob
@@ -50,6 +55,88 @@ def row(log):
     return r
 
 
+SITE_BEGIN, SITE_END = "<!-- toeplitz-site:begin -->", "<!-- toeplitz-site:end -->"
+SITE_COLS = ["run", "dofs", "steps", "kernels", "stored_GB", "kernels_s", "history_s", "history_ms_per_step",
+             "total_s", "peak_GB", "est_GB", "est_history_ms_per_step", "cli_GB", "cli_history_s", "cli_setup_s"]
+
+
+def site_row(outdir, r):
+    """A site run's row: its log's numbers and `petsc-ssi estimate`'s block for the same options."""
+    log = open(os.path.join(outdir, r["run"] + ".log")).read()
+    m = re.search(r"(\d+) history kernels K'_d in Fourier space(?: and the (\d+) interpolating)?", log)
+    s = dict(r)
+    s["kernels"] = (f"{m.group(1)} + {m.group(2)}" if m.group(2) else m.group(1)) if m else ""
+    s["est_history_ms_per_step"] = (round(1e3 * r["est_history_s"] / r["steps"], 2)
+                                    if r.get("est_history_s") not in (None, "") and r["steps"] else "")
+    est = os.path.join(outdir, r["run"] + ".estimate")
+    if os.path.exists(est):
+        text = open(est).read()
+        m = re.search(r"\[ssi\]\s+\d+ \|\s+(\S+)\s+(\S+) \|\s+(\S+) \|\s+(\S+) \|", text)
+        if m:
+            s["cli_history_s"], s["cli_GB"] = float(m.group(2)), float(m.group(4))
+        m = re.search(r"model set-up took (\S+) s", text)
+        s["cli_setup_s"] = float(m.group(1)) if m else ""
+    return s
+
+
+def site_accuracy(outdir):
+    """The interpolated site runs against their exact sibling: per receiver the largest difference over
+    the run relative to that receiver's peak |u|."""
+    import h5py
+    import numpy as np
+    out = []
+    for exact in sorted(glob.glob(os.path.join(outdir, "site-*-exact.h5"))):
+        other = exact.replace("-exact.h5", ".h5")
+        try:
+            with h5py.File(exact) as a, h5py.File(other) as b:
+                ua, ub, pts = a["receivers/u"][...], b["receivers/u"][...], a["receivers/points"][...]
+        except (OSError, KeyError):
+            continue
+        for i in range(ua.shape[1]):
+            err = float(np.abs(ub[:, i] - ua[:, i]).max() / np.abs(ua[:, i]).max())
+            out.append(f"{os.path.basename(other)[:-3]} against {os.path.basename(exact)[:-3]}: receiver at "
+                       f"({pts[i][0]:g}, {pts[i][1]:g}) m, largest difference {err:.3g} of its peak |u|")
+    return out
+
+
+def site_plot(rows, png):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    N = np.array([r["dofs"] for r in rows], float)
+    t = np.array([r["history_ms_per_step"] for r in rows], float)
+    est = np.array([r["est_history_ms_per_step"] if r["est_history_ms_per_step"] != "" else np.nan for r in rows])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(N, t, "o-", label="measured (-log_view SSI_BEM_History / steps)")
+    ax.loglog(N, est, "s--", label="the run's estimate (bem/toeplitz.py)")
+    ax.loglog(N, t[0] * (N * np.log(N)) / (N[0] * np.log(N[0])), ":", label="N log N through the first point")
+    ax.set_xlabel("soil DOFs N [-]")
+    ax.set_ylabel("history sum per step [ms]")
+    ax.set_title("toeplitz store, interpolated far lags: sites of 1 m elements, 0.3 s", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+
+
+def sites(rows, outdir, png, paths):
+    sr = sorted((r for r in rows if re.fullmatch(r"site-\d+", r["run"])), key=lambda r: r["dofs"] or 0)
+    if not sr:
+        return []
+    sr = [site_row(outdir, r) for r in sr]
+    md = ["| " + " | ".join(SITE_COLS) + " |", "|" + "---|" * len(SITE_COLS)]
+    md += ["| " + " | ".join(str(r.get(c, "")) for c in SITE_COLS) + " |" for r in sr]
+    acc = site_accuracy(outdir)
+    if acc:
+        md += [""] + ["- " + a for a in acc]
+    ok = [r for r in sr if r.get("history_ms_per_step") not in ("", None)]
+    if len(ok) >= 2:
+        site_plot(ok, png)
+    for path in paths:
+        put(path, SITE_BEGIN, SITE_END, md)
+    return md
+
+
 def receivers_agree(outdir):
     """Largest difference of the whole model's receivers from the quarter model's, relative to their peak."""
     import h5py
@@ -88,11 +175,10 @@ def scaling(rows, path):
     put(path, "<!-- toeplitz-scaling:begin -->", "<!-- toeplitz-scaling:end -->", lines)
 
 
-def main(outdir, readme, csvpath, png, scaling_readme=None):
-    rows = [row(p) for p in sorted(glob.glob(os.path.join(outdir, "*.log")))]
-    if scaling_readme:
-        scaling(rows, scaling_readme)
-    with open(csvpath, "w", newline="") as f:
+def write_csv(rows, path):
+    if not rows:
+        return
+    with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, COLS)
         w.writerow({c: c + {"stored_GB": " [GB]", "kernels_s": " [s]", "history_s": " [s]",
                             "history_ms_per_step": " [ms]", "total_s": " [s]", "peak_GB": " [GB]",
@@ -100,6 +186,20 @@ def main(outdir, readme, csvpath, png, scaling_readme=None):
                     for c in COLS})
         for r in rows:
             w.writerow({c: r.get(c, "") for c in COLS})
+
+
+def main(outdir, readme, csvpath, png, scaling_readme=None):
+    everything = [row(p) for p in sorted(glob.glob(os.path.join(outdir, "*.log")))]
+    base, ext = os.path.splitext(png)
+    site_md = sites(everything, outdir, base + "_site" + ext, [readme] + ([scaling_readme] if scaling_readme else []))
+    write_csv([r for r in everything if r["run"].startswith("site-")], os.path.splitext(csvpath)[0] + "_site.csv")
+    rows = [r for r in everything if not r["run"].startswith("site-")]
+    print("\n".join(site_md))
+    if not rows:                # (PARTS=site: the other tables stay as they are)
+        return
+    if scaling_readme:
+        scaling(rows, scaling_readme)
+    write_csv(rows, csvpath)
     agree = receivers_agree(outdir)
     md = ["| " + " | ".join(COLS) + " |", "|" + "---|" * len(COLS)]
     md += ["| " + " | ".join(str(r.get(c, "")) for c in COLS) + " |" for r in rows]

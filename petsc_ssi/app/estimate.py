@@ -66,6 +66,10 @@ def report(cfg, comm, out=None):
         from ..coupling.cost import CoupledCounts
         coupled = build_coupled(cfg, comm)
         cc = CoupledCounts(cfg, comm, *coupled)
+    tz = None if coupled is not None else _toeplitz_report(cfg, comm, ranks, cores, q, node_mem)
+    if tz is not None:                  # a uniform flat grid: the run takes the toeplitz store
+        out("\n".join(tz))
+        return {"counts": None, "rows": []}
     prob, plan, cnt = count_run(cfg, comm, ranks, node_mem, coupled)
     nd = int(cnt.storage.sum())
     n1 = int(cnt.single.sum())
@@ -115,19 +119,73 @@ def report(cfg, comm, out=None):
                      + (f"{t['cpl_setup']:16.4g} {t['cpl_loop']:15.4g} " if cc is not None else "")
                      + f"{t['loop']:11.4g} | {fmt_time(t['total']):>7} | "
                      f"{t['peak_bytes'] / 1e9:7.3g} {t['peak_rank_bytes'] / 1e9:11.3g} {per_node / 1e9:7.3g} | {flag}")
-    ok = [r for r in rows if r["fits"]]
-    if ok:
-        best = min(ok, key=lambda r: r["total"])
-        lines.append(f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
-                     f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
-    else:
-        lines.append(f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
-                     f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    lines.append(_verdict(rows, node_mem))
     lines += _toeplitz_lines(cfg, prob, cnt, ranks)
     lines.append(f"[ssi]   (model set-up took {cnt.setup_s:.3g} s on {comm.getSize()} rank(s); times are "
                  f"-log_view times; the model's measured error: jobscripts/README.md)")
     out("\n".join(lines))
     return {"counts": cnt, "rows": rows}
+
+
+def _verdict(rows, node_mem):
+    ok = [r for r in rows if r["fits"]]
+    if ok:
+        best = min(ok, key=lambda r: r["total"])
+        return (f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
+                f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
+    return (f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
+            f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+
+
+def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
+    """Collective: the estimate block of a run the toeplitz store takes (-ssi_lag_store toeplitz or auto on
+    a uniform flat grid), or None (not such a grid: the dense model's block follows). The dense model's
+    counts are not made: its element-pair tables hold every (node, element) pair (O(N^2) on a whole
+    grid: minutes and GBs on a 60 m site), and the run does not store those matrices."""
+    from ..bem.halfspace import HalfSpace
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets
+    from ..bem.lagset import load_kernels
+    from ..sysmem import process_rss
+    from ..petsc import SSIError
+    if cfg.get("lag_store", "dense") == "dense":
+        return None
+    t0 = time.perf_counter()
+    prob = HalfSpace(cfg, comm, log=lambda m: None)
+    prob.warn_diffraction()
+    plan = prob.interp_plan()
+    ls = prob.lagset(plan)
+    try:
+        if not ls.flat:
+            raise SSIError("the surface is not flat")
+        lat = detect(ls.VX, prob.mesh.nodes)
+    except SSIError:
+        return None
+    lat.n_offsets = len(kernel_offsets(lat))
+    g = prob.toeplitz_side_bytes(ls, plan)
+    load_kernels()                      # the process measured with the compiled kernels it will hold
+    rss = process_rss()
+    limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * node_mem
+    k = plan.k if plan.active else 0
+    N = prob.mesh.n_nodes
+    lines = ["[ssi] estimate of this BEM run on the toeplitz lag store (model petsc_ssi/bem/toeplitz.py "
+             "estimate; the dense lag matrices' model is not counted on a uniform grid)",
+             f"[ssi]   {3 * N} DOFs ({N} nodes), {len(ls.Vc)} elements with images, {prob.n_steps} steps, "
+             f"{prob.regions.n_t} traction nodes; {lat.describe()}; kernels: {plan.Lx} exact lags + {k} "
+             f"interpolating (of {prob.L} the run reaches), states kept {prob.L}",
+             "[ssi]   ranks | kernels_s history_s | GB over the ranks beside the processes | with the processes "
+             "(this one's resident size each) | fits"]
+    for p in ranks:
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
+                                stabilized=cfg.scheme.startswith("stabili"))
+        tot = b + p * rss
+        per_node = tot / p * min(q, p)
+        flag = "yes" if per_node <= limit else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
+        if min(q, p) > cores:
+            flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
+        lines.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g} | {tot / 1e9:7.3g} | {flag}")
+    lines.append(f"[ssi]   (model set-up took {time.perf_counter() - t0:.3g} s on {comm.getSize()} rank(s); the "
+                 "node's limit: 80 % of its memory or -ssi_memory_limit, as the run's check)")
+    return lines
 
 
 def _toeplitz_lines(cfg, prob, cnt, ranks):
@@ -149,7 +207,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     for p in ranks:
         lags = cnt.Lx + cnt.k
         g = 8.0 * 5 * prob.mesh.n_nodes * prob.regions.n_t * lags
-        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g)
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g,
+                                plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"))
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")
     return out
 

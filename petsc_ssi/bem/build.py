@@ -216,7 +216,10 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     mem_g = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in [M for M in H + G + GI if M is not None]))
     mem = mem_g + th.bytes
     printf(f"[ssi] assembly {fmt_time(t_asm)}: lag store toeplitz on the {prob.lattice.describe()}: "
-           f"{th.D} history kernels K'_d in Fourier space ({th.bytes / 1e9:.3g} GB with the kept states' "
+           f"{th.D} history kernels K'_d in Fourier space"
+           + (f" and the {th.k} interpolating matrices' kernels (the far lags' states weighted per step, {th.R} "
+              "steps kept)" if th.k else "")
+           + f" ({th.bytes / 1e9:.3g} GB with the kept states' "
            f"transforms; kernels {th.t_build:.3g} s), step matrix and G lags {mem_g / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations")
     _say_block(march)

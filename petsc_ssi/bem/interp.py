@@ -105,6 +105,22 @@ class Plan:
         return l, max(0.0, t - l * self.dt)
 
 
+def state_weights(plan, n, stabilized=True):
+    """coef[m, i]: the weight of state m in the interpolated history w_i = sum_l I(l, i) q_l(u) of step n
+    (q_l the scheme's states of lag l: ``march``), (n + 1, k); None: no interpolated lag reaches a state
+    yet."""
+    lags = np.arange(plan.Lx + 1, min(plan.L, n + 1) + 1)
+    if lags.size == 0:
+        return None
+    offs = ((2, 1.0), (1, 2.0), (0, 1.0)) if stabilized else ((1, 1.0),)
+    coef = np.zeros((n + 1, plan.k))      # coef[m, i]: weight of state m in w_i
+    for off, c in offs:
+        m = n - lags + off
+        ok = (m >= 1) & (m <= n - 1)
+        np.add.at(coef, m[ok], c * plan.W[lags[ok] - plan.Lx - 1])
+    return coef
+
+
 def auto(cs, dt, L, receivers, source, tau_l=1.5, steps_per_matrix=5):
     """The paper's rule: tau_L = c_s T_L / r above the Rayleigh arrival (1.5)
     for the farthest receiver of interest, one exact matrix every 5 steps.

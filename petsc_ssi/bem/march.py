@@ -312,18 +312,9 @@ class Marcher:
 
     def _interp_coef(self, n):
         """coef[m, i]: the weight of state m in the interpolated history w_i of step n (None: no
-        interpolated lag reaches a state yet)."""
-        plan = self.plan
-        lags = np.arange(plan.Lx + 1, min(plan.L, n + 1) + 1)
-        if lags.size == 0:
-            return None
-        offs = ((2, 1.0), (1, 2.0), (0, 1.0)) if self.scheme == "stabilized" else ((1, 1.0),)
-        coef = np.zeros((n + 1, plan.k))      # coef[m, i]: weight of state m in w_i
-        for off, c in offs:
-            m = n - lags + off
-            ok = (m >= 1) & (m <= n - 1)
-            np.add.at(coef, m[ok], c * plan.W[lags[ok] - plan.Lx - 1])
-        return coef
+        interpolated lag reaches a state yet): ``interp.state_weights``."""
+        from .interp import state_weights
+        return state_weights(self.plan, n, self.scheme == "stabilized")
 
     def _interp_history(self, n, out_u):
         plan = self.plan

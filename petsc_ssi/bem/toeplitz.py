@@ -139,31 +139,75 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # cost model (``estimate``), fitted to jobscripts/toeplitz_bench.sh's logs on the development machine (2
 # cores, idle; runs/pekeris/README.md "The toeplitz lag store"): the history's complex products per rank
 # (the block products' flops over this rate), the per-step work that grows with the soil's DOFs and is
-# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), and
-# seconds per (kernel offset, lag) of the kernels' integration
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6}
+# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), seconds
+# per (kernel offset, lag) of the kernels' integration, and the real flops per second of the interpolated
+# lags' weighted states (``interp_products``: real matrix products over the kept transforms; from the
+# 40, 60 and 80 m sites of jobscripts/toeplitz_bench.sh, run on the shared machine: each run's rate of the
+# weighted states over its rate of the exact products, times the idle r_products; median of 3.44, 6.67,
+# 4.69 GFlop/s), and the bytes of the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested
+# dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak
+# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
-def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None):
+def interp_work(plan, n_steps, block=8, stabilized=True):
+    """(steps whose history reads an interpolating matrix, summed (anchors x states) of the weighted states
+    over the run's blocks) of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block:
+    the code's own choice); (0, 0) without interpolation. The terms of a block's own states (T_L within a
+    block) are left out (a few states a step)."""
+    if plan is None or not plan.active:
+        return 0, 0.0
+    from .interp import state_weights
+    steps, work = 0, 0.0
+    R = plan.L
+    for n0 in range(0, n_steps, block):
+        C = np.zeros((block, plan.k, R))
+        for i in range(block):
+            n = n0 + 1 + i
+            coef = state_weights(plan, n, stabilized)
+            if coef is None:
+                continue
+            if n <= n_steps:
+                steps += 1
+            lo = n0 + 1 - R
+            m = np.arange(max(lo, 1), min(n0, n - 1) + 1)
+            C[i][:, m - lo] = coef[m].T
+        work += block * sum((j1 - j0) * (e - a) for j0, j1, a, e in _spans(C))
+    return steps, work
+
+
+def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
-    the history sum) of a toeplitz run: kernels 144 complex per frequency and history lag, kept
-    transforms 27 per frequency and kept state (D + 3 b + 8), the build's transients per rank (a chunk of
-    kernels, its spectra, its integrals), ``g_bytes`` of G and the step matrix; the history's complex
-    products, 8 x 144 flops per frequency and (step, lag) pair at ``r_products`` per rank, and
+    the history sum) of a toeplitz run: kernels 144 complex per frequency for each exact lag (D: L, or the
+    ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept transforms 27 per frequency
+    and kept state (L + 3 b + 8), the build's transients per rank (a chunk of kernels, its spectra, its
+    integrals), ``g_bytes`` of G and the step matrix, the march's past states (the ring and every rank's
+    copy of it), the step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 x 144 flops per
+    frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
+    (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums``, and
     ``t_step_dof`` per step and DOF."""
     r = dict(RATES, **(rates or {}))
-    D = int(L)
-    W = D + 3 * block + 8
+    active = plan is not None and plan.active
+    D = int(plan.Lx) if active else int(L)
+    k = int(plan.k) if active else 0
+    W = int(L) + 3 * block + 8
     F = lat.F
     per_lag = 144 * lat.Mx * lat.My * 8.0
-    build = ranks * 3 * per_lag * max(1, min(D, int(CHUNK_BYTES // per_lag)))
-    nbytes = 16.0 * F * (144 * D + 27 * W) + build + float(g_bytes)
+    build = ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag)))
+    # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
+    # rank's copies of them for the G lags' panel products (``_replicate``): 8 bytes a DOF and state
+    ring = 8.0 * n_dofs * (int(L) + 2 + 31) * (1 + ranks)
+    factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
+    nbytes = 16.0 * F * (144 * (D + k) + 27 * W) + build + float(g_bytes) + ring + factors
     pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
-    t_build = r["t_pair_lag"] * pairs * D / ranks
+    t_build = r["t_pair_lag"] * pairs * (D + k) / ranks
     n = np.arange(1, n_steps + 1)
     flops = 8.0 * 144 * F * float(np.minimum(np.maximum(n - 1, 0), D).sum())
-    t_hist = flops / (ranks * r["r_products"]) + n_steps * n_dofs * r["t_step_dof"]
+    isteps, iwork = interp_work(plan, n_steps, block, stabilized)
+    flops += 8.0 * 144 * F * k * isteps
+    t_hist = (flops / (ranks * r["r_products"]) + 2.0 * 54 * F * iwork / (ranks * r["r_sums"])
+              + n_steps * n_dofs * r["t_step_dof"])
     return nbytes, t_build, t_hist
 
 
@@ -296,60 +340,60 @@ class ToeplitzHistory:
             S = None
 
     def build(self, march, plan, monitor=False):
-        """Collective: the kernels K'_d (d = 1..D) of the march's history sum (its scheme and ``plan``)
-        in this rank's frequency slab."""
+        """Collective: the kernels K'_d (d = 1..D) of the march's exact lags and the kernels A_j of the
+        interpolating lags (``plan``: the far lags' matrices are sum_j w_j(l) H(T_j), so their part of the
+        history sum is sum_j A_j (sum_m c_j(n, m) v^m), the weights c of ``Marcher._interp_coef``, formed
+        per block over the kept transforms: only the exact and the anchors' kernels are stored), in this
+        rank's frequency slab."""
         t0 = time.perf_counter()
         lat, ls = self.lat, self.ls
         self.offsets = kernel_offsets(lat)
         lat.n_offsets = len(self.offsets)
         self.nev = 0
         nbig = ls.L + 8
-        terms = march._step_terms(nbig)
         by_key = {}
-        for key, m, c in terms:
+        for key, m, c in march._step_terms(nbig):
             if march._mat(key, "u") is not None:        # (lag 2: the step matrix's Mat takes its terms)
                 continue
             by_key.setdefault(key, []).append((nbig - m, c))
-        D = max([d for v in by_key.values() for d, _ in v] + [0])
+        D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
         self.D = D
+        # the history's reach: the oldest state a step reads (the interpolated lags' reach beyond D)
+        self.R = max([d for v in by_key.values() for d, _ in v] + [0])
+        self.k = plan.k if plan is not None and plan.active else 0
         slab = self.f1 - self.f0
         # per frequency two dense matrices, rows (d descending, slot, input component), columns (class,
         # output component): Kxy (x, y out of z in: entries xz, yz), Kz (z out of x, y in: zx, zy): the
-        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy)
+        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy); the
+        # anchors' Axy, Az the same with rows (anchor j, slot, input component)
         self.Kxy = np.zeros((slab, D * 9, 8), np.complex128)
         self.Kz = np.zeros((slab, D * 18, 4), np.complex128)
+        self.Axy = np.zeros((slab, self.k * 9, 8), np.complex128)
+        self.Az = np.zeros((slab, self.k * 18, 4), np.complex128)
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 for d, c in by_key.get(("x", lag), ()):
-                    self._add_kernel(d, c, S)
-        if plan is not None and plan.active:
-            for i in range(plan.k):
-                if ("i", i) not in by_key:
-                    continue
-                lag, toff = plan.kernel_time(i)
-                for _, S in self._spectra(lag, lag, toff, lag):
-                    for d, c in by_key[("i", i)]:
-                        self._add_kernel(d, c, S)
-        # the kept states' transforms, in time order (state m at m - base): z (slab, W, 9), x and y
-        # (slab, W, 18); states before the first are zeros, as are those not yet made
-        self.W = D + 3 * self.block + 8
-        self.Vz = np.zeros((slab, self.W, 9), np.complex128)
-        self.Vxy = np.zeros((slab, self.W, 18), np.complex128)
-        self.base = -D
+                    _add_kernel(self.Kxy, self.Kz, D - d, c, S)
+        for i in range(self.k):
+            if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
+                continue
+            lag, toff = plan.kernel_time(i)
+            for _, S in self._spectra(lag, lag, toff, lag):
+                _add_kernel(self.Axy, self.Az, i, 1.0, S)
+        # the kept states' transforms, in time order (state m at m - base; time-major, so a run of states
+        # is one strided matrix for the weighted states' products): z (W, slab, 9), x and y (W, slab, 18);
+        # states before the first are zeros, as are those not yet made
+        self.W = self.R + 3 * self.block + 8
+        self.Vz = np.zeros((self.W, slab, 9), np.complex128)
+        self.Vxy = np.zeros((self.W, slab, 18), np.complex128)
+        self.base = -self.R
         self._setup_state_maps(march)
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
-        self.bytes = mpi.allreduce(self.Kxy.nbytes + self.Kz.nbytes + self.Vz.nbytes + self.Vxy.nbytes)
+        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.Kxy, self.Kz, self.Axy, self.Az, self.Vz, self.Vxy)))
         return self
-
-    def _add_kernel(self, d, c, S):
-        """K'_d += c S: S (4, 9, 4, slab) one lag's kernel spectra (class, slot, H4 entry, frequency)."""
-        D, slab = self.D, S.shape[-1]
-        r = D - d
-        self.Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
-        self.Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
 
     def _setup_state_maps(self, march):
         lat, ls = self.lat, self.ls
@@ -380,64 +424,106 @@ class ToeplitzHistory:
                 f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
         S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
         i = m - self.base
-        self.Vz[:, i, :] = S[:, 2, :].T
-        self.Vxy[:, i, :] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
+        self.Vz[i] = S[:, 2, :].T
+        self.Vxy[i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
-        self.upto, self.base, self._blk = 0, -self.D, None
+        self.upto, self.base, self._blk = 0, -self.R, None
         self.Vz[...] = 0.0
         self.Vxy[...] = 0.0
 
     def _room(self, n0):
-        """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - D .. n0 + b;
-        when they would run past the end, the kept ones move to the start and the rest is zeroed."""
+        """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - R .. n0 + b (R the
+        history's reach); when they would run past the end, the kept ones move to the start and the rest is
+        zeroed."""
         if n0 + self.block - self.base < self.W:
             return
-        lo = n0 + 1 - self.D
+        lo = n0 + 1 - self.R
         keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
         k = keep.stop - keep.start
         for B in (self.Vz, self.Vxy):
-            B[:, :k] = B[:, keep]
-            B[:, k:] = 0.0
+            B[:k] = B[keep]
+            B[k:] = 0.0
         self.base = lo
 
     def _catch_up(self, n, march):
         """Collective: the transforms of the states up to n (final) not yet kept."""
         PETSc = march.PETSc
-        for m in range(max(self.upto + 1, n - self.D + 1, 1), n + 1):
+        for m in range(max(self.upto + 1, n - self.R + 1, 1), n + 1):
             self.sc.scatter(march.ubuf[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
             self._transform(self.seq.getArray(readonly=True), m)
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
-        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} (this rank's rows). Time-blocked:
-        at the first step of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart)
-        the terms of the states m <= n0 for all b steps at once (``history_products``: the kernels
-        read once for the b steps); each step adds those of the block's states before it (d < b)."""
-        from scipy.fft import irfft2
-        lat, b, D = self.lat, self.block, self.D
+        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} + sum_j A_j s_j^n (this rank's rows;
+        s_j^n = sum_m c_j(n, m) v^m the interpolated lags' weighted states). Time-blocked: at the first step
+        of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart) the terms of the states
+        m <= n0 for all b steps at once (``history_products``, ``interp_products``: the kernels read once
+        for the b steps); each step adds those of the block's states before it (m > n0)."""
+        b = self.block
         n0 = b * ((n - 1) // b)
         if self._blk is None or self._blk[0] != n0:
             self._room(n0)
             self._catch_up(n0, march)
             ev = event("SSI_BEM_HistFFTBlock")
             ev.begin()
-            p0 = n0 + 1 - D - self.base              # the first state row 0 reads (d = D)
-            acc_b = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, p0, b, D)
-            march.PETSc.Log.logFlops(8.0 * b * D * 144 * (self.f1 - self.f0))
+            self._blk = (n0, self._block_products(n0, march))
             ev.end()
-            self._blk = (n0, acc_b)
         self._catch_up(n - 1, march)
         acc = self._blk[1][:, n - n0 - 1].copy()            # (slab, 12)
+        self._step_products(n, n0, march, acc)
+        self._apply(acc, out_u)
+
+    def _block_products(self, n0, march):
+        """(slab, b, 12): the terms of the states m <= n0 in the history sums of steps n0 + 1 .. n0 + b."""
+        b, D, slab = self.block, self.D, self.f1 - self.f0
+        if D:
+            acc = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, n0 + 1 - D - self.base, b, D)
+            march.PETSc.Log.logFlops(8.0 * b * D * 144 * slab)
+        else:
+            acc = np.zeros((slab, b, 12), np.complex128)
+        if self.k:
+            lo = n0 + 1 - self.R                         # the oldest state the block reads
+            C = np.stack([self._weights(march, n0 + 1 + i, lo, n0) for i in range(b)])
+            ev = event("SSI_BEM_HistInterp")
+            ev.begin()
+            acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, lo - self.base, march.PETSc.Log)
+            ev.end()
+        return acc
+
+    def _step_products(self, n, n0, march, acc):
+        """acc += the terms of the block's states n0 < m <= n - 1 in step n's history sum."""
+        D = self.D
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
             acc += history_products(self.Kxy[:, 9 * (D - k):], self.Kz[:, 18 * (D - k):], self.Vz, self.Vxy,
                                     n - k - self.base, 1, k)[:, 0]
             march.PETSc.Log.logFlops(8.0 * k * 144 * (self.f1 - self.f0))
+        if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
+            C = self._weights(march, n, n0 + 1, n - 1)[None]
+            if C.any():
+                acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, n0 + 1 - self.base,
+                                       march.PETSc.Log)[:, 0]
+
+    def _weights(self, march, n, m_lo, m_hi):
+        """(k, m_hi - m_lo + 1): the weight of state m_lo + i in the interpolated history s_j^n of step n
+        (``Marcher._interp_coef``, the dense path's weights), zero for states outside 1..n-1."""
+        C = np.zeros((self.k, m_hi - m_lo + 1))
+        coef = march._interp_coef(n)
+        if coef is not None:
+            a, e = max(m_lo, 1), min(m_hi, n - 1)
+            if e >= a:
+                C[:, a - m_lo:e - m_lo + 1] = coef[a:e + 1].T
+        return C
+
+    def _apply(self, acc, out_u):
+        """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows taken off out_u."""
+        from scipy.fft import irfft2
+        from mpi4py import MPI
+        lat = self.lat
         full = np.empty((lat.F, 12), np.complex128)
         mpi = self.comm.tompi4py()
-        from mpi4py import MPI
         mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
                                                    MPI.C_DOUBLE_COMPLEX])
         # columns: (class t, x or y) for 0..7, then z of class t at 8 + t -> (t, component)
@@ -450,9 +536,68 @@ class ToeplitzHistory:
         arr -= vals.ravel()
 
 
+def _add_kernel(Kxy, Kz, r, c, S):
+    """Rows r of Kxy (9 a row) and Kz (18) += c S: S (4, 9, 4, slab) one lag's kernel spectra (class,
+    slot, H4 entry, frequency)."""
+    slab = S.shape[-1]
+    Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
+    Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
+
+
+def _spans(C):
+    """How ``interp_products`` forms the weighted states of C (b, k, ns): [(j0, j1, a, e)]: anchors j0..j1-1
+    from states a..e-1. One product over all anchors and their common span when that span is at most
+    twice their own spans' total (Chebyshev: every anchor weighs every state), else one per anchor
+    (multi-linear: an anchor weighs the states of its two intervals only)."""
+    nz = np.any(C != 0.0, axis=0)                       # (k, ns)
+    own = []
+    for j in range(C.shape[1]):
+        i = np.flatnonzero(nz[j])
+        if i.size:
+            own.append((j, j + 1, int(i[0]), int(i[-1]) + 1))
+    if not own:
+        return []
+    a, e = min(o[2] for o in own), max(o[3] for o in own)
+    if C.shape[1] * (e - a) <= 2 * sum(o[3] - o[2] for o in own):
+        return [(0, C.shape[1], a, e)]
+    return own
+
+
+def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=64):
+    """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
+    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
+    buffers; real weights on the real and imaginary parts: per span of ``_spans`` one real matrix product
+    of the weights with the span's states, read in place), then (b x 9k)(9k x 8) and (b x 18k)(18k x 4)
+    products with the anchors' kernels: (slab, b, 12) complex, columns as ``history_products``.
+    Frequencies in chunks so the weighted states stay small."""
+    slab = Axy.shape[0]
+    b, k, _ = C.shape
+    out = np.zeros((slab, b, 12), np.complex128)
+    spans = _spans(C)
+    if not spans:
+        return out
+    for f0 in range(0, slab, fchunk):
+        f1 = min(slab, f0 + fchunk)
+        fc = f1 - f0
+        Sz = np.zeros((fc, b, k, 9), np.complex128)
+        Sxy = np.zeros((fc, b, k, 18), np.complex128)
+        for j0, j1, a, e in spans:
+            Cj = C[:, j0:j1, a:e].reshape(-1, e - a)
+            for V, S in ((Vz, Sz), (Vxy, Sxy)):
+                c = V.shape[2]
+                Vf = V[r0 + a:r0 + e, f0:f1].view(np.float64).reshape(e - a, fc * 2 * c)     # (a view)
+                w = (Cj @ Vf).view(np.complex128).reshape(b, j1 - j0, fc, c)
+                S[:, :, j0:j1, :] = w.transpose(2, 0, 1, 3)
+        np.matmul(Sz.reshape(fc, b, 9 * k), Axy[f0:f1], out=out[f0:f1, :, :8])
+        np.matmul(Sxy.reshape(fc, b, 18 * k), Az[f0:f1], out=out[f0:f1, :, 8:])
+    if log is not None:
+        log.logFlops(slab * (8.0 * b * k * 144 + 2.0 * 54 * b * sum((j1 - j0) * (e - a) for j0, j1, a, e in spans)))
+    return out
+
+
 def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
     """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
-    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers, as two
+    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c), as two
     matrix products per frequency, (b x 9D) (b x 9D)-windows of Vz times Kxy (9D x 8) and (b x 18D)
     of Vxy times Kz (18D x 4): (slab, b, 12) complex, columns (class, x or y) then z by class. Array
     inputs and ``matmul`` only (the one function a GPU array module would take over); frequencies in
@@ -462,10 +607,10 @@ def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
     out = np.empty((slab, b, 12), np.complex128)
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
-        wz = sliding_window_view(Vz[f0:f1, p0:p0 + b - 1 + D], D, axis=1)      # (fc, b, 9, D)
-        wxy = sliding_window_view(Vxy[f0:f1, p0:p0 + b - 1 + D], D, axis=1)    # (fc, b, 18, D)
-        az = np.ascontiguousarray(wz.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 9 * D)
-        axy = np.ascontiguousarray(wxy.transpose(0, 1, 3, 2)).reshape(f1 - f0, b, 18 * D)
+        wz = sliding_window_view(Vz[p0:p0 + b - 1 + D, f0:f1], D, axis=0)      # (b, fc, 9, D)
+        wxy = sliding_window_view(Vxy[p0:p0 + b - 1 + D, f0:f1], D, axis=0)    # (b, fc, 18, D)
+        az = np.ascontiguousarray(wz.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 9 * D)
+        axy = np.ascontiguousarray(wxy.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 18 * D)
         np.matmul(az, Kxy[f0:f1], out=out[f0:f1, :, :8])
         np.matmul(axy, Kz[f0:f1], out=out[f0:f1, :, 8:])
     return out

@@ -99,6 +99,99 @@ def test_toeplitz_restart_is_bitwise(tmp_path):
     assert_same_files(ref, rs)
 
 
+# the far lags interpolated (-ssi_interp): the store keeps the exact lags' kernels and the k matrices'
+# kernels only, and sums each step's weighted states (bem/toeplitz.py interp_products). A small grid with
+# slow waves (24 lags; 12 exact, so a block of 8 steps reads only known states for the far lags), and T_L
+# inside a block (Lx = 4 < b: the far lags' terms of the block's own states step by step)
+SLOW_SITE = ["-ssi_problem", "bem", "-ssi_cp", "200", "-ssi_cs", "100", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1",
+             "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025",
+             "-ssi_t_end", "0.08", "-ssi_receivers", "1,0,0;0,1,0", "-ssi_output_stride", "7", "-ssi_warn_beta", "0"]
+CHEB = ["-ssi_interp", "chebyshev", "-ssi_interp_tl", "0.03", "-ssi_interp_k", "4"]
+INTERP_CASES = {
+    "linear": (["-ssi_interp", "linear", "-ssi_interp_tl", "0.03", "-ssi_interp_k", "5"], 1),
+    "chebyshev": (CHEB, 1),
+    "linear graded, T_L in a block, plain": (["-ssi_interp", "linear", "-ssi_interp_tl", "0.008", "-ssi_interp_k",
+                                              "6", "-ssi_interp_grading", "2", "-ssi_scheme", "plain"], 1),
+    "chebyshev, -n 2": (CHEB + ["-ssi_reproducible"], 2),
+}
+# slow tier: Chebyshev at -n 2 (its -n 1 sibling "chebyshev" stays; test_toeplitz_two_ranks_equal_one checks
+# the multi-linear interpolation at -n 2 in make test)
+INTERP_SLOW = ("chebyshev, -n 2",)
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in INTERP_SLOW else [])
+                                  for c in INTERP_CASES])
+def test_toeplitz_interp_equals_dense(tmp_path, case):
+    """The compressed store (exact kernels + the interpolating matrices' kernels, weighted states per
+    block) equals the dense store's interpolation to 1e-12: multi-linear, Chebyshev (also at -n 2), T_L
+    inside a block with the plain scheme; the log names the kernels kept."""
+    extra, nranks = INTERP_CASES[case]
+    args = SLOW_SITE + extra
+    ref, tz = str(tmp_path / "dense.h5"), str(tmp_path / "tz.h5")
+    cli(args + ["-ssi_output", ref])
+    out = cli(args + TZ + ["-ssi_output", tz], nranks=nranks).stdout
+    assert "interpolating matrices' kernels" in out
+    same(ref, tz)
+
+
+# slow tier: a restart with interpolated far lags (test_toeplitz_restart_is_bitwise is its sibling in make test)
+@pytest.mark.slow
+def test_toeplitz_interp_restart_is_bitwise(tmp_path):
+    """A checkpoint after step 10 of 32 (inside a block of 8) with the far lags interpolated: the restart
+    makes the kept transforms again back to the history's reach (24 states), and every dataset is the
+    uninterrupted run's bit for bit."""
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    from test_checkpoint import run_and_restart, assert_same_files
+    (ref, rs), = run_and_restart(SLOW_SITE + INTERP_CASES["linear"][0] + TZ, tmp_path, 1, 5, 10)
+    assert_same_files(ref, rs)
+
+
+def test_estimate_on_the_toeplitz_store(tmp_path):
+    """`petsc-ssi estimate -ssi_lag_store toeplitz` on a uniform grid prints the toeplitz block only (no
+    dense pair tables: O(N^2) on a whole grid) with the compressed kernels (exact lags + interpolating
+    matrices), and its bytes of kernels and kept transforms are the run's own (the ``bytes`` the run logs)."""
+    from petsc_ssi.bem import interp
+    from petsc_ssi.bem.toeplitz import estimate
+    args = SLOW_SITE + INTERP_CASES["linear"][0] + TZ
+    r = cli(["estimate"] + args + ["-ssi_estimate_ranks", "1,2"])
+    assert "estimate of this BEM run on the toeplitz lag store" in r.stdout
+    assert "kernels: 12 exact lags + 5 interpolating (of 24 the run reaches)" in r.stdout, r.stdout
+    assert "blocks assembled" not in r.stdout          # (the dense model's line)
+    out = cli(args + ["-ssi_output", str(tmp_path / "tz.h5")]).stdout
+    import re
+    stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
+
+    class Lat:
+        Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
+        F = 8 * 5
+        nx = ny = 4
+    plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
+    b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
+    build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes
+    assert abs((b - build) / 1e9 - stored) <= 0.01 * stored + 5e-6, (b - build, stored)
+
+
+def test_interp_products_match_the_sum():
+    """``interp_products`` (weighted states by spans, then the anchors' products) against the plain sum
+    over anchors, steps and states, for banded (per-anchor spans) and full (one span) weights."""
+    from petsc_ssi.bem.toeplitz import interp_products, _spans
+    rng = np.random.default_rng(3)
+    slab, k, b, W = 37, 4, 3, 30
+    cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
+    Axy, Az, Vz, Vxy = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4), cz(W, slab, 9), cz(W, slab, 18)
+    banded = np.zeros((b, k, 20))
+    for j in range(k):
+        banded[:, j, 4 * j:4 * j + 6] = rng.standard_normal((b, 6))
+    full = rng.standard_normal((b, k, 20))
+    for C, n_spans in ((banded, k), (full, 1)):
+        assert len(_spans(C)) == n_spans
+        got = interp_products(Axy, Az, Vz, Vxy, C, 5, fchunk=16)
+        Sz = np.einsum("bjm,mfc->fbjc", C, Vz[5:25]).reshape(slab, b, 9 * k)
+        Sxy = np.einsum("bjm,mfc->fbjc", C, Vxy[5:25]).reshape(slab, b, 18 * k)
+        ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)
+        assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
 def test_toeplitz_refusals_and_auto(tmp_path):
     """A grid whose patch edges cut the elements (0.75 m and 1 m columns) is refused in one line naming an
     element; auto falls back to the dense matrices and says why; -ssi_lags_save is refused."""
