@@ -129,12 +129,7 @@ class HalfSpace:
         if interface is not None:
             disp = interface.be_elems
         wave = cfg.get("seismic", "none") != "none"
-        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
-            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
-        if cfg.user_set("load_p0") and not cfg.load_group:
-            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
-        if cfg.user_set("disp_value") and not cfg.disp_group:
-            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+        self._load_warnings(wave)
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
         self._excavation = None
@@ -163,12 +158,7 @@ class HalfSpace:
             check_soil_around(self.mesh, disp, cfg.disp_group, 1e-6 * h, who="a massless footing (input-motion)")
         xref = self._massless_reference() if self.massless else None
         self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if prescribed else None
-        self.receivers = rec.parse(cfg.receivers)
-        for p in self.receivers:
-            q, _ = symmetry.map_point(p, self.planes)
-            rec.locate(self.mesh, q)
-            if self.mesh.flat and abs(p[2]) > 1e-6 * max(h, 1.0):
-                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        self.receivers = self._receivers(h)
         # a coupled run's structure: points of interest (the interpolation rule, the diffraction warning)
         self.sites = interface.x if interface is not None else np.zeros((0, 3))
         self.seismic = None
@@ -193,6 +183,28 @@ class HalfSpace:
             self._seismic_lines()
         if interface is not None:
             self.diffraction_warning(interface.x, "the structure (interface nodes)")
+
+    def _load_warnings(self, wave):
+        """One line for each load or prescribed-motion option that does nothing (``wave``: a seismic
+        input, which loads the soil itself)."""
+        cfg = self.cfg
+        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
+            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
+        if cfg.user_set("load_p0") and not cfg.load_group:
+            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
+        if cfg.user_set("disp_value") and not cfg.disp_group:
+            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+
+    def _receivers(self, h):
+        """The receivers of -ssi_receivers, each located on the surface (its symmetry image on the
+        meshed part; on a flat surface a point off z = 0 is refused)."""
+        out = rec.parse(self.cfg.receivers)
+        for p in out:
+            q, _ = symmetry.map_point(p, self.planes)
+            rec.locate(self.mesh, q)
+            if self.mesh.flat and abs(p[2]) > 1e-6 * max(h, 1.0):
+                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        return out
 
     def _check_excavation_run(self, interface):
         """What a surface with an excavation does not take yet (one line, before any assembly)."""
