@@ -16,7 +16,7 @@ from numba import njit, types
 from numba.typed import Dict, List
 
 from . import packs
-from .bsr import FULL, H4, G5
+from .patterns import FULL, H4, G5
 from .packs import DT, CP, CS, NU, MU, TOFF
 from .quadrature import integrate_pair, singular_static, plane_points, integrate_plane
 

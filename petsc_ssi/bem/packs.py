@@ -6,7 +6,7 @@ step, the wave speeds, the density, Poisson's ratio, the shear modulus rho c_s^2
 offset of a lag matrix at a non-integer lag). ``Quad``: the quadrature record (subdivisions, Gauss
 points, the singular rule, the singular-pair tolerance, the mesh's smallest element size). Both are
 read in njit code (numba types the record as a named tuple; the index constants are compile-time
-globals), and read by value: the kernels compute with the same numbers as before.
+globals), and read by value: the kernels compute with the same numbers as before. A leaf (numpy only).
 """
 from collections import namedtuple
 
