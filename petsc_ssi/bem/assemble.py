@@ -89,13 +89,12 @@ def _window(xc, v, mesh, reach, lags, phys, quad):
 # ---------------------------------------------------------------------------
 # The kernel table (issue 40): which kernels a (surface kind, block patterns) takes. Surface kinds:
 # "plane" (every node and element in z = 0), "flat" (in one plane z = z0 != 0), "general" (any other);
-# block patterns (H's, G's): bsr.PATTERNS, the flat ones (H4, G5) or the full 3x3 (``patterns``).
+# block patterns (H's, G's): patterns.PATTERNS, the flat ones (H4, G5) or the full 3x3 (``patterns``).
 # Values: (the integrator of a regular pair: PLANE, quadrature.integrate_plane on the element's
 # precomputed geometry (``plane``), the patterns' entries only; GENERAL, quadrature.integrate_pair on
 # full blocks, the entries a pattern drops checked to be zero, then compacted; the row emitters of H and
 # G: 4 or 5, ``_accumulate`` at that constant width (unrolled), 0 at the pattern's width).
 PLANE, GENERAL = 0, 1
-KINDS = ("plane", "flat", "general")
 KERNELS = {("plane", (H4, G5)): (PLANE, H4, G5),
            ("plane", (FULL, FULL)): (GENERAL, 0, 0),
            ("flat", (H4, G5)): (GENERAL, H4, G5),

@@ -88,6 +88,19 @@ def _add_block(acc0, acc1, acc2, a, XT, c, b4, b):
 
 
 @njit(cache=True, inline="always")
+def _sums(b):
+    """Three zeroed arrays of b sums (a row of blocks' three rows)."""
+    return np.zeros(b), np.zeros(b), np.zeros(b)
+
+
+@njit(cache=True, inline="always")
+def _zero(a0, a1, a2):
+    a0[:] = 0.0
+    a1[:] = 0.0
+    a2[:] = 0.0
+
+
+@njit(cache=True, inline="always")
 def _flush(RT, r, acc0, acc1, acc2, sign):
     """RT[r + p, t] += sign * acc_p[t]."""
     for t in range(acc0.shape[0]):
@@ -139,10 +152,9 @@ def _panel_of(m, wide):
         d = data.reshape((data.shape[0], m))
         b = XT.shape[1]
         b4 = b - b % 4 if wide else 0
-        acc = np.empty((3, b))                  # a row's sums, one row of acc a block row
-        a0, a1, a2 = acc[0], acc[1], acc[2]
+        a0, a1, a2 = _sums(b)                   # a row of blocks' sums, one array a block row
         for i in range(indptr.size - 1):
-            acc[:] = 0.0
+            _zero(a0, a1, a2)
             for k in range(indptr[i], indptr[i + 1]):
                 _add_block(a0, a1, a2, block_values(d, k, m), XT, 3 * indices[k], b4, b)
             _flush(RT, 3 * i, a0, a1, a2, sign)
@@ -165,11 +177,12 @@ def _panel_pair_of(m):
         b = XT.shape[1]
         b4 = b - b % 4
         n = indptr.size - 1
-        acc = np.empty((6, b))                  # the two rows' sums: rows 0-2 of acc the first's, 3-5 the second's
-        a0, a1, a2, e0, e1, e2 = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5]
+        a0, a1, a2 = _sums(b)                   # the first row of blocks' sums
+        e0, e1, e2 = _sums(b)                   # the second's
         for i in range(0, n, 2):
-            acc[:] = 0.0
+            _zero(a0, a1, a2)
             if i + 1 < n:
+                _zero(e0, e1, e2)
                 k, kend = indptr[i], indptr[i + 1]
                 l, lend = indptr[i + 1], indptr[i + 2]
                 while k < kend or l < lend:
