@@ -1,7 +1,7 @@
 """Where one rank's BEM assembly spends its time (issues 13 and 29): runs LagSet.assemble and the
 Mat build of an options file (default runs/pekeris/paper.opts) with wrappers timing the integration
 of the shared element cache (LagSet._share_cache: the listing of its geometries, enumerate_pairs, their
-integration, integrate_records, the replies, _send_segments, the indexing, cache_index), the kernel that sums the blocks and writes them
+integration, integrate_batch, the replies, _send_segments, the indexing, cache_index), the kernel that sums the blocks and writes them
 where they are kept (assemble_rows) and the Mat constructors, and prints per rank those times, the
 kernel (sys) time and minor page faults (getrusage), resident and huge-page memory, and ms per row.
 With -prefault 1 the lag arrays are written once (zeros) as they are allocated, timed apart: the
@@ -36,7 +36,7 @@ def wrap(mod, name):
         if name == "_send_segments": T["received cache, GB"] = 8e-9 * sum(int(n.sum()) for n, _ in a[2])
         return r
     setattr(mod, name, g)
-for n in ("assemble_rows", "enumerate_pairs", "integrate_records", "cache_index", "_send_segments"):
+for n in ("assemble_rows", "enumerate_pairs", "integrate_batch", "cache_index", "_send_segments"):
     wrap(model, n)                          # the last four: the parts of _share_cache
 wrap(model.LagSet, "_share_cache")
 _init = model.Buckets.__init__

@@ -21,6 +21,7 @@ from petsc_ssi.coupling import model as cm  # noqa: E402
 from petsc_ssi.bem.assemble import _pair_window, SING_TOL  # noqa: E402
 from petsc_ssi.bem.bsr import positions  # noqa: E402
 from petsc_ssi.bem.quadrature import integrate_pair, integrate_plane, plane_points  # noqa: E402
+from petsc_ssi.bem.packs import wave  # noqa: E402
 
 cm.printf = lambda *a, **k: None
 prob = cm.build_coupled(resolve("ssi"), PETSc.COMM_SELF)[0]
@@ -48,12 +49,12 @@ gp, gqi = positions(5)
 
 def general(xc, v, lo, hi, ns, wu):
     Ub[:] = 0.0; Pb[:] = 0.0
-    return integrate_pair(xc, ls.VX[v], -1, ns, gq, gw, lo, hi, dt, al, be, rho, nu, Ub, Pb, wu, 0.0)
+    return integrate_pair(xc, ls.VX[v], -1, ns, lo, hi, wave(dt, al, be, rho, nu), gq, gw, Ub, Pb, wu)
 
 
 def plane(xc, v, lo, hi, ns, wu):
     P[:] = 0.0; U[:] = 0.0
-    return integrate_plane(xc, *geo[(v, ns)], len(gq) ** 2, lo, hi, dt, al, be, rho, P, U, wu, 0.0)
+    return integrate_plane(xc, *geo[(v, ns)], len(gq) ** 2, lo, hi, wave(dt, al, be, rho, nu), P, U, wu)
 
 
 for p in pairs[::50]:                                    # the same numbers (and both compiled)

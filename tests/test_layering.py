@@ -145,7 +145,8 @@ def test_library_does_not_import_the_application():
 LEAVES = ("petsc_ssi.analytic.free_field", "petsc_ssi.analytic.pekeris", "petsc_ssi.analytic.impedance_refs",
           "petsc_ssi.seismic.records", "petsc_ssi.seismic.response_spectrum", "petsc_ssi.spectrum",
           "petsc_ssi.timegrid", "petsc_ssi.sysmem", "petsc_ssi.mesh.quad9", "petsc_ssi.bem.kernels",
-          "petsc_ssi.bem.simd", "petsc_ssi.bem.windows", "petsc_ssi.bem.stability_map",
+          "petsc_ssi.bem.simd", "petsc_ssi.bem.patterns", "petsc_ssi.bem.packs", "petsc_ssi.bem.windows",
+          "petsc_ssi.bem.stability_map",
           "petsc_ssi.fem.elements.base", "petsc_ssi.coupling.contact")
 # Folders: io/ holds files, formats and the recorder; the observers of a domain live beside it
 # (issue 40), so io/ imports none of the domains' packages (the seismic input's leaves, the record

@@ -73,12 +73,10 @@ def _shared_cache_kernels(PETSc):
             "cache": True}
     ls = LagSet(PETSc.COMM_SELF, mesh, Material(548.0, 316.0, 2000.0), 0.005, 3,
                 Regions(mesh, load_elems=mesh.groups["load"]), [], opts)
-    gq, gw = np.polynomial.legendre.leggauss(2)
-    gr, gwr = np.polynomial.legendre.leggauss(12)
     for flat in (True, False):                   # the flat surface's block patterns and the full one
         ls.mH, ls.mG = (4, 5) if flat else (9, 9)
-        ls._share_cache(*new_cache(), 1, 3, 0.0, 1.0 / (1e-9 * float(ls.Vh.min())), gq, gw, gr, gwr, ls.pattern(),
-                        np.zeros(2))
+        pk = ls.kernel_packs(1, 3, 0.0)
+        ls._share_cache(new_cache(), pk, ls.kernels(pk[3]), 1.0 / (1e-9 * float(ls.Vh.min())), np.zeros(2))
 
 
 def _single_kernels():

@@ -15,6 +15,9 @@ import numpy as np
 from numba import njit, types
 from numba.typed import Dict, List
 
+from . import packs
+from .patterns import FULL, H4, G5
+from .packs import DT, CP, CS, NU, MU, TOFF
 from .quadrature import integrate_pair, singular_static, plane_points, integrate_plane
 
 
@@ -74,6 +77,55 @@ def _pair_window(xc, X, c, R, h, reach, alpha, beta, dt, L, lag_lo, toff, tol, n
     return lo, hi, sing, ns
 
 
+@njit(cache=True, inline="always")
+def _window(xc, v, mesh, reach, lags, phys, quad):
+    """``_pair_window`` of the point xc and virtual element v of ``mesh`` (``assemble_rows``), from the
+    packs: lags = (lag_lo, L), phys (``packs.wave``), quad (``packs.Quad``)."""
+    VX, Vc, VR, Vh = mesh[1], mesh[5], mesh[6], mesh[7]
+    return _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, phys[CP], phys[CS], phys[DT], lags[1], lags[0],
+                        phys[TOFF], quad.tol, quad.ns_base, quad.ns_max, quad.near_factor)
+
+
+# ---------------------------------------------------------------------------
+# The kernel table (issue 40): which kernels a (surface kind, block patterns) takes. Surface kinds:
+# "plane" (every node and element in z = 0), "flat" (in one plane z = z0 != 0), "general" (any other);
+# block patterns (H's, G's): patterns.PATTERNS, the flat ones (H4, G5) or the full 3x3 (``patterns``).
+# Values: (the integrator of a regular pair: PLANE, quadrature.integrate_plane on the element's
+# precomputed geometry (``plane``), the patterns' entries only; GENERAL, quadrature.integrate_pair on
+# full blocks, the entries a pattern drops checked to be zero, then compacted; the row emitters of H and
+# G: 4 or 5, ``_accumulate`` at that constant width (unrolled), 0 at the pattern's width).
+PLANE, GENERAL = 0, 1
+KERNELS = {("plane", (H4, G5)): (PLANE, H4, G5),
+           ("plane", (FULL, FULL)): (GENERAL, 0, 0),
+           ("flat", (H4, G5)): (GENERAL, H4, G5),
+           ("flat", (FULL, FULL)): (GENERAL, 0, 0),
+           ("general", (H4, G5)): (GENERAL, H4, G5),        # (forced: a test of the dropped-entry check)
+           ("general", (FULL, FULL)): (GENERAL, 0, 0)}
+
+
+def surface_kind(nodes, VX):
+    """The kind of a soil surface for the kernel table: its collocation points ``nodes`` and virtual
+    elements ``VX`` (mesh elements and their symmetry images) all in z = 0 ("plane"), all in one plane
+    z = z0 ("flat"), or not ("general")."""
+    z0 = float(nodes[0, 2]) if len(nodes) else 0.0
+    if not (bool(np.all(nodes[:, 2] == z0)) and bool(np.all(VX[..., 2] == z0))):
+        return "general"
+    return "plane" if z0 == 0.0 else "flat"
+
+
+def patterns(kind, choice="auto"):
+    """(H's, G's block pattern) of a surface kind: the flat patterns where every point and element lies
+    in one plane, unless ``choice`` (-ssi_lag_pattern) is "full" (the check of both paths)."""
+    return (H4, G5) if kind != "general" and choice != "full" else (FULL, FULL)
+
+
+def kernels(kind, pattern, plane_geo):
+    """The kernels' pack of ``assemble_rows`` and ``integrate_batch``: (the table's codes for the surface
+    kind and the patterns of ``pattern`` (H's p, q, G's p, q, H's keep mask, G's: LagSet.pattern), the
+    pattern, the plane geometry (``plane``))."""
+    return KERNELS[(kind, (len(pattern[0]), len(pattern[2])))], pattern, plane_geo
+
+
 @njit(cache=True)
 def buffers(L, sP, sU):
     """The scratch of a pair's integrals (``bufs`` of ``_pair_integrals``): full blocks of L lags Ub,
@@ -83,22 +135,21 @@ def buffers(L, sP, sU):
 
 
 @njit(cache=True)
-def _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quadr, bufs):
+def _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quad, bufs):
     """Element integrals of one pair into Ub, Pb[:hi-lo+1] of ``bufs`` (the static singular part
-    added at the first lag of a singular pair); returns the kernel evaluations. Packs: ``phys`` =
-    (dt, alpha, beta, rho, nu, mu, toff) (the step and the material), ``quadr`` = (ns_base, gq, gw,
-    gr, gwr, h_ref) (the quadrature), ``bufs`` from ``buffers``."""
-    dt, alpha, beta, rho, nu, mu, toff = phys
-    _, gq, gw, gr, gwr, h_ref = quadr
+    added at the first lag of a singular pair); returns the kernel evaluations. Packs: ``phys`` the
+    material and the step (``packs.wave``), ``quad`` the quadrature (``packs.Quad``), ``bufs`` from
+    ``buffers``."""
     Ub, Pb, Us, Ps, _, _ = bufs
     nl = hi - lo + 1
     Ub[:nl] = 0.0
     Pb[:nl] = 0.0
-    nev = integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu, Ub, Pb, want_u, toff)
+    nev = integrate_pair(xc, X, sing, ns, lo, hi, phys, quad.gq, quad.gw, Ub, Pb, want_u)
     if sing >= 0:
         Us[:] = 0.0
         Ps[:] = 0.0
-        singular_static(X, sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, nu, mu, Us, Ps, h_ref)
+        gr, gwr = quad.gr, quad.gwr
+        singular_static(X, sing, gr.shape[0], gr.shape[0], gr, gwr, gr, gwr, phys[NU], phys[MU], Us, Ps, quad.h_ref)
         Ub[0] += Us
         Pb[0] += Ps
     return nev
@@ -119,9 +170,10 @@ def plane_geometry(VX, ns, gq, gw):
 
 
 def plane(flat, VX, ns, gq, gw, ns_max):
-    """The ``plane`` argument of ``assemble_rows`` and ``integrate_records``: (flat, the elements'
-    geometry at the base subdivisions, scratch for other subdivisions): with ``flat`` (every node
-    and element in the plane z = 0) regular pairs take ``quadrature.integrate_plane``."""
+    """The plane geometry of the kernels' pack (``kernels``) and of ``integrate_records``: (flat, the
+    elements' geometry at the base subdivisions, scratch for other subdivisions): with ``flat`` (every
+    node and element in the plane z = 0) regular pairs take ``quadrature.integrate_plane`` (the kernel
+    table's PLANE)."""
     ng2 = len(gq) ** 2
     if flat:
         sub, pts, Ntab = plane_geometry(VX, ns, gq, gw)
@@ -132,40 +184,47 @@ def plane(flat, VX, ns, gq, gw, ns_max):
 
 
 @njit(cache=True)
-def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quadr, bufs, plane, pattern, dH, dG):
+def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG):
+    """The PLANE integrator of the kernel table: a regular pair of the plane z = 0 by
+    ``integrate_plane`` into Pc[:9 mH nl] (and Uc) of ``bufs``, the element's geometry from ``plane`` at
+    the base subdivisions, else computed into its scratch. Returns the kernel evaluations."""
+    _, gsub, gpts, Ntab, ssub, spts, sN = plane
+    Pc, Uc = bufs[4], bufs[5]
+    nl = hi - lo + 1
+    ng2 = quad.gq.shape[0] ** 2
+    P = Pc[:nl * 9 * mH].reshape((nl, 9, mH))
+    U = Uc[:nl * 9 * mG].reshape((nl, 9, mG))
+    P[:] = 0.0
+    if want_u:
+        U[:] = 0.0
+    if ns == quad.ns_base:
+        return integrate_plane(xc, gsub[v], gpts[v], Ntab, ng2, lo, hi, phys, P, U, want_u)
+    m = ns * ns
+    plane_points(X, ns, quad.gq, quad.gw, ssub[:m], spts[:m * ng2], sN[:m * ng2])
+    return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, phys, P, U, want_u)
+
+
+@njit(cache=True)
+def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped):
     """A pair's integrals of lags lo..hi in the patterns' layout (``_compact``): Pc[:9 m_H nl] and, with
-    ``want_u``, Uc[:9 m_G nl]. A regular pair of the plane z = 0 (``plane``'s flag) by
-    ``integrate_plane`` (the pattern's entries only; the element's geometry from ``plane`` at the base
-    subdivisions, else computed into its scratch), any other by ``_integrate`` (the full blocks, the
-    entries a flat pattern drops checked into dH, dG, then compacted). Returns the kernel evaluations.
-    Packs as ``_integrate``'s; Pc, Uc are ``bufs``' last two."""
-    dt, alpha, beta, rho, _, _, toff = phys
-    ns_base, gq, gw, _, _, _ = quadr
-    Ub, Pb, _, _, Pc, Uc = bufs
+    ``want_u``, Uc[:9 m_G nl] of ``bufs``, by the integrator of the kernel table (``kern``, as from
+    ``kernels``): a regular pair by PLANE (``_plane_integrals``), any other by ``_integrate`` (the full
+    blocks, the entries a flat pattern drops checked into dropped[0] (H), dropped[1] (G), then
+    compacted). Returns the kernel evaluations. Packs as ``_integrate``'s."""
+    codes, pattern, plane = kern
     hp, hq, gp, gq_, hkeep, gkeep = pattern
     mH, mG = hp.shape[0], gp.shape[0]
+    if codes[0] == PLANE and sing < 0:
+        return _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG)
+    Ub, Pb, _, _, Pc, Uc = bufs
     nl = hi - lo + 1
-    flat, gsub, gpts, Ntab, ssub, spts, sN = plane
-    if flat and sing < 0 and mH == 4 and mG == 5:          # (the flat patterns: bsr.H4, bsr.G5)
-        ng2 = gq.shape[0] ** 2
-        P = Pc[:nl * 9 * mH].reshape((nl, 9, mH))
-        U = Uc[:nl * 9 * mG].reshape((nl, 9, mG))
-        P[:] = 0.0
-        if want_u:
-            U[:] = 0.0
-        if ns == ns_base:
-            return integrate_plane(xc, gsub[v], gpts[v], Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U, want_u, toff)
-        m = ns * ns
-        plane_points(X, ns, gq, gw, ssub[:m], spts[:m * ng2], sN[:m * ng2])
-        return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, dt, alpha, beta, rho, P, U,
-                               want_u, toff)
-    nev = _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quadr, bufs)
+    nev = _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quad, bufs)
     if mH < 9:
-        _check_dropped(Pb, nl, hkeep, dH)
+        _check_dropped(Pb, nl, hkeep, dropped[0:1])
     _compact(Pc, 0, Pb, nl, hp, hq)
     if want_u:
         if mG < 9:
-            _check_dropped(Ub, nl, gkeep, dG)
+            _check_dropped(Ub, nl, gkeep, dropped[1:2])
         _compact(Uc, 0, Ub, nl, gp, gq_)
     return nev
 
@@ -452,17 +511,29 @@ def _ordered(lst, n, touch):
 
 
 @njit(cache=True)
-def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv,
-                  work, dropped, hout, gout, loc, plane, cache_max=1 << 62):
+def _image_signs(Vsign, pp):
+    """sg[v, j]: element v's image sign of the column component of pattern entry j (pp: the entries'
+    column components)."""
+    nv = Vsign.shape[0]
+    sg = np.empty((nv, pp.shape[0]))
+    for v in range(nv):
+        for j in range(pp.shape[0]):
+            sg[v, j] = Vsign[v, pp[j]]
+    return sg
+
+
+@njit(cache=True)
+def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out):
     """Collective-free numba kernel: the blocks of H and G of ``rows``, written where they are kept.
 
     mesh = (xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh): collocation points and the virtual elements
-    (nodes, global columns, image signs, traction columns, bounding spheres, sizes);
-    wave = (L, dt, alpha, beta, rho, nu, lag_lo, toff); quad = (ns_base, near_factor, ns_max, gq, gw,
-    gr, gwr, tol, h_ref); pattern = (H's entries (p, q), G's, H's keep mask, G's: bsr.PATTERNS);
-    ``dropped`` (2,) the largest dropped magnitude of H and of G; work: ``new_work``; hout, gout: the
-    per-lag block CSR arrays of H and G (``_emit_lag``); loc: a node's place among the rank's rows;
-    plane: ``plane`` (regular pairs of a flat surface by ``quadrature.integrate_plane``).
+    (nodes, global columns, image signs, traction columns, bounding spheres, sizes); lags = (lag_lo, L);
+    phys: the material and the step (``packs.wave``, with the kernel time offset toff); quad: the
+    quadrature (``packs.Quad``); kern: the kernel table's choice, patterns and plane geometry
+    (``kernels``); cache = (use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv, cache_max): the element
+    cache (``new_cache``); work: ``new_work``; ``dropped`` (2,) the largest dropped magnitude of H and of
+    G; out = (hout, gout, loc): the per-lag block CSR arrays of H and G (``_emit_lag``) and a node's place
+    among the rank's rows.
 
     Per row: first every pair (row, virtual element) whose wave window reaches lags lag_lo..L is
     listed with where its element integrals are (the element cache, or integrated now: into the
@@ -472,75 +543,60 @@ def assemble_rows(rows, mesh, wave, quad, pattern, use_cache, cidx, ckeys, cmeta
     rows ascending, no sort or copy after. The free term is not added (the Buckets and Mats of H_1
     carry it apart).
 
-    Returns (work, nev, hits, cache arrays): ``nev`` counts (point, lag) kernel evaluations, ``hits``
-    the pairs taken from the cache. With ``use_cache`` the element integrals of a pair are
-    reused for every later pair with the same relative geometry (quantised to 1/qinv): translated
-    copies of an element on a structured mesh are integrated once. The key includes the node order,
-    so images and singular pairs are keyed correctly; the integrals depend on nothing else
-    (material, dt and lags are fixed). Only lags lag_lo..L are computed, at kernel times l dt + toff
-    (a cache must not be shared between calls with different lag_lo, L or toff). The cache stops
-    growing at ``cache_max`` bytes per pool (reuse goes on).
+    Returns (work, nev, hits, cache): ``nev`` counts (point, lag) kernel evaluations, ``hits`` the pairs
+    taken from the cache. With ``use_cache`` the element integrals of a pair are reused for every later
+    pair with the same relative geometry (quantised to 1/qinv): translated copies of an element on a
+    structured mesh are integrated once. The key includes the node order, so images and singular pairs
+    are keyed correctly; the integrals depend on nothing else (material, dt and lags are fixed). Only
+    lags lag_lo..L are computed, at kernel times l dt + toff (a cache must not be shared between calls
+    with different lag_lo, L or toff). The cache stops growing at ``cache_max`` bytes per pool (reuse
+    goes on).
     """
-    xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh = mesh
-    L, dt, alpha, beta, rho, nu, lag_lo, toff = wave
-    ns_base, near_factor, ns_max, gq, gw, gr, gwr, tol, h_ref = quad
-    hp, hq, gp, gq_, hkeep, gkeep = pattern
-    mH, mG = hp.shape[0], gp.shape[0]
-    sP, sU = 9 * mH, 9 * mG                    # doubles a lag slot of the P (H) and U (G) pools
+    use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv, cache_max = cache
+    pattern = kern[1]
+    sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]     # doubles a lag slot of the P (H), U (G) pools
     pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG = work
-    phys = (dt, alpha, beta, rho, nu, rho * beta * beta, toff)
-    quadr = (ns_base, gq, gw, gr, gwr, h_ref)
-    bufs = buffers(L, sP, sU)
+    cfg = (use_cache, cidx, qinv, cache_max)
+    bufs = buffers(lags[1], sP, sU)
     nev = 0
     hits = 0
     ncache = len(cidx)
     pool_n, upool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
-    nv = VX.shape[0]
-    sgH = np.empty((nv, mH))                    # an element's image sign of each pattern entry's column
-    sgG = np.empty((nv, mG))
-    for v in range(nv):
-        for j in range(mH):
-            sgH[v, j] = Vsign[v, hq[j]]
-        for j in range(mG):
-            sgG[v, j] = Vsign[v, gq_[j]]
+    sg = (_image_signs(mesh[3], pattern[1]), _image_signs(mesh[3], pattern[3]))
     for ii in range(rows.shape[0]):
         i = rows[ii]
         store = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, 0)
-        npair, n_ev, n_hit, store = _row_pairs(xnodes[i], mesh, wave, quad, pattern, plane, use_cache, cidx, qinv,
-                                               key, dropped, phys, quadr, bufs, cache_max, pairs, store)
+        npair, n_ev, n_hit, store = _row_pairs(mesh[0][i], mesh, lags, phys, quad, kern, cfg, key, dropped, bufs,
+                                               pairs, store)
         ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, _ = store
         nev += n_ev
         hits += n_hit
-        _row_blocks(loc[i], npair, pairs, lag_lo, L, Vnode, Vtcol, sgH, sgG, mH, mG, scP, scU, cpoolP, cpoolU,
-                    (bufH, bufG, touchH, touchG, lstH, lstG), hout, gout)
-    return ((pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG), nev, hits, ckeys, cmeta, cpoolP, cpoolU)
+        _row_blocks(out[2][i], npair, pairs, lags, mesh, sg, kern, (scP, scU, cpoolP, cpoolU),
+                    (bufH, bufG, touchH, touchG, lstH, lstG), out)
+    return ((pairs, scP, scU, bufH, bufG, touchH, touchG, lstH, lstG), nev, hits,
+            (use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv, cache_max))
 
 
 @njit(cache=True)
-def _row_pairs(xc, mesh, wave, quad, pattern, plane, use_cache, cidx, qinv, key, dropped, phys, quadr, bufs,
-               cache_max, pairs, store):
+def _row_pairs(xc, mesh, lags, phys, quad, kern, cfg, key, dropped, bufs, pairs, store):
     """The pairs (collocation point xc, virtual element) of one row whose wave window reaches lags
     lag_lo..L, listed in ``pairs`` (element, lo, hi, want_u, where (0: cache pools, 1: scratch), P slot,
-    U slot) with their integrals found in the cache or integrated now and stored (``_store_pair``).
-    Returns (pairs listed, kernel evaluations, cache hits, ``store`` updated)."""
-    _, VX, _, _, Vtcol, Vc, VR, Vh = mesh
-    L, dt, alpha, beta, _, _, lag_lo, toff = wave
-    ns_base, near_factor, ns_max, _, _, _, _, tol, _ = quad
-    sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]
-    Pc, Uc = bufs[4], bufs[5]
-    reach = alpha * (dt * L + toff)
+    U slot) with their integrals found in the cache or integrated now and stored (``_store_pair``);
+    cfg = (use_cache, cidx, qinv, cache_max). Returns (pairs listed, kernel evaluations, cache hits,
+    ``store`` updated)."""
+    VX, Vtcol = mesh[1], mesh[4]
+    use_cache, cidx, qinv, _ = cfg
+    reach = phys[CP] * (phys[DT] * lags[1] + phys[TOFF])
     npair = nev = hits = 0
     for v in range(VX.shape[0]):
-        lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
-                                        toff, tol, ns_base, ns_max, near_factor)
+        lo, hi, sing, ns = _window(xc, v, mesh, reach, lags, phys, quad)
         if lo > hi:
             continue
         want_u = False
         for a in range(9):
             if Vtcol[v, a] >= 0:
                 want_u = True
-        nl = hi - lo + 1
         found, fill_u, hsh = _cached(use_cache, cidx, store[0], store[1], VX[v], xc, qinv, key, lo, hi, want_u)
         where = 0
         if found >= 0:
@@ -548,10 +604,8 @@ def _row_pairs(xc, mesh, wave, quad, pattern, plane, use_cache, cidx, qinv, key,
             offU = store[1][found, 4]
             hits += 1
         else:
-            nev += _pair_integrals(xc, v, VX[v], sing, ns, lo, hi, want_u, phys, quadr, bufs, plane, pattern,
-                                   dropped[0:1], dropped[1:2])
-            store, where, off, offU = _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc,
-                                                  sP, sU, cache_max, store)
+            nev += _pair_integrals(xc, v, VX[v], sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped)
+            store, where, off, offU = _store_pair((fill_u, hsh, lo, hi, want_u), cfg, key, bufs, kern[1], store)
         pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
         pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
         pairs[npair, 6] = offU
@@ -559,20 +613,33 @@ def _row_pairs(xc, mesh, wave, quad, pattern, plane, use_cache, cidx, qinv, key,
     return npair, nev, hits, store
 
 
+@njit(cache=True, inline="always")
+def _put(pool, n, nl, s, src):
+    """pool[n s:(n + nl) s] = src[:nl s], the pool grown (doubling) as needed; returns the pool."""
+    while (n + nl) * s > pool.shape[0]:
+        pool = _grow(pool, pool.shape[0])
+    pool[n * s:(n + nl) * s] = src[:nl * s]
+    return pool
+
+
 @njit(cache=True)
-def _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc, sP, sU, cache_max, store):
-    """Where a pair's freshly integrated blocks (Pc, Uc) go: into the cache entry ``fill_u`` (its U
-    blocks), a new cache entry while the pools stay under ``cache_max`` bytes, or else the row's
-    scratch. ``store`` = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, sc_n).
-    Returns (``store`` updated, where (0: cache pools, 1: scratch), P slot, U slot)."""
+def _store_pair(pair, cfg, key, bufs, pattern, store):
+    """Where a pair's freshly integrated blocks (Pc, Uc of ``bufs``) go: pair = (fill_u, hsh, lo, hi,
+    want_u); into the cache entry ``fill_u`` (its U blocks), a new cache entry while the pools stay
+    under ``cache_max`` bytes, or else the row's scratch. ``store`` = (ckeys, cmeta, cpoolP, cpoolU,
+    pool_n, upool_n, ncache, scP, scU, sc_n). Returns (``store`` updated, where (0: cache pools, 1:
+    scratch), P slot, U slot)."""
     ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, sc_n = store
+    fill_u, hsh, lo, hi, want_u = pair
+    use_cache, cidx, _, cache_max = cfg
+    Pc, Uc = bufs[4], bufs[5]
+    sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]
+    nl = hi - lo + 1
     where = 0
     offU = 0
     if fill_u >= 0:                         # complete the entry with its U blocks
         off = cmeta[fill_u, 2]
-        while (upool_n + nl) * sU > cpoolU.shape[0]:
-            cpoolU = _grow(cpoolU, cpoolU.shape[0])
-        cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
+        cpoolU = _put(cpoolU, upool_n, nl, sU, Uc)
         cmeta[fill_u, 3] = 1
         cmeta[fill_u, 4] = upool_n
         offU = upool_n
@@ -581,16 +648,12 @@ def _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc, s
         c = ncache
         ckeys = _grow(ckeys, c)
         cmeta = _grow(cmeta, c)
-        while (pool_n + nl) * sP > cpoolP.shape[0]:
-            cpoolP = _grow(cpoolP, cpoolP.shape[0])
         ckeys[c] = key
         cmeta[c, 0] = lo; cmeta[c, 1] = hi; cmeta[c, 2] = pool_n
         cmeta[c, 3] = 1 if want_u else 0
-        cpoolP[pool_n * sP:(pool_n + nl) * sP] = Pc[:nl * sP]
+        cpoolP = _put(cpoolP, pool_n, nl, sP, Pc)
         if want_u:
-            while (upool_n + nl) * sU > cpoolU.shape[0]:
-                cpoolU = _grow(cpoolU, cpoolU.shape[0])
-            cpoolU[upool_n * sU:(upool_n + nl) * sU] = Uc[:nl * sU]
+            cpoolU = _put(cpoolU, upool_n, nl, sU, Uc)
             cmeta[c, 4] = upool_n
             offU = upool_n
             upool_n += nl
@@ -599,11 +662,9 @@ def _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc, s
         cidx[hsh] = c
         ncache += 1
     else:                                   # no cache (or full): the row's scratch
-        while (sc_n + nl) * sP > scP.shape[0]:
-            scP = _grow(scP, scP.shape[0])
+        scP = _put(scP, sc_n, nl, sP, Pc)
         while (sc_n + nl) * sU > scU.shape[0]:
             scU = _grow(scU, scU.shape[0])
-        scP[sc_n * sP:(sc_n + nl) * sP] = Pc[:nl * sP]
         if want_u:
             scU[sc_n * sU:(sc_n + nl) * sU] = Uc[:nl * sU]
         where = 1
@@ -614,14 +675,21 @@ def _store_pair(fill_u, hsh, nl, want_u, use_cache, cidx, key, lo, hi, Pc, Uc, s
 
 
 @njit(cache=True)
-def _row_blocks(li, npair, pairs, lag_lo, L, Vnode, Vtcol, sgH, sgG, mH, mG, scP, scU, cpoolP, cpoolU, rowbuf,
-                hout, gout):
+def _row_blocks(li, npair, pairs, lags, mesh, sg, kern, src, rowbuf, out):
     """Lag by lag, one row's blocks summed by column from its ``pairs`` (in element order: the sums
     of a block are those of the literal loop, bit for bit) and written where they are kept (row
-    ``li`` of the rank's rows); ``rowbuf`` = (bufH, bufG, touchH, touchG, lstH, lstG)."""
+    ``li`` of the rank's rows; out = (hout, gout, ...)) by the kernel table's emitters (``kern``: H's
+    and G's width when constant, the flat patterns' loops unrolled); sg = (H's, G's image signs by
+    element and entry), src = (scP, scU, cpoolP, cpoolU), rowbuf = (bufH, bufG, touchH, touchG, lstH,
+    lstG)."""
     bufH, bufG, touchH, touchG, lstH, lstG = rowbuf
+    scP, scU, cpoolP, cpoolU = src
+    sgH, sgG = sg
+    Vnode, Vtcol = mesh[2], mesh[4]
+    codes, pattern = kern[0], kern[1]
+    mH, mG = pattern[0].shape[0], pattern[2].shape[0]
     sP, sU = 9 * mH, 9 * mG
-    for lag in range(lag_lo, L + 1):
+    for lag in range(lags[0], lags[1] + 1):
         nH = 0
         nG = 0
         for k in range(npair):
@@ -629,43 +697,40 @@ def _row_blocks(li, npair, pairs, lag_lo, L, Vnode, Vtcol, sgH, sgG, mH, mG, scP
             if lag < lo or lag > pairs[k, 2]:
                 continue
             v = pairs[k, 0]
-            slot = pairs[k, 5] + (lag - lo)
             srcP = scP if pairs[k, 4] == 1 else cpoolP
-            if mH == 4:                     # the flat pattern: a constant width, loops unrolled
-                nH = _accumulate(srcP, slot * sP, 4, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
+            bP = (pairs[k, 5] + lag - lo) * sP
+            if codes[1] == H4:                  # the flat pattern: a constant width, loops unrolled
+                nH = _accumulate(srcP, bP, H4, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
             else:
-                nH = _accumulate(srcP, slot * sP, mH, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
+                nH = _accumulate(srcP, bP, mH, Vnode[v], sgH[v], bufH, touchH, lstH, nH, True)
             if pairs[k, 3] == 1:
                 srcU = scU if pairs[k, 4] == 1 else cpoolU
-                if mG == 5:
-                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, 5, Vtcol[v], sgG[v], bufG,
-                                     touchG, lstG, nG, False)
+                bU = (pairs[k, 6] + lag - lo) * sU
+                if codes[2] == G5:
+                    nG = _accumulate(srcU, bU, G5, Vtcol[v], sgG[v], bufG, touchG, lstG, nG, False)
                 else:
-                    nG = _accumulate(srcU, (pairs[k, 6] + lag - lo) * sU, mG, Vtcol[v], sgG[v], bufG,
-                                     touchG, lstG, nG, False)
+                    nG = _accumulate(srcU, bU, mG, Vtcol[v], sgG[v], bufG, touchG, lstG, nG, False)
         if nH:
-            cl = _ordered(lstH, nH, touchH)
-            _emit_lag(lag, nH, cl, bufH, li, hout)
+            _emit_lag(lag, nH, _ordered(lstH, nH, touchH), bufH, li, out[0])
         if nG:
-            cl = _ordered(lstG, nG, touchG)
-            _emit_lag(lag, nG, cl, bufG, li, gout)
+            _emit_lag(lag, nG, _ordered(lstG, nG, touchG), bufG, li, out[1])
 
 
 # ---------------------------------------------------------------------------
 # Element cache shared between ranks (model.LagSet.assemble): each rank lists
 # the distinct pair geometries its rows meet (enumerate_pairs), an owner rank
-# per geometry (its hash modulo the ranks) integrates it once (integrate_records)
+# per geometry (its hash modulo the ranks) integrates it once (integrate_batch)
 # and sends it back, and each rank fills its cache with what it asked for
 # (cache_index: the blocks are received in place) before assemble_rows runs, which then finds every
 # pair there.
 
 @njit(cache=True)
-def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_base, near_factor, ns_max,
-                    tol, qinv, lag_lo=1, toff=0.0, cache_max=1 << 62, stride=81):
-    """The distinct pair geometries that ``assemble_rows`` with a cache would store for ``rows``, in the
-    order it meets them, up to the same cache cap: (keys (m, 27), hashes (m,), meta (m, 6) = [lo, hi,
-    sing, ns, want_u, element], points (m, 3)). A hash met again with a different key or lag window is
-    left out (assemble_rows integrates such pairs itself, as it does now)."""
+def enumerate_pairs(rows, mesh, lags, phys, quad, qinv, cache_max=1 << 62, stride=81):
+    """The distinct pair geometries that ``assemble_rows`` with a cache would store for ``rows`` (packs
+    as its), in the order it meets them, up to the same cache cap: (keys (m, 27), hashes (m,), meta
+    (m, 6) = [lo, hi, sing, ns, want_u, element], points (m, 3)). A hash met again with a different key
+    or lag window is left out (assemble_rows integrates such pairs itself, as it does now)."""
+    VX, Vtcol = mesh[1], mesh[4]
     nv = VX.shape[0]
     cidx = Dict.empty(key_type=types.int64, value_type=types.int64)
     keys = np.zeros((64, 27), np.int64)
@@ -675,12 +740,11 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
     m = 0
     pool_n = 0
     key = np.zeros(27, np.int64)
-    reach = alpha * (dt * L + toff)
+    reach = phys[CP] * (phys[DT] * lags[1] + phys[TOFF])
     for ii in range(rows.shape[0]):
-        xc = xnodes[rows[ii]]
+        xc = mesh[0][rows[ii]]
         for v in range(nv):
-            lo, hi, sing, ns = _pair_window(xc, VX[v], Vc[v], VR[v], Vh[v], reach, alpha, beta, dt, L, lag_lo,
-                                            toff, tol, ns_base, ns_max, near_factor)
+            lo, hi, sing, ns = _window(xc, v, mesh, reach, lags, phys, quad)
             if lo > hi:
                 continue
             want_u = 0
@@ -709,15 +773,14 @@ def enumerate_pairs(rows, xnodes, VX, Vtcol, Vc, VR, Vh, L, dt, alpha, beta, ns_
 
 
 @njit(cache=True)
-def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff, h_ref, pattern, dropped,
-                      ns_base, plane):
-    """Integrals of the listed pairs (meta, points as from enumerate_pairs), the pattern's entries
-    (``pattern`` as in ``assemble_rows``; the others checked into ``dropped``, ``_check_dropped``;
-    ``plane``: as in ``assemble_rows``, ``ns_base`` the subdivisions its geometry is for):
-    (offsets (m + 1,) into the P pool, P pool, offsets (m + 1,) into the U pool (only records with
-    want_u take room), U pool, kernel evaluations); a lag slot takes 9 m doubles (``_compact``)."""
-    hp, hq, gp, gq_, hkeep, gkeep = pattern
-    sP, sU = 9 * hp.shape[0], 9 * gp.shape[0]
+def integrate_batch(meta, pts, VX, L, phys, quad, kern, dropped):
+    """Integrals of the listed pairs (meta, points as from enumerate_pairs) of lags up to L, the
+    patterns' entries (the others checked into ``dropped``, ``_check_dropped``), by the kernels of
+    ``kern`` (``kernels``; its plane geometry for quad.ns_base subdivisions): (offsets (m + 1,) into
+    the P pool, P pool, offsets (m + 1,) into the U pool (only records with want_u take room), U pool,
+    kernel evaluations); a lag slot takes 9 m doubles (``_compact``)."""
+    pattern = kern[1]
+    sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]
     m = meta.shape[0]
     off = np.zeros(m + 1, np.int64)
     uoff = np.zeros(m + 1, np.int64)
@@ -727,8 +790,6 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
         uoff[r + 1] = uoff[r] + (nl * sU if meta[r, 4] == 1 else 0)
     P = np.zeros(off[m])
     U = np.zeros(uoff[m])
-    phys = (dt, alpha, beta, rho, nu, rho * beta * beta, toff)
-    quadr = (ns_base, gq, gw, gr, gwr, h_ref)
     bufs = buffers(L, sP, sU)
     Pc, Uc = bufs[4], bufs[5]
     nev = 0
@@ -736,12 +797,23 @@ def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gw
         lo, hi = meta[r, 0], meta[r, 1]
         nl = hi - lo + 1
         v = meta[r, 5]
-        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], lo, hi, meta[r, 4] == 1, phys, quadr,
-                               bufs, plane, pattern, dropped[0:1], dropped[1:2])
+        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], lo, hi, meta[r, 4] == 1, phys, quad, kern,
+                               bufs, dropped)
         P[off[r]:off[r] + nl * sP] = Pc[:nl * sP]
         if meta[r, 4] == 1:
             U[uoff[r]:uoff[r] + nl * sU] = Uc[:nl * sU]
     return off, P, uoff, U, nev
+
+
+def integrate_records(meta, pts, VX, L, dt, alpha, beta, rho, nu, gq, gw, gr, gwr, toff, h_ref, pattern, dropped,
+                      ns_base, plane):
+    """``integrate_batch`` from positional arguments (bem/toeplitz.py's form): ``pattern`` as
+    LagSet.pattern, ``plane`` as from ``plane`` (its flag: the surface is the plane z = 0, else the
+    general kernels), ``ns_base`` the subdivisions its geometry is for."""
+    kind = "plane" if plane[0] else "general"
+    quad = packs.quad(ns_base, 0.0, ns_base, gq, gw, gr, gwr, SING_TOL, h_ref)     # (the windows are given)
+    return integrate_batch(meta, pts, VX, L, packs.wave(dt, alpha, beta, rho, nu, toff), quad,
+                           kernels(kind, pattern, plane), dropped)
 
 
 @njit(cache=True)

@@ -37,16 +37,10 @@ loaded one becomes one again (``from_aij``); a full-pattern MPIBAIJ of an older 
 import numpy as np
 from numba import njit
 
-from .simd import h4_4, h4pair_4
+from .patterns import PATTERNS, FULL, H4, G5, NAMES  # noqa: F401  (the entries (p, q) each pattern keeps)
+from .simd import block_values, block_rows, block_rows4, block_rows4_pair
 
 from ..petsc import init
-
-# entries (p, q) of a 3x3 block each pattern keeps, in storage order
-PATTERNS = {9: tuple((p, q) for p in range(3) for q in range(3)),
-            4: ((0, 2), (1, 2), (2, 0), (2, 1)),
-            5: ((0, 0), (0, 1), (1, 0), (1, 1), (2, 2))}
-FULL, H4, G5 = 9, 4, 5
-NAMES = {FULL: "full", H4: "flat-H", G5: "flat-G"}
 
 
 def positions(m):
@@ -77,222 +71,157 @@ def block_bytes(m, single=False):
     return (4 if single else 8) * m + 4
 
 
-@njit(cache=True)
-def _matvec(indptr, indices, data, x, y):
-    """y = A x, full 3x3 blocks (data (nnzb, 3, 3) or (nnzb, 9))."""
-    d = data.reshape((data.shape[0], 9))
-    for i in range(indptr.size - 1):
-        y0 = 0.0
-        y1 = 0.0
-        y2 = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            x0, x1, x2 = x[c], x[c + 1], x[c + 2]
-            y0 += d[k, 0] * x0 + d[k, 1] * x1 + d[k, 2] * x2
-            y1 += d[k, 3] * x0 + d[k, 4] * x1 + d[k, 5] * x2
-            y2 += d[k, 6] * x0 + d[k, 7] * x1 + d[k, 8] * x2
-        y[3 * i] = y0
-        y[3 * i + 1] = y1
-        y[3 * i + 2] = y2
+@njit(cache=True, inline="always")
+def _add_block(acc0, acc1, acc2, a, XT, c, b4, b):
+    """acc_p[t] += row p of a block (values ``a``, simd.block_values) times XT[c + q, t], t < b: states
+    four at a time up to b4 (simd.block_rows4), then one at a time (simd.block_rows): the same bits."""
+    x0 = XT[c]
+    x1 = XT[c + 1]
+    x2 = XT[c + 2]
+    for t in range(0, b4, 4):
+        block_rows4(acc0, acc1, acc2, t, a, x0, x1, x2)
+    for t in range(b4, b):
+        s0, s1, s2 = block_rows(a, x0[t], x1[t], x2[t])
+        acc0[t] += s0
+        acc1[t] += s1
+        acc2[t] += s2
 
 
-@njit(cache=True)
-def _matvec_h4(indptr, indices, d, x, y):
-    """y = A x, pattern H4: d[k] = (a02, a12, a20, a21)."""
-    for i in range(indptr.size - 1):
-        y0 = 0.0
-        y1 = 0.0
-        y2 = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            x2 = x[c + 2]
-            y0 += d[k, 0] * x2
-            y1 += d[k, 1] * x2
-            y2 += d[k, 2] * x[c] + d[k, 3] * x[c + 1]
-        y[3 * i] = y0
-        y[3 * i + 1] = y1
-        y[3 * i + 2] = y2
+@njit(cache=True, inline="always")
+def _sums(b):
+    """Three zeroed arrays of b sums (a row of blocks' three rows)."""
+    return np.zeros(b), np.zeros(b), np.zeros(b)
 
 
-@njit(cache=True)
-def _matvec_g5(indptr, indices, d, x, y):
-    """y = A x, pattern G5: d[k] = (a00, a01, a10, a11, a22)."""
-    for i in range(indptr.size - 1):
-        y0 = 0.0
-        y1 = 0.0
-        y2 = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            x0, x1 = x[c], x[c + 1]
-            y0 += d[k, 0] * x0 + d[k, 1] * x1
-            y1 += d[k, 2] * x0 + d[k, 3] * x1
-            y2 += d[k, 4] * x[c + 2]
-        y[3 * i] = y0
-        y[3 * i + 1] = y1
-        y[3 * i + 2] = y2
+@njit(cache=True, inline="always")
+def _zero(a0, a1, a2):
+    a0[:] = 0.0
+    a1[:] = 0.0
+    a2[:] = 0.0
 
 
-@njit(cache=True)
-def _panel(indptr, indices, data, XT, RT, sign):
-    """RT[3i+p, t] += sign * sum_k data[k, p, q] XT[3 col_k + q, t] (XT: columns x b, C order): per
-    block its nine values in registers and the three rows of XT it meets read once."""
-    d = data.reshape((data.shape[0], 9))
-    b = XT.shape[1]
-    acc0 = np.empty(b)
-    acc1 = np.empty(b)
-    acc2 = np.empty(b)
-    for i in range(indptr.size - 1):
-        acc0[:] = 0.0
-        acc1[:] = 0.0
-        acc2[:] = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            a00, a01, a02 = d[k, 0], d[k, 1], d[k, 2]
-            a10, a11, a12 = d[k, 3], d[k, 4], d[k, 5]
-            a20, a21, a22 = d[k, 6], d[k, 7], d[k, 8]
-            x0 = XT[c]
-            x1 = XT[c + 1]
-            x2 = XT[c + 2]
-            for t in range(b):
-                u0, u1, u2 = x0[t], x1[t], x2[t]
-                acc0[t] += a00 * u0 + a01 * u1 + a02 * u2
-                acc1[t] += a10 * u0 + a11 * u1 + a12 * u2
-                acc2[t] += a20 * u0 + a21 * u1 + a22 * u2
-        for t in range(b):
-            RT[3 * i, t] += sign * acc0[t]
-            RT[3 * i + 1, t] += sign * acc1[t]
-            RT[3 * i + 2, t] += sign * acc2[t]
+@njit(cache=True, inline="always")
+def _flush(RT, r, acc0, acc1, acc2, sign):
+    """RT[r + p, t] += sign * acc_p[t]."""
+    for t in range(acc0.shape[0]):
+        RT[r, t] += sign * acc0[t]
+        RT[r + 1, t] += sign * acc1[t]
+        RT[r + 2, t] += sign * acc2[t]
 
 
-@njit(cache=True)
-def _panel_h4(indptr, indices, d, XT, RT, sign):
-    """``_panel`` for pattern H4 (d[k] = a02, a12, a20, a21); XT, RT C-contiguous."""
-    b = XT.shape[1]
-    b4 = b - b % 4
-    acc0 = np.empty(b)
-    acc1 = np.empty(b)
-    acc2 = np.empty(b)
-    for i in range(indptr.size - 1):
-        acc0[:] = 0.0
-        acc1[:] = 0.0
-        acc2[:] = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            a02, a12, a20, a21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-            x0 = XT[c]
-            x1 = XT[c + 1]
-            x2 = XT[c + 2]
-            for t in range(0, b4, 4):               # four states at a time (simd.h4_4: the same bits)
-                h4_4(acc0, acc1, acc2, t, a02, a12, a20, a21, x0, x1, x2)
-            for t in range(b4, b):
-                u2 = x2[t]
-                acc0[t] += a02 * u2
-                acc1[t] += a12 * u2
-                acc2[t] += a20 * x0[t] + a21 * x1[t]
-        for t in range(b):
-            RT[3 * i, t] += sign * acc0[t]
-            RT[3 * i + 1, t] += sign * acc1[t]
-            RT[3 * i + 2, t] += sign * acc2[t]
+def _kernels(m, wide):
+    """The block kernels of pattern m, from one template: (matvec, panel, the panel two rows at a time or
+    None). Each is compiled for its m (the pattern's entries known to the compiler: a block's values in
+    registers, its rows' products written out, simd.py); ``wide``: panels take the states four at a time
+    (and two rows at a time from PAIR_FROM states). Every block row's products are summed in storage
+    order and added to the row's sum: the same operations in the same order as the block's full 3x3
+    product minus the terms that are exact zeros, so the same bits in every kernel and width."""
+    return _matvec_of(m), _panel_of(m, wide), (_panel_pair_of(m) if wide else None)
 
 
-@njit(cache=True)
-def _panel_h4_pair(indptr, indices, d, XT, RT, sign):
-    """``_panel_h4`` two rows at a time: a column both rows hold (neighbouring nodes see nearly the same
-    columns) has its rows of XT read once for both; each row's sums in the same order as ``_panel_h4``
-    (the same bits). With the states four at a time, faster than one row at a time at every width from 8
-    (`python jobscripts/panel_widths.py`: 0.36-0.37 against 0.46-0.53 ns per block and state at
-    b = 32 on the paper case's lags, 0.51 against 0.66 at b = 12); the scalar kernels before were
-    faster for narrow panels one row at a time (``jobscripts/panel_variants.py``)."""
-    b = XT.shape[1]
-    b4 = b - b % 4                      # states four at a time (simd.h4_4, h4pair_4: the same bits), then the rest
-    n = indptr.size - 1
-    a0 = np.empty(b); a1 = np.empty(b); a2 = np.empty(b)
-    e0 = np.empty(b); e1 = np.empty(b); e2 = np.empty(b)
-    i = 0
-    while i < n:
-        a0[:] = 0.0; a1[:] = 0.0; a2[:] = 0.0
-        if i + 1 < n:
-            e0[:] = 0.0; e1[:] = 0.0; e2[:] = 0.0
-            k, kend = indptr[i], indptr[i + 1]
-            l, lend = indptr[i + 1], indptr[i + 2]
-            while k < kend or l < lend:
-                ck = indices[k] if k < kend else 2147483647
-                cl = indices[l] if l < lend else 2147483647
-                if ck == cl:
-                    c = 3 * ck
-                    x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
-                    p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-                    q02, q12, q20, q21 = d[l, 0], d[l, 1], d[l, 2], d[l, 3]
-                    for t in range(0, b4, 4):
-                        h4pair_4(a0, a1, a2, e0, e1, e2, t, p02, p12, p20, p21, q02, q12, q20, q21, x0, x1, x2)
-                    for t in range(b4, b):
-                        u0 = x0[t]; u1 = x1[t]; u2 = x2[t]
-                        a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * u0 + p21 * u1
-                        e0[t] += q02 * u2; e1[t] += q12 * u2; e2[t] += q20 * u0 + q21 * u1
-                    k += 1; l += 1
-                elif ck < cl:
-                    c = 3 * ck
-                    x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
-                    p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-                    for t in range(0, b4, 4):
-                        h4_4(a0, a1, a2, t, p02, p12, p20, p21, x0, x1, x2)
-                    for t in range(b4, b):
-                        u2 = x2[t]
-                        a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * x0[t] + p21 * x1[t]
-                    k += 1
-                else:
-                    c = 3 * cl
-                    x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
-                    q02, q12, q20, q21 = d[l, 0], d[l, 1], d[l, 2], d[l, 3]
-                    for t in range(0, b4, 4):
-                        h4_4(e0, e1, e2, t, q02, q12, q20, q21, x0, x1, x2)
-                    for t in range(b4, b):
-                        u2 = x2[t]
-                        e0[t] += q02 * u2; e1[t] += q12 * u2; e2[t] += q20 * x0[t] + q21 * x1[t]
-                    l += 1
-            for t in range(b):
-                RT[3 * i + 3, t] += sign * e0[t]; RT[3 * i + 4, t] += sign * e1[t]; RT[3 * i + 5, t] += sign * e2[t]
-        else:
+def _matvec_of(m):
+    """The template's matrix-vector product of pattern m (``_kernels``)."""
+
+    @njit(cache=True)
+    def matvec(indptr, indices, data, x, y):
+        """y = A x (data (nnzb, m), or (nnzb, 3, 3) for the full pattern)."""
+        d = data.reshape((data.shape[0], m))
+        for i in range(indptr.size - 1):
+            y0 = 0.0
+            y1 = 0.0
+            y2 = 0.0
             for k in range(indptr[i], indptr[i + 1]):
                 c = 3 * indices[k]
-                x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
-                p02, p12, p20, p21 = d[k, 0], d[k, 1], d[k, 2], d[k, 3]
-                for t in range(0, b4, 4):
-                    h4_4(a0, a1, a2, t, p02, p12, p20, p21, x0, x1, x2)
-                for t in range(b4, b):
-                    u2 = x2[t]
-                    a0[t] += p02 * u2; a1[t] += p12 * u2; a2[t] += p20 * x0[t] + p21 * x1[t]
-        for t in range(b):
-            RT[3 * i, t] += sign * a0[t]; RT[3 * i + 1, t] += sign * a1[t]; RT[3 * i + 2, t] += sign * a2[t]
-        i += 2
+                s0, s1, s2 = block_rows(block_values(d, k, m), x[c], x[c + 1], x[c + 2])
+                y0 += s0
+                y1 += s1
+                y2 += s2
+            y[3 * i] = y0
+            y[3 * i + 1] = y1
+            y[3 * i + 2] = y2
+    return matvec
 
 
-@njit(cache=True)
-def _panel_g5(indptr, indices, d, XT, RT, sign):
-    """``_panel`` for pattern G5 (d[k] = a00, a01, a10, a11, a22)."""
-    b = XT.shape[1]
-    acc0 = np.empty(b)
-    acc1 = np.empty(b)
-    acc2 = np.empty(b)
-    for i in range(indptr.size - 1):
-        acc0[:] = 0.0
-        acc1[:] = 0.0
-        acc2[:] = 0.0
-        for k in range(indptr[i], indptr[i + 1]):
-            c = 3 * indices[k]
-            a00, a01, a10, a11, a22 = d[k, 0], d[k, 1], d[k, 2], d[k, 3], d[k, 4]
-            x0 = XT[c]
-            x1 = XT[c + 1]
-            x2 = XT[c + 2]
-            for t in range(b):
-                u0, u1 = x0[t], x1[t]
-                acc0[t] += a00 * u0 + a01 * u1
-                acc1[t] += a10 * u0 + a11 * u1
-                acc2[t] += a22 * x2[t]
-        for t in range(b):
-            RT[3 * i, t] += sign * acc0[t]
-            RT[3 * i + 1, t] += sign * acc1[t]
-            RT[3 * i + 2, t] += sign * acc2[t]
+def _panel_of(m, wide):
+    """The template's panel product of pattern m, the states four at a time if ``wide`` (``_kernels``)."""
+
+    @njit(cache=True)
+    def panel(indptr, indices, data, XT, RT, sign):
+        """RT[3i+p, t] += sign * sum_k A_k[p, q] XT[3 col_k + q, t] (XT: columns x b, C order): per block
+        its values in registers and the three rows of XT it meets read once."""
+        d = data.reshape((data.shape[0], m))
+        b = XT.shape[1]
+        b4 = b - b % 4 if wide else 0
+        a0, a1, a2 = _sums(b)                   # a row of blocks' sums, one array a block row
+        for i in range(indptr.size - 1):
+            _zero(a0, a1, a2)
+            for k in range(indptr[i], indptr[i + 1]):
+                _add_block(a0, a1, a2, block_values(d, k, m), XT, 3 * indices[k], b4, b)
+            _flush(RT, 3 * i, a0, a1, a2, sign)
+    return panel
+
+
+def _panel_pair_of(m):
+    """The template's panel product of pattern m two rows at a time, the states four at a time
+    (``_kernels``)."""
+
+    @njit(cache=True)
+    def panel_pair(indptr, indices, data, XT, RT, sign):
+        """``panel`` two rows at a time: a column both rows hold (neighbouring nodes see nearly the same
+        columns) has its rows of XT read once for both; each row's sums in the same order as ``panel``
+        (the same bits). For the flat H pattern with the states four at a time, faster than one row at a
+        time at every width from 8 (`python jobscripts/panel_widths.py`: 0.36-0.37 against 0.46-0.53 ns
+        per block and state at b = 32 on the paper case's lags, 0.51 against 0.66 at b = 12); the scalar
+        kernels before were faster for narrow panels one row at a time (``jobscripts/panel_variants.py``)."""
+        d = data.reshape((data.shape[0], m))
+        b = XT.shape[1]
+        b4 = b - b % 4
+        n = indptr.size - 1
+        a0, a1, a2 = _sums(b)                   # the first row of blocks' sums
+        e0, e1, e2 = _sums(b)                   # the second's
+        for i in range(0, n, 2):
+            _zero(a0, a1, a2)
+            if i + 1 < n:
+                _zero(e0, e1, e2)
+                k, kend = indptr[i], indptr[i + 1]
+                l, lend = indptr[i + 1], indptr[i + 2]
+                while k < kend or l < lend:
+                    ck = indices[k] if k < kend else 2147483647
+                    cl = indices[l] if l < lend else 2147483647
+                    if ck == cl:
+                        c = 3 * ck
+                        x0 = XT[c]; x1 = XT[c + 1]; x2 = XT[c + 2]
+                        p, q = block_values(d, k, m), block_values(d, l, m)
+                        for t in range(0, b4, 4):
+                            block_rows4_pair(a0, a1, a2, e0, e1, e2, t, p, q, x0, x1, x2)
+                        for t in range(b4, b):
+                            s0, s1, s2 = block_rows(p, x0[t], x1[t], x2[t])
+                            a0[t] += s0; a1[t] += s1; a2[t] += s2
+                            s0, s1, s2 = block_rows(q, x0[t], x1[t], x2[t])
+                            e0[t] += s0; e1[t] += s1; e2[t] += s2
+                        k += 1; l += 1
+                    elif ck < cl:
+                        _add_block(a0, a1, a2, block_values(d, k, m), XT, 3 * ck, b4, b)
+                        k += 1
+                    else:
+                        _add_block(e0, e1, e2, block_values(d, l, m), XT, 3 * cl, b4, b)
+                        l += 1
+                _flush(RT, 3 * i + 3, e0, e1, e2, sign)
+            else:
+                for k in range(indptr[i], indptr[i + 1]):
+                    _add_block(a0, a1, a2, block_values(d, k, m), XT, 3 * indices[k], b4, b)
+            _flush(RT, 3 * i, a0, a1, a2, sign)
+    return panel_pair
+
+
+# The kernel table of the block patterns: pattern -> (matvec, panel, panel two rows at a time or None),
+# each from the template. The flat H pattern takes the states four at a time (measured faster:
+# jobscripts/panel_widths.py); the others one at a time (their loops as before the template).
+WIDE = {FULL: False, H4: True, G5: False}
+_matvec, _panel, _ = _kernels(FULL, WIDE[FULL])
+_matvec_h4, _panel_h4, _panel_h4_pair = _kernels(H4, WIDE[H4])
+_matvec_g5, _panel_g5, _ = _kernels(G5, WIDE[G5])
+KERNELS = {FULL: (_matvec, _panel, None), H4: (_matvec_h4, _panel_h4, _panel_h4_pair), G5: (_matvec_g5, _panel_g5, None)}
 
 
 @njit(cache=True)
@@ -317,7 +246,7 @@ def _diag_panel(diag, r0, XT, RT, sign):
 
 def matvec(m, indptr, indices, data, x, y):
     """y = A x for pattern m."""
-    (_matvec_h4 if m == H4 else _matvec_g5 if m == G5 else _matvec)(indptr, indices, data, x, y)
+    KERNELS[m][0](indptr, indices, data, x, y)
 
 
 PAIR_FROM = 8       # panel width from which H4 panels take two rows at a time (``_panel_h4_pair``; jobscripts/panel_widths.py)
@@ -328,11 +257,8 @@ def panel(m, indptr, indices, data, XT, RT, sign):
     four states at a time)."""
     if not (XT.flags.c_contiguous and RT.flags.c_contiguous):
         raise ValueError("bsr.panel: the panels must be C-contiguous")
-    if m == H4:
-        f = _panel_h4_pair if XT.shape[1] >= PAIR_FROM else _panel_h4
-    else:
-        f = _panel_g5 if m == G5 else _panel
-    f(indptr, indices, data, XT, RT, float(sign))
+    _, one, two = KERNELS[m]
+    (two if two is not None and XT.shape[1] >= PAIR_FROM else one)(indptr, indices, data, XT, RT, float(sign))
 
 
 @njit(cache=True)

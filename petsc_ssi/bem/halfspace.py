@@ -127,12 +127,7 @@ class HalfSpace:
         if interface is not None:
             disp = interface.be_elems
         wave = cfg.get("seismic", "none") != "none"
-        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
-            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
-        if cfg.user_set("load_p0") and not cfg.load_group:
-            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
-        if cfg.user_set("disp_value") and not cfg.disp_group:
-            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+        self._load_warnings(wave)
         # histories are built (and tables read and checked) before any heavy work
         self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
         self._excavation = self._interface_ff = None
@@ -167,29 +162,10 @@ class HalfSpace:
             check_soil_around(self.mesh, disp, cfg.disp_group, 1e-6 * h, who="a massless footing (input-motion)")
         xref = self._massless_reference() if self.massless else None
         self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if prescribed else None
-        self.receivers = rec.parse(cfg.receivers)
-        for p in self.receivers:
-            q, _ = symmetry.map_point(p, self.planes)
-            rec.locate(self.mesh, q)
-            if self.mesh.flat and abs(p[2]) > 1e-6 * max(h, 1.0):
-                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        self.receivers = self._receivers(h)
         # a coupled run's structure: points of interest (the interpolation rule, the diffraction warning)
         self.sites = interface.x if interface is not None else np.zeros((0, 3))
-        self.seismic = None
-        if cfg.get("seismic", "none") != "none":
-            self.seismic = self._seismic_input(self._control_point(interface))   # (record and wave checked first)
-            if self._excavation is not None:
-                self._excavation.attach(self.seismic)
-            if self._interface_ff is not None:
-                self._interface_ff.attach(self.seismic)
-            loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
-            if interface is None and self.motion is None and not loaded:
-                # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
-                # marched, assembly and all, and the output held zeros beside the closed-form free field)
-                raise SSIError(f"-ssi_seismic {cfg.seismic} on the half-space alone with nothing in it (no "
-                               "-ssi_disp_group footing, no loaded -ssi_load_group): the scattered field would be "
-                               "zero at every step; give a footing (petsc-ssi input-motion) or a structure "
-                               "(-ssi_problem ssi)")
+        self.seismic = self._seismic_setup(interface) if wave else None
         # enough steps to reach t_end (a t_end off the step grid is passed, not cut)
         self.grid = timegrid.TimeGrid.of_run(cfg, [self.seismic.duration] if self.seismic is not None else [])
         self.dt, self.n_steps = self.grid.dt, self.grid.n_steps
@@ -199,6 +175,45 @@ class HalfSpace:
             self._seismic_lines()
         if interface is not None:
             self.diffraction_warning(interface.x, "the structure (interface nodes)")
+
+    def _seismic_setup(self, interface):
+        """The seismic input (record and wave checked first), attached to the sources that carry its free
+        field; SSIError when nothing would scatter it."""
+        seismic = self._seismic_input(self._control_point(interface))
+        for src in (self._excavation, self._interface_ff):
+            if src is not None:
+                src.attach(seismic)
+        loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
+        if interface is None and self.motion is None and not loaded:
+            # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
+            # marched, assembly and all, and the output held zeros beside the closed-form free field)
+            raise SSIError(f"-ssi_seismic {self.cfg.seismic} on the half-space alone with nothing in it (no "
+                           "-ssi_disp_group footing, no loaded -ssi_load_group): the scattered field would be "
+                           "zero at every step; give a footing (petsc-ssi input-motion) or a structure "
+                           "(-ssi_problem ssi)")
+        return seismic
+
+    def _load_warnings(self, wave):
+        """One line for each load or prescribed-motion option that does nothing (``wave``: a seismic
+        input, which loads the soil itself)."""
+        cfg = self.cfg
+        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
+            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
+        if cfg.user_set("load_p0") and not cfg.load_group:
+            warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
+        if cfg.user_set("disp_value") and not cfg.disp_group:
+            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
+
+    def _receivers(self, h):
+        """The receivers of -ssi_receivers, each located on the surface (its symmetry image on the
+        meshed part; on a flat surface a point off z = 0 is refused)."""
+        out = rec.parse(self.cfg.receivers)
+        for p in out:
+            q, _ = symmetry.map_point(p, self.planes)
+            rec.locate(self.mesh, q)
+            if self.mesh.flat and abs(p[2]) > 1e-6 * max(h, 1.0):
+                raise SSIError(f"receiver ({p[0]:g}, {p[1]:g}, {p[2]:g}) is not on the surface z = 0")
+        return out
 
     def _free_field_source(self, disp):
         """The free field's traction -t_ff on the excavation's faces (every element below the ground but

@@ -15,8 +15,10 @@ from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes
                    pair_table, cache_counts)
 from .windows import bounding_spheres, estimate_blocks
 from . import symmetry
-from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_records,
-                       cache_index, SING_TOL)
+from . import packs
+from .bsr import FULL
+from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_batch,
+                       cache_index, SING_TOL, KERNELS, PLANE, surface_kind, patterns, kernels)
 
 
 class Material:
@@ -307,17 +309,15 @@ class LagSet:
         self.regions, self.planes, self.opts = regions, planes, opts
         VX, VN, VS, VT = symmetry.virtual_elements(mesh.cell_coords(), mesh.cells, regions.tcols, planes)
         self.VX, self.VN, self.VS, self.VT = VX, VN, VS, VT
-        # the block patterns (bsr.PATTERNS): every collocation point and element in one plane z = z0
-        # (every surface petsc_ssi accepts: its nodes are set on z = 0) -> H 4 and G 5 entries a block;
-        # otherwise the general 3x3 (opts "block_pattern": "full" forces it: the check of both paths)
-        from .bsr import FULL, H4, G5
-        z0 = float(mesh.nodes[0, 2]) if mesh.n_nodes else 0.0
-        self.flat = (opts.get("block_pattern", "auto") != "full" and bool(np.all(mesh.nodes[:, 2] == z0))
-                     and bool(np.all(VX[..., 2] == z0)))
-        self.mH, self.mG = (H4, G5) if self.flat else (FULL, FULL)
-        # the plane z = 0 itself: regular pairs by quadrature.integrate_plane (the geometry of each
-        # element's Gauss points computed once, the pattern's entries only: the same bits)
-        self.in_plane = self.flat and z0 == 0.0
+        # the kernel table (assemble.KERNELS): the surface's kind (every collocation point and element in
+        # z = 0, in one plane z = z0, or not) -> the block patterns (bsr.PATTERNS: H 4 and G 5 entries a
+        # block in one plane, else the general 3x3; opts "block_pattern": "full" forces it: the check of
+        # both paths) and in the plane z = 0 the regular pairs by quadrature.integrate_plane (the geometry
+        # of each element's Gauss points computed once, the pattern's entries only: the same bits)
+        self.kind = surface_kind(mesh.nodes, VX)
+        self.mH, self.mG = patterns(self.kind, opts.get("block_pattern", "auto"))
+        self.flat = self.mH != FULL
+        self.in_plane = KERNELS[(self.kind, (self.mH, self.mG))][0] == PLANE
         self._plane = None
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
         from .partition import node_ranges, lag_weights
@@ -421,8 +421,20 @@ class LagSet:
             self._cache_est = (key, 8.0 * (sP + sU) * slots)
         return self._cache_est[1]
 
+    def kernels(self, quad):
+        """The kernels' pack of the assembly (``assemble.kernels``: the kernel table's choice for this
+        surface and the block patterns as they stand, the plane geometry of ``quad``)."""
+        return kernels(self.kind, self.pattern(), self.plane(quad.gq, quad.gw))
+
+    def kernel_packs(self, lag_lo, lag_hi, toff):
+        """(mesh, lags, phys, quad): the assembly kernels' packs of lags lag_lo..lag_hi at kernel times
+        l dt + toff (``assemble.assemble_rows``)."""
+        mesh = (self.mesh.nodes, self.VX, self.VN, self.VS, self.VT, self.Vc, self.VR, self.Vh)
+        phys = packs.wave(self.dt, self.mat.cp, self.mat.cs, self.mat.rho, self.mat.nu, toff)
+        return mesh, (int(lag_lo), int(lag_hi)), phys, packs.quad_from(self.opts, float(self.Vh.min()), SING_TOL)
+
     def plane(self, gq, gw):
-        """The ``plane`` argument of the assembly kernels (``assemble.plane``), made once: the Gauss
+        """The plane geometry of the assembly kernels (``assemble.plane``), made once: the Gauss
         points' geometry of every virtual element at -ssi_subdivisions (nv ns^2 ng^2 x 4 doubles: 2 KB
         an element at the defaults) when the surface is the plane z = 0."""
         o = self.opts
@@ -441,25 +453,24 @@ class LagSet:
         triplets the kernel once held, at least one row."""
         return chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
-    def _share_cache(self, cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff, qinv, gq, gw, gr, gwr, pattern,
-                     dropped):
-        """Collective: fill this rank's element cache with every distinct pair geometry its rows meet,
+    def _share_cache(self, cache, pk, kern, qinv, dropped):
+        """Collective: fill this rank's element cache (``cache``: cidx, ckeys, cmeta, cpP, cpU, as from
+        assemble.new_cache) for the assembly of ``pk`` (mesh, lags, phys, quad: ``kernel_packs``) with the
+        kernels of ``kern`` (``kernels``) with every distinct pair geometry its rows meet,
         each integrated once over all ranks. A geometry's owner is its hash modulo the ranks; requests
         go to the owners (all-to-all of keys), the owner integrates the representative of the lowest
         requesting rank (the pair a single rank would meet first, so -n p reproduces -n 1) and sends
         the blocks back (all-to-all-v of doubles). Returns the cache arrays and the owned evaluations."""
+        cidx, ckeys, cmeta, cpP, cpU = cache
         if index_len(cidx):             # (the same on every rank: assemble() passes a new cache)
             raise RuntimeError("_share_cache fills an empty element cache only")
-        o = self.opts
+        mesh, lags, phys, quad = pk
         mpi = self.comm.tompi4py()
         p = mpi.Get_size()
-        sP, sU = 9 * len(pattern[0]), 9 * len(pattern[2])       # doubles a lag slot (assemble._compact)
-        smax = max(sP, sU)
+        sP, sU = 9 * len(kern[1][0]), 9 * len(kern[1][2])       # doubles a lag slot (assemble._compact)
         with collective(self.comm, "listing the element-cache geometries"):     # e.g. MemoryError on one rank
-            keys, hs, meta, pts = enumerate_pairs(self.rows, self.mesh.nodes, self.VX, self.VT, self.Vc, self.VR,
-                                                  self.Vh, lag_hi, self.dt, self.mat.cp, self.mat.cs,
-                                                  o["subdivisions"], o["near_factor"], o["max_subdivisions"],
-                                                  SING_TOL, qinv, lag_lo, toff, self.CACHE_MAX, smax)
+            keys, hs, meta, pts = enumerate_pairs(self.rows, mesh, lags, phys, quad, qinv, self.CACHE_MAX,
+                                                  max(sP, sU))
         owner = np.mod(_mix64(hs), p)
         mine = [np.nonzero(owner == r)[0] for r in range(p)]
         got = mpi.alltoall([(keys[i], hs[i], meta[i], pts[i]) for i in mine])
@@ -471,10 +482,8 @@ class LagSet:
         umeta[inv[allm[:, 4] == 1], 4] = 1                    # (flags 0/1: np.maximum.at, without its slowness)
         allh = None
         with collective(self.comm, "integrating the shared element-cache geometries"):
-            off, P, uoff, U, nev = integrate_records(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
-                                                     lag_hi, self.dt, self.mat.cp, self.mat.cs, self.mat.rho,
-                                                     self.mat.nu, gq, gw, gr, gwr, toff, float(self.Vh.min()),
-                                                     pattern, dropped, int(o["subdivisions"]), self.plane(gq, gw))
+            off, P, uoff, U, nev = integrate_batch(umeta, np.concatenate([g[3] for g in got])[first], self.VX,
+                                                   lags[1], phys, quad, kern, dropped)
         # replies: per requester, its records in its order: P blocks, then U blocks of those wanting U
         seg = np.cumsum([0] + [len(g[2]) for g in got])
         jobs = []
@@ -511,8 +520,6 @@ class LagSet:
         G only, H's blocks not written (``build._traction_g``)."""
         o = self.opts
         lag_hi = self.L if lag_hi is None else lag_hi
-        gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
-        gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
         rows = self.rows
         chunk = chunk or self.chunk_rows(lag_hi - lag_lo + 1)
         prog = Progress(what, max(len(rows), 1), enabled=monitor, unit="row", comm=self.comm)
@@ -532,7 +539,6 @@ class LagSet:
         if gcap.sum() * (8.0 * mG + 4) > 0.5 * machine_memory():
             gcap[:] = 0
         G = Buckets(lag_hi, rows, self.mesh.n_nodes, gcap, single_from=single_from, m=mG, small=small)
-        pattern = self.pattern()
         dropped = np.zeros(2)
         nev = 0
         ev = _NoEvent() if quiet else event("SSI_BEM_Assembly")
@@ -540,22 +546,19 @@ class LagSet:
         cidx, ckeys, cmeta, cpP, cpU = new_cache()
         qinv = 1.0 / (1e-9 * float(self.Vh.min()))
         hits = 0
-        mesh = (self.mesh.nodes, self.VX, self.VN, self.VS, self.VT, self.Vc, self.VR, self.Vh)
-        wave = (int(lag_hi), float(self.dt), float(self.mat.cp), float(self.mat.cs), float(self.mat.rho),
-                float(self.mat.nu), int(lag_lo), float(toff))
-        quad = (int(o["subdivisions"]), float(o["near_factor"]), int(o["max_subdivisions"]), gq, gw, gr, gwr,
-                SING_TOL, float(self.Vh.min()))
+        pk = self.kernel_packs(lag_lo, lag_hi, toff)
+        kern = self.kernels(pk[3])
         if o.get("cache", True) and o.get("cache_share", True) and self.comm.getSize() > 1:
             with event("SSI_BEM_Integrate"):
-                ckeys, cmeta, cpP, cpU, nev = self._share_cache(cidx, ckeys, cmeta, cpP, cpU, lag_lo, lag_hi, toff,
-                                                                qinv, gq, gw, gr, gwr, pattern, dropped)
+                ckeys, cmeta, cpP, cpU, nev = self._share_cache((cidx, ckeys, cmeta, cpP, cpU), pk, kern, qinv,
+                                                                dropped)
             release_freed()         # the integrals' temporaries and messages: not resident through the assembly
         work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
+        out = (H.out() if keep_h else H.out()[:5] + (-1,), G.out(), H.loc)
         for s in range(0, len(rows), chunk):
-            work, n_ev, n_hit, ckeys, cmeta, cpP, cpU = assemble_rows(
-                rows[s:s + chunk], mesh, wave, quad, pattern, bool(o.get("cache", True)), cidx, ckeys, cmeta,
-                cpP, cpU, qinv, work, dropped, H.out() if keep_h else H.out()[:5] + (-1,), G.out(), H.loc,
-                self.plane(gq, gw), self.CACHE_MAX)
+            cache = (bool(o.get("cache", True)), cidx, ckeys, cmeta, cpP, cpU, qinv, self.CACHE_MAX)
+            work, n_ev, n_hit, cache = assemble_rows(rows[s:s + chunk], *pk, kern, cache, work, dropped, out)
+            ckeys, cmeta, cpP, cpU = cache[2:6]
             nev += n_ev
             hits += n_hit
             prog.update(min(s + chunk, len(rows)))

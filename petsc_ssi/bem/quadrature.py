@@ -44,6 +44,7 @@ import numpy as np
 from numba import njit
 
 from .kernels import ab1, ab2_fast, kelvin_u, kelvin_p
+from .packs import DT, CP, CS, RHO, NU, TOFF
 from .simd import acc4
 
 # natural coordinates of the nine nodes and 1D Lagrange indices (quad9 module)
@@ -143,13 +144,105 @@ def _lag_differences(S2, jj, fdt):
     return A, B, dA, dB
 
 
+@njit(cache=True, inline="always")
+def _sub_lags(cen, rad, xc, lo, hi, ia, ib, toff, dt):
+    """The lags lo..hi whose wave shell can reach a subdivision (centre cen, radius rad) from xc:
+    (slo, shi), slo > shi for none."""
+    dc = math.sqrt((cen[0] - xc[0]) ** 2 + (cen[1] - xc[1]) ** 2 + (cen[2] - xc[2]) ** 2)
+    dmin = max(dc - rad, 0.0)
+    dmax = dc + rad
+    slo = max(lo, int(math.floor((dmin * ia - toff) / dt)) + 1)
+    shi = min(hi, int(math.floor((dmax * ib - toff) / dt)) + 2)
+    return slo, shi
+
+
+@njit(cache=True, inline="always")
+def _seen_from(X, xc, xi, eta, N, d1, d2, x, jn, g, n):
+    """The point (xi, eta) of element X seen from xc: shape functions into N, g = x - xc, the unit
+    normal n; returns (the Jacobian J, r = |g|)."""
+    J = point_geometry(X, xi, eta, N, d1, d2, x, jn)
+    r = 0.0
+    for k in range(3):
+        g[k] = x[k] - xc[k]
+        r += g[k] * g[k]
+        n[k] = jn[k] / J
+    return J, math.sqrt(r)
+
+
+@njit(cache=True, inline="always")
+def _gauss_point(X, xc, xi, eta, wq, N, d1, d2, x, jn, g, n):
+    """The Gauss point (xi, eta) of element X seen from xc: shape functions into N, the unit vector g
+    from xc and the unit normal n; returns (weight wq J, distance r, g . n); r < 1e-14: the point is xc
+    (g, n and g . n not formed)."""
+    J, r = _seen_from(X, xc, xi, eta, N, d1, d2, x, jn, g, n)
+    w = wq * J
+    if r < 1e-14:
+        return w, r, 0.0
+    ir = 1.0 / r
+    for k in range(3):
+        g[k] *= ir
+    gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2]
+    return w, r, gn
+
+
+@njit(cache=True, inline="always")
+def _spread(B, li, t, w, N, skip_zero):
+    """B[li, c] += t w N_c (c = 0..8), entry by entry; with ``skip_zero`` an entry whose t w is zero adds
+    nothing."""
+    for a in range(3):
+        for b in range(3):
+            tw = t[a, b] * w
+            if skip_zero and tw == 0.0:
+                continue
+            for c in range(9):
+                B[li, c, a, b] += tw * N[c]
+
+
+@njit(cache=True, inline="always")
+def _add_u(Ub, li, jj, S1, s4, g, w, N, subtract1, ku, ut):
+    """Ub[li] += the displacement tensor of lag row jj (the first difference of ``_time_samples``'
+    once-integrated samples; minus Kelvin's static ku where ``subtract1``) times w N."""
+    A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
+    B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
+    for a in range(3):
+        for b in range(3):
+            ut[a, b] = B1 * g[a] * g[b]
+        ut[a, a] += A1
+    if subtract1:
+        ut -= ku
+    _spread(Ub, li, ut, w, N, False)
+
+
+@njit(cache=True, inline="always")
+def _add_lags(Ub, Pb, S2, S1, plo, phi, lo, pt_geo, mat, subtract, ks, scratch, want_u):
+    """The lags plo..phi of one Gauss point into Pb (and with ``want_u`` Ub): pt_geo = (g, n, g . n, r, w,
+    N), mat = (lam, mu, s4, s4 / dt), ks = Kelvin's static (ku, kp) subtracted from lag 1 where
+    ``subtract``, scratch = (pt, ut). Returns the (point, lag) evaluations: phi - plo + 1."""
+    g, n, gn, r, w, N = pt_geo
+    lam, mu, s4, fdt = mat
+    ku, kp = ks
+    pt, ut = scratch
+    for l in range(plo, phi + 1):
+        jj = l - (plo - 2)
+        A, B, dA, dB = _lag_differences(S2, jj, fdt)
+        if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0 and not (subtract and l == 1):
+            continue
+        li = l - lo
+        _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, pt)
+        if subtract and l == 1:
+            pt -= kp
+        _spread(Pb, li, pt, w, N, True)
+        if want_u:
+            _add_u(Ub, li, jj, S1, s4, g, w, N, subtract and l == 1, ku, ut)
+    return phi - plo + 1
+
+
 @njit(cache=True)
-def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
-                   Ub, Pb, want_u, toff=0.0):
+def integrate_pair(xc, X, sing, ns, lo, hi, phys, gq, gw, Ub, Pb, want_u):
     """Regular (subdivided Gauss) integration of lags lo..hi into Ub, Pb.
 
-    Lag l is evaluated at the kernel time T = l dt + toff (toff in [0, dt):
-    a lag matrix at a non-integer lag time, for the interpolation).
+    ``phys``: the material and the step (``packs.wave``). Lag l is evaluated at the kernel time
+    T = l dt + toff (toff in [0, dt): a lag matrix at a non-integer lag time, for the interpolation).
     Ub, Pb: (hi-lo+1, 9, 3, 3), accumulated (caller zeroes). ``sing`` >= 0:
     xi is node ``sing`` of the element; the static kernels are subtracted
     from lag 1 (their singular integral is added by ``singular_static``).
@@ -157,101 +250,94 @@ def integrate_pair(xc, X, sing, ns, gq, gw, lo, hi, dt, alpha, beta, rho, nu,
     time difference is taken on these four scalars and one tensor is formed
     per lag. Returns the number of (point, lag) kernel evaluations.
     """
+    dt, alpha, beta, rho, nu, toff = phys[DT], phys[CP], phys[CS], phys[RHO], phys[NU], phys[TOFF]
     mu = rho * beta * beta
-    lam = rho * alpha * alpha - 2.0 * mu
     s4 = 1.0 / (4.0 * math.pi * rho)
+    mat = (rho * alpha * alpha - 2.0 * mu, mu, s4, s4 / dt)
     ng = gq.shape[0]
     h = 2.0 / ns
     N = np.zeros(9); d1 = np.zeros(9); d2 = np.zeros(9)
     x = np.zeros(3); jn = np.zeros(3); cen = np.zeros(3); tmp = np.zeros(3)
     g = np.zeros(3); n = np.zeros(3)
-    nl = hi - lo + 1
-    S2 = np.zeros((nl + 3, 4))
-    S1 = np.zeros((nl + 3, 2))
-    pt = np.zeros((3, 3)); ut = np.zeros((3, 3))
-    ku = np.zeros((3, 3)); kp = np.zeros((3, 3))
+    S2 = np.zeros((hi - lo + 4, 4))
+    S1 = np.zeros((hi - lo + 4, 2))
+    scratch = (np.zeros((3, 3)), np.zeros((3, 3)))
+    ks = (np.zeros((3, 3)), np.zeros((3, 3)))
     ia = 1.0 / alpha
     ib = 1.0 / beta
+    subtract = sing >= 0 and lo == 1
     nev = 0
     for si in range(ns):
         for sj in range(ns):
             cx = -1.0 + h * (si + 0.5)
             cy = -1.0 + h * (sj + 0.5)
             rad = _sub_sphere(X, cx, cy, 0.5 * h, N, d1, d2, cen, jn, tmp)
-            dc = math.sqrt((cen[0] - xc[0]) ** 2 + (cen[1] - xc[1]) ** 2 + (cen[2] - xc[2]) ** 2)
-            dmin = max(dc - rad, 0.0)
-            dmax = dc + rad
-            slo = max(lo, int(math.floor((dmin * ia - toff) / dt)) + 1)
-            shi = min(hi, int(math.floor((dmax * ib - toff) / dt)) + 2)
+            slo, shi = _sub_lags(cen, rad, xc, lo, hi, ia, ib, toff, dt)
             if sing >= 0:
                 slo = lo  # lag 1 carries the static subtraction
             if slo > shi:
                 continue
             for p in range(ng):
                 for q in range(ng):
-                    xi = cx + 0.5 * h * gq[p]
-                    eta = cy + 0.5 * h * gq[q]
-                    J = point_geometry(X, xi, eta, N, d1, d2, x, jn)
-                    w = gw[p] * gw[q] * 0.25 * h * h * J
-                    r = 0.0
-                    for k in range(3):
-                        g[k] = x[k] - xc[k]
-                        r += g[k] * g[k]
-                        n[k] = jn[k] / J
-                    r = math.sqrt(r)
+                    w, r, gn = _gauss_point(X, xc, cx + 0.5 * h * gq[p], cy + 0.5 * h * gq[q],
+                                            gw[p] * gw[q] * 0.25 * h * h, N, d1, d2, x, jn, g, n)
                     if r < 1e-14:
                         continue
-                    ir = 1.0 / r
-                    for k in range(3):
-                        g[k] *= ir
-                    gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2]
                     plo = max(slo, int(math.floor((r * ia - toff) / dt)) + 1)
                     phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
-                    subtract = sing >= 0 and lo == 1
                     if subtract:
                         plo = 1
                     if plo > phi:
                         continue
-                    _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
+                    _time_samples(S2, S1, r, 1.0 / r, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
                     if subtract:
-                        kelvin_u(g, r, nu, mu, ku)
-                        kelvin_p(g, n, r, nu, kp)
-                    fdt = s4 / dt
-                    for l in range(plo, phi + 1):
-                        jj = l - (plo - 2)
-                        li = l - lo
-                        A, B, dA, dB = _lag_differences(S2, jj, fdt)
-                        nev += 1
-                        if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0 and not (subtract and l == 1):
-                            continue
-                        _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, pt)
-                        if subtract and l == 1:
-                            for a in range(3):
-                                for b in range(3):
-                                    pt[a, b] -= kp[a, b]
-                        for a in range(3):
-                            for b in range(3):
-                                pw = pt[a, b] * w
-                                if pw != 0.0:
-                                    for c in range(9):
-                                        Pb[li, c, a, b] += pw * N[c]
-                        if want_u:
-                            A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
-                            B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
-                            for a in range(3):
-                                for b in range(3):
-                                    ut[a, b] = B1 * g[a] * g[b]
-                                ut[a, a] += A1
-                            if subtract and l == 1:
-                                for a in range(3):
-                                    for b in range(3):
-                                        ut[a, b] -= ku[a, b]
-                            for a in range(3):
-                                for b in range(3):
-                                    uw = ut[a, b] * w
-                                    for c in range(9):
-                                        Ub[li, c, a, b] += uw * N[c]
+                        kelvin_u(g, r, nu, mu, ks[0])
+                        kelvin_p(g, n, r, nu, ks[1])
+                    nev += _add_lags(Ub, Pb, S2, S1, plo, phi, lo, (g, n, gn, r, w, N), mat, subtract, ks, scratch,
+                                     want_u)
     return nev
+
+
+@njit(cache=True, inline="always")
+def _polar_ray(X, node, th, wth, rhat, rule, nu, mu, h_ref, Us, Ps, scr):
+    """One direction th (weight wth) of ``singular_static``'s polar rule, from the node to the side at
+    rhat: the Gauss points in rho (rule = (order_r, gr, gwr)) into Us, Ps and the CPV's
+    -F_{-1}/rho and log terms into Ps[c]. node = (c, its natural coordinates, x, unit normal, Jacobian
+    and tangents there); scr: scratch."""
+    c, xc0, ec0, xs, nc, Jc, t1, t2 = node
+    order_r, gr, gwr = rule
+    N, d1, d2, x, jn, g, n, ahat, ku, kp, k0 = scr
+    ct = math.cos(th); st = math.sin(th)
+    Aabs = 0.0
+    for k in range(3):
+        ahat[k] = t1[k] * ct + t2[k] * st
+        Aabs += ahat[k] ** 2
+    Aabs = math.sqrt(Aabs)
+    for k in range(3):
+        ahat[k] /= Aabs
+    kelvin_p(ahat, nc, 1.0, nu, k0)
+    fm1 = Jc / (Aabs * Aabs)
+    for ir in range(order_r):
+        rho_ = 0.5 * rhat * (1.0 + gr[ir])
+        wr = 0.5 * rhat * gwr[ir]
+        J, r = _seen_from(X, xs, xc0 + rho_ * ct, ec0 + rho_ * st, N, d1, d2, x, jn, g, n)
+        for k in range(3):
+            g[k] /= r
+        kelvin_u(g, r, nu, mu, ku)
+        kelvin_p(g, n, r, nu, kp)
+        wgt = wth * wr * J * rho_
+        for a in range(9):
+            for p in range(3):
+                for q in range(3):
+                    Us[a, p, q] += wgt * ku[p, q] * N[a]
+                    Ps[a, p, q] += wgt * kp[p, q] * N[a]
+        for p in range(3):
+            for q in range(3):
+                Ps[c, p, q] -= wth * wr * fm1 * k0[p, q] / rho_
+    lg = math.log(rhat * Aabs / h_ref)
+    for p in range(3):
+        for q in range(3):
+            Ps[c, p, q] += wth * fm1 * k0[p, q] * lg
 
 
 @njit(cache=True)
@@ -269,9 +355,9 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_
     xc0 = _NXI[c]
     ec0 = _NET[c]
     N = np.zeros(9); d1 = np.zeros(9); d2 = np.zeros(9)
-    x = np.zeros(3); jn = np.zeros(3); xs = np.zeros(3); jnc = np.zeros(3)
-    g = np.zeros(3); n = np.zeros(3); ahat = np.zeros(3)
-    ku = np.zeros((3, 3)); kp = np.zeros((3, 3)); k0 = np.zeros((3, 3))
+    xs = np.zeros(3); jnc = np.zeros(3)
+    scr = (N, d1, d2, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros((3, 3)),
+           np.zeros((3, 3)), np.zeros((3, 3)))
     Jc = point_geometry(X, xc0, ec0, N, d1, d2, xs, jnc)
     nc = jnc / Jc
     t1 = np.zeros(3); t2 = np.zeros(3)
@@ -279,6 +365,7 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_
         for a in range(9):
             t1[k] += d1[a] * X[a, k]
             t2[k] += d2[a] * X[a, k]
+    node = (c, xc0, ec0, xs, nc, Jc, t1, t2)
     corners = np.array([[-1., -1.], [1., -1.], [1., 1.], [-1., 1.]])
     for e in range(4):
         v1 = corners[e]
@@ -297,45 +384,8 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_
         thp = math.atan2(ny_, nx_)
         for it in range(order_t):
             th = 0.5 * (th1 + th2) + 0.5 * (th2 - th1) * gt[it]
-            wth = 0.5 * (th2 - th1) * gwt[it]
-            ct = math.cos(th); st = math.sin(th)
-            rhat = dp / math.cos(th - thp)
-            Aabs = 0.0
-            for k in range(3):
-                ahat[k] = t1[k] * ct + t2[k] * st
-                Aabs += ahat[k] ** 2
-            Aabs = math.sqrt(Aabs)
-            for k in range(3):
-                ahat[k] /= Aabs
-            kelvin_p(ahat, nc, 1.0, nu, k0)
-            fm1 = Jc / (Aabs * Aabs)
-            for ir in range(order_r):
-                rho_ = 0.5 * rhat * (1.0 + gr[ir])
-                wr = 0.5 * rhat * gwr[ir]
-                J = point_geometry(X, xc0 + rho_ * ct, ec0 + rho_ * st, N, d1, d2, x, jn)
-                r = 0.0
-                for k in range(3):
-                    g[k] = x[k] - xs[k]
-                    r += g[k] * g[k]
-                    n[k] = jn[k] / J
-                r = math.sqrt(r)
-                for k in range(3):
-                    g[k] /= r
-                kelvin_u(g, r, nu, mu, ku)
-                kelvin_p(g, n, r, nu, kp)
-                wgt = wth * wr * J * rho_
-                for a in range(9):
-                    for p in range(3):
-                        for q in range(3):
-                            Us[a, p, q] += wgt * ku[p, q] * N[a]
-                            Ps[a, p, q] += wgt * kp[p, q] * N[a]
-                for p in range(3):
-                    for q in range(3):
-                        Ps[c, p, q] -= wth * wr * fm1 * k0[p, q] / rho_
-            lg = math.log(rhat * Aabs / h_ref)
-            for p in range(3):
-                for q in range(3):
-                    Ps[c, p, q] += wth * fm1 * k0[p, q] * lg
+            _polar_ray(X, node, th, 0.5 * (th2 - th1) * gwt[it], dp / math.cos(th - thp), (order_r, gr, gwr), nu, mu,
+                       h_ref, Us, Ps, scr)
 
 
 # ---------------------------------------------------------------------------
@@ -379,86 +429,88 @@ def plane_points(X, ns, gq, gw, sub, pts, Ntab):
                     k += 1
 
 
+@njit(cache=True, inline="always")
+def _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, pt_geo, mat, Nk, want_u):
+    """``_add_lags`` of a point of the plane: lags plo..phi into the flat patterns' P (four entries) and,
+    with ``want_u``, U (five), both flat (C order, (lags, 9, 4) and (lags, 9, 5)), four entries at a time
+    (``simd.acc4``); pt_geo = (g_x, g_y, n_z, r, w), Nk the shape functions. Returns the evaluations."""
+    g0, g1, nz, r, w = pt_geo
+    lam, mu, s4, fdt = mat
+    for l in range(plo, phi + 1):
+        jj = l - (plo - 2)
+        A, B, dA, dB = _lag_differences(S2, jj, fdt)
+        if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0:
+            continue
+        li = l - lo
+        br = B / r
+        a1 = lam * (dA + dB + 2.0 * br) + 2.0 * mu * br
+        a2 = mu * (dA + br)
+        v0 = a1 * g0 * nz * w
+        v1 = a1 * g1 * nz * w
+        v2 = a2 * nz * g0 * w
+        v3 = a2 * nz * g1 * w
+        b = li * 36                     # P[li, c, 0:4] += (v0, v1, v2, v3) N_c, 4-wide (simd.acc4)
+        for c in range(9):
+            acc4(Pf, b + 4 * c, v0, v1, v2, v3, Nk[c])
+        if want_u:
+            A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
+            B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
+            u0 = (B1 * g0 * g0 + A1) * w
+            u1 = B1 * g0 * g1 * w
+            u2 = B1 * g1 * g0 * w
+            u3 = (B1 * g1 * g1 + A1) * w
+            u4 = A1 * w
+            b = li * 45
+            for c in range(9):
+                Nc = Nk[c]
+                acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
+                Uf[b + 5 * c + 4] += u4 * Nc
+    return phi - plo + 1
+
+
 @njit(cache=True)
-def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, dt, alpha, beta, rho, P, U, want_u, toff=0.0):
+def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u):
     """``integrate_pair`` of a regular pair (``sing`` < 0) whose collocation point xc and element lie in
     the plane z = 0, the element given by ``plane_points`` (sub, pts, Ntab; ng2 Gauss points a
-    subdivision). Accumulates lags lo..hi into P[l - lo, node, j] (the entries of bsr's flat H
-    pattern: (x,z), (y,z), (z,x), (z,y)) and, with ``want_u``, U[l - lo, node, j] (flat G: (x,x),
-    (x,y), (y,x), (y,y), (z,z)); the caller zeroes them (C-contiguous: P (>= nl, 9, 4), U (>= nl, 9, 5),
-    updated four entries at a time by ``simd.acc4``). Returns the kernel evaluations.
+    subdivision), ``phys`` the material and the step (``packs.wave``). Accumulates lags lo..hi into
+    P[l - lo, node, j] (the entries of bsr's flat H pattern: (x,z), (y,z), (z,x), (z,y)) and, with
+    ``want_u``, U[l - lo, node, j] (flat G: (x,x), (x,y), (y,x), (y,y), (z,z)); the caller zeroes them
+    (C-contiguous: P (>= nl, 9, 4), U (>= nl, 9, 5), updated four entries at a time by ``simd.acc4``).
+    Returns the kernel evaluations.
 
     With g_z = 0 and n = (0, 0, n_z), integrate_pair's traction tensor a1 g_l n_k + a2 n_l g_k +
     a3 gn g_l g_k (+ a2 gn d_lk) is (a1 g_l) n_z at (l, z), (a2 n_z) g_k at (z, k) and exact zeros
     elsewhere (each kept entry is its first product plus exact zeros), and the displacement tensor
     B1 g_a g_b + A1 d_ab keeps the in-plane block and A1 at (z, z): the same values, bit for bit."""
+    dt, alpha, beta, rho, toff = phys[DT], phys[CP], phys[CS], phys[RHO], phys[TOFF]
     mu = rho * beta * beta
-    lam = rho * alpha * alpha - 2.0 * mu
     s4 = 1.0 / (4.0 * math.pi * rho)
-    nl = hi - lo + 1
-    S2 = np.zeros((nl + 3, 4))
-    S1 = np.zeros((nl + 3, 2))
+    mat = (rho * alpha * alpha - 2.0 * mu, mu, s4, s4 / dt)
+    S2 = np.zeros((hi - lo + 4, 4))
+    S1 = np.zeros((hi - lo + 4, 2))
     ia = 1.0 / alpha
     ib = 1.0 / beta
-    fdt = s4 / dt
     nev = 0
     if P.shape[1] != 9 or P.shape[2] != 4 or U.shape[1] != 9 or U.shape[2] != 5:
         raise ValueError("integrate_plane: P must be (lags, 9, 4) and U (lags, 9, 5)")
     Pf = P.reshape(P.size)              # (contiguous: the vector updates address them flat)
     Uf = U.reshape(U.size)
     for s in range(sub.shape[0]):
-        dc = math.sqrt((sub[s, 0] - xc[0]) ** 2 + (sub[s, 1] - xc[1]) ** 2 + (sub[s, 2] - xc[2]) ** 2)
-        rad = sub[s, 3]
-        dmin = max(dc - rad, 0.0)
-        dmax = dc + rad
-        slo = max(lo, int(math.floor((dmin * ia - toff) / dt)) + 1)
-        shi = min(hi, int(math.floor((dmax * ib - toff) / dt)) + 2)
+        slo, shi = _sub_lags(sub[s], sub[s, 3], xc, lo, hi, ia, ib, toff, dt)
         if slo > shi:
             continue
         for k in range(s * ng2, (s + 1) * ng2):
-            w = pts[k, 2]
-            nz = pts[k, 3]
             g0 = pts[k, 0] - xc[0]
             g1 = pts[k, 1] - xc[1]
             r = math.sqrt(g0 * g0 + g1 * g1)
             if r < 1e-14:
                 continue
             ir = 1.0 / r
-            g0 *= ir
-            g1 *= ir
             plo = max(slo, int(math.floor((r * ia - toff) / dt)) + 1)
             phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
             if plo > phi:
                 continue
             _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
-            for l in range(plo, phi + 1):
-                jj = l - (plo - 2)
-                li = l - lo
-                A, B, dA, dB = _lag_differences(S2, jj, fdt)
-                nev += 1
-                if A == 0.0 and B == 0.0 and dA == 0.0 and dB == 0.0:
-                    continue
-                br = B / r
-                a1 = lam * (dA + dB + 2.0 * br) + 2.0 * mu * br
-                a2 = mu * (dA + br)
-                v0 = a1 * g0 * nz * w
-                v1 = a1 * g1 * nz * w
-                v2 = a2 * nz * g0 * w
-                v3 = a2 * nz * g1 * w
-                b = li * 36                     # P[li, c, 0:4] += (v0, v1, v2, v3) N_c, 4-wide (simd.acc4)
-                for c in range(9):
-                    acc4(Pf, b + 4 * c, v0, v1, v2, v3, Ntab[k, c])
-                if want_u:
-                    A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
-                    B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
-                    u0 = (B1 * g0 * g0 + A1) * w
-                    u1 = B1 * g0 * g1 * w
-                    u2 = B1 * g1 * g0 * w
-                    u3 = (B1 * g1 * g1 + A1) * w
-                    u4 = A1 * w
-                    b = li * 45
-                    for c in range(9):
-                        Nc = Ntab[k, c]
-                        acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
-                        Uf[b + 5 * c + 4] += u4 * Nc
+            nev += _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, (g0 * ir, g1 * ir, pts[k, 3], r, pts[k, 2]), mat,
+                               Ntab[k], want_u)
     return nev

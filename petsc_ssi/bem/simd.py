@@ -6,10 +6,18 @@ the flat traction pattern's ``P[l, c, 0:4] += (v0, v1, v2, v3) * N_c`` stay four
 multiplies, adds and stores. ``acc4`` emits them as one vector multiply and one vector add:
 IEEE operations lane by lane without fast-math flags (no contraction into fused multiply-adds,
 no reassociation), so the same bits as the scalar statements (tests/bem/test_plane_kernel.py).
+
+The block products of bem/bsr.py's template, for any block pattern (patterns.py): ``block_values``
+(a block's values as a tuple), ``block_rows`` (its three row sums times a vector, scalar) and
+``block_rows4``, ``block_rows4_pair`` (the same on four states at a time, for one row of blocks or two
+sharing a column), each row's products summed in storage order, the same bits in every form.
 """
 from numba import types
+from numba.core import cgutils
 from numba.extending import intrinsic
 from llvmlite import ir
+
+from .patterns import PATTERNS, rows
 
 
 @intrinsic
@@ -56,16 +64,26 @@ def _splat(context, builder, ty, x):
     return v
 
 
-def _h4_update(context, builder, sig, args, acc, coef, u, t):
-    """acc0 += c02 u2; acc1 += c12 u2; acc2 += c20 u0 + c21 u1 on four states (the flat H pattern's
-    row update of ``bsr._panel_h4``, lane by lane as its scalar statements)."""
-    ps = [_vec_ptr(context, builder, sig.args[k], args[k], t) for k in acc]
-    c = [_splat(context, builder, sig.args[k], args[k]) for k in coef]
-    u0, u1, u2 = u
-    builder.store(builder.fadd(builder.load(ps[0], align=8), builder.fmul(c[0], u2)), ps[0], align=8)
-    builder.store(builder.fadd(builder.load(ps[1], align=8), builder.fmul(c[1], u2)), ps[1], align=8)
-    s = builder.fadd(builder.fmul(c[2], u0), builder.fmul(c[3], u1))
-    builder.store(builder.fadd(builder.load(ps[2], align=8), s), ps[2], align=8)
+def _values(tup):
+    """The pattern m of a block's values given as a tuple (UniTuple of m floats, m a pattern of
+    patterns.PATTERNS), or None."""
+    if isinstance(tup, types.UniTuple) and isinstance(tup.dtype, types.Float) and tup.count in PATTERNS:
+        return tup.count
+    return None
+
+
+def _row_sums(builder, c, u, m):
+    """Per block row p of pattern m, sum_j c_j u_{q_j} over the row's entries in storage order
+    (patterns.rows: the first product, then one add a term, as the scalar statement ``a + b + c``
+    reads), IEEE operations without fast-math flags: scalars or 4-wide vectors alike."""
+    out = []
+    for row in rows(m):
+        s = None
+        for j, q in row:
+            prod = builder.fmul(c[j], u[q])
+            s = prod if s is None else builder.fadd(s, prod)
+        out.append(s)
+    return out
 
 
 def _c_float64(*arrs):
@@ -74,34 +92,86 @@ def _c_float64(*arrs):
 
 
 @intrinsic
-def h4_4(typingctx, acc0, acc1, acc2, t, c02, c12, c20, c21, x0, x1, x2):
-    """States t..t+3 of one row of a flat-H panel product (``bsr._panel_h4``): with u_j = x_j[t:t+4],
-    acc0 += c02 u2, acc1 += c12 u2, acc2 += (c20 u0 + c21 u1), 4-wide (1-D C-contiguous float64
-    arrays, no bounds check)."""
-    if not (_c_float64(acc0, acc1, acc2, x0, x1, x2) and isinstance(t, types.Integer)):
+def block_values(typingctx, d, k, m):
+    """(d[k, 0], ..., d[k, m - 1]) in float64 (float32 values widened, exactly): the values of block k
+    of a 2-D C-contiguous (blocks, m) array of pattern m (a literal int), no bounds check."""
+    if not (isinstance(m, types.IntegerLiteral) and m.literal_value in PATTERNS and isinstance(d, types.Array)
+            and d.ndim == 2 and d.layout == "C" and isinstance(d.dtype, types.Float)
+            and isinstance(k, types.Integer)):
         return None
-    sig = types.void(acc0, acc1, acc2, t, c02, c12, c20, c21, x0, x1, x2)
+    n = m.literal_value
+    ret = types.UniTuple(types.float64, n)
+    sig = ret(d, k, m)
+
+    def codegen(context, builder, signature, args):
+        aty = signature.args[0]
+        ary = context.make_array(aty)(context, builder, args[0])
+        kk = context.cast(builder, args[1], signature.args[1], types.intp)
+        vals = []
+        for j in range(n):
+            ptr = cgutils.get_item_pointer(context, builder, aty, ary, [kk, context.get_constant(types.intp, j)])
+            vals.append(context.cast(builder, builder.load(ptr), aty.dtype, types.float64))
+        return context.make_tuple(builder, ret, vals)
+    return sig, codegen
+
+
+@intrinsic
+def block_rows(typingctx, c, u0, u1, u2):
+    """(s0, s1, s2): the rows of a block of pattern m (its values ``c``, a tuple from ``block_values``)
+    times the vector (u0, u1, u2), each row's products summed in storage order (``_row_sums``)."""
+    m = _values(c)
+    if m is None or not all(isinstance(u, types.Float) for u in (u0, u1, u2)):
+        return None
+    sig = types.UniTuple(types.float64, 3)(c, u0, u1, u2)
+
+    def codegen(context, builder, signature, args):
+        cv = [builder.extract_value(args[0], j) for j in range(m)]
+        u = [context.cast(builder, args[1 + q], signature.args[1 + q], types.float64) for q in range(3)]
+        return context.make_tuple(builder, signature.return_type, _row_sums(builder, cv, u, m))
+    return sig, codegen
+
+
+def _rows4_update(context, builder, sig, args, acc, c, u, t, m):
+    """acc_p[t:t+4] += row p of the block (values: tuple argument ``c``) times the states u (three
+    4-wide vectors), p = 0, 1, 2: lane by lane the scalar statements ``acc_p[t] += s_p``."""
+    cv = [_splat(context, builder, sig.args[c].dtype, builder.extract_value(args[c], j)) for j in range(m)]
+    for p, s in enumerate(_row_sums(builder, cv, u, m)):
+        ptr = _vec_ptr(context, builder, sig.args[acc[p]], args[acc[p]], t)
+        builder.store(builder.fadd(builder.load(ptr, align=8), s), ptr, align=8)
+
+
+@intrinsic
+def block_rows4(typingctx, acc0, acc1, acc2, t, c, x0, x1, x2):
+    """States t..t+3 of one block row of a panel product (``bsr``'s template): with u_q = x_q[t:t+4],
+    acc_p[t:t+4] += row p of the block (values ``c`` from ``block_values``) times u, 4-wide (1-D
+    C-contiguous float64 arrays, no bounds check); lane by lane the scalar ``block_rows``."""
+    m = _values(c)
+    if m is None or not (_c_float64(acc0, acc1, acc2, x0, x1, x2) and isinstance(t, types.Integer)):
+        return None
+    sig = types.void(acc0, acc1, acc2, t, c, x0, x1, x2)
 
     def codegen(context, builder, signature, args):
         tt = context.cast(builder, args[3], signature.args[3], types.intp)
-        u = [builder.load(_vec_ptr(context, builder, signature.args[k], args[k], tt), align=8) for k in (8, 9, 10)]
-        _h4_update(context, builder, signature, args, (0, 1, 2), (4, 5, 6, 7), u, tt)
+        u = [builder.load(_vec_ptr(context, builder, signature.args[k], args[k], tt), align=8) for k in (5, 6, 7)]
+        _rows4_update(context, builder, signature, args, (0, 1, 2), 4, u, tt, m)
         return context.get_dummy_value()
     return sig, codegen
 
 
 @intrinsic
-def h4pair_4(typingctx, a0, a1, a2, e0, e1, e2, t, p02, p12, p20, p21, q02, q12, q20, q21, x0, x1, x2):
-    """``h4_4`` for two rows holding the same column (``bsr._panel_h4_pair``): the states x_j[t:t+4]
-    loaded once, row one's coefficients p into a0..a2, row two's q into e0..e2."""
-    if not (_c_float64(a0, a1, a2, e0, e1, e2, x0, x1, x2) and isinstance(t, types.Integer)):
+def block_rows4_pair(typingctx, a0, a1, a2, e0, e1, e2, t, cp, cq, x0, x1, x2):
+    """``block_rows4`` for two rows of blocks holding the same column (``bsr``'s two-row panel): the
+    states x_q[t:t+4] loaded once, row one's block ``cp`` into a0..a2, row two's ``cq`` into e0..e2."""
+    m = _values(cp)
+    if m is None or _values(cq) != m or not (_c_float64(a0, a1, a2, e0, e1, e2, x0, x1, x2)
+                                             and isinstance(t, types.Integer)):
         return None
-    sig = types.void(a0, a1, a2, e0, e1, e2, t, p02, p12, p20, p21, q02, q12, q20, q21, x0, x1, x2)
+    sig = types.void(a0, a1, a2, e0, e1, e2, t, cp, cq, x0, x1, x2)
 
     def codegen(context, builder, signature, args):
         tt = context.cast(builder, args[6], signature.args[6], types.intp)
-        u = [builder.load(_vec_ptr(context, builder, signature.args[k], args[k], tt), align=8) for k in (15, 16, 17)]
-        _h4_update(context, builder, signature, args, (0, 1, 2), (7, 8, 9, 10), u, tt)
-        _h4_update(context, builder, signature, args, (3, 4, 5), (11, 12, 13, 14), u, tt)
+        u = [builder.load(_vec_ptr(context, builder, signature.args[k], args[k], tt), align=8) for k in (9, 10, 11)]
+        _rows4_update(context, builder, signature, args, (0, 1, 2), 7, u, tt, m)
+        _rows4_update(context, builder, signature, args, (3, 4, 5), 8, u, tt, m)
         return context.get_dummy_value()
     return sig, codegen

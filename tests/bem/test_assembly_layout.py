@@ -36,6 +36,7 @@ def _lagset(planes, chunk_cache, pattern="auto", bump=0.0):
 def _literal(ls):
     """Dense H (L+1, N, N, 3, 3), G (L+1, N, nt, 3, 3) and the touched-block masks, by plain loops."""
     from petsc_ssi.bem.assemble import _pair_window, _integrate, SING_TOL
+    from petsc_ssi.bem.packs import quad
     o, m = ls.opts, ls.mat
     gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
     gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
@@ -55,7 +56,8 @@ def _literal(ls):
                 continue
             want_u = bool((ls.VT[v] >= 0).any())
             _integrate(xc, ls.VX[v], sing, ns, lo, hi, want_u, (ls.dt, m.cp, m.cs, m.rho, m.nu, m.mu, 0.0),
-                       (o["subdivisions"], gq, gw, gr, gwr, float(ls.Vh.min())), (Ub, Pb, Us, Ps, Pc, Uc))
+                       quad(o["subdivisions"], 0.0, o["subdivisions"], gq, gw, gr, gwr, SING_TOL, float(ls.Vh.min())),
+                       (Ub, Pb, Us, Ps, Pc, Uc))
             for li in range(hi - lo + 1):
                 for a in range(9):
                     if np.any(Pb[li, a] != 0.0):

@@ -11,6 +11,7 @@ import pytest
 
 from petsc_ssi.bem.bsr import positions
 from petsc_ssi.bem.quadrature import integrate_pair, integrate_plane, plane_points
+from petsc_ssi.bem.packs import wave
 
 pytestmark = pytest.mark.unit
 
@@ -52,11 +53,11 @@ def test_plane_kernel_equals_the_general_kernel_bit_for_bit(want_u, toff):
         ns = 4 if case % 4 > 1 else [8, 16][case % 2]
         lo, hi = 1, L
         Ub, Pb = np.zeros((L, 9, 3, 3)), np.zeros((L, 9, 3, 3))
-        n_gen = integrate_pair(xc, X, -1, ns, gq, gw, lo, hi, DT, CP, CS, RHO, NU, Ub, Pb, want_u, toff)
+        n_gen = integrate_pair(xc, X, -1, ns, lo, hi, wave(DT, CP, CS, RHO, NU, toff), gq, gw, Ub, Pb, want_u)
         sub, pts, Ntab = np.zeros((ns * ns, 4)), np.zeros((ns * ns * 4, 4)), np.zeros((ns * ns * 4, 9))
         plane_points(X, ns, gq, gw, sub, pts, Ntab)
         P, U = np.zeros((L, 9, 4)), np.zeros((L, 9, 5))
-        n_pl = integrate_plane(xc, sub, pts, Ntab, 4, lo, hi, DT, CP, CS, RHO, P, U, want_u, toff)
+        n_pl = integrate_plane(xc, sub, pts, Ntab, 4, lo, hi, wave(DT, CP, CS, RHO, NU, toff), P, U, want_u)
         assert n_pl == n_gen > 0
         assert np.abs(P).max() > 0
         assert np.array_equal(P, Pb[:, :, hp, hq])                  # bit for bit

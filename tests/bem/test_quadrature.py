@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from petsc_ssi.bem.quadrature import singular_static, integrate_pair
+from petsc_ssi.bem.packs import wave
 from petsc_ssi.mesh import quad9
 from petsc_ssi.mesh.surface import grid
 
@@ -89,10 +90,10 @@ def test_element_lag_sum_is_static_integral():
         X = grid(1.0, 1.0, 1.0).cell_coords()[0] + np.array([shift, 0.3, 0.0])
         L = int((shift + 1.5) / (cs * dt)) + 4
         Ub = np.zeros((L, 9, 3, 3)); Pb = np.zeros((L, 9, 3, 3))
-        integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, L, dt, cp, cs, rho, nu, Ub, Pb, True)
+        integrate_pair(np.zeros(3), X, -1, 4, 1, L, wave(dt, cp, cs, rho, nu), gq, gw, Ub, Pb, True)
         # static reference with the same points: one "lag" of width infinity
         U0 = np.zeros((1, 9, 3, 3)); P0 = np.zeros((1, 9, 3, 3))
-        integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, 1, 1e3, cp, cs, rho, nu, U0, P0, True)
+        integrate_pair(np.zeros(3), X, -1, 4, 1, 1, wave(1e3, cp, cs, rho, nu), gq, gw, U0, P0, True)
         assert np.abs(Ub.sum(0) - U0[0]).max() <= 1e-10 * np.abs(U0).max()
 
 
@@ -105,9 +106,9 @@ def test_traction_lag_sum_is_static_integral():
     X[:, 2] = 0.05 * X[:, 0] ** 2          # curved: gamma.n != 0, all terms active
     L = int(3.0 / (cs * dt)) + 4
     Ub = np.zeros((L, 9, 3, 3)); Pb = np.zeros((L, 9, 3, 3))
-    integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, L, dt, cp, cs, rho, nu, Ub, Pb, False)
+    integrate_pair(np.zeros(3), X, -1, 4, 1, L, wave(dt, cp, cs, rho, nu), gq, gw, Ub, Pb, False)
     U0 = np.zeros((1, 9, 3, 3)); P0 = np.zeros((1, 9, 3, 3))
-    integrate_pair(np.zeros(3), X, -1, 4, gq, gw, 1, 1, 1e3, cp, cs, rho, nu, U0, P0, False)
+    integrate_pair(np.zeros(3), X, -1, 4, 1, 1, wave(1e3, cp, cs, rho, nu), gq, gw, U0, P0, False)
     assert np.abs(Pb.sum(0) - P0[0]).max() <= 1e-10 * np.abs(P0).max()
 
 
