@@ -116,6 +116,8 @@ def test_a_damaged_checkpoint_is_refused(tmp_path):
         assert len(f[vec].attrs["crc32"]) == 1 and len(f["serial/times"].attrs["crc32"]) == 1   # one 8 MiB piece
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_a_damaged_checkpoint_is_refused
+@pytest.mark.slow
 def test_a_restart_does_not_continue_another_runs_output(tmp_path):
     """-ssi_restart of run A with -ssi_output naming run B's finished result (another run id) is
     refused at -n 1 and -n 2, B untouched; A's own output (a copy keeps its id) restarts."""

@@ -90,6 +90,8 @@ def test_the_guard_stop_keeps_the_results(tmp_path):
     assert g["status"].startswith(f"stopped after step {step} of 700: the solution is diverging")
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_a_signal_stops_the_run_and_keeps_its_results
+@pytest.mark.slow
 def test_a_signal_stops_a_coupled_contact_run(tmp_path):
     """The coupled block on the half-space with unilateral contact (the foundation lifts off),
     signalled after 20 steps on 2 ranks: both files (soil with the interface series, structure)

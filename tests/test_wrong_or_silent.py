@@ -53,6 +53,8 @@ def _K0(csv_path):
         return {row["mode"]: float(row["K0"]) for row in csv.DictReader(fh)}
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_impedance_needs_soil_around_the_footing
+@pytest.mark.slow
 def test_impedance_of_an_off_centre_footing_uses_only_its_planes(tmp_path):
     """A 2 m x 2 m footing on x in [0, 2] m: the plane x = 0 used to be applied anyway (the footing
     mirrored into one twice as long: K0 1.45 times too large here, 2.9 in the issue's case). Now

@@ -147,6 +147,8 @@ def test_blocked_equals_per_step_coupled_contact_two_ranks(tmp_path):
     same(two1, two, rtol=1e-10)     # observed 2.0e-13 - 3.1e-13 (the contact pressure, uf)
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_blocked_equals_per_step
+@pytest.mark.slow
 def test_blocked_two_ranks_and_a_block_longer_than_the_lags(tmp_path):
     """-n 2: blocks of 8 in sub-blocks of 3 against step by step (both -ssi_reproducible); one rank: a block longer
     than the run (32 steps, the largest, for 30: every term past the first step is then an in-block

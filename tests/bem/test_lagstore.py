@@ -30,6 +30,8 @@ def fields(path, keys=("receivers/u", "displacement_000002", "traction_000002"))
         return {k: f[k][:] for k in keys}
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_a_restart_with_loaded_lags_is_bitwise
+@pytest.mark.slow
 def test_loaded_lags_give_the_assembled_run_bitwise(tmp_path):
     """Saved by one run, loaded by a run with twice the load: u is exactly twice the first run's
     (the solution is linear and scaling by 2 is exact in floating point) and bitwise the run

@@ -108,6 +108,8 @@ def test_balanced_evens_the_assembled_work():
         assert r["products_balanced"] < r["products_equal"] + 0.01, r
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_balanced_ranges_cover_and_balance, test_node_work_is_the_memory_estimate_count
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
 def test_two_ranks_balanced_and_equal_agree(tmp_path):
     """At -n 2 the balanced cut differs from the equal one (here: nodes near the symmetry corner carry

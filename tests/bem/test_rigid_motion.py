@@ -45,6 +45,8 @@ def test_folded_quarter_model_equals_the_full_model(tmp_path):
     assert np.array_equal(F["h"], np.ones(len(F["t"])))          # heaviside: h = 1 from the first step
 
 
+# slow tier: the make-test budget (10-20 s); the default tier's sibling: test_impedance.py's square footing and test_coupled.py's rigid footing static stiffness
+@pytest.mark.slow
 def test_static_stiffness_of_the_square_footing(tmp_path):
     """Late-time force of a held vertical translation and moment of a held rocking rotation, against
     Pais and Kausel (1988): K_z = 4.7 G B/(1 - nu), K_ry = 4.0 G B^3/(1 - nu). With two elements per
