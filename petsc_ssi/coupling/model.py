@@ -42,8 +42,8 @@ def build_coupled(cfg, comm):
     mesh = read_soil_surface(cfg, comm, planes)
     if not mesh.flat and cfg.contact == "unilateral":
         warn("-ssi_contact unilateral on a surface with an excavation: the contact's active set is known not to "
-             "settle there (a stiff block in a 2 x 2 x 1 m pit under a horizontal pulse cycled at 48 of 56 steps, 29 "
-             "with only its bottom unilateral; no sliding on the walls: closed nodes are bonded); read the run's "
+             "settle there (a stiff block in a 2 x 2 x 1 m pit under a horizontal pulse cycled at 48 of 56 steps; no "
+             "sliding on the walls: closed nodes are bonded); read the run's "
              "cycling warnings, or use -ssi_contact_preload so that the faces stay closed", comm)
     model = build_model(cfg, comm, assemble_matrices=False, receivers=cfg.structure_receivers,
                         receivers_what="-ssi_structure_receivers",
