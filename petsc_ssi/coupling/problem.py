@@ -239,7 +239,7 @@ class SSITransient(TransientProblem):
         if comm.getRank() == 0 and len(model.receiver_nodes):
             srecd = receiver_record(model, res["structure"])
         sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
-        sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1),
+        sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1, self.integ.modal),
                   "structure_mass": structure_mass(model, comm)}
         return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups}),
                 (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups})]
