@@ -238,3 +238,11 @@ def test_coupled_all_modes_equal_stiffness_damping(tmp_path, coupling):
           f"{np.abs(runs['none'] - u).max() / np.abs(u).max():.3g} of the peak; highest zeta {max(map(float, z.split(','))):.3g}")
     assert np.abs(runs["modal"] - u).max() < 1e-8 * np.abs(u).max()
     assert np.abs(runs["none"] - u).max() > 1e-3 * np.abs(u).max()
+
+
+def test_modes_command_lists_the_modal_ratios():
+    """petsc-ssi modes with -ssi_fem_modal_damping prints each flexible mode's modal ratio (0 above the list)."""
+    r = run_cli(["modes"] + BOX + ["-ssi_fem_fixed", "base", "-ssi_modes_n", "4", "-ssi_fem_modal_damping", "0.05,0.03"])
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "modal damping (-ssi_fem_modal_damping) of each flexible mode, added to the above: 1: 0.05, 2: 0.03, " \
+           "3: 0, 4: 0" in r.stdout
