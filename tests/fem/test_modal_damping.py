@@ -240,9 +240,10 @@ def test_coupled_all_modes_equal_stiffness_damping(tmp_path, coupling):
     assert np.abs(runs["none"] - u).max() > 1e-3 * np.abs(u).max()
 
 
-def test_modes_command_lists_the_modal_ratios():
+def test_modes_command_lists_the_modal_ratios(tmp_path):
     """petsc-ssi modes with -ssi_fem_modal_damping prints each flexible mode's modal ratio (0 above the list)."""
-    r = run_cli(["modes"] + BOX + ["-ssi_fem_fixed", "base", "-ssi_modes_n", "4", "-ssi_fem_modal_damping", "0.05,0.03"])
+    r = run_cli(["modes"] + BOX + ["-ssi_fem_fixed", "base", "-ssi_modes_n", "4", "-ssi_fem_modal_damping", "0.05,0.03",
+                                   "-ssi_output", str(tmp_path / "m.h5")])
     assert r.returncode == 0, r.stdout + r.stderr
     assert "modal damping (-ssi_fem_modal_damping) of each flexible mode, added to the above: 1: 0.05, 2: 0.03, " \
            "3: 0, 4: 0" in r.stdout
