@@ -254,8 +254,8 @@ def coupling_report(K0s, cross):
     if len(cross) == 2:
         a, b = cross["horizontal-rocking"], cross["rocking-horizontal"]
         out.append(f"[impedance] reciprocity of the coupling terms: K_hr / K_rh - 1 = {a / b - 1:.3g} "
-                   "(0 for the continuous soil; the BEM's comes mostly from the meshed surface's truncation: "
-                   "it falls as the surface grows, runs/impedance/README.md)")
+                   "(0 for the continuous soil; the BEM's comes from the meshed surface's truncation, falling as "
+                   "the surface grows, and from the collocation: runs/impedance/README.md)")
         out.append(f"[impedance] symmetric estimate of the coupling: (K_hr + K_rh) / 2 = {0.5 * (a + b):.5g}, "
                    f"{0.5 * (a + b) / scale:.3g} of sqrt(K0_h K0_r) (the mean is the better estimate: "
                    "runs/impedance/README.md; the CSV's rows 'coupling-mean')")
