@@ -13,9 +13,12 @@
 # then building_estimate_table.py writes the table into jobscripts/README.md. Run it on an idle machine:
 # the measured walls are the reference.
 #   bash jobscripts/building_estimate.sh            (about 6 minutes on the 2-core development machine)
+# OUT (default out/bench/buildings) and EXTRA (options appended to every run and estimate, e.g. a shorter
+# -ssi_t_end for a smoke test of the scripts) may be set.
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
-OUT=out/bench/buildings
+OUT=${OUT:-out/bench/buildings}
+EXTRA=${EXTRA:-}
 T=${T:-2}
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup
@@ -27,11 +30,11 @@ declare -A CASE=(
 )
 for name in demo paper seismic; do
   # shellcheck disable=SC2086
-  "$PY" -m petsc_ssi estimate ${CASE[$name]} -ssi_estimate_ranks 1,2 > "$OUT/$name.estimate" 2>&1
+  "$PY" -m petsc_ssi estimate ${CASE[$name]} $EXTRA -ssi_estimate_ranks 1,2 > "$OUT/$name.estimate" 2>&1
   for n in 1 2; do
     echo "[bench] $name on $n rank(s) -> $OUT/$name-n$n.log"
     # shellcheck disable=SC2086
-    mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi ${CASE[$name]} \
+    mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi ${CASE[$name]} $EXTRA \
       -ssi_output "$OUT/$name-n$n.h5" -ssi_output_overwrite -log_view -memory_view > "$OUT/$name-n$n.log" 2>&1
   done
 done
@@ -40,7 +43,7 @@ if [ "${FIT:-0}" = 1 ]; then
     for n in 1 2; do
       echo "[bench] the $name building's soil alone on $n rank(s) -> $OUT/soil-$name-n$n.log"
       # shellcheck disable=SC2086
-      mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi ${CASE[$name]} -ssi_problem bem \
+      mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi ${CASE[$name]} $EXTRA -ssi_problem bem \
         -ssi_output "$OUT/soil-$name-n$n.h5" -ssi_output_overwrite -log_view -memory_view > "$OUT/soil-$name-n$n.log" 2>&1
     done
   done
