@@ -346,6 +346,11 @@ class HalfSpace:
         out.getArray()[:] += self.free_field_owned(t, r0, r1)
         return out
 
+    @property
+    def has_interface_free_field(self):
+        """Whether the coupled structure's interface takes a free-field traction (``interface_free_field``)."""
+        return self._interface_ff is not None
+
     def interface_free_field(self, m):
         """The free field's traction t_ff = sigma_ff n_b (n_I, 3) [Pa] on a coupled structure's interface,
         the exact mean over ((m-1) dt, m dt], n_b the soil's outward normal, as the nodal field whose

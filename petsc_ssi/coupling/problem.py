@@ -145,7 +145,7 @@ class SSITransient(TransientProblem):
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
             (("uff",) if self.prob.seismic is not None else ()) + \
-            (("pff",) if self.prob.interface_free_field(1) is not None else ())
+            (("pff",) if self.prob.has_interface_free_field else ())
         rd = self._open_restart()
         self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None,
