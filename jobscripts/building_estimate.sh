@@ -36,6 +36,8 @@ for name in demo paper seismic; do
     # shellcheck disable=SC2086
     mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi ${CASE[$name]} $EXTRA \
       -ssi_output "$OUT/$name-n$n.h5" -ssi_output_overwrite -log_view -memory_view > "$OUT/$name-n$n.log" 2>&1
+    # the machine's 1-minute load average at the end of the run (the table marks a loaded machine)
+    echo "# load average after the run: $(cut -d' ' -f1 /proc/loadavg)" >> "$OUT/$name-n$n.log"
   done
 done
 if [ "${FIT:-0}" = 1 ]; then

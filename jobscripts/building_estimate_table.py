@@ -46,7 +46,10 @@ def main(out):
             log = os.path.join(out, f"{name}-n{n}.log")
             if not os.path.exists(log):
                 continue
-            lv = parse(open(log).read())
+            text = open(log).read()
+            lv = parse(text)
+            m = re.search(r"# load average after the run: ([0-9.]+)", text)
+            load = float(m.group(1)) if m else float("nan")
             st = lv["stages"]
             loop = sum(v for k, v in st.items() if "time loop" in k.lower())
             asm = sum(v for k, v in st.items() if "assembly" in k.lower())
@@ -57,16 +60,19 @@ def main(out):
                          "ratio_total": round(e["total"] / lv["total_s"], 3),
                          "measured_assembly_s": round(asm, 2), "estimate_assembly_s": round(pred_asm, 2),
                          "measured_loop_s": round(loop, 2), "estimate_loop_s": round(e["time_loop_s"], 2),
-                         "ratio_loop": round(e["time_loop_s"] / loop, 3) if loop else float("nan")})
+                         "ratio_loop": round(e["time_loop_s"] / loop, 3) if loop else float("nan"),
+                         "load_average_after": load})
     if not rows:
         sys.exit(f"no logs in {out}")
     write_csv(os.path.join(out, "buildings.csv"), rows)
     lines = ["| building | ranks | measured total [s] | estimate [s] | estimate / measured | assembly stages measured / "
-             "estimated [s] | time loop measured / estimated [s] | loop estimate / measured |", "|---" * 8 + "|"]
+             "estimated [s] | time loop measured / estimated [s] | loop estimate / measured | load average after "
+             "(2 cores) |", "|---" * 9 + "|"]
     for r in rows:
         lines.append(f"| {r['building']} | {r['ranks']} | {r['measured_total_s']} | {r['estimate_total_s']} | "
                      f"{r['ratio_total']} | {r['measured_assembly_s']} / {r['estimate_assembly_s']} | "
-                     f"{r['measured_loop_s']} / {r['estimate_loop_s']} | {r['ratio_loop']} |")
+                     f"{r['measured_loop_s']} / {r['estimate_loop_s']} | {r['ratio_loop']} | "
+                     f"{r['load_average_after']:g} |")
     block = "\n".join(lines)
     print(block)
     put_block("buildings", block, [os.path.join(HERE, "README.md")])
