@@ -8,17 +8,26 @@
 #        seismic   runs/seismic/building.opts cut to T s (default 2 s: 400 steps; a record's building,
 #                  as an engineer runs one; the record is ObsPy's AKT013 test file, found as run.sh finds it)
 #      -> out/bench/buildings/NAME-nN.log and NAME.estimate
-#   2. (FIT=1) the building soils alone (-ssi_problem bem, the paper's pulse) at 1 and 2 ranks
-#      -> out/bench/buildings/soil-NAME-nN.log, for jobscripts/calibration_runs.sh --fit-only
+#   2. (FIT=1) the building soils alone (-ssi_problem bem, the paper's pulse) and the Pekeris small, medium
+#      and paper cases at 1 and 2 ranks -> out/bench/buildings/soil-NAME-nN.log, pekeris-CASE-nN.log, for
+#      `calibrate.py --assembly-only` (the assembly's kernel line fitted on both kinds of mesh)
 # then building_estimate_table.py writes the table into jobscripts/README.md. Run it on an idle machine:
 # the measured walls are the reference.
 #   bash jobscripts/building_estimate.sh            (about 6 minutes on the 2-core development machine)
 # OUT (default out/bench/buildings) and EXTRA (options appended to every run and estimate, e.g. a shorter
-# -ssi_t_end for a smoke test of the scripts) may be set.
+# -ssi_t_end for a smoke test of the scripts) may be set; CONSTANTS=FILE.json gives the estimates other
+# constants (-ssi_estimate_constants), ESTIMATE_ONLY=1 redoes the estimates against the runs' logs already
+# in OUT, and TAG names the README block the table goes to (default buildings). A refit of the assembly's
+# kernel line on the FIT=1 logs, and its table:
+#   cp petsc_ssi/estimate_constants.json /tmp/refit.json
+#   .venv/bin/python jobscripts/calibrate.py --assembly-only --out /tmp/refit.json out/bench/buildings/soil-*.log \
+#       out/bench/buildings/pekeris-*.log
+#   ESTIMATE_ONLY=1 CONSTANTS=/tmp/refit.json TAG=buildings-refit bash jobscripts/building_estimate.sh
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 OUT=${OUT:-out/bench/buildings}
 EXTRA=${EXTRA:-}
+EST=${CONSTANTS:+-ssi_estimate_constants $CONSTANTS}
 T=${T:-2}
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup
@@ -30,7 +39,8 @@ declare -A CASE=(
 )
 for name in demo paper seismic; do
   # shellcheck disable=SC2086
-  "$PY" -m petsc_ssi estimate ${CASE[$name]} $EXTRA -ssi_estimate_ranks 1,2 > "$OUT/$name.estimate" 2>&1
+  "$PY" -m petsc_ssi estimate ${CASE[$name]} $EXTRA $EST -ssi_estimate_ranks 1,2 > "$OUT/$name.estimate" 2>&1
+  [ "${ESTIMATE_ONLY:-0}" = 1 ] && continue
   for n in 1 2; do
     echo "[bench] $name on $n rank(s) -> $OUT/$name-n$n.log"
     # shellcheck disable=SC2086
@@ -40,7 +50,17 @@ for name in demo paper seismic; do
     echo "# load average after the run: $(cut -d' ' -f1 /proc/loadavg)" >> "$OUT/$name-n$n.log"
   done
 done
-if [ "${FIT:-0}" = 1 ]; then
+if [ "${FIT:-0}" = 1 ] && [ "${ESTIMATE_ONLY:-0}" != 1 ]; then
+  # the flat Pekeris grids beside them, so that the assembly's kernel line (a0 + a_blk B + a_int I) is fitted
+  # jointly (calibrate.py --assembly-only): few distinct pair geometries there, many on the building soils
+  for case in small medium paper; do
+    for n in 1 2; do
+      echo "[bench] pekeris $case on $n rank(s) -> $OUT/pekeris-$case-n$n.log"
+      mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi -options_file "runs/pekeris/$case.opts" \
+        -ssi_output "$OUT/pekeris-$case-n$n.h5" -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view \
+        > "$OUT/pekeris-$case-n$n.log" 2>&1
+    done
+  done
   for name in demo paper; do
     for n in 1 2; do
       echo "[bench] the $name building's soil alone on $n rank(s) -> $OUT/soil-$name-n$n.log"
@@ -50,4 +70,4 @@ if [ "${FIT:-0}" = 1 ]; then
     done
   done
 fi
-"$PY" jobscripts/building_estimate_table.py "$OUT"
+"$PY" jobscripts/building_estimate_table.py "$OUT" "${TAG:-buildings}"

@@ -2,9 +2,10 @@
 """The estimate against the measured coupled buildings (jobscripts/building_estimate.sh): per building and
 rank count, the measured wall of the run (-log_view's total), of its BEM assembly stage and of its time
 loop, and `petsc-ssi estimate`'s predictions of the same; the ratio predicted / measured.
-Writes OUT/buildings.csv and the table between <!-- buildings:begin/end --> in jobscripts/README.md.
+Writes OUT/buildings.csv and the table between <!-- TAG:begin/end --> in jobscripts/README.md (TAG:
+buildings by default).
 
-  python jobscripts/building_estimate_table.py out/bench/buildings
+  python jobscripts/building_estimate_table.py out/bench/buildings [TAG]
 """
 import os
 import re
@@ -35,7 +36,7 @@ def _seconds(text):
     return 3600 * h + 60 * mi + s
 
 
-def main(out):
+def main(out, tag="buildings"):
     rows = []
     for name in ("demo", "paper", "seismic"):
         est_path = os.path.join(out, f"{name}.estimate")
@@ -73,10 +74,10 @@ def main(out):
                      f"{r['ratio_total']} | {r['measured_assembly_s']} / {r['estimate_assembly_s']} | "
                      f"{r['measured_loop_s']} / {r['estimate_loop_s']} | {r['ratio_loop']} | "
                      f"{r['load_average_after']:g} |")
-    block = "\n".join(lines)
+    block = "\n".join(lines) + "\n"
     print(block)
-    put_block("buildings", block, [os.path.join(HERE, "README.md")])
+    put_block(tag, block, [os.path.join(HERE, "README.md")])
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "out/bench/buildings")
+    main(sys.argv[1] if len(sys.argv) > 1 else "out/bench/buildings", sys.argv[2] if len(sys.argv) > 2 else "buildings")
