@@ -25,8 +25,8 @@ class BEMTransient(TransientProblem):
     kind = "bem"
 
     def __init__(self, cfg, comm=None, sources=None):
-        """``sources``: the surface tractions on the soil (``petsc_ssi.sources``); None: those of the
-        options (-ssi_load_*)."""
+        """``sources``: what loads the soil (``petsc_ssi.sources``: surface tractions, a rigid motion of a
+        region or a massless footing); None: those of the options (``sources.from_options``)."""
         super().__init__(cfg, comm)
         no_output_refused(cfg, "a BEM")
         self.check_output()
@@ -36,7 +36,7 @@ class BEMTransient(TransientProblem):
             self.plan, self.ls = self.prob.prepare()
         self.grid = self.prob.grid
         self.march = self.rec = self.out = None
-        self.footing = None                  # -ssi_disp_rigid massless (bem/input_motion.py)
+        self.footing = None                  # a massless footing's correction (sources/rigid.py)
         self.state = None
         self.check_disk()
 
@@ -51,9 +51,8 @@ class BEMTransient(TransientProblem):
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
                                               p.known_p(), self.log)
-            if p.massless:
-                from .input_motion import MasslessFooting
-                self.footing = MasslessFooting(self.comm, p, self.march)
+            if p.motion is not None:        # the motion source's step correction (a massless footing's)
+                self.footing = p.motion.correction(self.comm, p, self.march)
 
     def start(self):
         self._advance("set up", "started")
