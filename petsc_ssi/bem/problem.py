@@ -63,7 +63,7 @@ class BEMTransient(TransientProblem):
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
         if self.footing is not None:
-            self.rec.add(self.footing)                      # its motion series in checkpoints
+            self.rec.add(self.footing, out=self.out)        # its motion series in checkpoints, its group
         if self.cfg.guard:
             self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
         self._ut = self.march.u_tmpl.duplicate()            # the total field (a seismic input's u_sc + u_ff)
@@ -97,33 +97,26 @@ class BEMTransient(TransientProblem):
         return self.state
 
     def write_partial(self, status):
-        rec = self.rec
-        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
-               "resultants": rec.soil.resultants(rec.steps, rec.times)}
-        if self.footing is not None:
-            res["input_motion"] = self.footing.arrays(rec.times)
-        self.write_results(res, status=status, final=False)
+        self.write_results({"stats": {"steps_done": self.n}}, status=status, final=False)
 
     def output_parts(self, res):
-        """The soil's output: receivers, attributes, the groups (a prescribed region's resultants, the
-        seismic input, a massless footing's input motion) and the run record."""
+        """The soil's output: the groups its observers write (``Recorder.groups``: the receivers, a
+        prescribed region's resultants, a massless footing's input motion) and the seismic input's,
+        attributes and the run record."""
         cfg, comm, prob = self.cfg, self.comm, self.prob
-        recd = None
-        if res["u"] is not None:
-            recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+        groups = self.rec.groups(self.out)
+        recd = groups.pop("receivers", None)
         attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": prob.dt,
                  "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
-        groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
         if getattr(prob, "seismic", None) is not None:
-            groups = dict(groups or {}, seismic=prob.seismic.arrays())
+            groups["seismic"] = prob.seismic.arrays()
             attrs["seismic"] = prob.seismic.kind
-        if res.get("input_motion") is not None:
-            groups = dict(groups or {}, input_motion=res["input_motion"])
+        if self.footing is not None:
             attrs["disp_rigid"] = "massless"
         if cfg.mesh_patch and cfg.load_group == "load":
             attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
         record = provenance(cfg, comm, {"stats": res.get("stats", {})}, grid=prob.grid)
-        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups})]
+        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups or None})]
 
     def written(self, res):
         cfg = self.cfg
