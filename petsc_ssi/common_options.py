@@ -58,6 +58,10 @@ register("disk_check", "bool", True, "", "before the assembly, compare the free 
          "refuse a run that cannot fit (0: skip the check; the per-snapshot check still stops a run whose disk "
          "fills)", "common")
 
+register("estimate_constants", "str", "", "", "JSON file of machine constants of the cost model, for petsc-ssi "
+         "estimate and the run's own prediction of its time loop (default: petsc_ssi/estimate_constants.json; "
+         "jobscripts/calibrate.py writes one)", "common")
+
 register("max_steps", "int", 1000000, "steps", "refuse a run of more time steps than this, before any work: "
          "t_end / dt is reported with the predicted time of the loop, and a t_end or dt off by a few orders "
          "of magnitude would otherwise step for days; raise it for a longer run", "common", validator=at_least(1))

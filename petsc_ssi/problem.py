@@ -495,41 +495,57 @@ class TransientProblem:
 
     def loop_estimate(self):
         """(seconds of the whole time loop, seconds per step, what it covers) predicted before the
-        run, or None where the kind has no model (the BEM's: ``bem.cost.loop_seconds``)."""
+        run, or None where the kind has no model (the BEM's: ``bem.cost.loop_terms``, the model
+        ``petsc-ssi estimate`` evaluates)."""
         prob = getattr(self, "prob", None)
         est = getattr(prob, "loop_estimate", None)
         return None if est is None else (est[0], est[1], "the soil's BEM")
+
+    def loop_model(self):
+        """k -> the predicted seconds of the first k steps (None without a model)."""
+        return getattr(getattr(self, "prob", None), "loop_model", None)
+
+    # the coupled run prints its loop line after the structure's factorisation, whose solves it times
+    defer_loop_line = False
 
     def expect_progress(self):
         """The progress line (-ssi_monitor) compares the measured time of the steps with the run's
         own prediction (``loop_estimate``'s model for the first k steps) and warns once when it runs
         far above it (``monitor.slow_warning``: a loaded machine, oversubscribed ranks)."""
         prob = getattr(self, "prob", None)
-        model = getattr(prob, "loop_model", None)
+        model = self.loop_model()
         rec = getattr(self, "rec", None)
-        if model is None or rec is None:
+        est = self.loop_estimate()
+        if model is None or rec is None or est is None:
             return
         rec.progress.progress.expect(model, getattr(prob, "ranks_here", 1),
-                                     "the run's prediction (the soil's BEM, bem/cost.py)")
+                                     f"the run's prediction ({est[2]}, bem/cost.py)")
 
     def announce_loop(self):
         """Collective, before the set-up: one line with the number of steps and, where a model
         exists, the predicted time of the loop; SSIError beyond -ssi_max_steps (a run whose t_end
         comes from elsewhere, a seismic record's length, is checked here; -ssi_t_end itself when
-        the options resolve)."""
-        from .monitor import fmt_time
-        todo = self.n_steps - self.n
+        the options resolve). The coupled run prints the line in its set-up (``defer_loop_line``)."""
         limit = int(self.cfg.get("max_steps", 0) or 0)
         if limit and self.n_steps > limit:
             raise SSIError(f"the run to t = {self.time(self.n_steps):.6g} s with -ssi_dt {self.grid.dt:g} is "
                            f"{self.n_steps:.4g} time steps, more than -ssi_max_steps {limit}; check t_end and dt, "
                            "or raise -ssi_max_steps to run them")
+        if not self.defer_loop_line:
+            self.print_loop_line()
+
+    def print_loop_line(self):
+        """One line: the steps to go and, where a model exists, their predicted time (the model of
+        ``petsc-ssi estimate``: the same numbers for the same run and rank count)."""
+        from .monitor import fmt_time
+        todo = self.n_steps - self.n
         est = self.loop_estimate()
         line = (f"[ssi] time loop: {todo} steps of {self.grid.dt:.4g} s to t = {self.time(self.n_steps):.6g} s")
         if est is not None:
-            scale = todo / max(self.n_steps, 1)
-            line += (f"; predicted {fmt_time(est[0] * scale)} ({est[2]}: about {est[1]:.2g} s per step once every "
-                     "stored lag is in the history sum, and the field snapshots; bem/cost.py's model)")
+            model = self.loop_model()
+            left = est[0] - (model(self.n) if model is not None and self.n else 0.0)
+            line += (f"; predicted {f'{left:.3g} s' if left < 60 else fmt_time(left)} ({est[2]}: about {est[1]:.2g} s per step once every stored lag "
+                     "is in the history sum, and the field snapshots; the model of petsc-ssi estimate, bem/cost.py)")
         printf(line)
 
     def run(self):

@@ -179,3 +179,47 @@ def test_coupled_estimate_counts_the_interface_and_the_structure():
     for r in rows.values():
         assert r["coupling_setup_s"] > 0 and r["coupling_loop_s"] > 0
         assert r["time_loop_s"] >= r["history_s"] + r["solve_s"] + r["coupling_loop_s"] - 1e-9
+
+
+def _table(out):
+    """{ranks: {column: value}} of the estimate's table."""
+    import re as _re
+    head = [l for l in out.splitlines() if "ranks nodes |" in l][0].split("|")[1].split()
+    rows = {}
+    for line in out.splitlines():
+        m = _re.match(r"\[ssi\]\s+(\d+)\s+\d+\s+\|(.*?)\|", line)
+        if m:
+            rows[int(m.group(1))] = dict(zip(head, map(float, m.group(2).split())))
+    return rows
+
+
+def _run_prediction(out):
+    m = re.search(r"\[ssi\] time loop: \d+ steps of [0-9.e-]+ s to t = [0-9.e-]+ s; predicted ([0-9.e+-]+) s", out)
+    assert m, out[-3000:]
+    return float(m.group(1))
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_the_run_and_the_estimate_predict_the_same_loop(tmp_path, n):
+    """Issue 43: the run's own first line and `petsc-ssi estimate` were two code paths (on the demo building
+    5.3 s against 2.95 s); now one model (``bem.cost.loop_terms``, the coupling's ``step_seconds``): the
+    BEM run's predicted loop equals the estimate's time_loop_s on the same rank count to the printed 3
+    digits; the coupled run's soil part the same, and its coupling part the same function of the structure's
+    solve time, which each process times itself (n_fs = 2 solves a step: coupling/cost.py)."""
+    est = _table(cli(["estimate", "-options_file", SMALL, "-ssi_estimate_ranks", str(n)]).stdout)[n]["time_loop_s"]
+    run = _run_prediction(cli(["-options_file", SMALL, "-ssi_output", str(tmp_path / "s.h5")], nranks=n).stdout)
+    assert run == pytest.approx(est, rel=6e-3, abs=1e-3), (run, est)
+    coupled = [a for a in COUPLED if not a.startswith("-ssi_estimate")][:-1] + ["-ssi_t_end", "0.1"]
+    out = cli(["estimate"] + coupled + ["-ssi_estimate_ranks", str(n)]).stdout
+    row = _table(out)[n]
+    est_solve = float(re.search(r"a solve ([0-9.e+-]+) ms \(measured", out).group(1)) * 1e-3
+    out = cli(coupled + ["-ssi_output", str(tmp_path / "c.h5")], nranks=n).stdout
+    run = _run_prediction(out)
+    m = re.search(r"\(the soil's BEM ([0-9.e+-]+) s and the coupling ([0-9.e+-]+) s, a solve with the structure's D "
+                  r"([0-9.e+-]+) ms as timed", out)
+    assert m, out[-3000:]
+    bem, cpl, solve = float(m.group(1)), float(m.group(2)), float(m.group(3)) * 1e-3
+    assert run == pytest.approx(bem + cpl, rel=6e-3)
+    assert bem == pytest.approx(row["time_loop_s"] - row["coupling_loop_s"], rel=6e-3, abs=1e-3)
+    steps = 8                                     # 0.1 s / 0.0125 s
+    assert cpl - 2 * steps * solve == pytest.approx(row["coupling_loop_s"] - 2 * steps * est_solve, rel=0.02, abs=2e-3)

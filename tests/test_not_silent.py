@@ -189,6 +189,40 @@ def test_soil_numbers_out_of_range_are_refused(opts, words):
     assert err is not None and words in err, err
 
 
+def test_an_unusual_soil_is_said_once_before_the_assembly(tmp_path):
+    """A soil of c_s 5 m/s or rho 10 kg/m^3 (issue 44: a wrong unit ran without a word) gets one warning
+    line naming the option and the range; soils and rocks, and the tests' reduced soil (c_s 20 m/s), none."""
+    from petsc_ssi.bem.halfspace import soil_plausibility
+    for cs, rho in ((100.0, 1800.0), (20.0, 1800.0), (3500.0, 2700.0)):
+        assert soil_plausibility(cs, rho) is None
+    assert "-ssi_cs 5 m/s" in soil_plausibility(5.0, 1800.0) and "rho" not in soil_plausibility(5.0, 1800.0)
+    assert "-ssi_cs 0.2 m/s" in soil_plausibility(0.2, 1.8) and "-ssi_rho 1.8 kg/m^3" in soil_plausibility(0.2, 1.8)
+    assert "-ssi_rho 9000 kg/m^3" in soil_plausibility(100.0, 9000.0)
+    from helpers import cli
+    p = cli(["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
+             "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_cs", "5", "-ssi_cp", "10", "-ssi_rho", "10",
+             "-ssi_dt", "0.02", "-ssi_t_end", "0.04", "-ssi_output", str(tmp_path / "s.h5"), "-ssi_warn_beta", "0"],
+            nranks=2)
+    lines = [ln for ln in p.stdout.splitlines() if "unusual soil" in ln]
+    assert len(lines) == 1 and "-ssi_cs 5 m/s" in lines[0] and "-ssi_rho 10 kg/m^3" in lines[0], p.stdout[-2000:]
+    assert p.stdout.index("unusual soil") < p.stdout.index("[ssi] assembly")
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_geo_mesh_smaller_than_its_element_size_is_refused(tmp_path, n):
+    """Issue 44: -ssi_mesh_h 10 on a .geo of 4 m x 4 m (meshes/halfspace.geo) ran with elements of the
+    mesh's extent, not the size asked; now refused in one line on every rank before any assembly, as
+    the grid generator's is."""
+    from helpers import cli
+    p = cli(["-ssi_problem", "bem", "-ssi_mesh", "meshes/halfspace.geo", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "10",
+             "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005",
+             "-ssi_t_end", "0.01", "-ssi_output", str(tmp_path / "s.h5")], nranks=n, check=False)
+    errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    assert p.returncode != 0 and len(errs) == 1, p.stdout[-2000:]
+    assert "-ssi_mesh_h 10 m is larger than the mesh meshes/halfspace.geo (4 m x 4 m)" in errs[0], errs[0]
+    assert "[ssi] assembly" not in p.stdout
+
+
 def test_record_processing_refusals_name_the_options():
     from petsc_ssi.seismic import records as R
     t = np.arange(0.0, 1.0, 0.01)

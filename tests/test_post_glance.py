@@ -303,7 +303,7 @@ def test_given_damping_beside_the_identified(tmp_path, capsys):
     s, fx = write_ssi(str(tmp_path)), write_fixed(str(tmp_path))
     status, out, err = run([s, "--glance", fx], capsys)
     assert status == 0, err
-    q = "damping ratio given to the structure at that f0 (C = alpha_m M + a1 K)"
+    q = "damping ratio given to the structure at that f0 (Rayleigh, + modal: the nearest damped mode's)"
     assert f"| {q} | - | not recorded | not recorded |  |" in out
     a0, a1 = rayleigh_from_ratios(2.0, 8.0, 0.03, 0.03)               # 3 % at 2 and 8 Hz: 2.4 % at 4 Hz
     for p in (s[:-3] + "_structure.h5", fx):
@@ -319,3 +319,14 @@ def test_given_damping_beside_the_identified(tmp_path, capsys):
         assert given[k] == pytest.approx(a0 / (2 * w) + a1 * w / 2, rel=1e-12)
     assert given[1] == pytest.approx(0.03, rel=0.02)                   # SSI f0 = 2 Hz: 3 %
     assert given[2] == pytest.approx(0.024, rel=0.02)                  # fixed f0 = 4 Hz: 2.4 %
+    # modal damping (what a run with -ssi_fem_modal_damping writes): the ratio of the damped mode nearest
+    # f0 is added (the SSI's 2 Hz is nearest the fixed-base mode of 4 Hz, not the one of 11 Hz)
+    for p in (s[:-3] + "_structure.h5", fx):
+        with h5py.File(p, "r+") as f:
+            f.attrs["modal_damping_frequencies_hz"] = np.array([4.0, 11.0])
+            f.attrs["modal_damping_ratios"] = np.array([0.02, 0.05])
+    status, out, err = run([s, "--glance", fx, "--csv", tmp_path / "g2.csv"], capsys)
+    assert status == 0, err
+    given2 = read_csv(tmp_path / "g2.csv")[q]
+    for k in (1, 2):
+        assert given2[k] == pytest.approx(given[k] + 0.02, rel=1e-12)

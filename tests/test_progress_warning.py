@@ -39,3 +39,20 @@ def test_progress_warns_once_against_its_model(monkeypatch, capfd):
     out = capfd.readouterr().out
     assert out.count("times slower than the run's prediction") == 1
     assert "for 10 steps" in out
+
+
+def test_the_warning_comes_without_monitor_too(monkeypatch, capfd):
+    """Issue 44: `-n 2` ran 3-10 times slower than `-n 1` on shared cores with no word when -ssi_monitor was
+    off: the progress line stays off, the warning (once) does not."""
+    clock = iter(range(0, 10_000, 10))
+    monkeypatch.setattr(monitor.time, "perf_counter", lambda: float(next(clock)))
+    p = monitor.Progress("time loop", 40, enabled=False, every=10)
+    p.expect(lambda k: 1e-3 * k, ranks_here=1)
+    for k in range(1, 41):
+        p.update(k)
+    out = capfd.readouterr().out
+    assert out.count("times slower than the run's prediction") == 1 and "time loop: step" not in out
+    q = monitor.Progress("time loop", 40, enabled=False, every=10)           # no model: nothing at all
+    for k in range(1, 41):
+        q.update(k)
+    assert capfd.readouterr().out == ""

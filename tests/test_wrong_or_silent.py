@@ -218,7 +218,7 @@ def test_the_steps_and_the_predicted_time_are_told_before_the_loop(tmp_path):
     model's predicted time of the loop."""
     import re
     r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_t_end", "0.1", "-ssi_monitor"])
-    m = re.search(r"\[ssi\] time loop: (\d+) steps of 0.005 s to t = 0.1 s; predicted ([0-9.]+)s \(the soil's BEM: "
+    m = re.search(r"\[ssi\] time loop: (\d+) steps of 0.005 s to t = 0.1 s; predicted ([0-9.e-]+) ?s \(the soil's BEM: "
                   r"about ([0-9.e-]+) s per step", r.stdout)
     assert m and int(m.group(1)) == 20, r.stdout
     assert float(m.group(2)) > 0 and float(m.group(3)) > 0

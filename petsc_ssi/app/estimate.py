@@ -17,8 +17,6 @@ register("estimate_cores_per_node", "int", 0, "", "estimate: cores per node (0: 
          "cores on a node are oversubscribed", G, validator=lambda v: None if v >= 0 else "must be >= 0")
 register("estimate_node_memory", "real", 0.0, "GB", "estimate: memory of one node (0: this machine's)", G,
          validator=lambda v: None if v >= 0 else "must be >= 0")
-register("estimate_constants", "str", "", "", "estimate: JSON file of machine constants (default: "
-         "petsc_ssi/estimate_constants.json; jobscripts/calibrate.py writes one)", G)
 
 
 def parse_ranks(text):

@@ -241,14 +241,20 @@ def demands(path, component):
 
 def given_damping(path, f0):
     """The damping ratio the structure of ``path`` was given at the frequency f0 [Hz]: C = alpha_m M +
-    rayleigh_a1 K (file attributes; issue 43), zeta = alpha_m/(2 w) + rayleigh_a1 w/2; None when the
-    file does not record it."""
+    rayleigh_a1 K (file attributes; issue 43), zeta = alpha_m/(2 w) + rayleigh_a1 w/2, plus, with modal
+    damping (attributes modal_damping_frequencies_hz, modal_damping_ratios), the ratio of the damped
+    mode nearest f0 (a structure on soil vibrates below its fixed-base frequency: its first mode's ratio
+    is the one given to it); None when the file does not record it."""
     at = _attrs(path)
     if "alpha_m" not in at:
         return None
     a0, a1 = float(at["alpha_m"]), float(at.get("rayleigh_a1", 0.0))
     w = 2 * math.pi * f0
-    return a0 / (2 * w) + a1 * w / 2
+    z = a0 / (2 * w) + a1 * w / 2
+    fm = np.atleast_1d(np.asarray(at.get("modal_damping_frequencies_hz", []), float))
+    if fm.size:
+        z += float(np.atleast_1d(np.asarray(at["modal_damping_ratios"], float))[np.argmin(np.abs(fm - f0))])
+    return z
 
 
 # ---------------------------------------------------------------- report
@@ -276,7 +282,7 @@ def table(S, F):
             row("damping ratio zeta (SDOF fit)", "-", zs, zf, ratio=zf >= UNDAMPED),
             # what the structure was given (C = alpha_m M + a1 K of its output's attributes) at the identified f0:
             # the fixed base's identified zeta should equal it; with SSI the soil's radiation adds to it
-            row("damping ratio given to the structure at that f0 (C = alpha_m M + a1 K)", "-",
+            row("damping ratio given to the structure at that f0 (Rayleigh, + modal: the nearest damped mode's)", "-",
                 given_damping(S["pair"].structure_path, S["fit"].f0),
                 given_damping(F["pair"].structure_path, F["fit"].f0), ratio=False),
             row("period T0 = 1/f0 (ratio: period lengthening)", "s", 1 / S["fit"].f0, 1 / F["fit"].f0),

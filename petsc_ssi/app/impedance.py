@@ -24,7 +24,8 @@ model ending on the plane with the footing against it); the command says in one 
 it uses and why any is not. The rigid motions' reference point x_ref (-ssi_disp_ref) is by default
 the footing's centroid, so an off-centre footing rocks and twists about its own centre
 (-ssi_impedance_symmetry 0 meshes the whole surface instead). Outputs, from -ssi_output's stem:
-<stem>-<mode>.h5 (each run), <stem>-impedance.csv (a0, K, k, c per mode), <stem>-impedance.png
+<stem>-<mode>.h5 (each run), <stem>-impedance.csv (a0, K, k, c per mode; with the horizontal and rocking
+runs also the two coupling terms and their mean, mode coupling-mean), <stem>-impedance.png
 (k and c against a0, with each mode's high-frequency dashpot limit: rho c_p A, rho c_s A,
 rho c_p I_y, rho c_s J); all of them are checked before the first mode's run, and an existing
 one is refused unless -ssi_output_overwrite (``check_outputs``). The trusted band:
@@ -253,10 +254,29 @@ def coupling_report(K0s, cross):
     if len(cross) == 2:
         a, b = cross["horizontal-rocking"], cross["rocking-horizontal"]
         out.append(f"[impedance] reciprocity of the coupling terms: K_hr / K_rh - 1 = {a / b - 1:.3g} "
-                   "(0 for the continuous soil; the BEM's collocation is not symmetric)")
+                   "(0 for the continuous soil; the BEM's comes from the meshed surface's truncation, falling as "
+                   "the surface grows, and from the collocation: runs/impedance/README.md)")
         out.append(f"[impedance] symmetric estimate of the coupling: (K_hr + K_rh) / 2 = {0.5 * (a + b):.5g}, "
                    f"{0.5 * (a + b) / scale:.3g} of sqrt(K0_h K0_r) (the mean is the better estimate: "
-                   "runs/impedance/README.md)")
+                   "runs/impedance/README.md; the CSV's rows 'coupling-mean')")
+    return out
+
+
+def coupling_mean_rows(table):
+    """The CSV rows of the symmetric estimate of the coupling, mode 'coupling-mean': at every a0 the
+    mean of the horizontal-rocking and rocking-horizontal rows of ``table`` (rows (mode, a0, omega,
+    K_re, K_im, k, c, K0, trusted, k_ref, c_ref)), k and c of the mean K over the mean K0, trusted
+    where both are; [] unless both terms were run on the same a0 (the same record)."""
+    hr = [r for r in table if r[0] == "horizontal-rocking"]
+    rh = [r for r in table if r[0] == "rocking-horizontal"]
+    if not hr or len(hr) != len(rh) or any(abs(x[1] - y[1]) > 1e-9 * max(1.0, abs(x[1])) for x, y in zip(hr, rh)):
+        return []
+    K0 = 0.5 * (hr[0][7] + rh[0][7])
+    out = []
+    for x, y in zip(hr, rh):
+        re, im = 0.5 * (x[3] + y[3]), 0.5 * (x[4] + y[4])
+        c = im / (x[1] * K0) if x[1] > 0 else np.nan
+        out.append(("coupling-mean", x[1], x[2], re, im, re / K0, c, K0, int(x[8] and y[8]), np.nan, np.nan))
     return out
 
 
@@ -368,6 +388,7 @@ def main():
     if comm.getRank() == 0:
         for line in coupling_report(K0s, cross):
             printf(line)
+        table += coupling_mean_rows(table)
         import csv
         with open(stem + "-impedance.csv", "w", newline="") as fh:
             w = csv.writer(fh)

@@ -58,6 +58,12 @@ def _damping_note(cfg, freqs):
                + ", ".join(f"{k + 1}: {float(z):.4g}" for k, z in
                            zip(range(len(freqs)), rayleigh_zeta(a0, a1, np.where(freqs > 0, freqs, np.inf)))
                            if freqs[k] in flex))
+    from ..fem.modal_damping import ratios_of
+    zm = ratios_of(cfg)
+    if zm and flex.size:                            # -ssi_fem_modal_damping: its ratio in each damped mode
+        printf("[modes] modal damping (-ssi_fem_modal_damping) of each flexible mode, added to the above: "
+               + ", ".join(f"{k + 1}: {zm[i] if i < len(zm) else 0.0:.4g}"
+                           for i, k in enumerate(k for k in range(len(freqs)) if freqs[k] in flex)))
     if cfg.fem_damping_ratio > 0 and flex.size:
         f1 = flex[0]
         printf(f"[modes] zeta = {cfg.fem_damping_ratio:g} at the first flexible mode f = {f1:.6g} Hz: "

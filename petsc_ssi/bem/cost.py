@@ -173,7 +173,10 @@ class Counts:
 
     ``per_rank[p]``: a list over ranks of dicts of counts for p ranks."""
 
-    def __init__(self, prob, plan, ls, ranks, limit, comm):
+    def __init__(self, prob, plan, ls, ranks, limit, comm, assembly=True, ranges=None):
+        """``assembly``: count the element caches' integrations (``pair_table``; the assembly term's,
+        O(nodes x elements)); False for the time loop alone (the run's own prediction). ``ranges``:
+        {p: [(a, b) per rank]} the node ranges of a partition already made (the run's), else cut here."""
         cfg = prob.cfg
         self.N = N = prob.mesh.n_nodes
         self.Ev = len(ls.Vc)
@@ -193,15 +196,17 @@ class Counts:
         # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
         from . import partition
         w = None
-        if cfg.partition == "balanced" and max(ranks) > 1:
+        ranges = dict(ranges or {})
+        if cfg.partition == "balanced" and max(ranks) > 1 and set(ranks) - set(ranges):
             w = partition.all_weights(comm, prob.mesh.nodes, ls.Vc, ls.VR, prob.mat, prob.dt, nimg,
                                       partition.lag_weights(self.Lx, self.L, self.stabilized, self.interp_lags),
                                       self.Lx, self.nt)
-        self.ranges = {p: partition.balanced_ranges(w, p) if w is not None else partition.equal_ranges(N, p)
+        self.ranges = {p: [tuple(int(v) for v in r) for r in ranges[p]] if p in ranges else
+                       partition.balanced_ranges(w, p) if w is not None else partition.equal_ranges(N, p)
                        for p in ranks}
         jobs = [(p, r, a, b) for p in ranks for r, (a, b) in enumerate(self.ranges[p])]
         nb = self._blocks(prob, ls, jobs, Lmax, nimg, comm)
-        self.cache = self._cache(prob, ls, jobs, Lmax, comm) if cfg.cache else {}
+        self.cache = self._cache(prob, ls, jobs, Lmax, comm) if cfg.cache and assembly else {}
         total = nb[(ranks[0], 0)] * 0
         for r in range(ranks[0]):
             total = total + nb[(ranks[0], r)]
@@ -345,6 +350,43 @@ def features(cnt, p, q, cores):
     return mx, over, m
 
 
+# A field snapshot (u and p into the HDF5 file and its XDMF) [s], which the fitted constants do not see:
+# measured on the development machine with a 4 m x 4 m surface of 1 m elements (81 nodes), 100 steps,
+# 0.3 s of loop with -ssi_output_stride 0 and 1.7 s with stride 1. It dominates small cases only.
+SNAPSHOT_S = 1.4e-2
+
+
+def loop_terms(cnt, c, p, q, cores):
+    """Seconds of the BEM time loop on p ranks, q per node, ``cores`` per node (dict: history, solve,
+    step, snapshots, loop): the history sums (streamed bytes, products, panel flops), the solves with
+    the step matrix's factors, c_step per step and SNAPSHOT_S per field snapshot. The one model of the
+    loop that ``petsc-ssi estimate`` (``predict``) and the run's own first line
+    (``HalfSpace.check_memory``) both evaluate (issue 43: they had been two code paths)."""
+    mx, over, m = features(cnt, p, q, cores)
+    t = {"history": over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
+                            + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
+                            + mx["FD"] / c["r_panel_dense"] + mx["FS"] / c["r_panel_sparse"]),
+         "solve": c["c_sol"] * cnt.steps * cnt.N ** 1.5 * (1 + c["kappa"] * (p - 1)),
+         "step": c["c_step"] * cnt.steps, "snapshots": SNAPSHOT_S * cnt.writes}
+    t["loop"] = t["history"] + t["solve"] + t["step"] + t["snapshots"]
+    return t
+
+
+def loop_model(t, steps, lags):
+    """k -> the seconds of the first k steps of a loop of ``steps`` steps whose terms are ``t``
+    (``loop_terms``): the history sum grows with the lags in use (step n reads min(n, L) of the
+    ``lags`` L), the rest is the same each step. The progress line compares the measured time with it."""
+    L = max(int(lags), 1)
+
+    def used(k):
+        ramp = min(k, L)
+        return ramp * (ramp + 1) / 2.0 + max(k - L, 0) * L
+
+    total = max(used(steps), 1.0)
+    rest = (t["solve"] + t["step"] + t["snapshots"]) / max(steps, 1)
+    return lambda k: t["history"] * used(k) / total + rest * k
+
+
 def predict(cnt, c, p, q, cores):
     """Seconds per stage and bytes for p ranks (dict)."""
     mx, over, m = features(cnt, p, q, cores)
@@ -354,11 +396,7 @@ def predict(cnt, c, p, q, cores):
     t["assembly"] = c["a0"] + over * (c["a_blk"] * mx["B"] + c["a_int"] * mx["I"] + c["a_dense"] * mx["D"]
                                       + c["a_sparse"] * mx["S"] + c["a_lag"] * (cnt.Lx + cnt.k))
     t["factor"] = c["c_fac"] * N15
-    t["history"] = over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
-                           + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
-                           + mx["FD"] / c["r_panel_dense"] + mx["FS"] / c["r_panel_sparse"])
-    t["solve"] = c["c_sol"] * cnt.steps * N15 * (1 + c["kappa"] * (p - 1))
-    t["loop"] = t["history"] + t["solve"] + c["c_step"] * cnt.steps
+    t.update(loop_terms(cnt, c, p, q, cores))
     t["total"] = t["setup"] + t["assembly"] + t["factor"] + t["loop"] + c["c_main"] + (c["c_plot"] if cnt.plot else 0)
     rk = cnt.per_rank[p]
     asm = lambda r: c["rho_trip"] * (r["trip"] + c["c_cache"] * r["C"] + c["m_asm"])
@@ -517,31 +555,4 @@ def history_block(cfg, dense_bytes=None, sparse_bytes=None, sparse_values=None):
                         sub=sub)
 
 
-# Per-step work the fitted constants do not see, measured on the development machine with a 4 m x 4 m
-# surface of 1 m elements (81 nodes), 100 steps: 0.3 s of loop with -ssi_output_stride 0 (the Python
-# work of a step: recorder, receivers, guard), 1.7 s with stride 1 (a field snapshot, u and p, into
-# the HDF5 file and its XDMF). They dominate small cases only; the history sum dominates large ones.
-STEP_FLOOR_S = 2.5e-3
-SNAPSHOT_S = 1.4e-2
 
-
-def loop_seconds(lag_bytes, n_nodes, lags, steps, ranks, per_node, snapshots=0, dense=True, c=None):
-    """A cheap figure of the time loop's wall time [s] before it starts, from the model's
-    constants (``predict``'s history, solve and per-step terms without the per-rank counts): every
-    step streams the stored lag matrices that reach back to it (step n: min(n, L) of the ``lags``
-    L, ``lag_bytes`` over all ranks, each rank its 1/p at b_dense, slowed by the ``per_node`` ranks
-    sharing a memory bus; b_sparse where most lags are ``dense`` False: block-sparse), two
-    matrix-vector products per lag, one solve with the step matrix's
-    factors (N^1.5) and the per-step rest (at least STEP_FLOOR_S), and SNAPSHOT_S per field
-    snapshot written. Returns (total, per step once all L lags are in use, snapshots excluded)."""
-    c = c or load_constants()[0]
-    cores = max(os.cpu_count() or 1, 1)
-    m = max(1, min(per_node, cores))
-    over = max(1.0, per_node / float(cores))
-    full = over * (lag_bytes / max(ranks, 1) / c["b_dense" if dense else "b_sparse"] * (1 + c["sigma"] * (m - 1))
-                   + (c["c_op"] + (c["c_op_mpi"] if ranks > 1 else 0.0)) * 2 * lags)
-    rest = c["c_sol"] * n_nodes ** 1.5 * (1 + c["kappa"] * (ranks - 1)) + max(c["c_step"], STEP_FLOOR_S)
-    L = max(int(lags), 1)
-    ramp = min(steps, L)                     # steps 1..L use 1..L lags, the rest all L
-    used = ramp * (ramp + 1) / 2.0 + max(steps - L, 0) * L
-    return full * used / L + rest * steps + SNAPSHOT_S * snapshots, full + rest

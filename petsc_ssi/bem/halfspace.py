@@ -57,6 +57,12 @@ def read_surface_mesh(cfg, comm, planes):
                 user = parse_mesh_params(cfg.get("mesh_params", ""), "-ssi_mesh_params")
                 params.update(user)
                 mesh = surface.read_gmsh(cfg.mesh, params, tuple(user))
+                ext = np.ptp(np.asarray(mesh.nodes)[:, :2], axis=0)
+                if cfg.user_set("mesh_h") and cfg.mesh_h > ext.min():
+                    # (issue 44: the grid generator's check, for a .geo: its elements cannot have the size asked)
+                    raise SSIError(f"-ssi_mesh_h {cfg.mesh_h:g} m is larger than the mesh {cfg.mesh} "
+                                   f"({ext[0]:g} m x {ext[1]:g} m): its elements cannot have the size asked; "
+                                   f"give -ssi_mesh_h <= {ext.min():g} m or a larger extent")
             mesh.check()
             if mesh.in_plane():
                 # on the plane, exactly (the lag blocks' flat pattern, bem/bsr.py, holds)
@@ -88,6 +94,29 @@ def read_soil_surface(cfg, comm, planes):
     mesh = read_surface_mesh(cfg, comm, planes)
     symmetry.check_mesh(mesh.nodes, planes, float(mesh.element_sizes().max()))
     return mesh
+
+
+# Bounds that catch a wrong unit (issue 44: a soil of c_s 5 m/s or rho 10 kg/m^3 ran without a word):
+# km/s for m/s puts c_s below 10, g/cm^3 for kg/m^3 puts rho below 100. The softest peats have c_s
+# near 30 m/s, hard rock about 3500 m/s (c_p above 1e4 m/s is refused with the options); soils and
+# rocks weigh 1200-3000 kg/m^3. Wide on purpose: the tests' reduced soils (c_s 20 m/s) are models.
+SOIL_CS = (10.0, 6000.0)          # m/s
+SOIL_RHO = (100.0, 5000.0)        # kg/m^3
+
+
+def soil_plausibility(cs, rho):
+    """One line when the soil's shear-wave speed [m/s] or density [kg/m^3] lies outside what soils and
+    rocks have (a wrong unit: km/s, g/cm^3), else None. A warning, not a refusal: scaled and
+    non-dimensional models (c_s = rho = 1) are legitimate."""
+    out = []
+    if not SOIL_CS[0] <= cs <= SOIL_CS[1]:
+        out.append(f"-ssi_cs {cs:g} m/s (soils and rocks: within {SOIL_CS[0]:g} to {SOIL_CS[1]:g} m/s)")
+    if not SOIL_RHO[0] <= rho <= SOIL_RHO[1]:
+        out.append(f"-ssi_rho {rho:g} kg/m^3 (soils and rocks: within {SOIL_RHO[0]:g} to {SOIL_RHO[1]:g} kg/m^3)")
+    if not out:
+        return None
+    return ("unusual soil: " + "; ".join(out) + ": check the units (m/s, kg/m^3); a scaled or non-dimensional "
+            "model runs as given")
 
 
 class HalfSpace:
@@ -182,12 +211,16 @@ class HalfSpace:
 
     def _load_warnings(self, wave):
         """One line for each load option that does nothing (``wave``: a seismic input, which loads the
-        soil itself; the prescribed motion's options: ``sources.rigid.rigid_motion``)."""
+        soil itself; the prescribed motion's options: ``sources.rigid.rigid_motion``) and for a soil whose
+        c_s or rho looks like a wrong unit (``soil_plausibility``)."""
         cfg = self.cfg
         if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         if cfg.user_set("load_p0") and not cfg.load_group:
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
+        odd = soil_plausibility(cfg.cs, cfg.rho)
+        if odd:
+            warn(odd)
 
     def _receivers(self, h):
         """The receivers of -ssi_receivers, each located on the surface (its symmetry image on the
@@ -287,6 +320,11 @@ class HalfSpace:
         r0, r1 = out.getOwnershipRange()
         out.getArray()[:] += self.free_field_owned(t, r0, r1)
         return out
+
+    @property
+    def has_interface_free_field(self):
+        """Whether the coupled structure's interface takes a free-field traction (``interface_free_field``)."""
+        return self._interface_ff is not None
 
     def interface_free_field(self, m):
         """The free field's traction t_ff = sigma_ff n_b (n_I, 3) [Pa] on a coupled structure's interface,
@@ -530,6 +568,25 @@ class HalfSpace:
                     lag_weights=lag_weights(plan.Lx, self.L, self.cfg.scheme.startswith("stabili"), interp))
         return LagSet(self.comm, self.mesh, self.mat, self.dt, self.L, self.regions, self.planes, opts)
 
+    def predict_loop(self, ls, plan, limit):
+        """Collective: the time loop's prediction (``loop_estimate``: (seconds, seconds per step once every
+        stored lag is in use), ``loop_terms``: its parts, ``loop_model``: k -> seconds of the first k
+        steps) by the model ``petsc-ssi estimate`` evaluates (``cost.loop_terms`` of the counts of this
+        run's own partition, without the assembly's element caches)."""
+        import os
+        from .cost import Counts, load_constants, loop_terms, loop_model
+        plan = plan if plan is not None else self.interp_plan()
+        p = self.comm.getSize()
+        cnt = Counts(self, plan, ls, [p], limit, self.comm, assembly=False, ranges={p: ls.ranges})
+        t = loop_terms(cnt, load_constants(self.cfg.get("estimate_constants", ""))[0], p, self.ranks_here,
+                       max(os.cpu_count() or 1, 1))
+        lags = max(cnt.L, 1)
+        self.loop_terms = t
+        self.loop_model = loop_model(t, self.n_steps, lags)
+        per_step = self.loop_model(self.n_steps) - self.loop_model(self.n_steps - 1) if self.n_steps > lags \
+            else t["loop"] / max(self.n_steps, 1)
+        self.loop_estimate = (t["loop"], per_step)
+
     def check_memory(self, ls, plan=None, extra_bytes=0.0, extra_what=""):
         """Collective: refuse runs whose lag matrices would not fit; if the
         dense lags of the automatic storage choice would not fit but block-
@@ -576,16 +633,8 @@ class HalfSpace:
                 est, peak, nd = est2, peak2, 0
         self.mem_estimate = est
         self.mem_peak_estimate = peak
-        from .cost import loop_seconds
-        stride = self.grid.stride
-        here = int(round(share * mpi.Get_size()))
-        self.loop_estimate = loop_seconds(est, self.mesh.n_nodes, lags, self.n_steps, mpi.Get_size(), here,
-                                          self.n_steps // stride if stride else 0, dense=2 * nd >= lags)
-        # the same model for the first k steps: the progress line compares the measured time with it
-        n_nodes_, ranks_, dense_ = self.mesh.n_nodes, mpi.Get_size(), 2 * nd >= lags
-        self.loop_model = (lambda k: loop_seconds(est, n_nodes_, lags, k, ranks_, here,
-                                                  k // stride if stride else 0, dense=dense_)[0])
-        self.ranks_here = here
+        self.ranks_here = int(round(share * mpi.Get_size()))
+        self.predict_loop(ls, plan, limit)
         where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
         more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
         self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "

@@ -46,20 +46,8 @@ class CoupledCounts:
         _, integ, _ = make_model_integrator(cfg, comm, prob.dt, model, integrator=integrator)
         mpi.Barrier()
         self.fem_setup_s = time.perf_counter() - t0
-        b, x = integ.u.duplicate(), integ.u.duplicate()
-        b.setRandom()
-        b.pointwiseMult(b, integ.mask)
-        times = []
-        for _ in range(n_solves):
-            mpi.Barrier()
-            t1 = time.perf_counter()
-            integ.solve(b, x)
-            mpi.Barrier()
-            times.append(time.perf_counter() - t1)
-        self.fem_solve_s = statistics.median(times)
+        self.fem_solve_s = solve_seconds(integ, comm, n_solves)
         self.fem_bytes = mpi.allreduce(max(process_rss() - r0, 0.0))        # summed over ranks
-        for v in (b, x):
-            v.destroy()
         integ.destroy()
         from .model import interface_bytes
         self._iface_bytes = lambda p: interface_bytes(cfg, prob, model, iface, p)
@@ -73,9 +61,39 @@ class CoupledCounts:
         flops_col = 2.0 * (3.0 * self.N / p) * n               # one product with Z's local rows
         setup = self.fem_setup_s + n * (bem_solve_s + (self.fem_solve_s if self.implicit else 0.0)) \
             + n * flops_col / k["r_cpl"]
-        per_step = k["n_fs"] * self.fem_solve_s + (2 * flops_col + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
+        per_step = step_seconds(c, self.nI, self.N, p, self.fem_solve_s)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
                 "cpl_bytes": self._iface_bytes(p) + self.fem_bytes * p / max(self.ranks_measured, 1)}
+
+
+def solve_seconds(integ, comm, n_solves=5):
+    """Collective: the median wall time of ``n_solves`` solves with the structure's step matrix D [s]
+    (a random right-hand side on the free dofs)."""
+    mpi = comm.tompi4py()
+    b, x = integ.u.duplicate(), integ.u.duplicate()
+    b.setRandom()
+    b.pointwiseMult(b, integ.mask)
+    times = []
+    for _ in range(n_solves):
+        mpi.Barrier()
+        t1 = time.perf_counter()
+        integ.solve(b, x)
+        mpi.Barrier()
+        times.append(time.perf_counter() - t1)
+    for v in (b, x):
+        v.destroy()
+    return float(mpi.bcast(statistics.median(times)))        # (rank 0's: every rank predicts the same)
+
+
+def step_seconds(c, n_i, n_soil, p, fem_solve_s):
+    """Seconds the coupling adds to each step on p ranks (module docstring, 'per step'): n_fs solves with
+    D, the dense interface products at r_cpl flop/s and c_cstep; ``c``: the constants (FALLBACK where
+    they have none). ``petsc-ssi estimate`` and the coupled run's own prediction both use it."""
+    k = dict(FALLBACK)
+    k.update(c or {})
+    n = 3 * n_i
+    flops_col = 2.0 * (3.0 * n_soil / p) * n
+    return k["n_fs"] * fem_solve_s + (2 * flops_col + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
 
 
 def describe(cc):

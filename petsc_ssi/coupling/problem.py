@@ -67,6 +67,28 @@ class SSITransient(TransientProblem):
         self.state = None
         self.check_disk()
 
+    defer_loop_line = True          # (printed in setup, once the structure's solves are timed)
+    cpl_per_step = None
+
+    def loop_estimate(self):
+        """The soil's BEM loop and the coupling's per-step work (``coupling.cost.step_seconds``, the
+        structure's solves timed after its factorisation): the sum ``petsc-ssi estimate`` prints as
+        time_loop_s."""
+        est = super().loop_estimate()
+        if est is None or self.cpl_per_step is None:
+            return est
+        cpl = self.cpl_per_step * self.n_steps
+        return (est[0] + cpl, est[1] + self.cpl_per_step,
+                f"the soil's BEM {est[0]:.3g} s and the coupling {cpl:.3g} s, a solve with the structure's D "
+                f"{1e3 * self.fem_solve_s:.3g} ms as timed")
+
+    def loop_model(self):
+        model = super().loop_model()
+        if model is None or self.cpl_per_step is None:
+            return model
+        c = self.cpl_per_step
+        return lambda k: model(k) + c * k
+
     def output_bytes(self):
         from ..fem.problem import structure_bytes
         g, p = self.grid, self.prob
@@ -85,6 +107,12 @@ class SSITransient(TransientProblem):
         with staged("SSI FEM assembly"):
             self.model.assemble()
             _, self.integ, self.am = make_model_integrator(cfg, comm, self.grid.dt, self.model, integrator=self.integrator)
+            from .cost import solve_seconds, step_seconds
+            from ..bem.cost import load_constants
+            self.fem_solve_s = solve_seconds(self.integ, comm)
+            self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
+                                             prob.mesh.n_nodes, comm.getSize(), self.fem_solve_s)
+        self.print_loop_line()
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
             self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
@@ -117,7 +145,7 @@ class SSITransient(TransientProblem):
         cfg, comm = self.cfg, self.comm
         keys = INTERFACE_KEYS + (("uf_check",) if cfg.coupling == "implicit" else ()) + \
             (("uff",) if self.prob.seismic is not None else ()) + \
-            (("pff",) if self.prob.interface_free_field(1) is not None else ())
+            (("pff",) if self.prob.has_interface_free_field else ())
         rd = self._open_restart()
         self.out = Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.sout = Output(structure_output_path(cfg.output), comm, resume=rd.output_state("sout") if rd else None,
@@ -221,7 +249,7 @@ class SSITransient(TransientProblem):
         recd, srecd = groups.pop("receivers", None), sgroups.pop("receivers", None)
         if getattr(prob, "seismic", None) is not None:
             groups["seismic"] = prob.seismic.arrays()
-        sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1),
+        sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1, self.integ.modal),
                   "structure_mass": structure_mass(model, comm)}
         return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups or None}),
                 (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups or None})]

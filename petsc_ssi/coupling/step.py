@@ -254,6 +254,7 @@ class Coupler:
             e.pointwiseMult(e, integ.mask)
 
         def take(j, z):
+            integ.complete_solve(z)                  # (modal damping: the solve with D, not its factors')
             out[:, j] = z.getArray(readonly=True)
             C[:, j] = self.Top.gather(z)
         solve_columns(integ.ksp, integ.u, 3 * self.nI, fill, take)

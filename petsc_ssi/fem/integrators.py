@@ -232,7 +232,8 @@ class _Dynamic:
     """Shared set-up: D = k K + c M, the mask of free dofs, M^{-1} on free dofs. C = alpha_m M + a1 K."""
 
     def __init__(self, K, m, dt, alpha_m=0.0, fixed=(), alpha=0.25, delta=0.5,
-                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf, near_null=None, a1=0.0):
+                 prefix="ssi_fem_", solver="direct", coords_vec=None, log=printf, near_null=None, a1=0.0,
+                 modal=None):
         comm = K.getComm()
         check(dt > 0, f"time step dt = {dt} must be > 0", comm)
         check(a1 >= 0 and alpha_m >= 0, f"damping C = a0 M + a1 K needs a0, a1 >= 0 (got {alpha_m:g}, {a1:g})", comm)
@@ -246,6 +247,11 @@ class _Dynamic:
         self.ksp = make_solver(self.D, prefix, solver, comm, coords_vec, log, near_null)
         with event("FEM_factor"):
             setup_or_fail(self.ksp, self.mask, "D (eq. 15)", comm)
+        # modal damping (fem/modal_damping.py): D = D0 + delta/(alpha dt) C_modal, solved by Woodbury
+        self.modal = modal if modal is not None and modal.active else None
+        if self.modal is not None:
+            with event("FEM_factor"):
+                self.modal.bind(self._solve0, self.delta / (self.alpha * self.dt), self.mask)
         self.u, self.v, self.w, self.rhs = (self._zeros() for _ in range(4))
         self.n = 0
         self.fixed_load_warning = None       # the warning, once a load acted on fixed dofs
@@ -333,14 +339,35 @@ class _Dynamic:
         out.pointwiseMult(out, self.minv)
         return out
 
-    def solve(self, b, x):
+    def _solve0(self, b, x):
+        """The solve with the factorised D (without the modal part)."""
         self.ksp.solve(b, x)
         if self.ksp.getConvergedReason() < 0:
-            raise SSIError(f"solve with D diverged at step {self.n} (KSP reason {self.ksp.getConvergedReason()})")
+            raise SSIError(f"solve with D diverged at step {getattr(self, 'n', 0)} (KSP reason "
+                           f"{self.ksp.getConvergedReason()})")
+
+    def solve(self, b, x):
+        """x = D^{-1} b (with modal damping: the factorised part, then the Woodbury correction)."""
+        self._solve0(b, x)
+        self.complete_solve(x)
+
+    def complete_solve(self, x):
+        """Collective: a solution of the factorised D (e.g. a column of ``petsc.solve_columns`` on
+        ``self.ksp``) made a solution of D: the modal damping's correction (none without it)."""
+        if self.modal is not None:
+            self.modal.correct(x)
+        return x
+
+    def _add_modal(self, rhs, x, scale):
+        """rhs += scale C_modal x (nothing without modal damping)."""
+        if self.modal is not None:
+            self.modal.mult_add(x, rhs, scale)
 
     def destroy(self):
         for obj in (self.ksp, self.D, self.u, self.v, self.w, self.rhs, self.mask, self.minv):
             obj.destroy()
+        if self.modal is not None:
+            self.modal.destroy()
 
 
 class GreenIntegrator(_Dynamic):
@@ -363,6 +390,9 @@ class GreenIntegrator(_Dynamic):
               f"the Green's-function integrator takes stiffness-proportional damping (a1 = {a1:g} s) with the "
               f"trapezoidal rule only (alpha 1/4, delta 1/2; got {alpha:g}, {delta:g}); -ssi_fem_integrator "
               "newmark takes any", K.getComm())
+        check(kw.get("modal") is None or (abs(alpha - 0.25) < 1e-12 and abs(delta - 0.5) < 1e-12),
+              f"the Green's-function integrator takes modal damping with the trapezoidal rule only (alpha 1/4, "
+              f"delta 1/2; got {alpha:g}, {delta:g}); -ssi_fem_integrator newmark takes any", K.getComm())
         super().__init__(K, m, dt, alpha_m, fixed, alpha, delta, **kw)
         self.b = green_constants(dt, alpha_m, alpha, delta, self.a1)
         self.vhalf = m.duplicate()            # M^{-1} f dt/2 of the last impulse
@@ -398,6 +428,7 @@ class GreenIntegrator(_Dynamic):
         self.rhs.scale(b["b4"])
         self.rhs.axpy(b["b1"], self.v)
         self.rhs.pointwiseMult(self.rhs, self.m)
+        self._add_modal(self.rhs, self.u, 2.0 * (1.0 - b["b2"]) / self.dt)   # trapezoidal: (2/dt)(1 - b2) C_modal u
         self.rhs.pointwiseMult(self.rhs, self.mask)
         self.solve(self.rhs, self.w)                              # w = D^-1 M (b4 u + b1 v)
         self.v.scale(b["bv"])                                     # eq. 14 without f* (bv = b2 without a1)
@@ -474,6 +505,7 @@ class NewmarkIntegrator(_Dynamic):
         if self.a1:                                               # - a1 K v^0
             self.K.mult(self.v, self.rhs)
             self.w.axpy(-self.a1, self.rhs)
+        self._add_modal(self.w, self.v, -1.0)                     # - C_modal v^0
         self.w.pointwiseMult(self.w, self.minv)
         self.w.axpy(-self.alpha_m, self.v)
         self.w.pointwiseMult(self.w, self.mask)
@@ -501,6 +533,13 @@ class NewmarkIntegrator(_Dynamic):
             kx.axpy(self.k_a, self.a)
             self.K.mult(kx, kk)
             self.rhs.axpy(self.a1, kk)
+        if self.modal is not None:                                # + C_modal (k_u u + k_v v + k_a a)
+            mw = self.modal.work
+            mw.zeroEntries()
+            mw.axpy(self.k_u, self.u)
+            mw.axpy(self.k_v, self.v)
+            mw.axpy(self.k_a, self.a)
+            self.modal.mult_add(mw, self.rhs)
         if f is not None:
             self.rhs.axpy(1.0, f)
         self.rhs.pointwiseMult(self.rhs, self.mask)
@@ -575,6 +614,7 @@ class MidpointIntegrator(NewmarkIntegrator):
         self.rhs.pointwiseMult(self.rhs, self.m)
         self.K.mult(self.u, self.ku)
         self.rhs.axpy(2.0 * self.a1 / dt - 1.0, self.ku)          # (2C/dt - K) u: a1 K's part with -K
+        self._add_modal(self.rhs, self.u, 2.0 / dt)               # and the modal part of 2C/dt u
         if f is not None:
             self.rhs.axpy(2.0, f)
         self.rhs.pointwiseMult(self.rhs, self.mask)
@@ -624,7 +664,9 @@ def make_model_integrator(cfg, comm, dt, model=None, integrator=None):
     am, a1, note = damping(cfg)
     printf(f"[fem] {note}; integrator {name}, solver {cfg.fem_solver}")
     coords, near = near_null_args(cfg.fem_solver, model)
+    from .modal_damping import build as modal_damping
+    modal = modal_damping(cfg, model, comm)
     integ = make_integrator(name, model.K, model.m, dt, am, model.fixed,
                             cfg.fem_newmark_alpha, cfg.fem_newmark_delta, solver=cfg.fem_solver,
-                            coords_vec=coords, near_null=near, a1=a1)
+                            coords_vec=coords, near_null=near, a1=a1, modal=modal)
     return model, integ, am

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..petsc import SSIError, collective, collective_error
+from ..petsc import SSIError, collective
 from ..points import parse_triple
 from .elements import Props
 
@@ -383,6 +383,21 @@ def _frame_blocks(spec, cells, coords):
     return out
 
 
+def _layer_blocks(spec, cells, coords):
+    """Blocks of a hex8 part layered by depth (``parts.layer_of``: each cell by its centroid's elevation);
+    SSIError in one line for cells below the last layer's bottom."""
+    from .elements import get
+    from .parts import layer_of
+    z = coords[cells].mean(axis=1)[:, 2]
+    k = layer_of(spec, z)
+    if (k < 0).any():
+        raise SSIError(f"part '{spec.name}': {int((k < 0).sum())} cell(s) lie below the last layer's bottom "
+                       f"(z = {spec.layers[-1][0]:g} m; the lowest centroid at z = {z.min():.6g} m): extend "
+                       f"-ssi_fem_part_{spec.name}_layers down to the part's bottom")
+    el = get("hex8")
+    return [Block(spec.name, el, cells[k == i], pr) for i, (_, pr) in enumerate(spec.layers) if (k == i).any()]
+
+
 def structure_from_model(model, specs, path):
     """Serial: the StructureMesh of a gmsh model (``mesh.gmsh.GmshModel``) and the parts."""
     from .elements import get
@@ -412,6 +427,8 @@ def structure_from_model(model, specs, path):
             cells = orient_shells(cells, coords, spec.name)
         if spec.element == "frame":
             blocks += _frame_blocks(spec, cells, coords)
+        elif spec.layers:
+            blocks += _layer_blocks(spec, cells, coords)
         else:
             blocks.append(Block(spec.name, get(spec.element), cells, spec.props))
     mesh = StructureMesh(coords, blocks, source=path)

@@ -126,7 +126,7 @@ def compute_modes(K, m, fixed, n_modes, target, prefix="ssi_modes_", max_attempt
     eps.setOptionsPrefix(prefix)
     eps.setOperators(Kf, Mf)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-    eps.setDimensions(nev=n_modes + max(4, n_modes // 2))
+    eps.setDimensions(nev=min(n_modes + max(4, n_modes // 2), Kf.getSize()[0]))
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     eps.setTarget(target)
     eps.setTolerances(tol=1e-10)

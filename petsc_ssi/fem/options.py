@@ -98,6 +98,12 @@ register("fem_rayleigh_freqs", "str", "", "Hz", "Rayleigh damping C = a0 M + a1 
          G, validator=_pair("f1,f2", positive=True))
 register("fem_rayleigh_ratios", "str", "", "1", "damping ratios 'z1,z2' at -ssi_fem_rayleigh_freqs (e.g. "
          "0.05,0.05)", G, validator=_pair("z1,z2", nonneg=True))
+register("fem_modal_damping", "str", "", "1", "modal damping: one ratio 'z' for each of the first "
+         "-ssi_fem_modal_modes flexible modes, or one ratio per mode 'z1,z2,...' (0.05: 5 % of critical); "
+         "C = alpha_m M + a1 K + sum_i 2 z_i omega_i (M phi_i)(M phi_i)^T over the structure's modes on its supports "
+         "(rigid-body modes left out), added to any Rayleigh damping; the modes above get none from it", G)
+register("fem_modal_modes", "int", 0, "", "number of flexible modes -ssi_fem_modal_damping damps with its one ratio "
+         "(0: 10)", G, validator=nonnegative)
 register("fem_integrator", "enum", "green", "", "time integrator: green (implicit Green's functions, paper "
          "eqs. 13-24) or newmark (plain Newmark)", G, choices=("green", "newmark"))
 register("fem_newmark_alpha", "real", 0.25, "", "Newmark alpha (beta in most texts); green needs "
@@ -170,6 +176,10 @@ def _fem_checks(cfg):
     if cfg.user_set("fem_alpha_m") and cfg.fem_damping_ratio > 0:
         return "give either -ssi_fem_alpha_m or -ssi_fem_damping_ratio, not both"
     msg = _rayleigh_check(cfg)
+    if msg:
+        return msg
+    from .modal_damping import check_options
+    msg = check_options(cfg)
     if msg:
         return msg
     if cfg.fem_damping_ratio > 0 and cfg.fem_damping_freq <= 0:

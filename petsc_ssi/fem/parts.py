@@ -7,6 +7,10 @@ that carry elements. Each part takes its element and properties from
   element       hex8 | frame | shell            (required)
   E, nu, rho    Young's modulus [N/m^2], Poisson's ratio, density [kg/m^3]   (required)
   cp, cs        hex8: P- and S-wave speeds [m/s] instead of E and nu (a soil region: with rho)
+  layers        hex8: horizontal layers 'z1:cp,cs,rho;z2:cp,cs,rho;...' instead of E, nu, rho (cp, cs):
+                layer i holds the cells whose centroid lies between z_{i-1} (the first: any height)
+                and z_i [m, elevations falling]; a soil region layered by depth (layers by part:
+                one part per layer)
   thickness     shell thickness [m]                                           (shell, required)
   mass_per_area shell: mass per area [kg/m^2] used instead of rho * thickness
   section b,h   frame: rectangle of width b and depth h [m] (h along the orientation
@@ -53,6 +57,8 @@ PROPERTIES = {
     "rho": ("real", "kg/m^3", "density"),
     "cp": ("real", "m/s", "hex8: P-wave speed, with cs instead of E and nu (a soil region)"),
     "cs": ("real", "m/s", "hex8: S-wave speed, with cp instead of E and nu (a soil region)"),
+    "layers": ("z:cp,cs,rho;...", "m; m/s, m/s, kg/m^3", "hex8: layers by depth, each down to its elevation z "
+               "(falling), instead of E, nu, rho: a cell goes to the layer of its centroid"),
     "thickness": ("real", "m", "shell thickness"),
     "mass_per_area": ("real", "kg/m^2", "shell: mass per area used instead of rho * thickness"),
     "section": ("b,h", "m", "frame: rectangle of width b and depth h (h along the orientation vector)"),
@@ -68,7 +74,7 @@ PROPERTIES = {
                 "(translations tied, rotations released; default none: monolithic)"),
 }
 ALLOWED = {
-    "hex8": ("element", "E", "nu", "rho", "cp", "cs"),
+    "hex8": ("element", "E", "nu", "rho", "cp", "cs", "layers"),
     "shell": ("element", "E", "nu", "rho", "thickness", "mass_per_area", "shear_factor", "added_mass", "drilling",
               "release"),
     "frame": ("element", "E", "nu", "rho", "section", "area", "Iy", "Iz", "J", "orientation", "shear_factor",
@@ -86,6 +92,7 @@ class PartSpec:
     props: Props
     orientation_given: bool = False
     legacy: bool = False          # the single hex8 part of -ssi_fem_E/_nu/_rho
+    layers: tuple = ()            # hex8 layered by depth: ((z_bottom [m], Props), ...), elevations falling
 
 
 def rect_section(b, h):
@@ -216,6 +223,8 @@ def _spec(name, g):
         if p not in ALLOWED[el]:
             raise SSIError(f"{opt(p)}: a {el} part has no property '{p}' (its properties: "
                            f"{', '.join(q for q in ALLOWED[el] if q != 'element')})")
+    if "layers" in g:
+        return _layered_spec(name, g, opt)
     if "cp" in g or "cs" in g:
         g = _from_wave_speeds(g, opt)
     missing = [p for p in REQUIRED[el] if p not in g]
@@ -275,6 +284,40 @@ def _spec(name, g):
     if el != "shell" and props.rho == 0 and props.added_mass == 0:
         raise SSIError(f"part '{name}' ({el}) has no mass: {opt('rho')} must be > 0")
     return PartSpec(name, el, props, orientation_given=oriented)
+
+
+def _layered_spec(name, g, opt):
+    """A hex8 part layered by depth (``layers``: 'z1:cp,cs,rho;z2:cp,cs,rho;...'): each layer's Props
+    from its wave speeds and density; its bottoms' elevations must fall."""
+    other = [p for p in g if p not in ("element", "layers")]
+    if other:
+        raise SSIError(f"{opt('layers')}: each layer gives its cp, cs and rho; drop {', '.join(opt(p) for p in other)}")
+    text = str(g["layers"]).strip()
+    layers = []
+    for k, item in enumerate(t for t in text.split(";") if t.strip()):
+        z, sep, rest = item.partition(":")
+        if not sep:
+            raise SSIError(f"{opt('layers')} '{text}': layer {k + 1} '{item.strip()}' is not 'z:cp,cs,rho'")
+        zb = _real(z.strip(), f"{opt('layers')} layer {k + 1}'s elevation")
+        cp, cs, rho = _numbers(rest, 3, f"{opt('layers')} layer {k + 1}'s cp,cs,rho")
+        E, nu = elastic_from_wave_speeds(cp, cs, rho, f"{opt('layers')} layer {k + 1}")
+        if layers and not zb < layers[-1][0]:
+            raise SSIError(f"{opt('layers')} '{text}': the layers' bottom elevations must fall (layer {k + 1} at "
+                           f"z = {zb:g} m is not below {layers[-1][0]:g} m)")
+        layers.append((zb, Props(E=E, nu=nu, rho=rho)))
+    if not layers:
+        raise SSIError(f"{opt('layers')} '{text}': no layer ('z:cp,cs,rho;...')")
+    return PartSpec(name, "hex8", layers[0][1], layers=tuple(layers))
+
+
+def layer_of(spec, z):
+    """The layer index of cells whose centroids lie at elevations ``z`` [m] (int array), -1 below the
+    last layer's bottom."""
+    bottoms = np.array([zb for zb, _ in spec.layers])
+    # layer i: z_i <= z < z_{i-1}; a centroid on a bottom (to round-off) belongs to the layer above
+    tol = 1e-9 * max(1.0, float(np.abs(bottoms).max()))
+    k = np.searchsorted(-bottoms, -(np.asarray(z, float) + tol), side="right")
+    return np.where(k < len(bottoms), k, -1)
 
 
 def help_text():

@@ -203,7 +203,7 @@ class FEMTransient(TransientProblem):
         groups = self.rec.groups(self.out)
         receivers = groups.pop("receivers", None)
         dt = self.grid.dt
-        attrs = {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1),
+        attrs = {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1, self.integ.modal),
                  "structure_mass": structure_mass(model, comm)}
         if self.gravity is not None:
             attrs["gravity"] = self.gravity.g
@@ -264,11 +264,17 @@ def structure_mass(model, comm):
     return float(comm.tompi4py().allreduce(float(model.m.getArray(readonly=True)[d].sum())))
 
 
-def damping_attrs(am, a1):
-    """Output attributes of the structure's damping C = alpha_m M + rayleigh_a1 K."""
-    return {"alpha_m": float(am), "rayleigh_a1": float(a1),
-            "damping": "C = alpha_m M + rayleigh_a1 K (Rayleigh; alpha_m in 1/s, rayleigh_a1 in s); damping ratio "
-                       "of a mode of frequency f: alpha_m/(2 omega) + rayleigh_a1 omega/2, omega = 2 pi f"}
+def damping_attrs(am, a1, modal=None):
+    """Output attributes of the structure's damping C = alpha_m M + rayleigh_a1 K (+ the modal damping's
+    frequencies and ratios, ``fem.modal_damping``)."""
+    out = {"alpha_m": float(am), "rayleigh_a1": float(a1),
+           "damping": "C = alpha_m M + rayleigh_a1 K (Rayleigh; alpha_m in 1/s, rayleigh_a1 in s); damping ratio "
+                      "of a mode of frequency f: alpha_m/(2 omega) + rayleigh_a1 omega/2, omega = 2 pi f"}
+    if modal is not None:
+        out.update(modal.attrs())
+        out["damping"] += ("; + modal damping: ratio modal_damping_ratios[i] added in the mode of "
+                           "modal_damping_frequencies_hz[i] (Hz), none in higher modes")
+    return out
 
 
 def _plot(path, t, u):

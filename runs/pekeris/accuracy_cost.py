@@ -80,11 +80,32 @@ def pareto(rows, key):
     return front
 
 
+def smooth_levels():
+    """The smooth-pulse convergence study's levels (convergence_smooth.csv, runs/pekeris/convergence_smooth.py):
+    [(h [m], r [m], the larger of the radial and vertical relative L2 errors [%], wall [s], peak [GB])]."""
+    path = os.path.join(HERE, "convergence_smooth.csv")
+    if not os.path.exists(path):
+        return []
+    best = {}
+    with open(path) as fh:
+        for r in csv.DictReader(fh):
+            if r["kind"] != "error" or not r["wall time [s]"]:
+                continue
+            key = (float(r["h [m]"]), float(r["r [m]"]))
+            err = float(r["relative L2 error [%]"])
+            cost = (float(r["wall time [s]"]), float(r["peak memory, all ranks [GB]"]))
+            if key not in best or err > best[key][0]:
+                best[key] = (err, *cost)
+    return [(h, rr, *v) for (h, rr), v in sorted(best.items())]
+
+
 def plot(rows, key, label, png):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7.5, 5))
+    smooth = smooth_levels()
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 5), gridspec_kw={"width_ratios": [1.5, 1]})
+    _smooth_panel(ax2, smooth, key, label)
     styles = {"none": ("k", "o"), "auto (paper rule)": ("tab:red", "*"), "chebyshev": ("tab:blue", "s"),
               "linear": ("tab:green", "^")}
     for kind, (c, m) in styles.items():
@@ -104,7 +125,7 @@ def plot(rows, key, label, png):
                         xytext=(4, -10), textcoords="offset points")
     ax.set_xscale("log"); ax.set_yscale("log")
     ax.set_xlabel(label); ax.set_ylabel("max relative L2 error vs Pekeris (%)")
-    ax.set_title("Lamb problem, 16 m x 16 m quarter model: accuracy against cost")
+    ax.set_title("Heaviside load (the paper's), 16 m x 16 m quarter model, 1 rank", fontsize=10)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -112,11 +133,43 @@ def plot(rows, key, label, png):
     plt.close(fig)
 
 
+def _smooth_panel(ax, smooth, key, label):
+    """The smooth pulse's levels (error at r = 5 m and 15 m against the level's cost), beside the sweep."""
+    col = 3 if key == "time_s" else 4
+    # the h = 3 m level's wall held the first run's numba compilation (386 s against 53 s at h = 1.5 m):
+    # no time point for it, its memory stands
+    for rr, c in ((5.0, "tab:blue"), (15.0, "tab:orange")):
+        sel = [v for v in smooth if v[1] == rr and not (key == "time_s" and v[0] == 3.0)]
+        if not sel:
+            continue
+        ax.plot([v[col] for v in sel], [v[2] for v in sel], "-o", c=c, label=f"smooth pulse, r = {rr:g} m")
+        for v in sel:
+            ax.annotate(f"h = {v[0]:g} m", (v[col], v[2]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    for y in (1.0, 5.0):
+        ax.axhline(y, color="0.6", lw=0.8, ls=":")
+    ax.set_xscale("log"); ax.set_yscale("log")
+    ax.set_xlabel(label.replace("1 rank", "2 ranks") + (" (h = 3 m left out: its wall held numba's compilation)"
+                                                         if key == "time_s" else ""))
+    ax.set_ylabel("max relative L2 error vs convolved Pekeris (%)")
+    ax.set_title("smooth pulse sin^4 (T = 0.03 s), 48 m quarter model, 2 ranks\n(convergence_smooth.py; "
+                 "dotted: 1 % and 5 %)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "sweep"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--replot", action="store_true", help="redraw the PNGs from accuracy_cost.csv and "
+                    "convergence_smooth.csv without running")
     a = ap.parse_args()
+    if a.replot:
+        with open(os.path.join(HERE, "accuracy_cost.csv")) as fh:
+            rows = [{k: (v if k in ("name", "kind") else float(v)) for k, v in r.items()} for r in csv.DictReader(fh)]
+        plot(rows, "time_s", "wall time, 1 rank (s)", os.path.join(HERE, "accuracy_cost_time.png"))
+        plot(rows, "peak_GB", "peak memory (GB)", os.path.join(HERE, "accuracy_cost_memory.png"))
+        return
     os.makedirs(a.out, exist_ok=True)
     rows = []
     for name, opts, kind in configs(a.quick):

@@ -104,8 +104,10 @@ CASES = {        # (options, ranks): every storage the lags have, a G of tractio
 }
 
 
-# the slow tier: block-sparse with interpolation and dense with a prescribed region at -n 2 stay
-SLOW_CASES = ("single precision, symmetry, 2 ranks", "auto storage, prescribed motion, 1 rank")
+# the slow tier: the dense storage with a prescribed region at -n 2 stays in make test (the other storages'
+# patterns: the kernels' tests above and test_the_stored_entries_go_through_a_lag_files_aij_and_back)
+SLOW_CASES = ("single precision, symmetry, 2 ranks", "auto storage, prescribed motion, 1 rank",
+              "block-sparse, interpolated, 2 ranks")
 
 
 @pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in SLOW_CASES else []) for c in CASES])

@@ -68,7 +68,7 @@ def test_buckets_round_the_far_lags_to_float32():
 def test_single_lags_change_the_run_by_rounding_only(tmp_path):
     """Single precision from lag 3: 1e-6 of each field's maximum at most, and not zero; the block-
     sparse float32 Mats store less than the double ones (dense and block-sparse), as estimated."""
-    ref, sgl, blk = (str(tmp_path / f"{k}.h5") for k in ("ref", "sgl", "blk"))
+    ref, sgl = (str(tmp_path / f"{k}.h5") for k in ("ref", "sgl"))
     r0 = cli(BEM + ["-ssi_output", ref]).stdout
     r1 = cli(BEM + ["-ssi_output", sgl, "-ssi_lag_single_from", "3"]).stdout
     assert "single-precision block-sparse" in log_line(r1, "] assembly")[0]
@@ -78,9 +78,16 @@ def test_single_lags_change_the_run_by_rounding_only(tmp_path):
     e1, s1 = stored_gb(r1)
     assert s1 < 0.75 * s0, (s0, s1)
     assert abs(e1 - s1) <= 0.15 * s1, (e1, s1)          # the memory estimate follows the storage
-    # the float32 products: per step (the automatic choice for this run) and time-blocked the same
-    # sums in another order (observed 4.0e-16; the step-by-step run this compared before was the
-    # automatic choice itself, bit for bit)
+    assert "history sum: step by step" in r1, "the automatic choice changed: test_single_lags_time_blocked"
+
+
+# slow tier: the float32 products time-blocked (5 s; the sibling above runs them step by step)
+@pytest.mark.slow
+def test_single_lags_time_blocked(tmp_path):
+    """The float32 products per step (the automatic choice for this run) and time-blocked: the same sums in
+    another order (observed 4.0e-16)."""
+    sgl, blk = (str(tmp_path / f"{k}.h5") for k in ("sgl", "blk"))
+    r1 = cli(BEM + ["-ssi_output", sgl, "-ssi_lag_single_from", "3"]).stdout
     assert "history sum: step by step" in r1, "the automatic choice changed: run sgl with -ssi_history_block 1"
     out = cli(BEM + ["-ssi_output", blk, "-ssi_lag_single_from", "3", "-ssi_history_block", "5"]).stdout
     assert "time-blocked, 5 steps per block" in out

@@ -23,10 +23,10 @@ reproduce the free field, in the region and in the soil around it:
   * the quarter model (symmetry planes x = 0 anti, y = 0 sym through the pit) equals the whole to 1e-12;
   * -n 2 equals -n 1; refusals in one line.
 Known and not fixed: the interface's nodal scattered traction (the output's interface/p minus
-interface/pff) is a self-equilibrated field near the pit's edges of the size of t_ff (0.7-0.9 of its
-peak at bottom nodes at both meshes), though its resultant is 1 % of the free field's: the nodal
-traction is continuous across the wall-bottom edge where the true traction jumps, and its error there
-does not fall with the mesh; displacements and resultants do.
+interface/pff) is a self-equilibrated field of the size of t_ff over the whole bottom (0.75 of its peak
+at the nine-node elements' corners, 0.15-0.45 at the other nodes, at both meshes:
+runs/soil_region/edge_traction.py), though its resultant is 1 % of the free field's; it does not fall
+with the mesh; displacements and resultants do.
 """
 import h5py
 import numpy as np
