@@ -119,6 +119,18 @@ def soil_plausibility(cs, rho):
             "model runs as given")
 
 
+def node_share(comm):
+    """Collective: (share, nodes): the fraction of the run's ranks on its most loaded node (1 on one
+    machine), which the node's memory limit weighs the run's bytes by, and the number of nodes."""
+    from mpi4py import MPI
+    mpi = comm.tompi4py()
+    node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
+    share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
+    n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
+    node.Free()
+    return share, n_nodes
+
+
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
@@ -534,12 +546,8 @@ class HalfSpace:
         printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
                f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
                f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
-        # the limit holds per node: the run's memory is shared by its ranks, ``share`` of them on the most
-        # loaded node (all of them on one machine), as in check_memory
-        mpi = self.comm.tompi4py()
-        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
-        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
-        node.Free()
+        # the limit holds per node, as in check_memory
+        share, _ = node_share(self.comm)
         if share * est > limit:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
@@ -597,21 +605,40 @@ class HalfSpace:
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
         # the limit holds per node: the run's peak is shared by its ranks, of which
         # ``share`` run on the most loaded node (all of them on one machine)
-        mpi = self.comm.tompi4py()
-        from mpi4py import MPI
-        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
-        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
-        n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
-        node.Free()
+        share, n_nodes = node_share(self.comm)
         extra_bytes = float(extra_bytes)
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
         sf = int(c.lag_single_from)
-        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
         if sf > max([lags] + list(extra)):
             warn(f"-ssi_lag_single_from {sf}: beyond the {max([lags] + list(extra))} stored lags, every lag "
                  "stays in double precision")
+        est, peak, nd = self._lag_memory(ls, lags, extra, extra_bytes, (share, n_nodes, limit))
+        self.mem_estimate = est
+        self.mem_peak_estimate = peak
+        self.ranks_here = int(round(share * self.comm.getSize()))
+        self.predict_loop(ls, plan, limit)
+        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
+        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
+                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
+        if share * peak > limit:
+            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
+                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
+                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+
+    def _lag_memory(self, ls, lags, extra, extra_bytes, node):
+        """Collective: (bytes of the stored lags, the assembly's peak, the dense lags) of ``lags`` exact lags
+        and the interpolating ``extra``, with ``extra_bytes`` beside them; node = (share, nodes, limit) of
+        ``check_memory``. Refuses, from a sample of rows, a run far over the limit even with every lag
+        block-sparse; stores every lag block-sparse (``lag_fill``) when the automatic choice's dense lags
+        would not fit and block-sparse ones would."""
+        c = self.cfg
+        share, n_nodes, limit = node
+        sf = int(c.lag_single_from)
+        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
         # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
         # block-sparse is refused now, before the full O(N E) count
         est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
@@ -631,19 +658,7 @@ class HalfSpace:
                          f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
                 self.lag_fill = 1.01
                 est, peak, nd = est2, peak2, 0
-        self.mem_estimate = est
-        self.mem_peak_estimate = peak
-        self.ranks_here = int(round(share * mpi.Get_size()))
-        self.predict_loop(ls, plan, limit)
-        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
-        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
-        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
-                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
-        if share * peak > limit:
-            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
-                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
-                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
-                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+        return est, peak, nd
 
     def bind_sources(self):
         """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes
