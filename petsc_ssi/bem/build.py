@@ -72,6 +72,30 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
             G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
         else:
             G = [None] * plan.Lx
+    HI, GI = _interpolating_lags(cfg, comm, prob, plan, ls, tcol_loc if nt else None)
+    t_asm = time.perf_counter() - t0
+    info = _assembly_report(cfg, comm, plan, ls, N, (H, G, HI, GI), hinfo, t_asm)
+    b, sub = _block_of(cfg, comm, H, G, HI, GI)
+    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    _say_block(march)
+    ls.H = ls.G = None   # the triplets are in the Mats now
+    if cfg.get("lags_save"):
+        from . import lagstore
+        t1 = time.perf_counter()
+        size, t_crc = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
+        printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
+               f"{fmt_time(time.perf_counter() - t1)}, of which {t_crc:.2f} s the CRC32 checksums of its content; "
+               f"-ssi_lags_load {cfg.lags_save} reuses them)")
+    return march, info
+
+
+def _interpolating_lags(cfg, comm, prob, plan, ls, tcol_loc):
+    """Collective: the lag matrices (HI, GI) at the interpolation plan's kernel times (none without
+    interpolation; GI's None without traction columns, ``tcol_loc`` None); ``ls.kernel_evaluations``
+    then counts the exact lags' and theirs."""
+    N, nt = prob.mesh.n_nodes, prob.regions.n_t
+    r0, r1 = ls.node_range
+    single = int(cfg.lag_single_from)
     nev = ls.kernel_evaluations
     HI, GI = [], []
     for j in range(plan.k if plan.active else 0):
@@ -82,7 +106,13 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
                                     prob.lag_fill)[0])
         GI.append(lagmats.build_one(comm, gb, lag, ls.node_range, N, nt, tcol_loc, "dense")[0] if nt else None)
     ls.kernel_evaluations = nev
-    t_asm = time.perf_counter() - t0
+    return HI, GI
+
+
+def _assembly_report(cfg, comm, plan, ls, N, mats, hinfo, t_asm):
+    """Collective: the assembly's line (and the interpolating matrices' memory) and the run's info
+    {t_asm, mem_exact, mem_interp, ndense, nbaij, nsingle, fill, mem}; ``mats``: (H, G, HI, GI)."""
+    H, G, HI, GI = mats
     mem_exact = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
     mem_interp = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in HI + GI))
     mem = mem_exact + mem_interp
@@ -102,19 +132,8 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
            f"(cache {ls.cache_bytes / 1e6:.3g} MB)"
            + ("; lag arrays in 4 kB pages (-ssi_huge_pages: this machine hands free memory back to its host)"
               if ls.opts.get("small_pages") and cfg.get("huge_pages", "auto") == "auto" else ""))
-    b, sub = _block_of(cfg, comm, H, G, HI, GI)
-    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
-    _say_block(march)
-    ls.H = ls.G = None   # the triplets are in the Mats now
-    if cfg.get("lags_save"):
-        from . import lagstore
-        t1 = time.perf_counter()
-        size, t_crc = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
-        printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
-               f"{fmt_time(time.perf_counter() - t1)}, of which {t_crc:.2f} s the CRC32 checksums of its content; "
-               f"-ssi_lags_load {cfg.lags_save} reuses them)")
-    return march, {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
-                   "nbaij": nbaij, "nsingle": nsingle, "fill": fill, "mem": mem}
+    return {"t_asm": t_asm, "mem_exact": mem_exact, "mem_interp": mem_interp, "ndense": ndense,
+            "nbaij": nbaij, "nsingle": nsingle, "fill": fill, "mem": mem}
 
 
 def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):

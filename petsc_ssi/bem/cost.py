@@ -193,7 +193,6 @@ class Counts:
         self.writes = (self.steps // cfg.output_stride) if cfg.output_stride else 0
         nimg = len(ls.Vc) // prob.mesh.n_cells
         Lmax = max([self.Lx] + self.interp_lags)
-        mpi = comm.tompi4py()
         # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
         from . import partition
         w = None
@@ -205,28 +204,9 @@ class Counts:
         self.ranges = {p: [tuple(int(v) for v in r) for r in ranges[p]] if p in ranges else
                        partition.balanced_ranges(w, p) if w is not None else partition.equal_ranges(N, p)
                        for p in ranks}
-        # blocks per lag of every rank of every rank count (spread over the ranks of this process)
         jobs = [(p, r, a, b) for p in ranks for r, (a, b) in enumerate(self.ranges[p])]
-        nb = {}
-        for i, (p, r, a, b) in enumerate(jobs):
-            if i % comm.getSize() == comm.getRank():
-                rows = np.arange(a, b, dtype=np.int64)
-                nb[(p, r)] = estimate_blocks(prob.mesh.nodes, rows, ls.Vc, ls.VR, Lmax, prob.mat, prob.dt, nimg)
-        for part in mpi.allgather(nb):
-            nb.update(part)
-        # element cache of the assembly of the exact lags (one cache per rank and call)
-        self.cache = {}
-        if cfg.cache and assembly:
-            table = pair_table(prob, ls, Lmax)
-            g = global_distinct(table, self.Lx, self.interp_lags) if cfg.cache_share else None
-            cc = {}
-            for i, (p, r, a, b) in enumerate(jobs):
-                if i % comm.getSize() == comm.getRank():
-                    cc[(p, r)] = cache_counts(table, a, b, CACHE_MAX / 8, self.Lx, self.interp_lags,
-                                              (p,) + g if g and p > 1 else None, stride=9 * max(self.mH, self.mG))
-            for part in mpi.allgather(cc):
-                self.cache.update(part)
-            del table
+        nb = self._blocks(prob, ls, jobs, Lmax, nimg, comm)
+        self.cache = self._cache(prob, ls, jobs, Lmax, comm) if cfg.cache and assembly else {}
         total = nb[(ranks[0], 0)] * 0
         for r in range(ranks[0]):
             total = total + nb[(ranks[0], r)]
@@ -246,6 +226,34 @@ class Counts:
                                    + np.where(self.single, g / (4.0 * self.mG + 4) * self.mG, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(self.ranges[p])] for p in ranks}
+
+    @staticmethod
+    def _blocks(prob, ls, jobs, Lmax, nimg, comm):
+        """Collective: {(p, r): blocks per lag} of every rank r of every rank count p (``jobs``: (p, r,
+        first row, end row)), the jobs spread over the ranks of this process."""
+        nb = {}
+        for i, (p, r, a, b) in enumerate(jobs):
+            if i % comm.getSize() == comm.getRank():
+                rows = np.arange(a, b, dtype=np.int64)
+                nb[(p, r)] = estimate_blocks(prob.mesh.nodes, rows, ls.Vc, ls.VR, Lmax, prob.mat, prob.dt, nimg)
+        for part in comm.tompi4py().allgather(nb):
+            nb.update(part)
+        return nb
+
+    def _cache(self, prob, ls, jobs, Lmax, comm):
+        """Collective: {(p, r): counts} of the element cache of the exact lags' assembly (one cache per
+        rank and call; ``cache_counts``), the jobs spread as in ``_blocks``."""
+        cfg = prob.cfg
+        table = pair_table(prob, ls, Lmax)
+        g = global_distinct(table, self.Lx, self.interp_lags) if cfg.cache_share else None
+        cc, out = {}, {}
+        for i, (p, r, a, b) in enumerate(jobs):
+            if i % comm.getSize() == comm.getRank():
+                cc[(p, r)] = cache_counts(table, a, b, CACHE_MAX / 8, self.Lx, self.interp_lags,
+                                          (p,) + g if g and p > 1 else None, stride=9 * max(self.mH, self.mG))
+        for part in comm.tompi4py().allgather(cc):
+            out.update(part)
+        return out
 
     def _storage(self, cfg, used, limit):
         N = self.N

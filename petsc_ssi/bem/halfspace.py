@@ -11,9 +11,9 @@ import numpy as np
 from ..petsc import SSIError, collective, printf, warn
 from ..mesh import surface
 from .. import timegrid
-from . import symmetry, receivers as rec, histories
-from ..sources.traction import soil_sources, check_sources
-from .resultants import RigidMotion
+from . import symmetry, receivers as rec
+from ..sources import from_options, is_motion
+from ..sources.traction import check_sources
 from .lagset import Material, Regions, LagSet
 from .windows import causal_lags
 from . import interp
@@ -96,14 +96,6 @@ def read_soil_surface(cfg, comm, planes):
     return mesh
 
 
-def _history(cfg, which):
-    """The -ssi_<which>_history as a callable, read and checked now."""
-    try:
-        return histories.make(cfg.get(which + "_history"), cfg.get(which + "_t0"), cfg.get(which + "_table"))
-    except SSIError as exc:
-        raise SSIError(f"-ssi_{which}_history {cfg.get(which + '_history')}: {exc}") from None
-
-
 # Bounds that catch a wrong unit (issue 44: a soil of c_s 5 m/s or rho 10 kg/m^3 ran without a word):
 # km/s for m/s puts c_s below 10, g/cm^3 for kg/m^3 puts rho below 100. The softest peats have c_s
 # near 30 m/s, hard rock about 3500 m/s (c_p above 1e4 m/s is refused with the options); soils and
@@ -127,13 +119,26 @@ def soil_plausibility(cs, rho):
             "model runs as given")
 
 
+def node_share(comm):
+    """Collective: (share, nodes): the fraction of the run's ranks on its most loaded node (1 on one
+    machine), which the node's memory limit weighs the run's bytes by, and the number of nodes."""
+    from mpi4py import MPI
+    mpi = comm.tompi4py()
+    node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
+    share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
+    n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
+    node.Free()
+    return share, n_nodes
+
+
 class HalfSpace:
     """Everything a BEM run needs, checked before heavy work (collective)."""
 
     def __init__(self, cfg, comm, log=printf, sources=None, mesh=None, interface=None, record_scheme=None):
-        """``sources``: the surface tractions that load the soil (``petsc_ssi.sources``); None: those
-        of the options (-ssi_load_*). ``mesh``: the surface mesh when the caller has read it
-        (``read_soil_surface``). ``interface``: a coupled run's interface
+        """``sources``: what loads the soil (``petsc_ssi.sources``): surface tractions, summed, and at
+        most one rigid motion of a region (prescribed, or a massless footing's); None: those of the
+        options (``sources.from_options``: -ssi_load_*, -ssi_disp_*). ``mesh``: the surface mesh when
+        the caller has read it (``read_soil_surface``). ``interface``: a coupled run's interface
         (``coupling.interface.build_interface``): its soil elements carry the structure's tractions,
         its centroid is the seismic input's default control point and its nodes are points of
         interest. The seismic input, a source with a duration, comes before the time grid: without
@@ -152,13 +157,13 @@ class HalfSpace:
         if len(bad):
             printf(f"[ssi] {len(bad)} non-smooth surface nodes (edges/corners, up to {ang.max():.3g} degrees): "
                    f"free term from the interior solid angle (Hartmann)")
-        disp = self.mesh.select(cfg.disp_group) if cfg.disp_group else ()
-        if interface is not None:
-            disp = interface.be_elems
         wave = cfg.get("seismic", "none") != "none"
         self._load_warnings(wave)
         # histories are built (and tables read and checked) before any heavy work
-        self.sources = list(soil_sources(cfg, self.mesh) if sources is None else sources)
+        given = list(from_options(cfg, self.mesh) if sources is None else sources)
+        self.sources = [s for s in given if not is_motion(s)]          # tractions: summed (``known_p``)
+        self.motion = self._motion_source([s for s in given if is_motion(s)], interface)
+        disp = interface.be_elems if interface is not None else self.motion.elements if self.motion else ()
         self._excavation = self._interface_ff = None
         if wave and interface is not None and not self.mesh.flat:
             # the free field's traction on the structure's faces below the ground (walls, bottom): the
@@ -174,23 +179,17 @@ class HalfSpace:
                 else np.zeros(0, np.int64))
         if interface is not None:
             self._check_interface(load, interface)
-        self._disp_f = _history(cfg, "disp") if len(disp) and interface is None else None
         self.regions = Regions(self.mesh, load, disp)
         if interface is not None and not np.array_equal(self.regions.disp_nodes, interface.be_nodes):
             raise SSIError("interface: internal error, node order of the soil regions differs")
         self.bind_sources()
         for src in self.sources if sources is not None else [self._excavation] if self._excavation else ():
             printf(f"[ssi] source: {src.describe()}")
-        for name in ("disp_rotation", "disp_ref"):
-            if cfg.user_set(name) and not cfg.disp_group:
-                warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
-        prescribed = len(disp) > 0 and interface is None
-        self.massless = cfg.get("disp_rigid", "prescribed") == "massless" and prescribed
-        if self.massless:                 # a footing with no soil around it is not a footing (issue 44: it ran)
-            from .input_motion import check_soil_around
-            check_soil_around(self.mesh, disp, cfg.disp_group, 1e-6 * h, who="a massless footing (input-motion)")
-        xref = self._massless_reference() if self.massless else None
-        self.motion = RigidMotion(cfg, self.mesh, self.regions, self.planes, xref) if prescribed else None
+        self.massless = self.motion is not None and self.motion.massless
+        if self.motion is not None:       # (a massless footing with no soil around it is refused here)
+            self.motion.bind(self.mesh, self.regions, self.planes, h)
+            if sources is not None:
+                printf(f"[ssi] source: {self.motion.describe()}")
         self.receivers = self._receivers(h)
         # a coupled run's structure: points of interest (the interpolation rule, the diffraction warning)
         self.sites = interface.x if interface is not None else np.zeros((0, 3))
@@ -223,15 +222,14 @@ class HalfSpace:
         return seismic
 
     def _load_warnings(self, wave):
-        """One line for each load or prescribed-motion option that does nothing (``wave``: a seismic
-        input, which loads the soil itself)."""
+        """One line for each load option that does nothing (``wave``: a seismic input, which loads the
+        soil itself; the prescribed motion's options: ``sources.rigid.rigid_motion``) and for a soil whose
+        c_s or rho looks like a wrong unit (``soil_plausibility``)."""
         cfg = self.cfg
         if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
         if cfg.user_set("load_p0") and not cfg.load_group:
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
-        if cfg.user_set("disp_value") and not cfg.disp_group:
-            warn("-ssi_disp_value is set but no -ssi_disp_group: nothing is prescribed")
         odd = soil_plausibility(cfg.cs, cfg.rho)
         if odd:
             warn(odd)
@@ -269,33 +267,22 @@ class HalfSpace:
         region's or the interface's centroid, else the origin."""
         if interface is not None:
             return interface.x.mean(0)
-        if self.massless:
-            # the footing's centroid, as -ssi_seismic_ref auto says, whatever -ssi_disp_ref (which only
-            # says about which point the motion is told: it moved the wave's control point too, and every
-            # series shifted in time against the run without it; issue 44)
-            from .input_motion import region_centroid
-            return region_centroid(self.mesh, self.regions, self.planes)
-        if self.motion is not None:
-            return self.mesh.nodes[self.regions.disp_nodes].mean(0)
+        if self.motion is not None:       # (a massless footing's: its centroid, whatever its x_ref)
+            return self.motion.control_point(self.mesh, self.regions, self.planes)
         return np.zeros(3)
 
-    def _massless_reference(self):
-        """-ssi_disp_rigid massless: the footing's reference point x_ref [m], -ssi_disp_ref or by
-        default the whole region's centroid (the options stay as given: a restart's key compares
-        them); with symmetry planes it must lie on them (the rotations the planes allow are about
-        axes in them)."""
-        from .input_motion import region_centroid
-        from .resultants import parse_vector
-        cfg = self.cfg
-        if cfg.user_set("disp_ref"):
-            xr = parse_vector(cfg.disp_ref, "disp_ref")
-        else:
-            xr = region_centroid(self.mesh, self.regions, self.planes)
-        for ax, _ in self.planes:
-            if abs(xr[ax]) > 1e-9 * max(self.h, 1.0):
-                raise SSIError(f"-ssi_disp_ref {cfg.disp_ref}: with -ssi_symmetry {cfg.symmetry} the footing's "
-                               f"reference point must lie on the plane {'xy'[ax]} = 0")
-        return xr
+    def _motion_source(self, motions, interface):
+        """The one rigid-motion source of ``motions`` (``sources.rigid``), or None; SSIError for two, or
+        for one beside a coupled run's interface (the structure gives that region's displacements)."""
+        if len(motions) > 1:
+            raise SSIError(f"{len(motions)} prescribed motions of soil regions ({', '.join(m.name for m in motions)}): "
+                           "the soil takes one (give one region)")
+        if motions and interface is not None:
+            raise SSIError(f"{motions[0].name}: a coupled run's interface is the soil's displacement region (the "
+                           "structure gives its displacements); no other motion is prescribed")
+        if motions and not len(motions[0].elements):
+            return None
+        return motions[0] if motions else None
 
     def _seismic_input(self, ref):
         """Collective: the earthquake of -ssi_seismic (``seismic.input.SeismicInput``), with ``ref``
@@ -559,12 +546,8 @@ class HalfSpace:
         printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
                f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
                f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
-        # the limit holds per node: the run's memory is shared by its ranks, ``share`` of them on the most
-        # loaded node (all of them on one machine), as in check_memory
-        mpi = self.comm.tompi4py()
-        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
-        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
-        node.Free()
+        # the limit holds per node, as in check_memory
+        share, _ = node_share(self.comm)
         if share * est > limit:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
@@ -622,21 +605,40 @@ class HalfSpace:
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
         # the limit holds per node: the run's peak is shared by its ranks, of which
         # ``share`` run on the most loaded node (all of them on one machine)
-        mpi = self.comm.tompi4py()
-        from mpi4py import MPI
-        node = mpi.Split_type(MPI.COMM_TYPE_SHARED)
-        share = mpi.allreduce(node.Get_size(), op=MPI.MAX) / float(mpi.Get_size())
-        n_nodes = mpi.allreduce(1 if node.Get_rank() == 0 else 0)
-        node.Free()
+        share, n_nodes = node_share(self.comm)
         extra_bytes = float(extra_bytes)
         lags = plan.Lx if plan is not None and plan.active else self.L
         extra = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan is not None and plan.active else []
         self.lag_fill = c.lag_fill
         sf = int(c.lag_single_from)
-        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
         if sf > max([lags] + list(extra)):
             warn(f"-ssi_lag_single_from {sf}: beyond the {max([lags] + list(extra))} stored lags, every lag "
                  "stays in double precision")
+        est, peak, nd = self._lag_memory(ls, lags, extra, extra_bytes, (share, n_nodes, limit))
+        self.mem_estimate = est
+        self.mem_peak_estimate = peak
+        self.ranks_here = int(round(share * self.comm.getSize()))
+        self.predict_loop(ls, plan, limit)
+        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
+        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
+        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
+                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
+        if share * peak > limit:
+            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
+                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
+                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
+                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+
+    def _lag_memory(self, ls, lags, extra, extra_bytes, node):
+        """Collective: (bytes of the stored lags, the assembly's peak, the dense lags) of ``lags`` exact lags
+        and the interpolating ``extra``, with ``extra_bytes`` beside them; node = (share, nodes, limit) of
+        ``check_memory``. Refuses, from a sample of rows, a run far over the limit even with every lag
+        block-sparse; stores every lag block-sparse (``lag_fill``) when the automatic choice's dense lags
+        would not fit and block-sparse ones would."""
+        c = self.cfg
+        share, n_nodes, limit = node
+        sf = int(c.lag_single_from)
+        load = not c.get("lags_load")           # (a run with loaded lags does not assemble)
         # fast first: the blocks of a sample of rows; a run far over the limit even with every lag
         # block-sparse is refused now, before the full O(N E) count
         est0, peak0, _ = ls.estimate_memory(lags, "sparse", c.lag_fill, extra, sample=64, single_from=sf)
@@ -656,19 +658,7 @@ class HalfSpace:
                          f"{limit / 1e9:.3g} GB limit: all lags block-sparse ({peak2 / 1e9:.3g} GB)")
                 self.lag_fill = 1.01
                 est, peak, nd = est2, peak2, 0
-        self.mem_estimate = est
-        self.mem_peak_estimate = peak
-        self.ranks_here = int(round(share * mpi.Get_size()))
-        self.predict_loop(ls, plan, limit)
-        where = (f", {share * peak / 1e9:.3g} GB on the most loaded of {n_nodes} nodes" if n_nodes > 1 else "")
-        more = f", {extra_what} {extra_bytes / 1e9:.3g} GB" if extra_bytes else ""
-        self.log(f"[ssi] memory estimate: lag matrices {est / 1e9:.3g} GB ({nd} dense lags){more}, "
-                 f"peak {peak / 1e9:.3g} GB{where} (limit {limit / 1e9:.3g} GB per node)")
-        if share * peak > limit:
-            raise SSIError(f"the lag matrices need about {share * peak / 1e9:.3g} GB at assembly on "
-                           f"{'the most loaded node' if n_nodes > 1 else 'this node'}, more than the "
-                           f"{limit / 1e9:.3g} GB available (-ssi_memory_limit, per node); use symmetry planes, "
-                           f"-ssi_interp, a coarser mesh, a shorter -ssi_t_end or more nodes")
+        return est, peak, nd
 
     def bind_sources(self):
         """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes
@@ -694,14 +684,15 @@ class HalfSpace:
 
     def disp_factor(self, n):
         """h(t_n) of the prescribed motion."""
-        return float(self._disp_f(self.grid.time(n)))
+        return self.motion.factor(self.grid.time(n))
 
     def known_u(self):
         """callable(n) -> the prescribed displacements of step n at the region's nodes (3 n_disp,):
-        the rigid motion h(t_n) [u0 + theta0 x (x - x_ref)] (``resultants.RigidMotion``)."""
+        the motion source's values at t_n (``sources.rigid``: h(t_n) [u0 + theta0 x (x - x_ref)], zero for
+        a massless footing before its correction)."""
         if not self.regions.n_disp:
             return lambda n: np.zeros(0)
         if self.seismic is not None:           # the BEM carries the scattered field: u_sc = u - u_ff
             nodes = self.regions.disp_nodes
-            return lambda n: self.motion.values(self.disp_factor(n)) - self.free_field_at(nodes, self.grid.time(n))
-        return lambda n: self.motion.values(self.disp_factor(n))
+            return lambda n: self.motion.values(self.grid.time(n)) - self.free_field_at(nodes, self.grid.time(n))
+        return lambda n: self.motion.values(self.grid.time(n))

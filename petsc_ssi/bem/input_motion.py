@@ -105,7 +105,7 @@ class MasslessFooting:
     """Collective: the massless rigid footing of ``prob`` (a HalfSpace with -ssi_disp_rigid massless
     and a seismic input) driven through ``march`` (module docstring). ``correct`` is the march's step
     correction (``Marcher.step(correct)``); an observer of the recorder for checkpoints
-    (``state``/``restore``); ``arrays`` is the output group."""
+    (``state``/``restore``) and its output group (``groups``: 'input_motion', ``arrays``)."""
 
     def __init__(self, comm, prob, march):
         from .resultants import Resultants
@@ -208,6 +208,10 @@ class MasslessFooting:
         self.q = [row.copy() for row in np.asarray(s["input_motion_q"]).reshape(-1, 6)]
 
     # ------------------------------------------------------------ output
+    def groups(self, steps, times):
+        """The recorder's protocol (``io.recorder``): {'input_motion': ``arrays(times)``}."""
+        return {"input_motion": self.arrays(times)}
+
     def free_field(self, times):
         """(u (K, 3) [m], rotation (K, 3) [rad]): the free field at x_ref."""
         s = self.prob.seismic

@@ -25,8 +25,8 @@ class BEMTransient(TransientProblem):
     kind = "bem"
 
     def __init__(self, cfg, comm=None, sources=None):
-        """``sources``: the surface tractions on the soil (``petsc_ssi.sources``); None: those of the
-        options (-ssi_load_*)."""
+        """``sources``: what loads the soil (``petsc_ssi.sources``: surface tractions, a rigid motion of a
+        region or a massless footing); None: those of the options (``sources.from_options``)."""
         super().__init__(cfg, comm)
         no_output_refused(cfg, "a BEM")
         self.check_output()
@@ -36,7 +36,7 @@ class BEMTransient(TransientProblem):
             self.plan, self.ls = self.prob.prepare()
         self.grid = self.prob.grid
         self.march = self.rec = self.out = None
-        self.footing = None                  # -ssi_disp_rigid massless (bem/input_motion.py)
+        self.footing = None                  # a massless footing's correction (sources/rigid.py)
         self.state = None
         self.check_disk()
 
@@ -51,9 +51,8 @@ class BEMTransient(TransientProblem):
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(self.cfg, self.comm, p, self.plan, self.ls, p.known_u(),
                                               p.known_p(), self.log)
-            if p.massless:
-                from .input_motion import MasslessFooting
-                self.footing = MasslessFooting(self.comm, p, self.march)
+            if p.motion is not None:        # the motion source's step correction (a massless footing's)
+                self.footing = p.motion.correction(self.comm, p, self.march)
 
     def start(self):
         self._advance("set up", "started")
@@ -64,7 +63,7 @@ class BEMTransient(TransientProblem):
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
                             soil=SoilRecorder(self.out, self.comm, self.prob, self.march))
         if self.footing is not None:
-            self.rec.add(self.footing)                      # its motion series in checkpoints
+            self.rec.add(self.footing, out=self.out)        # its motion series in checkpoints, its group
         if self.cfg.guard:
             self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
         self._ut = self.march.u_tmpl.duplicate()            # the total field (a seismic input's u_sc + u_ff)
@@ -98,33 +97,26 @@ class BEMTransient(TransientProblem):
         return self.state
 
     def write_partial(self, status):
-        rec = self.rec
-        res = {"t": np.array(rec.times), "u": rec.soil_receivers(), "stats": {"steps_done": self.n},
-               "resultants": rec.soil.resultants(rec.steps, rec.times)}
-        if self.footing is not None:
-            res["input_motion"] = self.footing.arrays(rec.times)
-        self.write_results(res, status=status, final=False)
+        self.write_results({"stats": {"steps_done": self.n}}, status=status, final=False)
 
     def output_parts(self, res):
-        """The soil's output: receivers, attributes, the groups (a prescribed region's resultants, the
-        seismic input, a massless footing's input motion) and the run record."""
+        """The soil's output: the groups its observers write (``Recorder.groups``: the receivers, a
+        prescribed region's resultants, a massless footing's input motion) and the seismic input's,
+        attributes and the run record."""
         cfg, comm, prob = self.cfg, self.comm, self.prob
-        recd = None
-        if res["u"] is not None:
-            recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
+        groups = self.rec.groups(self.out)
+        recd = groups.pop("receivers", None)
         attrs = {"problem": "bem", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": prob.dt,
                  "scheme": cfg.scheme, "load_p0": cfg.load_p0, "load_history": cfg.load_history}
-        groups = {"resultants": res["resultants"]} if res.get("resultants") is not None else None
         if getattr(prob, "seismic", None) is not None:
-            groups = dict(groups or {}, seismic=prob.seismic.arrays())
+            groups["seismic"] = prob.seismic.arrays()
             attrs["seismic"] = prob.seismic.kind
-        if res.get("input_motion") is not None:
-            groups = dict(groups or {}, input_motion=res["input_motion"])
+        if self.footing is not None:
             attrs["disp_rigid"] = "massless"
         if cfg.mesh_patch and cfg.load_group == "load":
             attrs["load_patch"] = cfg.mesh_patch     # half-widths a,b of the loaded rectangle
         record = provenance(cfg, comm, {"stats": res.get("stats", {})}, grid=prob.grid)
-        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups})]
+        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups or None})]
 
     def written(self, res):
         cfg = self.cfg

@@ -114,11 +114,15 @@ def _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, out):
 
 
 @njit(cache=True, inline="always")
-def _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u):
-    """At a point at distance r, rows j - (plo - 2) of S2 = (A, B, dA, dB) of the twice-integrated
-    response at the kernel times T = j dt + toff, j = plo - 2 .. phi (zero for T <= 0), and with
-    ``want_u`` of S1 = (A, B) of the once-integrated one: the samples whose differences are the lags
-    plo..phi (``integrate_pair``, ``integrate_plane``)."""
+def _time_samples(S2, S1, r, ir, plo, phi, phys, want_u):
+    """At a point at distance r (ir = 1 / r), rows j - (plo - 2) of S2 = (A, B, dA, dB) of the
+    twice-integrated response at the kernel times T = j dt + toff, j = plo - 2 .. phi (zero for T <= 0),
+    and with ``want_u`` of S1 = (A, B) of the once-integrated one: the samples whose differences are the
+    lags plo..phi (``integrate_pair``, ``integrate_plane``). ``phys``: the material and the step
+    (``packs.wave``)."""
+    dt, toff, alpha, beta = phys[DT], phys[TOFF], phys[CP], phys[CS]
+    ia = 1.0 / alpha
+    ib = 1.0 / beta
     for j in range(plo - 2, phi + 1):
         jj = j - (plo - 2)
         t = j * dt + toff
@@ -214,14 +218,16 @@ def _add_u(Ub, li, jj, S1, s4, g, w, N, subtract1, ku, ut):
 
 
 @njit(cache=True, inline="always")
-def _add_lags(Ub, Pb, S2, S1, plo, phi, lo, pt_geo, mat, subtract, ks, scratch, want_u):
-    """The lags plo..phi of one Gauss point into Pb (and with ``want_u`` Ub): pt_geo = (g, n, g . n, r, w,
-    N), mat = (lam, mu, s4, s4 / dt), ks = Kelvin's static (ku, kp) subtracted from lag 1 where
-    ``subtract``, scratch = (pt, ut). Returns the (point, lag) evaluations: phi - plo + 1."""
+def _add_lags(Ub, Pb, samples, lags, pt_geo, mat, work, want_u):
+    """The lags plo..phi of one Gauss point into Pb (and with ``want_u`` Ub): samples = (S2, S1) of
+    ``_time_samples``, lags = (plo, phi, lo, subtract), pt_geo = (g, n, g . n, r, w, N), mat = (lam, mu,
+    s4, s4 / dt), work = (ku, kp, pt, ut): Kelvin's static (ku, kp) subtracted from lag 1 where
+    ``subtract``, and scratch. Returns the (point, lag) evaluations: phi - plo + 1."""
+    S2, S1 = samples
+    plo, phi, lo, subtract = lags
     g, n, gn, r, w, N = pt_geo
     lam, mu, s4, fdt = mat
-    ku, kp = ks
-    pt, ut = scratch
+    ku, kp, pt, ut = work
     for l in range(plo, phi + 1):
         jj = l - (plo - 2)
         A, B, dA, dB = _lag_differences(S2, jj, fdt)
@@ -261,8 +267,7 @@ def integrate_pair(xc, X, sing, ns, lo, hi, phys, gq, gw, Ub, Pb, want_u):
     g = np.zeros(3); n = np.zeros(3)
     S2 = np.zeros((hi - lo + 4, 4))
     S1 = np.zeros((hi - lo + 4, 2))
-    scratch = (np.zeros((3, 3)), np.zeros((3, 3)))
-    ks = (np.zeros((3, 3)), np.zeros((3, 3)))
+    work = (np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros((3, 3)))    # ku, kp, pt, ut
     ia = 1.0 / alpha
     ib = 1.0 / beta
     subtract = sing >= 0 and lo == 1
@@ -289,22 +294,26 @@ def integrate_pair(xc, X, sing, ns, lo, hi, phys, gq, gw, Ub, Pb, want_u):
                         plo = 1
                     if plo > phi:
                         continue
-                    _time_samples(S2, S1, r, 1.0 / r, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
+                    _time_samples(S2, S1, r, 1.0 / r, plo, phi, phys, want_u)
                     if subtract:
-                        kelvin_u(g, r, nu, mu, ks[0])
-                        kelvin_p(g, n, r, nu, ks[1])
-                    nev += _add_lags(Ub, Pb, S2, S1, plo, phi, lo, (g, n, gn, r, w, N), mat, subtract, ks, scratch,
+                        kelvin_u(g, r, nu, mu, work[0])
+                        kelvin_p(g, n, r, nu, work[1])
+                    nev += _add_lags(Ub, Pb, (S2, S1), (plo, phi, lo, subtract), (g, n, gn, r, w, N), mat, work,
                                      want_u)
     return nev
 
 
 @njit(cache=True, inline="always")
-def _polar_ray(X, node, th, wth, rhat, rule, nu, mu, h_ref, Us, Ps, scr):
-    """One direction th (weight wth) of ``singular_static``'s polar rule, from the node to the side at
-    rhat: the Gauss points in rho (rule = (order_r, gr, gwr)) into Us, Ps and the CPV's
-    -F_{-1}/rho and log terms into Ps[c]. node = (c, its natural coordinates, x, unit normal, Jacobian
-    and tangents there); scr: scratch."""
+def _polar_ray(X, node, ray, rule, elastic, out, scr):
+    """One direction of ``singular_static``'s polar rule, ray = (th, its weight wth, rhat: the distance
+    from the node to the side along it): the Gauss points in rho (rule = (order_r, gr, gwr)) into
+    out = (Us, Ps) and the CPV's -F_{-1}/rho and log terms into Ps[c]; elastic = (nu, mu, h_ref: the
+    CPV's length unit). node = (c, its natural coordinates, x, unit normal, Jacobian and tangents
+    there); scr: scratch."""
     c, xc0, ec0, xs, nc, Jc, t1, t2 = node
+    th, wth, rhat = ray
+    nu, mu, h_ref = elastic
+    Us, Ps = out
     order_r, gr, gwr = rule
     N, d1, d2, x, jn, g, n, ahat, ku, kp, k0 = scr
     ct = math.cos(th); st = math.sin(th)
@@ -384,8 +393,8 @@ def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_
         thp = math.atan2(ny_, nx_)
         for it in range(order_t):
             th = 0.5 * (th1 + th2) + 0.5 * (th2 - th1) * gt[it]
-            _polar_ray(X, node, th, 0.5 * (th2 - th1) * gwt[it], dp / math.cos(th - thp), (order_r, gr, gwr), nu, mu,
-                       h_ref, Us, Ps, scr)
+            _polar_ray(X, node, (th, 0.5 * (th2 - th1) * gwt[it], dp / math.cos(th - thp)), (order_r, gr, gwr),
+                       (nu, mu, h_ref), (Us, Ps), scr)
 
 
 # ---------------------------------------------------------------------------
@@ -510,7 +519,7 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u):
             phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
             if plo > phi:
                 continue
-            _time_samples(S2, S1, r, ir, plo, phi, dt, toff, ia, ib, alpha, beta, want_u)
+            _time_samples(S2, S1, r, ir, plo, phi, phys, want_u)
             nev += _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, (g0 * ir, g1 * ir, pts[k, 3], r, pts[k, 2]), mat,
                                Ntab[k], want_u)
     return nev

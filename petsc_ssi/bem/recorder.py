@@ -1,7 +1,7 @@
 """The soil's observer of the recorder (``io.recorder`` protocol): its mesh and fields in an Output
 (displacement, nodal traction), the soil receiver series (a PETSc operator from the nodal field to
-the receiver points; gathered to rank 0 once, at the end) and a prescribed region's resultants.
-Collective unless said otherwise."""
+the receiver points; gathered to rank 0 once, at the end) and a prescribed region's resultants;
+its output groups 'receivers' and 'resultants' (``groups``). Collective unless said otherwise."""
 import numpy as np
 
 from ..monitor import event
@@ -80,6 +80,13 @@ class SoilRecorder:
             full = np.asarray(s["soil_resultants"]).reshape(len(s["times"]), 6)
             r0, r1 = self.res.R.getOwnershipRange()
             self.res.series = [row[r0:r1].copy() for row in full]
+
+    def groups(self, steps, times):
+        """Collective: the output groups 'receivers' (points, t, u) and 'resultants' (``resultants``),
+        rank 0's (None elsewhere, or without receivers or a prescribed region)."""
+        u = self.receivers(len(times))
+        recd = {"points": self.prob.receivers, "t": np.asarray(times), "u": u} if u is not None else None
+        return {"receivers": recd, "resultants": self.resultants(steps, times)}
 
     def resultants(self, steps, times):
         """Collective: the output group 'resultants' (rank 0; None elsewhere or without a

@@ -1,11 +1,12 @@
-"""A soil region's rigid-body motion and traction resultants (issue 12, item 1).
+"""A soil region's traction resultants (issue 12, item 1).
 
 ``-ssi_disp_group G`` prescribes on the region G the rigid motion
 
     u(x, t) = h(t) [u0 + theta0 x (x - x_ref)]
 
 (``-ssi_disp_value`` u0, ``-ssi_disp_rotation`` theta0: small rotations about the axes through
-``-ssi_disp_ref`` x_ref; ``-ssi_disp_history`` h), and the run records every step the resultants
+``-ssi_disp_ref`` x_ref; ``-ssi_disp_history`` h; the source ``sources.rigid.PrescribedRigidMotion``,
+or the massless footing's ``sources.rigid.MasslessRigidFooting``), and the run records every step the resultants
 of the region's traction (the force the soil exerts... on the region, i.e. the integral of the
 traction vector p that acts on the soil):
 
@@ -60,41 +61,6 @@ def _skew(v):
     z = np.zeros(v.shape[:-1])
     return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
                      np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
-class RigidMotion:
-    """The prescribed rigid motion of the -ssi_disp_group region (``known_u``) and its checks."""
-
-    def __init__(self, cfg, mesh, regions, planes, xref=None):
-        """``xref``: the reference point [m] if not -ssi_disp_ref's (the massless footing's default,
-        ``halfspace.HalfSpace``)."""
-        self.u0 = parse_vector(cfg.disp_value, "disp_value")
-        self.theta = parse_vector(cfg.disp_rotation, "disp_rotation")
-        self.xref = parse_vector(cfg.disp_ref, "disp_ref") if xref is None else np.asarray(xref, float)
-        self.x = mesh.nodes[regions.disp_nodes]
-        self.base = (self.u0 + np.cross(self.theta, self.x - self.xref)).ravel()     # (3 n_disp,)
-        self._check_symmetry(planes)
-
-    def _check_symmetry(self, planes):
-        """u(R x) = S u(x) about every plane (S its sign pattern): the motion must be of the
-        declared kind, and x_ref must lie on the plane where a rotation makes it matter."""
-        for ax, kind in planes:
-            s = symmetry.sign_matrix(ax, kind)
-            xr = self.x.copy()
-            xr[:, ax] *= -1.0
-            u = self.u0 + np.cross(self.theta, self.x - self.xref)
-            ur = self.u0 + np.cross(self.theta, xr - self.xref)
-            scale = max(np.abs(u).max(), 1e-300)
-            if np.abs(ur - s * u).max() > 1e-9 * scale:
-                name = f"{'xy'[ax]}={'sym' if kind > 0 else 'anti'}"
-                raise SSIError(f"-ssi_symmetry {name}: the prescribed motion (-ssi_disp_value "
-                               f"{','.join(f'{v:g}' for v in self.u0)}, -ssi_disp_rotation "
-                               f"{','.join(f'{v:g}' for v in self.theta)} about -ssi_disp_ref "
-                               f"{','.join(f'{v:g}' for v in self.xref)}) is not "
-                               f"{'symmetric' if kind > 0 else 'antisymmetric'} about this plane")
-
-    def values(self, factor):
-        return self.base * factor
 
 
 class Resultants:

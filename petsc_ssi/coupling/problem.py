@@ -20,7 +20,7 @@ from ..io.output import Output
 from ..problem import TransientProblem, no_output_refused
 from ..io.output import provenance
 from ..fem.forces import add_force_recorder
-from ..io.structure import receiver_record
+from ..io.recorder import InterfaceSeries
 from ..bem.build import build_marcher
 from ..fem.integrators import make_model_integrator
 from ..fem.loads import load_history
@@ -152,13 +152,13 @@ class SSITransient(TransientProblem):
                            run_id=self.run_id)
         self.rec = Recorder(cfg, comm, "SSI time loop", self.grid,
                             soil=SoilRecorder(self.out, comm, self.prob, self.march),
-                            structure=StructureRecorder(self.sout, self.model, comm), interface_keys=keys,
-                            interface_nodal=NODAL_KEYS, interface_stride=cfg.interface_stride)
+                            structure=StructureRecorder(self.sout, self.model, comm),
+                            interface=InterfaceRecord(keys, NODAL_KEYS, cfg.interface_stride, self.iface, self.grid))
         self.forces = add_force_recorder(cfg, self.sout, self.model, comm, self.rec)
         self.rec.add(_FiniteCheck(self.integ))
-        self.clock = self.rec.add(StepClock())
+        self.clock = self.rec.add(StepClock(group=cfg.step_times), out=self.out)    # (-ssi_step_times: written)
         from ..fem.demands import Demands       # base shear, overturning moment, drifts (fem/demands.py)
-        self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"))
+        self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"), out=self.sout)
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
         if rd is None:                            # the records of t = 0 (no fields: the soil has none at rest)
@@ -218,20 +218,9 @@ class SSITransient(TransientProblem):
 
     def results(self):
         """Collective: the series so far (soil receivers, structure, interface; rank 0)."""
-        rec, iface, comm = self.rec, self.iface, self.comm
+        rec, comm = self.rec, self.comm
         times = rec.times
-        nI = self.coupler.nI
-        inter = rec.interface_arrays()
-        nodal = inter.pop("nodal_steps")
-        for k in ("uf", "ub", "p") + tuple(k for k in ("uf_check", "uff", "pff") if k in inter):
-            inter[k] = inter[k].reshape(len(nodal), nI, 3)
-        inter["n_open"] = np.asarray(inter["n_open"], np.int64)
-        inter["t"] = np.asarray(times)
-        if self.cfg.interface_stride > 1:       # the nodal series' own steps and times
-            inter["nodal_steps"] = nodal
-            inter["t_nodal"] = self.grid.time(nodal) if len(nodal) else np.zeros(0)
-        inter["x"] = iface.x
-        inter["normal"] = iface.n_b
+        inter = rec.interface.laid_out(times)
         st, su = rec.structure.rec.arrays()
         sall = rec.structure.rec.all_arrays() if comm.getRank() == 0 else None
         inter["preload"] = self.coupler.preload            # p_w [N/m^2] (0: none)
@@ -240,9 +229,7 @@ class SSITransient(TransientProblem):
                 "structure": sall, "interface": inter, "unorm": np.asarray(rec.unorm), "demands": dem}
 
     def write_partial(self, status):
-        res = self.results()
-        res["stats"] = {"steps_done": self.n}
-        self.write_results(res, status=status, final=False)
+        self.write_results({"stats": {"steps_done": self.n}}, status=status, final=False)
 
     def output_parts(self, res):
         """Both outputs: the soil's (receivers, the interface series, the seismic input, the step
@@ -251,33 +238,26 @@ class SSITransient(TransientProblem):
         cfg, comm, prob, model = self.cfg, self.comm, self.prob, self.model
         attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": self.grid.dt, "scheme": cfg.scheme,
                  "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
-                 "contact_preload": float(res["interface"].get("preload", 0.0)),
+                 "contact_preload": float(self.coupler.preload),
                  "structure_output": os.path.basename(structure_output_path(cfg.output))}
         if getattr(prob, "seismic", None) is not None:
             attrs["seismic"] = prob.seismic.kind
         record = provenance(cfg, comm, {"stats": res["stats"]}, grid=prob.grid)
-        recd = None
-        if res["u"] is not None:
-            recd = {"points": prob.receivers, "t": res["t"], "u": res["u"]}
-        inter = res["interface"] if comm.getRank() == 0 else None
-        groups = _groups(prob, inter)
-        if comm.getRank() == 0 and res.get("timing") is not None:
-            groups = dict(groups or {}, timing=res["timing"])
-        srecd = None
-        if comm.getRank() == 0 and len(model.receiver_nodes):
-            srecd = receiver_record(model, res["structure"])
-        sgroups = {"demands": res["demands"]} if res.get("demands") is not None else None
+        # the groups the observers write: the soil's receivers, the interface series, the step times
+        # (-ssi_step_times); the structure's receivers and demands
+        groups, sgroups = self.rec.groups(self.out), self.rec.groups(self.sout)
+        recd, srecd = groups.pop("receivers", None), sgroups.pop("receivers", None)
+        if getattr(prob, "seismic", None) is not None:
+            groups["seismic"] = prob.seismic.arrays()
         sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1, self.integ.modal),
                   "structure_mass": structure_mass(model, comm)}
-        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups}),
-                (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups})]
+        return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups or None}),
+                (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups or None})]
 
     def finish(self):
         self._advance("stepping" if self.n else "started", "finished")
         cfg, comm, coupler, march, plan, prob = self.cfg, self.comm, self.coupler, self.march, self.plan, self.prob
         res = self.results()
-        if cfg.step_times:
-            res["timing"] = {"step_wall": (np.asarray(self.clock.values, float), "s")}
         law = coupler.law
         nch = law.total_changes
         stats = {"wall_s": time.perf_counter() - self.t_start, "assembly_s": self.info["t_asm"],
@@ -324,16 +304,37 @@ def interface_centroid(prob, iface):
     return c
 
 
-def _groups(prob, inter):
-    """The serial groups of the soil output: the interface series (rank 0) and the seismic input."""
-    g = {}
-    if inter is not None:
-        # time series only (readers slice every dataset of the group); the static contact pressure
-        # p_w is the file's attribute contact_preload [N/m^2]
-        g["interface"] = {k: v for k, v in inter.items() if k != "preload"}
-    if getattr(prob, "seismic", None) is not None:
-        g["seismic"] = prob.seismic.arrays()
-    return g or None
+class InterfaceRecord(InterfaceSeries):
+    """The coupling's interface series (``io.recorder.InterfaceSeries``) laid out for its output group
+    'interface' (``laid_out``): the vectors per node (n_I, 3) at each kept step, t, and with
+    -ssi_interface_stride > 1 the nodal series' own steps and times; the nodes' x and normal. The static
+    contact pressure p_w is the file's attribute contact_preload [N/m^2], not a series."""
+
+    VECTORS = ("uf", "ub", "p", "uf_check", "uff", "pff")
+
+    def __init__(self, keys, nodal, stride, iface, grid):
+        super().__init__(keys, nodal, stride)
+        self.iface, self.grid = iface, grid
+
+    def laid_out(self, times):
+        """{name: array} (every rank holds the same)."""
+        nI = self.iface.n
+        inter = self.arrays()
+        nodal = inter.pop("nodal_steps")
+        for k in (k for k in self.VECTORS if k in inter):
+            inter[k] = inter[k].reshape(len(nodal), nI, 3)
+        inter["n_open"] = np.asarray(inter["n_open"], np.int64)
+        inter["t"] = np.asarray(times)
+        if self.stride > 1:                       # the nodal series' own steps and times
+            inter["nodal_steps"] = nodal
+            inter["t_nodal"] = self.grid.time(nodal) if len(nodal) else np.zeros(0)
+        inter["x"] = self.iface.x
+        inter["normal"] = self.iface.n_b
+        return inter
+
+    def groups(self, steps, times):
+        # time series only (readers slice every dataset of the group)
+        return {"interface": self.laid_out(times)}
 
 
 class _FiniteCheck:

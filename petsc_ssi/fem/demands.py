@@ -398,6 +398,10 @@ class Demands:
             out["overturning_moment"] = v[:, nd + 2:nd + 4]
         return out
 
+    def groups(self, steps=None, times=None):
+        """The recorder's protocol (``io.recorder``): {'demands': ``group()``} (None off rank 0)."""
+        return {"demands": self.group() if self.rank == 0 else None}
+
     def group(self):
         """Rank 0: the output group 'demands' {name: (array, unit, attrs)} (series, peaks, levels)."""
         sp = self.spec

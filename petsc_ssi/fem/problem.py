@@ -146,7 +146,8 @@ class FEMTransient(TransientProblem):
             self.out = (Output(cfg.output, comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
                         if cfg.output else None)
             self.rec = Recorder(cfg, comm, "FEM time loop", self.grid,
-                                structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io"))
+                                structure=StructureRecorder(self.out, self.model, comm, io_event="FEM_io",
+                                                            always=True))
             self.forces = add_force_recorder(cfg, self.out, self.model, comm, self.rec)
             if self.forces is not None and self.gravity is not None:
                 self.forces.set_gravity(self.gravity.u)      # G, and the signed extremes of E(t) from t = 0
@@ -155,7 +156,7 @@ class FEMTransient(TransientProblem):
             sup = self.support                    # the base moves with the ground: its inertia m a_g
             ground = (lambda t: np.array([float(sup.acceleration(a, t)) for a in "xyz"])) if sup is not None else None
             self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[fem]", ground=ground,
-                                                a1=self.integ.a1))
+                                                a1=self.integ.a1), out=self.out)
         self.integ.start(f0=self.load(0))
         if rd is None:                            # the records of t = 0 (series, fields, forces, demands)
             self.rec.initial(self.time(0), write=self.grid.writes(0),
@@ -192,18 +193,18 @@ class FEMTransient(TransientProblem):
         self.write_results(None, status=status, final=False)
 
     def output_parts(self, res):
-        """The structure's output (none without -ssi_output): receivers (with the ground's and the
-        absolute acceleration under a support motion), attributes, the groups (demands, the support
-        motion) and the run record."""
+        """The structure's output (none without -ssi_output): the groups its observers write
+        (``Recorder.groups``: the receivers, with the ground's and the absolute acceleration under a
+        support motion added here; the demands), the gravity case's and the support motion's,
+        attributes and the run record."""
         cfg, comm, model, am, n_steps = self.cfg, self.comm, self.model, self.am, self.n_steps
         if self.out is None:
             return []
-        receivers = self.rec.structure.receivers() if comm.getRank() == 0 else None
+        groups = self.rec.groups(self.out)
+        receivers = groups.pop("receivers", None)
         dt = self.grid.dt
-        groups, attrs = {}, {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1, self.integ.modal),
-                             "structure_mass": structure_mass(model, comm)}
-        if self.demands is not None and comm.getRank() == 0:
-            groups["demands"] = self.demands.group()
+        attrs = {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1, self.integ.modal),
+                 "structure_mass": structure_mass(model, comm)}
         if self.gravity is not None:
             attrs["gravity"] = self.gravity.g
             if comm.getRank() == 0:

@@ -8,11 +8,14 @@ from ..monitor import event
 
 
 class StructureRecorder:
-    """Collective: the structure's fields (an Output, or None) and receiver series."""
+    """Collective: the structure's fields (an Output, or None) and receiver series, its output group
+    'receivers' (``groups``); ``always``: that group even without receivers (the fixed base's file
+    has one; the coupled structure's only with receivers)."""
 
-    def __init__(self, out, model, comm, io_event="SSI_IO"):
+    def __init__(self, out, model, comm, io_event="SSI_IO", always=False):
         from ..io.structure import FieldWriter, ReceiverSeries
         self.out, self.model, self.comm, self.io_event = out, model, comm, io_event
+        self.always = always
         self.fw = FieldWriter(out, model, comm) if out is not None else None
         self.rec = ReceiverSeries(model.dofmap, model.receiver_nodes, comm)
 
@@ -59,6 +62,12 @@ class StructureRecorder:
         r.u = [a.copy() for a in s["structure_u"]]
         r.r = [a.copy() for a in s["structure_r"]]
         r.v = [a.copy() for a in s["structure_v"]] if "structure_v" in s else []
+
+    def groups(self, steps=None, times=None):
+        """{'receivers': ``receivers()``} on rank 0 (None elsewhere, and without receivers unless
+        ``always``)."""
+        keep = self.comm.getRank() == 0 and (self.always or len(self.model.receiver_nodes))
+        return {"receivers": self.receivers() if keep else None}
 
     def receivers(self):
         """Rank 0: the output group of the structure receivers (points, nodes, t, u, rotation, ...)."""

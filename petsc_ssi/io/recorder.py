@@ -3,15 +3,25 @@ observers with one small protocol (``Recorder``; PyLith's observers). The observ
 live beside it (issue 40: ``io/`` holds files, formats and the recorder, and imports neither
 ``bem/`` nor ``fem/``):
 
-  bem.recorder.SoilRecorder       the soil's mesh, fields and receiver series
-  fem.recorder.StructureRecorder  the structure's mesh, fields and receiver series
-  fem.forces, fem.demands         member forces; base shear, overturning moment, drifts
-  InterfaceSeries    per-step arrays of the coupling (a dict of lists, rank 0's copy)
+  bem.recorder.SoilRecorder       the soil's mesh, fields and receiver series; groups 'receivers',
+                                  'resultants' (a prescribed region's force and moment)
+  bem.input_motion.MasslessFooting  a massless footing's motion; group 'input_motion'
+  fem.recorder.StructureRecorder  the structure's mesh, fields and receiver series; group 'receivers'
+  fem.forces.ForceRecorder        member forces (its group 'forces' of virtual datasets is written
+                                  through the Output's call-backs, ``write_serial``)
+  fem.demands.Demands             base shear, overturning moment, drifts; group 'demands'
+  InterfaceSeries    per-step arrays of the coupling (a dict of lists, rank 0's copy); group
+                     'interface' (``coupling.problem.InterfaceRecord`` lays it out)
+  StepClock          the wall time of every step; group 'timing' when asked for
   NormHistory        |u| of every step; ProgressLine the -ssi_monitor line
 
 A problem hands each step to ``Recorder.step``; fields are written on the steps its time
-grid says (``TimeGrid.writes``: every -ssi_output_stride steps), receivers every step. A new
-output is a new observer. Collective unless said otherwise.
+grid says (``TimeGrid.writes``: every -ssi_output_stride steps), receivers every step. At the
+end (and at each flush) the problem asks the recorder for the groups of each of its outputs
+(``Recorder.groups(out)``) and gives them to ``Output.close``/``flush``: each observer says the
+groups it writes. A new output is a new observer: a class with the protocol's methods (those it
+needs), added with ``Recorder.add`` or ``add_recorder`` (``out``: the Output its groups go to,
+unless it has its own ``out``). Collective unless said otherwise.
 """
 import numpy as np
 
@@ -29,6 +39,11 @@ class InterfaceSeries:
         self.nodal = set(k for k in nodal if k in self.series)
         self.stride = max(int(stride), 1)
         self.nodal_steps = []
+
+    def groups(self, steps, times):
+        """{'interface': the series as arrays with the steps' times 't'} (a subclass lays them out:
+        ``coupling.problem.InterfaceRecord``)."""
+        return {"interface": dict(self.arrays(), t=np.asarray(times, float))}
 
     def observe(self, n, t, step):
         res = step.get("interface")
@@ -62,13 +77,18 @@ class InterfaceSeries:
 
 class StepClock:
     """The wall time of every step (seconds from the end of the previous step's records to the end of
-    this one's, on this rank): what a long record's per-step cost is, and whether it stays flat."""
+    this one's, on this rank): what a long record's per-step cost is, and whether it stays flat.
+    ``group``: written as the output group 'timing' (dataset step_wall [s])."""
 
-    def __init__(self):
+    def __init__(self, group=False):
         import time
         self._now = time.perf_counter
         self.last = None
         self.values = []
+        self.group = bool(group)
+
+    def groups(self, steps, times):
+        return {"timing": {"step_wall": (np.asarray(self.values, float), "s")}} if self.group else {}
 
     def observe(self, n, t, step):
         now = self._now()
@@ -132,35 +152,66 @@ class Recorder:
       restore(s, n)          the same from a checkpoint after step n
       checkpoint_vecs()      {name: Vec} for a checkpoint (saved globally: any rank count restarts)
       restore_vecs(reader)   the same from a checkpoint's reader
+      groups(steps, times)   the output groups it writes, {group: {dataset: array, (array, unit) or
+                             (array, unit, {attribute: value})}} (``Output.close``), of the recorded
+                             ``steps`` at ``times``; the group 'receivers' is the file's receivers.
+                             Collective (it may gather); the data is rank 0's (Output writes rank
+                             0's), a group None where a rank has none
 
     each method optional. The recorder keeps the steps and times itself; ``soil``, ``structure``
     and ``interface`` name the observers the problems read back, and ``add`` appends one (e.g. the
     BEM's divergence guard, ``bem.stability.DivergenceGuard``), which sees every step after the
-    recorders and before the progress line."""
+    recorders and before the progress line. An observer's groups go to its ``out`` (the Output of
+    its fields), or to the one given to ``add``/``add_recorder``; the interface series' to the
+    soil's. ``interface``: the coupling's series (an ``InterfaceSeries``), else one of
+    ``interface_keys`` when given."""
 
     def __init__(self, cfg, comm, what, grid, soil=None, structure=None, interface_keys=(), interface_nodal=(),
-                 interface_stride=1):
+                 interface_stride=1, interface=None):
         self.cfg, self.comm, self.grid = cfg, comm, grid
         self.soil, self.structure = soil, structure
-        self.interface = (InterfaceSeries(interface_keys, interface_nodal, interface_stride)
-                          if interface_keys else None)
+        self.interface = interface if interface is not None else (
+            InterfaceSeries(interface_keys, interface_nodal, interface_stride) if interface_keys else None)
         self.norms = NormHistory()
         self.progress = ProgressLine(cfg, comm, what, grid.n_steps)
         self.steps, self.times = [], []
         self.observers = [o for o in (soil, structure, self.interface, self.norms) if o is not None]
         self.extra = []
+        self._outs = {}                       # id(observer) -> the Output its groups go to
+        if self.interface is not None:
+            self._outs[id(self.interface)] = getattr(soil, "out", None)
 
-    def add(self, observer):
-        """Append an observer (it sees each step after the recorders, before the progress line)."""
+    def add(self, observer, out=None):
+        """Append an observer (it sees each step after the recorders, before the progress line);
+        ``out``: the Output its groups go to (else its own ``out``)."""
         self.extra.append(observer)
+        if out is not None:
+            self._outs[id(observer)] = out
         return observer
 
-    def add_recorder(self, observer):
+    def add_recorder(self, observer, out=None):
         """Append an observer among the recorders: it sees each step with them (``observe``), and
         the steps the time grid writes (``snapshot``) after the structure's and soil's fields;
-        its ``state``/``restore`` go into checkpoints."""
+        its ``state``/``restore`` go into checkpoints; ``out`` as for ``add``."""
         self.observers.append(observer)
+        if out is not None:
+            self._outs[id(observer)] = out
         return observer
+
+    def output_of(self, observer):
+        """The Output ``observer``'s groups go to (None: none)."""
+        return self._outs.get(id(observer), getattr(observer, "out", None))
+
+    def groups(self, out):
+        """Collective: {group: data} of every observer whose output is ``out`` (``groups`` of the
+        protocol; the groups a rank does not hold, None, left out), in the observers' order."""
+        found = {}
+        for o in self._all():
+            if hasattr(o, "groups") and self.output_of(o) is out:
+                for name, data in o.groups(self.steps, self.times).items():
+                    if data is not None:
+                        found[name] = data
+        return found
 
     def _all(self):
         return self.observers + self.extra + [self.progress]
@@ -228,5 +279,3 @@ class Recorder:
     def soil_receivers(self):
         return self.soil.receivers(len(self.times)) if self.soil is not None else None
 
-    def interface_arrays(self):
-        return self.interface.arrays() if self.interface is not None else {}

@@ -24,8 +24,34 @@ The structure's load (``nodal.NodalLoad``): F a(t) with F the nodal forces of th
 and point loads, sampled per step by the integrator's rule ('cell' or 'step'); the fixed base and
 the coupled run both take it (their load() methods had each written the sampling).
 
+The soil's prescribed motion (``rigid.PrescribedRigidMotion``, h(t) [u0 + theta0 x (x - x_ref)] on a
+region) and the massless footing (``rigid.MasslessRigidFooting``, whose rigid motion is the unknown of
+every step) are sources too: they load the soil through the displacement of a region of elements
+(``rigid``'s docstring has their protocol: ``bind``, ``values``, ``factor``, ``control_point``,
+``correction``). The soil tells the two kinds apart by what they give: a traction source has
+``step_mean``, a motion source ``values``; it takes at most one motion source.
+
 Where a new excitation goes: a new kind of source is a module here; the domains take it through
-their ``sources`` argument (``bem.problem.BEMTransient(cfg, comm, sources=[...])``).
+their ``sources`` argument (``bem.problem.BEMTransient(cfg, comm, sources=[...])``); without it the
+soil takes the sources the options describe (``from_options``).
 """
-from .traction import SurfaceTraction, uniform_patch, soil_sources  # noqa: F401
-from .nodal import NodalLoad  # noqa: F401
+from .traction import SurfaceTraction, uniform_patch, soil_sources
+from .nodal import NodalLoad
+from .rigid import PrescribedRigidMotion, MasslessRigidFooting, rigid_motion
+
+__all__ = ["SurfaceTraction", "uniform_patch", "soil_sources", "NodalLoad", "PrescribedRigidMotion",
+           "MasslessRigidFooting", "rigid_motion", "from_options", "is_motion"]
+
+
+def from_options(cfg, mesh):
+    """The soil's sources the options describe: the surface traction of -ssi_load_* and the rigid
+    motion of -ssi_disp_* (prescribed or a massless footing); a list, empty when nothing loads the
+    soil."""
+    tractions = soil_sources(cfg, mesh)
+    motion = rigid_motion(cfg, mesh)
+    return tractions + ([motion] if motion is not None else [])
+
+
+def is_motion(source):
+    """Whether ``source`` prescribes the displacement of a region (``rigid``) rather than a traction."""
+    return hasattr(source, "values") and not hasattr(source, "step_mean")

@@ -8,6 +8,9 @@ given to the soil, not code in it.
   travel time).
 - The step mean of a delayed box against its closed form.
 - Two sources on adjacent patches are refused (their shared nodes would carry the sum of both).
+- A region's prescribed rigid motion is a source too (``sources.rigid``): given as data through
+  ``sources=[...]``, it equals bit for bit the run of the options that describe it (-ssi_disp_*),
+  its resultants included; a second motion source is refused.
 """
 import os
 
@@ -29,11 +32,11 @@ SMALL = {"problem": "bem", "cp": 548, "cs": 316, "rho": 2000, "dt": 7.5e-4, "t_e
          "receivers": "-2.5,1.5,0;2.5,1.5,0", "output_stride": 8, "output_overwrite": 1, "warn_beta": 0}
 
 
-def _cfg(out):
+def _cfg(out, **extra):
     PETSc = petsc()
     from petsc_ssi.app.kinds import resolve
     db = PETSc.Options()
-    opts = dict(SMALL, output=out)
+    opts = dict(SMALL, output=out, **extra)
     for k, v in opts.items():
         db.setValue("ssi_" + k, str(v))
     try:
@@ -73,14 +76,14 @@ def patches(mesh, elements):
     return out
 
 
-def _run(out, make_sources):
+def _run(out, make_sources, **extra):
     PETSc = petsc()
     from petsc_ssi.bem.problem import BEMTransient
     from petsc_ssi.bem.halfspace import read_surface_mesh
     from petsc_ssi.bem import symmetry
-    cfg = _cfg(out)
+    cfg = _cfg(out, **extra)
     mesh = read_surface_mesh(cfg, PETSc.COMM_WORLD, symmetry.parse(cfg.symmetry))
-    BEMTransient(cfg, PETSc.COMM_WORLD, sources=make_sources(mesh)).run()
+    BEMTransient(cfg, PETSc.COMM_WORLD, sources=make_sources(mesh) if make_sources else None).run()
     with h5py.File(out) as f:
         snaps = {k: f[k][...] for k in f if k.startswith("displacement_") or k.startswith("traction_")}
         return f["receivers/t"][...], f["receivers/u"][...], snaps
@@ -138,3 +141,52 @@ def test_adjacent_sources_are_refused():
     with pytest.raises(SSIError, match="left patch and right patch load different elements that share 9 nodes"):
         check_sources(mesh, [a, b])
     check_sources(mesh, [a, SurfaceTraction(left, [0, 0, -2.0], h)])      # the same elements: summed
+
+
+# the rigid motion of the 2 m x 2 m patch (group 'load' of the grid): a translation and a rocking about
+# y (both even about the plane y = 0), about a reference point off the centre, switched on for 10 ms
+U0, THETA, XREF, T0 = (1e-6, 0.0, -1e-6), (0.0, 1e-6, 0.0), (0.2, 0.0, 0.0), 0.01
+DISP = {"disp_group": "load", "disp_value": "1e-6,0,-1e-6", "disp_rotation": "0,1e-6,0", "disp_ref": "0.2,0,0",
+        "disp_history": "box", "disp_t0": T0}
+
+
+def test_a_rigid_motion_as_data_equals_the_options_that_describe_it(tmp_path):
+    from petsc_ssi.sources import PrescribedRigidMotion
+    from petsc_ssi.histories import History
+    motion = []
+
+    def given(mesh):
+        motion.append(PrescribedRigidMotion(mesh.select("load"), U0, THETA, History("box", T0), XREF,
+                                            name="the patch's rigid motion"))
+        return motion
+
+    a, b = str(tmp_path / "data.h5"), str(tmp_path / "options.h5")
+    t, u_data, s_data = _run(a, given)
+    t2, u_opts, s_opts = _run(b, None, **DISP)
+    assert np.array_equal(t, t2) and np.array_equal(u_data, u_opts) and np.abs(u_data).max() > 0
+    assert len(s_data) >= 4 and set(s_data) == set(s_opts)
+    for k in s_data:
+        assert np.array_equal(s_data[k], s_opts[k]), k
+    with h5py.File(a) as f, h5py.File(b) as g:
+        assert set(f["resultants"]) == set(g["resultants"])
+        for k in f["resultants"]:
+            assert np.array_equal(f["resultants"][k][()], g["resultants"][k][()]), k
+        assert np.array_equal(f["resultants/x_ref"][()], XREF)
+        h = f["resultants/h"][()]
+        assert h[0] == 1.0 and h[-1] == 0.0          # the box: on for 10 ms of the 36
+        assert np.abs(f["resultants/force"][()][:, 2]).max() > 0
+    assert motion[0].x is not None and len(motion[0].base) == 3 * len(motion[0].x)     # bound by the soil
+
+
+def test_two_rigid_motions_are_refused(tmp_path):
+    from petsc_ssi.sources import PrescribedRigidMotion
+    from petsc_ssi.histories import History
+    from petsc_ssi.petsc import SSIError
+
+    def two(mesh):
+        e = mesh.select("load")
+        return [PrescribedRigidMotion(e[:1], U0, THETA, History("heaviside"), XREF, name="first"),
+                PrescribedRigidMotion(e[1:], U0, THETA, History("heaviside"), XREF, name="second")]
+
+    with pytest.raises(SSIError, match="2 prescribed motions of soil regions \\(first, second\\)"):
+        _run(str(tmp_path / "two.h5"), two)
