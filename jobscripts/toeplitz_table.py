@@ -37,6 +37,9 @@ def row(log):
     m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s\)", text)
     if m:
         r["stored_GB"], r["kernels_s"] = float(m.group(1)), float(m.group(2))
+        g = re.search(r"G lags as \d+ kernels on the traction elements' .*?, ([\d.e+-]+) GB\)", text)
+        if g:                                   # the G side's kernels and kept transforms (issue 41 G on the store)
+            r["stored_GB"] = round(r["stored_GB"] + float(g.group(1)), 4)
     else:
         m = re.search(r"stored (\S+) GB", text)
         r["stored_GB"] = float(m.group(1)) if m else ""

@@ -151,7 +151,7 @@ class Marcher:
         self.norm_prefix_max = []   # the divergence guard's running max of |u| (bem/stability.py guard)
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
-        self.toeplitz = None        # bem/toeplitz.ToeplitzHistory: the H lags >= 2 as FFT kernels
+        self.toeplitz = []          # bem/toeplitz.ToeplitzHistory per side: the H (and G) lags >= 3 as FFT kernels
 
     def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
@@ -281,10 +281,11 @@ class Marcher:
             self._blocked_history(n, out_u)
         else:
             self.history_step(n, out_u)
-        if self.toeplitz is not None:       # the H lags of a uniform grid in Fourier space (bem/toeplitz.py)
+        if self.toeplitz:                   # the H and G lags of a uniform grid in Fourier space (bem/toeplitz.py)
             ev = event("SSI_BEM_HistFFT")
             ev.begin()
-            self.toeplitz.add(n, self, out_u)
+            for side in self.toeplitz:
+                side.add(n, self, out_u)
             ev.end()
 
     def history_step(self, n, out_u):
@@ -672,8 +673,8 @@ class Marcher:
         of an older version holds one dataset per step, ``bem_u_000123``)."""
         self.n = int(n)
         self._blk = self._rep = None
-        if self.toeplitz is not None:
-            self.toeplitz.reset()           # its kept transforms are made again from the restored states
+        for side in self.toeplitz:
+            side.reset()                    # its kept transforms are made again from the restored states
         steps = list(self._kept_steps())
         for name, buf, tmpl in (("u", self.ubuf, self.u_tmpl), ("p", self.pbuf, self.p_tmpl)):
             if not tmpl.getSize():
