@@ -481,6 +481,9 @@ class HalfSpace:
         if why is not None:
             if store == "toeplitz":
                 raise SSIError(f"-ssi_lag_store toeplitz: {why}")
+            if self.cfg.get("toeplitz_precision", "double") != "double":
+                raise SSIError(f"-ssi_toeplitz_precision {self.cfg.toeplitz_precision}: -ssi_lag_store auto takes the "
+                               f"dense lag matrices here ({why}), which keep no transforms")
             printf(f"[ssi] lag store: dense lag matrices ({why})")
             return None
         printf(f"[ssi] lag store: toeplitz, {lat.describe()}")
