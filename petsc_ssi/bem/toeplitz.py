@@ -214,8 +214,9 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     k = int(plan.k) if active else 0
     W = int(L) + 3 * block + 8
     # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
-    # rank's copies of them for the step matrix's lags' panel products (``_replicate``): 8 bytes a DOF and state
-    ring = 8.0 * n_dofs * (int(L) + 2 + 31) * (1 + ranks)
+    # rank's copies of the states lags 1-2's panel products read (``_replicate``, ``rep_depth``: 2 + 3 + 32):
+    # 8 bytes a DOF and state
+    ring = 8.0 * n_dofs * ((int(L) + 2 + 31) + ranks * (2 + 3 + 32))
     factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
     nbytes = float(g_bytes) + ring + factors
     build = t_build = flops = sums = 0.0
