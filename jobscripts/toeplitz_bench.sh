@@ -44,8 +44,8 @@ run() {
     -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 &
   local pid=$! peak=0 rss avail
   while kill -0 "$pid" 2>/dev/null; do     # the ranks' resident memory (children of this mpirun), and the guard
-    rss=$(ps --ppid "$pid" -o rss= | awk '{s += $1} END {print s + 0}')
-    (( rss > peak )) && peak=$rss
+    rss=$( (ps --ppid "$pid" -o rss= || true) | awk '{s += $1} END {print s + 0}')   # (ps fails once the ranks end)
+    if (( rss > peak )); then peak=$rss; fi
     avail=$(awk '/MemAvailable/ {print int($2 / 1048576)}' /proc/meminfo)
     if (( MIN_FREE_GB > 0 && avail < MIN_FREE_GB )); then
       echo "# stopped by the script: the machine's available memory fell to $avail GB (MIN_FREE_GB=$MIN_FREE_GB)," \
