@@ -218,7 +218,8 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     tz_bytes = sum(t.bytes for t in march.toeplitz)
     mem = mem_g + tz_bytes
     gside = (f"; G lags as {march.toeplitz[1].D} kernels on the traction elements' {glat.in_n[0]} x "
-             f"{glat.in_n[1]} window (FFT grid {glat.Mx} x {glat.My}, {march.toeplitz[1].bytes / 1e9:.3g} GB)"
+             f"{glat.in_n[1]} window (FFT grid {glat.Mx} x {glat.My}, kernels {march.toeplitz[1].t_build:.3g} s, "
+             f"{march.toeplitz[1].bytes / 1e9:.3g} GB)"
              if glat is not None else "")
     printf(f"[ssi] assembly {fmt_time(t_asm)}: lag store toeplitz on the {prob.lattice.describe()}: "
            f"{th.D} history kernels K'_d in Fourier space"

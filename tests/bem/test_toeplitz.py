@@ -163,7 +163,7 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     import re
     stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
     g_stored = float(re.search(r"G lags as \d+ kernels on the traction elements' 2 x 2 window \(FFT grid 6 x 6, "
-                               r"([\d.e+-]+) GB\)", out).group(1))
+                               r"kernels [\d.e+-]+ s, ([\d.e+-]+) GB\)", out).group(1))
 
     class Lat:
         Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
