@@ -164,8 +164,11 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # weighted states over its rate of the exact products, times the idle r_products; median of 3.44, 6.67,
 # 4.69 GFlop/s), and the bytes of the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested
 # dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak
-# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0}
+# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors); a G kernel offset costs
+# g_pair_factor H offsets (the displacement kernel's integrals beside the traction kernel's: the 40 m site
+# of jobscripts/toeplitz_bench.sh, 8.58 s for 6 889 G offsets against 19.3 s for 25 281 H offsets: 1.63)
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0,
+         "g_pair_factor": 1.6}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
@@ -231,7 +234,7 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag))))
         nbytes += 16.0 * F * m * (D + k) + vbytes * F * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
-        t_build += r["t_pair_lag"] * pairs * (D + k) / ranks
+        t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
         flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         sums += 2.0 * 54 * F * iwork
     t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"])
