@@ -15,7 +15,11 @@
 # runs/pekeris/toeplitz_bench.csv, the plot runs/pekeris/toeplitz_cost_per_step.png and the scaling
 # table into jobscripts/README.md.
 #   bash jobscripts/toeplitz_bench.sh            (RANKS=1 SIZES="24 36" T_END=0.05 to change;
-#   PARTS="site" runs only the sites; PARTS="paper grid scale site" is everything)
+#   PARTS="site" runs only the sites; PARTS="paper grid scale site" is everything; SITE_OPTS: options of
+#   every site run, default single-precision kept transforms; SITE_EXACT: the size whose all-exact sibling
+#   runs, default the first of SITE_SIZES, "" none; MIN_FREE_GB: stop a run when the machine's available
+#   memory falls below this many GB, default 0: never. Every run's log ends with its ranks' resident
+#   memory sampled every 2 s: "# sampled peak RSS over the ranks")
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 RANKS=${RANKS:-2}
@@ -25,6 +29,9 @@ OUT=${OUT:-out/bench/toeplitz}
 PARTS=${PARTS:-"paper grid scale site"}
 SITE_SIZES=${SITE_SIZES:-"40 50 60 80 100"}
 SITE_INTERP=${SITE_INTERP:-"-ssi_interp linear -ssi_interp_tl 0.0712 -ssi_interp_k 31"}
+SITE_OPTS=${SITE_OPTS:-"-ssi_toeplitz_precision single"}
+SITE_EXACT=${SITE_EXACT-${SITE_SIZES%% *}}
+MIN_FREE_GB=${MIN_FREE_GB:-0}
 has() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup > /dev/null
@@ -34,7 +41,21 @@ run() {
   echo "[bench] $name on $RANKS rank(s) -> $OUT/$name.log"
   echo "# load average before the run (other users of the machine): $(cat /proc/loadavg)" > "$OUT/$name.log"
   mpirun --allow-run-as-root --oversubscribe -n "$RANKS" "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" \
-    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 || true
+    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 &
+  local pid=$! peak=0 rss avail
+  while kill -0 "$pid" 2>/dev/null; do     # the ranks' resident memory (children of this mpirun), and the guard
+    rss=$( (ps --ppid "$pid" -o rss= || true) | awk '{s += $1} END {print s + 0}')   # (ps fails once the ranks end)
+    if (( rss > peak )); then peak=$rss; fi
+    avail=$(awk '/MemAvailable/ {print int($2 / 1048576)}' /proc/meminfo)
+    if (( MIN_FREE_GB > 0 && avail < MIN_FREE_GB )); then
+      echo "# stopped by the script: the machine's available memory fell to $avail GB (MIN_FREE_GB=$MIN_FREE_GB)," \
+        "the ranks held $(awk -v k="$rss" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
+      kill "$pid"
+    fi
+    sleep 2
+  done
+  wait "$pid" || true
+  echo "# sampled peak RSS over the ranks: $(awk -v k="$peak" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
   echo "# load average after the run: $(cat /proc/loadavg)" >> "$OUT/$name.log"
 }
 P=(-options_file runs/pekeris/paper.opts)
@@ -60,9 +81,11 @@ if has scale; then
 fi
 # the sites (issue 41's 100 m item): interpolated far lags, the estimate of each beside it
 if has site; then
-  S=("${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_t_end 0.3)
-  first=${SITE_SIZES%% *}
-  run "site-$first-exact" "${S[@]}" -ssi_mesh_size "$first,$first"
+  # shellcheck disable=SC2206
+  S=("${P[@]}" -ssi_symmetry none -ssi_lag_store toeplitz -ssi_t_end 0.3 $SITE_OPTS)
+  if [[ -n "$SITE_EXACT" ]]; then
+    run "site-$SITE_EXACT-exact" "${S[@]}" -ssi_mesh_size "$SITE_EXACT,$SITE_EXACT"
+  fi
   for L in $SITE_SIZES; do
     # shellcheck disable=SC2086
     run "site-$L" "${S[@]}" -ssi_mesh_size "$L,$L" $SITE_INTERP

@@ -22,7 +22,7 @@ from logview import parse  # noqa: E402
 
 BEGIN, END = "<!-- toeplitz:begin -->", "<!-- toeplitz:end -->"
 COLS = ["run", "store", "ranks", "dofs", "steps", "stored_GB", "kernels_s", "history_s", "history_ms_per_step",
-        "total_s", "peak_GB", "est_GB", "est_kernels_s", "est_history_s", "note"]
+        "total_s", "peak_GB", "sampled_peak_GB", "est_GB", "est_kernels_s", "est_history_s", "note"]
 
 
 def row(log):
@@ -37,6 +37,9 @@ def row(log):
     m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s\)", text)
     if m:
         r["stored_GB"], r["kernels_s"] = float(m.group(1)), float(m.group(2))
+        g = re.search(r"G lags as \d+ kernels on the traction elements' .*?, ([\d.e+-]+) GB\)", text)
+        if g:                                   # the G side's kernels and kept transforms (issue 41 G on the store)
+            r["stored_GB"] = round(r["stored_GB"] + float(g.group(1)), 4)
     else:
         m = re.search(r"stored (\S+) GB", text)
         r["stored_GB"] = float(m.group(1)) if m else ""
@@ -50,14 +53,20 @@ def row(log):
     m = re.search(r"toeplitz estimate: (\S+) GB over the ranks .*kernels (\S+) s, history sum (\S+) s", text)
     if m:
         r["est_GB"], r["est_kernels_s"], r["est_history_s"] = (float(m.group(i)) for i in (1, 2, 3))
+    m = re.search(r"# sampled peak RSS over the ranks: (\S+) GB", text)     # (toeplitz_bench.sh's own sampling)
+    r["sampled_peak_GB"] = float(m.group(1)) if m else ""
     m = re.search(r"error: (.*)", text)
     r["note"] = ("refused: " + m.group(1)[:160]) if m else ""
+    m = re.search(r"# (stopped by the script: .*)", text)
+    if m:
+        r["note"] = m.group(1)
     return r
 
 
 SITE_BEGIN, SITE_END = "<!-- toeplitz-site:begin -->", "<!-- toeplitz-site:end -->"
 SITE_COLS = ["run", "dofs", "steps", "kernels", "stored_GB", "kernels_s", "history_s", "history_ms_per_step",
-             "total_s", "peak_GB", "est_GB", "est_history_ms_per_step", "cli_GB", "cli_history_s", "cli_setup_s"]
+             "total_s", "peak_GB", "sampled_peak_GB", "est_GB", "est_history_ms_per_step", "cli_GB", "cli_history_s",
+             "cli_setup_s", "note"]
 
 
 def site_row(outdir, r):
@@ -182,7 +191,7 @@ def write_csv(rows, path):
         w = csv.DictWriter(f, COLS)
         w.writerow({c: c + {"stored_GB": " [GB]", "kernels_s": " [s]", "history_s": " [s]",
                             "history_ms_per_step": " [ms]", "total_s": " [s]", "peak_GB": " [GB]",
-                            "est_GB": " [GB]", "est_kernels_s": " [s]", "est_history_s": " [s]"}.get(c, "")
+                            "sampled_peak_GB": " [GB]", "est_GB": " [GB]", "est_kernels_s": " [s]", "est_history_s": " [s]"}.get(c, "")
                     for c in COLS})
         for r in rows:
             w.writerow({c: r.get(c, "") for c in COLS})

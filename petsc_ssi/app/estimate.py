@@ -141,7 +141,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
     counts are not made: its element-pair tables hold every (node, element) pair (O(N^2) on a whole
     grid: minutes and GBs on a 60 m site), and the run does not store those matrices."""
     from ..bem.halfspace import HalfSpace
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
     from ..bem.lagset import load_kernels
     from ..sysmem import process_rss
     from ..petsc import SSIError
@@ -159,6 +159,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
     except SSIError:
         return None
     lat.n_offsets = len(kernel_offsets(lat))
+    glat = traction_grid(lat, ls.VT)
+    single = cfg.get("toeplitz_precision", "double") == "single"
     g = prob.toeplitz_side_bytes(ls, plan)
     load_kernels()                      # the process measured with the compiled kernels it will hold
     rss = process_rss()
@@ -169,12 +171,15 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
              "estimate; the dense lag matrices' model is not counted on a uniform grid)",
              f"[ssi]   {3 * N} DOFs ({N} nodes), {len(ls.Vc)} elements with images, {prob.n_steps} steps, "
              f"{prob.regions.n_t} traction nodes; {lat.describe()}; kernels: {plan.Lx} exact lags + {k} "
-             f"interpolating (of {prob.L} the run reaches), states kept {prob.L}",
+             f"interpolating (of {prob.L} the run reaches), states kept {prob.L} ("
+             f"{'single' if single else 'double'} precision transforms)"
+             + (f"; G kernels on the traction elements' {glat.in_n[0]} x {glat.in_n[1]} window (FFT grid "
+                f"{glat.Mx} x {glat.My})" if glat is not None else ""),
              "[ssi]   ranks | kernels_s history_s | GB over the ranks beside the processes | with the processes "
              "(this one's resident size each) | fits"]
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
-                                stabilized=cfg.scheme.startswith("stabili"))
+                                stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
         tot = b + p * rss
         per_node = tot / p * min(q, p)
         flag = "yes" if per_node <= limit else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
@@ -191,7 +196,7 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     and the surface is a uniform flat grid (else the reason, one line)."""
     if cfg.get("lag_store", "dense") == "dense":
         return []
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
     from ..petsc import SSIError
     try:
         if not cnt.lagset.flat:
@@ -200,13 +205,14 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     except SSIError as e:
         return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
     lat.n_offsets = len(kernel_offsets(lat))
+    glat = traction_grid(lat, cnt.lagset.VT)
     out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks "
            "beside the processes"]
     for p in ranks:
-        lags = cnt.Lx + cnt.k
-        g = 8.0 * 5 * prob.mesh.n_nodes * prob.regions.n_t * lags
+        g = 8.0 * 5 * prob.mesh.n_nodes * prob.regions.n_t * min(2, cnt.Lx)      # (G lags 1-2 dense)
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g,
-                                plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"))
+                                plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
+                                single=cfg.get("toeplitz_precision", "double") == "single")
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")
     return out
 

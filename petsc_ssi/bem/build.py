@@ -199,48 +199,55 @@ def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0):
 
 def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     """Collective: build_marcher on a uniform flat grid (-ssi_lag_store toeplitz, ``bem.toeplitz``):
-    lags 1 and 2 assembled as always (the step matrix), the H lags of the history sum as FFT
-    kernels on the grid, G (traction columns only) as the dense path stores it."""
-    from .toeplitz import ToeplitzHistory
+    lags 1 and 2 assembled as always (H and, with tractions, G: the step matrix and the known values'
+    terms), the H lags of the history sum beyond them as FFT kernels on the grid, the G lags as FFT
+    kernels on the window of the traction elements (``toeplitz.traction_grid``)."""
+    from .toeplitz import ToeplitzHistory, traction_grid
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
     ls.assemble(monitor=cfg.monitor, lag_hi=2)
     nev = ls.kernel_evaluations
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))
+    k = plan.k if plan.active else 0
     with event("SSI_BEM_LagMats"):
         H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
         H = list(H) + [None] * (plan.Lx - 2)
-        k = plan.k if plan.active else 0
-        HI, GI = [None] * k, []
+        G = [None] * plan.Lx
         if prob.regions.n_t:
-            G, tl = _traction_g(comm, prob, plan, ls, plan.Lx)
+            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx))
+            G[:len(g)] = g
             nev += tl.kernel_evaluations
-            for j in range(k):
-                lag, toff = plan.kernel_time(j)
-                g, tl = _traction_g(comm, prob, plan, ls, lag, lag, toff)
-                GI.append(g[0])
-                nev += tl.kernel_evaluations
-        else:
-            G = [None] * plan.Lx
     ls.H = ls.G = None
-    b, sub = _block_of(cfg, comm, H, G, HI, GI)
-    march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
+    b, sub = _block_of(cfg, comm, H, G, [None] * k, [])
+    march.set_lags(H, G, plan, [None] * k, [None] * k if prob.regions.n_t else [], block=b, sub=sub)
+    grids = [("u", prob.lattice)]
+    glat = traction_grid(prob.lattice, ls.VT) if prob.regions.n_t else None
+    if glat is not None:
+        grids.append(("p", glat))
     with event("SSI_BEM_Toeplitz"):
-        th = ToeplitzHistory(comm, ls, prob.lattice, log, block=int(cfg.history_block) or 8).build(march, plan,
-                                                                                            monitor=cfg.monitor)
-    march.toeplitz = th
-    ls.kernel_evaluations = nev + th.nev
+        for side, lat in grids:
+            march.toeplitz.append(ToeplitzHistory(comm, ls, lat, log, block=int(cfg.history_block) or 8, side=side,
+                                                  precision=cfg.get("toeplitz_precision", "double"))
+                                  .build(march, plan, monitor=cfg.monitor))
+    th = march.toeplitz[0]
+    ls.kernel_evaluations = nev + sum(t.nev for t in march.toeplitz)
     t_asm = time.perf_counter() - t0
-    mem_g = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in [M for M in H + G + GI if M is not None]))
-    mem = mem_g + th.bytes
+    mem_g = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in [M for M in H + G if M is not None]))
+    tz_bytes = sum(t.bytes for t in march.toeplitz)
+    mem = mem_g + tz_bytes
+    gside = (f"; G lags as {march.toeplitz[1].D} kernels on the traction elements' {glat.in_n[0]} x "
+             f"{glat.in_n[1]} window (FFT grid {glat.Mx} x {glat.My}, kernels {march.toeplitz[1].t_build:.3g} s, "
+             f"{march.toeplitz[1].bytes / 1e9:.3g} GB)"
+             if glat is not None else "")
     printf(f"[ssi] assembly {fmt_time(t_asm)}: lag store toeplitz on the {prob.lattice.describe()}: "
            f"{th.D} history kernels K'_d in Fourier space"
            + (f" and the {th.k} interpolating matrices' kernels (the far lags' states weighted per step, {th.R} "
               "steps kept)" if th.k else "")
-           + f" ({th.bytes / 1e9:.3g} GB with the kept states' "
-           f"transforms; kernels {th.t_build:.3g} s), step matrix and G lags {mem_g / 1e9:.3g} GB, "
-           f"{ls.kernel_evaluations:.3g} kernel evaluations")
+           + f" ({th.bytes / 1e9:.3g} GB with the kept states' transforms; kernels "
+           f"{sum(t.t_build for t in march.toeplitz):.3g} s){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
+           f"{ls.kernel_evaluations:.3g} kernel evaluations; kept transforms in "
+           f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)")
     _say_block(march)
     return march, {"t_asm": t_asm, "mem_exact": mem, "mem_interp": 0.0, "ndense": 0, "nbaij": 0, "nsingle": 0,
                    "fill": float("nan"), "mem": mem}

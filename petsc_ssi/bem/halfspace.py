@@ -505,19 +505,21 @@ class HalfSpace:
         if why is not None:
             if store == "toeplitz":
                 raise SSIError(f"-ssi_lag_store toeplitz: {why}")
+            if self.cfg.get("toeplitz_precision", "double") != "double":
+                raise SSIError(f"-ssi_toeplitz_precision {self.cfg.toeplitz_precision}: -ssi_lag_store auto takes the "
+                               f"dense lag matrices here ({why}), which keep no transforms")
             printf(f"[ssi] lag store: dense lag matrices ({why})")
             return None
         printf(f"[ssi] lag store: toeplitz, {lat.describe()}")
         return lat
 
     def toeplitz_side_bytes(self, ls, plan):
-        """Collective: the bytes of a toeplitz run beside its kernels: G dense (N x n_t blocks of 5 values,
-        exact and interpolating lags), lags 1 and 2 as Mats (block-sparse: their wave reaches a few
-        elements) and the step matrix's factors, counted from the blocks of the lag-2 window on a sample
-        of rows, 36 B a block, three times over."""
+        """Collective: the bytes of a toeplitz run beside its kernels: G lags 1 and 2 dense (N x n_t blocks of
+        5 values; the later G lags are kernels on the store, ``toeplitz.estimate``), H lags 1 and 2 as Mats
+        (block-sparse: their wave reaches a few elements) and the step matrix's factors, counted from the
+        blocks of the lag-2 window on a sample of rows, 36 B a block, three times over."""
         from .windows import estimate_blocks
-        lags = plan.Lx + (plan.k if plan.active else 0)
-        g = 8.0 * 5 * self.mesh.n_nodes * self.regions.n_t * lags
+        g = 8.0 * 5 * self.mesh.n_nodes * self.regions.n_t * min(2, plan.Lx)
         rows = ls.rows[::max(1, len(ls.rows) // 256)]          # (a sample of rows: O(rows x elements))
         nb = estimate_blocks(self.mesh.nodes, rows, ls.Vc, ls.VR, 2, self.mat, self.dt,
                              len(ls.Vc) // self.mesh.n_cells) * (len(ls.rows) / max(len(rows), 1))
@@ -526,7 +528,7 @@ class HalfSpace:
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
         """Collective: refuse a toeplitz run whose kernels and kept transforms would not fit the node
         (``toeplitz.estimate``), and predict its time loop (``loop_estimate``)."""
-        from .toeplitz import estimate, kernel_offsets
+        from .toeplitz import estimate, kernel_offsets, traction_grid
         from mpi4py import MPI
         c = self.cfg
         lat = self.lattice
@@ -537,7 +539,8 @@ class HalfSpace:
         block = int(c.history_block) or 8
         g = self.toeplitz_side_bytes(ls, plan)
         est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g, plan=plan,
-                                        stabilized=c.scheme.startswith("stabili"))
+                                        stabilized=c.scheme.startswith("stabili"), glat=traction_grid(lat, ls.VT),
+                                        single=c.get("toeplitz_precision", "double") == "single")
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)

@@ -151,7 +151,7 @@ class Marcher:
         self.norm_prefix_max = []   # the divergence guard's running max of |u| (bem/stability.py guard)
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
-        self.toeplitz = None        # bem/toeplitz.ToeplitzHistory: the H lags >= 2 as FFT kernels
+        self.toeplitz = []          # bem/toeplitz.ToeplitzHistory per side: the H (and G) lags >= 3 as FFT kernels
 
     def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =
@@ -170,6 +170,13 @@ class Marcher:
         # uninterrupted run), and a checkpoint holds what any b <= BLOCK_MAX needs, so a restart
         # on another rank count, whose automatic b may differ, has every state it reads
         self.depth = self.L + 2 + (BLOCK_MAX - 1)
+        # every rank's copies of the states for the panel products (``_replicate``): as deep as the Mats'
+        # lags reach from a block's start through its b <= BLOCK_MAX steps; all of the ring when an
+        # interpolating Mat weighs far states (on the toeplitz store only lags 1-2 are Mats: 37 states, not
+        # L + 33 states of every DOF on every rank)
+        lmat = max([j + 1 for Ms in (H, G) for j, M in enumerate(Ms) if M is not None] + [0])
+        far = any(M is not None for M in self.HI + self.GI)
+        self.rep_depth = self.depth if far else min(self.depth, lmat + 3 + BLOCK_MAX)
         self.ubuf = [self.u_tmpl.duplicate() for _ in range(self.depth)]
         self.pbuf = [self.p_tmpl.duplicate() for _ in range(self.depth)]
         self._setup_index_maps()
@@ -266,6 +273,10 @@ class Marcher:
     def _slot(self, m):
         return m % self.depth
 
+    def _rslot(self, m):
+        """The row of state m in every rank's copies (``_replicate``)."""
+        return m % self.rep_depth
+
     def _terms(self, n, j):
         """(state index m, coefficient) of q_j at step n, indices in 1..n-1."""
         if self.scheme == "stabilized":
@@ -281,10 +292,11 @@ class Marcher:
             self._blocked_history(n, out_u)
         else:
             self.history_step(n, out_u)
-        if self.toeplitz is not None:       # the H lags of a uniform grid in Fourier space (bem/toeplitz.py)
+        if self.toeplitz:                   # the H and G lags of a uniform grid in Fourier space (bem/toeplitz.py)
             ev = event("SSI_BEM_HistFFT")
             ev.begin()
-            self.toeplitz.add(n, self, out_u)
+            for side in self.toeplitz:
+                side.add(n, self, out_u)
             ev.end()
 
     def history_step(self, n, out_u):
@@ -385,16 +397,16 @@ class Marcher:
             self._rep = {}
             for side, tmpl in (("u", self.u_tmpl), ("p", self.p_tmpl)):
                 sc, seq = PETSc.Scatter.toAll(tmpl)
-                self._rep[side] = (sc, seq, np.zeros((self.depth, tmpl.getSize())))
+                self._rep[side] = (sc, seq, np.zeros((self.rep_depth, tmpl.getSize())))
             self._rep_upto = 0
-        lo = max(self._rep_upto + 1, n0 - self.depth + 1, 1)
+        lo = max(self._rep_upto + 1, n0 - self.rep_depth + 1, 1)
         for m in range(lo, n0 + 1):
             for side, bufs in (("u", self.ubuf), ("p", self.pbuf)):
                 sc, seq, arr = self._rep[side]
                 if arr.shape[1] == 0:
                     continue
                 sc.scatter(bufs[self._slot(m)], seq, addv=self.PETSc.InsertMode.INSERT_VALUES)
-                arr[self._slot(m)] = seq.getArray(readonly=True)
+                arr[self._rslot(m)] = seq.getArray(readonly=True)
         self._rep_upto = max(self._rep_upto, n0)
 
     def _new_block(self, n0):
@@ -446,7 +458,7 @@ class Marcher:
             x[...] = 0.0
             terms = panel[(key, side)]
             bsr.panel_states(rep, np.array([k for k, _, _ in terms], np.int64),
-                             np.array([self._slot(m) for _, m, _ in terms], np.int64),
+                             np.array([self._rslot(m) for _, m, _ in terms], np.int64),
                              np.array([c for _, _, c in terms], float), x, kind != "dense")
             sign = -1.0 if side == "u" else 1.0
             if kind == "dense":
@@ -512,7 +524,7 @@ class Marcher:
                 continue
             rep = self._rep[side][2]
             x = np.zeros(rep.shape[1])
-            bsr.panel_states(rep, np.zeros(len(terms), np.int64), np.array([self._slot(m) for m, _ in terms], np.int64),
+            bsr.panel_states(rep, np.zeros(len(terms), np.int64), np.array([self._rslot(m) for m, _ in terms], np.int64),
                              np.array([c for _, c in terms], float), x[None, :], False)
             if kind == "dense":
                 A = M.getDenseArray(readonly=True)
@@ -672,8 +684,8 @@ class Marcher:
         of an older version holds one dataset per step, ``bem_u_000123``)."""
         self.n = int(n)
         self._blk = self._rep = None
-        if self.toeplitz is not None:
-            self.toeplitz.reset()           # its kept transforms are made again from the restored states
+        for side in self.toeplitz:
+            side.reset()                    # its kept transforms are made again from the restored states
         steps = list(self._kept_steps())
         for name, buf, tmpl in (("u", self.ubuf, self.u_tmpl), ("p", self.pbuf, self.p_tmpl)):
             if not tmpl.getSize():

@@ -44,6 +44,11 @@ register("lag_store", "enum", "dense", "", "how the lags of the history sum are 
          "bem/toeplitz.py; the same answer to round-off; refused in one line naming the first element off the grid); "
          "auto: toeplitz where the grid allows it, else dense (said in one log line)", "bem",
          choices=("dense", "toeplitz", "auto"))
+register("toeplitz_precision", "enum", "double", "", "-ssi_lag_store toeplitz: the precision of the kept states' "
+         "transforms (27 complex numbers per frequency and state on each side's FFT grid, kept while a kernel reads "
+         "the state): double, or single (half their memory; the products still accumulate in double, the kernels "
+         "stay double; the answer moves by about the single-precision rounding of the states: bem/toeplitz.py)",
+         "bem", choices=("double", "single"))
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))
 register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "
@@ -170,6 +175,9 @@ def _bem_checks(cfg):
         for name in ("disp_value", "disp_rotation", "disp_history", "disp_t0", "disp_table"):
             if cfg.user_set(name):
                 return f"-ssi_disp_rigid massless: the footing's motion is the unknown; drop -ssi_{name}"
+    if cfg.get("toeplitz_precision", "double") != "double" and cfg.get("lag_store", "dense") == "dense":
+        return ("-ssi_toeplitz_precision single: the kept transforms are the toeplitz store's; add -ssi_lag_store "
+                "toeplitz (or auto on a uniform flat grid)")
     if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
         return f"-ssi_load_table '{cfg.load_table}': no such file"
     return None

@@ -58,18 +58,36 @@ class Lattice:
         self.perm = perm                # (nv, 9): local node of element v at slot a (SLOTS)
         self.node_fine = node_fine      # (N, 2): a node's position in half element sizes from o
         self.code0 = code0              # (9,): the slot of each local node of element 0 (the kernels')
-        # the FFT grid: a circular convolution of size M gives the linear one on the outputs of lattice
-        # indices r0..r1 (the nodes' span) from inputs 0..n-1 when M >= r1 - r0 + n (their offsets then
-        # differ modulo M): 2 n for a whole grid, less for a symmetric model's rows in one quarter
+        self.in_lo, self.in_n = (0, 0), (nx, ny)    # the lattice box of the inputs (``window``)
+        self._fft_grid()
+
+    def _fft_grid(self):
+        """The FFT grid: a circular convolution of size M gives the linear one on the outputs of lattice
+        indices r0..r1 (the nodes' span) from inputs lo..lo+n-1 (placed at 0..n-1) when M >= r1 - r0 + n
+        (their offsets then differ modulo M): 2 n for a whole grid, less for a symmetric model's rows in
+        one quarter or for inputs on a patch (the G side: the traction elements only)."""
         from scipy.fft import next_fast_len
-        span = [2 * nx, 2 * ny]
+        node_fine = self.node_fine
+        span = [self.nx + self.in_n[0], self.ny + self.in_n[1]]
         if len(node_fine):
-            for ax, n in ((0, nx), (1, ny)):
+            for ax in (0, 1):
                 i = (node_fine[:, ax] - (node_fine[:, ax] & 1)) // 2
-                span[ax] = int(i.max() - i.min() + n)
+                span[ax] = int(i.max() - i.min() + self.in_n[ax])
         self.Mx = next_fast_len(span[0], real=True)
         self.My = next_fast_len(span[1], real=True)
         self.F = self.Mx * (self.My // 2 + 1)
+
+    def window(self, sel):
+        """A copy of this grid whose inputs are the virtual elements ``sel`` (bool) only: their lattice box
+        is the input range and the FFT grid is sized for it (the G side, whose inputs are the elements
+        carrying traction columns)."""
+        import copy
+        w = copy.copy(self)
+        ix, iy = self.cell[sel] // self.ny, self.cell[sel] % self.ny
+        w.in_lo = (int(ix.min()), int(iy.min()))
+        w.in_n = (int(ix.max()) - w.in_lo[0] + 1, int(iy.max()) - w.in_lo[1] + 1)
+        w._fft_grid()
+        return w
 
     def describe(self):
         return (f"{self.nx} x {self.ny} lattice of {self.h[0]:g} x {self.h[1]:g} m elements (FFT grid "
@@ -146,8 +164,11 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # weighted states over its rate of the exact products, times the idle r_products; median of 3.44, 6.67,
 # 4.69 GFlop/s), and the bytes of the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested
 # dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak
-# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0}
+# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors); a G kernel offset costs
+# g_pair_factor H offsets (the displacement kernel's integrals beside the traction kernel's: the 40 m site
+# of jobscripts/toeplitz_bench.sh, 8.58 s for 6 889 G offsets against 19.3 s for 25 281 H offsets: 1.63)
+RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0,
+         "g_pair_factor": 1.6}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
@@ -177,13 +198,16 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
     return steps, work
 
 
-def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True):
+def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
+             glat=None, single=False):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
-    the history sum) of a toeplitz run: kernels 144 complex per frequency for each exact lag (D: L, or the
-    ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept transforms 27 per frequency
-    and kept state (L + 3 b + 8), the build's transients per rank (a chunk of kernels, its spectra, its
-    integrals), ``g_bytes`` of G and the step matrix, the march's past states (the ring and every rank's
-    copy of it), the step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 x 144 flops per
+    the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
+    elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
+    each exact lag (D: L, or the ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept
+    transforms 27 per frequency and kept state (L + 3 b + 8; complex64 with ``single``); the build's
+    transients per rank (a chunk of kernels, its spectra, its integrals: the larger side's), ``g_bytes``
+    of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
+    step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
     (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums``, and
     ``t_step_dof`` per step and DOF."""
@@ -192,43 +216,62 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     D = int(plan.Lx) if active else int(L)
     k = int(plan.k) if active else 0
     W = int(L) + 3 * block + 8
-    F = lat.F
-    per_lag = 144 * lat.Mx * lat.My * 8.0
-    build = ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag)))
     # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
-    # rank's copies of them for the G lags' panel products (``_replicate``): 8 bytes a DOF and state
-    ring = 8.0 * n_dofs * (int(L) + 2 + 31) * (1 + ranks)
+    # rank's copies of the states lags 1-2's panel products read (``_replicate``, ``rep_depth``: 2 + 3 + 32):
+    # 8 bytes a DOF and state
+    ring = 8.0 * n_dofs * ((int(L) + 2 + 31) + ranks * (2 + 3 + 32))
     factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
-    nbytes = 16.0 * F * (144 * (D + k) + 27 * W) + build + float(g_bytes) + ring + factors
-    pairs = lat.n_offsets if hasattr(lat, "n_offsets") else 4 * (2 * lat.nx) * (2 * lat.ny)
-    t_build = r["t_pair_lag"] * pairs * (D + k) / ranks
+    nbytes = float(g_bytes) + ring + factors
+    build = t_build = flops = sums = 0.0
     n = np.arange(1, n_steps + 1)
-    flops = 8.0 * 144 * F * float(np.minimum(np.maximum(n - 1, 0), D).sum())
     isteps, iwork = interp_work(plan, n_steps, block, stabilized)
-    flops += 8.0 * 144 * F * k * isteps
-    t_hist = (flops / (ranks * r["r_products"]) + 2.0 * 54 * F * iwork / (ranks * r["r_sums"])
+    vbytes = 8.0 if single else 16.0
+    for g, m in ((lat, 144), (glat, 180)):
+        if g is None:
+            continue
+        F = g.F
+        per_lag = m * g.Mx * g.My * 8.0
+        build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(CHUNK_BYTES // per_lag))))
+        nbytes += 16.0 * F * m * (D + k) + vbytes * F * 27 * W
+        pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
+        t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
+        flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
+        sums += 2.0 * 54 * F * iwork
+    t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"])
               + n_steps * n_dofs * r["t_step_dof"])
-    return nbytes, t_build, t_hist
+    return nbytes + build, t_build, t_hist
 
 
 def kernel_offsets(lat):
     """The collocation points of the kernels relative to an element of the lattice: per class t the
-    lattice offsets k = i' - i a node of that class (at i') and an element (at i) can have, (points (n, 2)
-    in half element sizes, class, kx, ky); offsets no node reads are left out (their kernel is zero:
-    the outputs they reach are no node's)."""
+    lattice offsets k = i' - i a node of that class (at i') and an input element (at i, in the grid's
+    input box ``in_lo``, ``in_n``) can have, (points (n, 2) in half element sizes, class, kx, ky); offsets
+    no node reads are left out (their kernel is zero: the outputs they reach are no node's)."""
     out = []
     nf = lat.node_fine
+    (lx, ly), (nx, ny) = lat.in_lo, lat.in_n
     for t, (tx, ty) in enumerate(CLASSES):
         sel = ((nf[:, 0] & 1) == tx) & ((nf[:, 1] & 1) == ty)
         if not np.any(sel):
             continue
         ix = (nf[sel, 0] - tx) // 2
         iy = (nf[sel, 1] - ty) // 2
-        kx = np.arange(ix.min() - (lat.nx - 1), ix.max() + 1)
-        ky = np.arange(iy.min() - (lat.ny - 1), iy.max() + 1)
+        kx = np.arange(ix.min() - (lx + nx - 1), ix.max() - lx + 1)
+        ky = np.arange(iy.min() - (ly + ny - 1), iy.max() - ly + 1)
         KX, KY = np.meshgrid(kx, ky, indexing="ij")
         out.append(np.c_[2 * KX.ravel() + tx, 2 * KY.ravel() + ty, np.full(KX.size, t), KX.ravel(), KY.ravel()])
     return np.concatenate(out)
+
+
+def traction_grid(lat, VT):
+    """The G side's grid: ``lat``'s window on the virtual elements with a traction column (VT: their
+    traction columns, -1 none), its kernel offsets counted (``n_offsets``); None without tractions."""
+    sel = np.any(np.asarray(VT) >= 0, axis=1)
+    if not sel.any():
+        return None
+    g = lat.window(sel)
+    g.n_offsets = len(kernel_offsets(g))
+    return g
 
 
 @njit(cache=True)
@@ -255,13 +298,27 @@ def _windows(pts, X, c0, R0, h0, reach, alpha, beta, dt, L, lag_lo, toff, tol, n
     return meta, keep
 
 
-class ToeplitzHistory:
-    """Collective: the H part of the history sum of a uniform flat grid in Fourier space (module
-    docstring). ``build`` computes the kernels; ``add(n, march, out_u)`` subtracts the H terms of step
-    n's history sum from ``out_u``."""
+# the two sides of the history sum (``ToeplitzHistory.side``): H on the displacements (flat pattern H4: x, y
+# out of z in and z out of x, y in; subtracted) and G on the tractions (G5: x, y out of x, y in and z out of z
+# in; added). Per side: the pattern's entries, the output columns of the products with the 9-row (z input)
+# and the 18-row (x, y input) kernels, and the sign of its terms in the history sum
+SIDES = {"u": {"m": 4, "n9": 8, "n18": 4, "sign": -1.0, "what": "H"},
+         "p": {"m": 5, "n9": 4, "n18": 8, "sign": 1.0, "what": "G"}}
+PRECISIONS = {"double": np.complex128, "single": np.complex64}
 
-    def __init__(self, comm, ls, lat, log=printf, block=8):
+
+class ToeplitzHistory:
+    """Collective: one side of the history sum of a uniform flat grid in Fourier space (module
+    docstring): ``side`` "u" the H lags on the displacements (the grid ``lat``), "p" the G lags on the
+    tractions (``lat`` the window of the traction elements, ``traction_grid``). ``build`` computes the
+    kernels; ``add(n, march, out_u)`` adds this side's terms of step n's history sum to ``out_u``. The
+    kept states' transforms in ``precision`` (double, or single: half their memory, the products still in
+    double)."""
+
+    def __init__(self, comm, ls, lat, log=printf, block=8, side="u", precision="double"):
         self.comm, self.ls, self.lat, self.log = comm, ls, lat, log
+        self.side, self.spec = side, SIDES[side]
+        self.vdtype = PRECISIONS[precision]
         self.block = max(1, int(block))     # steps whose known-state products share one pass over the kernels
         self._blk = None
         mpi = comm.tompi4py()
@@ -269,8 +326,6 @@ class ToeplitzHistory:
         F = lat.F
         self.f0, self.f1 = (F * r) // p, (F * (r + 1)) // p
         self.counts = np.array([(F * (q + 1)) // p - (F * q) // p for q in range(p)], np.int64)
-        from .bsr import positions, H4
-        self.pp, self.pq = positions(H4)
         self.upto = 0
 
     # ---------------------------------------------------------------- kernels
@@ -279,7 +334,7 @@ class ToeplitzHistory:
         c_lo..c_hi at kernel time l dt + toff, with the windows, subdivisions and singular treatment
         of the dense assembly of lags lag_lo..L (``_pair_window``); a singular pair (its point a node
         of the element) from lag_lo on, as that assembly integrates it. Returns (offsets kept, meta,
-        P pool offsets, P pool)."""
+        pool offsets, pool): the H integrals' (P) pool on the u side, the G integrals' (U) on the p side."""
         from .assemble import integrate_records, SING_TOL, plane
         ls, lat = self.ls, self.lat
         o = ls.opts
@@ -298,39 +353,41 @@ class ToeplitzHistory:
         meta, keep = _windows(pts, X[0], c0, R0, h0, reach, mat.cp, mat.cs, dt, L, lag_lo, toff, SING_TOL,
                               int(o["subdivisions"]), int(o["max_subdivisions"]), float(o["near_factor"]), c_lo, c_hi)
         meta, pts, idx = meta[keep], pts[keep], np.asarray(sel)[keep]
+        meta[:, 4] = 1 if self.side == "p" else 0            # (want_u: the G integrals too)
         if not hasattr(self, "_plane") or self._plane is None:
             self._plane = plane(ls.in_plane, X, int(o["subdivisions"]), gq, gw, int(o["max_subdivisions"]))
         dropped = np.zeros(2)
-        offP, P, _, _, nev = integrate_records(meta, pts, X, c_hi, dt, mat.cp, mat.cs, mat.rho, mat.nu, gq, gw, gr,
-                                               gwr, toff, float(ls.Vh.min()), ls.pattern(), dropped,
-                                               int(o["subdivisions"]), self._plane)
+        offP, P, offU, U, nev = integrate_records(meta, pts, X, c_hi, dt, mat.cp, mat.cs, mat.rho, mat.nu, gq, gw,
+                                                  gr, gwr, toff, float(ls.Vh.min()), ls.pattern(), dropped,
+                                                  int(o["subdivisions"]), self._plane)
         from mpi4py import MPI
         lost = self.comm.tompi4py().allreduce(float(dropped.max()), op=MPI.MAX)    # (every rank: no hang)
         if lost != 0.0:
             raise SSIError(f"-ssi_lag_store toeplitz: a flat-surface block entry outside its pattern is "
                            f"{lost:.3g}, not 0; report this with the mesh")
         self.nev += int(nev)
-        return idx, meta, offP, P
+        return (idx, meta, offU, U) if self.side == "p" else (idx, meta, offP, P)
 
     def _spectra(self, lag_lo, lag_hi, toff, L):
-        """Yield (lag, this rank's slab of the lag's kernel spectra (4, 9, 4, slab) complex) for lags
-        lag_lo..lag_hi, integrated in chunks of lags (the integrals split over the ranks by offset,
-        summed: each offset is integrated by one rank, so the sum is exact)."""
+        """Yield (lag, this rank's slab of the lag's kernel spectra (4, 9, m, slab) complex: class, slot,
+        pattern entry, frequency) for lags lag_lo..lag_hi, integrated in chunks of lags (the integrals split
+        over the ranks by offset, summed: each offset is integrated by one rank, so the sum is exact)."""
         from scipy.fft import rfft2
         lat = self.lat
+        m = self.spec["m"]
         mpi = self.comm.tompi4py()
         p, r = mpi.Get_size(), mpi.Get_rank()
         n_off = len(self.offsets)
         sel = np.arange(r, n_off, p)
-        per_lag = 4 * 9 * 4 * lat.Mx * lat.My * 8
+        per_lag = 4 * 9 * m * lat.Mx * lat.My * 8
         chunk = max(1, min(lag_hi - lag_lo + 1, int(CHUNK_BYTES // per_lag)))
         t = self.offsets[:, 2]
-        kx = np.mod(self.offsets[:, 3], lat.Mx)
-        ky = np.mod(self.offsets[:, 4], lat.My)
+        kx = np.mod(self.offsets[:, 3] + lat.in_lo[0], lat.Mx)      # (inputs placed from lattice index in_lo)
+        ky = np.mod(self.offsets[:, 4] + lat.in_lo[1], lat.My)
         for c_lo in range(lag_lo, lag_hi + 1, chunk):
             c_hi = min(lag_hi, c_lo + chunk - 1)
             idx, meta, offP, P = self._integrate(lag_lo, c_lo, c_hi, toff, L, sel)
-            Kp = np.zeros((c_hi - c_lo + 1, 4, 9, 4, lat.Mx, lat.My))
+            Kp = np.zeros((c_hi - c_lo + 1, 4, 9, m, lat.Mx, lat.My))
             _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, lat.code0)
             mpi.Allreduce(mpi_in_place(), Kp)
             S = rfft2(Kp, axes=(-2, -1), workers=1).reshape(Kp.shape[:4] + (-1,))
@@ -339,71 +396,86 @@ class ToeplitzHistory:
                 yield c_lo + i, np.ascontiguousarray(S[i, ..., self.f0:self.f1])
             S = None
 
+    def _terms(self, march):
+        """{key: [(time distance d, coefficient)]}: the history terms this side takes (``Marcher._step_terms``
+        of a step past the lags' reach), all but those of a lag whose Mat the march holds (lag 2: the
+        step matrix's lags are Mats, and the march applies their history terms)."""
+        nbig = self.ls.L + 8
+        by_key = {}
+        for key, m, c in march._step_terms(nbig):
+            if march._mat(key, self.side) is not None:
+                continue
+            by_key.setdefault(key, []).append((nbig - m, c))
+        return by_key
+
     def build(self, march, plan, monitor=False):
         """Collective: the kernels K'_d (d = 1..D) of the march's exact lags and the kernels A_j of the
-        interpolating lags (``plan``: the far lags' matrices are sum_j w_j(l) H(T_j), so their part of the
+        interpolating lags (``plan``: the far lags' matrices are sum_j w_j(l) M(T_j), so their part of the
         history sum is sum_j A_j (sum_m c_j(n, m) v^m), the weights c of ``Marcher._interp_coef``, formed
         per block over the kept transforms: only the exact and the anchors' kernels are stored), in this
         rank's frequency slab."""
         t0 = time.perf_counter()
-        lat, ls = self.lat, self.ls
-        self.offsets = kernel_offsets(lat)
-        lat.n_offsets = len(self.offsets)
+        self.offsets = kernel_offsets(self.lat)
+        self.lat.n_offsets = len(self.offsets)
         self.nev = 0
-        nbig = ls.L + 8
-        by_key = {}
-        for key, m, c in march._step_terms(nbig):
-            if march._mat(key, "u") is not None:        # (lag 2: the step matrix's Mat takes its terms)
-                continue
-            by_key.setdefault(key, []).append((nbig - m, c))
+        by_key = self._terms(march)
         D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
         self.D = D
         # the history's reach: the oldest state a step reads (the interpolated lags' reach beyond D)
         self.R = max([d for v in by_key.values() for d, _ in v] + [0])
         self.k = plan.k if plan is not None and plan.active else 0
         slab = self.f1 - self.f0
+        n9, n18 = self.spec["n9"], self.spec["n18"]
         # per frequency two dense matrices, rows (d descending, slot, input component), columns (class,
-        # output component): Kxy (x, y out of z in: entries xz, yz), Kz (z out of x, y in: zx, zy): the
-        # flat H pattern's 4 entries of every block, no zeros (bsr.H4 order: xz, yz, zx, zy); the
-        # anchors' Axy, Az the same with rows (anchor j, slot, input component)
-        self.Kxy = np.zeros((slab, D * 9, 8), np.complex128)
-        self.Kz = np.zeros((slab, D * 18, 4), np.complex128)
-        self.Axy = np.zeros((slab, self.k * 9, 8), np.complex128)
-        self.Az = np.zeros((slab, self.k * 18, 4), np.complex128)
+        # output component): K9 (z in; H: x, y out, entries xz, yz; G: z out, zz), K18 (x, y in; H: z out,
+        # zx, zy; G: x, y out, xx, xy, yx, yy): the flat pattern's entries of every block, no zeros (``_add_kernel``);
+        # the anchors' A9, A18 the same with rows (anchor j, slot, input component)
+        self.K9 = np.zeros((slab, D * 9, n9), np.complex128)
+        self.K18 = np.zeros((slab, D * 18, n18), np.complex128)
+        self.A9 = np.zeros((slab, self.k * 9, n9), np.complex128)
+        self.A18 = np.zeros((slab, self.k * 18, n18), np.complex128)
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 for d, c in by_key.get(("x", lag), ()):
-                    _add_kernel(self.Kxy, self.Kz, D - d, c, S)
+                    _add_kernel(self.K9, self.K18, D - d, c, S)
         for i in range(self.k):
             if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
-                _add_kernel(self.Axy, self.Az, i, 1.0, S)
+                _add_kernel(self.A9, self.A18, i, 1.0, S)
         # the kept states' transforms, in time order (state m at m - base; time-major, so a run of states
         # is one strided matrix for the weighted states' products): z (W, slab, 9), x and y (W, slab, 18);
         # states before the first are zeros, as are those not yet made
         self.W = self.R + 3 * self.block + 8
-        self.Vz = np.zeros((self.W, slab, 9), np.complex128)
-        self.Vxy = np.zeros((self.W, slab, 18), np.complex128)
+        self.V9 = np.zeros((self.W, slab, 9), self.vdtype)
+        self.V18 = np.zeros((self.W, slab, 18), self.vdtype)
         self.base = -self.R
         self._setup_state_maps(march)
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
-        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.Kxy, self.Kz, self.Axy, self.Az, self.Vz, self.Vxy)))
+        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18)))
         return self
 
     def _setup_state_maps(self, march):
+        """The gather of this side's state (u or p) to every rank, and per input element of the grid its
+        lattice position (from in_lo), its 9 slots' rows of the gathered state (reshaped (-1, 3), one zero
+        row appended: -1 for a slot without a traction column) and image signs; this rank's output rows'
+        class and FFT grid position."""
         lat, ls = self.lat, self.ls
         PETSc = march.PETSc
-        self.sc, self.seq = PETSc.Scatter.toAll(march.u_tmpl)
-        # v_a(cell) = S_v u(VN[v, perm[v, a]]): for every virtual element and slot
-        self.vnode = ls.VN[np.arange(len(ls.VN))[:, None], lat.perm]      # (nv, 9)
-        self.vsign = ls.VS                                                 # (nv, 3)
-        ix, iy = lat.cell // lat.ny, lat.cell % lat.ny
-        self.vpos = (ix, iy)
+        tmpl = march.u_tmpl if self.side == "u" else march.p_tmpl
+        self.sc, self.seq = PETSc.Scatter.toAll(tmpl)
+        # v_a(cell) = S_v u(VN[v, perm[v, a]]) (or S_v p(VT[v, perm[v, a]])): for every input element and slot
+        src = ls.VN if self.side == "u" else ls.VT
+        vidx = src[np.arange(len(src))[:, None], lat.perm]                  # (nv, 9)
+        use = np.any(vidx >= 0, axis=1)
+        self.vnode = vidx[use]
+        self.vsign = ls.VS[use]                                              # (nv, 3)
+        cell = lat.cell[use]
+        self.vpos = (cell // lat.ny - lat.in_lo[0], cell % lat.ny - lat.in_lo[1])
         r0, r1 = march.u_tmpl.getOwnershipRange()
         rows = np.arange(r0 // 3, r1 // 3)
         nf = lat.node_fine[rows]
@@ -416,7 +488,7 @@ class ToeplitzHistory:
     def _transform(self, u_all, m):
         from scipy.fft import rfft2
         lat = self.lat
-        U = u_all.reshape(-1, 3)
+        U = np.concatenate([u_all.reshape(-1, 3), np.zeros((1, 3))])     # (row -1: no traction column)
         f = np.zeros((9, 3, lat.Mx, lat.My))
         ix, iy = self.vpos
         for a in range(9):
@@ -424,14 +496,14 @@ class ToeplitzHistory:
                 f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
         S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
         i = m - self.base
-        self.Vz[i] = S[:, 2, :].T
-        self.Vxy[i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
+        self.V9[i] = S[:, 2, :].T
+        self.V18[i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
         self.upto, self.base, self._blk = 0, -self.R, None
-        self.Vz[...] = 0.0
-        self.Vxy[...] = 0.0
+        self.V9[...] = 0.0
+        self.V18[...] = 0.0
 
     def _room(self, n0):
         """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - R .. n0 + b (R the
@@ -442,7 +514,7 @@ class ToeplitzHistory:
         lo = n0 + 1 - self.R
         keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
         k = keep.stop - keep.start
-        for B in (self.Vz, self.Vxy):
+        for B in (self.V9, self.V18):
             B[:k] = B[keep]
             B[k:] = 0.0
         self.base = lo
@@ -450,17 +522,19 @@ class ToeplitzHistory:
     def _catch_up(self, n, march):
         """Collective: the transforms of the states up to n (final) not yet kept."""
         PETSc = march.PETSc
+        bufs = march.ubuf if self.side == "u" else march.pbuf
         for m in range(max(self.upto + 1, n - self.R + 1, 1), n + 1):
-            self.sc.scatter(march.ubuf[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
+            self.sc.scatter(bufs[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
             self._transform(self.seq.getArray(readonly=True), m)
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
-        """Collective: out_u -= sum_{d=1..min(D, n-1)} K'_d u^{n-d} + sum_j A_j s_j^n (this rank's rows;
-        s_j^n = sum_m c_j(n, m) v^m the interpolated lags' weighted states). Time-blocked: at the first step
-        of each block of b steps (n0 + 1, n0 a multiple of b, also after a restart) the terms of the states
-        m <= n0 for all b steps at once (``history_products``, ``interp_products``: the kernels read once
-        for the b steps); each step adds those of the block's states before it (m > n0)."""
+        """Collective: out_u += sign (sum_{d=1..min(D, n-1)} K'_d v^{n-d} + sum_j A_j s_j^n) (this rank's
+        rows; v the side's state, sign -1 for H on u, +1 for G on p; s_j^n = sum_m c_j(n, m) v^m the
+        interpolated lags' weighted states). Time-blocked: at the first step of each block of b steps
+        (n0 + 1, n0 a multiple of b, also after a restart) the terms of the states m <= n0 for all b steps
+        at once (``history_products``, ``interp_products``: the kernels read once for the b steps); each
+        step adds those of the block's states before it (m > n0)."""
         b = self.block
         n0 = b * ((n - 1) // b)
         if self._blk is None or self._blk[0] != n0:
@@ -478,9 +552,10 @@ class ToeplitzHistory:
     def _block_products(self, n0, march):
         """(slab, b, 12): the terms of the states m <= n0 in the history sums of steps n0 + 1 .. n0 + b."""
         b, D, slab = self.block, self.D, self.f1 - self.f0
+        flops = 8.0 * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * slab     # complex products a (d, step)
         if D:
-            acc = history_products(self.Kxy, self.Kz, self.Vz, self.Vxy, n0 + 1 - D - self.base, b, D)
-            march.PETSc.Log.logFlops(8.0 * b * D * 144 * slab)
+            acc = history_products(self.K9, self.K18, self.V9, self.V18, n0 + 1 - D - self.base, b, D)
+            march.PETSc.Log.logFlops(b * D * flops)
         else:
             acc = np.zeros((slab, b, 12), np.complex128)
         if self.k:
@@ -488,7 +563,7 @@ class ToeplitzHistory:
             C = np.stack([self._weights(march, n0 + 1 + i, lo, n0) for i in range(b)])
             ev = event("SSI_BEM_HistInterp")
             ev.begin()
-            acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, lo - self.base, march.PETSc.Log)
+            acc += interp_products(self.A9, self.A18, self.V9, self.V18, C, lo - self.base, march.PETSc.Log)
             ev.end()
         return acc
 
@@ -497,13 +572,13 @@ class ToeplitzHistory:
         D = self.D
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
-            acc += history_products(self.Kxy[:, 9 * (D - k):], self.Kz[:, 18 * (D - k):], self.Vz, self.Vxy,
+            acc += history_products(self.K9[:, 9 * (D - k):], self.K18[:, 18 * (D - k):], self.V9, self.V18,
                                     n - k - self.base, 1, k)[:, 0]
-            march.PETSc.Log.logFlops(8.0 * k * 144 * (self.f1 - self.f0))
+            march.PETSc.Log.logFlops(8.0 * k * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * (self.f1 - self.f0))
         if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
             C = self._weights(march, n, n0 + 1, n - 1)[None]
             if C.any():
-                acc += interp_products(self.Axy, self.Az, self.Vz, self.Vxy, C, n0 + 1 - self.base,
+                acc += interp_products(self.A9, self.A18, self.V9, self.V18, C, n0 + 1 - self.base,
                                        march.PETSc.Log)[:, 0]
 
     def _weights(self, march, n, m_lo, m_hi):
@@ -518,7 +593,8 @@ class ToeplitzHistory:
         return C
 
     def _apply(self, acc, out_u):
-        """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows taken off out_u."""
+        """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows added to out_u with
+        the side's sign."""
         from scipy.fft import irfft2
         from mpi4py import MPI
         lat = self.lat
@@ -526,22 +602,35 @@ class ToeplitzHistory:
         mpi = self.comm.tompi4py()
         mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
                                                    MPI.C_DOUBLE_COMPLEX])
-        # columns: (class t, x or y) for 0..7, then z of class t at 8 + t -> (t, component)
+        # columns: the K9 products' then the K18 products'; (class t, x or y) for the 8-wide, z of class t
+        # for the 4-wide -> (t, component)
+        n9 = self.spec["n9"]
+        xy, z = (full[:, :8], full[:, 8:]) if n9 == 8 else (full[:, 4:], full[:, :4])
         out = np.empty((4, 3, lat.F), np.complex128)
-        out[:, 0:2, :] = full[:, :8].T.reshape(4, 2, lat.F)
-        out[:, 2, :] = full[:, 8:].T
+        out[:, 0:2, :] = xy.T.reshape(4, 2, lat.F)
+        out[:, 2, :] = z.T
         phys = irfft2(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
         vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
         arr = out_u.getArray()
-        arr -= vals.ravel()
+        if self.spec["sign"] < 0:
+            arr -= vals.ravel()
+        else:
+            arr += vals.ravel()
 
 
-def _add_kernel(Kxy, Kz, r, c, S):
-    """Rows r of Kxy (9 a row) and Kz (18) += c S: S (4, 9, 4, slab) one lag's kernel spectra (class,
-    slot, H4 entry, frequency)."""
+def _add_kernel(K9, K18, r, c, S):
+    """Rows r of K9 (9 a row) and K18 (18) += c S: S (4, 9, m, slab) one lag's kernel spectra (class,
+    slot, pattern entry, frequency); m = 4 the H pattern (xz, yz, zx, zy: K9 columns (class, xz/yz), K18
+    rows (slot, zx/zy) columns class), m = 5 the G pattern (xx, xy, yx, yy, zz: K9 columns class (zz), K18
+    rows (slot, input component q) columns (class, output component p), entry 2 p + q)."""
     slab = S.shape[-1]
-    Kxy[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
-    Kz[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
+    if S.shape[2] == 4:
+        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
+        K18[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
+    else:
+        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 4, :].transpose(2, 1, 0)
+        G = S[:, :, 0:4, :].reshape(4, 9, 2, 2, slab)             # (class, slot, p, q, frequency)
+        K18[:, 18 * r:18 * (r + 1), :] += c * G.transpose(4, 1, 3, 0, 2).reshape(slab, 18, 8)
 
 
 def _spans(C):
@@ -563,56 +652,58 @@ def _spans(C):
     return own
 
 
-def interp_products(Axy, Az, Vz, Vxy, C, r0, log=None, fchunk=64):
+def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
     """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
     weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
-    buffers; real weights on the real and imaginary parts: per span of ``_spans`` one real matrix product
-    of the weights with the span's states, read in place), then (b x 9k)(9k x 8) and (b x 18k)(18k x 4)
-    products with the anchors' kernels: (slab, b, 12) complex, columns as ``history_products``.
-    Frequencies in chunks so the weighted states stay small."""
-    slab = Axy.shape[0]
+    buffers, double or single; real weights on the real and imaginary parts: per span of ``_spans`` one
+    real matrix product of the weights with the span's states, read in place), then (b x 9k)(9k x n9) and
+    (b x 18k)(18k x n18) products with the anchors' kernels: (slab, b, n9 + n18) complex, columns as
+    ``history_products``. Frequencies in chunks so the weighted states stay small."""
+    slab, n9, n18 = A9.shape[0], A9.shape[2], A18.shape[2]
     b, k, _ = C.shape
-    out = np.zeros((slab, b, 12), np.complex128)
+    out = np.zeros((slab, b, n9 + n18), np.complex128)
     spans = _spans(C)
     if not spans:
         return out
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
         fc = f1 - f0
-        Sz = np.zeros((fc, b, k, 9), np.complex128)
-        Sxy = np.zeros((fc, b, k, 18), np.complex128)
+        S9 = np.zeros((fc, b, k, 9), np.complex128)
+        S18 = np.zeros((fc, b, k, 18), np.complex128)
         for j0, j1, a, e in spans:
             Cj = C[:, j0:j1, a:e].reshape(-1, e - a)
-            for V, S in ((Vz, Sz), (Vxy, Sxy)):
+            for V, S in ((V9, S9), (V18, S18)):
                 c = V.shape[2]
-                Vf = V[r0 + a:r0 + e, f0:f1].view(np.float64).reshape(e - a, fc * 2 * c)     # (a view)
+                Vf = V[r0 + a:r0 + e, f0:f1].view(V.real.dtype).reshape(e - a, fc * 2 * c)     # (a view)
                 w = (Cj @ Vf).view(np.complex128).reshape(b, j1 - j0, fc, c)
                 S[:, :, j0:j1, :] = w.transpose(2, 0, 1, 3)
-        np.matmul(Sz.reshape(fc, b, 9 * k), Axy[f0:f1], out=out[f0:f1, :, :8])
-        np.matmul(Sxy.reshape(fc, b, 18 * k), Az[f0:f1], out=out[f0:f1, :, 8:])
+        np.matmul(S9.reshape(fc, b, 9 * k), A9[f0:f1], out=out[f0:f1, :, :n9])
+        np.matmul(S18.reshape(fc, b, 18 * k), A18[f0:f1], out=out[f0:f1, :, n9:])
     if log is not None:
-        log.logFlops(slab * (8.0 * b * k * 144 + 2.0 * 54 * b * sum((j1 - j0) * (e - a) for j0, j1, a, e in spans)))
+        log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
+                             + 2.0 * 54 * b * sum((j1 - j0) * (e - a) for j0, j1, a, e in spans)))
     return out
 
 
-def history_products(Kxy, Kz, Vz, Vxy, p0, b, D, fchunk=64):
+def history_products(K9, K18, V9, V18, p0, b, D, fchunk=64):
     """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
-    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c), as two
-    matrix products per frequency, (b x 9D) (b x 9D)-windows of Vz times Kxy (9D x 8) and (b x 18D)
-    of Vxy times Kz (18D x 4): (slab, b, 12) complex, columns (class, x or y) then z by class. Array
-    inputs and ``matmul`` only (the one function a GPU array module would take over); frequencies in
-    chunks so the windows' copies stay small."""
+    block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c),
+    as two matrix products per frequency, (b x 9D)-windows of V9 (z inputs) times K9 (9D x n9) and (b x
+    18D) of V18 (x, y inputs) times K18 (18D x n18): (slab, b, n9 + n18) complex (H: columns (class, x or
+    y) then z by class; G: z by class, then (class, x or y)). The kept states double or single (the
+    windows' copies in double). Array inputs and ``matmul`` only (the one function a GPU array module
+    would take over); frequencies in chunks so the windows' copies stay small."""
     from numpy.lib.stride_tricks import sliding_window_view
-    slab = Kxy.shape[0]
-    out = np.empty((slab, b, 12), np.complex128)
+    slab, n9, n18 = K9.shape[0], K9.shape[2], K18.shape[2]
+    out = np.empty((slab, b, n9 + n18), np.complex128)
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
-        wz = sliding_window_view(Vz[p0:p0 + b - 1 + D, f0:f1], D, axis=0)      # (b, fc, 9, D)
-        wxy = sliding_window_view(Vxy[p0:p0 + b - 1 + D, f0:f1], D, axis=0)    # (b, fc, 18, D)
-        az = np.ascontiguousarray(wz.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 9 * D)
-        axy = np.ascontiguousarray(wxy.transpose(1, 0, 3, 2)).reshape(f1 - f0, b, 18 * D)
-        np.matmul(az, Kxy[f0:f1], out=out[f0:f1, :, :8])
-        np.matmul(axy, Kz[f0:f1], out=out[f0:f1, :, 8:])
+        w9 = sliding_window_view(V9[p0:p0 + b - 1 + D, f0:f1], D, axis=0)      # (b, fc, 9, D)
+        w18 = sliding_window_view(V18[p0:p0 + b - 1 + D, f0:f1], D, axis=0)    # (b, fc, 18, D)
+        a9 = np.ascontiguousarray(w9.transpose(1, 0, 3, 2), dtype=np.complex128).reshape(f1 - f0, b, 9 * D)
+        a18 = np.ascontiguousarray(w18.transpose(1, 0, 3, 2), dtype=np.complex128).reshape(f1 - f0, b, 18 * D)
+        np.matmul(a9, K9[f0:f1], out=out[f0:f1, :, :n9])
+        np.matmul(a18, K18[f0:f1], out=out[f0:f1, :, n9:])
     return out
 
 
@@ -624,15 +715,16 @@ def mpi_in_place():
 @njit(cache=True)
 def _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, code0):
     """Kp[l - c_lo, t, code0[a], e, kx, ky] = the integrals of lag l of offset idx[r] (pool layout of
-    ``assemble._compact``: lag slot, local node a of the reference element, entry e), for lags of the
-    chunk (slot code0[a]: the node's position)."""
+    ``assemble._compact``: lag slot, local node a of the reference element, entry e of m = Kp.shape[3]),
+    for lags of the chunk (slot code0[a]: the node's position)."""
     nl_c = Kp.shape[0]
+    m = Kp.shape[3]
     for r in range(idx.shape[0]):
         o = idx[r]
         lo, hi = meta[r, 0], meta[r, 1]
         base = offP[r]
         for l in range(max(lo, c_lo), min(hi, c_lo + nl_c - 1) + 1):
-            s = base + (l - lo) * 36
+            s = base + (l - lo) * 9 * m
             for a in range(9):
-                for e in range(4):
-                    Kp[l - c_lo, t[o], code0[a], e, kx[o], ky[o]] = P[s + 4 * a + e]
+                for e in range(m):
+                    Kp[l - c_lo, t[o], code0[a], e, kx[o], ky[o]] = P[s + m * a + e]

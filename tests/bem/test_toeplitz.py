@@ -16,7 +16,7 @@ import pytest
 from helpers import cli
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from test_history_block import BEM, INTERP, DISP, SSI, same  # noqa: E402
+from test_history_block import BEM, INTERP, DISP, SSI, same, fields, scales  # noqa: E402
 
 pytestmark = pytest.mark.mpi
 
@@ -44,6 +44,7 @@ def test_toeplitz_equals_dense(tmp_path, case):
     cli(args + ["-ssi_output", ref])
     out = cli(args + TZ + ["-ssi_output", tz]).stdout
     assert "lag store: toeplitz" in out and "history kernels K'_d in Fourier space" in out
+    assert "G lags as" in out               # the traction history (G lags >= 3) on the store too
     same(ref, tz)
 
 
@@ -157,28 +158,44 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     assert "estimate of this BEM run on the toeplitz lag store" in r.stdout
     assert "kernels: 12 exact lags + 5 interpolating (of 24 the run reaches)" in r.stdout, r.stdout
     assert "blocks assembled" not in r.stdout          # (the dense model's line)
+    assert "G kernels on the traction elements' 2 x 2 window (FFT grid 6 x 6)" in r.stdout, r.stdout
     out = cli(args + ["-ssi_output", str(tmp_path / "tz.h5")]).stdout
     import re
     stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
+    g_stored = float(re.search(r"G lags as \d+ kernels on the traction elements' 2 x 2 window \(FFT grid 6 x 6, "
+                               r"kernels [\d.e+-]+ s, ([\d.e+-]+) GB\)", out).group(1))
 
     class Lat:
         Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
         F = 8 * 5
         nx = ny = 4
+
+    class GLat:
+        Mx, My = 6, 6           # the load patch's 2 x 2 elements: 4 + 2 per axis
+        F = 6 * 4
+        nx = ny = 4
     plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
     b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
     build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes
     assert abs((b - build) / 1e9 - stored) <= 0.01 * stored + 5e-6, (b - build, stored)
+    bg, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat)
+    assert abs((bg - b) / 1e9 - g_stored) <= 0.01 * g_stored + 5e-6, (bg - b, g_stored)
+    bs, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat, single=True)
+    assert bs < bg and abs((bg - bs) - 8.0 * 27 * (24 + 3 * 8 + 8) * (Lat.F + GLat.F)) < 1.0   # kept states halved
 
 
-def test_interp_products_match_the_sum():
+@pytest.mark.parametrize("widths,dtype", [((8, 4), np.complex128), ((4, 8), np.complex128), ((4, 8), np.complex64)])
+def test_interp_products_match_the_sum(widths, dtype):
     """``interp_products`` (weighted states by spans, then the anchors' products) against the plain sum
-    over anchors, steps and states, for banded (per-anchor spans) and full (one span) weights."""
+    over anchors, steps and states, for banded (per-anchor spans) and full (one span) weights; with the H
+    side's output widths (8, 4), the G side's (4, 8) and single-precision kept states (the sums in double)."""
     from petsc_ssi.bem.toeplitz import interp_products, _spans
     rng = np.random.default_rng(3)
     slab, k, b, W = 37, 4, 3, 30
+    n9, n18 = widths
     cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
-    Axy, Az, Vz, Vxy = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4), cz(W, slab, 9), cz(W, slab, 18)
+    Axy, Az = cz(slab, 9 * k, n9), cz(slab, 18 * k, n18)
+    Vz, Vxy = cz(W, slab, 9).astype(dtype), cz(W, slab, 18).astype(dtype)
     banded = np.zeros((b, k, 20))
     for j in range(k):
         banded[:, j, 4 * j:4 * j + 6] = rng.standard_normal((b, 6))
@@ -186,10 +203,34 @@ def test_interp_products_match_the_sum():
     for C, n_spans in ((banded, k), (full, 1)):
         assert len(_spans(C)) == n_spans
         got = interp_products(Axy, Az, Vz, Vxy, C, 5, fchunk=16)
-        Sz = np.einsum("bjm,mfc->fbjc", C, Vz[5:25]).reshape(slab, b, 9 * k)
-        Sxy = np.einsum("bjm,mfc->fbjc", C, Vxy[5:25]).reshape(slab, b, 18 * k)
+        Sz = np.einsum("bjm,mfc->fbjc", C, Vz[5:25].astype(np.complex128)).reshape(slab, b, 9 * k)
+        Sxy = np.einsum("bjm,mfc->fbjc", C, Vxy[5:25].astype(np.complex128)).reshape(slab, b, 18 * k)
         ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)
-        assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
+        assert got.dtype == np.complex128 and np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+def test_history_products_match_the_sum():
+    """``history_products`` (sliding windows of the kept states times the stacked kernels) against the plain
+    sum over steps and time distances, for the H side's (8, 4) and the G side's (4, 8) output widths, kept
+    states in double and in single (the windows' copies and the products in double)."""
+    from petsc_ssi.bem.toeplitz import history_products
+    rng = np.random.default_rng(5)
+    slab, D, b, W = 29, 5, 4, 16
+    cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
+    for n9, n18 in ((8, 4), (4, 8)):
+        K9, K18 = cz(slab, 9 * D, n9), cz(slab, 18 * D, n18)
+        for dtype in (np.complex128, np.complex64):
+            V9, V18 = cz(W, slab, 9).astype(dtype), cz(W, slab, 18).astype(dtype)
+            got = history_products(K9, K18, V9, V18, 3, b, D, fchunk=8)
+            ref = np.zeros((slab, b, n9 + n18), np.complex128)
+            for k in range(b):
+                for d in range(1, D + 1):
+                    row = 3 + k + (D - d)
+                    r = D - d
+                    ref[:, k, :n9] += np.einsum("fa,fac->fc", V9[row].astype(np.complex128), K9[:, 9 * r:9 * r + 9])
+                    ref[:, k, n9:] += np.einsum("fa,fac->fc", V18[row].astype(np.complex128),
+                                                K18[:, 18 * r:18 * r + 18])
+            assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), (n9, dtype)
 
 
 def test_toeplitz_refusals_and_auto(tmp_path):
@@ -208,6 +249,13 @@ def test_toeplitz_refusals_and_auto(tmp_path):
     r = cli(BEM + TZ + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_lags_save", str(tmp_path / "lags")],
             check=False)
     assert r.returncode != 0 and "-ssi_lags_save" in r.stdout + r.stderr and "Traceback" not in r.stderr
+    # single-precision kept transforms where no store keeps them: the dense store, and auto falling back to it
+    for store in ("dense", "auto"):
+        r = cli(bad + ["-ssi_lag_store", store, "-ssi_toeplitz_precision", "single", "-ssi_output",
+                       str(tmp_path / "d.h5")], nranks=2, check=False)
+        err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
+        assert r.returncode != 0 and "Traceback" not in r.stderr, (store, r.stderr[-2000:])
+        assert err and all("-ssi_toeplitz_precision" in ln for ln in err), (store, err)
 
 
 def test_detect_names_the_element():
@@ -286,3 +334,26 @@ def test_toeplitz_block_longer_than_the_lags(tmp_path):
     out = cli(args + TZ + ["-ssi_history_block", "16", "-ssi_output", tz]).stdout
     assert "lags stored 9 " in out
     same(ref, tz)
+
+
+# single-precision kept transforms (-ssi_toeplitz_precision single): the states' spectra rounded to float32,
+# the kernels and every product in double. Measured on this case by jobscripts/toeplitz_exact.py: 1.76e-9 of
+# the largest displacement (3.46e-9 on the prescribed-motion case); the bound leaves a factor of about 5
+SINGLE_ERR = 1e-8
+
+
+def test_toeplitz_single_precision_transforms(tmp_path):
+    """The loaded 10 m grid (H and G on the store) with the kept transforms in single precision against
+    double: every recorded field within SINGLE_ERR of its kind's largest value, and not equal to round-off
+    (the option takes effect); the log says which precision, and the stored bytes shrink."""
+    import re
+    a, b = str(tmp_path / "double.h5"), str(tmp_path / "single.h5")
+    da = cli(BEM + TZ + ["-ssi_output", a]).stdout
+    sb = cli(BEM + TZ + ["-ssi_toeplitz_precision", "single", "-ssi_output", b]).stdout
+    assert "kept transforms in double precision" in da and "kept transforms in single precision" in sb
+    gb = [float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", t).group(1)) for t in (da, sb)]
+    assert gb[1] < gb[0]
+    A, B = fields(a), fields(b)
+    S = scales(A)
+    err = max(np.abs(A[k] - B[k]).max() / S[k] for k in A if S[k] > 0)
+    assert 1e-12 < err <= SINGLE_ERR, err
