@@ -76,7 +76,8 @@ def run_and_restart(args, tmp_path, nranks, every, restart_step, nranks_restart=
     return [(str(ref / o), str(rs / o)) for o in outputs]
 
 
-@pytest.mark.parametrize("case", ["stabilised", "plain", "interpolated"])
+# slow tier: the interpolated case (14 s); the stabilised and plain cases stay in make test
+@pytest.mark.parametrize("case", ["stabilised", "plain", pytest.param("interpolated", marks=pytest.mark.slow)])
 def test_bem_restart_is_bitwise(case, tmp_path):
     """The quarter-model half-space (two symmetry planes), 60 steps, restarted after step 25 on
     2 ranks with -ssi_reproducible (with MUMPS, restarts of the plain case differed from each other
@@ -106,7 +107,8 @@ def test_fem_restart_is_bitwise(integrator, tmp_path):
         assert len(d["demands/t"]) == 51 and np.abs(d["demands/base_shear"]).max() > 0    # fem/demands.py
 
 
-@pytest.mark.parametrize("coupling", ["implicit", "staggered"])
+# slow tier: the staggered coupling (12 s); the default (implicit) coupling's restart stays in make test
+@pytest.mark.parametrize("coupling", ["implicit", pytest.param("staggered", marks=pytest.mark.slow)])
 def test_coupled_contact_restart_is_bitwise(coupling, tmp_path):
     """The block on the half-space with unilateral contact, 80 steps on 2 ranks with
     -ssi_reproducible, restarted after step 30 while part of the interface is open: both files
