@@ -157,6 +157,18 @@ COUPLED = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", 
            "-ssi_estimate_ranks", "1,2"]
 
 
+def _table(out):
+    """{ranks: {column: value}} of the estimate's table."""
+    import re as _re
+    head = [l for l in out.splitlines() if "ranks nodes |" in l][0].split("|")[1].split()
+    rows = {}
+    for line in out.splitlines():
+        m = _re.match(r"\[ssi\]\s+(\d+)\s+\d+\s+\|(.*?)\|", line)
+        if m:
+            rows[int(m.group(1))] = dict(zip(head, map(float, m.group(2).split())))
+    return rows
+
+
 def test_coupled_estimate_counts_the_interface_and_the_structure():
     """-ssi_problem ssi (issue 28): the soil is counted with the interface as its traction region, as the
     coupled run assembles it (the traction nodes are the interface's nodes, which the run reports), and
@@ -169,28 +181,11 @@ def test_coupled_estimate_counts_the_interface_and_the_structure():
     n_t = int(_re.search(r"(\d+) traction nodes", out).group(1))
     n_i = int(_re.search(r"coupling: (\d+) interface nodes \((\d+) columns\), structure (\d+) dofs", out).group(1))
     assert n_t == n_i == 25                          # a 1 m x 1 m block on 0.25 m nodes: 5 x 5
-    head = [l for l in out.splitlines() if "ranks nodes |" in l][0].split("|")[1].split()
-    rows = {}
-    for line in out.splitlines():
-        m = _re.match(r"\[ssi\]\s+(\d+)\s+\d+\s+\|(.*?)\|", line)
-        if m:
-            rows[int(m.group(1))] = dict(zip(head, map(float, m.group(2).split())))
+    rows = _table(out)
     assert set(rows) == {1, 2}
     for r in rows.values():
         assert r["coupling_setup_s"] > 0 and r["coupling_loop_s"] > 0
         assert r["time_loop_s"] >= r["history_s"] + r["solve_s"] + r["coupling_loop_s"] - 1e-9
-
-
-def _table(out):
-    """{ranks: {column: value}} of the estimate's table."""
-    import re as _re
-    head = [l for l in out.splitlines() if "ranks nodes |" in l][0].split("|")[1].split()
-    rows = {}
-    for line in out.splitlines():
-        m = _re.match(r"\[ssi\]\s+(\d+)\s+\d+\s+\|(.*?)\|", line)
-        if m:
-            rows[int(m.group(1))] = dict(zip(head, map(float, m.group(2).split())))
-    return rows
 
 
 def _run_prediction(out):

@@ -165,14 +165,19 @@ BAD = [
 ]
 
 
-@pytest.mark.parametrize("opts, msg", BAD, ids=[str(i) for i in range(len(BAD))])
-def test_bad_input_refused(PETSc, opts, msg):
+def assert_refused(opts, msg):
+    """The fem options ``opts`` are refused with ``msg`` in one line."""
     from petsc_ssi.petsc import SSIError
     with Opts(**opts) as res:
         with pytest.raises(SSIError) as e:
             res()
     assert msg in str(e.value), str(e.value)
     assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("opts, msg", BAD, ids=[str(i) for i in range(len(BAD))])
+def test_bad_input_refused(PETSc, opts, msg):
+    assert_refused(opts, msg)
 
 
 def test_newmark_takes_stiffness_damping_with_any_constants(PETSc):
