@@ -57,6 +57,21 @@ import numpy as np
 import scipy.linalg as sla
 
 
+def normal_frames(n):
+    """Per node an orthonormal frame (n_I, 3, 3), rows t1, t2, n: t1 the first axis least aligned with n
+    projected off it, t2 = n x t1."""
+    n = np.asarray(n, float)
+    e = np.eye(3)[np.argmin(np.abs(n), axis=1)]
+    t1 = e - np.einsum("ij,ij->i", e, n)[:, None] * n
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    return np.stack([t1, np.cross(n, t1), n], axis=1)
+
+
+def stuck_rows(frames, S):
+    """The rows 3k..3k+2 of the stuck nodes S (flat index array) and their frames (|S|, 3, 3)."""
+    return (3 * S[:, None] + np.arange(3)).ravel(), frames[S]
+
+
 class LUCache:
     """Dense LU factors cached per key (an active set), bounded by bytes (oldest out);
     counts the factorisations and their time (the cost of status changes)."""
@@ -103,7 +118,7 @@ class ContactLaw:
     u_f^n depends on the interface force, there is no prediction)."""
 
     def __init__(self, n_b, zero, law="bonded", p_C=0.0, tol=1e-8, max_iter=25, open_traction="zero",
-                 comm=None, preload=0.0):
+                 comm=None, preload=0.0, separation="free"):
         self.comm = comm if comm is not None and comm.Get_size() > 1 else None   # mpi4py
         self.n_b = np.asarray(n_b, float)            # (n_I, 3)
         self.open_traction = open_traction
@@ -116,6 +131,9 @@ class ContactLaw:
         self.max_iter = int(max_iter)
         self.offset = None                           # the step's free-field traction t_ff (3 n_I) or None
         self.closed = np.ones(self.nI, bool)
+        self.separation = separation                 # free | normal | auto (module docstring)
+        self.stick = np.zeros(self.nI, bool)         # open nodes whose tangential bond is kept (this iterate)
+        self.frames = normal_frames(self.n_b)        # (n_I, 3, 3): rows t1, t2, n_b
         self.ub_prev = np.zeros(3 * self.nI)
         self.total_changes = 0
         self.cycled_steps = []
@@ -152,6 +170,76 @@ class ContactLaw:
     def _normal(self, v):
         return np.einsum("ij,ij->i", v.reshape(-1, 3), self.n_b)
 
+    def key(self, closed, stick=None):
+        """The cache key of a contact state: the closed set, and the stuck open nodes when there are any."""
+        stick = self.stick if stick is None else stick
+        return closed.tobytes() + (stick.tobytes() if stick.any() else b"")
+
+    def open_free_dofs(self, closed):
+        """The open dofs free in every direction (not stuck; not fixed by a symmetry plane) and the stuck
+        open nodes (their normal released, their tangential bond kept)."""
+        stuck = self.stick & ~closed
+        m = np.repeat(~closed & ~stuck, 3) & ~self.zero.ravel()
+        return np.nonzero(m)[0], np.nonzero(stuck)[0]
+
+    def _violations(self, closed, pN, gap, p, ub, uf, scale_u):
+        """Each node's violation relative to its own scale (> 0: its status must change): a closed node's
+        total normal traction p_N - p_w beyond p_C, an open node's penetration."""
+        sp = max(np.abs(p).max(), self.p_C, self.preload, 1e-300)
+        su = max(scale_u, np.abs(uf).max(), np.abs(ub).max(), 1e-300)
+        v_open = np.where(closed, (pN - self.p_C - self.preload) / sp - self.tol, -np.inf)   # > 0: open
+        v_close = np.where(~closed, -gap / su - self.tol, -np.inf)                          # > 0: must close
+        return v_open, v_close
+
+    def _move(self, closed, stick, barred, flip):
+        """The statuses after changing the nodes ``flip`` (separation free: open <-> closed; auto: a
+        closed node opens free unless it penetrated free in this step (``barred``: then it opens stuck),
+        a free open node that penetrates is stuck (and barred), a stuck one closes; normal: every open
+        node stuck)."""
+        new, st = closed.copy(), stick.copy()
+        if self.separation == "auto":
+            to_stick = flip & ~closed & ~stick
+            barred |= to_stick
+            st[to_stick] = True
+            shut = flip & ~closed & stick
+            new[shut], st[shut] = True, False
+            opening = flip & closed
+            new[opening], st[opening] = False, barred[opening]
+        else:
+            new[flip] = ~closed[flip]
+            st = ~new if self.separation == "normal" else st
+        return new, st
+
+    def _iterate(self, solve, closed, start, scale_u):
+        """The active-set loop of a unilateral step from the status ``closed``: solve, check, update until
+        nothing changes (a repeated status set: only the worst violation changes) or ``max_iter``."""
+        self.stick = ~closed if self.separation == "normal" else np.zeros(self.nI, bool)
+        barred = np.zeros(self.nI, bool)
+        seen = {self.key(closed)}
+        changes = int((closed != start).sum())
+        its = 0
+        while True:
+            its += 1
+            sol = solve(closed)
+            O, ub, uf, p = sol
+            v_open, v_close = self._violations(closed, self._normal(self.total(p)), -self._normal(ub - uf),
+                                               p, ub, uf, scale_u)
+            viol = np.maximum(v_open, v_close)
+            new = None
+            if np.any(viol > 0) and its < self.max_iter:
+                new, stick = self._move(closed, self.stick, barred, viol > 0)
+                if self.key(new, stick) in seen:    # a repeated set: change the worst node only
+                    k = int(np.argmax(viol))
+                    new, stick = self._move(closed, self.stick, barred, np.arange(self.nI) == k)
+                new = (new, stick)
+            new, cycled = self._agree((new, bool(np.any(viol > 0))))
+            if new is None:
+                break                               # settled, or cycled: accepted with violations left
+            changes += int((new[0] != closed).sum() + (new[1] != self.stick).sum())
+            closed, self.stick = new
+            seen.add(self.key(closed))
+        return closed, its, changes, cycled, sol
+
     def step(self, solve, uf_pred):
         t0 = time.perf_counter()
         if self.law == "bonded":
@@ -167,37 +255,7 @@ class ContactLaw:
                 g_pred = -self._normal(self.ub_prev - uf_pred)
                 closed |= (~closed) & (g_pred < -self.tol * scale_u)
                 closed = self._agree(closed)
-            seen = {closed.tobytes()}
-            changes = int((closed != start).sum())
-            cycled = False
-            its = 0
-            while True:
-                its += 1
-                O, ub, uf, p = solve(closed)
-                pN = self._normal(self.total(p))
-                gap = -self._normal(ub - uf)
-                # violations relative to their own scales (tractions and displacements)
-                sp = max(np.abs(p).max(), self.p_C, self.preload, 1e-300)
-                su = max(scale_u, np.abs(uf).max(), np.abs(ub).max(), 1e-300)
-                # total normal traction pN - p_w against p_C
-                v_open = np.where(closed, (pN - self.p_C - self.preload) / sp - self.tol, -np.inf)  # > 0: open
-                v_close = np.where(~closed, -gap / su - self.tol, -np.inf)              # > 0: must close
-                viol = np.maximum(v_open, v_close)
-                new = None
-                if np.any(viol > 0) and its < self.max_iter:
-                    new = closed.copy()
-                    new[v_open > 0] = False
-                    new[v_close > 0] = True
-                    if new.tobytes() in seen:          # a repeated set: change the worst node only
-                        new = closed.copy()
-                        k = int(np.argmax(viol))
-                        new[k] = not closed[k]
-                new, cycled = self._agree((new, bool(np.any(viol > 0))))
-                if new is None:
-                    break                               # cycled: accepted with violations left
-                changes += int((new != closed).sum())
-                closed = new
-                seen.add(closed.tobytes())
+            closed, its, changes, cycled, (O, ub, uf, p) = self._iterate(solve, closed, start, scale_u)
         pN = self._normal(self.total(p))
         gap = -self._normal(ub - uf)
         self.closed = closed
@@ -217,8 +275,11 @@ class StaggeredSolve:
 
     def __call__(self, y, uf):
         def solve(closed):
-            O = self.law.open_dofs(closed)
-            t = self.law.target(closed)
+            law = self.law
+            if law.stick.any():
+                return self._stuck(closed, y, uf)
+            O = law.open_dofs(closed)
+            t = law.target(closed)
             delta = np.zeros_like(y)
             p = y.copy()
             if O.size:
@@ -228,6 +289,29 @@ class StaggeredSolve:
                 p[O] = t[O]
             return O, uf + delta, uf, p
         return solve
+
+    def _stuck(self, closed, y, uf):
+        """With stuck open nodes (their tangential bond kept): the jump delta = E c in the basis E of the
+        free open dofs' unit vectors and the stuck nodes' normals, E^T Z E c = E^T (y - t), p = y - Z E c."""
+        law = self.law
+        O, S = law.open_free_dofs(closed)
+        t = law.target(closed)
+        E = np.zeros((len(y), len(O) + len(S)))
+        E[O, np.arange(len(O))] = 1.0
+        for j, k in enumerate(S):
+            E[3 * k:3 * k + 3, len(O) + j] = law.n_b[k]
+        ZE = self.cap.Z @ E
+        lu = self.cap.get(law.key(closed), lambda: E.T @ ZE)
+        c = sla.lu_solve(lu, E.T @ (y - t), check_finite=False)
+        delta = E @ c
+        p = y - ZE @ c
+        p[O] = t[O]
+        rows, R = stuck_rows(law.frames, S)
+        if S.size:                                   # the stuck nodes' normal traction exactly the target
+            pk, tk = p[rows].reshape(-1, 3), t[rows].reshape(-1, 3)
+            pk += law.n_b[S] * np.einsum("ij,ij->i", tk - pk, law.n_b[S])[:, None]
+            p[rows] = pk.ravel()
+        return np.union1d(O, rows), uf + delta, uf, p
 
 
 class ImplicitSolve(LUCache):
@@ -248,14 +332,22 @@ class ImplicitSolve(LUCache):
         self.CM = C @ M3
         self.B = np.eye(len(Z)) - self.a * self.CM @ Z
 
-    def _matrix(self, O):
+    def _matrix(self, O, S=None):
         K = self.B.copy()
         K[O] = self.Z[O]
+        if S is not None and S.size:                 # stuck nodes: tangential rows t.(u_b - u_f) = 0,
+            rows, R = stuck_rows(self.law.frames, S)     # the normal row n.p = n.t
+            Kr = np.einsum("sab,sbj->saj", R, K[rows].reshape(len(S), 3, -1))
+            Kr[:, 2] = np.einsum("sb,sbj->sj", self.law.n_b[S], self.Z[rows].reshape(len(S), 3, -1))
+            K[rows] = Kr.reshape(len(rows), -1)
         return K
 
     def lu(self, closed, O=None):
         """The LU of the contact state ``closed`` (cached; ``O`` its open dofs, from the law when not
         given): the step's solve, or a factorisation made ahead (the bonded state, at set-up)."""
+        if self.law.stick.any():
+            O, S = self.law.open_free_dofs(closed)
+            return self.get(self.law.key(closed), lambda: self._matrix(O, S))
         O = self.law.open_dofs(closed) if O is None else O
         return self.get(closed.tobytes(), lambda: self._matrix(O))
 
@@ -263,6 +355,8 @@ class ImplicitSolve(LUCache):
         g_closed = w - self.CM @ (self.a * q + r)
 
         def solve(closed):
+            if self.law.stick.any():
+                return self._stuck(closed, q, w, r, g_closed)
             O = self.law.open_dofs(closed)
             t = self.law.target(closed)
             g = g_closed.copy()
@@ -276,3 +370,29 @@ class ImplicitSolve(LUCache):
             ub[C] = uf[C]            # equal up to round-off; exact compatibility
             return O, ub, uf, p
         return solve
+
+    def _stuck(self, closed, q, w, r, g_closed):
+        """The solve with stuck open nodes: their rows rotated into their frame (``_matrix``); afterwards
+        their normal traction is the target and their tangential displacement the structure's, exactly."""
+        law = self.law
+        O, S = law.open_free_dofs(closed)
+        t = law.target(closed)
+        rows, R = stuck_rows(law.frames, S)
+        g = g_closed.copy()
+        g[O] = q[O] - t[O]
+        gr = np.einsum("sab,sb->sa", R, g[rows].reshape(-1, 3))
+        gr[:, 2] = np.einsum("sb,sb->s", law.n_b[S], (q - t)[rows].reshape(-1, 3))
+        g[rows] = gr.ravel()
+        s = sla.lu_solve(self.lu(closed), g, check_finite=False)
+        p = q - self.Z @ s
+        p[O] = t[O]
+        nS = law.n_b[S]
+        pk, tk = p[rows].reshape(-1, 3), t[rows].reshape(-1, 3)
+        pk += nS * np.einsum("ij,ij->i", tk - pk, nS)[:, None]
+        p[rows] = pk.ravel()
+        uf = w - self.CM @ (self.a * p + r)
+        ub = uf.copy()
+        ub[O] = s[O]
+        d = (s - uf)[rows].reshape(-1, 3)             # the stuck nodes' jump: its normal part only
+        ub[rows] = (uf[rows].reshape(-1, 3) + nS * np.einsum("ij,ij->i", d, nS)[:, None]).ravel()
+        return np.union1d(O, rows), ub, uf, p

@@ -70,6 +70,12 @@ register("contact_preload", "str", "none", "N/m^2", "static contact pressure und
 register("contact_open_traction", "enum", "zero", "", "traction an open node carries: zero (p_C is a "
          "strength lost on opening) or cohesion (the normal tension p_C, eq. 25 read literally: "
          "(p_C - p_N) g = 0 with g > 0)", G, choices=("zero", "cohesion"))
+register("contact_separation", "enum", "free", "", "what an open node keeps of the bond: free (no "
+         "traction in any direction: the tangential traction is released with the normal one) or auto (free, "
+         "but a node that then penetrates keeps its tangential bond and releases its normal traction only, "
+         "for the rest of the step: on walls a node's shear, released, can push it into the soil, and the "
+         "free law has no consistent status there) or normal (every open node keeps its tangential bond)", G,
+         choices=("free", "auto", "normal"))
 register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact checks: gap < -tol max|u_f| "
          "closes a node, p_N > p_C + preload + tol max(|p|, p_C, preload) opens one", G, validator=positive)
 register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "
@@ -107,6 +113,10 @@ def _ssi_checks(cfg):
                 f"{cfg.symmetry}): contact destroys the antisymmetry of the response (the side in "
                 "compression stays closed, the other may open), so an antisymmetric half model is "
                 "wrong; mesh the whole interface")
+    if cfg.contact == "unilateral" and cfg.contact_separation != "free" and planes:
+        return (f"-ssi_contact_separation {cfg.contact_separation} with -ssi_symmetry {cfg.symmetry}: a stuck node's "
+                "frame ignores the dofs a symmetry plane fixes (not implemented); mesh the whole interface or use "
+                "-ssi_contact_separation free")
     if cfg.contact != "unilateral" and parse_preload(cfg.contact_preload) is not None:
         return (f"-ssi_contact_preload {cfg.contact_preload} needs -ssi_contact unilateral (a bonded interface "
                 f"is linear: the static pressure does not change its dynamic response)")
@@ -122,7 +132,7 @@ def _ssi_checks(cfg):
     return None
 
 
-CONTACT_ONLY = ("contact_cohesion", "contact_open_traction", "contact_tol", "contact_max_iter")
+CONTACT_ONLY = ("contact_cohesion", "contact_open_traction", "contact_tol", "contact_max_iter", "contact_separation")
 
 
 def ignored_contact_options(cfg):

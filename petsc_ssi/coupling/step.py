@@ -171,7 +171,7 @@ class Coupler:
         self.preload = contact_preload(cfg, comm, model, iface)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
                               cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py(),
-                              preload=self.preload)
+                              preload=self.preload, separation=cfg.contact_separation)
         ex = cfg.coupling_traction == "extrapolated"
         self.c_new, self.c_old = (1.5, 0.5) if ex else (1.0, 0.0)
         self.M3 = np.kron(iface.M.toarray(), np.eye(3))   # (dense: the interface LUs' set-up)
