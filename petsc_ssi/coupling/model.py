@@ -40,11 +40,11 @@ def build_coupled(cfg, comm):
              f"ignored (the interface is {cfg.contact})", comm)
     planes = symmetry.parse(cfg.symmetry)
     mesh = read_soil_surface(cfg, comm, planes)
-    if not mesh.flat and cfg.contact == "unilateral":
-        warn("-ssi_contact unilateral on a surface with an excavation: the contact's active set is known not to "
-             "settle there (a stiff block in a 2 x 2 x 1 m pit under a horizontal pulse cycled at 48 of 56 steps; no "
-             "sliding on the walls: closed nodes are bonded); read the run's "
-             "cycling warnings, or use -ssi_contact_preload so that the faces stay closed", comm)
+    if not mesh.flat and cfg.contact == "unilateral" and cfg.contact_separation == "free":
+        warn("-ssi_contact unilateral on a surface with an excavation with -ssi_contact_separation free: the active "
+             "set is known not to settle there (a wall node in tension whose released shear pushes it into the "
+             "soil has no consistent status; a stiff block in a 2 x 2 x 1 m pit under a horizontal pulse cycled at "
+             "48 of 56 steps); -ssi_contact_separation auto keeps such a node's tangential bond and settles", comm)
     model = build_model(cfg, comm, assemble_matrices=False, receivers=cfg.structure_receivers,
                         receivers_what="-ssi_structure_receivers",
                         check_mesh=lambda fe: check_on_surface(fe, cfg.fem_interface, mesh))

@@ -87,3 +87,25 @@ def test_walls_separate_in_turn_and_the_bottom_edge_lifts(tmp_path, record):
         assert opened[np.ix_(now, edge)].any() and not opened[np.ix_(later, edge)].any(), side
         assert gap[np.ix_(now, edge)].max() > 0.5e-6           # the edge lifts by 0.77 um (measured)
     assert not opened[:, bottom & (np.abs(x[:, 0]) < 1.0 - 1e-9)].any()
+
+
+@pytest.mark.parametrize("coupling, rho", [("implicit", 2000), ("staggered", 8000)])
+def test_flat_footing_auto_is_free_and_normal_holds_its_equations(tmp_path, coupling, rho):
+    """On the flat footing of test_coupled's box pulse with lift-off (p_C = 100 N/m^2, the whole base opens), no
+    freed node penetrates: auto is free bit for bit, both couplings. normal (every open node keeps its
+    tangential bond) solves its own equations: the BEM residual with the final interface values 1e-10, no
+    penetration, closed nodes within p_C, open nodes at p_N = p_C exactly (open traction cohesion)."""
+    from test_coupled import rigid
+    kw = dict(fem_E=300e6, fem_rho=rho, fem_box_cells="4,4,2", fem_box_size="1,1,0.5", fem_load_group="top",
+              fem_load_p0=1000.0, fem_load_history="box", fem_load_t0=0.025, t_end=0.4, contact="unilateral",
+              contact_cohesion=100.0, coupling=coupling)
+    free = rigid(tmp_path, contact_separation="free", **kw)["interface"]
+    auto = rigid(tmp_path, contact_separation="auto", **kw)["interface"]
+    for k in ("uf", "ub", "p", "closed"):
+        assert np.array_equal(auto[k], free[k]), k
+    r = rigid(tmp_path, contact_separation="normal", contact_open_traction="cohesion", **kw)["interface"]
+    closed = r["closed"].astype(bool)
+    assert r["n_open"].max() > 0 and r["bem_residual"].max() <= 1e-10
+    assert r["gap"][~closed].min() >= -1e-7 * np.abs(r["uf"]).max()
+    assert r["pN"][closed].max() <= 100.0 * (1 + 1e-7)
+    assert np.abs(r["pN"][~closed] - 100.0).max() <= 1e-9 * np.abs(r["p"]).max()
