@@ -126,7 +126,8 @@ class ContactLaw:
         self.zero = np.asarray(zero, bool).reshape(self.nI, 3)
         self.law = law
         self.p_C = float(p_C)
-        self.preload = float(preload)                # p_w: the static compression [N/m^2], >= 0
+        # p_w: the static compression [N/m^2], >= 0: uniform, or per node (n_I,) (-ssi_contact_preload earth:K0)
+        self.preload = float(preload) if np.ndim(preload) == 0 else np.asarray(preload, float)
         self.tol = float(tol)
         self.max_iter = int(max_iter)
         self.offset = None                           # the step's free-field traction t_ff (3 n_I) or None
@@ -150,8 +151,9 @@ class ContactLaw:
         minus the preload's -p_w n_b: (p_w [+ p_C]) n_b."""
         t = np.zeros(3 * self.nI)
         p_open = self.p_C if (self.open_traction == "cohesion" and self.p_C > 0) else 0.0
-        if p_open > 0 or self.preload > 0:
-            tt = ((p_open + self.preload) * self.n_b) * (~closed)[:, None]
+        pw = self.preload if np.ndim(self.preload) == 0 else self.preload[:, None]
+        if p_open > 0 or np.any(self.preload > 0):
+            tt = ((p_open + pw) * self.n_b) * (~closed)[:, None]
             t[:] = tt.ravel()
             t[self.zero.ravel()] = 0.0
         if self.offset is not None:                  # the soil carries t - t_ff: the total is the target
@@ -185,7 +187,7 @@ class ContactLaw:
     def _violations(self, closed, pN, gap, p, ub, uf, scale_u):
         """Each node's violation relative to its own scale (> 0: its status must change): a closed node's
         total normal traction p_N - p_w beyond p_C, an open node's penetration."""
-        sp = max(np.abs(p).max(), self.p_C, self.preload, 1e-300)
+        sp = max(np.abs(p).max(), self.p_C, np.max(self.preload), 1e-300)
         su = max(scale_u, np.abs(uf).max(), np.abs(ub).max(), 1e-300)
         v_open = np.where(closed, (pN - self.p_C - self.preload) / sp - self.tol, -np.inf)   # > 0: open
         v_close = np.where(~closed, -gap / su - self.tol, -np.inf)                          # > 0: must close

@@ -38,16 +38,25 @@ G_N = 9.81                                   # m/s^2: the weight preload's gravi
 
 
 def parse_preload(text):
-    """-ssi_contact_preload: None ('none'), 'weight', or a pressure [N/m^2] >= 0; ValueError in words."""
+    """-ssi_contact_preload: None ('none'), 'weight', ('earth', K0) from 'earth:K0', or a pressure [N/m^2] >= 0;
+    ValueError in words."""
     t = str(text).strip().lower()
     if t in ("none", ""):
         return None
     if t == "weight":
         return "weight"
+    if t.startswith("earth:"):
+        try:
+            k0 = float(t[6:])
+        except ValueError:
+            k0 = -1.0
+        if not (np.isfinite(k0) and 0.0 <= k0 <= 10.0):
+            raise ValueError(f"earth:K0 takes the lateral earth pressure coefficient K0 in [0, 10], not '{t[6:]}'")
+        return ("earth", k0)
     try:
         v = float(t)
     except ValueError:
-        raise ValueError("expected none, weight or a pressure in N/m^2") from None
+        raise ValueError("expected none, weight, earth:K0 or a pressure in N/m^2") from None
     if not np.isfinite(v) or v < 0:
         raise ValueError("the preload is a compression: it must be a finite pressure >= 0 N/m^2")
     return v
@@ -63,8 +72,10 @@ def _preload_ok(text):
 
 register("contact_preload", "str", "none", "N/m^2", "static contact pressure under the dynamic increment "
          "(unilateral contact): none (tractions are increments from rest: any tension beyond p_C opens), "
-         "weight (the structure's total mass x 9.81 m/s^2 spread uniformly over the interface area) or a "
-         "pressure in N/m^2; a node opens when its dynamic normal tension exceeds preload + p_C, and an open "
+         "weight (the structure's total mass x 9.81 m/s^2 spread uniformly over the interface area), "
+         "earth:K0 (a structure in an excavation: per node n_z^2 q + (1 - n_z^2) K0 rho g |z|, the lateral earth "
+         "pressure K0 rho g |z| of the soil's -ssi_rho on walls and q on the bottom, q such that the vertical "
+         "resultant is the weight) or a pressure in N/m^2; a node opens when its dynamic normal tension exceeds preload + p_C, and an open "
          "node carries total traction zero (dynamic traction = the preload's relief)", G,
          validator=_preload_ok)
 register("contact_open_traction", "enum", "zero", "", "traction an open node carries: zero (p_C is a "

@@ -238,7 +238,8 @@ class SSITransient(TransientProblem):
         cfg, comm, prob, model = self.cfg, self.comm, self.prob, self.model
         attrs = {"problem": "ssi", "cp": cfg.cp, "cs": cfg.cs, "rho": cfg.rho, "dt": self.grid.dt, "scheme": cfg.scheme,
                  "contact": cfg.contact, "contact_cohesion": cfg.contact_cohesion,
-                 "contact_preload": float(self.coupler.preload),
+                 "contact_preload": (float(self.coupler.preload) if np.ndim(self.coupler.preload) == 0
+                                     else np.asarray(self.coupler.preload)),
                  "structure_output": os.path.basename(structure_output_path(cfg.output))}
         if getattr(prob, "seismic", None) is not None:
             attrs["seismic"] = prob.seismic.kind

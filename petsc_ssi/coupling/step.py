@@ -383,9 +383,33 @@ def contact_preload(cfg, comm, model, iface):
                f"the interface area {a:.6g} m^2: p_w = {p:.6g} N/m^2, uniform (a node opens when its dynamic "
                f"tension exceeds p_w + p_C = {p + cfg.contact_cohesion:.6g} N/m^2)")
         return p
+    if isinstance(v, tuple):
+        return earth_preload(cfg, model, iface, v[1])
     printf(f"[ssi] contact preload: p_w = {v:.6g} N/m^2, uniform (a node opens when its dynamic tension exceeds "
            f"p_w + p_C = {v + cfg.contact_cohesion:.6g} N/m^2)")
     return float(v)
+
+
+def earth_preload(cfg, model, iface, k0):
+    """Collective: -ssi_contact_preload earth:K0, per node p_w = n_z^2 q + (1 - n_z^2) K0 rho g |z| [N/m^2] (n_z the
+    vertical component of the soil's normal n_b, rho the soil's): the lateral earth pressure at rest on walls,
+    q on the bottom, chosen so that the static traction's vertical resultant sum_k a_k p_w,k n_z,k (a_k = int N_k
+    dGamma, the interface mass matrix's row sums) carries the structure's weight; an edge node takes its mean
+    normal's share of both. One report line."""
+    from .options import G_N
+    nz, z = iface.n_b[:, 2], iface.x[:, 2]
+    a = np.asarray(iface.M.sum(axis=1)).ravel()
+    lateral = k0 * cfg.rho * G_N * np.abs(np.minimum(z, 0.0)) * (1.0 - nz ** 2)
+    w = structure_mass(model) * G_N
+    q = (w - float(np.sum(a * lateral * nz))) / float(np.sum(a * nz ** 3))
+    if not q > 0:
+        from ..petsc import SSIError
+        raise SSIError(f"-ssi_contact_preload earth:{k0:g}: the walls' lateral pressure leaves the bottom q = {q:.4g} "
+                       "N/m^2 to carry the weight (<= 0): is the interface's bottom there?")
+    pw = nz ** 2 * q + lateral
+    printf(f"[ssi] contact preload earth: K0 {k0:g}, rho {cfg.rho:g} kg/m^3: walls up to {lateral.max():.6g} N/m^2, "
+           f"bottom q = {q:.6g} N/m^2 (the weight {w:.6g} N); per node {pw.min():.6g} .. {pw.max():.6g} N/m^2")
+    return pw
 
 
 def _owned(dofs, vec):

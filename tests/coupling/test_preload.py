@@ -284,7 +284,9 @@ def test_preload_restart_and_two_ranks(tmp_path, coupling, extra, mass, landed):
 @pytest.mark.parametrize("kw,words", [
     (dict(contact="unilateral", contact_preload="-100"), "must be a finite pressure >= 0"),
     (dict(contact="unilateral", contact_preload="nan"), "must be a finite pressure >= 0"),
-    (dict(contact="unilateral", contact_preload="heavy"), "expected none, weight or a pressure"),
+    (dict(contact="unilateral", contact_preload="heavy"), "expected none, weight, earth:K0 or a pressure"),
+    (dict(contact="unilateral", contact_preload="earth:-1"), "earth:K0 takes the lateral earth pressure"),
+    (dict(contact="unilateral", contact_preload="earth:x"), "earth:K0 takes the lateral earth pressure"),
     (dict(contact_preload="weight"), "needs -ssi_contact unilateral"),
     (dict(contact_preload="1000"), "needs -ssi_contact unilateral"),
 ])
