@@ -1,6 +1,7 @@
 #!/bin/bash
 # Unilateral contact of a stiff block in a 2 x 2 x 1 m pit under a horizontal pulse pair (issue 42): counts
-# the steps whose active set did not settle (README limitation: 48 of 56). Usage: bash jobscripts/pit_contact.sh
+# the steps whose active set did not settle (-ssi_contact_separation free, the default: 48 of 56; auto: 0 of 56,
+# runs/basement/README.md). Usage: bash jobscripts/pit_contact.sh [-ssi_contact_separation auto] [other options]
 set -e
 cd "$(dirname "$0")/.."
 PY=${PY:-.venv/bin/python}

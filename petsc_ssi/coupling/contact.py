@@ -49,7 +49,16 @@ carries total traction zero (or p_C n_b with open_traction 'cohesion'), i.e.
 the dynamic traction (p_C + p_w) n_b or p_w n_b: the soil unloads by the
 preload, and the structure (f = -M p) loses the same support. The gap is the
 dynamic one (the static displacements of both sides are equal); p_w = 0 is
-today's law bit for bit.
+today's law bit for bit. With -ssi_contact_preload earth:K0 p_w is per node (the lateral earth pressure at rest
+on an excavation's walls, the weight on its bottom: ``step.earth_preload``).
+
+What an open node keeps of the bond (-ssi_contact_separation): 'free' nothing (every component of its traction
+prescribed). On an excavation's walls that law can have no consistent status at a node: closed, it is in
+(small) normal tension; freed, the release of its (large) shear pushes its soil into the pit (g < 0). 'auto'
+then keeps the node's tangential bond and releases its normal traction only ("stuck": in its frame (t1, t2, n),
+rows t.(u_b - u_f) = 0 and n.p = n.target; g >= 0 is still checked) for the rest of the step; a stuck node that
+penetrates closes, and a closed node that had been stuck in the step reopens stuck. 'normal' makes every open
+node stuck. Nodes start each step free (``stick`` is per iterate, not carried between steps).
 """
 import time
 

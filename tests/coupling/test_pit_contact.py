@@ -91,7 +91,7 @@ def test_walls_separate_in_turn_and_the_bottom_edge_lifts(tmp_path, record):
         at = np.isclose(x[:, 0], side)
         assert opened[np.ix_(now, at & mid)].any(), side
         assert opened[np.ix_(now, at & bottom)].any() and not opened[np.ix_(later, at & bottom)].any(), side
-        assert r["gap"][np.ix_(now, at & bottom)].max() > 1e-6          # the edge lifts (measured 3.2 um)
+        assert r["gap"][np.ix_(now, at & bottom)].max() > 1e-5          # the edge lifts (33 um, measured)
     assert not opened[:, interior].any()
 
 
