@@ -165,15 +165,27 @@ def fit(runs):
     s, sk = _nnls(A, arr(lambda me, ms, *r: ms["solve"]))
     c["c_sol"], c["kappa"] = float(s), float(sk / s) if s > 0 else 0.0
     # time-blocked history sum: the panel products (event SSI_BEM_HistPanel) against their flops,
-    # dense and block-sparse; the rest of the history sum as the per-step sum below
-    from petsc_ssi.bem.cost import FALLBACK
-    A = np.stack([arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FD"]),
-                  arr(lambda me, ms, cn, p, q, mx, o, m: o * mx["FS"])], 1)
+    # dense and block-sparse, each width's flops scaled by the kernel's relative rate at that width
+    # (cost.panel_width_factor), with the contention of m ranks on a node (sigma_panel, on a grid);
+    # the rest of the history sum as the per-step sum below
+    from petsc_ssi.bem.cost import FALLBACK, panel_width_factor as pwf
+    col = lambda kind, K: arr(lambda me, ms, cn, p, q, mx, o, m: o * (mx[K + "b"] / pwf(cn.block, kind)
+                                                                   + mx[K + "s"] / pwf(cn.sub, kind)))
+    A0 = np.stack([col("dense", "FD"), col("sparse", "FS")], 1)
+    mm = arr(lambda me, ms, cn, p, q, mx, o, m: m)
     panel = arr(lambda me, ms, *r: ms.get("hist_panel", 0.0))
-    has = A.sum(1) > 0
-    ird, irs = _nnls(A[has], panel[has]) if has.sum() >= 2 else (0.0, 0.0)
-    c["r_panel_dense"] = 1.0 / ird if ird > 0 and A[has, 0].any() else FALLBACK["r_panel_dense"]
-    c["r_panel_sparse"] = 1.0 / irs if irs > 0 and A[has, 1].any() else FALLBACK["r_panel_sparse"]
+    has = (A0.sum(1) > 0) & (panel > 0)
+    best = (None, 0.0, (0.0, 0.0))
+    if has.sum() >= 2:
+        for sp in np.linspace(0.0, 1.5, 61):
+            A = A0[has] * (1 + sp * (mm[has] - 1))[:, None]
+            x = _nnls(A, panel[has])
+            err = np.sum(((A @ x - panel[has]) / panel[has]) ** 2)
+            if best[0] is None or err < best[0]:
+                best = (err, sp, x)
+    _, c["sigma_panel"], (ird, irs) = best
+    c["r_panel_dense"] = 1.0 / ird if ird > 0 and A0[has, 0].any() else FALLBACK["r_panel_dense"]
+    c["r_panel_sparse"] = 1.0 / irs if irs > 0 and A0[has, 1].any() else FALLBACK["r_panel_sparse"]
     # history: bytes over bandwidth with contention sigma (grid), products
     hist = arr(lambda me, ms, *r: ms["history"] - ms.get("hist_panel", 0.0))
     best = None

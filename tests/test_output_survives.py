@@ -48,7 +48,8 @@ def test_flushing_every_step_changes_nothing(nranks, tmp_path):
     assert json.load(open(b.replace(".h5", ".json")))["run_status"] == "completed"
 
 
-@pytest.mark.parametrize("how", ["SIGTERM one rank", "SIGUSR1 mpirun two ranks"])
+# slow tier: mpirun's SIGUSR1 to two ranks (9-17 s); the one-rank SIGTERM stays in make test
+@pytest.mark.parametrize("how", ["SIGTERM one rank", pytest.param("SIGUSR1 mpirun two ranks", marks=pytest.mark.slow)])
 def test_a_signal_stops_the_run_and_keeps_its_results(how, tmp_path):
     """A long BEM run is signalled once it has taken 30 steps: it ends at the end of a step with
     one line and exit status 2, and its file holds the steps done, equal bit for bit to the same

@@ -38,7 +38,8 @@ def record_run(tmp_path_factory):
     return d, A
 
 
-@pytest.mark.parametrize("n", [1, 2])
+# slow tier: the two-rank restart (9-10 s); the one-rank restart stays in make test
+@pytest.mark.parametrize("n", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_a_run_that_lasts_the_record_restarts_with_its_own_options(record_run, tmp_path, n):
     d, A = record_run
     a, ck = str(d / "a.h5"), str(d / "ck-4.h5")

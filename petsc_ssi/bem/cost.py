@@ -18,17 +18,17 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
                                                        a cost per Mat (creation, collectives)
   factor     c_fac * N^1.5                              (sparse LU of the local step matrix)
   history    (HD_r / b_dense + HS_r / b_sparse)        bytes of lag matrices streamed over
-             * (1 + sigma (m - 1))                     the run (a dense lag: 8 m N n_r B,
-             + (c_op + c_op_mpi [p > 1]) * P_r
-             + FD_r / r_panel_dense                    time-blocked sum (-ssi_history_block b,
-             + FS_r / r_panel_sparse                   -ssi_history_sub s): flops of the block and
-                                                       sub-block panel products (2 per entry and
-                                                       column: width b or s; march.block_terms), dense and
-                                                       block-sparse; HD, HS, P then count only
-                                                       the per-step products
-                                                       sparse: 8 m + 4 B per block), m ranks per
-                                                       node sharing the memory bus; P_r
-                                                       matrix-vector products
+             * (1 + sigma (m - 1))                     the run by per-step products (a dense
+             + (c_op + c_op_mpi [p > 1]) * P_r          lag: 8 m N n_r B, block-sparse: 8 m + 4 B
+             + (FD_r / r_panel_dense                    per block), m ranks per node sharing the
+                + FS_r / r_panel_sparse)                memory bus; P_r matrix-vector products;
+               * (1 + sigma_panel (m - 1))              FD, FS: flops of the time-blocked sum's
+                                                       panel products (-ssi_history_block b,
+                                                       -ssi_history_sub s; 2 per entry and state;
+                                                       march.block_terms), dense and block-sparse,
+                                                       each width's at its rate (the r_panel are
+                                                       a 32-state panel's, panel_width_factor
+                                                       scales them to b and s)
   solve      c_sol * steps * N^1.5 * (1 + kappa (p - 1))
   setup      s0 + s1 * N * E_v / p                    (block estimate, free terms)
   rest       c_step * steps + c_main + c_plot [-ssi_plot]
@@ -68,7 +68,7 @@ DEFAULT_CONSTANTS = os.path.join(HERE, "estimate_constants.json")
 FALLBACK = {"a0": 0.5, "a_blk": 6e-7, "a_int": 0.0, "a_lag": 0.0, "c_cache": 1.0, "rho_trip": 1.0, "a_dense": 1.0e-9, "a_sparse": 5e-7, "c_fac": 1e-6, "b_dense": 16e9,
             "b_sparse": 9e9, "sigma": 0.4, "c_op": 2e-5, "c_op_mpi": 0.0, "c_sol": 2.5e-8, "kappa": 0.3, "s0": 0.2,
             "s1": 3e-7, "c_step": 1e-3, "c_main": 0.7, "c_plot": 1.8, "m0": 0.15e9, "m_asm": 0.15e9,
-            "gamma": 1.0, "r_panel_dense": 25e9, "r_panel_sparse": 15e9}
+            "gamma": 1.0, "r_panel_dense": 25e9, "r_panel_sparse": 15e9, "sigma_panel": 0.0}
 
 
 def load_constants(path=""):
@@ -293,43 +293,47 @@ class Counts:
         n = np.arange(1, self.steps + 1)
         from .partition import lag_uses
         uses = lag_uses(Lx, self.steps, self.stabilized, self.k)     # steps in which each stored matrix is used
-        fd = fs = 0.0
+        fl = {k: 0.0 for k in ("FDb", "FDs", "FSb", "FSs")}
         if self.block > 1:
             # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
-            # one of the block's steps reads a state known at its start; the rest are per-step products
-            uses, width = self._blocked_uses(n, used)
+            # one of the block's steps reads a state known at its start; the rest are per-step products.
+            # The panel flops by width: the block's panels are b states wide, the sub-blocks' s (the
+            # kernels' rates differ by 2-4x between them: panel_rate)
+            uses, wb, ws = self._blocked_uses(n, used)
             entries = np.where(dense, mat_bytes / 8.0, self.mH * used) * nonempty
             g_entries = self.mG * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
-            fd = float(np.sum(width * 2.0 * (entries * dense + g_entries * ~self.single)))
-            fs = float(np.sum(width * 2.0 * (entries * ~dense + g_entries * self.single)))
+            d_ent = entries * dense + g_entries * ~self.single
+            s_ent = entries * ~dense + g_entries * self.single
+            fl = {"FDb": float(np.sum(wb * 2.0 * d_ent)), "FDs": float(np.sum(ws * 2.0 * d_ent)),
+                  "FSb": float(np.sum(wb * 2.0 * s_ent)), "FSs": float(np.sum(ws * 2.0 * s_ent))}
+        fd, fs = fl["FDb"] + fl["FDs"], fl["FSb"] + fl["FSs"]
         hd = float(np.sum(uses * (mat_bytes + g_bytes) * dense))
         hs = float(np.sum(uses * mat_bytes * ~dense) + np.sum(uses * g_bytes * ~dense))
         prods = float(np.sum(uses * nonempty) * (2 if self.nt else 1))
         # integrated pair-lags: with the cache its misses; without, every pair (~ blocks / 4)
         integ, pool = cache if cache is not None else (float(used.sum()) / 4.0, 0.0)
         return {"B": float(used.sum()), "I": integ, "C": 8.0 * 9 * (self.mH + self.mG) * pool, "D": float(np.sum(mat_bytes * dense)),
-                "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods, "FD": fd, "FS": fs,
+                "S": float(np.sum(used * ~dense * nonempty)), "HD": hd, "HS": hs, "P": prods, "FD": fd, "FS": fs, **fl,
                 "mats": float(mat_bytes.sum() + g_bytes.sum()), "trip": float(trip.sum()),
                 "build": float(build.max() + g_bytes.sum()), "rows": nrows}
 
     def _blocked_uses(self, n, used):
-        """(per-step uses, summed panel width) of each stored matrix with blocks of ``self.block``
-        steps and sub-blocks of ``self.sub`` (``march.block_terms``: the states a block's or a
-        sub-block's start knows go into its panel product, the others into a product of the step)."""
+        """(per-step uses, summed block-panel width, summed sub-block-panel width) of each stored matrix
+        with blocks of ``self.block`` steps and sub-blocks of ``self.sub`` (``march.block_terms``: the
+        states a block's or a sub-block's start knows go into its panel product, the others into a
+        product of the step)."""
         key = (len(n), len(used))
         if getattr(self, "_uses", (None,))[0] == key:      # the same for every rank and rank count
             return self._uses[1]
         from .march import block_terms
         b, s, Lx = self.block, self.sub, self.Lx
-        steps_in, width = np.zeros(len(used)), np.zeros(len(used))
+        steps_in, wblk, wsub = np.zeros(len(used)), np.zeros(len(used)), np.zeros(len(used))
         for j in range(2, Lx + 1):
-            st, wb, ws = block_terms(n, [j], b, s, self.stabilized)
-            steps_in[j - 1], width[j - 1] = st, wb + ws
+            steps_in[j - 1], wblk[j - 1], wsub[j - 1] = block_terms(n, [j], b, s, self.stabilized)
         if self.k:
-            st, wb, ws = block_terms(n, range(Lx + 1, self.L + 1), b, s, self.stabilized)
-            steps_in[Lx:], width[Lx:] = st, wb + ws
-        self._uses = (key, (steps_in, width))
-        return steps_in, width
+            steps_in[Lx:], wblk[Lx:], wsub[Lx:] = block_terms(n, range(Lx + 1, self.L + 1), b, s, self.stabilized)
+        self._uses = (key, (steps_in, wblk, wsub))
+        return steps_in, wblk, wsub
 
     def nb_total_used(self):
         t = self.nb_total
@@ -343,7 +347,8 @@ def features(cnt, p, q, cores):
     """Model terms for p ranks, q per node, ``cores`` per node: the maxima over
     ranks of each count, the oversubscription factor and the concurrency m."""
     rk = cnt.per_rank[p]
-    mx = {key: max(r[key] for r in rk) for key in ("B", "I", "D", "S", "HD", "HS", "P", "FD", "FS")}
+    mx = {key: max(r[key] for r in rk) for key in ("B", "I", "D", "S", "HD", "HS", "P", "FD", "FS",
+                                                   "FDb", "FDs", "FSb", "FSs")}
     qn = min(q, p)
     over = max(1.0, qn / float(cores))
     m = min(qn, cores)
@@ -365,11 +370,30 @@ def loop_terms(cnt, c, p, q, cores):
     mx, over, m = features(cnt, p, q, cores)
     t = {"history": over * ((mx["HD"] / c["b_dense"] + mx["HS"] / c["b_sparse"]) * (1 + c["sigma"] * (m - 1))
                             + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
-                            + mx["FD"] / c["r_panel_dense"] + mx["FS"] / c["r_panel_sparse"]),
+                            + panel_seconds(mx, cnt.block, cnt.sub, c, m)),
          "solve": c["c_sol"] * cnt.steps * cnt.N ** 1.5 * (1 + c["kappa"] * (p - 1)),
          "step": c["c_step"] * cnt.steps, "snapshots": SNAPSHOT_S * cnt.writes}
     t["loop"] = t["history"] + t["solve"] + t["step"] + t["snapshots"]
     return t
+
+
+def panel_width_factor(w, kind):
+    """The panel kernel's rate at w states relative to its rate at 32 (PANEL_DENSE_GFPS and
+    PANEL_SPARSE_GFPS, measured on one core by jobscripts/dgemm_rate.py; clamped outside 8-32 states):
+    a sub-block's panel of 12 states runs at 0.42 of a block's of 32 (block-sparse)."""
+    table = PANEL_DENSE_GFPS if kind == "dense" else PANEL_SPARSE_GFPS
+    return float(np.interp(w, PANEL_B, table)) / table[-1]
+
+
+def panel_seconds(mx, b, s, c, m=1):
+    """Seconds of the time-blocked history sum's panel products (event SSI_BEM_HistPanel) from their
+    flops by kind and width (``mx``: FDb, FDs, FSb, FSs of Counts): r_panel_dense and r_panel_sparse are
+    the rates of panels 32 states wide, scaled to b and s by ``panel_width_factor``; m ranks of a node
+    slow each other by 1 + sigma_panel (m - 1) (the shared memory bus and caches)."""
+    rd, rs = c["r_panel_dense"], c["r_panel_sparse"]
+    t = (mx["FDb"] / (rd * panel_width_factor(b, "dense")) + mx["FDs"] / (rd * panel_width_factor(s, "dense"))
+         + mx["FSb"] / (rs * panel_width_factor(b, "sparse")) + mx["FSs"] / (rs * panel_width_factor(s, "sparse")))
+    return t * (1 + c.get("sigma_panel", 0.0) * (m - 1))
 
 
 def loop_model(t, steps, lags):

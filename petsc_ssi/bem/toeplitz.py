@@ -154,21 +154,26 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
     return Lattice(o, h, nx, ny, cell, perm, nfi.astype(np.int64), code[0].copy())
 
 
-# cost model (``estimate``), fitted to jobscripts/toeplitz_bench.sh's logs on the development machine (2
-# cores, idle; runs/pekeris/README.md "The toeplitz lag store"): the history's complex products per rank
-# (the block products' flops over this rate), the per-step work that grows with the soil's DOFs and is
-# not split over the ranks (the state's gather and 27 + 12 FFTs of every rank, the G products), seconds
-# per (kernel offset, lag) of the kernels' integration, and the real flops per second of the interpolated
-# lags' weighted states (``interp_products``: real matrix products over the kept transforms; from the
-# 40, 60 and 80 m sites of jobscripts/toeplitz_bench.sh, run on the shared machine: each run's rate of the
-# weighted states over its rate of the exact products, times the idle r_products; median of 3.44, 6.67,
-# 4.69 GFlop/s), and the bytes of the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested
-# dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak
-# over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors); a G kernel offset costs
-# g_pair_factor H offsets (the displacement kernel's integrals beside the traction kernel's: the 40 m site
-# of jobscripts/toeplitz_bench.sh, 8.58 s for 6 889 G offsets against 19.3 s for 25 281 H offsets: 1.63)
-RATES = {"r_products": 4.07e9, "t_step_dof": 1.22e-6, "t_pair_lag": 2.4e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0,
-         "g_pair_factor": 1.6}
+# cost model (``estimate``). The time rates r_products (the history's complex products per rank: the
+# block products' flops over this rate), the per-step work of every rank that is not split over the ranks
+# (t_step_dof a DOF, t_step_grid an FFT grid point, t_step_elem a virtual element: the state's gather, the
+# 27 + 12 transforms and their inputs element by element, images included) and t_pair_lag (seconds per
+# kernel offset and lag of the kernels' integration) are fitted by `python jobscripts/toeplitz_fit.py` to
+# the logs of `PARTS="paper grid site" SITE_SIZES=40 bash jobscripts/quiet.sh bash
+# jobscripts/toeplitz_bench.sh` (2026-11-29, 2 ranks of the 2-core development machine with every other
+# process paused: grids of 24-64 m, the paper's quarter and whole models, the 40 m site): within 20 % of
+# every one of those 7 logs in both kernels and history (the per-element term took the per-step work: the
+# DOF and grid terms came out 0, and without the element term the quarter model, whose transforms read
+# its images, was estimated at half its time). r_sums, the real flops per second of the interpolated lags'
+# weighted states (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's
+# rate of the weighted states over its rate of the exact products, times the idle r_products of the time;
+# median of 3.44, 6.67, 4.69 GFlop/s), is not refitted. fill_bytes: the step matrix's LU factors (MUMPS)
+# per DOF and ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m
+# site's two steps: 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of
+# factors); a G kernel offset costs g_pair_factor H offsets (the displacement kernel's integrals beside the
+# traction kernel's: the 40 m site, 8.58 s for 6 889 G offsets against 19.3 s for 25 281 H offsets: 1.63)
+RATES = {"r_products": 8.48e9, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 1.4e-5, "t_pair_lag": 3.52e-6,
+         "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.6}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed this many bytes of lags at a time per rank
 
 
@@ -237,8 +242,14 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
         flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         sums += 2.0 * 54 * F * iwork
+    # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
+    # transforms over the FFT grids of both sides (t_step_grid a grid point) and the transforms' inputs
+    # element by element (t_step_elem a virtual element: a symmetric model's images count, so its step
+    # costs nearly a whole model's for a quarter of the DOFs)
+    grid = sum(g.Mx * g.My for g in (lat, glat) if g is not None)
+    elems = sum(g.cell.size for g in (lat, glat) if g is not None)       # virtual elements: images too
     t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"])
-              + n_steps * n_dofs * r["t_step_dof"])
+              + n_steps * (n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]))
     return nbytes + build, t_build, t_hist
 
 

@@ -272,3 +272,23 @@ def test_an_explicit_block_size_is_kept():
     assert history_block(Cfg(history_block=2), np.zeros(3), d, 9 * d / 76) == (2, 2)
     assert history_block(Cfg(history_block=1), np.zeros(3), d, 9 * d / 76) == (1, 1)
     assert history_block(Cfg(history_block=16, history_sub=4), np.zeros(3), d, 9 * d / 76) == (16, 4)
+
+
+def test_the_panel_model_prices_each_width_at_its_rate():
+    """``cost.panel_seconds``: the block's and the sub-blocks' panel flops each at the kernel's rate for
+    its width (the one-core table of ``dgemm_rate.py``: a 12-state block-sparse panel at 0.42 of a
+    32-state one), so a run whose sub-blocks carry the work is priced slower per flop than one whose
+    blocks do; two ranks of a node slow each other by sigma_panel, one rank not."""
+    from petsc_ssi.bem.cost import panel_seconds, panel_width_factor, PANEL_SPARSE_GFPS
+    c = {"r_panel_dense": 20e9, "r_panel_sparse": 10e9, "sigma_panel": 0.5}
+    assert panel_width_factor(32, "sparse") == 1.0
+    assert panel_width_factor(16, "sparse") == pytest.approx(PANEL_SPARSE_GFPS[1] / PANEL_SPARSE_GFPS[2])
+    assert panel_width_factor(12, "sparse") == pytest.approx(0.5 * (8.2 + 18.8) / 32.2)
+    z = {"FDb": 0.0, "FDs": 0.0, "FSb": 0.0, "FSs": 0.0}
+    blk = dict(z, FSb=1e10)
+    sub = dict(z, FSs=1e10)
+    assert panel_seconds(blk, 32, 16, c) == pytest.approx(1.0)
+    assert panel_seconds(sub, 32, 16, c) == pytest.approx(32.2 / 18.8)
+    assert panel_seconds(dict(z, FDb=2e10), 32, 16, c) == pytest.approx(1.0)
+    assert panel_seconds(blk, 32, 16, c, m=2) == pytest.approx(1.5)
+    assert panel_seconds(blk, 24, 12, c) > panel_seconds(blk, 32, 16, c)

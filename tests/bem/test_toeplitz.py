@@ -169,11 +169,13 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
         Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
         F = 8 * 5
         nx = ny = 4
+        cell = np.arange(16)    # its elements (the per-step term counts them)
 
     class GLat:
         Mx, My = 6, 6           # the load patch's 2 x 2 elements: 4 + 2 per axis
         F = 6 * 4
         nx = ny = 4
+        cell = np.arange(4)
     plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
     b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
     build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes

@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Fit the toeplitz store's time rates (petsc_ssi/bem/toeplitz.py RATES) to -log_view logs of toeplitz
+runs (jobscripts/toeplitz_bench.sh), and print the model against each log.
+
+    python jobscripts/toeplitz_fit.py LOG...
+
+Each log's option table rebuilds its set-up in this process (no assembly: the lattice, the interpolation
+plan, the traction window), as `petsc-ssi estimate` does; ``toeplitz.estimate`` is then evaluated with one
+rate at a time to get each term's count, and the rates are fitted by non-negative least squares on
+relative errors: the kernels' build (t_pair_lag, seconds per kernel offset and lag) against the run's
+'kernels ... s', the history sum (event SSI_BEM_History) against the products (1 / r_products), the
+per-step DOF term (t_step_dof) and the per-step FFT-grid term (t_step_grid); r_sums (the interpolated lags'
+weighted states) is kept as it is. Oversubscribed runs are left out. The printed RATES line goes into
+toeplitz.py by hand, with the logs' names and date in its comment.
+"""
+import contextlib
+import importlib
+import io
+import os
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+sys.path.insert(0, ROOT)
+from calibrate import log_options, _nnls  # noqa: E402
+from toeplitz_table import row  # noqa: E402
+
+
+def terms(opts, ranks):
+    """{term: count} of ``toeplitz.estimate`` for the case ``opts`` on ``ranks`` ranks."""
+    from petsc_ssi.petsc import init
+    PETSc = init([sys.argv[0]])
+    from petsc_ssi import options
+    importlib.import_module("petsc_ssi.app.estimate")        # (registers the options)
+    from petsc_ssi.bem.halfspace import HalfSpace
+    from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES
+    db = PETSc.Options()
+    for k in list(db.getAll()):
+        if k.startswith("ssi_"):
+            db.delValue(k)
+    for k, v in opts.items():
+        db.setValue("ssi_" + k, v)
+    db.setValue("ssi_warn_beta", "0")
+    cfg = options.resolve(("common", "bem", "estimate"))
+    with contextlib.redirect_stdout(io.StringIO()):
+        prob = HalfSpace(cfg, PETSc.COMM_SELF, log=lambda m: None)
+        plan = prob.interp_plan()
+        ls = prob.lagset(plan)
+    lat = detect(ls.VX, prob.mesh.nodes)
+    lat.n_offsets = len(kernel_offsets(lat))
+    glat = traction_grid(lat, ls.VT)
+    big = 1e300
+    args = (lat, prob.L, prob.n_steps, ranks, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, 0.0)
+    kw = dict(plan=plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
+              single=cfg.get("toeplitz_precision", "double") == "single")
+    zero = {"r_products": big, "r_sums": big, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 0.0,
+            "t_pair_lag": 0.0}
+    one = lambda **r: estimate(*args, rates=dict(zero, **r), **kw)
+    return {"pairs": one(t_pair_lag=1.0)[1], "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
+            "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2], "sums": one(r_sums=RATES["r_sums"])[2]}
+
+
+def main(logs):
+    runs = []
+    for path in logs:
+        text = open(path, errors="replace").read()
+        opts = log_options(text)
+        r = row(path)
+        if not opts or opts.get("lag_store") != "toeplitz" or not r.get("kernels_s") or r["history_s"] != r["history_s"]:
+            print(f"[toeplitz_fit] skip {path}: not a finished toeplitz run", file=sys.stderr)
+            continue
+        if int(r["ranks"]) > (os.cpu_count() or 1):
+            print(f"[toeplitz_fit] skip {path}: oversubscribed", file=sys.stderr)
+            continue
+        runs.append((path, r, terms(opts, int(r["ranks"]))))
+    kern = np.array([r["kernels_s"] for _, r, _ in runs], float)
+    hist = np.array([r["history_s"] for _, r, _ in runs], float)
+    t_pair = float(_nnls(np.array([[t["pairs"]] for *_, t in runs]), kern)[0])
+    A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
+    sums = np.array([t["sums"] for *_, t in runs])
+    inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
+    fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
+           "t_step_grid": float(t_grid), "t_step_elem": float(t_elem), "t_pair_lag": t_pair}
+    print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] |")
+    print("|---|---|---|---|---|")
+    for (path, r, t), k, h in zip(runs, kern, hist):
+        mk = t_pair * t["pairs"]
+        mh = inv_r * t["prod"] + t_dof * t["dof"] + t_grid * t["grid"] + t_elem * t["elem"] + t["sums"]
+        print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
+              f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) |")
+    print("fitted: " + ", ".join(f'"{k}": {v:.3g}' for k, v in fit.items()))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
