@@ -10,6 +10,9 @@
 #   uniform-36     -ssi_mesh grid 36 x 37.2 m of equal 1.2 m nine-node cells (node spacing 0.6 m = the slab's
 #                  shell nodes; y edges at +-18.6 so that +-5.4 are cell edges), toeplitz, the same load
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
+#   estimate       (not by default) petsc-ssi estimate of uniform-72 -> OUT/uniform-72.estimate
+#   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
+#                  coupled case (every recorded series' largest difference over the largest value of its kind)
 # The far lags are interpolated as in today's run (Chebyshev from T_L = 0.27 s, k = 20: ssi-common.opts).
 # Then jobscripts/building_uniform_table.py writes the tables (walls, stages, memory; receivers against
 # today's) into runs/building/README.md and jobscripts/README.md and the CSVs under runs/building/.
@@ -55,6 +58,12 @@ for r in $RUNS; do
     uniform-36) run uniform-36 "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 $EXTRA ;;
     # shellcheck disable=SC2086
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
+    # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz
+    check) run check-dense "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 -ssi_lag_store dense
+           run check-toeplitz "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 ;;
+    # petsc-ssi estimate of uniform-72 (the cost model's prediction beside the run; not a run)
+    estimate) "$PY" -m petsc_ssi estimate "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA -ssi_estimate_ranks "$RANKS" \
+                > "$OUT/uniform-72.estimate" 2>&1 || true ;;
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
