@@ -18,7 +18,7 @@
 # today's) into runs/building/README.md and jobscripts/README.md and the CSVs under runs/building/.
 #   bash jobscripts/building_uniform.sh
 #   RUNS="uniform-72" bash jobscripts/building_uniform.sh      (a subset; T_END=0.05 for a short check;
-#   OUT=... another directory; EXTRA="-ssi_toeplitz_precision single" options added to the toeplitz runs)
+#   OUT=... another directory, whose tables are printed, not written; EXTRA="-ssi_toeplitz_precision single" options added to the toeplitz runs)
 # Each run's log ends with its ranks' resident memory sampled every 2 s ("# sampled peak RSS over the ranks").
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
@@ -67,4 +67,9 @@ for r in $RUNS; do
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
-"$PY" jobscripts/building_uniform_table.py "$OUT"
+# the READMEs' tables and the CSVs from the default directory only (another OUT: printed)
+if [[ "$OUT" == out/bench/building_uniform ]]; then
+  "$PY" jobscripts/building_uniform_table.py "$OUT"
+else
+  "$PY" jobscripts/building_uniform_table.py "$OUT" --print
+fi

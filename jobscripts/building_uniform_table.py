@@ -12,12 +12,12 @@
   displacements x, z at the soil receivers on y = 0), with the first time at which |a - b| exceeds 1 % of
   b's peak (when an edge's reflection or the other mesh's waves first show).
 
-    python jobscripts/building_uniform_table.py OUTDIR [README ...]
+    python jobscripts/building_uniform_table.py OUTDIR [README ... | --print]
 
 README defaults to runs/building/README.md and jobscripts/README.md; the blocks between
 <!-- building-uniform-cost:begin/end --> and <!-- building-uniform-receivers:begin/end --> are replaced.
 CSVs: runs/building/building_uniform_cost.csv, runs/building/building_uniform_receivers.csv (every
-quantity of every pair).
+quantity of every pair). ``--print``: the tables on stdout only (building_uniform.sh with another OUT).
 """
 import csv
 import json
@@ -136,17 +136,23 @@ def put(path, tag, lines):
 
 
 def main(outdir, *readmes):
-    readmes = readmes or (os.path.join(ROOT, "runs/building/README.md"), os.path.join(HERE, "README.md"))
+    if readmes == ("--print",):          # (another OUT: the tables on stdout only, the READMEs and CSVs untouched)
+        readmes, csvs = (), False
+    else:
+        csvs = True
+    readmes = readmes if readmes or not csvs else (os.path.join(ROOT, "runs/building/README.md"),
+                                                    os.path.join(HERE, "README.md"))
     names = [n for n in MESH if os.path.exists(os.path.join(outdir, n + ".log"))]
     cost = [cost_row(outdir, n) for n in names if not n.startswith("check-")]   # (the check: not a timing)
     ccols = ["run", "soil mesh", "store", "soil DOFs", "steps", "run wall [s]", "set-up [s]", "BEM assembly [s]",
              "toeplitz kernels [s]", "time loop [s]", "history sum [s]", "peak over the ranks [GB]",
              "sampled peak [GB]", "toeplitz estimate [GB]"]
     cost_md = md(cost, ccols)
-    with open(os.path.join(ROOT, "runs/building/building_uniform_cost.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, list(cost[0]) if cost else ccols)
-        w.writeheader()
-        w.writerows(cost)
+    if csvs:
+        with open(os.path.join(ROOT, "runs/building/building_uniform_cost.csv"), "w", newline="") as fh:
+            w = csv.DictWriter(fh, list(cost[0]) if cost else ccols)
+            w.writeheader()
+            w.writerows(cost)
     rec = {}
     for n in names:
         try:
@@ -174,10 +180,11 @@ def main(outdir, *readmes):
              "soil: largest peak diff [%]", "soil: largest history diff [%]", "largest history diff at"]
     rec_md = md(summary, scols)
     if detail:
-        with open(os.path.join(ROOT, "runs/building/building_uniform_receivers.csv"), "w", newline="") as fh:
-            w = csv.DictWriter(fh, list(detail[0]))
-            w.writeheader()
-            w.writerows(detail)
+        if csvs:
+            with open(os.path.join(ROOT, "runs/building/building_uniform_receivers.csv"), "w", newline="") as fh:
+                w = csv.DictWriter(fh, list(detail[0]))
+                w.writeheader()
+                w.writerows(detail)
         # the per-receiver detail of the pairs: one column pair per comparison
         pairs = list(dict.fromkeys(d["pair"] for d in detail))
         qs = list(dict.fromkeys(d["quantity"] for d in detail))
