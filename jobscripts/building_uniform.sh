@@ -10,6 +10,8 @@
 #   uniform-36     -ssi_mesh grid 36 x 37.2 m of equal 1.2 m nine-node cells (node spacing 0.6 m = the slab's
 #                  shell nodes; y edges at +-18.6 so that +-5.4 are cell edges), toeplitz, the same load
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
+#   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
+#                  T_L and k, kept transforms in single precision): what the history sum's options save
 #   estimate       (not by default) petsc-ssi estimate of uniform-72 -> OUT/uniform-72.estimate
 #   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
 #                  coupled case (every recorded series' largest difference over the largest value of its kind)
@@ -27,6 +29,7 @@ OUT=${OUT:-out/bench/building_uniform}
 RUNS=${RUNS:-"today today-load15 uniform-36 uniform-72"}
 T_END=${T_END:-}
 EXTRA=${EXTRA:-}
+FAST=${FAST:-"-ssi_interp linear -ssi_toeplitz_precision single"}
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup > /dev/null
 B=(-options_file runs/building/ssi-full-bonded.opts ${T_END:+-ssi_t_end "$T_END"})
@@ -58,6 +61,8 @@ for r in $RUNS; do
     uniform-36) run uniform-36 "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 $EXTRA ;;
     # shellcheck disable=SC2086
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
+    # shellcheck disable=SC2086
+    uniform-72-fast) run uniform-72-fast "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $FAST ;;
     # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz
     check) run check-dense "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 -ssi_lag_store dense
            run check-toeplitz "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 ;;

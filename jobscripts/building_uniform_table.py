@@ -37,12 +37,14 @@ MESH = {"today": "graded 36 x 36 m (building_soil.geo), 1 m load at x = 14.5",
         "today-load15": "graded 36 x 36 m (building_soil.geo), 1.2 m load at x = 15",
         "uniform-36": "uniform 36 x 37.2 m, 1.2 m cells, 1.2 m load at x = 15",
         "uniform-72": "uniform 72 x 73.2 m, 1.2 m cells, 1.2 m load at x = 15",
+        "uniform-72-fast": "as uniform-72, multi-linear far lags, single-precision transforms",
         "check-dense": "uniform 36 x 37.2 m, 6 steps", "check-toeplitz": "uniform 36 x 37.2 m, 6 steps"}
 PAIRS = [("uniform-72", "today", "uniform 72 m (toeplitz) vs today"),
          ("today-load15", "today", "load: 1.2 m cell at x = 15 vs 1 m patch at 14.5 (graded mesh both)"),
          ("uniform-36", "today-load15", "uniform 1.2 m cells vs graded, same extent and load"),
          ("uniform-72", "uniform-36", "extent 72 m vs 36 m (edge reflections), uniform both"),
-         ("uniform-72", "today-load15", "uniform 72 m vs graded 36 m, same load")]
+         ("uniform-72", "today-load15", "uniform 72 m vs graded 36 m, same load"),
+         ("uniform-72-fast", "uniform-72", "multi-linear far lags, single transforms vs Chebyshev, double")]
 
 
 def cost_row(outdir, name):
