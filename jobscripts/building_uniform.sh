@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# The paper's building on a uniform soil grid on the toeplitz lag store (issue 41's building item), against
+# today's building (runs/building/ssi-full-bonded.opts: the graded 36 m x 36 m soil of
+# meshes/building_soil.geo, dense lag matrices), on RANKS ranks (default 2), with -log_view and -memory_view:
+#   today          runs/building/ssi-full-bonded.opts as it is (1 m x 1 m load patch centred at x = 14.5 m)
+#   today-load15   the same graded mesh, but the load of the uniform grids: one 1.2 m x 1.2 m cell centred at
+#                  x = 15.0 m (-ssi_mesh_params xl=15,w=1.2), p0 = 1000 / 1.44 N/m^2 (the same 1 kN resultant).
+#                  A uniform grid whose nodes are the slab's 0.6 m shell nodes has its cell edges on
+#                  x = 1.2 k and y = 0.6 + 1.2 k: no cell holds the 1 m patch at x = 14.5 (runs/building/README.md)
+#   uniform-36     -ssi_mesh grid 36 x 37.2 m of equal 1.2 m nine-node cells (node spacing 0.6 m = the slab's
+#                  shell nodes; y edges at +-18.6 so that +-5.4 are cell edges), toeplitz, the same load
+#   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
+#   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
+#                  T_L and k, kept transforms in single precision): what the history sum's options save
+#   estimate       (not by default) petsc-ssi estimate of uniform-72 -> OUT/uniform-72.estimate
+#   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
+#                  coupled case (every recorded series' largest difference over the largest value of its kind)
+# The far lags are interpolated as in today's run (Chebyshev from T_L = 0.27 s, k = 20: ssi-common.opts).
+# Then jobscripts/building_uniform_table.py writes the tables (walls, stages, memory; receivers against
+# today's) into runs/building/README.md and jobscripts/README.md and the CSVs under runs/building/.
+#   bash jobscripts/building_uniform.sh
+#   RUNS="uniform-72" bash jobscripts/building_uniform.sh      (a subset; T_END=0.05 for a short check;
+#   OUT=... another directory, whose tables are printed, not written; EXTRA="-ssi_toeplitz_precision single" options added to the toeplitz runs)
+# Each run's log ends with its ranks' resident memory sampled every 2 s ("# sampled peak RSS over the ranks").
+set -euo pipefail
+source "$(dirname "$0")/bench_env.sh"
+RANKS=${RANKS:-2}
+OUT=${OUT:-out/bench/building_uniform}
+RUNS=${RUNS:-"today today-load15 uniform-36 uniform-72"}
+T_END=${T_END:-}
+EXTRA=${EXTRA:-}
+FAST=${FAST:-"-ssi_interp linear -ssi_toeplitz_precision single"}
+mkdir -p "$OUT"
+"$PY" -m petsc_ssi.app.warmup > /dev/null
+B=(-options_file runs/building/ssi-full-bonded.opts ${T_END:+-ssi_t_end "$T_END"})
+P15=(-ssi_load_p0 694.4444444444445)          # 1000 N over the 1.44 m^2 cell
+U=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14.9,15.1,-0.1,0.1 "${P15[@]}"
+   -ssi_lag_store toeplitz)
+run() {
+  local name=$1
+  shift
+  echo "[bench] $name on $RANKS rank(s) -> $OUT/$name.log"
+  echo "# load average before the run (other users of the machine): $(cat /proc/loadavg)" > "$OUT/$name.log"
+  mpirun --allow-run-as-root --oversubscribe -n "$RANKS" "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" \
+    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 &
+  local pid=$! peak=0 rss
+  while kill -0 "$pid" 2>/dev/null; do     # the ranks' resident memory (children of this mpirun)
+    rss=$( (ps --ppid "$pid" -o rss= || true) | awk '{s += $1} END {print s + 0}')
+    if (( rss > peak )); then peak=$rss; fi
+    sleep 2
+  done
+  wait "$pid" || true
+  echo "# sampled peak RSS over the ranks: $(awk -v k="$peak" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
+  echo "# load average after the run: $(cat /proc/loadavg)" >> "$OUT/$name.log"
+}
+for r in $RUNS; do
+  case $r in
+    today) run today "${B[@]}" ;;
+    today-load15) run today-load15 "${B[@]}" -ssi_mesh_params xl=15,w=1.2 "${P15[@]}" ;;
+    # shellcheck disable=SC2086
+    uniform-36) run uniform-36 "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 $EXTRA ;;
+    # shellcheck disable=SC2086
+    uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
+    # shellcheck disable=SC2086
+    uniform-72-fast) run uniform-72-fast "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $FAST ;;
+    # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz
+    check) run check-dense "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 -ssi_lag_store dense
+           run check-toeplitz "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 ;;
+    # petsc-ssi estimate of uniform-72 (the cost model's prediction beside the run; not a run)
+    estimate) "$PY" -m petsc_ssi estimate "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA -ssi_estimate_ranks "$RANKS" \
+                > "$OUT/uniform-72.estimate" 2>&1 || true ;;
+    *) echo "unknown run $r" >&2; exit 2 ;;
+  esac
+done
+# the READMEs' tables and the CSVs from the default directory only (another OUT: printed)
+if [[ "$OUT" == out/bench/building_uniform ]]; then
+  "$PY" jobscripts/building_uniform_table.py "$OUT"
+else
+  "$PY" jobscripts/building_uniform_table.py "$OUT" --print
+fi
