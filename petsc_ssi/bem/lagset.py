@@ -237,7 +237,7 @@ class SplitBuckets:
     blocks whose entries outside the flat pattern (bsr.H4) are exact zeros, 4 values each (every block
     whose pairs all lie in one horizontal plane: the ground, the pit's bottom), and ``full``, the others
     (9 values). The assembly kernel sorts each row's blocks between them (``assemble._emit_split``).
-    Reads as one Buckets where the lag's blocks are wanted whole (``count``, ``peek``, ``diag``);
+    Reads as one Buckets where the lag's blocks are wanted whole (``count``, ``csr``, ``peek``, ``diag``);
     ``parts`` gives the two block CSRs of a lag for its Mat (``lagmats.build``)."""
 
     def __init__(self, full, flat):
@@ -253,6 +253,11 @@ class SplitBuckets:
 
     def dtype(self, lag):
         return self.full.dtype(lag)
+
+    def csr(self, lag):
+        """``Buckets.csr`` of the whole lag: (indptr, columns, (blocks, 9)), the parts merged (a copy)."""
+        from .lagmats import merged
+        return merged([self.full.csr(lag), self.flat.csr(lag)], [self.full.m, self.flat.m], self.nloc)
 
     def parts(self, lag):
         """[(block CSR, pattern)] of lag ``lag``, the full part first (it carries the free term); the lag
