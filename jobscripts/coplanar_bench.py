@@ -44,6 +44,8 @@ def timed(ctxs, f, R):
 
 def main(L=20, b=16, R=5):
     from petsc_ssi.bem import bsr, lagmats
+    from petsc_ssi.bem.lagset import load_kernels
+    load_kernels()                            # (the compiled kernels loaded before either assembly is timed)
     res = {}
     for pattern in ("auto", "full"):
         mats, t_asm, N = lags(pattern, L)
