@@ -480,6 +480,33 @@ class SplitBSR:
     diag_aij = BSRMat.diag_aij
 
 
+def split_flat(ctx):
+    """A full-pattern BSRMat whose blocks outside the flat pattern H4 are exact zeros in places (a split lag
+    saved and loaded, ``from_aij``) as a SplitBSR again (the full part first, with the free term): those
+    blocks in H4, the others as they are; ``ctx`` itself when it has none or is not full."""
+    if ctx.pattern != FULL or not ctx.blocks:
+        return ctx
+    p, q = positions(H4)
+    off = np.ones((3, 3), bool)
+    off[p, q] = False
+    B = ctx.data.reshape(-1, 3, 3)
+    flat = ~np.any(B[:, off] != 0, axis=1)
+    if not flat.any():
+        return ctx
+    nloc = ctx.indptr.size - 1
+    rows = np.repeat(np.arange(nloc, dtype=np.int64), np.diff(ctx.indptr))
+    (ml, mg), (nl, ng) = ctx.sizes
+    parts = []
+    for keep, m in ((~flat, FULL), (flat, H4)):
+        ip = np.zeros(nloc + 1, np.int64)
+        np.cumsum(np.bincount(rows[keep], minlength=nloc), out=ip[1:])
+        vals = ctx.data[keep] if m == FULL else B[keep][:, p, q]
+        parts.append(BSRMat(ctx.comm, ip, ctx.indices[keep], vals, ml // 3, nl // 3, mg // 3, ng // 3, m,
+                            ctx.diag if m == FULL else None, ctx.row0, shell=False))
+    ctx.mat.destroy()
+    return SplitBSR(ctx.comm, parts)
+
+
 class DenseSplit:
     """A dense lag of a flat surface in its pattern's two dense pieces (this rank's rows, every
     column): H4 as A_xy,z (2 local rows per node x 1 column per node) and A_z,xy (1 x 2), G5 as A_xy,xy
