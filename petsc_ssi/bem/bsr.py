@@ -21,7 +21,9 @@ pairs are all coplanar stores 4 (H) or 5 (G) numbers a block instead of 9 (``FUL
 path for surfaces that are not flat); its products skip the zeros: the same products and sums in
 the same order as the full kernel minus terms that are exact zeros, so the same bits. Bytes per
 block: (m values + one int32 column): H 36, G 44, full 76; in single precision
-(-ssi_lag_single_from, products still accumulated in double) 20, 24, 40.
+(-ssi_lag_single_from, products still accumulated in double) 20, 24, 40. On a surface with an excavation
+(ground, walls, bottom) H is kept in two parts (``SplitBSR``): the blocks whose pairs all lie in one
+horizontal plane in H4, the others full.
 
 The free term (the jump term c_ij of the collocation equation, block diagonal, lag 1 only) is not
 in the block pattern: a Mat of H_1 carries it apart (``diag``, one 3x3 block per local row, added

@@ -582,9 +582,15 @@ class LagSet:
         est[:lag_lo - 1] = 0
         cap = 1.15 * est if keep_h else np.zeros_like(est)
         mH, mG = self.mH, self.mG
+        est_flat = None
+        if self.split and keep_h:       # (the flat part's expected blocks: where its last page is; room as H's)
+            est_flat = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg,
+                                       plane_z=plane_heights(self.VX, nimg))
+            est_flat[:lag_lo - 1] = 0
         small = bool(self.opts.get("small_pages", False))      # -ssi_huge_pages (petsc.lag_small_pages)
         H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=mH,
-                    free=self.cfree[rows] if lag_lo == 1 else None, expected=est, small=small)
+                    free=self.cfree[rows] if lag_lo == 1 else None,
+                    expected=est if est_flat is None else est - est_flat, small=small)
         # G: a block for every traction column a row's wave window reaches; room for all of them (never
         # touched beyond what is written: not resident) unless that is more than the node's memory
         gcap = np.full(lag_hi, len(rows) * self.regions.n_t, np.int64)
@@ -609,9 +615,9 @@ class LagSet:
             release_freed()         # the integrals' temporaries and messages: not resident through the assembly
         work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
         hout = H.out() if keep_h else H.out()[:5] + (-1,)
-        if self.split and keep_h:       # the coplanar blocks' part (``SplitBuckets``), room as H's
+        if est_flat is not None:        # the coplanar blocks' part (``SplitBuckets``)
             H = SplitBuckets(H, Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=H4,
-                                        small=small))
+                                        expected=est_flat, small=small))
         out = (hout, G.out(), H.loc, H.flat.out() if isinstance(H, SplitBuckets) else hout[:5] + (-1,))
         for s in range(0, len(rows), chunk):
             cache = (bool(o.get("cache", True)), cidx, ckeys, cmeta, cpP, cpU, qinv, self.CACHE_MAX)
