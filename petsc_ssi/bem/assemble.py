@@ -16,7 +16,7 @@ from numba import njit, types
 from numba.typed import Dict, List
 
 from . import packs
-from .patterns import FULL, H4, G5
+from .patterns import FULL, H4, G5, PATTERNS
 from .packs import DT, CP, CS, NU, MU, TOFF
 from .quadrature import integrate_pair, singular_static, plane_points, integrate_plane
 
@@ -428,6 +428,66 @@ def _emit_lag(lag, n, cl, buf, li, out):
     counts[lag, li] += n
 
 
+# The flat H pattern's entries (patterns.H4) in a full block's row-major layout (3 p + q), and the others:
+# a full block whose others are exact zeros is stored in the flat pattern (``_emit_split``).
+H4_AT = np.array([3 * p + q for p, q in PATTERNS[H4]], np.int64)
+H4_OFF = np.array([k for k in range(9) if k not in H4_AT], np.int64)
+
+
+@njit(cache=True)
+def _emit_split(lag, n, cl, buf, li, out, flat):
+    """``_emit_lag`` of one row's full blocks (buf (columns, 9)) split in two (a surface that is not one
+    plane, -ssi_lag_pattern auto): the blocks whose entries outside the flat H pattern are exact zeros
+    (every block whose pairs all lie in one horizontal plane: the point on the element's plane, r . n =
+    0) to ``flat`` in that pattern (4 values), the others to ``out`` (9). Each list in column order:
+    the same blocks, a product of either part the same bits block by block (the dropped entries are
+    exact zeros)."""
+    if n == 0 or out[5] < 0:
+        return
+    sel = np.empty(n, cl.dtype)
+    nf = 0
+    for k in range(n):                      # the flat blocks first, in column order
+        col = cl[k]
+        z = True
+        for j in range(H4_OFF.shape[0]):
+            if buf[col, H4_OFF[j]] != 0.0:
+                z = False
+        if z:
+            sel[nf] = col
+            nf += 1
+    ng = nf
+    for k in range(n):                      # then the others, in column order
+        col = cl[k]
+        z = True
+        for j in range(H4_OFF.shape[0]):
+            if buf[col, H4_OFF[j]] != 0.0:
+                z = False
+        if not z:
+            sel[ng] = col
+            ng += 1
+    _emit_lag(lag, n - nf, sel[nf:], buf, li, out)
+    if nf == 0:
+        return
+    _room(flat, lag, nf)
+    cols, vals, vals32, fill, counts, single_from = flat
+    f = fill[lag]
+    c = cols[lag]
+    for k in range(nf):
+        c[f + k] = sel[k]
+    if single_from > 0 and lag >= single_from:
+        v32 = vals32[lag]
+        for k in range(nf):
+            for j in range(4):
+                v32[f + k, j] = buf[sel[k], H4_AT[j]]
+    else:
+        v = vals[lag]
+        for k in range(nf):
+            for j in range(4):
+                v[f + k, j] = buf[sel[k], H4_AT[j]]
+    fill[lag] = f + nf
+    counts[lag, li] += nf
+
+
 @njit(cache=True)
 def emit_row(n, tlag, tcol, tval, li, out):
     """Append one row's blocks given as triplets 0..n (in (lag, column) order) to ``out`` (as
@@ -532,8 +592,8 @@ def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out)
     quadrature (``packs.Quad``); kern: the kernel table's choice, patterns and plane geometry
     (``kernels``); cache = (use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv, cache_max): the element
     cache (``new_cache``); work: ``new_work``; ``dropped`` (2,) the largest dropped magnitude of H and of
-    G; out = (hout, gout, loc): the per-lag block CSR arrays of H and G (``_emit_lag``) and a node's place
-    among the rank's rows.
+    G; out = (hout, gout, loc, hflat): the per-lag block CSR arrays of H and G (``_emit_lag``), a node's place
+    among the rank's rows and those of H's flat part (``_emit_split``; hflat[5] < 0: H not split).
 
     Per row: first every pair (row, virtual element) whose wave window reaches lags lag_lo..L is
     listed with where its element integrals are (the element cache, or integrated now: into the
@@ -710,7 +770,9 @@ def _row_blocks(li, npair, pairs, lags, mesh, sg, kern, src, rowbuf, out):
                     nG = _accumulate(srcU, bU, G5, Vtcol[v], sgG[v], bufG, touchG, lstG, nG, False)
                 else:
                     nG = _accumulate(srcU, bU, mG, Vtcol[v], sgG[v], bufG, touchG, lstG, nG, False)
-        if nH:
+        if nH and out[3][5] >= 0:              # H of a surface that is not one plane: flat and full parts
+            _emit_split(lag, nH, _ordered(lstH, nH, touchH), bufH, li, out[0], out[3])
+        elif nH:
             _emit_lag(lag, nH, _ordered(lstH, nH, touchH), bufH, li, out[0])
         if nG:
             _emit_lag(lag, nG, _ordered(lstG, nG, touchG), bufG, li, out[1])

@@ -21,7 +21,9 @@ pairs are all coplanar stores 4 (H) or 5 (G) numbers a block instead of 9 (``FUL
 path for surfaces that are not flat); its products skip the zeros: the same products and sums in
 the same order as the full kernel minus terms that are exact zeros, so the same bits. Bytes per
 block: (m values + one int32 column): H 36, G 44, full 76; in single precision
-(-ssi_lag_single_from, products still accumulated in double) 20, 24, 40.
+(-ssi_lag_single_from, products still accumulated in double) 20, 24, 40. On a surface with an excavation
+(ground, walls, bottom) H is kept in two parts (``SplitBSR``): the blocks whose pairs all lie in one
+horizontal plane in H4, the others full.
 
 The free term (the jump term c_ij of the collocation equation, block diagonal, lag 1 only) is not
 in the block pattern: a Mat of H_1 carries it apart (``diag``, one 3x3 block per local row, added
@@ -315,8 +317,7 @@ class BSRMat:
     kind = "bsr"
 
     def __init__(self, comm, indptr, indices, data, nrow_loc, ncol_loc, nrow_glob, ncol_glob, pattern=FULL,
-                 diag=None, row0=0):
-        PETSc = init()
+                 diag=None, row0=0, shell=True):
         self.pattern = int(pattern)
         self.indptr = np.ascontiguousarray(indptr, dtype=np.int64)
         self.indices = np.ascontiguousarray(indices, dtype=np.int32)
@@ -326,9 +327,7 @@ class BSRMat:
         self.row0 = int(row0)                   # first local node row (the free term's column)
         self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
         self.comm = comm
-        self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
-        self.mat.setBlockSizes(3, 3)            # node blocks: its Vecs (traction histories, checkpoints) keep
-        self.mat.setUp()                        # the layout of MATDENSE's and the step matrix's
+        self.mat = _python_mat(self) if shell else None     # (shell False: a part of a SplitBSR)
 
     @property
     def nbytes(self):
@@ -338,6 +337,15 @@ class BSRMat:
     @property
     def blocks(self):
         return int(self.indices.size)
+
+    @property
+    def entries(self):
+        """Values this rank stores (blocks times the pattern's entries)."""
+        return self.blocks * self.pattern
+
+    @property
+    def dtype(self):
+        return self.data.dtype
 
     def to_single(self):
         """Keep the values in float32 (a loaded lag of a -ssi_lag_single_from run); returns self."""
@@ -397,6 +405,110 @@ class BSRMat:
         return A
 
 
+def _python_mat(ctx):
+    """The python Mat (MatMult, MatMultAdd by ``ctx``'s kernels) of a BSRMat, DenseSplit or SplitBSR."""
+    PETSc = init()
+    M = PETSc.Mat().createPython(ctx.sizes, context=_Shell(ctx), comm=ctx.comm)
+    M.setBlockSizes(3, 3)            # node blocks: its Vecs (traction histories, checkpoints) keep
+    M.setUp()                        # the layout of MATDENSE's and the step matrix's
+    return M
+
+
+class SplitBSR:
+    """A block-sparse lag kept in parts, each a BSRMat of its own pattern over the same rows and
+    columns, a block in one part: H of a surface that is not one plane (an excavation), its blocks
+    whose pairs all lie in one horizontal plane in the flat pattern H4 (4 values) and the others full
+    (9) (``lagset.SplitBuckets``); the free term with the first part. Products are the parts' products
+    summed (each block's the same bits as in one full matrix; a row's sum over blocks in another
+    order: round-off). Saved (``to_aij``) as the full pattern's entries it holds: a loaded lag is one
+    full-pattern BSRMat."""
+
+    kind = "bsr"
+    pattern = FULL
+
+    def __init__(self, comm, parts):
+        self.parts = list(parts)
+        self.comm = comm
+        self.sizes = self.parts[0].sizes
+        self.diag, self.row0 = self.parts[0].diag, self.parts[0].row0
+        self.mat = _python_mat(self)
+
+    @property
+    def nbytes(self):
+        return sum(p.nbytes for p in self.parts)
+
+    @property
+    def blocks(self):
+        return sum(p.blocks for p in self.parts)
+
+    @property
+    def entries(self):
+        return sum(p.entries for p in self.parts)
+
+    @property
+    def dtype(self):
+        return self.parts[0].dtype
+
+    def to_single(self):
+        for p in self.parts:
+            p.to_single()
+        return self
+
+    def matvec(self, x, y):
+        self.parts[0].matvec(x, y)
+        tmp = np.empty_like(y)
+        for p in self.parts[1:]:
+            p.matvec(x, tmp)
+            y += tmp
+
+    def panel(self, XT, RT, sign):
+        for p in self.parts:
+            p.panel(XT, RT, sign)
+
+    def flops(self, w=1):
+        return sum(p.flops(w) for p in self.parts)
+
+    def scalar_csr(self):
+        """As BSRMat.scalar_csr, the parts' entries together (columns sorted within each row)."""
+        ips, Cs, Vs = zip(*(p.scalar_csr() for p in self.parts))
+        R = np.concatenate([np.repeat(np.arange(len(ip) - 1, dtype=np.int64), np.diff(ip)) for ip in ips])
+        C, V = np.concatenate(Cs), np.concatenate(Vs)
+        order = np.lexsort((C, R))
+        ip = np.zeros(len(ips[0]), np.int64)
+        np.cumsum(np.bincount(R, minlength=len(ip) - 1), out=ip[1:])
+        return ip, C[order], V[order]
+
+    to_aij = BSRMat.to_aij
+    diag_aij = BSRMat.diag_aij
+
+
+def split_flat(ctx):
+    """A full-pattern BSRMat whose blocks outside the flat pattern H4 are exact zeros in places (a split lag
+    saved and loaded, ``from_aij``) as a SplitBSR again (the full part first, with the free term): those
+    blocks in H4, the others as they are; ``ctx`` itself when it has none or is not full."""
+    if ctx.pattern != FULL or not ctx.blocks:
+        return ctx
+    p, q = positions(H4)
+    off = np.ones((3, 3), bool)
+    off[p, q] = False
+    B = ctx.data.reshape(-1, 3, 3)
+    flat = ~np.any(B[:, off] != 0, axis=1)
+    if not flat.any():
+        return ctx
+    nloc = ctx.indptr.size - 1
+    rows = np.repeat(np.arange(nloc, dtype=np.int64), np.diff(ctx.indptr))
+    (ml, mg), (nl, ng) = ctx.sizes
+    parts = []
+    for keep, m in ((~flat, FULL), (flat, H4)):
+        ip = np.zeros(nloc + 1, np.int64)
+        np.cumsum(np.bincount(rows[keep], minlength=nloc), out=ip[1:])
+        vals = ctx.data[keep] if m == FULL else B[keep][:, p, q]
+        parts.append(BSRMat(ctx.comm, ip, ctx.indices[keep], vals, ml // 3, nl // 3, mg // 3, ng // 3, m,
+                            ctx.diag if m == FULL else None, ctx.row0, shell=False))
+    ctx.mat.destroy()
+    return SplitBSR(ctx.comm, parts)
+
+
 class DenseSplit:
     """A dense lag of a flat surface in its pattern's two dense pieces (this rank's rows, every
     column): H4 as A_xy,z (2 local rows per node x 1 column per node) and A_z,xy (1 x 2), G5 as A_xy,xy
@@ -408,7 +520,6 @@ class DenseSplit:
     kind = "dense"
 
     def __init__(self, comm, pattern, pieces, nrow_loc, ncol_loc, nrow_glob, ncol_glob, diag=None, row0=0):
-        PETSc = init()
         self.pattern = int(pattern)
         self.pieces = [(np.array(r), np.array(c), np.ascontiguousarray(A, dtype=np.float64)) for r, c, A in pieces]
         self.nloc, self.ncol = nrow_loc, ncol_glob
@@ -416,9 +527,7 @@ class DenseSplit:
         self.row0 = int(row0)
         self.sizes = ((3 * nrow_loc, 3 * nrow_glob), (3 * ncol_loc, 3 * ncol_glob))
         self.comm = comm
-        self.mat = PETSc.Mat().createPython(self.sizes, context=_Shell(self), comm=comm)
-        self.mat.setBlockSizes(3, 3)            # node blocks: its Vecs (traction histories, checkpoints) keep
-        self.mat.setUp()                        # the layout of MATDENSE's and the step matrix's
+        self.mat = _python_mat(self)
 
     @classmethod
     def from_csr(cls, comm, pattern, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, cols, vals, diag=None, row0=0):

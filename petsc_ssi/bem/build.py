@@ -27,7 +27,7 @@ def _block_of(cfg, comm, H, G, HI, GI):
             sparse = ctx is not None and ctx.kind == "bsr"
             d[1 if sparse else 0, i] += lagmats.mat_bytes(M)
             if sparse:
-                d[2, i] += ctx.blocks * ctx.pattern
+                d[2, i] += ctx.entries
     tot = np.zeros_like(d)
     comm.tompi4py().Allreduce(d, tot)
     return history_block(cfg, tot[0], tot[1], tot[2])
@@ -163,7 +163,7 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     ndense = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}", "").startswith(("dense", "split")))
     from . import bsr
     nsingle = sum(1 for M in H if bsr.context(M) is not None and bsr.context(M).kind == "bsr"
-                  and bsr.context(M).data.dtype == np.float32)
+                  and bsr.context(M).dtype == np.float32)
     nbaij = sum(1 for i in range(plan.Lx) if kinds.get(f"H{i + 1}", "").startswith("bsr")) - nsingle
     ls.kernel_evaluations = ls.cache_hits = 0
     ls.cache_bytes = 0.0

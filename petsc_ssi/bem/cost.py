@@ -211,6 +211,8 @@ class Counts:
         for r in range(ranks[0]):
             total = total + nb[(ranks[0], r)]
         self.nb_total = total
+        # of them, the blocks H keeps in the flat pattern (a split H: a surface that is not one plane)
+        self.flat_frac = flat_fraction(prob.mesh.nodes, ls, total, Lmax, prob.mat, prob.dt, nimg)
         # storage rule of lagmats (and the all-sparse fallback of check_memory)
         self.limit = limit
         used = np.r_[total[:self.Lx], [total[l - 1] for l in self.interp_lags]]
@@ -218,11 +220,11 @@ class Counts:
         self.storage, self.fill = self._storage(cfg, used, limit)
         # the time-blocked history sum's block: the run's choice from these matrices' bytes
         tot = self.nb_total_used()
-        mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt, self.mH, self.mG)
+        mats, _, g = lag_bytes(tot, self.storage, self.single, N, N, self.nt, self.mH, self.mG, self.flat_of(tot))
         g = g * (tot > 0) * (self.nt > 0)
         self.block, self.sub = history_block(cfg, np.where(self.storage, mats, 0.0) * (tot > 0) + np.where(self.single, 0.0, g),
                                    np.where(self.storage, 0.0, mats) + np.where(self.single, g, 0.0),
-                                   np.where(self.storage, 0.0, self.mH * tot)
+                                   np.where(self.storage, 0.0, self.h_entries(tot))
                                    + np.where(self.single, g / (4.0 * self.mG + 4) * self.mG, 0.0))
         self.per_rank = {p: [self._rank(nb[(p, r)], b - a, p, self.cache.get((p, r))) for r, (a, b)
                              in enumerate(self.ranges[p])] for p in ranks}
@@ -272,7 +274,7 @@ class Counts:
         """check_memory's assembly-peak bound (LagSet.estimate_memory), for the
         storage decision the run will take."""
         N = self.N
-        mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt, self.mH, self.mG)
+        mats, trip, g = lag_bytes(used, dense, self.single, N, N, self.nt, self.mH, self.mG, self.flat_of(used))
         asm, rss = transient_bytes(used[:self.Lx].sum() / p, N, self.Lx, N / p, parts=True)
         asm_i = transient_bytes(max(list(used[self.Lx:]) + [0.0]) / p, N, 1, N / p, parts=True)[0] if self.k else 0.0
         return peak_bytes(mats, trip, g, asm * p, rss * p, n_exact=self.Lx, asm_interp=asm_i * p)
@@ -284,7 +286,8 @@ class Counts:
         used = np.r_[nb[:Lx], [nb[l - 1] for l in self.interp_lags]]
         dense = self.storage
         nonempty = self.nb_total_used() > 0
-        mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt, self.mH, self.mG)
+        mat_bytes, trip, g_bytes = lag_bytes(used, dense, self.single, N, nrows, self.nt, self.mH, self.mG,
+                                             self.flat_of(used))
         mat_bytes = mat_bytes * nonempty
         g_bytes = g_bytes * nonempty if self.nt else np.zeros(len(used))
         build = np.cumsum(mat_bytes) + (trip.sum() - np.cumsum(trip))
@@ -298,9 +301,9 @@ class Counts:
             # the time-blocked sum (bem/march.py): a matrix takes part in a block's panel product when
             # one of the block's steps reads a state known at its start; the rest are per-step products.
             # The panel flops by width: the block's panels are b states wide, the sub-blocks' s (the
-            # kernels' rates differ by 2-4x between them: panel_rate)
+            # kernels' rates differ by 2-4x between them: panel_width_factor)
             uses, wb, ws = self._blocked_uses(n, used)
-            entries = np.where(dense, mat_bytes / 8.0, self.mH * used) * nonempty
+            entries = np.where(dense, mat_bytes / 8.0, self.h_entries(used)) * nonempty
             g_entries = self.mG * nrows * self.nt * nonempty         # (single: block-sparse, with the sparse)
             d_ent = entries * dense + g_entries * ~self.single
             s_ent = entries * ~dense + g_entries * self.single
@@ -338,6 +341,17 @@ class Counts:
     def nb_total_used(self):
         t = self.nb_total
         return np.r_[t[:self.Lx], [t[l - 1] for l in self.interp_lags]]
+
+    def flat_of(self, used):
+        """Of ``used`` blocks of the stored matrices (exact lags, then interpolating), those H keeps in the
+        flat pattern (``flat_fraction``), or None (not split)."""
+        f = self.flat_frac
+        return None if f is None else used * np.r_[f[:self.Lx], [f[l - 1] for l in self.interp_lags]]
+
+    def h_entries(self, used):
+        """Values H stores in ``used`` blocks of the stored matrices (a split H: 4 a flat block)."""
+        flat = self.flat_of(used)
+        return self.mH * used - (0.0 if flat is None else (self.mH - 4.0) * flat)
 
     def lag_bytes(self):
         return sum(r["mats"] for r in self.per_rank[min(self.per_rank)])
@@ -443,7 +457,19 @@ def chunk_rows(n_nodes, lag_hi, n_rows):
     return int(max(1, min(64, 256e6 // row_work_bytes(n_nodes, lag_hi), n_rows // 20 + 1)))
 
 
-def lag_bytes(used, dense, single, n_cols, n_rows, n_t, mH=9, mG=9):
+def flat_fraction(xnodes, ls, total, L, mat, dt, n_images):
+    """Per lag 1..L the fraction of H's estimated blocks (``total``, all rows) it keeps in the flat pattern
+    when split (``ls.split``: a surface that is not one plane, ``lagset.SplitBuckets``): the pairs whose
+    point lies in the element's horizontal plane (``windows.estimate_blocks`` with ``plane_z``), or None."""
+    if not getattr(ls, "split", False):
+        return None
+    from .windows import plane_heights
+    nbf = estimate_blocks(xnodes, np.arange(len(xnodes)), ls.Vc, ls.VR, L, mat, dt, n_images,
+                          plane_z=plane_heights(ls.VX, n_images))
+    return np.where(total > 0, nbf / np.maximum(total, 1e-300), 0.0)
+
+
+def lag_bytes(used, dense, single, n_cols, n_rows, n_t, mH=9, mG=9, flat=None):
     """Per stored matrix (arrays over them): (bytes of its Mat, of its assembly buckets, of its G),
     for ``used`` blocks in ``n_rows`` node rows of ``n_cols`` columns, each block holding the ``mH``
     entries of H's pattern (bem/bsr.py PATTERNS: 9, or 4 on a flat surface; G's ``mG``: 9 or 5):
@@ -451,11 +477,15 @@ def lag_bytes(used, dense, single, n_cols, n_rows, n_t, mH=9, mG=9):
     values, an int32 column: 76 B full, 36 B flat), single precision (``single``:
     -ssi_lag_single_from) 4 mH + 4 B whatever the fill; the buckets take the same bytes (their 15 %
     headroom is allocated but never touched, so not resident); G (the ``n_t`` traction columns)
-    dense (8 mG B a block), or 4 mG + 4 B a block single."""
+    dense (8 mG B a block), or 4 mG + 4 B a block single. ``flat``: of the ``used`` blocks, those a split H
+    keeps in the flat pattern (4 values: lagset.SplitBuckets, an excavated surface; a dense lag is merged,
+    mH a block), or None."""
     single = np.asarray(single, bool)
     dense = np.asarray(dense, bool) & ~single
-    mats = np.where(single, (4.0 * mH + 4) * used, np.where(dense, 8.0 * mH * n_cols * n_rows, (8.0 * mH + 4) * used))
-    trip = np.where(single, 4.0 * mH + 4, 8.0 * mH + 4) * used
+    fewer = 0.0 if flat is None else (mH - 4.0) * np.asarray(flat, float)     # values the flat blocks leave out
+    mats = np.where(single, (4.0 * mH + 4) * used - 4.0 * fewer,
+                    np.where(dense, 8.0 * mH * n_cols * n_rows, (8.0 * mH + 4) * used - 8.0 * fewer))
+    trip = np.where(single, (4.0 * mH + 4) * used - 4.0 * fewer, (8.0 * mH + 4) * used - 8.0 * fewer)
     g = np.where(single, 4.0 * mG + 4, 8.0 * mG) * n_rows * max(n_t, 1)
     return mats, trip, g
 

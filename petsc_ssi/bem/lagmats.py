@@ -77,9 +77,9 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     mats, info = [], []
     for li in range(L):
         F = buckets.diag(li + 1)
-        csr = buckets.take_csr(li + 1)
+        csr, pattern = _take(buckets, li + 1)
         A, kind = _make(comm, int(gcounts[li]), nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill,
-                        buckets.m, F, r0)
+                        pattern, F, r0)
         mats.append(A)
         info.append((li + 1, kind, int(gcounts[li])))
         del csr
@@ -87,9 +87,46 @@ def build(comm, buckets, L, node_range, n_rows_glob, n_cols_glob, col_loc, stora
     return mats, info
 
 
+def _take(buckets, lag):
+    """(block CSR, pattern) of one lag, freed from ``buckets``: a Buckets' own, or a SplitBuckets' two
+    parts as ([CSR, CSR], [pattern, pattern]) (the full part first)."""
+    if not hasattr(buckets, "parts"):
+        return buckets.take_csr(lag), buckets.m
+    parts = buckets.parts(lag)
+    return [c for c, _ in parts], [m for _, m in parts]
+
+
+def merged(parts, patterns, nloc):
+    """One full-pattern block CSR (indptr, columns, (n, 9) blocks) of the parts of a split lag (each
+    row's blocks in column order; a column is in one part)."""
+    from . import bsr
+    rows = np.concatenate([np.repeat(np.arange(nloc, dtype=np.int64), np.diff(ip)) for ip, _, _ in parts])
+    cols = np.concatenate([c for _, c, _ in parts]).astype(np.int32)
+    vals = np.concatenate([bsr.expand(v, m).reshape(-1, 9).astype(v.dtype) for (_, _, v), m in zip(parts, patterns)])
+    o = np.lexsort((cols, rows))
+    indptr = np.zeros(nloc + 1, np.int64)
+    np.cumsum(np.bincount(rows, minlength=nloc), out=indptr[1:])
+    return indptr, cols[o], np.ascontiguousarray(vals[o])
+
+
+def split(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, parts, patterns, diag=None, row0=0):
+    """A block-sparse lag kept in parts of their own patterns (``bsr.SplitBSR``: a split H of an
+    excavated surface), the free term with the first."""
+    from . import bsr
+    return bsr.SplitBSR(comm, [bsr.BSRMat(comm, *csr, nrow_loc, ncol_loc, nrow_glob, ncol_glob, m,
+                                          diag if k == 0 else None, row0, shell=False)
+                               for k, (csr, m) in enumerate(zip(parts, patterns))]).mat
+
+
 def _make(comm, nb, nloc, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill, pattern=9, diag=None, row0=0):
     if nb == 0 and diag is None:
         return None, "empty"
+    if isinstance(pattern, list):       # a split lag: its parts (block-sparse), or merged (dense)
+        f = nb / float(n_rows_glob * n_cols_glob)
+        if csr[0][2].dtype == np.float32 or not (storage == "dense" or (storage == "auto" and f > fill)):
+            kind = "single" if csr[0][2].dtype == np.float32 else "baij"
+            return split(comm, nloc, col_loc, n_rows_glob, n_cols_glob, csr, pattern, diag, row0), kind
+        csr, pattern = merged(csr, pattern, nloc), 9
     extra = (pattern, diag, row0)
     if csr[2].dtype == np.float32:       # -ssi_lag_single_from: block-sparse whatever the fill (a dense
         return baij(comm, nloc, col_loc, n_rows_glob, n_cols_glob, *csr, *extra), "single"    # lag: every block)
@@ -103,9 +140,14 @@ def build_one(comm, buckets, lag, node_range, n_rows_glob, n_cols_glob, col_loc,
     """Collective: the Mat of one lag of ``buckets`` (an interpolating matrix)."""
     r0, r1 = node_range
     F = buckets.diag(lag)
-    csr = buckets.take_csr(lag)
-    nb = comm.tompi4py().allreduce(len(csr[1]))
-    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill, buckets.m, F, r0)
+    csr, pattern = _take(buckets, lag)
+    nb = comm.tompi4py().allreduce(buckets_count(csr, pattern))
+    return _make(comm, nb, r1 - r0, col_loc, n_rows_glob, n_cols_glob, csr, storage, fill, pattern, F, r0)
+
+
+def buckets_count(csr, pattern):
+    """Blocks of a lag's CSR as ``_take`` gives it (one, or a split lag's parts)."""
+    return sum(len(c[1]) for c in csr) if isinstance(pattern, list) else len(csr[1])
 
 
 def mat_bytes(A):

@@ -13,10 +13,10 @@ from ..petsc import SSIError, collective, printf
 from ..monitor import Progress, event
 from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
                    pair_table, cache_counts)
-from .windows import bounding_spheres, estimate_blocks
+from .windows import bounding_spheres, estimate_blocks, plane_heights
 from . import symmetry
 from . import packs
-from .bsr import FULL
+from .bsr import FULL, H4
 from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_batch,
                        cache_index, SING_TOL, KERNELS, PLANE, surface_kind, patterns, kernels)
 
@@ -232,6 +232,51 @@ class Buckets:
         return int(self.n[lag])
 
 
+class SplitBuckets:
+    """H's blocks of a surface that is not one plane (an excavation) in two ``Buckets``: ``flat``, the
+    blocks whose entries outside the flat pattern (bsr.H4) are exact zeros, 4 values each (every block
+    whose pairs all lie in one horizontal plane: the ground, the pit's bottom), and ``full``, the others
+    (9 values). The assembly kernel sorts each row's blocks between them (``assemble._emit_split``).
+    Reads as one Buckets where the lag's blocks are wanted whole (``count``, ``csr``, ``peek``, ``diag``);
+    ``parts`` gives the two block CSRs of a lag for its Mat (``lagmats.build``)."""
+
+    def __init__(self, full, flat):
+        self.full, self.flat = full, flat
+        self.m = full.m
+        self.rows, self.nloc, self.loc = full.rows, full.nloc, full.loc
+
+    def count(self, lag):
+        return self.full.count(lag) + self.flat.count(lag)
+
+    def diag(self, lag):
+        return self.full.diag(lag)
+
+    def dtype(self, lag):
+        return self.full.dtype(lag)
+
+    def csr(self, lag):
+        """``Buckets.csr`` of the whole lag: (indptr, columns, (blocks, 9)), the parts merged (a copy)."""
+        from .lagmats import merged
+        return merged([self.full.csr(lag), self.flat.csr(lag)], [self.full.m, self.flat.m], self.nloc)
+
+    def parts(self, lag):
+        """[(block CSR, pattern)] of lag ``lag``, the full part first (it carries the free term); the lag
+        is no longer held here."""
+        return [(self.full.take_csr(lag), self.full.m), (self.flat.take_csr(lag), self.flat.m)]
+
+    def peek(self, lag):
+        """``Buckets.peek`` of both parts together: (rows, columns, full 3x3 blocks), the free term added,
+        in (row, column) order (a block is in one part; the free term's diagonal block may meet a flat
+        kernel block: their sum, as Buckets.peek adds them)."""
+        r1, c1, v1 = self.full.peek(lag)
+        r2, c2, v2 = self.flat.peek(lag)
+        r, c, v = np.r_[r1, r2], np.r_[c1, c2].astype(np.int64), np.concatenate([v1, v2])
+        key, inv = np.unique(r * len(self.loc) + c, return_inverse=True)
+        out = np.zeros((len(key), 3, 3))
+        np.add.at(out, inv.ravel(), v)              # (at most two terms a block: the same sum either way)
+        return key // len(self.loc), (key % len(self.loc)).astype(np.int32), out
+
+
 def _first_occurrences(h, meta, full_keys):
     """(first, inverse) of the distinct requests: first occurrence (in the order given) of each
     (hash, lo, hi), and for each request the index of its distinct one. Hash collisions (equal
@@ -317,6 +362,9 @@ class LagSet:
         self.kind = surface_kind(mesh.nodes, VX)
         self.mH, self.mG = patterns(self.kind, opts.get("block_pattern", "auto"))
         self.flat = self.mH != FULL
+        # a surface that is not one plane (an excavation) with the general pattern chosen automatically: H's
+        # blocks whose pairs all lie in one horizontal plane keep the flat pattern (``SplitBuckets``)
+        self.split = self.kind == "general" and opts.get("block_pattern", "auto") == "auto"
         self.in_plane = KERNELS[(self.kind, (self.mH, self.mG))][0] == PLANE
         self._plane = None
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
@@ -367,6 +415,12 @@ class LagSet:
         nb = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, L, self.mat, self.dt, nimg)
         nb = nb * (len(self.rows) / max(len(rows), 1))
         mpi = self.comm.tompi4py()
+        nbf = None
+        if self.split:          # the blocks H keeps in the flat pattern (``SplitBuckets``)
+            nbf = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, L, self.mat, self.dt, nimg,
+                                  plane_z=plane_heights(self.VX, nimg)) * (len(self.rows) / max(len(rows), 1))
+            nbf = mpi.allreduce(nbf)
+            nbf = np.r_[nbf[:lags], [nbf[l - 1] for l in extra_lags]] if len(extra_lags) else nbf[:lags]
         local_blocks = float(nb[:lags].sum())
         local_interp = max([float(nb[l - 1]) for l in extra_lags] + [0.0])
         nb = mpi.allreduce(nb)
@@ -375,7 +429,7 @@ class LagSet:
         f = use / float(N * N)
         single = single_lags(np.r_[np.arange(1, lags + 1), list(extra_lags)], single_from)
         dense = ((f > fill) if storage == "auto" else np.full(len(use), storage == "dense")) & ~single
-        mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t, self.mH, self.mG)
+        mats, trip, g = lag_bytes(use, dense, single, N, N, self.regions.n_t, self.mH, self.mG, nbf)
         cache = None if sample else self.cache_estimate(lags, extra_lags)    # (sample: the bound per block)
         asm, rss = (mpi.allreduce(v) for v in transient_bytes(local_blocks, N, L, len(self.rows), cache, parts=True))
         asm_i = mpi.allreduce(transient_bytes(local_interp, N, 1, len(self.rows), parts=True)[0]) if len(extra_lags) else 0.0
@@ -528,9 +582,15 @@ class LagSet:
         est[:lag_lo - 1] = 0
         cap = 1.15 * est if keep_h else np.zeros_like(est)
         mH, mG = self.mH, self.mG
+        est_flat = None
+        if self.split and keep_h:       # (the flat part's expected blocks: where its last page is; room as H's)
+            est_flat = estimate_blocks(self.mesh.nodes, rows, self.Vc, self.VR, lag_hi, self.mat, self.dt, nimg,
+                                       plane_z=plane_heights(self.VX, nimg))
+            est_flat[:lag_lo - 1] = 0
         small = bool(self.opts.get("small_pages", False))      # -ssi_huge_pages (petsc.lag_small_pages)
         H = Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=mH,
-                    free=self.cfree[rows] if lag_lo == 1 else None, expected=est, small=small)
+                    free=self.cfree[rows] if lag_lo == 1 else None,
+                    expected=est if est_flat is None else est - est_flat, small=small)
         # G: a block for every traction column a row's wave window reaches; room for all of them (never
         # touched beyond what is written: not resident) unless that is more than the node's memory
         gcap = np.full(lag_hi, len(rows) * self.regions.n_t, np.int64)
@@ -554,7 +614,11 @@ class LagSet:
                                                                 dropped)
             release_freed()         # the integrals' temporaries and messages: not resident through the assembly
         work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
-        out = (H.out() if keep_h else H.out()[:5] + (-1,), G.out(), H.loc)
+        hout = H.out() if keep_h else H.out()[:5] + (-1,)
+        if est_flat is not None:        # the coplanar blocks' part (``SplitBuckets``)
+            H = SplitBuckets(H, Buckets(lag_hi, rows, self.mesh.n_nodes, cap, single_from=single_from, m=H4,
+                                        expected=est_flat, small=small))
+        out = (hout, G.out(), H.loc, H.flat.out() if isinstance(H, SplitBuckets) else hout[:5] + (-1,))
         for s in range(0, len(rows), chunk):
             cache = (bool(o.get("cache", True)), cidx, ckeys, cmeta, cpP, cpU, qinv, self.CACHE_MAX)
             work, n_ev, n_hit, cache = assemble_rows(rows[s:s + chunk], *pk, kern, cache, work, dropped, out)

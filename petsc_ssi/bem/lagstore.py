@@ -231,6 +231,8 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
                 M = aij(cols)
                 D = aij(cols) if extra == "diag" else None
                 M = bsr.from_aij(M, pattern, D, dense=storage == "split")
+                if group in ("H", "HI") and storage == "bsr" and pattern == bsr.FULL:   # a split H, split again
+                    M = bsr.split_flat(bsr.context(M)).mat
                 idx = int(name[len(group):])
                 lag = interp_lags[idx - 1] if group in ("HI", "GI") else idx
                 if kind.startswith("bsr") and 0 < single_from <= lag:

@@ -62,8 +62,10 @@ register("history_sub", "int", 0, "steps", "sub-blocks of the time-blocked histo
 register("lag_pattern", "enum", "auto", "", "the entries a 3x3 block of the lag matrices stores: auto (where every "
          "collocation point and element lie in one plane, as on every surface petsc-ssi accepts, H keeps the 4 "
          "entries coupling in-plane with out-of-plane components and G the 5 of the in-plane pair and zz, the others "
-         "being exact zeros: bem/bsr.py; else all 9) or full (all 9 everywhere: the general path, to check the flat "
-         "one or to measure what it saves; the same results to round-off)", "bem", choices=("auto", "full"))
+         "being exact zeros: bem/bsr.py; on a surface with an excavation H's blocks whose pairs all lie in one "
+         "horizontal plane, the ground's or the pit's bottom's, keep those 4 and the others all 9: bsr.SplitBSR) or "
+         "full (all 9 everywhere: the general path, to check the flat one or to measure what it saves; the same "
+         "results to round-off)", "bem", choices=("auto", "full"))
 register("lag_fill", "real", 0.95, "", "auto storage: lags with block fill above this are dense (0.95: dense where it "
          "stores fewer bytes; per block of the whole lag dense 8 m B against 8 m + 4 B per stored block, m the "
          "entries of the block pattern, -ssi_lag_pattern)", "bem",

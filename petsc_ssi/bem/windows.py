@@ -42,14 +42,27 @@ def pair_windows(xc, Vc, VR, L, mat, dt, n_images=1):
     return lo, hi, np.isfinite(lo) & (hi >= lo)
 
 
-def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256):
+def plane_heights(VX, n_images=1):
+    """Per element (without symmetry images, which stay in their plane) the height z of the horizontal
+    plane holding all its nodes, NaN where there is none (a wall)."""
+    E = len(VX) // n_images
+    z = VX[:E, :, 2]
+    return np.where(np.all(z == z[:, :1], axis=1), z[:, 0], np.nan)
+
+
+def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256, plane_z=None):
     """Estimated number of non-zero 3x3 blocks of each H lag (array, index
     l-1) in ``rows``: for each (row, element) the lags its wave window touches
     (union over the element's symmetry images, which fold onto the same
-    columns), times four nodes per element (a node is shared by about four)."""
+    columns), times four nodes per element (a node is shared by about four).
+    ``plane_z`` (``plane_heights``): only the pairs whose point lies in the element's horizontal plane
+    (the blocks H keeps in the flat pattern on a surface that is not one plane, ``lagset.SplitBuckets``;
+    a column also met by elements of another plane, at an edge, is counted as theirs)."""
     diff = np.zeros(L + 2)
     for s in range(0, len(rows), chunk):
         lo, hi, ok = pair_windows(xnodes[rows[s:s + chunk]], Vc, VR, L, mat, dt, n_images)
+        if plane_z is not None:
+            ok = ok & (xnodes[rows[s:s + chunk], 2][:, None] == plane_z[None, :])
         # counts of window starts and ends (np.add.at of 4.0 per pair summed the same integers, slowly)
         diff += 4.0 * np.bincount(lo[ok].astype(np.int64), minlength=L + 2)[:L + 2]
         diff -= 4.0 * np.bincount(hi[ok].astype(np.int64) + 1, minlength=L + 2)[:L + 2]
