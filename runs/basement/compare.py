@@ -1,7 +1,8 @@
-"""The demo's building under the earthquake, founded on the ground and on a 3 m basement (runs/basement/README.md):
+"""A building under the earthquake, founded on the ground and on a 3 m basement (runs/basement/README.md):
 the peaks of both runs side by side and their histories.
 
-    python runs/basement/compare.py [DIR]       (default out/basement: the outputs of run.sh)
+    python runs/basement/compare.py [DIR]       (default out/basement: the outputs of run.sh; out/basement-paper
+                                                 for BUILDING=paper)
 
 reads DIR/{surface,basement}.h5 and their _structure.h5, writes DIR/basement.csv (one row per quantity, units
 in the names) and DIR/basement.png (roof absolute acceleration, first-storey drift ratio and base shear of
@@ -9,8 +10,9 @@ both against time) and prints the CSV. runs/basement keeps copies of the CSV and
 
 Quantities (x, the wave's polarisation; the full model's values):
   * the free field's PGA at the ground surface (the soil output's seismic group, the record as applied);
-  * the peak absolute acceleration of the roof centre (0, 0, 6), the first floor's (0, 0, 3) and the ground
-    floor's (the foundation slab's centre, (0, 0, 0): with the basement, the basement's top);
+  * the peak absolute acceleration of each structure receiver (the run's -ssi_structure_receivers: the demo's
+    roof centre (0, 0, 6), first floor (0, 0, 3) and ground floor, the foundation slab's centre (0, 0, 0):
+    with the basement, the basement's top; the paper's building has (0, 0, 9) above them);
   * the peak drift ratio of each storey, total (the base's rocking in it) and of deformation alone;
   * the peak rocking theta_y of the ground floor (the rigid rotation fitted to the slab's u_z at z = 0);
   * the peak base shear and overturning moment about (0, 0, 0): the force the structure exerts on the soil
@@ -30,7 +32,8 @@ def load(d, case):
     out = {}
     with h5py.File(os.path.join(d, f"{case}_structure.h5")) as f:
         out["t"] = f["receivers/t"][:]
-        out["acc"] = f["receivers/acceleration"][:, :, 0]          # (K, 3) roof, first floor, ground floor
+        out["acc"] = f["receivers/acceleration"][:, :, 0]          # (K, receivers): roof first, ground floor last
+        out["z"] = f["receivers/points"][:, 2]
         g = f["demands"]
         out["td"] = g["t"][:]
         out["shear"] = g["base_shear"][:, 0]
@@ -44,17 +47,17 @@ def load(d, case):
 
 
 def table(r):
-    rows = [("free-field PGA [m/s^2]", lambda o: o["pga"]),
-            ("peak roof absolute acceleration [m/s^2]", lambda o: np.abs(o["acc"][:, 0]).max()),
-            ("peak first-floor absolute acceleration [m/s^2]", lambda o: np.abs(o["acc"][:, 1]).max()),
-            ("peak ground-floor absolute acceleration [m/s^2]", lambda o: np.abs(o["acc"][:, 2]).max()),
-            ("peak drift ratio storey 1 [-]", lambda o: np.abs(o["drift"][:, 0]).max()),
-            ("peak drift ratio storey 2 [-]", lambda o: np.abs(o["drift"][:, 1]).max()),
-            ("peak deformation drift ratio storey 1 [-]", lambda o: np.abs(o["drift_def"][:, 0]).max()),
-            ("peak deformation drift ratio storey 2 [-]", lambda o: np.abs(o["drift_def"][:, 1]).max()),
-            ("peak rocking theta_y of the ground floor [rad]", lambda o: np.abs(o["rot"]).max()),
-            ("peak base shear at the interface [N]", lambda o: np.abs(o["shear"]).max()),
-            ("peak overturning moment about (0 0 0) [N m]", lambda o: np.abs(o["moment"]).max())]
+    o0 = r["surface"]
+    rows = [("free-field PGA [m/s^2]", lambda o: o["pga"])]
+    for i, z in enumerate(o0["z"]):
+        rows.append((f"peak absolute acceleration at (0 0 {z:g}) [m/s^2]", lambda o, i=i: np.abs(o["acc"][:, i]).max()))
+    for k in range(o0["drift"].shape[1]):
+        rows.append((f"peak drift ratio storey {k + 1} [-]", lambda o, k=k: np.abs(o["drift"][:, k]).max()))
+    for k in range(o0["drift"].shape[1]):
+        rows.append((f"peak deformation drift ratio storey {k + 1} [-]", lambda o, k=k: np.abs(o["drift_def"][:, k]).max()))
+    rows += [("peak rocking theta_y of the ground floor [rad]", lambda o: np.abs(o["rot"]).max()),
+             ("peak base shear at the interface [N]", lambda o: np.abs(o["shear"]).max()),
+             ("peak overturning moment about (0 0 0) [N m]", lambda o: np.abs(o["moment"]).max())]
     return [(name, fn(r["surface"]), fn(r["basement"])) for name, fn in rows]
 
 
@@ -87,7 +90,9 @@ def plot(r, png):
     for a in ax:
         a.grid(alpha=0.3)
     ax[0].legend(fontsize=8)
-    ax[0].set_title("demo building (2 x 2 bays, 2 storeys, full model), K-NET AKT013 E-W x 22.8, c_s 100 m/s")
+    n = r["surface"]["drift"].shape[1]
+    what = {2: "demo building (2 x 2 bays, 2 storeys", 3: "the paper's building (4 x 3 bays, 3 storeys"}.get(n, f"building ({n} storeys")
+    ax[0].set_title(f"{what}, full model), K-NET AKT013 E-W x 22.8, c_s 100 m/s")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
 
