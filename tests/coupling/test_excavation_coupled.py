@@ -253,6 +253,9 @@ def test_a_footing_on_the_filled_pit_responds_as_on_the_plain_half_space(tmp_pat
     assert err[0.5]["z"] < 0.5 * err[1.0]["z"] and err[0.5]["x"] < 0.7 * err[1.0]["x"], err   # 0.34, 0.55
 
 
+# slow tier: two coupled runs with contact (20 s); the default tier's siblings: tests/coupling/test_pit_contact.py
+# (the same case on one rank, Kuhn-Tucker checked every step)
+@pytest.mark.slow
 def test_pit_contact_auto_two_ranks_equal_one(tmp_path):
     """Unilateral contact in the pit with -ssi_contact_separation auto and -ssi_contact_preload earth:0.5 (the case of
     test_pit_contact.py, to 70 ms: the first wall opens and its edge lifts): -n 2 takes the same statuses in the same
