@@ -30,7 +30,8 @@ def numbered(tmp_path_factory):
     return d
 
 
-@pytest.mark.parametrize("n", [1, 2])
+# slow tier: the two-rank case (5-9 s); the one-rank case stays in make test
+@pytest.mark.parametrize("n", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_another_runs_numbered_checkpoints_are_not_replaced(numbered, tmp_path, n):
     import shutil
     run = tmp_path / "run"
@@ -49,7 +50,8 @@ def test_another_runs_numbered_checkpoints_are_not_replaced(numbered, tmp_path, 
         assert "restarted from" in r.stdout
 
 
-@pytest.mark.parametrize("n", [1, 2])
+# slow tier: the two-rank case (5-9 s); the one-rank case stays in make test
+@pytest.mark.parametrize("n", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_a_checkpoint_or_lag_file_that_is_the_output_through_a_link_is_refused(numbered, tmp_path, n):
     import shutil
     run = tmp_path / "run"
@@ -85,7 +87,8 @@ def _im_args(tmp_path):
             "-ssi_t_end", "0.03"]
 
 
-@pytest.mark.parametrize("n", [1, 2])
+# slow tier: the two-rank case (5-9 s); the one-rank case stays in make test
+@pytest.mark.parametrize("n", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_input_motion_replaces_no_file_of_the_user(tmp_path, n):
     args = _im_args(tmp_path)
     out = str(tmp_path / "im.h5")
