@@ -160,10 +160,11 @@ def fit(runs):
     # factorisation, solve
     N15 = arr(lambda me, ms, cn, *r: cn.N ** 1.5)
     c["c_fac"] = float(_nnls(N15[:, None], arr(lambda me, ms, *r: ms["factor"]))[0])
-    A = np.stack([arr(lambda me, ms, cn, *r: cn.steps * cn.N ** 1.5),
-                  arr(lambda me, ms, cn, p, *r: cn.steps * cn.N ** 1.5 * (p - 1))], 1)
+    nlogn = lambda cn: cn.N * np.log(max(cn.N, 2))
+    A = np.stack([arr(lambda me, ms, cn, *r: cn.steps * nlogn(cn)),
+                  arr(lambda me, ms, cn, p, *r: cn.steps * nlogn(cn) * (p - 1))], 1)
     s, sk = _nnls(A, arr(lambda me, ms, *r: ms["solve"]))
-    c["c_sol"], c["kappa"] = float(s), float(sk / s) if s > 0 else 0.0
+    c["c_sol_nlogn"], c["kappa"] = float(s), float(sk / s) if s > 0 else 0.0
     # time-blocked history sum: the panel products (event SSI_BEM_HistPanel) against their flops,
     # dense and block-sparse, each width's flops scaled by the kernel's relative rate at that width
     # (cost.panel_width_factor), with the contention of m ranks on a node (sigma_panel, on a grid);

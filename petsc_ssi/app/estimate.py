@@ -6,7 +6,7 @@ import time
 
 from ..options import register, SSIError
 from ..monitor import fmt_time
-from ..bem.cost import Counts, load_constants, predict
+from ..bem.cost import Counts, bem_solve_seconds, load_constants, predict
 from .kinds import problem_kind, resolve
 
 G = "estimate"
@@ -64,7 +64,7 @@ def report(cfg, comm, out=None):
         from ..coupling.cost import CoupledCounts
         coupled = build_coupled(cfg, comm)
         cc = CoupledCounts(cfg, comm, *coupled)
-    tz = None if coupled is not None else _toeplitz_report(cfg, comm, ranks, cores, q, node_mem)
+    tz = _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled, cc, c)
     if tz is not None:                  # a uniform flat grid: the run takes the toeplitz store
         out("\n".join(tz))
         return {"counts": None, "rows": []}
@@ -93,7 +93,7 @@ def report(cfg, comm, out=None):
     for p in ranks:
         t = predict(cnt, c, p, q, cores)
         if cc is not None:            # the structure, the interface matrices and the coupled step
-            bem_solve = c["c_sol"] * cnt.N ** 1.5 * (1 + c["kappa"] * (p - 1))
+            bem_solve = bem_solve_seconds(c, cnt.N, p)
             add = cc.predict(c, p, bem_solve)
             t.update(add)
             t["loop"] += add["cpl_loop"]
@@ -135,11 +135,14 @@ def _verdict(rows, node_mem):
             f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
 
 
-def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
+def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None, c=None):
     """Collective: the estimate block of a run the toeplitz store takes (-ssi_lag_store toeplitz or auto on
     a uniform flat grid), or None (not such a grid: the dense model's block follows). The dense model's
     counts are not made: its element-pair tables hold every (node, element) pair (O(N^2) on a whole
-    grid: minutes and GBs on a 60 m site), and the run does not store those matrices."""
+    grid: minutes and GBs on a 60 m site), and the run does not store those matrices. Coupled
+    (``coupled``: build_coupled's tuple, ``cc``: its CoupledCounts, ``c``: the constants), the soil is the
+    coupled set-up's and the coupling's set-up and steps are added (``CoupledCounts.predict``, its BEM
+    solve the dense model's ``bem_solve_seconds``: the step matrix is the same sparse lag-0/1 matrix)."""
     from ..bem.halfspace import HalfSpace
     from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
     from ..bem.lagset import load_kernels
@@ -148,7 +151,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
     if cfg.get("lag_store", "dense") == "dense":
         return None
     t0 = time.perf_counter()
-    prob = HalfSpace(cfg, comm, log=lambda m: None)
+    prob = coupled[0] if coupled is not None else HalfSpace(cfg, comm, log=lambda m: None)
     prob.warn_diffraction()
     plan = prob.interp_plan()
     ls = prob.lagset(plan)
@@ -177,15 +180,27 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem):
                 f"{glat.Mx} x {glat.My})" if glat is not None else ""),
              "[ssi]   ranks | kernels_s history_s | GB over the ranks beside the processes | with the processes "
              "(this one's resident size each) | fits"]
+    if cc is not None:
+        from ..coupling.cost import describe
+        lines.insert(2, describe(cc))
+        lines[-1] = ("[ssi]   ranks | kernels_s history_s coupling_setup_s coupling_loop_s total | GB over the ranks "
+                     "beside the processes | with the processes (this one's resident size each) | fits")
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
+        cpl = ""
+        if cc is not None:            # the structure, the interface matrices and the coupled steps
+            add = cc.predict(c, p, bem_solve_seconds(c, N, p))
+            b += add["cpl_bytes"]
+            steps_s = prob.n_steps * bem_solve_seconds(c, N, p)
+            cpl = (f" {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
+                   f"{fmt_time(tb + th + add['cpl_setup'] + add['cpl_loop'] + steps_s):>7}")
         tot = b + p * rss
         per_node = tot / p * min(q, p)
         flag = "yes" if per_node <= limit else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
         if min(q, p) > cores:
             flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
-        lines.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g} | {tot / 1e9:7.3g} | {flag}")
+        lines.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g}{cpl} | {b / 1e9:7.3g} | {tot / 1e9:7.3g} | {flag}")
     lines.append(f"[ssi]   (model set-up took {time.perf_counter() - t0:.3g} s on {comm.getSize()} rank(s); the "
                  "node's limit: 80 % of its memory or -ssi_memory_limit, as the run's check)")
     return lines

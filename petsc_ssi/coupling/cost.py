@@ -7,7 +7,7 @@ assembles it). What the coupling adds is counted here, in three parts:
   structure    measured, not modelled: the estimate assembles K and M and factorises D as the run
                does (seconds on every structure this code meshes), and times solves with D
                (t_fs, the median of a few) and the growth of the resident memory (the factors)
-  interface    3 n_I columns Z = A^-1 H_s e_j: 3 n_I BEM solves (c_sol N^1.5 (1 + kappa (p - 1)),
+  interface    3 n_I columns Z = A^-1 H_s e_j: 3 n_I BEM solves (bem.cost.bem_solve_seconds,
   set-up       the BEM model's solve) and, implicit, 3 n_I solves with D (t_fs); plus the dense
                products (flops / r_cpl)
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products

@@ -359,3 +359,22 @@ def test_toeplitz_single_precision_transforms(tmp_path):
     S = scales(A)
     err = max(np.abs(A[k] - B[k]).max() / S[k] for k in A if S[k] > 0)
     assert 1e-12 < err <= SINGLE_ERR, err
+
+
+def test_the_estimate_of_a_coupled_run_on_the_toeplitz_store():
+    """`petsc-ssi estimate` of a coupled run on a uniform grid with -ssi_lag_store toeplitz prints the toeplitz
+    store's block with the coupling's columns (the structure timed, the interface set-up and steps), not the
+    dense lag matrices' model the run would not use: the coupling's set-up and steps take time and its GB
+    are more than the soil alone's."""
+    import re
+    soil = cli(["estimate", "-ssi_problem", "bem"] + SSI[2:] + TZ + ["-ssi_estimate_ranks", "1"], check=False).stdout
+    r = cli(["estimate"] + SSI + TZ + ["-ssi_estimate_ranks", "1,2"])
+    assert "estimate of this BEM run on the toeplitz lag store" in r.stdout and "coupling:" in r.stdout
+    assert "blocks assembled" not in r.stdout                 # (the dense model's line)
+    row = re.search(r"\[ssi\]\s+1 \|\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+) \|\s+(\S+) \|", r.stdout)
+    assert row, r.stdout
+    kern, hist, setup, loop = (float(row.group(i)) for i in (1, 2, 3, 4))
+    assert kern > 0 and hist > 0 and setup > 0 and loop > 0
+    gb = float(row.group(6))
+    soil_gb = float(re.search(r"\[ssi\]\s+1 \|\s+\S+\s+\S+ \|\s+(\S+) \|", soil).group(1))
+    assert gb > soil_gb, (gb, soil_gb)
