@@ -50,3 +50,31 @@ repeat_runs() {
     done
   done
 }
+
+# sampled_run NAME ARGS...: one petsc_ssi run on $RANKS ranks into $OUT/NAME.{h5,log} with -log_view and -memory_view,
+# its ranks' resident memory sampled every 2 s ("# sampled peak RSS over the ranks" at the log's end), the load
+# average before and after; MIN_FREE_GB > 0 stops the run when the machine's available memory falls below it
+# (toeplitz_bench.sh, building_uniform.sh)
+sampled_run() {
+  local name=$1
+  shift
+  echo "[bench] $name on $RANKS rank(s) -> $OUT/$name.log"
+  echo "# load average before the run (other users of the machine): $(cat /proc/loadavg)" > "$OUT/$name.log"
+  mpirun --allow-run-as-root --oversubscribe -n "$RANKS" "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" \
+    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 &
+  local pid=$! peak=0 rss avail
+  while kill -0 "$pid" 2>/dev/null; do     # the ranks' resident memory (children of this mpirun), and the guard
+    rss=$( (ps --ppid "$pid" -o rss= || true) | awk '{s += $1} END {print s + 0}')   # (ps fails once the ranks end)
+    if (( rss > peak )); then peak=$rss; fi
+    avail=$(awk '/MemAvailable/ {print int($2 / 1048576)}' /proc/meminfo)
+    if (( ${MIN_FREE_GB:-0} > 0 && avail < MIN_FREE_GB )); then
+      echo "# stopped by the script: the machine's available memory fell to $avail GB (MIN_FREE_GB=${MIN_FREE_GB:-0})," \
+        "the ranks held $(awk -v k="$rss" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
+      kill "$pid"
+    fi
+    sleep 2
+  done
+  wait "$pid" || true
+  echo "# sampled peak RSS over the ranks: $(awk -v k="$peak" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
+  echo "# load average after the run: $(cat /proc/loadavg)" >> "$OUT/$name.log"
+}

@@ -36,23 +36,7 @@ B=(-options_file runs/building/ssi-full-bonded.opts ${T_END:+-ssi_t_end "$T_END"
 P15=(-ssi_load_p0 694.4444444444445)          # 1000 N over the 1.44 m^2 cell
 U=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14.9,15.1,-0.1,0.1 "${P15[@]}"
    -ssi_lag_store toeplitz)
-run() {
-  local name=$1
-  shift
-  echo "[bench] $name on $RANKS rank(s) -> $OUT/$name.log"
-  echo "# load average before the run (other users of the machine): $(cat /proc/loadavg)" > "$OUT/$name.log"
-  mpirun --allow-run-as-root --oversubscribe -n "$RANKS" "$PY" -m petsc_ssi "$@" -ssi_output "$OUT/$name.h5" \
-    -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view >> "$OUT/$name.log" 2>&1 &
-  local pid=$! peak=0 rss
-  while kill -0 "$pid" 2>/dev/null; do     # the ranks' resident memory (children of this mpirun)
-    rss=$( (ps --ppid "$pid" -o rss= || true) | awk '{s += $1} END {print s + 0}')
-    if (( rss > peak )); then peak=$rss; fi
-    sleep 2
-  done
-  wait "$pid" || true
-  echo "# sampled peak RSS over the ranks: $(awk -v k="$peak" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
-  echo "# load average after the run: $(cat /proc/loadavg)" >> "$OUT/$name.log"
-}
+run() { sampled_run "$@"; }
 for r in $RUNS; do
   case $r in
     today) run today "${B[@]}" ;;

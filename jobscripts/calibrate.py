@@ -23,6 +23,7 @@ and give the table to the estimate: -ssi_estimate_constants mycluster.json.
 """
 import argparse
 import contextlib
+import importlib
 import io
 import json
 import os
@@ -85,15 +86,13 @@ def measured(text):
             "peak": lv["peak_rss_bytes"], "peak_rank": lv.get("peak_rss_max_rank_bytes")}
 
 
-def counts(opts, ranks):
-    """The model's counts of the case ``opts`` for rank counts ``ranks`` (in-process set-up)."""
-    key = (tuple(sorted((k, v) for k, v in opts.items() if k not in ("output",))), tuple(ranks))
-    if key in _CACHE:
-        return _CACHE[key]
+def case_config(opts):
+    """(PETSc, cfg): this process's options database holding the -ssi_ options ``opts`` of a log (and no
+    others), resolved as `petsc-ssi estimate` resolves them (common, bem, estimate)."""
     from petsc_ssi.petsc import init
     PETSc = init([sys.argv[0]])
     from petsc_ssi import options
-    from petsc_ssi.app import estimate
+    importlib.import_module("petsc_ssi.app.estimate")        # (registers the options)
     db = PETSc.Options()
     for k in list(db.getAll()):
         if k.startswith("ssi_"):
@@ -101,7 +100,16 @@ def counts(opts, ranks):
     for k, v in opts.items():
         db.setValue("ssi_" + k, v)
     db.setValue("ssi_warn_beta", "0")
-    cfg = options.resolve(("common", "bem", "estimate"))
+    return PETSc, options.resolve(("common", "bem", "estimate"))
+
+
+def counts(opts, ranks):
+    """The model's counts of the case ``opts`` for rank counts ``ranks`` (in-process set-up)."""
+    key = (tuple(sorted((k, v) for k, v in opts.items() if k not in ("output",))), tuple(ranks))
+    if key in _CACHE:
+        return _CACHE[key]
+    from petsc_ssi.app import estimate
+    PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
         _, _, cnt = estimate.count_run(cfg, PETSc.COMM_SELF, sorted(set(ranks)), 0.0)
     _CACHE[key] = cnt

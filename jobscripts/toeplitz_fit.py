@@ -14,7 +14,6 @@ weighted states) is kept as it is. Oversubscribed runs are left out. The printed
 toeplitz.py by hand, with the logs' names and date in its comment.
 """
 import contextlib
-import importlib
 import io
 import os
 import sys
@@ -25,26 +24,15 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
-from calibrate import log_options, _nnls  # noqa: E402
+from calibrate import case_config, log_options, _nnls  # noqa: E402
 from toeplitz_table import row  # noqa: E402
 
 
 def terms(opts, ranks):
     """{term: count} of ``toeplitz.estimate`` for the case ``opts`` on ``ranks`` ranks."""
-    from petsc_ssi.petsc import init
-    PETSc = init([sys.argv[0]])
-    from petsc_ssi import options
-    importlib.import_module("petsc_ssi.app.estimate")        # (registers the options)
     from petsc_ssi.bem.halfspace import HalfSpace
     from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES
-    db = PETSc.Options()
-    for k in list(db.getAll()):
-        if k.startswith("ssi_"):
-            db.delValue(k)
-    for k, v in opts.items():
-        db.setValue("ssi_" + k, v)
-    db.setValue("ssi_warn_beta", "0")
-    cfg = options.resolve(("common", "bem", "estimate"))
+    PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
         prob = HalfSpace(cfg, PETSc.COMM_SELF, log=lambda m: None)
         plan = prob.interp_plan()
