@@ -6,6 +6,12 @@
 # (an MPI job paused whole resumes; a test with a wall-clock timeout may fail).
 #   bash jobscripts/quiet.sh COMMAND [ARGS...]      e.g.  bash jobscripts/quiet.sh bash jobscripts/calibration_runs.sh
 set -uo pipefail
+# one quiet command at a time (two would pause each other's processes, each holding its memory): a lock
+exec 9> "${TMPDIR:-/tmp}/petsc_ssi-quiet.lock"
+if ! flock -n 9; then
+  echo "[quiet] another jobscripts/quiet.sh runs: waiting for it to end" >&2
+  flock 9
+fi
 export QUIET_MINE=1
 "$@" &
 CMD=$!
