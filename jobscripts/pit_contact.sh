@@ -6,13 +6,7 @@ set -e
 cd "$(dirname "$0")/.."
 PY=${PY:-.venv/bin/python}
 out=out/pit_contact; mkdir -p $out
-$PY - <<PYEOF
-import numpy as np
-T = 0.04
-t = np.arange(0.0, 2 * T + 1e-9, T / 80)
-a = sum(s * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0) for k, s in enumerate((1, -1)))
-np.savetxt("$out/pulse.txt", np.c_[t, a], header="units: m/s2")
-PYEOF
+$PY -c "import sys; sys.path.insert(0, 'runs/seismic'); import input_motion; input_motion.pulse('$out/pulse.txt', 0.04)"
 $PY -m petsc_ssi run -ssi_problem ssi -ssi_mesh pit -ssi_mesh_params a=1,b=1,d=1 -ssi_mesh_size 6,6 -ssi_mesh_h 1 \
   -ssi_dt 0.0025 -ssi_t_end 0.14 -ssi_seismic vertical -ssi_seismic_record $out/pulse.txt -ssi_seismic_units m/s2 \
   -ssi_seismic_taper 0 -ssi_seismic_baseline none -ssi_fem_mesh box -ssi_fem_box_cells 4,4,3 \

@@ -22,15 +22,14 @@ import sys
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "runs", "seismic"))
+import input_motion  # noqa: E402
 T = 0.04                                      # s: each sin^4 pulse of the pair
 
 
 def pulse(path):
-    t = np.arange(0.0, 2 * T + 1e-9, T / 80)
-    a = sum(s * np.where((t >= k * T) & (t < (k + 1) * T), np.sin(np.pi * (t - k * T) / T) ** 4, 0.0)
-            for k, s in enumerate((1, -1)))
-    np.savetxt(path, np.c_[t, a], header="t [s], a [m/s2]")
-    return path
+    """The sin^4 pulse pair of length T each (1 m/s^2), the record of runs/seismic/input_motion.py."""
+    return input_motion.pulse(path, T)
 
 
 def args(record, out, separation, preload, scale):

@@ -28,6 +28,8 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "runs", "seismic"))
+import input_motion  # noqa: E402
 CS, CP, RHO = 316.0, 548.0, 2000.0
 CS1, CP1, RHO1 = 158.0, 274.0, 1800.0
 H, DT, T_END, PULSE = 2.0, 0.0025, 0.4, 0.01
@@ -36,12 +38,9 @@ F0 = CS1 / (4 * H)
 
 
 def record(path):
-    """The 10 ms sin^4 acceleration pulse and its reverse (zero net velocity), 1 m/s^2 [table 't a']."""
-    t = np.arange(0.0, 2 * PULSE + 1e-9, PULSE / 80)
-    a = sum(sg * np.where((t >= k * PULSE) & (t < (k + 1) * PULSE), np.sin(np.pi * (t - k * PULSE) / PULSE) ** 4, 0.0)
-            for k, sg in enumerate((1, -1)))
-    np.savetxt(path, np.c_[t, a], header="units: m/s2")
-    return path
+    """The 10 ms sin^4 acceleration pulse and its reverse (zero net velocity), 1 m/s^2 [table 't a']: the
+    record of runs/seismic/input_motion.py."""
+    return input_motion.pulse(path, PULSE)
 
 
 def run(W, ranks, out):
