@@ -2,7 +2,7 @@
 """Fit the toeplitz store's time rates (petsc_ssi/bem/toeplitz.py RATES) to -log_view logs of toeplitz
 runs (jobscripts/toeplitz_bench.sh), and print the model against each log.
 
-    python jobscripts/toeplitz_fit.py LOG...
+    python jobscripts/toeplitz_fit.py [--check] LOG...     (--check: the committed RATES, no fit)
 
 Each log's option table rebuilds its set-up in this process (no assembly: the lattice, the interpolation
 plan, the traction window), as `petsc-ssi estimate` does; ``toeplitz.estimate`` is then evaluated with one
@@ -16,6 +16,7 @@ toeplitz.py by hand, with the logs' names and date in its comment.
 import contextlib
 import io
 import os
+import re
 import sys
 
 import numpy as np
@@ -51,7 +52,11 @@ def terms(opts, ranks):
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2], "sums": one(r_sums=RATES["r_sums"])[2]}
 
 
-def main(logs):
+def main(logs, check=False):
+    """Fit the rates to ``logs`` and print the fitted model against each; ``check``: no fit, the committed
+    RATES (and the step solve, cost.bem_solve_seconds with the committed constants) against each log."""
+    from petsc_ssi.bem.cost import bem_solve_seconds, load_constants
+    from petsc_ssi.bem.toeplitz import RATES
     runs = []
     for path in logs:
         text = open(path, errors="replace").read()
@@ -63,24 +68,34 @@ def main(logs):
         if int(r["ranks"]) > (os.cpu_count() or 1):
             print(f"[toeplitz_fit] skip {path}: oversubscribed", file=sys.stderr)
             continue
+        m = re.search(r"^SSI_BEM_Solve\s+(\d+)\s+\S+\s+(\S+)", text, re.M)
+        r["solve_s"] = float(m.group(2)) / int(m.group(1)) if m else float("nan")
         runs.append((path, r, terms(opts, int(r["ranks"]))))
     kern = np.array([r["kernels_s"] for _, r, _ in runs], float)
     hist = np.array([r["history_s"] for _, r, _ in runs], float)
-    t_pair = float(_nnls(np.array([[t["pairs"]] for *_, t in runs]), kern)[0])
-    A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
     sums = np.array([t["sums"] for *_, t in runs])
-    inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
-    fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
-           "t_step_grid": float(t_grid), "t_step_elem": float(t_elem), "t_pair_lag": t_pair}
-    print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] |")
-    print("|---|---|---|---|---|")
+    if check:
+        fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag")}
+    else:
+        A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
+        inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
+        fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
+               "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
+               "t_pair_lag": float(_nnls(np.array([[t["pairs"]] for *_, t in runs]), kern)[0])}
+    c, _ = load_constants()
+    print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] | a step solve measured / "
+          "model [ms] |")
+    print("|---|---|---|---|---|---|")
     for (path, r, t), k, h in zip(runs, kern, hist):
-        mk = t_pair * t["pairs"]
-        mh = inv_r * t["prod"] + t_dof * t["dof"] + t_grid * t["grid"] + t_elem * t["elem"] + t["sums"]
+        mk = fit["t_pair_lag"] * t["pairs"]
+        mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
+              + fit["t_step_elem"] * t["elem"] + t["sums"])
+        ms = 1e3 * bem_solve_seconds(c, int(r["dofs"]) // 3, int(r["ranks"]))
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
-              f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) |")
-    print("fitted: " + ", ".join(f'"{k}": {v:.3g}' for k, v in fit.items()))
+              f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")
+    print(("committed: " if check else "fitted: ") + ", ".join(f'"{k}": {v:.3g}' for k, v in fit.items()))
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    args = sys.argv[1:]
+    main([a for a in args if a != "--check"], check="--check" in args)

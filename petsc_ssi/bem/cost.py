@@ -31,8 +31,8 @@ splits them), with nb[l] the estimated non-zero 3x3 blocks of lag l in r's rows:
                                                        scales them to b and s)
   solve      c_sol_nlogn * steps * N ln N * (1 + kappa (p - 1))   (solves with the factors: their fill
                                                        grows as N log N on a surface; N^1.5, the form
-                                                       before, put a 49 923-DOF grid's solve at 4.6x its
-                                                       measured time)
+                                                       before, put a 49 923-DOF grid's solve at 247 ms
+                                                       against 53.7 ms measured, N ln N puts it at 80 ms)
   setup      s0 + s1 * N * E_v / p                    (block estimate, free terms)
   rest       c_step * steps + c_main + c_plot [-ssi_plot]
 
