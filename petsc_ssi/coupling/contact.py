@@ -307,17 +307,23 @@ class StaggeredSolve:
         law = self.law
         O, S = law.open_free_dofs(closed)
         t = law.target(closed)
-        E = np.zeros((len(y), len(O) + len(S)))
-        E[O, np.arange(len(O))] = 1.0
-        for j, k in enumerate(S):
-            E[3 * k:3 * k + 3, len(O) + j] = law.n_b[k]
-        ZE = self.cap.Z @ E
-        lu = self.cap.get(law.key(closed), lambda: E.T @ ZE)
-        c = sla.lu_solve(lu, E.T @ (y - t), check_finite=False)
-        delta = E @ c
+        rows, R = stuck_rows(law.frames, S)
+        nS = law.n_b[S]
+        Z = self.cap.Z
+        # E's columns are unit vectors (the free open dofs) and the stuck nodes' normals: Z E and E^T v by
+        # gathering, not by products with the mostly zero E
+
+        def ET(V):                                   # E^T V for V (3 n_I, ...)
+            Vs = V[rows].reshape((len(S), 3) + V.shape[1:])
+            return np.concatenate([V[O], np.einsum("sb,sb...->s...", nS, Vs)])
+        ZE = np.concatenate([Z[:, O], np.einsum("isb,sb->is", Z[:, rows].reshape(len(y), len(S), 3), nS)], axis=1)
+        lu = self.cap.get(law.key(closed), lambda: ET(ZE))
+        c = sla.lu_solve(lu, ET(y - t), check_finite=False)
+        delta = np.zeros_like(y)
+        delta[O] = c[:len(O)]
+        delta[rows] = (nS * c[len(O):, None]).ravel()
         p = y - ZE @ c
         p[O] = t[O]
-        rows, R = stuck_rows(law.frames, S)
         if S.size:                                   # the stuck nodes' normal traction exactly the target
             pk, tk = p[rows].reshape(-1, 3), t[rows].reshape(-1, 3)
             pk += law.n_b[S] * np.einsum("ij,ij->i", tk - pk, law.n_b[S])[:, None]
