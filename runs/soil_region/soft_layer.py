@@ -16,13 +16,15 @@ the layer's surface centre and of the free-surface velocity of the half-space (t
 
 so a narrow box resonates higher than the 1D layer and tends to it as W/H grows.
 
-Run: python runs/soil_region/soft_layer.py [W1,W2,...] [ranks]   (default 6,10 and 1 rank)
+Run: python runs/soil_region/soft_layer.py [W1,W2,...] [ranks] [full] [--post]   (default 6,10,20,30, 1 rank,
+quarter models; --post: read the outputs of an earlier run instead of running)
 Writes soft_layer.csv (frequency [Hz], |TF| per width [1], the 1D |TF| [1]) and soft_layer.png beside this
 file, and prints each width's peak (frequency, amplitude) beside the estimates above.
 """
 import os
 import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -43,20 +45,25 @@ def record(path):
     return input_motion.pulse(path, PULSE)
 
 
-def run(W, ranks, out):
-    """The coupled run of a box of width W [m]: soil elements 1 m, bricks 0.5 m, ground W + 6 m wide."""
+def run(W, ranks, out, quarter=True, command="run"):
+    """The coupled run of a box of width W [m]: soil elements 1 m, bricks 0.5 m, ground W + 6 m wide.
+    quarter: the quarter model x >= 0, y >= 0 (-ssi_symmetry x=anti,y=sym: the wave moves the ground in x,
+    so the plane x = 0 is one of antisymmetry and y = 0 one of symmetry), 1/16 of the whole model's lags."""
     n = int(round(2 * W))
-    args = ["-m", "petsc_ssi", "run", "-ssi_problem", "ssi", "-ssi_mesh", "pit",
+    box = ([f"{n // 2},{n // 2},{int(2 * H)}", f"{W / 2},{W / 2},{H}", f"0,0,{-H}", "xmax,ymax,base"] if quarter
+           else [f"{n},{n},{int(2 * H)}", f"{W},{W},{H}", f"{-W / 2},{-W / 2},{-H}", "xmin,xmax,ymin,ymax,base"])
+    args = ["-m", "petsc_ssi", command, "-ssi_problem", "ssi", "-ssi_mesh", "pit",
             "-ssi_mesh_params", f"a={W / 2},b={W / 2},d={H}", "-ssi_mesh_size", f"{W + 6},{W + 6}",
             "-ssi_mesh_h", "1", "-ssi_dt", str(DT), "-ssi_t_end", str(T_END), "-ssi_seismic", "vertical",
             "-ssi_seismic_record", record(os.path.join(os.path.dirname(out), "pulse.txt")),
             "-ssi_seismic_units", "m/s2", "-ssi_seismic_taper", "0", "-ssi_seismic_baseline", "none",
-            "-ssi_fem_mesh", "box", "-ssi_fem_box_cells", f"{n},{n},{int(2 * H)}",
-            "-ssi_fem_box_size", f"{W},{W},{H}", "-ssi_fem_box_origin", f"{-W / 2},{-W / 2},{-H}",
-            "-ssi_fem_interface", "xmin,xmax,ymin,ymax,base", "-ssi_fem_cp", str(CP1), "-ssi_fem_cs", str(CS1),
-            "-ssi_fem_rho", str(RHO1), "-ssi_structure_receivers", "0,0,0", "-ssi_receivers", f"{W / 2 + 2},0,0",
-            "-ssi_output", out, "-ssi_output_overwrite", "1", "-ssi_output_stride", "0", "-ssi_warn_beta", "0",
-            "-ssi_monitor"]
+            "-ssi_fem_mesh", "box", "-ssi_fem_box_cells", box[0], "-ssi_fem_box_size", box[1],
+            "-ssi_fem_box_origin", box[2], "-ssi_fem_interface", box[3], "-ssi_fem_cp", str(CP1),
+            "-ssi_fem_cs", str(CS1), "-ssi_fem_rho", str(RHO1), "-ssi_structure_receivers", "0,0,0",
+            "-ssi_receivers", f"{W / 2 + 2},0,0", "-ssi_output", out, "-ssi_output_overwrite", "1",
+            "-ssi_output_stride", "0", "-ssi_warn_beta", "0", "-ssi_monitor"]
+    if quarter:
+        args += ["-ssi_symmetry", "x=anti,y=sym"]
     cmd = [sys.executable] + args
     if ranks > 1:
         cmd = ["mpirun", "--allow-run-as-root", "-n", str(ranks)] + cmd
@@ -78,23 +85,126 @@ def transfer(out, nfft_factor=4):
         return np.fft.rfftfreq(n, dt), np.abs(V / Vff)
 
 
-def one_d(f):
+def one_d(f, complex_=False):
+    """|U_top / U_outcrop| of the 1D layer (module docstring); complex_: the complex ratio to the outcrop
+    motion at the ground surface z = 0 (the record's), e^(+i omega t) as numpy's inverse transform: the
+    textbook ratio references the outcrop at the layer's base (its incident wave's phase at z = -H), so the
+    surface outcrop's ratio carries e^(i omega H / c_s) (the half-space's wave reaches z = 0 H/c_s later)."""
     k = 2 * np.pi * f / CS1
-    return 1.0 / np.abs(np.cos(k * H) + 1j * ALPHA * np.sin(k * H))
+    r = 1.0 / (np.cos(k * H) + 1j * ALPHA * np.sin(k * H))
+    return r * np.exp(2j * np.pi * f * H / CS) if complex_ else np.abs(r)
+
+
+def one_d_column(t_end, outcrop, ne=100, dt=2e-5):
+    """An independent check of ``one_d(complex_=True)``: the 1D layer as ne linear finite elements on the
+    half-space's exact 1D boundary (a dashpot rho c_s at the base loaded by 2 rho c_s v_inc, the incident
+    velocity at the base v_inc(t) = v_outcrop(t + H/c_s) / 2), Newmark's average acceleration at dt.
+    ``outcrop(t)``: the outcrop (free surface) displacement [m]. Returns (t [s], u_x at the top [m])."""
+    h = H / ne
+    n = ne + 1
+    K, M = np.zeros((n, n)), np.zeros((n, n))
+    for e in range(ne):
+        K[e:e + 2, e:e + 2] += RHO1 * CS1 ** 2 / h * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        M[e:e + 2, e:e + 2] += RHO1 * h / 6 * np.array([[2.0, 1.0], [1.0, 2.0]])
+    C = np.zeros((n, n))
+    C[0, 0] = RHO * CS                                 # node 0 at the base
+    nt = int(round(t_end / dt))
+    t = np.arange(nt + 1) * dt
+    vo = np.gradient(outcrop(t), dt)
+    f0 = 2 * RHO * CS * np.interp(t + H / CS, t, vo) / 2
+    b = 4.0 / dt ** 2
+    Ainv = np.linalg.inv(b * M + 2.0 / dt * C + K)
+    u, v, a = np.zeros(n), np.zeros(n), np.zeros(n)
+    top = np.zeros(nt + 1)
+    for i in range(nt):
+        rhs = M @ (b * u + 4.0 / dt * v + a) + C @ (2.0 / dt * u + v)
+        rhs[0] += f0[i + 1]
+        un = Ainv @ rhs
+        an = b * (un - u) - 4.0 / dt * v - a
+        v, a, u = v + 0.5 * dt * (a + an), an, un
+        top[i + 1] = u[-1]
+    return t, top
+
+
+def lowpass(f, f1=25.0, f2=40.0):
+    """A cosine taper from 1 at f1 to 0 at f2 [Hz]: the band the box's discretisation holds (6 bricks and
+    10 steps per wavelength and period of the layer at 40 Hz)."""
+    w = np.ones_like(f)
+    m = (f > f1) & (f < f2)
+    w[m] = 0.5 * (1 + np.cos(np.pi * (f[m] - f1) / (f2 - f1)))
+    w[f >= f2] = 0.0
+    return w
+
+
+def time_histories(out, nfft_factor=16):
+    """(t [s], v_x at the layer's surface centre [m/s], the 1D layer's v_x for the same outcrop motion [m/s],
+    the record's time origin t0 [s]), both low-passed by ``lowpass`` (velocities: the record's displacement
+    keeps a permanent offset); the 1D one exact in the frequency domain (``one_d(complex_=True)``,
+    zero-padded 16 x: its reverberation has died out before it wraps)."""
+    import h5py
+    with h5py.File(out.replace(".h5", "_structure.h5")) as fs, h5py.File(out) as f:
+        t, u = fs["receivers/t"][:], fs["receivers/u"][:, 0, 0]
+        D, td, t0 = f["seismic/x_displacement"][:], f["seismic/x_t"][:], float(f["seismic/t0"][()])
+    uff = np.interp(t - t0, td, D, left=0.0)
+    n = nfft_factor * len(t)
+    fr = np.fft.rfftfreq(n, t[1] - t[0])
+    w = lowpass(fr)
+    dt = t[1] - t[0]
+    v, vff = np.gradient(u, dt), np.gradient(uff, dt)
+    box = np.fft.irfft(np.fft.rfft(v, n) * w, n)[:len(t)]
+    one = np.fft.irfft(np.fft.rfft(vff, n) * one_d(fr, True) * w, n)[:len(t)]
+    return t, box, one, t0
+
+
+def edge_time(W, t0):
+    """The earliest time [s] the waves the box's walls send in reach its centre: the record's time origin
+    t0 plus (W/2) / c_s (Love waves in a layer on a stiffer half-space travel between c_s1 and the
+    half-space's c_s; the walls meet the incident wave when the surface does, within H/c_s)."""
+    return t0 + 0.5 * W / CS
+
+
+def window_errors(out, W):
+    """(max |v_box - v_1D| / max |v_1D| for t <= edge_time, the same over the whole run, rms of v_box /
+    rms of v_1D after edge_time) of ``time_histories``."""
+    t, box, one, t0 = time_histories(out)
+    te = edge_time(W, t0)
+    e = np.abs(box - one) / np.abs(one).max()
+    late = t > te
+    rms = float(np.sqrt(np.mean(box[late] ** 2) / np.mean(one[late] ** 2))) if late.any() else float("nan")
+    return float(e[t <= te].max()), float(e.max()), rms
 
 
 def main():
-    widths = [float(w) for w in (sys.argv[1] if len(sys.argv) > 1 else "6,10").split(",")]
-    ranks = int(sys.argv[2]) if len(sys.argv) > 2 else 1
+    post = "--post" in sys.argv           # the outputs of an earlier run of this script, not run again
+    argv = [a for a in sys.argv if a != "--post"]
+    widths = [float(w) for w in (argv[1] if len(argv) > 1 else "6,10,20,30").split(",")]
+    ranks = int(argv[2]) if len(argv) > 2 else 1
+    quarter = not (len(argv) > 3 and argv[3] == "full")
     os.makedirs(os.path.join(ROOT, "out", "soft_layer"), exist_ok=True)
-    cols, f = {}, None
+    cols, f, walls = {}, None, {}
     for W in widths:
         out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}.h5")
-        run(W, ranks, out)
+        t0 = time.perf_counter()
+        if not post:
+            run(W, ranks, out, quarter=quarter)
+        walls[W] = time.perf_counter() - t0
         f, tf = transfer(out)
         cols[W] = tf
     keep = f <= 40.0                      # 6 bricks and 10 steps per wavelength and period of the layer
     f = f[keep]
+    print("| W [m] | W/H [-] | t_edge = t0 + W / 2 c_s [s] | max \\|v - v_1D\\| / max \\|v_1D\\|, t <= t_edge [-] | "
+          "the same, whole run [-] | rms v / rms v_1D after t_edge [-] |")
+    print("|---|---|---|---|---|---|")
+    hist = {}
+    for W in widths:
+        out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}.h5")
+        hist[W] = time_histories(out)
+        e_edge, e_all, rms = window_errors(out, W)
+        print(f"| {W:g} | {W / H:g} | {edge_time(W, hist[W][3]):.4f} | {e_edge:.3f} | {e_all:.3f} | {rms:.2f} |")
+    t = hist[widths[0]][0]
+    np.savetxt(os.path.join(HERE, "soft_layer_time.csv"),
+               np.column_stack([t] + [hist[W][1] for W in widths] + [hist[widths[-1]][2]]), delimiter=",",
+               header="t_s," + ",".join(f"vx_W{W:g}m_m_per_s" for W in widths) + ",vx_1D_m_per_s", comments="", fmt="%.6g")
     table = np.column_stack([f] + [cols[W][keep] for W in widths] + [one_d(f)])
     head = "f_Hz," + ",".join(f"TF_W{W:g}m_1" for W in widths) + ",TF_1D_1"
     np.savetxt(os.path.join(HERE, "soft_layer.csv"), table, delimiter=",", header=head, comments="", fmt="%.6g")
@@ -104,7 +214,7 @@ def main():
         k = int(np.argmax(tf))
         fr = F0 * np.sqrt(1 + 2 * (2 * H / W) ** 2)
         print(f"W = {W:g} m (W/H = {W / H:g}): peak {tf[k]:.3f} at {f[k]:.2f} Hz; rigid-walled box's first mode "
-              f"{fr:.2f} Hz")
+              f"{fr:.2f} Hz; run {walls[W]:.1f} s on {ranks} rank(s), {'quarter' if quarter else 'whole'} model")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -121,6 +231,21 @@ def main():
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(os.path.join(HERE, "soft_layer.png"), dpi=120)
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for W in widths:
+        tw, box, one, t0 = hist[W]
+        ax.plot(tw, 1e3 * box, lw=1, label=f"box W = {W:g} m")
+        ax.axvline(edge_time(W, t0), ls=":", lw=0.8, color=ax.lines[-1].get_color())
+    ax.plot(tw, 1e3 * one, "k--", lw=1.2, label="1D layer on the half-space")
+    ax.set_xlim(0, 0.25)
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("v_x, surface centre [mm/s]")
+    ax.set_title("soft layer in a box under vertical S: the centre against the 1D layer (low-passed 25-40 Hz)\n"
+                 "dotted: t0 + W / 2 c_s, the earliest the walls' waves reach the centre", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "soft_layer_time.png"), dpi=120)
 
 
 if __name__ == "__main__":
