@@ -7,9 +7,10 @@ the footing (B = a = b = 1 m) gets a rigid translation h(t) u0 with h a smooth s
 transient run records the soil's resultant R on it, K(omega) = FFT(dR) / FFT(dh) (the traction's
 half-step shift applied), K0 = R / h at the last step, and K = K0 [k(a0) + i a0 c(a0)],
 a0 = omega B / c_s, each curve normalised by its own K0. The embedded footing is the pit's walls and
-bottom (``-ssi_mesh pit``, depth D) moved rigidly (``-ssi_disp_group pit``), meshed whole (the pit takes
-no symmetry planes yet); the surface footing is the flat grid's patch on the same ground, with the
-quarter model its mode allows (the same answer to 1e-6: tests/bem/test_impedance.py).
+bottom (``-ssi_mesh pit``, depth D) moved rigidly (``-ssi_disp_group pit``); the surface footing is the flat
+grid's patch on the same ground; both on the quarter model the mode allows (``MODES``: the same answer as the
+whole model, to 1e-6 on the surface, tests/bem/test_impedance.py, and to 1e-9 in the pit's static stiffness,
+tests/bem/test_embedded_footing.py; ``quarter=False`` runs the embedded footing whole).
 
 The references, in the same normalisation (each by its own static stiffness):
     surface   k = alpha_j (Table 2-3a), c = the bracket of beta_j (2 alpha beta / a0)
@@ -19,8 +20,9 @@ The references, in the same normalisation (each by its own static stiffness):
 The trusted band of a0 is the impedance command's: two frequency bins of the record, one Rayleigh
 wavelength across the ground, four elements per shear wavelength and omega dt <= 0.3.
 
-``python runs/embedment/dynamic_stiffness.py [OUT.csv] [h] [L]`` writes the CSV (units in the headers),
-OUT.png, and prints the table at a0 = 0.5, 1, 1.5, 2 as Markdown (runs/embedment/README.md);
+``python runs/embedment/dynamic_stiffness.py [OUT.csv] [h] [L] [D,D,...]`` (depths D/B, default 0.5,1) writes
+the CSV (units in the headers), OUT.png, and prints the table at a0 = 0.5, 1, 1.5, 2 as Markdown
+(runs/embedment/README.md);
 ``python runs/embedment/dynamic_stiffness.py --summary FILE.csv`` prints the ratios the README quotes."""
 import csv
 import math
@@ -97,15 +99,30 @@ def embedment_ref(mode, D_B=0.5):
     return ir.pais_kausel_embedment(mode, D_B, 1.0)
 
 
-def curves(h=0.5, L=8.0, D=0.5, dt=4.75e-4, t_end=0.1, modes=tuple(MODES), out="dyn.h5"):
-    """{(footing, mode): (a0, k, c, K0, k_ref, c_ref)} for the surface and the embedded footing."""
+def embedded(D):
+    """The footing's name in the results of ``curves`` for the embedment D/B = D."""
+    return f"embedded D/B = {D:g}"
+
+
+def depth(name):
+    """D/B of a footing name of ``curves`` (0 for the surface)."""
+    return float(name.split("=")[1]) if name.startswith("embedded") else 0.0
+
+
+def curves(h=0.5, L=8.0, depths=(0.5,), dt=4.75e-4, t_end=0.1, modes=tuple(MODES), out="dyn.h5", quarter=True):
+    """{(footing, mode): (a0, k, c, K0, k_ref, c_ref)} for the surface footing ("surface") and the footing
+    embedded D/B = D for each of ``depths`` (``embedded(D)``)."""
     flat = dict(mesh_size=f"{L},{L}", mesh_h=h, mesh_patch="1,1", disp_group="load")
-    pit = dict(mesh="pit", mesh_params=f"a=1,b=1,d={D}", mesh_size=f"{L},{L}", mesh_h=h, disp_group="pit")
     res = {}
     for mode in modes:
-        for name, mesh, D_B in (("surface", dict(flat, symmetry=MODES[mode][2]), 0.0), ("embedded", pit, D)):
+        sym = dict(symmetry=MODES[mode][2])
+        cases = [("surface", dict(flat, **sym))]
+        for D in depths:
+            pit = dict(mesh="pit", mesh_params=f"a=1,b=1,d={D}", mesh_size=f"{L},{L}", mesh_h=h, disp_group="pit")
+            cases.append((embedded(D), dict(pit, **sym) if quarter else pit))
+        for name, mesh in cases:
             a0, k, c, K0 = impedance(mesh, mode, dt, t_end, out)
-            res[(name, mode)] = (a0, k, c, K0) + tuple(references(mode, a0, D_B))
+            res[(name, mode)] = (a0, k, c, K0) + tuple(references(mode, a0, depth(name)))
     return res
 
 
@@ -116,17 +133,18 @@ def at(a0, y, x):
     return float(np.interp(x, a0, y))
 
 
-def plot(res, png, lohi, D):
+def plot(res, png, lohi):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     modes = sorted({m for _, m in res}, key=list(MODES).index)
     fig, ax = plt.subplots(2, len(modes), figsize=(5 * len(modes), 6.5), squeeze=False)
     for j, mode in enumerate(modes):
-        for name, col in (("surface", "C0"), ("embedded", "C3")):
+        names = [n for n, m in res if m == mode]
+        for name, col in zip(names, ("C0", "C3", "C2", "C1")):
             a0, k, c, K0, kr, cr = res[(name, mode)]
             sel = a0 <= 3.0
-            lab = "surface" if name == "surface" else f"embedded D/B = {D:g}"
+            lab = name
             ax[0, j].plot(a0[sel], k[sel], color=col, label=f"BEM {lab}")
             ax[0, j].plot(a0[sel], kr[sel], "--", color=col, label=f"Pais & Kausel {lab}")
             ax[1, j].plot(a0[sel], c[sel], color=col, label=f"BEM {lab}")
@@ -144,30 +162,33 @@ def plot(res, png, lohi, D):
 
 
 def summary(path, lo=0.72, hi=1.997):
-    """From a CSV this script wrote: per mode over lo <= a0 <= hi, the ranges of the embedded c over Table
-    2-3b's - 1, the embedded over the surface footing's c, the same of the dashpots K0 c (K0 included), the
-    largest |k_embedded - k_surface|, and the surface c over Table 2-3a's - 1."""
+    """From a CSV this script wrote: per embedded footing and mode over lo <= a0 <= hi, the ranges of the
+    embedded c over Table 2-3b's - 1, the embedded over the surface footing's c, the same of the dashpots K0 c
+    (K0 included), the largest |k_embedded - k_surface|, and the surface c over Table 2-3a's - 1."""
     with open(path) as fh:
         rows = list(csv.DictReader(fh))
     out = {}
-    for mode in MODES:
-        d = {}
-        for f in ("surface", "embedded"):
-            r = [x for x in rows if x["footing"] == f and x["mode"] == mode]
-            col = {k: np.array([float(x[k]) for x in r]) for k in ("a0 [-]", "k [-]", "c [-]", "c_PK [-]")}
-            d[f] = col, float(r[0]["K0 [N/m]"])
-        (e, Ke), (s_, Ks) = d["embedded"], d["surface"]
-        a0 = e["a0 [-]"]
-        sel = (a0 >= lo) & (a0 <= hi)
-        cs = np.interp(a0[sel], s_["a0 [-]"], s_["c [-]"])
-        ks = np.interp(a0[sel], s_["a0 [-]"], s_["k [-]"])
-        ss = (s_["a0 [-]"] >= lo) & (s_["a0 [-]"] <= hi)
-        rng = lambda v: (float(v.min()), float(v.max()))  # noqa: E731
-        out[mode] = {"c_emb/c_PK - 1": rng(e["c [-]"][sel] / e["c_PK [-]"][sel] - 1),
-                     "c_emb/c_sur": rng(e["c [-]"][sel] / cs), "C_emb/C_sur": rng(Ke * e["c [-]"][sel] / (Ks * cs)),
-                     "max |k_emb - k_sur|": float(np.abs(e["k [-]"][sel] - ks).max()),
-                     "c_sur/c_PK - 1": rng(s_["c [-]"][ss] / s_["c_PK [-]"][ss] - 1)}
-        print(mode, ", ".join(f"{k} {v if isinstance(v, float) else v}" for k, v in out[mode].items()))
+    names = [n for n in dict.fromkeys(x["footing"] for x in rows) if n != "surface"]
+    for name in names:
+        for mode in MODES:
+            d = {}
+            for f in ("surface", name):
+                r = [x for x in rows if x["footing"] == f and x["mode"] == mode]
+                col = {k: np.array([float(x[k]) for x in r]) for k in ("a0 [-]", "k [-]", "c [-]", "c_PK [-]")}
+                d[f] = col, float(r[0]["K0 [N/m]"])
+            (e, Ke), (s_, Ks) = d[name], d["surface"]
+            a0 = e["a0 [-]"]
+            sel = (a0 >= lo) & (a0 <= hi)
+            cs = np.interp(a0[sel], s_["a0 [-]"], s_["c [-]"])
+            ks = np.interp(a0[sel], s_["a0 [-]"], s_["k [-]"])
+            ss = (s_["a0 [-]"] >= lo) & (s_["a0 [-]"] <= hi)
+            rng = lambda v: (round(float(v.min()), 3), round(float(v.max()), 3))  # noqa: E731
+            out[(name, mode)] = {"c_emb/c_PK - 1": rng(e["c [-]"][sel] / e["c_PK [-]"][sel] - 1),
+                                 "c_emb/c_sur": rng(e["c [-]"][sel] / cs),
+                                 "C_emb/C_sur": rng(Ke * e["c [-]"][sel] / (Ks * cs)),
+                                 "max |k_emb - k_sur|": round(float(np.abs(e["k [-]"][sel] - ks).max()), 3),
+                                 "c_sur/c_PK - 1": rng(s_["c [-]"][ss] / s_["c_PK [-]"][ss] - 1)}
+            print(name, mode, ", ".join(f"{k} {v}" for k, v in out[(name, mode)].items()))
     return out
 
 
@@ -177,8 +198,9 @@ def main(argv):
     out = argv[1] if len(argv) > 1 else "embedment-dynamic.csv"
     h = float(argv[2]) if len(argv) > 2 else 0.5
     L = float(argv[3]) if len(argv) > 3 else 8.0
-    dt, t_end, D = 4.75e-4, 0.1, 0.5
-    res = curves(h, L, D, dt, t_end, out=out + ".h5")
+    depths = tuple(float(v) for v in (argv[4] if len(argv) > 4 else "0.5,1").split(","))
+    dt, t_end = 4.75e-4, 0.1
+    res = curves(h, L, depths, dt, t_end, out=out + ".h5")
     os.remove(out + ".h5")
     lo, hi = band(h, L, dt, t_end)
     with open(out, "w", newline="") as fh:
@@ -188,7 +210,7 @@ def main(argv):
             for i in range(len(a0)):
                 w.writerow((name, mode, f"{a0[i]:.6g}", f"{k[i]:.6g}", f"{c[i]:.6g}", f"{K0:.6g}", f"{kr[i]:.6g}",
                             f"{cr[i]:.6g}", int(lo <= a0[i] <= hi)))
-    plot(res, os.path.splitext(out)[0] + ".png", (lo, hi), D)
+    plot(res, os.path.splitext(out)[0] + ".png", (lo, hi))
     print(f"h = {h:g} m, ground {L:g} m x {L:g} m, dt = {dt:g} s, t_end = {t_end:g} s; "
           f"trusted a0 in [{lo:.2f}, {hi:.2f}]")
     print("| footing | mode | K0 [N/m] | a0 [-] | k BEM [-] | k P&K [-] | c BEM [-] | c P&K [-] |")
