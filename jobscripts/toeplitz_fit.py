@@ -7,8 +7,9 @@ runs (jobscripts/toeplitz_bench.sh), and print the model against each log.
 Each log's option table rebuilds its set-up in this process (no assembly: the lattice, the interpolation
 plan, the traction window), as `petsc-ssi estimate` does; ``toeplitz.estimate`` is then evaluated with one
 rate at a time to get each term's count, and the rates are fitted by non-negative least squares on
-relative errors: the kernels' build (t_pair_lag, seconds per kernel offset and lag) against the run's
-'kernels ... s', the history sum (event SSI_BEM_History) against the products (1 / r_products), the
+relative errors: the kernels' build per side (t_pair_lag, seconds per H kernel offset and lag, against the
+H side's 'kernels ... s'; g_pair_factor, a G offset's seconds over an H offset's, against the G side's), the
+history sum (event SSI_BEM_History) against the products (1 / r_products), the
 per-step DOF term (t_step_dof) and the per-step FFT-grid term (t_step_grid); r_sums (the interpolated lags'
 weighted states) is kept as it is. Oversubscribed runs are left out. The printed RATES line goes into
 toeplitz.py by hand, with the logs' names and date in its comment.
@@ -48,7 +49,10 @@ def terms(opts, ranks):
     zero = {"r_products": big, "r_sums": big, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 0.0,
             "t_pair_lag": 0.0}
     one = lambda **r: estimate(*args, rates=dict(zero, **r), **kw)
-    return {"pairs": one(t_pair_lag=1.0)[1], "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
+    # the kernels' build per side: H's offsets and lags (glat=None) and G's, unweighted (g_pair_factor 1)
+    pairs_h = estimate(*args, rates=dict(zero, t_pair_lag=1.0), **dict(kw, glat=None))[1]
+    pairs_g = one(t_pair_lag=1.0, g_pair_factor=1.0)[1] - pairs_h
+    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2], "sums": one(r_sums=RATES["r_sums"])[2]}
 
 
@@ -72,22 +76,29 @@ def main(logs, check=False):
         r["solve_s"] = float(m.group(2)) / int(m.group(1)) if m else float("nan")
         runs.append((path, r, terms(opts, int(r["ranks"]))))
     kern = np.array([r["kernels_s"] for _, r, _ in runs], float)
+    kh = np.array([r.get("kernels_h_s", r["kernels_s"]) for _, r, _ in runs], float)
+    kg = np.array([r.get("kernels_g_s", 0.0) for _, r, _ in runs], float)
     hist = np.array([r["history_s"] for _, r, _ in runs], float)
     sums = np.array([t["sums"] for *_, t in runs])
     if check:
-        fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag")}
+        fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
+                                     "g_pair_factor")}
     else:
         A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
         inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
         fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
                "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
-               "t_pair_lag": float(_nnls(np.array([[t["pairs"]] for *_, t in runs]), kern)[0])}
+               "t_pair_lag": float(_nnls(np.array([[t["pairs_h"]] for *_, t in runs]), kh)[0])}
+        # G's offsets against the G side's own seconds (the logs that print them)
+        gsel = [i for i, (*_, t) in enumerate(runs) if t["pairs_g"] > 0 and kg[i] > 0]
+        t_g = float(_nnls(np.array([[runs[i][2]["pairs_g"]] for i in gsel]), kg[gsel])[0]) if gsel else 0.0
+        fit["g_pair_factor"] = t_g / fit["t_pair_lag"] if gsel and fit["t_pair_lag"] > 0 else RATES["g_pair_factor"]
     c, _ = load_constants()
     print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] | a step solve measured / "
           "model [ms] |")
     print("|---|---|---|---|---|---|")
     for (path, r, t), k, h in zip(runs, kern, hist):
-        mk = fit["t_pair_lag"] * t["pairs"]
+        mk = fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
               + fit["t_step_elem"] * t["elem"] + t["sums"])
         ms = 1e3 * bem_solve_seconds(c, int(r["dofs"]) // 3, int(r["ranks"]))

@@ -37,9 +37,14 @@ def row(log):
     m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s\)", text)
     if m:
         r["stored_GB"], r["kernels_s"] = float(m.group(1)), float(m.group(2))
+        r["kernels_h_s"], r["kernels_g_s"] = r["kernels_s"], 0.0
         g = re.search(r"G lags as \d+ kernels on the traction elements' .*?, ([\d.e+-]+) GB\)", text)
         if g:                                   # the G side's kernels and kept transforms (issue 41 G on the store)
             r["stored_GB"] = round(r["stored_GB"] + float(g.group(1)), 4)
+            gs = re.search(r"G lags as \d+ kernels on the traction elements' .*?kernels ([\d.e+-]+) s", text)
+            if gs:                              # kernels_s: both sides' build, as the estimate's kernels
+                r["kernels_g_s"] = float(gs.group(1))
+                r["kernels_s"] = round(r["kernels_s"] + r["kernels_g_s"], 3)
     else:
         m = re.search(r"stored (\S+) GB", text)
         r["stored_GB"] = float(m.group(1)) if m else ""

@@ -157,23 +157,23 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # cost model (``estimate``). The time rates r_products (the history's complex products per rank: the
 # block products' flops over this rate), the per-step work of every rank that is not split over the ranks
 # (t_step_dof a DOF, t_step_grid an FFT grid point, t_step_elem a virtual element: the state's gather, the
-# 27 + 12 transforms and their inputs element by element, images included) and t_pair_lag (seconds per
-# kernel offset and lag of the kernels' integration) are fitted by `python jobscripts/toeplitz_fit.py` to
-# the logs of `PARTS="paper grid site" SITE_SIZES=40 bash jobscripts/quiet.sh bash
-# jobscripts/toeplitz_bench.sh` (2026-11-29, 2 ranks of the 2-core development machine with every other
-# process paused: grids of 24-64 m, the paper's quarter and whole models, the 40 m site): within 20 % of
-# every one of those 7 logs in both kernels and history (the per-element term took the per-step work: the
-# DOF and grid terms came out 0, and without the element term the quarter model, whose transforms read
-# its images, was estimated at half its time). r_sums, the real flops per second of the interpolated lags'
-# weighted states (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's
-# rate of the weighted states over its rate of the exact products, times the idle r_products of the time;
-# median of 3.44, 6.67, 4.69 GFlop/s), is not refitted. fill_bytes: the step matrix's LU factors (MUMPS)
-# per DOF and ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m
-# site's two steps: 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of
-# factors); a G kernel offset costs g_pair_factor H offsets (the displacement kernel's integrals beside the
-# traction kernel's: the 40 m site, 8.58 s for 6 889 G offsets against 19.3 s for 25 281 H offsets: 1.63)
-RATES = {"r_products": 8.48e9, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 1.4e-5, "t_pair_lag": 3.52e-6,
-         "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.6}
+# 27 + 12 transforms and their inputs element by element, images included), t_pair_lag (seconds per H
+# kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
+# displacement kernel's integrals beside the traction kernel's) are fitted by `python
+# jobscripts/toeplitz_fit.py` to the logs of `PARTS="paper grid site" SITE_SIZES=40 SITE_EXACT="" bash
+# jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (2026-11-29 04:41-04:44, 2 ranks of the 2-core
+# development machine with every other process paused: grids of 24-64 m, the paper's quarter and whole
+# models, the 40 m site): kernels within 19 % and history within 23 % of each of those 7 logs. The kernels
+# are fitted per side (the log's H and G seconds; the fit before 2026-11-29 04:40 compared the H side's
+# seconds alone with the model's H + G, which put g_pair_factor at 1.6 and a 625-traction-node patch's
+# kernels at +55 %). r_sums, the real flops per second of the interpolated lags' weighted states
+# (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
+# weighted states over its rate of the exact products, times the idle r_products of the time; median of
+# 3.44, 6.67, 4.69 GFlop/s), is not refitted. fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
+# ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
+# 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
+RATES = {"r_products": 1.13e10, "t_step_dof": 3.86e-7, "t_step_grid": 0.0, "t_step_elem": 9.95e-6,
+         "t_pair_lag": 3.81e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.06}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
