@@ -60,7 +60,7 @@ def _model(opts_file, ranks, extra=(), cores=2):
 
 
 def _stage_count(text, stage, name):
-    sec = text.split(f"--- Event Stage", )
+    sec = text.split("--- Event Stage")
     for s in sec:
         if s.strip().split(":", 1)[-1].strip().startswith(stage):
             m = re.search(rf"^{name}\s+(\d+)", s, re.M)
@@ -211,7 +211,8 @@ def _run_prediction(out):
     return float(m.group(1))
 
 
-@pytest.mark.parametrize("n", [1, 2])
+# slow tier: the two-rank case (14 s); the one-rank case, the same model and code path, stays in make test
+@pytest.mark.parametrize("n", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_the_run_and_the_estimate_predict_the_same_loop(tmp_path, n):
     """Issue 43: the run's own first line and `petsc-ssi estimate` were two code paths (on the demo building
     5.3 s against 2.95 s); now one model (``bem.cost.loop_terms``, the coupling's ``step_seconds``): the

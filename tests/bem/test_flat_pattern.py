@@ -104,10 +104,11 @@ CASES = {        # (options, ranks): every storage the lags have, a G of tractio
 }
 
 
-# the slow tier: the dense storage with a prescribed region at -n 2 stays in make test (the other storages'
-# patterns: the kernels' tests above and test_the_stored_entries_go_through_a_lag_files_aij_and_back)
+# slow tier: every whole run (11-14 s each); make test keeps the patterns' kernels against the full kernels
+# (test_pattern_kernels_give_the_full_kernels_numbers), the split dense and free term
+# (test_split_dense_and_the_free_term_give_the_dense_products) and the lag files' round trip above and below
 SLOW_CASES = ("single precision, symmetry, 2 ranks", "auto storage, prescribed motion, 1 rank",
-              "block-sparse, interpolated, 2 ranks")
+              "block-sparse, interpolated, 2 ranks", "dense, prescribed motion, 2 ranks")
 
 
 @pytest.mark.parametrize("case", [pytest.param(c, marks=[pytest.mark.slow] if c in SLOW_CASES else []) for c in CASES])

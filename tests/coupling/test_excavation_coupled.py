@@ -184,6 +184,9 @@ def test_bad_input_is_refused_in_one_line_on_every_rank(tmp_path, extra, msg):
     assert len(lines) == 1 or len(set(lines)) == 1
 
 
+# slow tier: the 6 m box's quarter model (7 s); the default tier's siblings: the 1D reference below and the
+# filled pit above (the same coupling of a soil region under a wave)
+@pytest.mark.slow
 def test_a_soft_layer_in_a_narrow_box_resonates_as_a_box(tmp_path):
     """runs/soil_region/soft_layer.py at W = 6 m, H = 2 m (its quarter model, -ssi_symmetry x=anti,y=sym): the
     surface centre's transfer function peaks near the rigid-walled box's first mode f0 sqrt(1 + 2 (2H/W)^2) =
