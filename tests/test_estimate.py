@@ -236,3 +236,24 @@ def test_the_run_and_the_estimate_predict_the_same_loop(tmp_path, n):
     assert bem == pytest.approx(row["time_loop_s"] - row["coupling_loop_s"], rel=6e-3, abs=1e-3)
     steps = 8                                     # 0.1 s / 0.0125 s
     assert cpl - 2 * steps * solve == pytest.approx(row["coupling_loop_s"] - 2 * steps * est_solve, rel=0.02, abs=2e-3)
+
+
+def test_the_toeplitz_tables_kernel_seconds_are_both_sides(tmp_path):
+    """jobscripts/toeplitz_table.row: a toeplitz run's kernels_s is the H and G sides' build together (the
+    estimate's 'kernels' prices both); until 2026-11-29 it read the H side's alone, and the rates fitted to it
+    (jobscripts/toeplitz_fit.py) priced a G offset at 1.6 H offsets. The line is a real run's."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from toeplitz_table import row
+    log = tmp_path / "paper-quarter-toeplitz.log"
+    log.write_text(
+        "[ssi] BEM: 324 nine-node elements (1296 with symmetry images), 1369 nodes, 4107 DOFs; 9 traction nodes; "
+        "dt 0.00075 s, 159 steps, scheme stabilized\n[ssi] lag store: toeplitz, 36 x 36 lattice\n"
+        "[ssi] assembly 3.4s: lag store toeplitz on the 36 x 36 lattice of 1 x 1 m elements (FFT grid 54 x 54): "
+        "160 history kernels K'_d in Fourier space (0.683 GB with the kept states' transforms; kernels 3.01 s); G "
+        "lags as 160 kernels on the traction elements' 2 x 2 window (FFT grid 20 x 20, kernels 0.424 s, 0.12 GB), "
+        "step matrix and G lags 1-2 0.0035 GB, 3.35e+07 kernel evaluations\n")
+    r = row(str(log))
+    assert (r["kernels_h_s"], r["kernels_g_s"]) == (3.01, 0.424)
+    assert r["kernels_s"] == pytest.approx(3.434) and r["stored_GB"] == pytest.approx(0.803)
+    assert (r["dofs"], r["steps"], r["store"]) == (4107, 159, "toeplitz")
