@@ -22,8 +22,12 @@ SLOW = {
     "runs/building/ssi-full-unilateral.opts", "runs/building/ssi-full-bonded.opts",
     # the disk's and the rectangle's impedances: the square's stays
     "runs/impedance/disk.opts", "runs/impedance/rectangle.opts",
-    # the antisymmetric foundation cases: anti-unilateral and the symmetric ones stay
+    # the antisymmetric foundation cases: anti-unilateral and the symmetric ones stay; the symmetric bonded
+    # case: the symmetric unilateral and bonded-staggered ones stay
     "runs/foundation/anti-bonded.opts", "runs/foundation/anti-unilateral-cohesive.opts",
+    "runs/foundation/sym-bonded.opts",
+    # the half building bonded: the half building unilateral (the same mesh and soil) stays
+    "runs/building/ssi-half-bonded.opts",
     # the paper's building under a record: the half building's file (same mesh) and the seismic building stay
     "runs/seismic/paper-building.opts",
     # the building on a basement (the pit's BEM assembly, half a minute): runs/basement/surface.opts stays
