@@ -402,7 +402,10 @@ class ToeplitzHistory:
         n_off = len(self.offsets)
         sel = np.arange(r, n_off, p)
         per_lag = 4 * 9 * m * lat.Mx * lat.My * 8
-        kern = sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18))
+        # (the same chunk on every rank: each chunk is one Allreduce, and the ranks' slabs may differ by a
+        # frequency, so their own kernels' bytes may not give the same chunk)
+        from mpi4py import MPI
+        kern = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18)), op=MPI.MAX)
         chunk = max(1, min(lag_hi - lag_lo + 1, int(chunk_bytes(kern) // per_lag)))
         t = self.offsets[:, 2]
         kx = np.mod(self.offsets[:, 3] + lat.in_lo[0], lat.Mx)      # (inputs placed from lattice index in_lo)
