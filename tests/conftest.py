@@ -9,6 +9,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # `make test` runs two pytest workers (pytest-xdist), so two mpiruns may share the 2 cores: their
 # ranks yield in MPI waits instead of spinning against each other (results do not depend on it)
 os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
+# After a rank exits non-zero, OpenMPI's mpirun signals the job's processes and waits
+# odls_base_sigkill_timeout (1 s, twice) before it returns: 2.0 of the 3.7 s of every refused two-rank
+# run (`time mpirun -n 1 python -c "import sys; sys.exit(2)"`: 2.1 s, 0.1 s with 0). The refusal tests
+# (about a hundred) assert the exit status, which mpirun still returns (2); the ranks of a refused run
+# exit by themselves, rank 0 first (app/cli.py), so nothing they print is cut.
+os.environ.setdefault("OMPI_MCA_odls_base_sigkill_timeout", "0")
 # The suite starts about a thousand petsc-ssi processes (mpirun ranks counted). Where the shell sets
 # PYTHONDONTWRITEBYTECODE (this machine and CI's do), each one compiled the ~90 modules it imports from
 # source again: 0.24 s of every start (cProfile of a 3-step run: 102 compile() calls, 2.0 s in all).
