@@ -479,6 +479,8 @@ class ToeplitzHistory:
         self.V18 = np.zeros((self.W, slab, 18), self.vdtype)
         self.base = -self.R
         self._setup_state_maps(march)
+        from ..sysmem import release_freed
+        release_freed()         # the chunks' integrals and spectra, freed into the C heap: not resident in the run
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
@@ -678,7 +680,7 @@ def _spans(C):
     return own
 
 
-def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
+def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=16):
     """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
     weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
     buffers, double or single; real weights on the real and imaginary parts: per span of ``_spans`` one
@@ -711,7 +713,7 @@ def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
     return out
 
 
-def history_products(K9, K18, V9, V18, p0, b, D, fchunk=64):
+def history_products(K9, K18, V9, V18, p0, b, D, fchunk=16):
     """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
     block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c),
     as two matrix products per frequency, (b x 9D)-windows of V9 (z inputs) times K9 (9D x n9) and (b x
