@@ -680,7 +680,7 @@ def _spans(C):
     return own
 
 
-def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=16):
+def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
     """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
     weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
     buffers, double or single; real weights on the real and imaginary parts: per span of ``_spans`` one
@@ -713,7 +713,13 @@ def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=16):
     return out
 
 
-def history_products(K9, K18, V9, V18, p0, b, D, fchunk=16):
+# the history products' window copies, per chunk of frequencies: at most about this many bytes (the
+# largest transient of the time loop; 24 MB a rank on the paper's quarter case when the chunk was 64
+# frequencies of a block, while a single step's products have windows of a few states only)
+WINDOW_BYTES = 8e6
+
+
+def history_products(K9, K18, V9, V18, p0, b, D, fchunk=None):
     """The history sum's products in Fourier space, per frequency f of a slab: for the b steps k of a
     block, sum_d K'_d v^{m}, m the state at row p0 + k + (D - d) of the time-ordered buffers (W, slab, c),
     as two matrix products per frequency, (b x 9D)-windows of V9 (z inputs) times K9 (9D x n9) and (b x
@@ -724,6 +730,8 @@ def history_products(K9, K18, V9, V18, p0, b, D, fchunk=16):
     from numpy.lib.stride_tricks import sliding_window_view
     slab, n9, n18 = K9.shape[0], K9.shape[2], K18.shape[2]
     out = np.empty((slab, b, n9 + n18), np.complex128)
+    if fchunk is None:
+        fchunk = max(1, int(WINDOW_BYTES // (b * 27 * D * 16)))
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
         w9 = sliding_window_view(V9[p0:p0 + b - 1 + D, f0:f1], D, axis=0)      # (b, fc, 9, D)
