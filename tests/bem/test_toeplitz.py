@@ -197,7 +197,7 @@ def test_interp_products_match_the_sum(widths, dtype):
     n9, n18 = widths
     cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
     Axy, Az = cz(slab, 9 * k, n9), cz(slab, 18 * k, n18)
-    Vz, Vxy = cz(W, slab, 9).astype(dtype), cz(W, slab, 18).astype(dtype)
+    Vz, Vxy = cz(slab, W, 9).astype(dtype), cz(slab, W, 18).astype(dtype)
     banded = np.zeros((b, k, 20))
     for j in range(k):
         banded[:, j, 4 * j:4 * j + 6] = rng.standard_normal((b, 6))
@@ -205,8 +205,8 @@ def test_interp_products_match_the_sum(widths, dtype):
     for C, n_spans in ((banded, k), (full, 1)):
         assert len(_spans(C)) == n_spans
         got = interp_products(Axy, Az, Vz, Vxy, C, 5, fchunk=16)
-        Sz = np.einsum("bjm,mfc->fbjc", C, Vz[5:25].astype(np.complex128)).reshape(slab, b, 9 * k)
-        Sxy = np.einsum("bjm,mfc->fbjc", C, Vxy[5:25].astype(np.complex128)).reshape(slab, b, 18 * k)
+        Sz = np.einsum("bjm,fmc->fbjc", C, Vz[:, 5:25].astype(np.complex128)).reshape(slab, b, 9 * k)
+        Sxy = np.einsum("bjm,fmc->fbjc", C, Vxy[:, 5:25].astype(np.complex128)).reshape(slab, b, 18 * k)
         ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)
         assert got.dtype == np.complex128 and np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
 
@@ -222,15 +222,16 @@ def test_history_products_match_the_sum():
     for n9, n18 in ((8, 4), (4, 8)):
         K9, K18 = cz(slab, 9 * D, n9), cz(slab, 18 * D, n18)
         for dtype in (np.complex128, np.complex64):
-            V9, V18 = cz(W, slab, 9).astype(dtype), cz(W, slab, 18).astype(dtype)
+            V9, V18 = cz(slab, W, 9).astype(dtype), cz(slab, W, 18).astype(dtype)
             got = history_products(K9, K18, V9, V18, 3, b, D, fchunk=8)
             ref = np.zeros((slab, b, n9 + n18), np.complex128)
             for k in range(b):
                 for d in range(1, D + 1):
                     row = 3 + k + (D - d)
                     r = D - d
-                    ref[:, k, :n9] += np.einsum("fa,fac->fc", V9[row].astype(np.complex128), K9[:, 9 * r:9 * r + 9])
-                    ref[:, k, n9:] += np.einsum("fa,fac->fc", V18[row].astype(np.complex128),
+                    ref[:, k, :n9] += np.einsum("fa,fac->fc", V9[:, row].astype(np.complex128),
+                                                K9[:, 9 * r:9 * r + 9])
+                    ref[:, k, n9:] += np.einsum("fa,fac->fc", V18[:, row].astype(np.complex128),
                                                 K18[:, 18 * r:18 * r + 18])
             assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), (n9, dtype)
 

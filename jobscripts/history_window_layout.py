@@ -1,0 +1,61 @@
+"""A/B of the toeplitz history products' window copies (issue 41): the kept states' transforms
+time-major (W, slab, c), each step's window gathered by ``sliding_window_view`` (the code before
+the change), against frequency-major (slab, W, c), each window one contiguous run of states
+(``bem.toeplitz.history_products`` now). The sizes of one rank's block on the paper's quarter
+case at 2 ranks (slab 756 frequencies, D = 160 lags, blocks of 8 steps, H's output widths 8 and
+4); both give the same numbers (checked, the largest difference printed). One BLAS thread.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python jobscripts/history_window_layout.py [REPEATS]
+"""
+import os
+import sys
+import time
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from petsc_ssi.bem.toeplitz import WINDOW_BYTES, history_products  # noqa: E402
+
+SLAB, D, B, W, N9, N18 = 756, 160, 8, 192, 8, 4
+
+
+def time_major(K9, K18, V9, V18, p0, b, D, fchunk):
+    """The history products as they were: time-major buffers, windows gathered."""
+    slab = K9.shape[0]
+    out = np.empty((slab, b, N9 + N18), np.complex128)
+    for f0 in range(0, slab, fchunk):
+        f1 = min(slab, f0 + fchunk)
+        w9 = sliding_window_view(V9[p0:p0 + b - 1 + D, f0:f1], D, axis=0)
+        w18 = sliding_window_view(V18[p0:p0 + b - 1 + D, f0:f1], D, axis=0)
+        a9 = np.ascontiguousarray(w9.transpose(1, 0, 3, 2), dtype=np.complex128).reshape(f1 - f0, b, 9 * D)
+        a18 = np.ascontiguousarray(w18.transpose(1, 0, 3, 2), dtype=np.complex128).reshape(f1 - f0, b, 18 * D)
+        np.matmul(a9, K9[f0:f1], out=out[f0:f1, :, :N9])
+        np.matmul(a18, K18[f0:f1], out=out[f0:f1, :, N9:])
+    return out
+
+
+def main(repeats=5):
+    rng = np.random.default_rng(0)
+    K9 = rng.standard_normal((SLAB, 9 * D, N9)) + 0j
+    K18 = rng.standard_normal((SLAB, 18 * D, N18)) + 0j
+    V9 = rng.standard_normal((SLAB, W, 9)) + 1j * rng.standard_normal((SLAB, W, 9))
+    V18 = rng.standard_normal((SLAB, W, 18)) + 1j * rng.standard_normal((SLAB, W, 18))
+    T9, T18 = np.ascontiguousarray(V9.transpose(1, 0, 2)), np.ascontiguousarray(V18.transpose(1, 0, 2))
+    fchunk = max(1, int(WINDOW_BYTES // (B * 27 * D * 16)))
+    print(f"| round | time-major, gathered windows [ms] | frequency-major, contiguous windows [ms] | largest difference [-] |")
+    print("|---|---|---|---|")
+    for r in range(3):
+        t = time.perf_counter()
+        for _ in range(repeats):
+            a = time_major(K9, K18, T9, T18, 10, B, D, fchunk)
+        t_old = (time.perf_counter() - t) / repeats
+        t = time.perf_counter()
+        for _ in range(repeats):
+            n = history_products(K9, K18, V9, V18, 10, B, D)
+        t_new = (time.perf_counter() - t) / repeats
+        print(f"| {r + 1} | {1e3 * t_old:.0f} | {1e3 * t_new:.0f} | {np.abs(a - n).max() / np.abs(a).max():.1e} |")
+
+
+if __name__ == "__main__":
+    main(*(int(a) for a in sys.argv[1:2]))
