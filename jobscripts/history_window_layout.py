@@ -43,7 +43,7 @@ def main(repeats=5):
     V18 = rng.standard_normal((SLAB, W, 18)) + 1j * rng.standard_normal((SLAB, W, 18))
     T9, T18 = np.ascontiguousarray(V9.transpose(1, 0, 2)), np.ascontiguousarray(V18.transpose(1, 0, 2))
     fchunk = max(1, int(WINDOW_BYTES // (B * 27 * D * 16)))
-    print(f"| round | time-major, gathered windows [ms] | frequency-major, contiguous windows [ms] | largest difference [-] |")
+    print("| round | time-major, gathered windows [ms] | frequency-major, contiguous windows [ms] | largest difference [-] |")
     print("|---|---|---|---|")
     for r in range(3):
         t = time.perf_counter()
