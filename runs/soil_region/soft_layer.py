@@ -16,10 +16,21 @@ the layer's surface centre and of the free-surface velocity of the half-space (t
 
 so a narrow box resonates higher than the 1D layer and tends to it as W/H grows.
 
-Run: python runs/soil_region/soft_layer.py [W1,W2,...] [ranks] [full] [--post]   (default 6,10,20,30, 1 rank,
-quarter models; --post: read the outputs of an earlier run instead of running)
-Writes soft_layer.csv (frequency [Hz], |TF| per width [1], the 1D |TF| [1]) and soft_layer.png beside this
-file, and prints each width's peak (frequency, amplitude) beside the estimates above.
+With --damping=Z the layer's bricks carry stiffness-proportional damping C = a1 K of ratio Z at the
+layer's frequency f0 (-ssi_fem_rayleigh 0,a1, a1 = 2 Z / (2 pi f0): the ratio grows as f / f0), the
+half-space stays elastic, and the 1D reference is the same damped layer: its wave number and impedance
+with the complex modulus G1 (1 + i omega a1) (``one_d``; checked against the damped 1D finite element
+column, ``one_d_column``). No mass-proportional term: in a region of total motion under seismic input
+a0 M would damp the ground's own motion (the layer's rigid translation against a fixed frame: the 1D
+layer's ratio then falls to 1 / (1 + a0 rho1 H / (rho c_s)) at low frequency, tried with Z at 10 and 40
+Hz). The waves the walls send in die out as they cross the layer, as exp(-Z k x) near f0, so the box's
+centre can tend to the 1D layer as W grows, which the elastic layer's trapped waves prevent.
+
+Run: python runs/soil_region/soft_layer.py [W1,W2,...] [ranks] [full] [--post] [--damping=Z]   (default
+6,10,20,30, 1 rank, quarter models, elastic; --post: read the outputs of an earlier run instead of running)
+Writes soft_layer.csv (frequency [Hz], |TF| per width [1], the 1D |TF| [1]), soft_layer.png, and the time
+histories soft_layer_time.csv/png beside this file (soft_layer_zZ*.csv/png with --damping=Z), and prints
+each width's peak (frequency, amplitude) beside the estimates above.
 """
 import os
 import subprocess
@@ -39,16 +50,23 @@ ALPHA = RHO1 * CS1 / (RHO * CS)
 F0 = CS1 / (4 * H)
 
 
+def rayleigh(zeta):
+    """(a0 [1/s], a1 [s]) of the layer's damping C = a0 M + a1 K: stiffness-proportional, ratio zeta at f0
+    (a0 = 0; module docstring)."""
+    return 0.0, 2.0 * zeta / (2 * np.pi * F0)
+
+
 def record(path):
     """The 10 ms sin^4 acceleration pulse and its reverse (zero net velocity), 1 m/s^2 [table 't a']: the
     record of runs/seismic/input_motion.py."""
     return input_motion.pulse(path, PULSE)
 
 
-def run(W, ranks, out, quarter=True, command="run"):
+def run(W, ranks, out, quarter=True, command="run", zeta=0.0):
     """The coupled run of a box of width W [m]: soil elements 1 m, bricks 0.5 m, ground W + 6 m wide.
     quarter: the quarter model x >= 0, y >= 0 (-ssi_symmetry x=anti,y=sym: the wave moves the ground in x,
-    so the plane x = 0 is one of antisymmetry and y = 0 one of symmetry), 1/16 of the whole model's lags."""
+    so the plane x = 0 is one of antisymmetry and y = 0 one of symmetry), 1/16 of the whole model's lags.
+    zeta: the layer's Rayleigh damping ratio at F_DAMP (module docstring)."""
     n = int(round(2 * W))
     box = ([f"{n // 2},{n // 2},{int(2 * H)}", f"{W / 2},{W / 2},{H}", f"0,0,{-H}", "xmax,ymax,base"] if quarter
            else [f"{n},{n},{int(2 * H)}", f"{W},{W},{H}", f"{-W / 2},{-W / 2},{-H}", "xmin,xmax,ymin,ymax,base"])
@@ -64,6 +82,8 @@ def run(W, ranks, out, quarter=True, command="run"):
             "-ssi_output_stride", "0", "-ssi_warn_beta", "0", "-ssi_monitor"]
     if quarter:
         args += ["-ssi_symmetry", "x=anti,y=sym"]
+    if zeta:
+        args += ["-ssi_fem_rayleigh", "{:.17g},{:.17g}".format(*rayleigh(zeta))]
     cmd = [sys.executable] + args
     if ranks > 1:
         cmd = ["mpirun", "--allow-run-as-root", "-n", str(ranks)] + cmd
@@ -85,29 +105,38 @@ def transfer(out, nfft_factor=4):
         return np.fft.rfftfreq(n, dt), np.abs(V / Vff)
 
 
-def one_d(f, complex_=False):
+def one_d(f, complex_=False, zeta=0.0):
     """|U_top / U_outcrop| of the 1D layer (module docstring); complex_: the complex ratio to the outcrop
     motion at the ground surface z = 0 (the record's), e^(+i omega t) as numpy's inverse transform: the
     textbook ratio references the outcrop at the layer's base (its incident wave's phase at z = -H), so the
-    surface outcrop's ratio carries e^(i omega H / c_s) (the half-space's wave reaches z = 0 H/c_s later)."""
-    k = 2 * np.pi * f / CS1
-    r = 1.0 / (np.cos(k * H) + 1j * ALPHA * np.sin(k * H))
-    return r * np.exp(2j * np.pi * f * H / CS) if complex_ else np.abs(r)
+    surface outcrop's ratio carries e^(i omega H / c_s) (the half-space's wave reaches z = 0 H/c_s later).
+    zeta: the layer's Rayleigh damping (``rayleigh``): rho1 (u'' + a0 u') = G1 (1 + a1 d/dt) u_zz gives
+    k^2 = (omega / c_s1)^2 (1 - i a0 / omega) / (1 + i omega a1) and the impedance k G1 (1 + i omega a1) /
+    omega in place of rho1 c_s1 (either root of k: the ratio is even in it)."""
+    a0, a1 = rayleigh(zeta)
+    w = 2 * np.pi * np.asarray(f, float)
+    ws = np.where(w > 0, w, 1.0)                         # (f = 0: the layer moves with the outcrop)
+    k = w / CS1 * np.sqrt((1 - 1j * a0 / ws) / (1 + 1j * w * a1)) if zeta else w / CS1 + 0j
+    alpha = k * RHO1 * CS1 ** 2 * (1 + 1j * w * a1) / (ws * RHO * CS) if zeta else ALPHA
+    r = np.where(w > 0, 1.0 / (np.cos(k * H) + 1j * alpha * np.sin(k * H)), 1.0)
+    return r * np.exp(1j * w * H / CS) if complex_ else np.abs(r)
 
 
-def one_d_column(t_end, outcrop, ne=100, dt=2e-5):
+def one_d_column(t_end, outcrop, ne=100, dt=2e-5, zeta=0.0):
     """An independent check of ``one_d(complex_=True)``: the 1D layer as ne linear finite elements on the
     half-space's exact 1D boundary (a dashpot rho c_s at the base loaded by 2 rho c_s v_inc, the incident
     velocity at the base v_inc(t) = v_outcrop(t + H/c_s) / 2), Newmark's average acceleration at dt.
-    ``outcrop(t)``: the outcrop (free surface) displacement [m]. Returns (t [s], u_x at the top [m])."""
+    ``outcrop(t)``: the outcrop (free surface) displacement [m]; zeta: the layer's Rayleigh damping a0 M + a1 K
+    (``rayleigh``). Returns (t [s], u_x at the top [m])."""
     h = H / ne
     n = ne + 1
     K, M = np.zeros((n, n)), np.zeros((n, n))
     for e in range(ne):
         K[e:e + 2, e:e + 2] += RHO1 * CS1 ** 2 / h * np.array([[1.0, -1.0], [-1.0, 1.0]])
         M[e:e + 2, e:e + 2] += RHO1 * h / 6 * np.array([[2.0, 1.0], [1.0, 2.0]])
-    C = np.zeros((n, n))
-    C[0, 0] = RHO * CS                                 # node 0 at the base
+    a0, a1 = rayleigh(zeta)
+    C = a0 * M + a1 * K
+    C[0, 0] += RHO * CS                                # node 0 at the base
     nt = int(round(t_end / dt))
     t = np.arange(nt + 1) * dt
     vo = np.gradient(outcrop(t), dt)
@@ -136,11 +165,11 @@ def lowpass(f, f1=25.0, f2=40.0):
     return w
 
 
-def time_histories(out, nfft_factor=16):
+def time_histories(out, nfft_factor=16, zeta=0.0):
     """(t [s], v_x at the layer's surface centre [m/s], the 1D layer's v_x for the same outcrop motion [m/s],
     the record's time origin t0 [s]), both low-passed by ``lowpass`` (velocities: the record's displacement
     keeps a permanent offset); the 1D one exact in the frequency domain (``one_d(complex_=True)``,
-    zero-padded 16 x: its reverberation has died out before it wraps)."""
+    zero-padded 16 x: its reverberation has died out before it wraps; zeta: the layer's damping, ``one_d``)."""
     import h5py
     with h5py.File(out.replace(".h5", "_structure.h5")) as fs, h5py.File(out) as f:
         t, u = fs["receivers/t"][:], fs["receivers/u"][:, 0, 0]
@@ -152,7 +181,7 @@ def time_histories(out, nfft_factor=16):
     dt = t[1] - t[0]
     v, vff = np.gradient(u, dt), np.gradient(uff, dt)
     box = np.fft.irfft(np.fft.rfft(v, n) * w, n)[:len(t)]
-    one = np.fft.irfft(np.fft.rfft(vff, n) * one_d(fr, True) * w, n)[:len(t)]
+    one = np.fft.irfft(np.fft.rfft(vff, n) * one_d(fr, True, zeta) * w, n)[:len(t)]
     return t, box, one, t0
 
 
@@ -163,10 +192,10 @@ def edge_time(W, t0):
     return t0 + 0.5 * W / CS
 
 
-def window_errors(out, W):
+def window_errors(out, W, zeta=0.0):
     """(max |v_box - v_1D| / max |v_1D| for t <= edge_time, the same over the whole run, rms of v_box /
     rms of v_1D after edge_time) of ``time_histories``."""
-    t, box, one, t0 = time_histories(out)
+    t, box, one, t0 = time_histories(out, zeta=zeta)
     te = edge_time(W, t0)
     e = np.abs(box - one) / np.abs(one).max()
     late = t > te
@@ -176,17 +205,20 @@ def window_errors(out, W):
 
 def main():
     post = "--post" in sys.argv           # the outputs of an earlier run of this script, not run again
-    argv = [a for a in sys.argv if a != "--post"]
+    zeta = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--damping=")), 0.0))
+    argv = [a for a in sys.argv if a != "--post" and not a.startswith("--damping=")]
+    tag = f"-z{zeta:g}" if zeta else ""
+    name = f"soft_layer_z{zeta:g}" if zeta else "soft_layer"
     widths = [float(w) for w in (argv[1] if len(argv) > 1 else "6,10,20,30").split(",")]
     ranks = int(argv[2]) if len(argv) > 2 else 1
     quarter = not (len(argv) > 3 and argv[3] == "full")
     os.makedirs(os.path.join(ROOT, "out", "soft_layer"), exist_ok=True)
     cols, f, walls = {}, None, {}
     for W in widths:
-        out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}.h5")
+        out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}{tag}.h5")
         t0 = time.perf_counter()
         if not post:
-            run(W, ranks, out, quarter=quarter)
+            run(W, ranks, out, quarter=quarter, zeta=zeta)
         walls[W] = time.perf_counter() - t0
         f, tf = transfer(out)
         cols[W] = tf
@@ -197,23 +229,28 @@ def main():
     print("|---|---|---|---|---|---|")
     hist = {}
     for W in widths:
-        out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}.h5")
-        hist[W] = time_histories(out)
-        e_edge, e_all, rms = window_errors(out, W)
+        out = os.path.join(ROOT, "out", "soft_layer", f"W{W:g}{tag}.h5")
+        hist[W] = time_histories(out, zeta=zeta)
+        e_edge, e_all, rms = window_errors(out, W, zeta)
         print(f"| {W:g} | {W / H:g} | {edge_time(W, hist[W][3]):.4f} | {e_edge:.3f} | {e_all:.3f} | {rms:.2f} |")
     t = hist[widths[0]][0]
-    np.savetxt(os.path.join(HERE, "soft_layer_time.csv"),
+    np.savetxt(os.path.join(HERE, f"{name}_time.csv"),
                np.column_stack([t] + [hist[W][1] for W in widths] + [hist[widths[-1]][2]]), delimiter=",",
                header="t_s," + ",".join(f"vx_W{W:g}m_m_per_s" for W in widths) + ",vx_1D_m_per_s", comments="", fmt="%.6g")
-    table = np.column_stack([f] + [cols[W][keep] for W in widths] + [one_d(f)])
+    table = np.column_stack([f] + [cols[W][keep] for W in widths] + [one_d(f, zeta=zeta)])
     head = "f_Hz," + ",".join(f"TF_W{W:g}m_1" for W in widths) + ",TF_1D_1"
-    np.savetxt(os.path.join(HERE, "soft_layer.csv"), table, delimiter=",", header=head, comments="", fmt="%.6g")
-    print(f"1D: peak {1 / ALPHA:.3f} at f0 = c_s1/4H = {F0:.2f} Hz (alpha = {ALPHA:.3f})")
+    np.savetxt(os.path.join(HERE, f"{name}.csv"), table, delimiter=",", header=head, comments="", fmt="%.6g")
+    one = one_d(f, zeta=zeta)
+    print(f"1D: peak {one.max():.3f} at {f[np.argmax(one)]:.2f} Hz; elastic: {1 / ALPHA:.3f} at f0 = c_s1/4H = "
+          f"{F0:.2f} Hz (alpha = {ALPHA:.3f})" + (f"; layer damped a1 K, {zeta:g} at f0 (a1 = {rayleigh(zeta)[1]:.4g} s)"
+                                                     if zeta else ""))
     for W in widths:
         tf = cols[W][keep]
         k = int(np.argmax(tf))
         fr = F0 * np.sqrt(1 + 2 * (2 * H / W) ** 2)
-        print(f"W = {W:g} m (W/H = {W / H:g}): peak {tf[k]:.3f} at {f[k]:.2f} Hz; rigid-walled box's first mode "
+        dev = np.abs(tf - one)[f <= 35.0].max() / one.max()
+        print(f"W = {W:g} m (W/H = {W / H:g}): peak {tf[k]:.3f} at {f[k]:.2f} Hz ({tf[k] / one.max() - 1:+.1%} of the "
+              f"1D peak); max |TF - TF_1D| up to 35 Hz {dev:.1%} of the 1D peak; rigid-walled box's first mode "
               f"{fr:.2f} Hz; run {walls[W]:.1f} s on {ranks} rank(s), {'quarter' if quarter else 'whole'} model")
     import matplotlib
     matplotlib.use("Agg")
@@ -222,15 +259,16 @@ def main():
     for W in widths:
         ax.plot(f, cols[W][keep], label=f"box W = {W:g} m, H = {H:g} m (FEM soil region on the BEM half-space)")
         ax.axvline(F0 * np.sqrt(1 + 2 * (2 * H / W) ** 2), ls=":", lw=0.8, color=ax.lines[-1].get_color())
-    ax.plot(f, one_d(f), "k--", label="1D layer on the half-space (infinitely wide)")
+    ax.plot(f, one_d(f, zeta=zeta), "k--", label="1D layer on the half-space (infinitely wide)")
     ax.set_xlabel("frequency f [Hz]")
     ax.set_ylabel("|V_surface centre / V_free surface| [1]")
-    ax.set_title(f"soft layer (c_s1 = {CS1:g} m/s) on the half-space (c_s = {CS:g} m/s), vertical S\n"
+    damp = f", damping a1 K: {zeta:g} at f0" if zeta else ""
+    ax.set_title(f"soft layer (c_s1 = {CS1:g} m/s{damp}) on the half-space (c_s = {CS:g} m/s), vertical S\n"
                  "dotted: the rigid-walled box's first mode", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(os.path.join(HERE, "soft_layer.png"), dpi=120)
+    fig.savefig(os.path.join(HERE, f"{name}.png"), dpi=120)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for W in widths:
         tw, box, one, t0 = hist[W]
@@ -240,12 +278,13 @@ def main():
     ax.set_xlim(0, 0.25)
     ax.set_xlabel("time t [s]")
     ax.set_ylabel("v_x, surface centre [mm/s]")
-    ax.set_title("soft layer in a box under vertical S: the centre against the 1D layer (low-passed 25-40 Hz)\n"
-                 "dotted: t0 + W / 2 c_s, the earliest the walls' waves reach the centre", fontsize=9)
+    ax.set_title(f"soft layer in a box under vertical S{damp}: the centre against the 1D layer\n"
+                 "(low-passed 25-40 Hz); dotted: t0 + W / 2 c_s, the earliest the walls' waves reach the centre",
+                 fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(os.path.join(HERE, "soft_layer_time.png"), dpi=120)
+    fig.savefig(os.path.join(HERE, f"{name}_time.png"), dpi=120)
 
 
 if __name__ == "__main__":
