@@ -61,27 +61,26 @@ def interp_time_major(A9, A18, V9, V18, C, r0, fchunk=64):
     return out
 
 
-def interp_ab(repeats=2):
-    slab, k, b, R = 3780, 20, 8, 207
-    W = R + 32
-    rng = np.random.default_rng(1)
-    A9 = rng.standard_normal((slab, 9 * k, N9)) + 0j
-    A18 = rng.standard_normal((slab, 18 * k, N18)) + 0j
+def states(rng, slab, W):
+    """Random kept transforms (slab, W, 9) and (slab, W, 18), frequency-major, and their time-major copies."""
     V9 = rng.standard_normal((slab, W, 9)) + 1j * rng.standard_normal((slab, W, 9))
     V18 = rng.standard_normal((slab, W, 18)) + 1j * rng.standard_normal((slab, W, 18))
-    T9, T18 = np.ascontiguousarray(V9.transpose(1, 0, 2)), np.ascontiguousarray(V18.transpose(1, 0, 2))
-    C = rng.standard_normal((b, k, R))
-    print()
-    print("| round | weighted states, time-major [ms] | weighted states, frequency-major [ms] | largest difference [-] |")
+    return V9, V18, np.ascontiguousarray(V9.transpose(1, 0, 2)), np.ascontiguousarray(V18.transpose(1, 0, 2))
+
+
+def ab(what, old, new, repeats):
+    """Three rounds of ``old()`` (time-major) against ``new()`` (frequency-major): a markdown table of
+    their mean seconds and the largest difference of their results."""
+    print(f"| round | {what}, time-major [ms] | {what}, frequency-major [ms] | largest difference [-] |")
     print("|---|---|---|---|")
     for r in range(3):
         t = time.perf_counter()
         for _ in range(repeats):
-            a = interp_time_major(A9, A18, T9, T18, C, 5)
+            a = old()
         t_old = (time.perf_counter() - t) / repeats
         t = time.perf_counter()
         for _ in range(repeats):
-            n = interp_products(A9, A18, V9, V18, C, 5)
+            n = new()
         t_new = (time.perf_counter() - t) / repeats
         print(f"| {r + 1} | {1e3 * t_old:.0f} | {1e3 * t_new:.0f} | {np.abs(a - n).max() / np.abs(a).max():.1e} |")
 
@@ -90,23 +89,20 @@ def main(repeats=5):
     rng = np.random.default_rng(0)
     K9 = rng.standard_normal((SLAB, 9 * D, N9)) + 0j
     K18 = rng.standard_normal((SLAB, 18 * D, N18)) + 0j
-    V9 = rng.standard_normal((SLAB, W, 9)) + 1j * rng.standard_normal((SLAB, W, 9))
-    V18 = rng.standard_normal((SLAB, W, 18)) + 1j * rng.standard_normal((SLAB, W, 18))
-    T9, T18 = np.ascontiguousarray(V9.transpose(1, 0, 2)), np.ascontiguousarray(V18.transpose(1, 0, 2))
+    V9, V18, T9, T18 = states(rng, SLAB, W)
     fchunk = max(1, int(WINDOW_BYTES // (B * 27 * D * 16)))
-    print("| round | time-major, gathered windows [ms] | frequency-major, contiguous windows [ms] | largest difference [-] |")
-    print("|---|---|---|---|")
-    for r in range(3):
-        t = time.perf_counter()
-        for _ in range(repeats):
-            a = time_major(K9, K18, T9, T18, 10, B, D, fchunk)
-        t_old = (time.perf_counter() - t) / repeats
-        t = time.perf_counter()
-        for _ in range(repeats):
-            n = history_products(K9, K18, V9, V18, 10, B, D)
-        t_new = (time.perf_counter() - t) / repeats
-        print(f"| {r + 1} | {1e3 * t_old:.0f} | {1e3 * t_new:.0f} | {np.abs(a - n).max() / np.abs(a).max():.1e} |")
-    interp_ab()
+    ab("windows", lambda: time_major(K9, K18, T9, T18, 10, B, D, fchunk),
+       lambda: history_products(K9, K18, V9, V18, 10, B, D), repeats)
+    # the interpolated lags' weighted states at the building's sizes (module docstring)
+    slab, k, R = 3780, 20, 207
+    rng = np.random.default_rng(1)
+    A9 = rng.standard_normal((slab, 9 * k, N9)) + 0j
+    A18 = rng.standard_normal((slab, 18 * k, N18)) + 0j
+    V9, V18, T9, T18 = states(rng, slab, R + 32)
+    C = rng.standard_normal((B, k, R))
+    print()
+    ab("weighted states", lambda: interp_time_major(A9, A18, T9, T18, C, 5),
+       lambda: interp_products(A9, A18, V9, V18, C, 5), max(1, repeats // 2))
 
 
 if __name__ == "__main__":
