@@ -6,7 +6,8 @@ whole model's receivers against the quarter model's.
 
     python jobscripts/toeplitz_table.py OUTDIR README CSV PNG [SCALING_README]
 
-The sites (runs site-<L>, issue 41's 100 m item) get their own table (between <!-- toeplitz-site:begin/end -->
+A table's rows whose run has no log in OUTDIR are kept as they stand (``merge``: a partial rerun,
+PARTS=paper, does not drop the other parts' rows). The sites (runs site-<L>, issue 41's 100 m item) get their own table (between <!-- toeplitz-site:begin/end -->
 in README and SCALING_README), with `petsc-ssi estimate`'s block (site-<L>.estimate) beside each run, the
 interpolation's effect on the receivers (site-<L> against site-<L>-exact), and the plot PNG with
 "_site" before its extension.
@@ -164,8 +165,38 @@ def receivers_agree(outdir):
         return None
 
 
+def _first_cell(line):
+    return line.split("|")[1].strip() if line.startswith("| ") else None
+
+
+def merge(old_lines, lines):
+    """``lines`` (a table: header, separator, rows, then other lines) merged into ``old_lines`` (the block as
+    it stands): the old rows in their order, each replaced by the new row of its run (first cell), the new
+    runs' rows after them; the old table's other lines kept where the new table has no line that begins
+    alike (40 characters). A rerun of some parts of the benchmark (PARTS=paper) into a directory without
+    the other parts' logs keeps their rows instead of dropping them."""
+    if len(lines) < 2 or len(old_lines) < 2:
+        return lines
+    new_rows = {_first_cell(ln): ln for ln in lines[2:] if _first_cell(ln)}
+    old_rows = [ln for ln in old_lines[2:] if _first_cell(ln)]
+    kept = [_first_cell(ln) for ln in old_rows if _first_cell(ln) not in new_rows]
+    if not kept:
+        return lines
+    rows = [new_rows.get(_first_cell(ln), ln) for ln in old_rows]
+    rows += [ln for n, ln in new_rows.items() if n not in {_first_cell(r) for r in old_rows}]
+    extra = [ln for ln in lines[2:] if not _first_cell(ln)]
+    heads = {ln[:40] for ln in extra if ln.strip()}
+    old_extra = [ln for ln in old_lines[2:] if not _first_cell(ln) and ln.strip() and ln[:40] not in heads]
+    print(f"[toeplitz_table] kept {len(kept)} row(s) without a log here: {', '.join(kept)}")
+    tail = extra + ([""] if old_extra and not any(ln.strip() == "" for ln in extra) else []) + old_extra
+    return lines[:2] + rows + tail
+
+
 def put(path, begin, end, lines):
     text = open(path).read()
+    if begin in text:
+        old = text[text.index(begin) + len(begin):text.index(end)].strip("\n").split("\n")
+        lines = merge(old, lines)
     block = begin + "\n" + "\n".join(lines) + "\n" + end
     if begin in text:
         text = text[:text.index(begin)] + block + text[text.index(end) + len(end):]

@@ -257,3 +257,22 @@ def test_the_toeplitz_tables_kernel_seconds_are_both_sides(tmp_path):
     assert (r["kernels_h_s"], r["kernels_g_s"]) == (3.01, 0.424)
     assert r["kernels_s"] == pytest.approx(3.434) and r["stored_GB"] == pytest.approx(0.803)
     assert (r["dofs"], r["steps"], r["store"]) == (4107, 159, "toeplitz")
+
+
+def test_a_partial_benchmark_rerun_keeps_the_other_rows():
+    """jobscripts/toeplitz_table.merge: rerunning some parts (PARTS=paper) into a directory without the other
+    parts' logs replaces those runs' rows in place and keeps the rest with their notes (2026-11-29: such a
+    rerun had dropped three of the four site rows from runs/pekeris/README.md)."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from toeplitz_table import merge
+    old = ["| run | s |", "|---|---|", "| grid-24 | 1 |", "| paper-quarter | 2 |", "| site-100 | 3 |", "",
+           "- site-100 against its exact run: 0.1", "Whole model's receivers against the quarter model's: 4e-14"]
+    new = ["| run | s |", "|---|---|", "| paper-quarter | 5 |", "| paper-whole | 6 |", "",
+           "Whole model's receivers against the quarter model's: 5e-14"]
+    got = merge(old, new)
+    assert got[:6] == ["| run | s |", "|---|---|", "| grid-24 | 1 |", "| paper-quarter | 5 |", "| site-100 | 3 |",
+                       "| paper-whole | 6 |"]
+    assert "- site-100 against its exact run: 0.1" in got and "Whole model's receivers against the quarter model's: 5e-14" in got
+    assert not any("4e-14" in ln for ln in got)
+    assert merge(old[:2] + ["| paper-quarter | 2 |"], new) == new        # nothing to keep: the new table as it is
