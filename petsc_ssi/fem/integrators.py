@@ -663,6 +663,11 @@ def make_model_integrator(cfg, comm, dt, model=None, integrator=None):
         model = build_model(cfg, comm)
     am, a1, note = damping(cfg)
     printf(f"[fem] {note}; integrator {name}, solver {cfg.fem_solver}")
+    from .options import total_motion_damping_warning
+    msg = total_motion_damping_warning(cfg, am)
+    if msg:
+        from ..petsc import warn
+        warn(msg, comm)
     coords, near = near_null_args(cfg.fem_solver, model)
     from .modal_damping import build as modal_damping
     modal = modal_damping(cfg, model, comm)

@@ -303,6 +303,25 @@ def damping(cfg):
     return am, 0.0, note
 
 
+def total_motion_damping_warning(cfg, a0, raw=None):
+    """The warning for mass-proportional damping (a0 > 0) on a soil region of finite elements (-ssi_fem_cp/_cs
+    or a part's cp, cs or layers) under seismic input, else None: the region's motion is total, so a0 M damps
+    the ground's own motion against a fixed frame (the soft layer's 1D ratio fell to 0.9 at 0.6 Hz with a0 =
+    20 1/s where the boxes stayed at 1: runs/soil_region/README.md). ``raw``: the part options (default: the
+    options database's)."""
+    if not a0 > 0 or str(cfg.get("seismic", "none") or "none") == "none":
+        return None
+    if raw is None:
+        from .parts import raw_part_options
+        raw = raw_part_options()
+    soil = float(cfg.get("fem_cs", 0.0) or 0.0) > 0 or any(k.endswith(("_cs", "_layers")) for k in raw)
+    if not soil:
+        return None
+    return (f"mass-proportional damping (a0 = {a0:.4g} 1/s) on a soil region under seismic input damps the ground's own "
+            f"motion (the region's total motion against a fixed frame): for the soil's damping use the stiffness-"
+            f"proportional term alone, -ssi_fem_rayleigh 0,a1 (runs/soil_region/README.md)")
+
+
 def _zeta_note(a0, a1):
     """'; zeta ... at ... Hz' at a few frequencies, and the frequency of least damping."""
     import math
