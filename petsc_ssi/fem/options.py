@@ -305,11 +305,13 @@ def damping(cfg):
 
 def total_motion_damping_warning(cfg, a0, raw=None):
     """The warning for mass-proportional damping (a0 > 0) on a soil region of finite elements (-ssi_fem_cp/_cs
-    or a part's cp, cs or layers) under seismic input, else None: the region's motion is total, so a0 M damps
+    or a part's cp, cs or layers) under seismic input in a coupled run (-ssi_problem ssi), else None: there
+    the region's motion is total, so a0 M damps
     the ground's own motion against a fixed frame (the soft layer's 1D ratio fell to 0.9 at 0.6 Hz with a0 =
     20 1/s where the boxes stayed at 1: runs/soil_region/README.md). ``raw``: the part options (default: the
-    options database's)."""
-    if not a0 > 0 or str(cfg.get("seismic", "none") or "none") == "none":
+    options database's). A structure alone on a moving base (-ssi_problem fem) runs in relative motion, where
+    a0 M is ordinary Rayleigh damping: no warning."""
+    if not a0 > 0 or str(cfg.get("seismic", "none") or "none") == "none" or cfg.get("problem", "") != "ssi":
         return None
     if raw is None:
         from .parts import raw_part_options

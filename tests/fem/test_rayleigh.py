@@ -219,14 +219,16 @@ def test_coefficients_and_frequencies_give_the_same_run(tmp_path):
 def test_mass_proportional_damping_of_a_soil_region_under_seismic_input_is_warned():
     """fem.options.total_motion_damping_warning: a0 > 0 on a soil region (-ssi_fem_cs, or a part's cs or
     layers) under seismic input gets the warning naming the stiffness-proportional form; none without a0,
-    without seismic input or without a soil region (a structure's own a0 stays as it is). (The warning
+    without seismic input, without a soil region (a structure's own a0 stays as it is) or in a run of the finite
+    elements alone (-ssi_problem fem: relative motion on the moving base). (The warning
     printed by a coupled run: runs/soil_region/soft_layer.py's 6 m box with -ssi_fem_rayleigh 5,0.)"""
     from petsc_ssi.fem.options import total_motion_damping_warning as w
-    seismic, soil = {"seismic": "vertical", "fem_cs": 158.0}, {"seismic": "vertical"}
+    seismic, soil = {"seismic": "vertical", "fem_cs": 158.0, "problem": "ssi"}, {"seismic": "vertical", "problem": "ssi"}
     msg = w(seismic, 5.0, raw={})
     assert msg and "-ssi_fem_rayleigh 0,a1" in msg and "a0 = 5 1/s" in msg
     assert w(seismic, 0.0, raw={}) is None
-    assert w({"seismic": "none", "fem_cs": 158.0}, 5.0, raw={}) is None
+    assert w({"seismic": "none", "fem_cs": 158.0, "problem": "ssi"}, 5.0, raw={}) is None
+    assert w({**seismic, "problem": "fem"}, 5.0, raw={}) is None      # a column alone on its moving base: relative motion
     assert w(soil, 5.0, raw={}) is None                                        # a structure only
     assert w(soil, 5.0, raw={"soft_cs": "158", "soft_cp": "274"}) is not None  # a part given by wave speeds
     assert w(soil, 5.0, raw={"ground_layers": "-2:274,158,1800"}) is not None
