@@ -66,7 +66,7 @@ def run(W, ranks, out, quarter=True, command="run", zeta=0.0):
     """The coupled run of a box of width W [m]: soil elements 1 m, bricks 0.5 m, ground W + 6 m wide.
     quarter: the quarter model x >= 0, y >= 0 (-ssi_symmetry x=anti,y=sym: the wave moves the ground in x,
     so the plane x = 0 is one of antisymmetry and y = 0 one of symmetry), 1/16 of the whole model's lags.
-    zeta: the layer's Rayleigh damping ratio at F_DAMP (module docstring)."""
+    zeta: the layer's damping ratio at f0 (stiffness-proportional, ``rayleigh``; module docstring)."""
     n = int(round(2 * W))
     box = ([f"{n // 2},{n // 2},{int(2 * H)}", f"{W / 2},{W / 2},{H}", f"0,0,{-H}", "xmax,ymax,base"] if quarter
            else [f"{n},{n},{int(2 * H)}", f"{W},{W},{H}", f"{-W / 2},{-W / 2},{-H}", "xmin,xmax,ymin,ymax,base"])
@@ -115,10 +115,12 @@ def one_d(f, complex_=False, zeta=0.0):
     omega in place of rho1 c_s1 (either root of k: the ratio is even in it)."""
     a0, a1 = rayleigh(zeta)
     w = 2 * np.pi * np.asarray(f, float)
-    ws = np.where(w > 0, w, 1.0)                         # (f = 0: the layer moves with the outcrop)
+    ws = np.where(w != 0, w, 1.0)
     k = w / CS1 * np.sqrt((1 - 1j * a0 / ws) / (1 + 1j * w * a1)) if zeta else w / CS1 + 0j
     alpha = k * RHO1 * CS1 ** 2 * (1 + 1j * w * a1) / (ws * RHO * CS) if zeta else ALPHA
-    r = np.where(w > 0, 1.0 / (np.cos(k * H) + 1j * alpha * np.sin(k * H)), 1.0)
+    # f = 0: the limit, 1 / (1 + a0 rho1 H / (rho c_s)) (1 without mass-proportional damping: the layer moves
+    # with the outcrop); negative f: the conjugate ratio (the ratio is even in k)
+    r = np.where(w != 0, 1.0 / (np.cos(k * H) + 1j * alpha * np.sin(k * H)), 1.0 / (1 + a0 * RHO1 * H / (RHO * CS)))
     return r * np.exp(1j * w * H / CS) if complex_ else np.abs(r)
 
 
