@@ -177,6 +177,10 @@ def merge(old_lines, lines):
     the other parts' logs keeps their rows instead of dropping them."""
     if len(lines) < 2 or len(old_lines) < 2:
         return lines
+    if old_lines[0] != lines[0]:           # other columns: the old rows would shift under the new header
+        dropped = [_first_cell(ln) for ln in old_lines[2:] if _first_cell(ln)]
+        print(f"[toeplitz_table] the table's columns changed: its old rows are not kept ({', '.join(dropped)})")
+        return lines
     new_rows = {_first_cell(ln): ln for ln in lines[2:] if _first_cell(ln)}
     old_rows = [ln for ln in old_lines[2:] if _first_cell(ln)]
     kept = [_first_cell(ln) for ln in old_rows if _first_cell(ln) not in new_rows]
@@ -192,9 +196,11 @@ def merge(old_lines, lines):
     return lines[:2] + rows + tail
 
 
-def put(path, begin, end, lines):
+def put(path, begin, end, lines, keep=True):
+    """The block begin..end of the file at ``path`` (appended when missing) set to ``lines``, merged with its
+    old rows (``merge``) unless ``keep`` is False."""
     text = open(path).read()
-    if begin in text:
+    if begin in text and keep:
         old = text[text.index(begin) + len(begin):text.index(end)].strip("\n").split("\n")
         lines = merge(old, lines)
     block = begin + "\n" + "\n".join(lines) + "\n" + end
@@ -220,12 +226,24 @@ def scaling(rows, path):
         st = round(t1 / r["total_s"], 2) if r["total_s"] else ""
         lines.append(f"| {r['ranks']} | {r.get('kernels_s', '')} | {r['history_s']} | {r['history_ms_per_step']} | "
                      f"{sp} | {r['total_s']} | {st} | {r['peak_GB']} | {r.get('sampled_peak_GB', '')} |")
-    put(path, "<!-- toeplitz-scaling:begin -->", "<!-- toeplitz-scaling:end -->", lines)
+    # (not merged: its speed-ups are against this run's first row)
+    put(path, "<!-- toeplitz-scaling:begin -->", "<!-- toeplitz-scaling:end -->", lines, keep=False)
 
 
 def write_csv(rows, path):
+    """The rows' CSV, with the rows of the CSV already at ``path`` whose run has no new row (as ``merge``
+    keeps the tables' rows), when its columns are these."""
     if not rows:
         return
+    names = {r["run"] for r in rows}
+    old = []
+    if os.path.exists(path):
+        with open(path, newline="") as f:
+            rd = csv.reader(f)
+            head = next(rd, [])
+            if [h.split(" [")[0] for h in head] == COLS:
+                old = [dict(zip(COLS, r)) for r in rd if r and r[0] not in names]
+    rows = list(rows) + old
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, COLS)
         w.writerow({c: c + {"stored_GB": " [GB]", "kernels_s": " [s]", "history_s": " [s]",

@@ -276,3 +276,5 @@ def test_a_partial_benchmark_rerun_keeps_the_other_rows():
     assert "- site-100 against its exact run: 0.1" in got and "Whole model's receivers against the quarter model's: 5e-14" in got
     assert not any("4e-14" in ln for ln in got)
     assert merge(old[:2] + ["| paper-quarter | 2 |"], new) == new        # nothing to keep: the new table as it is
+    wider = ["| run | s | peak |", "|---|---|---|", "| paper-quarter | 5 | 1 |"]
+    assert merge(old, wider) == wider                  # other columns: the old rows would shift, so they go
