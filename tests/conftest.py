@@ -13,7 +13,11 @@ os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 # odls_base_sigkill_timeout (1 s, twice) before it returns: 2.0 of the 3.7 s of every refused two-rank
 # run (`time mpirun -n 1 python -c "import sys; sys.exit(2)"`: 2.1 s, 0.1 s with 0). The refusal tests
 # (about a hundred) assert the exit status, which mpirun still returns (2); the ranks of a refused run
-# exit by themselves, rank 0 first (app/cli.py), so nothing they print is cut.
+# exit by themselves (the Barrier in app/cli.py, then MPI_Finalize's fence), so nothing they print is cut.
+# Where a run calls MPI_Abort (an I/O failure: app/cli.py, petsc.collective_io) the other ranks are now
+# killed at once, before rank 0's SIGTERM handler can remove the output's lock (io/lock.py): the next run
+# takes the stale lock over with a warning, as after a kill. (Tests that time mpirun's own signal
+# forwarding set the timeout on their command line, which overrides this: test_checkpoint.py.)
 os.environ.setdefault("OMPI_MCA_odls_base_sigkill_timeout", "0")
 # The suite starts about a thousand petsc-ssi processes (mpirun ranks counted). Where the shell sets
 # PYTHONDONTWRITEBYTECODE (this machine and CI's do), each one compiled the ~90 modules it imports from
