@@ -544,8 +544,11 @@ class ToeplitzHistory:
         keep = slice(lo - self.base, max(self.upto, lo - 1) - self.base + 1)
         k = keep.stop - keep.start
         for B in (self.V9, self.V18):
-            B[:, :k] = B[:, keep]
-            B[:, k:] = 0.0
+            # in chunks of frequencies: numpy copies an overlapping source whole before the move (35 MB a
+            # rank for V18 on the paper's quarter case), a chunk's own rows only here
+            for f0 in range(0, B.shape[0], 64):
+                B[f0:f0 + 64, :k] = B[f0:f0 + 64, keep]
+                B[f0:f0 + 64, k:] = 0.0
         self.base = lo
 
     def _catch_up(self, n, march):
@@ -683,11 +686,10 @@ def _spans(C):
 
 def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
     """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
-    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (rows r0 + m of the time-major
-    buffers (slab, W, c), double or single; real weights on the real and imaginary parts: per span of
-    ``_spans`` and frequency one real matrix product of the weights with the span's states, read in
-    place), then (b x 9k)(9k x n9) and
-    (b x 18k)(18k x n18) products with the anchors' kernels: (slab, b, n9 + n18) complex, columns as
+    weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (states r0 + m of the
+    frequency-major buffers (slab, W, c), double or single; real weights on the real and imaginary parts:
+    per span of ``_spans`` and frequency one real matrix product of the weights with the span's states,
+    read in place), then (b x 9k)(9k x n9) and (b x 18k)(18k x n18) products with the anchors' kernels: (slab, b, n9 + n18) complex, columns as
     ``history_products``. Frequencies in chunks so the weighted states stay small."""
     slab, n9, n18 = A9.shape[0], A9.shape[2], A18.shape[2]
     b, k, _ = C.shape
@@ -734,6 +736,11 @@ def history_products(K9, K18, V9, V18, p0, b, D, fchunk=None):
     over); frequencies in chunks so the windows' copies stay small."""
     from numpy.lib.stride_tricks import as_strided
     slab, n9, n18 = K9.shape[0], K9.shape[2], K18.shape[2]
+    for V, c in ((V9, 9), (V18, 18)):       # (the strided windows read within each frequency's states only)
+        if p0 < 0 or p0 + b - 1 + D > V.shape[1] or V.shape[2] != c or V.strides[2] != V.itemsize \
+                or V.strides[1] != c * V.itemsize:
+            raise ValueError(f"history_products: states {p0}..{p0 + b - 2 + D} of a buffer of {V.shape[1]} "
+                             f"(shape {V.shape}, strides {V.strides}): out of range or not (slab, W, c) contiguous rows")
     out = np.empty((slab, b, n9 + n18), np.complex128)
     if fchunk is None:
         fchunk = max(1, int(WINDOW_BYTES // (b * 27 * D * 16)))
