@@ -307,8 +307,8 @@ def total_motion_damping_warning(cfg, a0, raw=None):
     """The warning for mass-proportional damping (a0 > 0) on a soil region of finite elements (-ssi_fem_cp/_cs
     or a part's cp, cs or layers) under seismic input in a coupled run (-ssi_problem ssi), else None: there
     the region's motion is total, so a0 M damps
-    the ground's own motion against a fixed frame (the soft layer's 1D ratio fell to 0.9 at 0.6 Hz with a0 =
-    20 1/s where the boxes stayed at 1: runs/soil_region/README.md). ``raw``: the part options (default: the
+    the ground's own motion against a fixed frame (a 1D soft layer's ratio tends to 1 / (1 + a0 rho1 H /
+    (rho c_s)) < 1 as f -> 0: runs/soil_region/README.md). ``raw``: the part options (default: the
     options database's). A structure alone on a moving base (-ssi_problem fem) runs in relative motion, where
     a0 M is ordinary Rayleigh damping: no warning."""
     if not a0 > 0 or str(cfg.get("seismic", "none") or "none") == "none" or cfg.get("problem", "") != "ssi":
