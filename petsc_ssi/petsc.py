@@ -364,10 +364,11 @@ def direct_solver_defaults(comm, soil=False):
                    "run on one rank or choose an iterative solver with -ssi_*_ksp_type/-pc_type")
 
 
-def solve_columns(ksp, template, m, fill, take, chunk=256):
+def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     """Collective: x_j = A^-1 b_j for j = 0 .. m-1 with the KSP's operator A. ``fill(j, b)`` writes
     right-hand side j into the Vec b (layout of ``template``), ``take(j, x)`` receives its solution
-    (a Vec, valid during the call). When the KSP is a direct solve (preonly with an LU or Cholesky
+    (a Vec, valid during the call); ``block(j0, j1)``, if given, returns the local rows of the
+    right-hand sides j0 .. j1-1 at once as an array (local size, j1 - j0), or None (then ``fill``). When the KSP is a direct solve (preonly with an LU or Cholesky
     factorisation by MUMPS, or PETSc's own on one rank) the columns are solved ``chunk`` at a time in
     one multi-right-hand-side solve of the factors (MatMatSolve: the triangular solves done for
     many columns at once, 3-10x fewer seconds than one solve per column; the solutions equal to
@@ -390,13 +391,23 @@ def solve_columns(ksp, template, m, fill, take, chunk=256):
             except PETSc.Error:
                 F = None
     try:
+        def rhs(j0, j1):
+            """The right-hand sides j0 .. j1-1 as an array, or None (fill them one by one)."""
+            return None if block is None else block(j0, j1)
+
         if F is None:
-            for j in range(m):
-                fill(j, b)
-                ksp.solve(b, x)
-                if ksp.getConvergedReason() < 0:
-                    raise SSIError(f"a solve for column {j} of {m} diverged (KSP reason {ksp.getConvergedReason()})")
-                take(j, x)
+            for j0 in range(0, m, chunk):
+                j1 = min(m, j0 + chunk)
+                blk = rhs(j0, j1)
+                for j in range(j0, j1):
+                    if blk is None:
+                        fill(j, b)
+                    else:
+                        b.getArray()[:] = blk[:, j - j0]
+                    ksp.solve(b, x)
+                    if ksp.getConvergedReason() < 0:
+                        raise SSIError(f"a solve for column {j} of {m} diverged (KSP reason {ksp.getConvergedReason()})")
+                    take(j, x)
             return
         nloc, n = template.getLocalSize(), template.getSize()
         for j0 in range(0, m, chunk):
@@ -406,7 +417,10 @@ def solve_columns(ksp, template, m, fill, take, chunk=256):
             B.setUp()
             X.setUp()
             Ba = B.getDenseArray()
-            for c in range(w):
+            blk = rhs(j0, j0 + w)
+            if blk is not None:
+                Ba[:, :] = blk
+            for c in range(w if blk is None else 0):
                 fill(j0 + c, b)
                 Ba[:, c] = b.getArray(readonly=True)
             B.assemble()

@@ -223,8 +223,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     glat = traction_grid(lat, cnt.lagset.VT)
     out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks "
            "beside the processes"]
+    g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
     for p in ranks:
-        g = 8.0 * 5 * prob.mesh.n_nodes * prob.regions.n_t * min(2, cnt.Lx)      # (G lags 1-2 dense)
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single")

@@ -358,6 +358,40 @@ class BSRMat:
         if self.diag is not None:
             _diag_add(self.diag, self.row0, x, y, 1.0)
 
+    def columns(self, dofs):
+        """The local rows of the global columns ``dofs`` (DOF numbers) as a dense (local rows,
+        len(dofs)) array: the products A e_j with unit vectors, read off the blocks instead of one
+        matvec over every block per column (a block's entry alone, then the free term added: the
+        matvec's own sum, the same bits); None if a row holds a column node twice (the matvec would
+        sum such blocks)."""
+        if not hasattr(self, "_unique"):
+            rows = np.repeat(np.arange(self.indptr.size - 1), np.diff(self.indptr))
+            o = np.lexsort((self.indices, rows))
+            self._unique = bool(np.all((np.diff(rows[o]) > 0) | (np.diff(self.indices[o]) > 0)))
+        if not self._unique:
+            return None
+        dofs, back = np.unique(np.asarray(dofs, np.int64), return_inverse=True)     # (a column asked twice)
+        nloc = self.indptr.size - 1
+        out = np.zeros((3 * nloc, dofs.size))
+        want = np.full(self.sizes[1][1], -1, np.int64)
+        want[dofs] = np.arange(dofs.size)
+        wn = want.reshape(-1, 3)
+        hit = np.flatnonzero(np.any(wn[self.indices] >= 0, axis=1))       # blocks in a wanted column node
+        rows = np.searchsorted(self.indptr, hit, side="right") - 1
+        d = self.data                           # (nnzb, m)
+        for s, (p, q) in enumerate(PATTERNS[self.pattern]):
+            j = wn[self.indices[hit], q]
+            k = j >= 0
+            out[3 * rows[k] + p, j[k]] = d[hit[k], s]
+        if self.diag is not None:               # the free term: column node row0 + i of local row i
+            i = np.arange(nloc)
+            for q in range(3):
+                j = wn[self.row0 + i, q]
+                k = j >= 0
+                for p in range(3):
+                    out[3 * i[k] + p, j[k]] += self.diag[i[k], p, q]
+        return out[:, back]
+
     def panel(self, XT, RT, sign):
         """RT += sign * (local rows) @ XT: XT (all columns x b), RT (local rows x b), C order."""
         panel(self.pattern, self.indptr, self.indices, self.data, XT, RT, sign)
@@ -461,6 +495,16 @@ class SplitBSR:
             p.matvec(x, tmp)
             y += tmp
 
+    def columns(self, dofs):
+        """As BSRMat.columns: the parts' columns summed in the matvec's order."""
+        out = self.parts[0].columns(dofs)
+        for p in self.parts[1:]:
+            c = p.columns(dofs) if out is not None else None
+            if c is None:
+                return None
+            out += c
+        return out
+
     def panel(self, XT, RT, sign):
         for p in self.parts:
             p.panel(XT, RT, sign)
@@ -560,6 +604,25 @@ class DenseSplit:
         if self.diag is not None:
             _diag_add(self.diag, self.row0, x, y, 1.0)
 
+    def columns(self, dofs):
+        """As BSRMat.columns: the pieces' entries of the columns ``dofs``, the free term added."""
+        dofs = np.asarray(dofs, np.int64)
+        out = np.zeros((3 * self.nloc, dofs.size))
+        O = out.reshape(self.nloc, 3, dofs.size)
+        node, comp = dofs // 3, dofs % 3
+        for rs, cs, A in self.pieces:
+            A4 = A.reshape(self.nloc, len(rs), self.ncol, len(cs))
+            for b, q in enumerate(cs):
+                k = np.flatnonzero(comp == q)
+                for a, p in enumerate(rs):
+                    O[:, p, k] = A4[:, a, node[k], b]
+        if self.diag is not None:
+            for j in range(dofs.size):
+                r = node[j] - self.row0
+                if 0 <= r < self.nloc:
+                    O[r, :, j] += self.diag[r, :, comp[j]]
+        return out
+
     def panel(self, XT, RT, sign):
         """RT += sign * A XT: per piece X_c^T A^T (the panel on the left: OpenBLAS's faster layout for a
         skinny product, as march's MATDENSE panels)."""
@@ -602,6 +665,14 @@ def context(M):
         return None
     ctx = M.getPythonContext()
     return ctx.bsr if isinstance(ctx, _Shell) else None
+
+
+def columns(M, dofs):
+    """The local rows of the global columns ``dofs`` of a lag Mat as a dense (local rows, len(dofs))
+    array (the products M e_j with unit vectors, the same bits), or None: not a Mat of this module's, or
+    one whose columns it does not read off (the caller multiplies unit vectors)."""
+    ctx = context(M)
+    return None if ctx is None or not hasattr(ctx, "columns") else ctx.columns(dofs)
 
 
 def from_csr(comm, nrow_loc, ncol_loc, nrow_glob, ncol_glob, indptr, indices, values, pattern=FULL, diag=None,

@@ -180,10 +180,14 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
                    "nbaij": nbaij, "nsingle": nsingle, "fill": float("nan"), "mem": mem_exact + mem_interp}
 
 
-def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0):
-    """Collective: the G lags lag_lo..lag_hi (at kernel times l dt + toff) as the dense path stores
-    them, from an assembly over the elements that carry traction columns only (the others add
-    nothing to G; the same elements in the same order: the same bits)."""
+def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0, storage="dense", fill=0.95):
+    """Collective: the G lags lag_lo..lag_hi (at kernel times l dt + toff), from an assembly over the
+    elements that carry traction columns only (the others add nothing to G; the same elements in the
+    same order: the same blocks), stored as ``storage`` (-ssi_lag_storage; ``fill`` its threshold):
+    the dense path's "dense" or, on the toeplitz store, "auto": lags 1-2 reach only the soil nodes
+    near the traction elements, where a dense Mat of every soil node's rows was read in full at each
+    step (the uniform 72 m building, 484 traction nodes: 2 x 0.29 GB; block-sparse, its first 80 steps'
+    MatMults 2.9 -> 1.4 s and the lags' panel products, 1.8 s, gone: jobscripts/README.md)."""
     nt = prob.regions.n_t
     tl = ls.restricted(np.any(ls.VT >= 0, axis=1))
     PETSc = init()
@@ -193,8 +197,8 @@ def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0):
     _, gb = tl.assemble(monitor=False, lag_lo=lag_lo, lag_hi=lag_hi, toff=toff, quiet=True, keep_h=False)
     N = prob.mesh.n_nodes
     if lag_lo == lag_hi and lag_lo > 1:
-        return [lagmats.build_one(comm, gb, lag_lo, ls.node_range, N, nt, tcol_loc, "dense")[0]], tl
-    return lagmats.build(comm, gb, lag_hi, ls.node_range, N, nt, tcol_loc, "dense")[0], tl
+        return [lagmats.build_one(comm, gb, lag_lo, ls.node_range, N, nt, tcol_loc, storage, fill)[0]], tl
+    return lagmats.build(comm, gb, lag_hi, ls.node_range, N, nt, tcol_loc, storage, fill)[0], tl
 
 
 def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
@@ -215,7 +219,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         H = list(H) + [None] * (plan.Lx - 2)
         G = [None] * plan.Lx
         if prob.regions.n_t:
-            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx))
+            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), storage=cfg.lag_storage, fill=prob.lag_fill)
             G[:len(g)] = g
             nev += tl.kernel_evaluations
     ls.H = ls.G = None

@@ -514,16 +514,27 @@ class HalfSpace:
         return lat
 
     def toeplitz_side_bytes(self, ls, plan):
-        """Collective: the bytes of a toeplitz run beside its kernels: G lags 1 and 2 dense (N x n_t blocks of
-        5 values; the later G lags are kernels on the store, ``toeplitz.estimate``), H lags 1 and 2 as Mats
-        (block-sparse: their wave reaches a few elements) and the step matrix's factors, counted from the
-        blocks of the lag-2 window on a sample of rows, 36 B a block, three times over."""
+        """Collective: the bytes of a toeplitz run beside its kernels: G lags 1 and 2 as Mats (the later G
+        lags are kernels on the store, ``toeplitz.estimate``): block-sparse, 44 B a block (5 values and a
+        column), their blocks counted as H's below over the traction elements alone, n_t / (traction
+        elements) columns an element, or dense (N x n_t blocks of 5 values) where a lag's fill exceeds
+        -ssi_lag_fill, as ``build._traction_g`` stores them; H lags 1 and 2 as Mats (block-sparse: their
+        wave reaches a few elements) and the step matrix's factors, counted from the blocks of the lag-2
+        window on a sample of rows, 36 B a block, three times over."""
         from .windows import estimate_blocks
-        g = 8.0 * 5 * self.mesh.n_nodes * self.regions.n_t * min(2, plan.Lx)
+        mpi = self.comm.tompi4py()
+        N, nt, nimg = self.mesh.n_nodes, self.regions.n_t, max(1, len(ls.Vc) // self.mesh.n_cells)
         rows = ls.rows[::max(1, len(ls.rows) // 256)]          # (a sample of rows: O(rows x elements))
-        nb = estimate_blocks(self.mesh.nodes, rows, ls.Vc, ls.VR, 2, self.mat, self.dt,
-                             len(ls.Vc) // self.mesh.n_cells) * (len(ls.rows) / max(len(rows), 1))
-        return g + 3 * 36.0 * self.comm.tompi4py().allreduce(float(nb.sum()))
+        scale = len(ls.rows) / max(len(rows), 1)
+        nb = estimate_blocks(self.mesh.nodes, rows, ls.Vc, ls.VR, 2, self.mat, self.dt, nimg) * scale
+        g = 0.0
+        tel = np.flatnonzero(np.any(ls.VT >= 0, axis=1))
+        if nt and tel.size:
+            nbg = estimate_blocks(self.mesh.nodes, rows, ls.Vc[tel], ls.VR[tel], 2, self.mat, self.dt, nimg) * scale
+            nbg = mpi.allreduce(nbg) / 4.0 * (nt / max(tel.size / nimg, 1.0))
+            for b in nbg[:min(2, plan.Lx)]:
+                g += 40.0 * N * nt if b / float(N * nt) > self.cfg.lag_fill else 44.0 * b
+        return g + 3 * 36.0 * mpi.allreduce(float(nb.sum()))
 
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
         """Collective: refuse a toeplitz run whose kernels and kept transforms would not fit the node

@@ -251,6 +251,27 @@ class Marcher:
             out.getArray()[self.zero_local] = 0.0
         return out
 
+    def step_H_columns(self, dofs):
+        """The columns ``dofs`` (global DOFs) of H_s = sum c H_lag, this rank's rows, as a dense (local
+        rows, len(dofs)) array: ``mult_step_H`` of the unit vectors, read off the lags' blocks
+        (``bsr.columns``; the sum in mult_step_H's order), rows of symmetry-zero DOFs 0; None where a
+        lag is a Mat whose columns are not read off (dense PETSc Mats, loaded AIJ) on any rank: multiply
+        instead. Collective (the ranks agree on None: the fallback's products are collective); the
+        coefficients are 1 and 4, so c H_1 e + H_2 e rounds as mult_step_H's VecAXPYs do."""
+        out = None
+        for lag, c in self.coefficients():
+            col = bsr.columns(self.H[lag - 1], dofs)
+            if col is None:
+                out = None
+                break
+            out = c * col if out is None else out + c * col
+        from mpi4py import MPI
+        if not self.comm.tompi4py().allreduce(out is not None, op=MPI.LAND):
+            return None
+        if self.zero_local.size:
+            out[self.zero_local] = 0.0
+        return out
+
     def residual(self, x, b, out):
         """Collective: out = A x - b (the step equations)."""
         self.A.mult(x, out)

@@ -231,10 +231,13 @@ class Coupler:
                 e.getArray()[lut[j]] = 1.0
             m.mult_step_H(e, rhs)
 
+        def block(i0, i1):                      # H_s's columns read off its lags (None: multiply)
+            return m.step_H_columns(self.dofs_be[cols[i0:i1]])
+
         def take(i, z):
             Z[:, cols[i]] = z.getArray(readonly=True)
         with event("SSI_BEM_Solve"):
-            solve_columns(m.ksp, m.u_tmpl, len(cols), fill, take)
+            solve_columns(m.ksp, m.u_tmpl, len(cols), fill, take, block=block)
         e.destroy()
         return Z
 

@@ -95,6 +95,53 @@ def test_split_dense_and_the_free_term_give_the_dense_products(m):
         assert values == m * (len(indices) if ctx.kind == "bsr" else nrow * ncol)
 
 
+@pytest.mark.parametrize("m", [4, 5, 9])
+def test_columns_are_the_products_with_unit_vectors_bit_for_bit(m):
+    """bsr.columns (the coupled set-up's right-hand sides H_s e_j read off the blocks instead of a
+    product per column) equals the matvec with each unit vector exactly, for a block-sparse lag with the
+    free term, its dense pieces, a split lag (two parts, their products summed) and a lag that holds a
+    column twice in a row (not read off: None, the caller multiplies); columns in any order, with
+    repeats and the free term's own column among them."""
+    PETSc = petsc()
+    from petsc_ssi.bem import bsr
+    rng = np.random.default_rng(40 + m)
+    nrow, ncol, row0 = 11, 26, 7
+    indptr, indices, data = _random_pattern_csr(rng, m, nrow, ncol, 0.5)
+    diag = rng.standard_normal((nrow, 3, 3))
+    ctxs = [bsr.BSRMat(PETSc.COMM_SELF, indptr, indices, data, nrow, ncol, nrow, ncol, m, diag, row0)]
+    if m in (4, 5):
+        ctxs.append(bsr.DenseSplit.from_csr(PETSc.COMM_SELF, m, nrow, ncol, nrow, ncol, indptr, indices, data,
+                                            diag, row0))
+    else:                       # a split lag: the blocks of even columns in H4, the others full
+        rows = np.repeat(np.arange(nrow), np.diff(indptr))
+        parts = []
+        for keep, mm in ((indices % 2 == 0, 4), (indices % 2 == 1, 9)):
+            ip = np.zeros(nrow + 1, np.int64)
+            np.cumsum(np.bincount(rows[keep], minlength=nrow), out=ip[1:])
+            vals = bsr.compact(bsr.expand(data[keep], 9), mm) if mm == 4 else data[keep]
+            parts.append(bsr.BSRMat(PETSc.COMM_SELF, ip, indices[keep], vals, nrow, ncol, nrow, ncol, mm,
+                                    diag if mm == 4 else None, row0, shell=False))
+        ctxs.append(bsr.SplitBSR(PETSc.COMM_SELF, parts))
+    dofs = np.concatenate([rng.permutation(3 * ncol)[:20], [3 * (row0 + 2) + 1, 5, 5]])
+    for ctx in ctxs:
+        got = bsr.columns(ctx.mat, dofs)
+        ref = np.zeros((3 * nrow, dofs.size))
+        x = np.zeros(3 * ncol)
+        for j, d in enumerate(dofs):
+            x[:] = 0.0
+            x[d] = 1.0
+            ctx.matvec(x, ref[:, j])
+        assert got is not None and np.array_equal(got, ref) and np.abs(ref).max() > 0, type(ctx).__name__
+    empty = bsr.BSRMat(PETSc.COMM_SELF, np.zeros(nrow + 1, np.int64), np.zeros(0, np.int32), np.zeros((0, m)),
+                       nrow, ncol, nrow, ncol, m)                   # (a split lag's part can hold no block)
+    assert np.array_equal(empty.columns(dofs), np.zeros((3 * nrow, dofs.size)))
+    twice = indices.copy()
+    twice[indptr[3] + 1] = twice[indptr[3]]           # row 3 holds a column node twice
+    dup = bsr.BSRMat(PETSc.COMM_SELF, indptr, twice, data, nrow, ncol, nrow, ncol, m, diag, row0)
+    assert bsr.columns(dup.mat, dofs) is None
+    assert bsr.columns(None, dofs) is None
+
+
 CASES = {        # (options, ranks): every storage the lags have, a G of traction columns, interpolation
     "block-sparse, interpolated, 2 ranks": (BEM + INTERP + ["-ssi_lag_storage", "sparse"], 2),
     "dense, prescribed motion, 2 ranks": (DISP + ["-ssi_lag_storage", "dense", "-ssi_t_end", "0.03"], 2),
