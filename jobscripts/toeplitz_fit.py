@@ -11,7 +11,9 @@ relative errors: the kernels' build per side (t_pair_lag, seconds per H kernel o
 H side's 'kernels ... s'; g_pair_factor, a G offset's seconds over an H offset's, against the G side's), the
 history sum (event SSI_BEM_History) against the products (1 / r_products), the
 per-step DOF term (t_step_dof) and the per-step FFT-grid term (t_step_grid); r_sums (the interpolated lags'
-weighted states) is kept as it is. Oversubscribed runs are left out. The printed RATES line goes into
+weighted states anchor by anchor) is kept as it is; r_sums_span (over the anchors' common span: Chebyshev)
+is the median over the logs that have it of the span's flops over the event SSI_BEM_HistInterp less its
+anchors' kernel products. Oversubscribed runs are left out. The printed RATES line goes into
 toeplitz.py by hand, with the logs' names and date in its comment.
 """
 import contextlib
@@ -36,7 +38,13 @@ def terms(opts, ranks):
     from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES
     PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
-        prob = HalfSpace(cfg, PETSc.COMM_SELF, log=lambda m: None)
+        if opts.get("problem") == "ssi":    # a coupled run: the soil of its set-up (the interface's tractions)
+            from petsc_ssi.coupling.model import build_coupled
+            from petsc_ssi.app.kinds import resolve
+            cfg = resolve("ssi", ("estimate",))
+            prob = build_coupled(cfg, PETSc.COMM_SELF)[0]
+        else:
+            prob = HalfSpace(cfg, PETSc.COMM_SELF, log=lambda m: None)
         plan = prob.interp_plan()
         ls = prob.lagset(plan)
     lat = detect(ls.VX, prob.mesh.nodes)
@@ -46,14 +54,27 @@ def terms(opts, ranks):
     args = (lat, prob.L, prob.n_steps, ranks, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, 0.0)
     kw = dict(plan=plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
               single=cfg.get("toeplitz_precision", "double") == "single")
-    zero = {"r_products": big, "r_sums": big, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 0.0,
-            "t_pair_lag": 0.0}
+    zero = {"r_products": big, "r_sums": big, "r_sums_span": big, "t_step_dof": 0.0, "t_step_grid": 0.0,
+            "t_step_elem": 0.0, "t_pair_lag": 0.0}
     one = lambda **r: estimate(*args, rates=dict(zero, **r), **kw)
     # the kernels' build per side: H's offsets and lags (glat=None) and G's, unweighted (g_pair_factor 1)
     pairs_h = estimate(*args, rates=dict(zero, t_pair_lag=1.0), **dict(kw, glat=None))[1]
     pairs_g = one(t_pair_lag=1.0, g_pair_factor=1.0)[1] - pairs_h
     return {"pairs_h": pairs_h, "pairs_g": pairs_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
-            "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2], "sums": one(r_sums=RATES["r_sums"])[2]}
+            "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2],
+            "sums": one(r_sums=RATES["r_sums"], r_sums_span=RATES["r_sums_span"])[2],
+            # the weighted states over the anchors' common span (Chebyshev), flops a rank, and the anchors'
+            # kernel products of the same event (SSI_BEM_HistInterp), flops a rank (at r_products in the model)
+            "span": one(r_sums_span=1.0)[2], "interp_prod": _interp_products(lat, glat, plan, prob.n_steps, ranks, kw, cfg)}
+
+
+def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
+    """Flops a rank of the interpolating matrices' kernel products (8 m F k per step that reads them)."""
+    from petsc_ssi.bem.toeplitz import interp_work
+    if plan is None or not plan.active:
+        return 0.0
+    isteps = interp_work(plan, n_steps, int(cfg.history_block) or 8, kw["stabilized"])[0]
+    return sum(8.0 * m * g.F * plan.k * isteps for g, m in ((lat, 144), (glat, 180)) if g is not None) / ranks
 
 
 def main(logs, check=False):
@@ -72,8 +93,8 @@ def main(logs, check=False):
         if int(r["ranks"]) > (os.cpu_count() or 1):
             print(f"[toeplitz_fit] skip {path}: oversubscribed", file=sys.stderr)
             continue
-        m = re.search(r"^SSI_BEM_Solve\s+(\d+)\s+\S+\s+(\S+)", text, re.M)
-        r["solve_s"] = float(m.group(2)) / int(m.group(1)) if m else float("nan")
+        m = re.findall(r"^SSI_BEM_Solve\s+(\d+)\s+\S+\s+(\S+)", text, re.M)      # the time loop's: the last
+        r["solve_s"] = float(m[-1][1]) / int(m[-1][0]) if m else float("nan")
         runs.append((path, r, terms(opts, int(r["ranks"]))))
     kern = np.array([r["kernels_s"] for _, r, _ in runs], float)
     kh = np.array([r.get("kernels_h_s", r["kernels_s"]) for _, r, _ in runs], float)
@@ -93,6 +114,17 @@ def main(logs, check=False):
         gsel = [i for i, (*_, t) in enumerate(runs) if t["pairs_g"] > 0 and kg[i] > 0]
         t_g = float(_nnls(np.array([[runs[i][2]["pairs_g"]] for i in gsel]), kg[gsel])[0]) if gsel else 0.0
         fit["g_pair_factor"] = t_g / fit["t_pair_lag"] if gsel and fit["t_pair_lag"] > 0 else RATES["g_pair_factor"]
+    # r_sums_span from the logs whose far lags weigh states over a common span (Chebyshev): the span's flops
+    # over the event SSI_BEM_HistInterp less its anchors' kernel products at r_products; the median of the logs
+    spans = []
+    for path, r, t in runs:
+        m = re.search(r"^SSI_BEM_HistInterp\s+(\d+)\s+\S+\s+(\S+)", open(path, errors="replace").read(), re.M)
+        if m and t["span"] > 0:
+            left = float(m.group(2)) - t["interp_prod"] / fit["r_products"]
+            spans.append((os.path.relpath(path, ROOT), t["span"] / left if left > 0 else float("nan")))
+    for name, rate in spans:
+        print(f"[toeplitz_fit] {name}: the weighted states over the common span at {rate / 1e9:.3g} GFlop/s a rank")
+    fit["r_sums_span"] = RATES["r_sums_span"] if check or not spans else float(np.nanmedian([v for _, v in spans]))
     c, _ = load_constants()
     print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] | a step solve measured / "
           "model [ms] |")
@@ -100,7 +132,8 @@ def main(logs, check=False):
     for (path, r, t), k, h in zip(runs, kern, hist):
         mk = fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
-              + fit["t_step_elem"] * t["elem"] + t["sums"])
+              + fit["t_step_elem"] * t["elem"] + t["sums"] + t["span"] * (1.0 / fit["r_sums_span"]
+                                                                          - 1.0 / RATES["r_sums_span"]))
         ms = 1e3 * bem_solve_seconds(c, int(r["dofs"]) // 3, int(r["ranks"]))
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
               f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")

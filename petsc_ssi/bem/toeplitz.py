@@ -169,11 +169,18 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # kernels at +55 %). r_sums, the real flops per second of the interpolated lags' weighted states
 # (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
 # weighted states over its rate of the exact products, times the idle r_products of the time; median of
-# 3.44, 6.67, 4.69 GFlop/s), is not refitted. fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
+# 3.44, 6.67, 4.69 GFlop/s), is not refitted: it prices the multi-linear weights, anchor by anchor (small
+# products). r_sums_span prices Chebyshev's, every anchor over the common span of states (one larger product a
+# frequency): `python jobscripts/toeplitz_fit.py --check` on the logs of `bash jobscripts/quiet.sh bash
+# jobscripts/building_uniform.sh` (2026-11-29 10:51-11:03, the building on the uniform 36 m and 72 m grids, 2
+# ranks): the span's flops over the event SSI_BEM_HistInterp less its anchors' kernel products, 17.8 and 20.2
+# GFlop/s a rank (before, at r_sums, the 72 m building's history sum was estimated at 107 s against 46.6 s
+# measured). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
 RATES = {"r_products": 1.13e10, "t_step_dof": 3.86e-7, "t_step_grid": 0.0, "t_step_elem": 9.95e-6,
-         "t_pair_lag": 3.81e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.06}
+         "t_pair_lag": 3.81e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.06,
+         "r_sums_span": 1.9e10}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
@@ -189,13 +196,15 @@ def chunk_bytes(kernel_bytes):
 
 def interp_work(plan, n_steps, block=8, stabilized=True):
     """(steps whose history reads an interpolating matrix, summed (anchors x states) of the weighted states
-    over the run's blocks) of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block:
-    the code's own choice); (0, 0) without interpolation. The terms of a block's own states (T_L within a
-    block) are left out (a few states a step)."""
+    over the run's blocks in products anchor by anchor, the same in products over all anchors' common span)
+    of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block: the code's own choice;
+    multi-linear weights go anchor by anchor, small products, Chebyshev's over the common span, one larger
+    product a frequency: their rates differ, ``RATES`` r_sums and r_sums_span); (0, 0, 0) without
+    interpolation. The terms of a block's own states (T_L within a block) are left out (a few states a step)."""
     if plan is None or not plan.active:
-        return 0, 0.0
+        return 0, 0.0, 0.0
     from .interp import state_weights
-    steps, work = 0, 0.0
+    steps, work, span = 0, 0.0, 0.0
     R = plan.L
     for n0 in range(0, n_steps, block):
         C = np.zeros((block, plan.k, R))
@@ -209,8 +218,13 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
             lo = n0 + 1 - R
             m = np.arange(max(lo, 1), min(n0, n - 1) + 1)
             C[i][:, m - lo] = coef[m].T
-        work += block * sum((j1 - j0) * (e - a) for j0, j1, a, e in _spans(C))
-    return steps, work
+        sp = _spans(C)
+        w = block * sum((j1 - j0) * (e - a) for j0, j1, a, e in sp)
+        if len(sp) == 1 and sp[0][1] - sp[0][0] > 1:
+            span += w
+        else:
+            work += w
+    return steps, work, span
 
 
 def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
@@ -224,7 +238,8 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
     step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
-    (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums``, and
+    (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums`` anchor by anchor
+    and ``r_sums_span`` over the anchors' common span, and
     ``t_step_dof`` per step and DOF."""
     r = dict(RATES, **(rates or {}))
     active = plan is not None and plan.active
@@ -237,9 +252,9 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     ring = 8.0 * n_dofs * ((int(L) + 2 + 31) + ranks * (2 + 3 + 32))
     factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
     nbytes = float(g_bytes) + ring + factors
-    build = t_build = flops = sums = 0.0
+    build = t_build = flops = sums = sums_span = 0.0
     n = np.arange(1, n_steps + 1)
-    isteps, iwork = interp_work(plan, n_steps, block, stabilized)
+    isteps, iwork, ispan = interp_work(plan, n_steps, block, stabilized)
     vbytes = 8.0 if single else 16.0
     for g, m in ((lat, 144), (glat, 180)):
         if g is None:
@@ -253,13 +268,14 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
         flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         sums += 2.0 * 54 * F * iwork
+        sums_span += 2.0 * 54 * F * ispan
     # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
     # transforms over the FFT grids of both sides (t_step_grid a grid point) and the transforms' inputs
     # element by element (t_step_elem a virtual element: a symmetric model's images count, so its step
     # costs nearly a whole model's for a quarter of the DOFs)
     grid = sum(g.Mx * g.My for g in (lat, glat) if g is not None)
     elems = sum(g.cell.size for g in (lat, glat) if g is not None)       # virtual elements: images too
-    t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"])
+    t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
               + n_steps * (n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]))
     return nbytes + build, t_build, t_hist
 

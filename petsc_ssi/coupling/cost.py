@@ -7,13 +7,17 @@ assembles it). What the coupling adds is counted here, in three parts:
   structure    measured, not modelled: the estimate assembles K and M and factorises D as the run
                does (seconds on every structure this code meshes), and times solves with D
                (t_fs, the median of a few) and the growth of the resident memory (the factors)
-  interface    3 n_I columns Z = A^-1 H_s e_j: 3 n_I BEM solves (bem.cost.bem_solve_seconds,
-  set-up       the BEM model's solve) and, implicit, 3 n_I solves with D (t_fs); plus the dense
-               products (flops / r_cpl)
+  interface    3 n_I columns Z = A^-1 H_s e_j, solved 256 at a time by one multi-right-hand-side
+  set-up       solve of the factors (petsc.solve_columns): a column costs r_mms times one BEM step
+               solve (bem.cost.bem_solve_seconds, the BEM model's solve) and, implicit, r_mms times
+               one solve with D (t_fs); plus the bonded interface system's LU (2/3 (3 n_I)^3 flops,
+               replicated) at r_cpl flop/s. (Until 2026-11-29 it also priced 3 n_I products with Z's
+               local rows, which the set-up does not make: 45 s of the uniform 72 m building's 68 s.)
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products
-               (Z's local rows: 2 (3 N / p) (3 n_I) flops twice; M3 and Z_II: 2 (3 n_I)^2 each,
-               replicated) at r_cpl flop/s, the step's BEM residual (two products with the step
-               matrices, part of c_cstep), the contact law and the step's bookkeeping c_cstep
+               (Z's local rows: 2 (3 N / p) (3 n_I) flops, and, implicit, D^-1 T^T's: 2 (n_fem / p)
+               (3 n_I); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
+               residual (two products with the step matrices, part of c_cstep), the contact law and
+               the step's bookkeeping c_cstep
   memory       the interface matrices (``interface_bytes``) and the structure's measured growth
                times the ranks
 
@@ -25,7 +29,13 @@ import time
 
 from ..sysmem import process_rss
 
-FALLBACK = {"r_cpl": 2.0e9, "c_cstep": 4.0e-3, "n_fs": 2}
+# r_mms: a column of the multi-right-hand-side solves over one single solve (MUMPS reads the factors once a
+# chunk of 256 columns; a single solve is bound by reading them). Measured on 2 ranks (-log_view, the set-up's
+# SSI_BEM_Solve over its columns against the time loop's SSI_BEM_Solve a step): the paper's building, 825
+# columns, 0.25 (jobscripts/building_estimate.sh); the building on the uniform 72 m grid, 1425 columns of a
+# 44 649-DOF step matrix, 0.15 (jobscripts/building_uniform.sh); 0.2 between them. Before, every column was
+# priced as a single solve (the uniform 72 m building's interface set-up: 155 s predicted, 21-27 s measured).
+FALLBACK = {"r_cpl": 2.0e9, "c_cstep": 4.0e-3, "n_fs": 2, "r_mms": 0.2}
 
 
 class CoupledCounts:
@@ -58,10 +68,9 @@ class CoupledCounts:
         k = dict(FALLBACK)
         k.update(c or {})
         n = 3 * self.nI
-        flops_col = 2.0 * (3.0 * self.N / p) * n               # one product with Z's local rows
-        setup = self.fem_setup_s + n * (bem_solve_s + (self.fem_solve_s if self.implicit else 0.0)) \
-            + n * flops_col / k["r_cpl"]
-        per_step = step_seconds(c, self.nI, self.N, p, self.fem_solve_s)
+        setup = self.fem_setup_s + n * k["r_mms"] * (bem_solve_s + (self.fem_solve_s if self.implicit else 0.0)) \
+            + 2.0 / 3.0 * n ** 3 / k["r_cpl"]
+        per_step = step_seconds(c, self.nI, self.N, p, self.fem_solve_s, self.n_fem if self.implicit else 0)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
                 "cpl_bytes": self._iface_bytes(p) + self.fem_bytes * p / max(self.ranks_measured, 1)}
 
@@ -85,15 +94,16 @@ def solve_seconds(integ, comm, n_solves=5):
     return float(mpi.bcast(statistics.median(times)))        # (rank 0's: every rank predicts the same)
 
 
-def step_seconds(c, n_i, n_soil, p, fem_solve_s):
+def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0):
     """Seconds the coupling adds to each step on p ranks (module docstring, 'per step'): n_fs solves with
-    D, the dense interface products at r_cpl flop/s and c_cstep; ``c``: the constants (FALLBACK where
-    they have none). ``petsc-ssi estimate`` and the coupled run's own prediction both use it."""
+    D, the dense interface products at r_cpl flop/s (Z's local rows; ``n_fem`` > 0, the implicit step:
+    D^-1 T^T's) and c_cstep; ``c``: the constants (FALLBACK where they have none). ``petsc-ssi estimate``
+    and the coupled run's own prediction both use it."""
     k = dict(FALLBACK)
     k.update(c or {})
     n = 3 * n_i
-    flops_col = 2.0 * (3.0 * n_soil / p) * n
-    return k["n_fs"] * fem_solve_s + (2 * flops_col + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
+    flops = 2.0 * (3.0 * n_soil / p) * n + 2.0 * (n_fem / p) * n
+    return k["n_fs"] * fem_solve_s + (flops + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
 
 
 def describe(cc):

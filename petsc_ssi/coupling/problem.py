@@ -111,7 +111,8 @@ class SSITransient(TransientProblem):
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
             self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
-                                             prob.mesh.n_nodes, comm.getSize(), self.fem_solve_s)
+                                             prob.mesh.n_nodes, comm.getSize(), self.fem_solve_s,
+                                             self.model.dofmap.size if cfg.coupling == "implicit" else 0)
         self.print_loop_line()
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
