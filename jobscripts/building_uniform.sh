@@ -12,7 +12,8 @@
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
 #                  T_L and k, kept transforms in single precision): what the history sum's options save
-#   estimate       (not by default) petsc-ssi estimate of uniform-72 -> OUT/uniform-72.estimate
+#   estimate       (not by default) petsc-ssi estimate of uniform-36 and uniform-72 -> OUT/uniform-36.estimate,
+#                  OUT/uniform-72.estimate
 #   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
 #                  coupled case (every recorded series' largest difference over the largest value of its kind)
 # The far lags are interpolated as in today's run (Chebyshev from T_L = 0.27 s, k = 20: ssi-common.opts).
@@ -50,9 +51,11 @@ for r in $RUNS; do
     # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz
     check) run check-dense "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 -ssi_lag_store dense
            run check-toeplitz "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 ;;
-    # petsc-ssi estimate of uniform-72 (the cost model's prediction beside the run; not a run)
-    estimate) "$PY" -m petsc_ssi estimate "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA -ssi_estimate_ranks "$RANKS" \
-                > "$OUT/uniform-72.estimate" 2>&1 || true ;;
+    # petsc-ssi estimate of uniform-36 and uniform-72 (the cost model's prediction beside the runs; not runs)
+    estimate) for size in 36,37.2 72,73.2; do
+                "$PY" -m petsc_ssi estimate "${B[@]}" "${U[@]}" -ssi_mesh_size $size $EXTRA -ssi_estimate_ranks "$RANKS" \
+                  > "$OUT/uniform-${size%%,*}.estimate" 2>&1 || true
+              done ;;
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
