@@ -304,3 +304,21 @@ def test_a_partial_benchmark_rerun_keeps_the_other_rows():
     assert merge(old[:2] + ["| paper-quarter | 2 |"], new) == new        # nothing to keep: the new table as it is
     wider = ["| run | s | peak |", "|---|---|---|", "| paper-quarter | 5 | 1 |"]
     assert merge(old, wider) == wider                  # other columns: the old rows would shift, so they go
+
+
+def test_the_profile_table_counts_each_function_once_a_stack(tmp_path):
+    """jobscripts/spy_table.table (jobscripts/spy_profile.sh's summary): a function's samples are those of
+    the stacks that hold it, counted once a stack however deep the recursion and whatever line; --filter
+    keeps the stacks through a function."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from spy_table import table
+    prof = tmp_path / "prof.0.txt"
+    prof.write_text("main (a.py:1);solve (b.py:3);MatMatSolve (libpetsc.so);VecScatterCreate (libpetsc.so) 5\n"
+                    "main (a.py:1);solve (b.py:4);solve (b.py:9);MatSolve (libpetsc.so) 3\n"
+                    "main (a.py:2);history (c.py:7) 2\n")
+    tot, inc = table(str(prof))
+    assert tot == 10 and inc["main (a.py)"] == 10 and inc["solve (b.py)"] == 8
+    assert inc["VecScatterCreate (libpetsc.so)"] == 5 and inc["history (c.py)"] == 2
+    tot, inc = table(str(prof), "VecScatterCreate")
+    assert tot == 5 and inc["solve (b.py)"] == 5 and "history (c.py)" not in inc
