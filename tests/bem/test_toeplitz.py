@@ -370,12 +370,14 @@ def test_the_estimate_of_a_coupled_run_on_the_toeplitz_store():
     import re
     soil = cli(["estimate", "-ssi_problem", "bem"] + SSI[2:] + TZ + ["-ssi_estimate_ranks", "1"], check=False).stdout
     r = cli(["estimate"] + SSI + TZ + ["-ssi_estimate_ranks", "1,2"])
-    assert "estimate of this BEM run on the toeplitz lag store" in r.stdout and "coupling:" in r.stdout
+    assert "estimate of this coupled run on the toeplitz lag store" in r.stdout and "coupling:" in r.stdout
     assert "blocks assembled" not in r.stdout                 # (the dense model's line)
-    row = re.search(r"\[ssi\]\s+1 \|\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+) \|\s+(\S+) \|", r.stdout)
+    # kernels, history, the step matrix's factorisation and solves, the coupling's set-up and steps, total
+    row = re.search(r"\[ssi\]\s+1 \|\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+) \|\s+(\S+) \|",
+                    r.stdout)
     assert row, r.stdout
-    kern, hist, setup, loop = (float(row.group(i)) for i in (1, 2, 3, 4))
-    assert kern > 0 and hist > 0 and setup > 0 and loop > 0
-    gb = float(row.group(6))
+    kern, hist, fac, solve, setup, loop = (float(row.group(i)) for i in range(1, 7))
+    assert kern > 0 and hist > 0 and fac > 0 and solve > 0 and setup > 0 and loop > 0
+    gb = float(row.group(8))
     soil_gb = float(re.search(r"\[ssi\]\s+1 \|\s+\S+\s+\S+ \|\s+(\S+) \|", soil).group(1))
     assert gb > soil_gb, (gb, soil_gb)
