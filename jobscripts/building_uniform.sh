@@ -12,6 +12,9 @@
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
 #                  T_L and k, kept transforms in single precision): what the history sum's options save
+#   uniform-72-blr (not by default) uniform-72 with the step matrix's MUMPS LU in block low-rank form (BLR:
+#                  -ssi_bem_mat_mumps_icntl_35 2 -ssi_bem_mat_mumps_cntl_7 $BLR_EPS, default 1e-12): the factors,
+#                  the interface columns and the step solves cheaper, the answer moved by about the dropping threshold
 #   estimate       (not by default) petsc-ssi estimate of uniform-36 and uniform-72 -> OUT/uniform-36.estimate,
 #                  OUT/uniform-72.estimate
 #   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
@@ -31,6 +34,7 @@ RUNS=${RUNS:-"today today-load15 uniform-36 uniform-72"}
 T_END=${T_END:-}
 EXTRA=${EXTRA:-}
 FAST=${FAST:-"-ssi_interp linear -ssi_toeplitz_precision single"}
+BLR_EPS=${BLR_EPS:-1e-12}
 mkdir -p "$OUT"
 "$PY" -m petsc_ssi.app.warmup > /dev/null
 B=(-options_file runs/building/ssi-full-bonded.opts ${T_END:+-ssi_t_end "$T_END"})
@@ -48,6 +52,8 @@ for r in $RUNS; do
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
     uniform-72-fast) run uniform-72-fast "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $FAST ;;
+    uniform-72-blr) run uniform-72-blr "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 -ssi_bem_mat_mumps_icntl_35 2 \
+                      -ssi_bem_mat_mumps_cntl_7 "$BLR_EPS" ;;
     # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz
     check) run check-dense "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 -ssi_lag_store dense
            run check-toeplitz "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 -ssi_t_end 0.03 ;;

@@ -38,20 +38,29 @@ MESH = {"today": "graded 36 x 36 m (building_soil.geo), 1 m load at x = 14.5",
         "uniform-36": "uniform 36 x 37.2 m, 1.2 m cells, 1.2 m load at x = 15",
         "uniform-72": "uniform 72 x 73.2 m, 1.2 m cells, 1.2 m load at x = 15",
         "uniform-72-fast": "as uniform-72, multi-linear far lags, single-precision transforms",
+        "uniform-72-blr": "as uniform-72, the step matrix's MUMPS LU block low-rank (ICNTL(35) 2, CNTL(7) {eps})",
         "check-dense": "uniform 36 x 37.2 m, 6 steps", "check-toeplitz": "uniform 36 x 37.2 m, 6 steps"}
 PAIRS = [("uniform-72", "today", "uniform 72 m (toeplitz) vs today"),
          ("today-load15", "today", "load: 1.2 m cell at x = 15 vs 1 m patch at 14.5 (graded mesh both)"),
          ("uniform-36", "today-load15", "uniform 1.2 m cells vs graded, same extent and load"),
          ("uniform-72", "uniform-36", "extent 72 m vs 36 m (edge reflections), uniform both"),
          ("uniform-72", "today-load15", "uniform 72 m vs graded 36 m, same load"),
-         ("uniform-72-fast", "uniform-72", "multi-linear far lags, single transforms vs Chebyshev, double")]
+         ("uniform-72-fast", "uniform-72", "multi-linear far lags, single transforms vs Chebyshev, double"),
+         ("uniform-72-blr", "uniform-72", "block low-rank LU ({eps}) vs full-rank LU of the step matrix")]
+
+
+def blr_eps(outdir):
+    """The BLR run's dropping threshold, from its log's options (building_uniform.sh BLR_EPS)."""
+    path = os.path.join(outdir, "uniform-72-blr.log")
+    m = re.search(r"-ssi_bem_mat_mumps_cntl_7 (\S+)", open(path, errors="replace").read()) if os.path.exists(path) else None
+    return m.group(1) if m else "?"
 
 
 def cost_row(outdir, name):
     log = os.path.join(outdir, name + ".log")
     text = open(log, errors="replace").read()
     lv = parse(text)
-    r = {"run": name, "soil mesh": MESH.get(name, name),
+    r = {"run": name, "soil mesh": MESH.get(name, name).replace("{eps}", blr_eps(outdir)),
          "store": "toeplitz" if "lag store: toeplitz" in text else "dense"}
     m = re.search(r"(\d+) DOFs", text)
     r["soil DOFs"] = int(m.group(1)) if m else ""
@@ -165,6 +174,7 @@ def main(outdir, *readmes):
     for a, b, what in PAIRS:
         if a not in rec or b not in rec:
             continue
+        what = what.replace("{eps}", blr_eps(outdir))
         rows = compare(rec[a], rec[b])
         for r in rows:
             detail.append(dict(pair=f"{a} vs {b}", **r))

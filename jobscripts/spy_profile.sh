@@ -4,7 +4,7 @@
 # samples whose stack holds it), rank 0's by default.
 #   bash jobscripts/spy_profile.sh OUT RANKS PETSC-SSI-OPTIONS...
 #   e.g. bash jobscripts/spy_profile.sh /tmp/spy 2 -options_file runs/building/ssi-full-bonded.opts -ssi_t_end 0.4
-# Writes OUT/prof.<rank>.txt (py-spy's raw collapsed stacks, 50 samples a second) and OUT/run.log, then
+# OUT relative to the repository root (the script works there). Writes OUT/prof.<rank>.txt (py-spy's raw collapsed stacks, 50 samples a second) and OUT/run.log, then
 # prints `python jobscripts/spy_table.py OUT/prof.0.txt` (FILTER=name: only the stacks through that
 # function, e.g. FILTER=VecScatterCreate; TOP=n lines). Needs py-spy (`.venv/bin/pip install py-spy`: a
 # development tool, not installed by `make deps`); sampling slows the ranks by a few per cent.
@@ -17,9 +17,10 @@ if [ ! -x "$SPY" ]; then
   exit 2
 fi
 mkdir -p "$OUT"
+OUT=$(realpath "$OUT"); PYA=$(realpath "$PY"); SPY=$(realpath "$SPY")
 "$PY" -m petsc_ssi.app.warmup > /dev/null
-# each rank under py-spy, its output named by the rank (OpenMPI's environment)
+# each rank under py-spy, its output named by the rank (OpenMPI's environment); the paths as arguments
 mpirun --allow-run-as-root --oversubscribe -n "$RANKS" bash -c \
-  "exec '$SPY' record --native -r 50 -f raw -o '$OUT/prof.'\$OMPI_COMM_WORLD_RANK'.txt' -- '$PWD/$PY' -m petsc_ssi \"\$@\"" \
-  spy "$@" -ssi_output "$OUT/run.h5" -ssi_output_overwrite -log_view > "$OUT/run.log" 2>&1
+  'exec "$1" record --native -r 50 -f raw -o "$2/prof.$OMPI_COMM_WORLD_RANK.txt" -- "$3" -m petsc_ssi "${@:4}"' \
+  spy "$SPY" "$OUT" "$PYA" "$@" -ssi_output "$OUT/run.h5" -ssi_output_overwrite -log_view > "$OUT/run.log" 2>&1
 "$PY" jobscripts/spy_table.py "$OUT/prof.0.txt" ${FILTER:+--filter "$FILTER"} ${TOP:+--top "$TOP"}

@@ -41,9 +41,8 @@ def main():
     print(f"{tot} samples ({tot / a.rate:.1f} s at {a.rate:g} a second)" + (f" through '{a.filter}'" if a.filter else ""))
     print("| samples | seconds | share of these samples | function (file) |")
     print("|---|---|---|---|")
-    for f, v in inc.most_common(a.top):
-        if f.startswith("0x"):                   # unresolved native frames: addresses only
-            continue
+    named = [(f, v) for f, v in inc.most_common() if not f.startswith("0x")]   # (unresolved native frames)
+    for f, v in named[:a.top]:
         print(f"| {v} | {v / a.rate:.1f} | {100.0 * v / max(tot, 1):.1f} % | {f[:140]} |")
 
 

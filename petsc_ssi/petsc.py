@@ -393,7 +393,11 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     try:
         def rhs(j0, j1):
             """The right-hand sides j0 .. j1-1 as an array, or None (fill them one by one)."""
-            return None if block is None else block(j0, j1)
+            blk = None if block is None else block(j0, j1)
+            if blk is not None and blk.shape != (template.getLocalSize(), j1 - j0):
+                raise ValueError(f"solve_columns: block({j0}, {j1}) gave shape {blk.shape}, not "
+                                 f"({template.getLocalSize()}, {j1 - j0})")
+            return blk
 
         if F is None:
             for j0 in range(0, m, chunk):

@@ -370,13 +370,16 @@ class BSRMat:
             self._unique = bool(np.all((np.diff(rows[o]) > 0) | (np.diff(self.indices[o]) > 0)))
         if not self._unique:
             return None
-        dofs, back = np.unique(np.asarray(dofs, np.int64), return_inverse=True)     # (a column asked twice)
+        dofs = np.asarray(dofs, np.int64)
+        back = None
+        if dofs.size > 1 and not np.all(np.diff(dofs) > 0):        # (unsorted, or a column asked twice)
+            dofs, back = np.unique(dofs, return_inverse=True)
         nloc = self.indptr.size - 1
         out = np.zeros((3 * nloc, dofs.size))
         want = np.full(self.sizes[1][1], -1, np.int64)
         want[dofs] = np.arange(dofs.size)
         wn = want.reshape(-1, 3)
-        hit = np.flatnonzero(np.any(wn[self.indices] >= 0, axis=1))       # blocks in a wanted column node
+        hit = np.flatnonzero(np.any(wn >= 0, axis=1)[self.indices])       # blocks in a wanted column node
         rows = np.searchsorted(self.indptr, hit, side="right") - 1
         d = self.data                           # (nnzb, m)
         for s, (p, q) in enumerate(PATTERNS[self.pattern]):
@@ -390,7 +393,7 @@ class BSRMat:
                 k = j >= 0
                 for p in range(3):
                     out[3 * i[k] + p, j[k]] += self.diag[i[k], p, q]
-        return out[:, back]
+        return out if back is None else out[:, back]
 
     def panel(self, XT, RT, sign):
         """RT += sign * (local rows) @ XT: XT (all columns x b), RT (local rows x b), C order."""

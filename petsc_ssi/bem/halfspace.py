@@ -518,7 +518,7 @@ class HalfSpace:
         lags are kernels on the store, ``toeplitz.estimate``): block-sparse, 44 B a block (5 values and a
         column), their blocks counted as H's below over the traction elements alone, n_t / (traction
         elements) columns an element, or dense (N x n_t blocks of 5 values) where a lag's fill exceeds
-        -ssi_lag_fill, as ``build._traction_g`` stores them; H lags 1 and 2 as Mats (block-sparse: their
+        -ssi_lag_fill or -ssi_lag_storage dense asks, as ``build._traction_g`` stores them; H lags 1 and 2 as Mats (block-sparse: their
         wave reaches a few elements) and the step matrix's factors, counted from the blocks of the lag-2
         window on a sample of rows, 36 B a block, three times over."""
         from .windows import estimate_blocks
@@ -532,8 +532,10 @@ class HalfSpace:
         if nt and tel.size:
             nbg = estimate_blocks(self.mesh.nodes, rows, ls.Vc[tel], ls.VR[tel], 2, self.mat, self.dt, nimg) * scale
             nbg = mpi.allreduce(nbg) / 4.0 * (nt / max(tel.size / nimg, 1.0))
+            st = self.cfg.lag_storage
             for b in nbg[:min(2, plan.Lx)]:
-                g += 40.0 * N * nt if b / float(N * nt) > self.cfg.lag_fill else 44.0 * b
+                dense = st == "dense" or (st == "auto" and b / float(N * nt) > self.cfg.lag_fill)
+                g += 40.0 * N * nt if dense else 44.0 * b
         return g + 3 * 36.0 * mpi.allreduce(float(nb.sum()))
 
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):

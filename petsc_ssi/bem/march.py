@@ -264,7 +264,12 @@ class Marcher:
             if col is None:
                 out = None
                 break
-            out = c * col if out is None else out + c * col
+            if c != 1.0:
+                col *= c                        # (in place: the chunk's arrays stay two)
+            if out is None:
+                out = col
+            else:
+                out += col
         from mpi4py import MPI
         if not self.comm.tompi4py().allreduce(out is not None, op=MPI.LAND):
             return None
