@@ -17,7 +17,10 @@ if [ ! -x "$SPY" ]; then
   exit 2
 fi
 mkdir -p "$OUT"
-OUT=$(realpath "$OUT"); PYA=$(realpath "$PY"); SPY=$(realpath "$SPY")
+# absolute paths without resolving symbolic links (the venv's python is a link to the system's: resolved,
+# it would lose the venv's packages)
+abs() { echo "$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"; }
+OUT=$(abs "$OUT"); PYA=$(abs "$PY"); SPY=$(abs "$SPY")
 "$PY" -m petsc_ssi.app.warmup > /dev/null
 # each rank under py-spy, its output named by the rank (OpenMPI's environment); the paths as arguments
 mpirun --allow-run-as-root --oversubscribe -n "$RANKS" bash -c \
