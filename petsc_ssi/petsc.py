@@ -368,7 +368,8 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     """Collective: x_j = A^-1 b_j for j = 0 .. m-1 with the KSP's operator A. ``fill(j, b)`` writes
     right-hand side j into the Vec b (layout of ``template``), ``take(j, x)`` receives its solution
     (a Vec, valid during the call); ``block(j0, j1)``, if given, returns the local rows of the
-    right-hand sides j0 .. j1-1 at once as an array (local size, j1 - j0), or None (then ``fill``). When the KSP is a direct solve (preonly with an LU or Cholesky
+    right-hand sides j0 .. j1-1 at once as an array (local size, j1 - j0), or None (then ``fill``).
+    When the KSP is a direct solve (preonly with an LU or Cholesky
     factorisation by MUMPS, or PETSc's own on one rank) the columns are solved ``chunk`` at a time in
     one multi-right-hand-side solve of the factors (MatMatSolve: the triangular solves done for
     many columns at once, 3-10x fewer seconds than one solve per column; the solutions equal to
