@@ -180,12 +180,11 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
                    "nbaij": nbaij, "nsingle": nsingle, "fill": float("nan"), "mem": mem_exact + mem_interp}
 
 
-def _traction_g(comm, prob, plan, ls, lag_hi, lag_lo=1, toff=0.0, storage="dense", fill=0.95):
+def _traction_g(comm, prob, plan, ls, lag_hi, storage, fill, lag_lo=1, toff=0.0):
     """Collective: the G lags lag_lo..lag_hi (at kernel times l dt + toff), from an assembly over the
     elements that carry traction columns only (the others add nothing to G; the same elements in the
-    same order: the same blocks), stored as ``storage`` (-ssi_lag_storage; ``fill`` its threshold):
-    the dense path's "dense" or, on the toeplitz store, "auto": lags 1-2 reach only the soil nodes
-    near the traction elements, where a dense Mat of every soil node's rows was read in full at each
+    same order: the same blocks), stored as ``storage`` (-ssi_lag_storage, auto by default; ``fill`` its
+    threshold; the toeplitz store calls it): lags 1-2 reach only the soil nodes near the traction elements, where a dense Mat of every soil node's rows was read in full at each
     step (the uniform 72 m building, 484 traction nodes: 2 x 0.29 GB; block-sparse, its first 80 steps'
     MatMults 2.9 -> 1.4 s and the lags' panel products, 1.8 s, gone: jobscripts/README.md)."""
     nt = prob.regions.n_t
@@ -219,7 +218,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         H = list(H) + [None] * (plan.Lx - 2)
         G = [None] * plan.Lx
         if prob.regions.n_t:
-            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), storage=cfg.lag_storage, fill=prob.lag_fill)
+            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), cfg.lag_storage, prob.lag_fill)
             G[:len(g)] = g
             nev += tl.kernel_evaluations
     ls.H = ls.G = None

@@ -518,9 +518,9 @@ class HalfSpace:
         lags are kernels on the store, ``toeplitz.estimate``): block-sparse, 44 B a block (5 values and a
         column), their blocks counted as H's below over the traction elements alone, n_t / (traction
         elements) columns an element, or dense (N x n_t blocks of 5 values) where a lag's fill exceeds
-        -ssi_lag_fill or -ssi_lag_storage dense asks, as ``build._traction_g`` stores them; H lags 1 and 2 as Mats (block-sparse: their
-        wave reaches a few elements) and the step matrix's factors, counted from the blocks of the lag-2
-        window on a sample of rows, 36 B a block, three times over."""
+        -ssi_lag_fill or -ssi_lag_storage dense asks, as ``build._traction_g`` stores them; H lags 1 and 2
+        as Mats (block-sparse: their wave reaches a few elements) and the step matrix's factors, counted
+        from the blocks of the lag-2 window on a sample of rows, 36 B a block, three times over."""
         from .windows import estimate_blocks
         mpi = self.comm.tompi4py()
         N, nt, nimg = self.mesh.n_nodes, self.regions.n_t, max(1, len(ls.Vc) // self.mesh.n_cells)
