@@ -304,13 +304,18 @@ def pais_kausel(mode, a0, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
 def pais_kausel_embedment(mode, D_B, LB=1.0):
     """Pais & Kausel's static embedment factor eta = K_emb / K_sur of a rectangle 2L x 2B embedded D deep
     with its side walls in contact (NIST GCR 12-917-21 Table 2-2b; runs/embedment/static_stiffness.py).
-    Vertical and horizontal (either direction: the table gives one factor for both)."""
+    Vertical and horizontal (either direction: the table gives one factor for both), rocking (about y,
+    the project's "rocking": eta_yy, taken about the centre of the base) and torsion (eta_zz)."""
     r = _check_rect(mode, LB)
     if mode == "vertical":
         return 1.0 + (0.25 + 0.25 / r) * D_B ** 0.8
     if mode in ("horizontal", "horizontal_y"):
         return 1.0 + (0.33 + 1.34 / (1.0 + r)) * D_B ** 0.8
-    raise NotImplementedError(f"embedment factor of {mode!r}: only vertical and horizontal here")
+    if mode == "rocking":
+        return 1.0 + D_B + 1.6 / (0.35 + r ** 4) * D_B ** 2
+    if mode == "torsion":
+        return 1.0 + (1.3 + 1.32 / r) * D_B ** 0.9
+    raise NotImplementedError(f"embedment factor of {mode!r}: vertical, horizontal, rocking and torsion only")
 
 
 def pais_kausel_embedded(mode, a0, D_B, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
@@ -322,19 +327,38 @@ def pais_kausel_embedded(mode, a0, D_B, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
         vertical      c = 4 (psi L/B + D/B (1 + L/B)) / (K0 / (G B))
         horizontal    c = 4 (L/B + D/B (psi + L/B)) / (K0 / (G B))          (along the long side, x)
         horizontal_y  c = 4 (L/B + D/B (1 + psi L/B)) / (K0 / (G B))        (along the short side, y)
+        rocking       c = (4/3) [psi + 4 D/B + (1 + psi) (D/B)^3] a0^2 / (1.8 + a0^2) / (K0 / (G B^3))
+                        + (4/3) (1 + psi) (D/B)^3 / (K0 / (G B^3))                 (the square only)
 
     Source: the only transcription of Table 2-3b found, eng-tools/geofound's
     geofound/damping/pais_1988.py ([T3] of the module docstring). Each bracket is the sum of the
     plane-wave dashpots of the base and of the four walls (rho c_p on the faces the motion pushes,
     rho c_s on those it shears, psi for c_p/c_s): that independent reading gives the same terms.
-    Vertical and horizontal only (the embedded rocking and torsion are not transcribed here)."""
+    The rocking (about y, through the centre of the base, K0 = eta_yy K_yy) is [T3]'s beta_yy of Table
+    2-3b at L/B = 1: its first bracket is again the plane-wave sum (base psi I/B^4 = (4/3) psi; the walls
+    x = +-L in shear 4 D/B and pushed (4/3) psi (D/B)^3, the walls y = +-B in shear (4/3)(D/B + (D/B)^3)),
+    reduced at low a0 by a0^2 / (1.8 + a0^2) as the surface's (Table 2-3a, 1.8 at L/B = 1); the second
+    term, (4/3)(1 + psi)(D/B)^3 without that reduction, is as [T3] prints it (so c tends to more than the
+    plane-wave sum). [T3] writes the a0^2 factor's denominator as a multiplication (an operator-precedence
+    slip: c would grow as a0^4); read as the surface formula's division. For L/B != 1 [T3]'s wall terms
+    do not match the plane-wave reading (which side's walls carry psi) and its rocking about x takes the
+    yy factor 1.8/(1 + 1.75(L/B - 1)) where Table 2-3a's xx has 2.2 - 0.4/(L/B)^3: refused there.
+    Embedded torsion: not transcribed in any source found (refused)."""
     r = _check_rect(mode, LB)
     nu = _check_nu(nu)
     a = _a0_array(a0)
+    if mode not in ("vertical", "horizontal", "horizontal_y", "rocking"):
+        raise NotImplementedError(f"embedded damping of {mode!r}: vertical, horizontal and (square) rocking only")
+    if mode == "rocking" and r != 1.0:
+        raise NotImplementedError(f"embedded rocking damping of a rectangle L/B = {r:g}: the square (L/B = 1) only")
     eta = pais_kausel_embedment(mode, D_B, r)
-    Kn = eta * pais_kausel_static(mode, r, nu)                 # K_emb / (G B)
+    Kn = eta * pais_kausel_static(mode, r, nu)                 # K_emb / (G B) or K_emb / (G B^3)
     alpha, _ = _pk_alpha_c(mode, a, r, nu)
     p = psi(nu)
+    if mode == "rocking":
+        bracket = ((4.0 / 3.0) * (p + 4.0 * D_B + (1.0 + p) * D_B ** 3) * a * a / (1.8 + a * a)
+                   + (4.0 / 3.0) * (1.0 + p) * D_B ** 3)
+        return Kn * G * B ** 3, _out(alpha, a), _out(bracket / Kn, a)
     bracket = {"vertical": 4.0 * (p * r + D_B * (1.0 + r)), "horizontal": 4.0 * (r + D_B * (p + r)),
                "horizontal_y": 4.0 * (r + D_B * (1.0 + p * r))}[mode]
     return Kn * G * B, _out(alpha, a), _out(bracket / Kn * np.ones_like(a), a)

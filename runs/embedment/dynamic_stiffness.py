@@ -16,7 +16,9 @@ The references, in the same normalisation (each by its own static stiffness):
     surface   k = alpha_j (Table 2-3a), c = the bracket of beta_j (2 alpha beta / a0)
     embedded  k = alpha_j (Table 2-3b: the surface modifiers), c = the embedded bracket over the embedded
               static stiffness K_emb = eta K_sur (Table 2-2b): vertical 4 (psi L/B + D/B (1 + L/B)),
-              horizontal 4 (L/B + D/B (psi + L/B)), psi = c_p / c_s (capped at 2.5).
+              horizontal 4 (L/B + D/B (psi + L/B)), rocking (about the base's centre) the plane-wave sum
+              (4/3) (psi + 4 D/B + (1 + psi) (D/B)^3) times a0^2 / (1.8 + a0^2) plus (4/3) (1 + psi) (D/B)^3
+              (``impedance_refs.pais_kausel_embedded``: read from [T3]), psi = c_p / c_s (capped at 2.5).
 The trusted band of a0 is the impedance command's: two frequency bins of the record, one Rayleigh
 wavelength across the ground, four elements per shear wavelength and omega dt <= 0.3.
 
@@ -34,7 +36,11 @@ import numpy as np
 
 SOIL = dict(cp=548.0, cs=316.0, rho=2000.0)
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-MODES = {"vertical": ("0,0,1e-6", 2, "x=sym,y=sym"), "horizontal": ("1e-6,0,0", 0, "x=anti,y=sym")}
+# per mode: the footing's translation [m], its rotation [rad] (about the base's centre), the resultant's
+# component and kind, the quarter model's planes
+MODES = {"vertical": ("0,0,1e-6", "0,0,0", 2, "force", "x=sym,y=sym"),
+         "horizontal": ("1e-6,0,0", "0,0,0", 0, "force", "x=anti,y=sym"),
+         "rocking": ("0,0,0", "0,1e-6,0", 1, "moment", "x=anti,y=sym")}
 A0 = (0.5, 1.0, 1.5, 2.0)
 
 
@@ -45,7 +51,8 @@ def nu():
 
 def _run(opts, out):
     """One BEM run with -ssi_<key> <value> options (``python -m petsc_ssi`` in a child process: repeated
-    runs in one process kept gigabytes resident): (h (steps,), force (steps, 3) [N])."""
+    runs in one process kept gigabytes resident): (h (steps,), force (steps, 3) [N], moment (steps, 3) [N m]
+    about the motion's reference point)."""
     import h5py
     out = os.path.abspath(out)
     opts = dict(opts, problem="bem", scheme="plain", output=out, output_stride=0, output_overwrite=1, warn_beta=0,
@@ -56,16 +63,19 @@ def _run(opts, out):
     if p.returncode:
         raise RuntimeError(f"petsc-ssi {' '.join(args)} failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}")
     with h5py.File(out) as f:
-        return f["resultants/h"][:], f["resultants/force"][:]
+        return f["resultants/h"][:], f["resultants/force"][:], f["resultants/moment"][:]
 
 
-def impedance(mesh, mode, dt, t_end, out, B=1.0):
-    """(a0, k, c, K0 [N/m]) of ``mode`` for the rigid region of ``mesh`` (options), up to where the smooth
-    step's spectrum falls below 1e-3 of its peak (the impedance command's cut)."""
+def impedance(mesh, mode, dt, t_end, out, B=1.0, D=0.0):
+    """(a0, k, c, K0 [N/m, or N m/rad for rocking]) of ``mode`` for the rigid region of ``mesh`` (options),
+    up to where the smooth step's spectrum falls below 1e-3 of its peak (the impedance command's cut).
+    Rotations about the centre of the footing's base (0, 0, -D), as the static stiffness's
+    (runs/embedment/static_stiffness.py) and Table 2-2b's eta_yy."""
     from petsc_ssi.bem.impedance import spectrum, step_spectrum
-    val, comp, _ = MODES[mode]
-    h, F = _run(dict(mesh, disp_value=val, disp_ref="0,0,0", disp_t0=4 * dt, dt=dt, t_end=t_end), out)
-    R = F[:, comp] / 1e-6
+    val, rot, comp, kind, _ = MODES[mode]
+    h, F, M = _run(dict(mesh, disp_value=val, disp_rotation=rot, disp_ref=f"0,0,{-D:g}", disp_t0=4 * dt, dt=dt,
+                        t_end=t_end), out)
+    R = (F if kind == "force" else M)[:, comp] / 1e-6
     with np.errstate(divide="ignore", invalid="ignore"):        # beyond the pulse's band (cut below)
         om, K = spectrum(R, h, dt)
     Dh = np.abs(step_spectrum(h, dt)[1])
@@ -115,18 +125,18 @@ def curves(h=0.5, L=8.0, depths=(0.5,), dt=4.75e-4, t_end=0.1, modes=tuple(MODES
     flat = dict(mesh_size=f"{L},{L}", mesh_h=h, mesh_patch="1,1", disp_group="load")
     res = {}
     for mode in modes:
-        sym = dict(symmetry=MODES[mode][2])
+        sym = dict(symmetry=MODES[mode][4])
         cases = [("surface", dict(flat, **sym))]
         for D in depths:
             pit = dict(mesh="pit", mesh_params=f"a=1,b=1,d={D}", mesh_size=f"{L},{L}", mesh_h=h, disp_group="pit")
             cases.append((embedded(D), dict(pit, **sym) if quarter else pit))
         for name, mesh in cases:
-            a0, k, c, K0 = impedance(mesh, mode, dt, t_end, out)
+            a0, k, c, K0 = impedance(mesh, mode, dt, t_end, out, D=depth(name))
             res[(name, mode)] = (a0, k, c, K0) + tuple(references(mode, a0, depth(name)))
     return res
 
 
-HEAD = ("footing", "mode", "a0 [-]", "k [-]", "c [-]", "K0 [N/m]", "k_PK [-]", "c_PK [-]", "trusted [0/1]")
+HEAD = ("footing", "mode", "a0 [-]", "k [-]", "c [-]", "K0 [N/m; N m/rad rocking]", "k_PK [-]", "c_PK [-]", "trusted [0/1]")
 
 
 def at(a0, y, x):
@@ -175,7 +185,7 @@ def summary(path, lo=0.72, hi=1.997):
             for f in ("surface", name):
                 r = [x for x in rows if x["footing"] == f and x["mode"] == mode]
                 col = {k: np.array([float(x[k]) for x in r]) for k in ("a0 [-]", "k [-]", "c [-]", "c_PK [-]")}
-                d[f] = col, float(r[0]["K0 [N/m]"])
+                d[f] = col, float(r[0][HEAD[5]])
             (e, Ke), (s_, Ks) = d[name], d["surface"]
             a0 = e["a0 [-]"]
             sel = (a0 >= lo) & (a0 <= hi)
@@ -213,7 +223,7 @@ def main(argv):
     plot(res, os.path.splitext(out)[0] + ".png", (lo, hi))
     print(f"h = {h:g} m, ground {L:g} m x {L:g} m, dt = {dt:g} s, t_end = {t_end:g} s; "
           f"trusted a0 in [{lo:.2f}, {hi:.2f}]")
-    print("| footing | mode | K0 [N/m] | a0 [-] | k BEM [-] | k P&K [-] | c BEM [-] | c P&K [-] |")
+    print("| footing | mode | K0 [N/m; N m/rad] | a0 [-] | k BEM [-] | k P&K [-] | c BEM [-] | c P&K [-] |")
     print("|---|---|---|---|---|---|---|---|")
     for (name, mode), (a0, k, c, K0, kr, cr) in res.items():
         for x in A0:

@@ -35,11 +35,9 @@ SOIL = dict(cp=548.0, cs=316.0, rho=2000.0)
 
 
 def eta_pais_kausel(mode, D_B, L_B=1.0):
-    """Pais & Kausel's embedment factor (module docstring)."""
-    return {"vertical": 1 + (0.25 + 0.25 / L_B) * D_B ** 0.8,
-            "horizontal": 1 + (0.33 + 1.34 / (1 + L_B)) * D_B ** 0.8,
-            "torsion": 1 + (1.3 + 1.32 / L_B) * D_B ** 0.9,
-            "rocking": 1 + D_B + 1.6 / (0.35 + L_B ** 4) * D_B ** 2}[mode]
+    """Pais & Kausel's embedment factor (module docstring; ``impedance_refs.pais_kausel_embedment``)."""
+    from petsc_ssi.analytic.impedance_refs import pais_kausel_embedment
+    return pais_kausel_embedment(mode, D_B, L_B)
 
 
 def _run(opts, out):

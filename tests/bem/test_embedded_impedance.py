@@ -36,6 +36,33 @@ def test_pais_kausel_embedded_brackets_are_the_plane_wave_dashpots():
         assert np.isclose(K00, Ks) and np.allclose(c0, cs, rtol=1e-12)
 
 
+def test_pais_kausel_embedded_rocking_is_the_plane_wave_sum_plus_the_printed_wall_term():
+    """Table 2-3b's rocking of the square (as read from [T3] of impedance_refs): its a0-reduced bracket tends
+    to the plane-wave dashpot of base and walls about the base's centre, derived here from the faces'
+    second moments (base rho c_p I_y; the walls x = +-L in shear (z motion, arm L) and pushed (x motion,
+    arm z above the base); the walls y = +-B sheared by both); the unreduced (4/3)(1 + psi)(D/B)^3 is
+    added; at D = 0 it is the surface's Table 2-3a rocking; rectangles and embedded torsion are refused."""
+    from petsc_ssi.analytic import impedance_refs as ir
+    psi, D = 3 ** 0.5, 0.75                                    # nu = 0.25; B = L = 1
+    base = psi * 4.0 / 3.0                                     # integral of x^2 over [-1, 1]^2
+    walls_x = 2 * (2 * D * 1.0) + psi * 2 * (2 * D ** 3 / 3)   # two walls x = +-1: shear z (arm 1), normal x
+    walls_y = 2 * (D * 2.0 / 3.0) + 2 * (2 * D ** 3 / 3)       # two walls y = +-1: shear z (arm x), shear x
+    plane_wave = base + walls_x + walls_y
+    K0, k, c = ir.pais_kausel_embedded("rocking", [1e3, 1e4], D, 1.0, 0.25)
+    extra = 4.0 / 3.0 * (1 + psi) * D ** 3
+    assert np.allclose(c * K0, plane_wave + extra, rtol=1e-5)  # (a0^2 / (1.8 + a0^2) -> 1)
+    a0 = np.array([0.5, 1.0, 2.0])
+    _, _, c1 = ir.pais_kausel_embedded("rocking", a0, D, 1.0, 0.25)
+    assert np.allclose(c1 * K0, plane_wave * a0 ** 2 / (1.8 + a0 ** 2) + extra, rtol=1e-12)
+    assert np.isclose(K0, ir.pais_kausel_static("rocking", 1.0, 0.25) * (1 + D + 1.6 / 1.35 * D ** 2))
+    Ks, ks, cs = ir.pais_kausel("rocking", a0, 1.0, 0.25)
+    K00, k0, c0 = ir.pais_kausel_embedded("rocking", a0, 0.0, 1.0, 0.25)
+    assert np.isclose(K00, Ks) and np.allclose(c0, cs, rtol=1e-12) and np.allclose(k0, ks, rtol=1e-12)
+    for mode, LB in (("rocking", 2.0), ("torsion", 1.0)):
+        with pytest.raises(NotImplementedError):
+            ir.pais_kausel_embedded(mode, a0, D, LB, 0.25)
+
+
 def test_the_embedded_footings_walls_radiate(tmp_path):
     """h = 1 m, an 8 m ground, dt = 0.94 ms (trusted a0 0.72 - 1.01), horizontal: over a0 = 0.75 - 1 the
     embedded footing's c is within 15 % of Table 2-3b's (measured -8 %), at least 1.25 times the surface
