@@ -12,7 +12,8 @@
 //   c      the footing's half-width (m), c < a and c < b
 //   hf     the footing's height (m)
 //   h      the soil's element size (m): bricks of h/2; 2a/h, 2b/h, d/(h/2), (a-c)/(h/2), (b-c)/(h/2)
-//          and c/(h/2) must be integers (the region's faces must carry the soil's nodes)
+//          and c/(h/2) must be integers (the region's faces must carry the soil's nodes); with -ssi_mesh pit
+//          d/h too (its walls take round(d/h) elements: d = 1.5 with h = 1 gives 0.75 m wall elements)
 //   fill   1: the soil region and the footing; 0: the footing alone
 // Physical groups
 //   soil     volume: the region filling the pit (fill = 1)

@@ -71,7 +71,16 @@ def read_surface_mesh(cfg, comm, planes):
                 # an excavation: the ground z = 0 closed by walls and bottoms, normals out of the soil
                 # (refused in one line before any assembly); the general 3x3 block pattern
                 surface.check_excavation(mesh, f"-ssi_mesh {cfg.mesh}", planes)
-    return mpi.bcast(mesh)
+    mesh = mpi.bcast(mesh)
+    if cfg.mesh in ("grid", "pit") and not cfg.get("mesh_grade", 0.0):
+        # the generators round each stretch's element count: say so where the sizes moved from h
+        sz = 2.0 * mesh.element_sizes()              # (node spacing: half an element side)
+        lo, hi = float(sz.min()), float(sz.max())
+        if hi > 1.01 * cfg.mesh_h or lo < 0.99 * cfg.mesh_h:
+            printf(f"[ssi] mesh: element sides {lo:.4g} .. {hi:.4g} m for -ssi_mesh_h {cfg.mesh_h:g} m (each "
+                   "stretch between the extent, the patch and the excavation's edges takes a whole number of "
+                   "elements)")
+    return mesh
 
 
 def _pit(cfg, Lx, Ly, patch, planes):
@@ -430,7 +439,7 @@ class HalfSpace:
                 f"dt {self.dt:g} s, {self.n_steps} steps, scheme {self.cfg.scheme}; "
                 f"r_max {self.r_max:.4g} m, T_N = r_max/c_s = {self.T_N:.4g} s; lags stored {self.L} "
                 f"(causal limit {causal_lags(self.r_max, self.mat, self.dt)}); "
-                f"beta in [{self.beta[0]:.3f}, {self.beta[1]:.3f}]")
+                f"beta = c dt / l from c_s dt / l_max = {self.beta[0]:.3f} to c_p dt / l_min = {self.beta[1]:.3f}")
 
     def interp_plan(self):
         """The lag interpolation plan from -ssi_interp* (auto: the paper's rule)."""
@@ -495,7 +504,14 @@ class HalfSpace:
         elif int(self.cfg.lag_single_from):
             why = "-ssi_lag_single_from keeps lag matrices in single precision; use -ssi_lag_store dense"
         elif not ls.flat:
-            why = "the surface is not flat (or -ssi_lag_pattern full); use -ssi_lag_store dense"
+            z = self.mesh.cell_coords()[:, :, 2]
+            off = np.flatnonzero(np.abs(z).max(axis=1) > 0.0)
+            if off.size:
+                c = self.mesh.centres()[off[0]]
+                why = (f"the surface is not the plane z = 0 (element {off[0]}, centre ({c[0]:.6g}, {c[1]:.6g}, "
+                       f"{c[2]:.6g}) m, and {off.size - 1} more: an excavation); use -ssi_lag_store dense")
+            else:
+                why = "-ssi_lag_pattern full keeps every 3x3 entry; use -ssi_lag_store dense"
         if why is None:
             try:
                 lat = detect(ls.VX, self.mesh.nodes)

@@ -148,6 +148,10 @@ def _bem_checks(cfg):
             lx, ly = (float(v) for v in str(cfg.mesh_size).split(","))
         except ValueError:
             lx = ly = None                   # the mesh generator reports the format
+        if lx is not None and min(lx, ly) <= 0:
+            return f"-ssi_mesh_size {cfg.mesh_size}: the mesh's extent must be positive in x and y [m]"
+        if cfg.mesh_h <= 0:
+            return f"-ssi_mesh_h {cfg.mesh_h:g}: the element size must be positive [m]"
         if lx is not None and cfg.mesh_h > min(lx, ly):
             return (f"-ssi_mesh_h {cfg.mesh_h:g} m is larger than the mesh (-ssi_mesh_size {cfg.mesh_size}): the grid "
                     f"would have elements of {min(lx, ly):g} m, not the size asked; give -ssi_mesh_h <= "

@@ -214,7 +214,9 @@ def build_interface(be_mesh, fe_mesh, spec, fe_groups, tol_rel, planes=(), h=1.0
     hit[match] = True
     if not hit.all():
         raise SSIError(f"interface: {int((~hit).sum())} node(s) of the structure's '{fe_groups}' faces match no "
-                       f"soil node of the interface elements within {tol:.3g} m: {_fmt(xf[~hit])}")
+                       f"soil node of the interface elements within {tol:.3g} m: {_fmt(xf[~hit])} (the soil's "
+                       "nodes are every half element side: the mesh log's element sides, e.g. an excavation's walls "
+                       "take a whole number of elements of about -ssi_mesh_h)")
     fe_nodes = fnodes[match]
     x = xb_all[bnodes]
     # normals: soil (nine-node geometry at the nodes, averaged) and structure (faces, averaged)

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..petsc import SSIError, collective
+from ..petsc import SSIError, collective, warn
 from ..points import parse_triple
 from .elements import Props
 
@@ -218,12 +218,16 @@ def parse_mesh_params(text, what="-ssi_fem_mesh_params"):
     out = {}
     for item in [s.strip() for s in str(text or "").split(",") if s.strip()]:
         name, sep, val = item.partition("=")
-        try:
-            out[name.strip()] = float(val)
-        except ValueError:
-            raise SSIError(f"{what}: '{item}' is not name=value") from None
-        if not sep or not name.strip():
+        name = name.strip()
+        if not sep or not name:
             raise SSIError(f"{what}: '{item}' is not name=value")
+        try:
+            v = float(val)
+        except ValueError:
+            raise SSIError(f"{what}: '{item}': the value '{val.strip()}' is not a number") from None
+        if name in out:
+            raise SSIError(f"{what}: '{name}' given twice ({out[name]:g} and {v:g})")
+        out[name] = v
     return out
 
 
@@ -394,6 +398,17 @@ def _layer_blocks(spec, cells, coords):
         raise SSIError(f"part '{spec.name}': {int((k < 0).sum())} cell(s) lie below the last layer's bottom "
                        f"(z = {spec.layers[-1][0]:g} m; the lowest centroid at z = {z.min():.6g} m): extend "
                        f"-ssi_fem_part_{spec.name}_layers down to the part's bottom")
+    top = float(coords[np.unique(cells)][:, 2].max())
+    counts = np.bincount(k, minlength=len(spec.layers))
+    for i, (zb, _) in enumerate(spec.layers):
+        if counts[i]:
+            continue
+        if zb >= top - 1e-9 * max(1.0, abs(top)):
+            raise SSIError(f"part '{spec.name}': layer {i + 1}'s bottom z = {zb:g} m is at or above the part's top "
+                           f"(z = {top:.6g} m): it holds no cell (a sign slip in -ssi_fem_part_{spec.name}_layers?)")
+        if counts[i + 1:].any():
+            warn(f"part '{spec.name}': layer {i + 1} (bottom z = {zb:g} m) holds no cell centroid: thinner than the "
+                 "part's cells there, its soil is not in the model")
     el = get("hex8")
     return [Block(spec.name, el, cells[k == i], pr) for i, (_, pr) in enumerate(spec.layers) if (k == i).any()]
 

@@ -81,6 +81,9 @@ UNITS = {
     "interface/changes": "1", "interface/force_fe": "N", "interface/force_be": "N", "interface/moment_fe": "N m",
     "interface/moment_be": "N m", "interface/bem_residual": "1", "interface/force_map_error": "N",
     "interface/nodal_steps": "1", "interface/t_nodal": "s",
+    "resultants/t": "s", "resultants/force": "N", "resultants/moment": "N m (about resultants/x_ref)",
+    "resultants/h": "1 (the prescribed motion's factor at t)", "resultants/u0": "m", "resultants/theta0": "rad",
+    "resultants/x_ref": "m",
 }
 
 

@@ -22,7 +22,7 @@ whose amplitude is a field over both).
 """
 import numpy as np
 
-from ..petsc import SSIError
+from ..petsc import SSIError, warn
 from ..histories import History
 
 
@@ -96,6 +96,12 @@ def uniform_patch(cfg, mesh):
         hist = History(cfg.load_history, cfg.load_t0, cfg.load_table if cfg.load_history == "table" else None)
     except SSIError as exc:
         raise SSIError(f"-ssi_load_history {cfg.load_history}: {exc}") from None
+    z = mesh.cell_coords()[elems][:, :, 2]
+    tilted = int(np.count_nonzero(np.ptp(z, axis=1) > 1e-9 * (1.0 + np.abs(z).max())))
+    if tilted:      # (a pit's walls: the vertical traction shears them)
+        warn(f"-ssi_load_group {cfg.load_group}: {tilted} of its {len(elems)} elements are not horizontal (an "
+             f"excavation's walls?): -ssi_load_p0 is the vertical traction (0, 0, -p0) on every loaded element, a "
+             "shear on a wall, not a pressure normal to it")
     return SurfaceTraction(elems, np.array([0.0, 0.0, -cfg.load_p0]), hist, name=f"-ssi_load_group {cfg.load_group}")
 
 
