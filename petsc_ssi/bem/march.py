@@ -639,14 +639,19 @@ class Marcher:
 
     def add_known(self, b):
         """Collective: b += the terms of the known values in kv_u / kv_p (step matrix
-        coefficients of lags 1 and 2); rows of symmetry-zero DOFs set to 0."""
+        coefficients of lags 1 and 2); rows of symmetry-zero DOFs set to 0. A known vector that is zero
+        on every rank (the implicit coupled step's interface displacements, a load after its end) is not
+        multiplied: its terms are exact zeros (b unchanged bit for bit)."""
+        NI = self.PETSc.NormType.INFINITY
+        load = self.reg.n_load and not self.kv_p.norm(NI) == 0.0        # (NaN: multiplied, and seen)
+        disp = self.reg.n_disp and not self.kv_u.norm(NI) == 0.0
         for lag, c in self.coefficients():
             if lag > self.L:
                 continue
-            if self.reg.n_load and self.G[lag - 1] is not None:
+            if load and self.G[lag - 1] is not None:
                 self.G[lag - 1].mult(self.kv_p, self.rhs)
                 b.axpy(c, self.rhs)
-            if self.reg.n_disp and self.H[lag - 1] is not None:
+            if disp and self.H[lag - 1] is not None:
                 self.H[lag - 1].mult(self.kv_u, self.rhs)
                 b.axpy(-c, self.rhs)
         if self.zero_local.size:
