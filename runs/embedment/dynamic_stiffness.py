@@ -40,7 +40,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 # component and kind, the quarter model's planes
 MODES = {"vertical": ("0,0,1e-6", "0,0,0", 2, "force", "x=sym,y=sym"),
          "horizontal": ("1e-6,0,0", "0,0,0", 0, "force", "x=anti,y=sym"),
-         "rocking": ("0,0,0", "0,1e-6,0", 1, "moment", "x=anti,y=sym")}
+         "rocking": ("0,0,0", "0,1e-6,0", 1, "moment", "x=anti,y=sym"),
+         "torsion": ("0,0,0", "0,0,1e-6", 2, "moment", "x=anti,y=anti")}
 A0 = (0.5, 1.0, 1.5, 2.0)
 
 
@@ -100,7 +101,10 @@ def references(mode, a0, D_B):
     from petsc_ssi.analytic import impedance_refs as ir
     if D_B == 0:
         return ir.pais_kausel(mode, a0, 1.0, nu())[1:]
-    return ir.pais_kausel_embedded(mode, a0, D_B, 1.0, nu())[1:]
+    try:
+        return ir.pais_kausel_embedded(mode, a0, D_B, 1.0, nu())[1:]
+    except NotImplementedError:               # (embedded torsion: no transcription of Table 2-3b's c)
+        return ir.pais_kausel(mode, a0, 1.0, nu())[1], np.full(np.shape(a0), np.nan)   # (k: alpha_emb = alpha_sur)
 
 
 def embedment_ref(mode, D_B=0.5):
@@ -158,13 +162,16 @@ def plot(res, png, lohi):
             ax[0, j].plot(a0[sel], k[sel], color=col, label=f"BEM {lab}")
             ax[0, j].plot(a0[sel], kr[sel], "--", color=col, label=f"Pais & Kausel {lab}")
             ax[1, j].plot(a0[sel], c[sel], color=col, label=f"BEM {lab}")
-            ax[1, j].plot(a0[sel], cr[sel], "--", color=col, label=f"Pais & Kausel {lab}")
+            if np.isfinite(cr[sel]).any():      # (embedded torsion: no published c)
+                ax[1, j].plot(a0[sel], cr[sel], "--", color=col, label=f"Pais & Kausel {lab}")
         for i, what in enumerate(("k = Re K / K0 [-]", "c = Im K / (a0 K0) [-]")):
             ax[i, j].axvspan(*lohi, color="0.92", zorder=0)
             ax[i, j].set_xlabel("a0 = omega B / c_s [-]")
             ax[i, j].set_ylabel(what)
             ax[i, j].set_xlim(0, 3)
         ax[0, j].set_title(f"{mode} (grey: the trusted a0)", fontsize=9)
+        if mode == "torsion":
+            ax[1, j].set_title("embedded torsion: no published Table 2-3b curve found", fontsize=8)
         ax[1, j].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
