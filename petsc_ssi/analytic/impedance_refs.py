@@ -338,8 +338,10 @@ def pais_kausel_embedded(mode, a0, D_B, LB=1.0, nu=1.0 / 3.0, G=1.0, B=1.0):
     2-3b at L/B = 1: its first bracket is again the plane-wave sum (base psi I/B^4 = (4/3) psi; the walls
     x = +-L in shear 4 D/B and pushed (4/3) psi (D/B)^3, the walls y = +-B in shear (4/3)(D/B + (D/B)^3)),
     reduced at low a0 by a0^2 / (1.8 + a0^2) as the surface's (Table 2-3a, 1.8 at L/B = 1); the second
-    term, (4/3)(1 + psi)(D/B)^3 without that reduction, is as [T3] prints it (so c tends to more than the
-    plane-wave sum). [T3] writes the a0^2 factor's denominator as a multiplication (an operator-precedence
+    term, (4/3)(1 + psi)(D/B)^3 without that reduction, is as [T3] prints it: it repeats the walls' theta z
+    terms the bracket already holds, so c tends to more than the plane-wave sum (which of the two places
+    is the misprint, if either, cannot be settled without the table; for L/B != 1 [T3]'s second term
+    assigns psi to the walls as the plane-wave reading does and its first bracket does not). [T3] writes the a0^2 factor's denominator as a multiplication (an operator-precedence
     slip: c would grow as a0^4); read as the surface formula's division. For L/B != 1 [T3]'s wall terms
     do not match the plane-wave reading (which side's walls carry psi) and its rocking about x takes the
     yy factor 1.8/(1 + 1.75(L/B - 1)) where Table 2-3a's xx has 2.2 - 0.4/(L/B)^3: refused there.

@@ -439,7 +439,8 @@ class HalfSpace:
                 f"dt {self.dt:g} s, {self.n_steps} steps, scheme {self.cfg.scheme}; "
                 f"r_max {self.r_max:.4g} m, T_N = r_max/c_s = {self.T_N:.4g} s; lags stored {self.L} "
                 f"(causal limit {causal_lags(self.r_max, self.mat, self.dt)}); "
-                f"beta = c dt / l from c_s dt / l_max = {self.beta[0]:.3f} to c_p dt / l_min = {self.beta[1]:.3f}")
+                f"beta = c dt / l (l: node spacing, half an element side) from c_s dt / l_max = {self.beta[0]:.3f} to "
+                f"c_p dt / l_min = {self.beta[1]:.3f}")
 
     def interp_plan(self):
         """The lag interpolation plan from -ssi_interp* (auto: the paper's rule)."""

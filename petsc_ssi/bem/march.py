@@ -642,9 +642,12 @@ class Marcher:
         coefficients of lags 1 and 2); rows of symmetry-zero DOFs set to 0. A known vector that is zero
         on every rank (the implicit coupled step's interface displacements, a load after its end) is not
         multiplied: its terms are exact zeros (b unchanged bit for bit)."""
-        NI = self.PETSc.NormType.INFINITY
-        load = self.reg.n_load and not self.kv_p.norm(NI) == 0.0        # (NaN: multiplied, and seen)
-        disp = self.reg.n_disp and not self.kv_u.norm(NI) == 0.0
+        # (the 2-norm: a NaN on any rank reaches every rank's sum, where MPI's MAX of the infinity norm can
+        # drop it; the norms are collective, and read the Vecs' current state only once every rank has
+        # released its writable view: set_known_u_owned's array is released by the caller before this)
+        N2 = self.PETSc.NormType.NORM_2
+        load = self.reg.n_load and not self.kv_p.norm(N2) == 0.0        # (NaN: multiplied, and seen)
+        disp = self.reg.n_disp and not self.kv_u.norm(N2) == 0.0
         for lag, c in self.coefficients():
             if lag > self.L:
                 continue

@@ -200,9 +200,12 @@ class Coupler:
 
     def dense_bytes(self):
         """Bytes of the dense interface matrices this rank holds (Z's and D^-1 T^T's local rows,
-        Z_II, M3, C)."""
+        Z_II, M3, C), and H_s's sparse interface columns (HsI)."""
         n = 3 * self.nI
         b = self.Zloc.nbytes + self.Z_II.nbytes + self.M3.nbytes
+        H = getattr(self, "HsI", None)
+        if H is not None:
+            b += H.data.nbytes + H.indices.nbytes + H.indptr.nbytes
         if hasattr(self, "DEloc"):
             b += self.DEloc.nbytes + 8 * n * n
         return b

@@ -404,9 +404,10 @@ def _layer_blocks(spec, cells, coords):
         if counts[i]:
             continue
         if zb >= top - 1e-9 * max(1.0, abs(top)):
-            raise SSIError(f"part '{spec.name}': layer {i + 1}'s bottom z = {zb:g} m is at or above the part's top "
-                           f"(z = {top:.6g} m): it holds no cell (a sign slip in -ssi_fem_part_{spec.name}_layers?)")
-        if counts[i + 1:].any():
+            # (a site's profile reused for a part below its first layers is legitimate: said, not refused)
+            warn(f"part '{spec.name}': layer {i + 1}'s bottom z = {zb:g} m is at or above the part's top (z = "
+                 f"{top:.6g} m): it holds no cell (a sign slip in -ssi_fem_part_{spec.name}_layers?)")
+        elif counts[i + 1:].any():
             warn(f"part '{spec.name}': layer {i + 1} (bottom z = {zb:g} m) holds no cell centroid: thinner than the "
                  "part's cells there, its soil is not in the model")
     el = get("hex8")
