@@ -129,3 +129,21 @@ def test_layers_take_no_part_material():
     from petsc_ssi.fem.parts import layer_of
     assert list(layer_of(spec, [0.5, -0.5, -1.0, -1.0 - 1e-6, -3.9, -4.5])) == [0, 0, 0, 1, 1, -1]
     assert np.allclose(speeds(spec.layers[1][1]), (600.0, 300.0), rtol=1e-13)
+
+
+def test_a_layer_that_holds_no_cell_is_warned(tmp_path):
+    """On the 3 m column (cells of 0.5 m): a layer wholly above the part's top (its bottom at +0.5 m: a sign
+    slip, or a site profile reused for a buried part) and a layer thinner than the cells (-1.1 to -1.2 m:
+    no centroid in it) each get one warning line naming the layer; the run goes on."""
+    from helpers import cli
+    geo = tmp_path / "column.geo"
+    geo.write_text(COLUMN_GEO)
+    a, b = "300,150,1700", "600,300,1900"
+    p = cli(["-ssi_problem", "fem", "-ssi_fem_mesh", str(geo), "-ssi_fem_fixed", "base", "-ssi_fem_point_load",
+             "0.5,0.5,0,1e5,0,-1e5", "-ssi_dt", "0.002", "-ssi_t_end", "0.004", "-ssi_fem_parts", "column",
+             "-ssi_fem_part_column_element", "hex8", "-ssi_fem_part_column_layers",
+             f"0.5:{a};-1.1:{a};-1.2:{b};-3:{b}", "-ssi_output", str(tmp_path / "w.h5")])
+    warns = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: warning: part 'column'")]
+    assert len(warns) == 2, p.stdout[-3000:]
+    assert "layer 1's bottom z = 0.5 m is at or above the part's top (z = 0 m)" in warns[0], warns
+    assert "layer 3 (bottom z = -1.2 m) holds no cell centroid" in warns[1], warns
