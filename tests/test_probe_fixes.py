@@ -46,3 +46,19 @@ def test_a_load_on_a_pits_walls_is_warned_and_rounded_element_sides_are_logged(t
     r = cli(BEM + ["-ssi_mesh", "grid", "-ssi_mesh_size", "8,8", "-ssi_mesh_h", "1", "-ssi_load_group",
                    "box:0,1,0,1", "-ssi_load_p0", "1000", "-ssi_output", str(tmp_path / "h.h5")])
     assert "[ssi] mesh: element sides" not in r.stdout                  # (sizes as asked: no line)
+
+
+def test_a_threshold_time_before_the_rayleigh_arrival_is_warned(tmp_path):
+    """-ssi_interp linear with T_L = 0.015 s on an 11 x 7 m grid: the receiver 5 m from the load's centre sees
+    the Rayleigh wave at 5 / c_R = 0.0172 s (c_R = 290.5 m/s for c_s 316, c_p 548), so lags that carry it are
+    interpolated: one warning naming both times and the paper's rule (1.5 x 5 / 316 = 0.0237 s). T_L = 0.03 s,
+    after the arrival: no warning."""
+    base = BEM[:-2] + ["-ssi_t_end", "0.15", "-ssi_mesh", "grid", "-ssi_mesh_size", "11,7", "-ssi_mesh_h", "1",
+                       "-ssi_load_group", "box:-1,1,-1,1", "-ssi_load_p0", "1000", "-ssi_receivers", "3,0,0;5,0,0",
+                       "-ssi_interp", "linear", "-ssi_interp_k", "6"]
+    r = cli(base + ["-ssi_interp_tl", "0.015", "-ssi_output", str(tmp_path / "a.h5")])
+    w = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: warning: -ssi_interp_tl")]
+    assert len(w) == 1 and "0.015 s is before the Rayleigh wave's arrival" in w[0] and "(0.01721 s)" in w[0] \
+        and "T_L = 0.02373 s" in w[0], r.stdout[-3000:]
+    r = cli(base + ["-ssi_interp_tl", "0.03", "-ssi_output", str(tmp_path / "b.h5")])
+    assert "warning: -ssi_interp_tl" not in r.stdout, r.stdout[-3000:]

@@ -447,22 +447,38 @@ class HalfSpace:
         c = self.cfg
         method, TL, k = c.interp, c.interp_tl, c.interp_k
         if method == "auto":
-            src = (self.mesh.nodes[self.regions.load_nodes].mean(0) if self.regions.n_load
-                   else np.zeros(3))
-            for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
-                src[ax] = 0.0
-            sites = getattr(self, "sites", np.zeros((0, 3)))
-            pts = np.vstack([np.asarray(self.receivers).reshape(-1, 3), sites])
-            TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, pts, src)
-            if len(sites):
-                why += f" (points of interest: {len(self.receivers)} receivers and {len(sites)} interface nodes)"
+            TL, k, why = self._auto_tl()
             method = "chebyshev"
             printf(f"[ssi] -ssi_interp auto: {why}")
         plan = interp.Plan(method, self.dt, self.L, TL if TL else None, k, c.interp_grading)
         if c.interp != "none" and not plan.active:
             printf("[ssi] lag interpolation falls back to exact lags (T_L >= T_N or no lag to replace)")
+        elif c.interp in ("chebyshev", "linear") and plan.active:
+            # a T_L the user chose before the Rayleigh wave reaches the farthest point of interest: said
+            from ..analytic.free_field import rayleigh_speed
+            t_arr, _, _ = self._auto_tl(self.mat.cs / rayleigh_speed(self.mat.cs, self.mat.cp))
+            if t_arr is not None and plan.TL < t_arr * (1.0 - 1e-9):
+                t_rule, _, _ = self._auto_tl()
+                warn(f"-ssi_interp_tl {plan.TL:g} s is before the Rayleigh wave's arrival at the farthest receiver or "
+                     f"interface node ({t_arr:.4g} s): the interpolated lags then carry that arrival, where the "
+                     f"interpolation is least accurate (runs/pekeris/README.md); the paper's rule, -ssi_interp auto, "
+                     f"takes T_L = {t_rule:.4g} s here (tau_L = 1.5)")
         self.plan = plan
         return plan
+
+    def _auto_tl(self, tau_l=1.5):
+        """The paper's rule (``interp.auto``, tau_L = c_s T_L / r) for this problem's points of interest:
+        (T_L, k, why); T_L None where it would reach T_N."""
+        src = (self.mesh.nodes[self.regions.load_nodes].mean(0) if self.regions.n_load
+               else np.zeros(3))
+        for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
+            src[ax] = 0.0
+        sites = getattr(self, "sites", np.zeros((0, 3)))
+        pts = np.vstack([np.asarray(self.receivers).reshape(-1, 3), sites])
+        TL, k, why = interp.auto(self.mat.cs, self.dt, self.L, pts, src, tau_l=tau_l)
+        if len(sites):
+            why += f" (points of interest: {len(self.receivers)} receivers and {len(sites)} interface nodes)"
+        return TL, k, why
 
     def prepare(self, extra=(), extra_bytes=0.0, extra_what=""):
         """Collective: print the summary (and ``extra`` lines), choose the interpolation
