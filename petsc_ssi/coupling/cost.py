@@ -16,7 +16,8 @@ assembles it). What the coupling adds is counted here, in three parts:
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products
                (Z's local rows: 2 (3 N / p) (3 n_I) flops, and, implicit, D^-1 T^T's: 2 (n_fem / p)
                (3 n_I); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
-               residual (two products with the step matrices, part of c_cstep), the contact law and
+               residual (a product with the step matrix, and H_s's kept interface columns times the
+               interface change: part of c_cstep), the contact law and
                the step's bookkeeping c_cstep
   memory       the interface matrices (``interface_bytes``) and the structure's measured growth
                times the ranks

@@ -203,7 +203,7 @@ class Coupler:
         Z_II, M3, C), and H_s's sparse interface columns (HsI)."""
         n = 3 * self.nI
         b = self.Zloc.nbytes + self.Z_II.nbytes + self.M3.nbytes
-        H = getattr(self, "HsI", None)
+        H = self.HsI
         if H is not None:
             b += H.data.nbytes + H.indices.nbytes + H.indptr.nbytes
         if hasattr(self, "DEloc"):
@@ -356,7 +356,7 @@ class Coupler:
         lags' products otherwise, or where it moves a symmetry-zero DOF, which has no column)."""
         m = self.march
         m.residual(m.x, b, self._r)
-        if getattr(self, "HsI", None) is not None and dI is not None and not np.any(dI[self.zero]):
+        if self.HsI is not None and dI is not None and not np.any(dI[self.zero]):
             self._r.getArray()[:] += self.HsI @ dI
         else:
             m.kv_u.copy(self._dkv)
