@@ -91,6 +91,13 @@ register("contact_tol", "real", 1e-8, "", "relative tolerance of the contact che
          "closes a node, p_N > p_C + preload + tol max(|p|, p_C, preload) opens one", G, validator=positive)
 register("contact_max_iter", "int", 25, "", "active-set iterations per step before the step is accepted with "
          "a warning (cycling)", G, validator=lambda v: None if v >= 1 else "must be >= 1")
+register("interface_columns", "enum", "auto", "", "how the interface columns Z = A^-1 H_s E_I are solved: "
+         "region (on the soil DOFs within a margin of the interface, with their own LU: A^-1 decays "
+         "geometrically, the truncation's residual is checked and the margin doubled until it is at round-off, "
+         "coupling/columns.py), full (with the step matrix's factors, every row) or auto (region when it holds at "
+         "most 60 % of the soil's DOFs)", G, choices=("auto", "region", "full"))
+register("interface_columns_margin", "real", 4.0, "", "the region's first margin, in reaches of the step "
+         "matrix (the largest distance between two nodes it couples)", G, validator=positive)
 register("coupling", "enum", "implicit", "", "time coupling: implicit (the structure's interface "
          "displacement and the soil traction of a step solved together on the interface; structure by the "
          "trapezoidal rule in midpoint form with the traction as the interval-mean force) or staggered (the "

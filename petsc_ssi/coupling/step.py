@@ -69,7 +69,7 @@ class StaggeredStep:
     def correct_soil(self, x, res, wI):
         O = res["O"]
         if O.size:                                                  # x = y - Z[:, O] delta_O
-            x -= self.cp.Zloc[:, O] @ (res["ub"] - wI)[O]
+            self.cp.subtract_Z(x, (res["ub"] - wI)[O], O)
 
     def finish(self, f_ext, fI, res):
         cp = self.cp
@@ -117,7 +117,7 @@ class ImplicitStep:
         return res
 
     def correct_soil(self, x, res, wI):
-        x -= self.cp.Zloc @ (res["ub"] - self.cp.uffI)              # x = q - Z (u_b - u_ff)
+        self.cp.subtract_Z(x, res["ub"] - self.cp.uffI)              # x = q - Z (u_b - u_ff)
 
     def finish(self, f_ext, fI, res):
         cp = self.cp
@@ -167,8 +167,8 @@ class Coupler:
         ev = event("SSI_Capacitance")
         ev.begin()
         t0 = time.perf_counter()
-        self.Zloc = self._bem_columns()
-        self.Z_II = self._gather_rows(self.Zloc, self.own_k, self.own_loc)
+        self.Zrows, self.Zloc = self._bem_columns()
+        self.Z_II = self._gather_rows(self.Zloc, self.own_k, self._zpos(self.own_loc))
         self.preload = contact_preload(cfg, comm, model, iface)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
                               cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py(),
@@ -219,41 +219,82 @@ class Coupler:
         return out
 
     def _bem_columns(self):
-        """Z[:, j] = A^{-1} H_s e_j for the interface DOFs (local rows; 3 n_I right-hand sides,
-        solved many at a time: ``petsc.solve_columns``)."""
+        """(rows, Z): Z[:, j] = A^{-1} H_s e_j for the interface DOFs, this rank's local rows ``rows``
+        (None: every local row); 3 n_I right-hand sides, solved many at a time (``petsc.solve_columns``),
+        on a region around the interface with its own LU where -ssi_interface_columns allows
+        (``columns.region_columns``: A^-1 decays geometrically; its truncation residual checked), else
+        with the step matrix's factors."""
         m = self.march
-        e = m.u_tmpl.duplicate()
-        Z = np.zeros((e.getLocalSize(), 3 * self.nI))
+        cols = np.flatnonzero(~self.zero)
+        unit = m.u_tmpl.duplicate()
+        tmp = m.u_tmpl.duplicate()
         lut = -np.ones(3 * self.nI, np.int64)
         lut[self.own_k] = self.own_loc
-        cols = np.flatnonzero(~self.zero)
+        parts = {}                              # H_s's columns by chunk, kept sparse for the residual check
 
-        def fill(i, rhs):
+        def by_product(i, rhs):                 # H_s e_j by the lags' products (collective)
             j = cols[i]
-            e.set(0.0)
+            unit.set(0.0)
             if lut[j] >= 0:
-                e.getArray()[lut[j]] = 1.0
-            m.mult_step_H(e, rhs)
-
-        parts = []                              # H_s's columns, kept sparse for the steps' residual check
+                unit.getArray()[lut[j]] = 1.0
+            m.mult_step_H(unit, rhs)
 
         def block(i0, i1):                      # H_s's columns read off its lags (None: multiply)
             blk = m.step_H_columns(self.dofs_be[cols[i0:i1]])
-            parts.append(None if blk is None else sp.csc_matrix(blk))
+            parts[i0] = None if blk is None else sp.csc_matrix(blk)
             return blk
 
-        def take(i, z):
-            Z[:, cols[i]] = z.getArray(readonly=True)
+        def full_block(i0, i1):                 # the columns as local rows, always
+            blk = block(i0, i1)
+            if blk is None:
+                blk = np.zeros((tmp.getLocalSize(), i1 - i0))
+                for i in range(i0, i1):
+                    by_product(i, tmp)
+                    blk[:, i - i0] = tmp.getArray(readonly=True)
+            return blk
+
+        from .columns import region_columns
+        rows = None
         with event("SSI_BEM_Solve"):
-            solve_columns(m.ksp, m.u_tmpl, len(cols), fill, take, block=block)
-        e.destroy()
+            got = region_columns(self.cfg, m, self.prob.mesh.nodes, np.asarray(self.iface.be_nodes), cols,
+                                 3 * self.nI, full_block)
+            if got is not None:
+                rows, Z, line = got
+                printf(line)
+            else:
+                parts.clear()
+                Z = np.zeros((m.u_tmpl.getLocalSize(), 3 * self.nI))
+
+                def take(i, z):
+                    Z[:, cols[i]] = z.getArray(readonly=True)
+                solve_columns(m.ksp, m.u_tmpl, len(cols), by_product, take, block=block)
+        unit.destroy()
+        tmp.destroy()
         # (local rows, 3 n_I): H_s e_j of the interface DOFs (symmetry-zero ones: no column); None where a
         # chunk was multiplied instead (the residual check then multiplies too; the ranks agree, as on blocks)
         self.HsI = None
-        if parts and all(q is not None for q in parts):
-            Hc = sp.hstack(parts, format="coo")
+        if parts and all(q is not None for q in parts.values()):
+            Hc = sp.hstack([parts[k] for k in sorted(parts)], format="coo")
             self.HsI = sp.csr_matrix((Hc.data, (Hc.row, cols[Hc.col])), shape=(Hc.shape[0], 3 * self.nI))
-        return Z
+        return rows, Z
+
+    def _zpos(self, loc):
+        """Positions in Zloc's rows of the rank's local rows ``loc`` (all in Zrows: the region holds
+        the interface)."""
+        if self.Zrows is None:
+            return loc
+        pos = np.searchsorted(self.Zrows, loc)
+        assert np.all(self.Zrows[np.minimum(pos, self.Zrows.size - 1)] == loc), "interface row outside Z's region"
+        return pos
+
+    def subtract_Z(self, x, d, O=None):
+        """x -= Z d (this rank's rows of the soil's step solution; ``O``: Z's columns d stands for, all if
+        None): on Z's rows only (``Zrows``, the region around the interface, or every row)."""
+        Zc = self.Zloc if O is None else self.Zloc[:, O]
+        if self.Zrows is None:
+            x -= Zc @ d
+        else:
+            x[self.Zrows] -= Zc @ d
 
     def fem_columns(self):
         """D^{-1} T^T e_j (local rows) and C = T D^{-1} T^T (replicated) for the interface

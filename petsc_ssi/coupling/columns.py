@@ -1,0 +1,164 @@
+r"""The interface columns Z = A^{-1} H_s E_I of the coupled step on a region around the interface
+(``-ssi_interface_columns``; issue 41's building on a large uniform grid).
+
+A is the soil's step matrix (lags 1-2: a node couples only to the nodes of the elements a wave reaches
+within a step or two, the *reach* r, read off A's pattern). Its inverse decays geometrically away from
+the diagonal: on the paper's building on the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs) the
+soil's displacement response to a unit interface displacement falls from 0.16 just outside the footprint
+to 1e-14 at 12 m and 2e-18 at 15 m (by a factor of about 6 per node spacing). So the columns' rows beyond
+a margin of a few reaches are zero to round-off, and the kept rows are the solution of the same equations
+restricted to the region Omega of the DOFs within the margin of an interface node:
+
+    A_{Omega Omega} Z_Omega = (H_s E_I)_Omega,     Z = Z_Omega on Omega, 0 elsewhere,
+
+a factorisation and 3 n_I solves of a matrix a fraction of A's size instead of 3 n_I solves with A's
+factors (and each step's correction x -= Z du reads Z_Omega's rows only). The truncation is checked,
+not assumed: the residual A Z - H_s E_I of the region's solution is nonzero only in the rows just outside
+Omega that couple into it (A_{ring Omega} Z_Omega), computed for every column; where its largest value
+exceeds ``TOL`` times the column's right-hand side, the margin is doubled, and where Omega would then hold
+most of the grid the columns are solved with A's own factors (``full``), as before. The step equations
+themselves are unchanged (the run's residual check, ``bem_residual``, measures them every step).
+"""
+import numpy as np
+
+from ..petsc import init, printf, solve_columns, set_default_options, direct_solver_defaults
+
+# the largest residual of the region's columns, over the column's right-hand side (both in the
+# infinity norm), that keeps the region: round-off of the step equations' own size
+TOL = 1e-14
+# auto: the region when it holds at most this share of the soil's DOFs (the full solve otherwise)
+AUTO_SHARE = 0.6
+
+
+def step_reach(A, X, comm):
+    """Collective: the largest distance [m] between the nodes of a row and a column that the step matrix
+    A couples (DOF 3 k + c at node k of X), over every rank's rows."""
+    r0, r1 = A.getOwnershipRange()
+    ip, jj, _ = A.getValuesCSR()
+    ip = np.asarray(ip, np.int64)
+    rows = (r0 + np.repeat(np.arange(r1 - r0), np.diff(ip))) // 3
+    d = np.linalg.norm(X[rows] - X[np.asarray(jj, np.int64) // 3], axis=1) if rows.size else np.zeros(1)
+    from mpi4py import MPI
+    return float(comm.tompi4py().allreduce(float(d.max()) if d.size else 0.0, op=MPI.MAX))
+
+
+def region_nodes(X, nodes_I, margin):
+    """Boolean mask of the nodes of X within ``margin`` [m] of an interface node (3-D distance)."""
+    from scipy.spatial import cKDTree
+    d, _ = cKDTree(X[nodes_I]).query(X, k=1)
+    return d <= margin
+
+
+class RegionColumns:
+    """Collective: Z's columns ``cols`` (of the 3 n_I interface DOFs) on the region within ``margin`` [m]
+    of the interface nodes. ``rhs(i0, i1)``: the right-hand sides i0..i1-1 of ``cols`` as the rank's full
+    local rows (local rows, i1 - i0). After ``solve()``: ``rows`` (the rank's local row indices of the
+    region, ascending), ``Z`` (len(rows), 3 n_I) and ``residual`` (the largest ring residual over its
+    column's right-hand side); ``ok`` whether it is within ``TOL`` and every right-hand side lies in the
+    region."""
+
+    def __init__(self, march, X, nodes_I, margin, log=printf):
+        PETSc = init()
+        self.PETSc, self.march, self.comm = PETSc, march, march.comm
+        A = march.A
+        r0, r1 = A.getOwnershipRange()
+        inside = np.repeat(region_nodes(X, nodes_I, margin), 3)
+        self.margin = margin
+        self.keep = inside[r0:r1]
+        self.rows = np.flatnonzero(self.keep)
+        mpi = self.comm.tompi4py()
+        self.n_region = int(mpi.allreduce(int(self.rows.size)))
+        self.n_all = A.getSize()[0]
+        gl = (r0 + self.rows).astype(PETSc.IntType)
+        self.is_r = PETSc.IS().createGeneral(gl, comm=self.comm)
+        # the ring: rows outside the region that couple into it (their residual is the truncation's)
+        ip, jj, _ = A.getValuesCSR()
+        ip = np.asarray(ip, np.int64)
+        row_e = np.repeat(np.arange(r1 - r0), np.diff(ip))
+        per_row = np.bincount(row_e[inside[np.asarray(jj, np.int64)]], minlength=r1 - r0)
+        ring = np.flatnonzero((per_row > 0) & ~self.keep)
+        self.is_ring = PETSc.IS().createGeneral((r0 + ring).astype(PETSc.IntType), comm=self.comm)
+        self.n_ring = int(mpi.allreduce(int(ring.size)))
+        self.log = log
+
+    def solve(self, cols, n_cols, rhs):
+        PETSc, A = self.PETSc, self.march.A
+        AR = A.createSubMatrix(self.is_r, self.is_r)
+        AQ = A.createSubMatrix(self.is_ring, self.is_r)
+        ksp = PETSc.KSP().create(comm=self.comm)
+        ksp.setOptionsPrefix("ssi_bem_columns_")
+        set_default_options("ssi_bem_columns_", direct_solver_defaults(self.comm, soil=True), self.log)
+        ksp.setOperators(AR)
+        ksp.setFromOptions()
+        ksp.setUp()
+        tmpl = AR.createVecRight()
+        rq = AQ.createVecLeft()
+        Z = np.zeros((self.rows.size, n_cols))
+        bmax = np.zeros(len(cols))
+        rmax = np.zeros(len(cols))
+        outside = [False]
+
+        def block(i0, i1):
+            full = rhs(i0, i1)
+            if full.shape[0] and np.any(full[~self.keep] != 0.0):
+                outside[0] = True
+            blk = np.ascontiguousarray(full[self.rows])
+            if blk.size:
+                bmax[i0:i1] = np.abs(blk).max(axis=0)
+            return blk
+
+        def fill(i, b):                         # (not reached: ``block`` always gives the columns)
+            b.getArray()[:] = block(i, i + 1)[:, 0]
+
+        def take(i, z):
+            Z[:, cols[i]] = z.getArray(readonly=True)
+            AQ.mult(z, rq)
+            a = rq.getArray(readonly=True)
+            rmax[i] = np.abs(a).max() if a.size else 0.0
+
+        solve_columns(ksp, tmpl, len(cols), fill, take, block=block)
+        from mpi4py import MPI
+        mpi = self.comm.tompi4py()
+        mpi.Allreduce(MPI.IN_PLACE, bmax, op=MPI.MAX)
+        mpi.Allreduce(MPI.IN_PLACE, rmax, op=MPI.MAX)
+        self.rhs_outside = bool(mpi.allreduce(outside[0], op=MPI.LOR))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = np.where(bmax > 0, rmax / np.where(bmax > 0, bmax, 1.0), rmax)
+        self.residual = float(rel.max()) if rel.size else 0.0
+        self.ok = (not self.rhs_outside) and self.residual <= TOL
+        self.Z = Z
+        for o in (ksp, AR, AQ, tmpl, rq):
+            o.destroy()
+        return self
+
+
+def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
+    """Collective: Z's columns on a region around the interface when ``-ssi_interface_columns`` (auto or
+    region) allows it: (rows, Z, line) with ``line`` the log's account, or None (the caller solves with A's
+    factors: full, a region holding most of the grid, or no region within the margins tried)."""
+    mode = str(cfg.get("interface_columns") or "auto").lower()
+    if mode == "full":
+        return None
+    reach = step_reach(march.A, X, march.comm)
+    margin = float(cfg.get("interface_columns_margin") or 4.0) * reach
+    share_max = 1.0 if mode == "region" else AUTO_SHARE
+    tried = []
+    while True:
+        reg = RegionColumns(march, X, nodes_I, margin, log)
+        share = reg.n_region / max(reg.n_all, 1)
+        if share > share_max:
+            why = (f"the region within {margin:.3g} m of the interface holds {100 * share:.0f} % of the soil's "
+                   f"DOFs")
+            printf("[ssi] interface columns: with the step matrix's factors (" + why
+                   + (f"; {', '.join(tried)}" if tried else "") + "; -ssi_interface_columns)")
+            return None
+        reg.solve(cols, n_cols, rhs)
+        if reg.ok:
+            line = (f"[ssi] interface columns: on the {reg.n_region} soil DOFs within {margin:.3g} m of the "
+                    f"interface ({100 * share:.0f} % of {reg.n_all}; margin {margin / reach:.3g} x the step "
+                    f"matrix's reach {reach:.3g} m), their own LU; truncation residual {reg.residual:.2e} of "
+                    f"the right-hand sides (<= {TOL:g}; -ssi_interface_columns)")
+            return reg.rows, reg.Z, line
+        tried.append(f"{margin:.3g} m: residual {reg.residual:.2e}"
+                     + (", a right-hand side outside" if reg.rhs_outside else ""))
+        margin *= 2.0

@@ -1,0 +1,76 @@
+"""The interface columns Z = A^-1 H_s E_I on a region around the interface (coupling/columns.py,
+-ssi_interface_columns): the coupled run with unilateral contact (it lifts off) on a grid whose region
+holds about half the soil's DOFs equals the run with the step matrix's factors (every row) to 1e-10 of
+each field's scale at -n 1 and -n 2 (the bound tests/bem/test_toeplitz.py allows the contact case's free
+flight, whose round-off grows: 1.5e-12 seen), and a bonded run to 1e-12; a first margin too small for round-off is doubled (the log says
+so); auto keeps the full solve where the region would hold most of the grid."""
+import os
+import re
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from helpers import cli
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "bem"))
+from test_history_block import SSI, same  # noqa: E402
+
+pytestmark = pytest.mark.mpi
+
+# a 2 m x 2 m footing (4 soil elements) on a 24 m x 24 m grid of 1 m elements (7203 DOFs), toeplitz store
+BIG = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "24,24",
+       "-ssi_mesh_h", "1", "-ssi_mesh_patch", "2,2", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size", "2,2,0.25",
+       "-ssi_fem_box_origin", "-1,-1,0", "-ssi_fem_E", "3e8", "-ssi_fem_rho", "2000", "-ssi_dt", "0.0125",
+       "-ssi_t_end", "0.5", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history",
+       "box", "-ssi_fem_load_t0", "0.05", "-ssi_contact", "unilateral", "-ssi_receivers", "1,0,0;6,0,0",
+       "-ssi_output_stride", "5", "-ssi_warn_beta", "0", "-ssi_lag_store", "toeplitz"]
+
+
+def region_line(out):
+    m = re.search(r"interface columns: on the (\d+) soil DOFs within ([\d.]+) m of the interface \((\d+) % of "
+                  r"(\d+); margin ([\d.]+) x the step matrix's reach ([\d.]+) m\).*truncation residual ([\d.e+-]+)",
+                  out)
+    assert m, out[-3000:]
+    return m
+
+
+def test_region_columns_equal_the_full_solve(tmp_path):
+    full, reg, two = (str(tmp_path / f"{k}.h5") for k in ("full", "reg", "two"))
+    out_f = cli(BIG + ["-ssi_output", full, "-ssi_interface_columns", "full"]).stdout
+    assert "interface columns: on the" not in out_f
+    out = cli(BIG + ["-ssi_output", reg]).stdout                 # auto: the region
+    m = region_line(out)
+    n_reg, share, n_all, mult = int(m.group(1)), int(m.group(3)), int(m.group(4)), float(m.group(5))
+    assert n_all == 7203 and 0.3 * n_all < n_reg < 0.6 * n_all and mult == 4.0
+    assert float(m.group(7)) <= 1e-14
+    same(full, reg, rtol=1e-10)
+    with h5py.File(reg) as f:
+        closed = f["interface/closed"][...]
+    assert closed.any() and not closed.all()        # contact is active: it lifts off
+    cli(BIG + ["-ssi_output", two], nranks=2)
+    same(full, two, rtol=1e-10)                      # (the free flight's round-off, as test_toeplitz's bound)
+
+
+def test_a_margin_too_small_is_doubled(tmp_path):
+    """A first margin of one reach leaves a residual above round-off: the margin is doubled until it is
+    not (the log line's margin), and the bonded run equals the full solve to 1e-12."""
+    full, reg = str(tmp_path / "full.h5"), str(tmp_path / "reg.h5")
+    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.2"]
+    cli(bonded + ["-ssi_output", full, "-ssi_interface_columns", "full"])
+    out = cli(bonded + ["-ssi_output", reg, "-ssi_interface_columns", "region",
+                     "-ssi_interface_columns_margin", "1"]).stdout
+    m = region_line(out)
+    assert float(m.group(5)) >= 2.0 and float(m.group(7)) <= 1e-14
+    same(full, reg)                                  # (bonded: no free flight)
+
+
+def test_auto_keeps_the_full_solve_on_a_small_grid(tmp_path):
+    """The 2 m x 2 m grid under a 1 m footing: the region would hold nearly every DOF, so auto solves
+    with the step matrix's factors and says why."""
+    out = cli(SSI + ["-ssi_t_end", "0.05", "-ssi_output", str(tmp_path / "a.h5")]).stdout
+    line = [s for s in out.splitlines() if "interface columns:" in s]
+    assert line and "with the step matrix's factors" in line[0] and "% of the soil's DOFs" in line[0]
+    share = float(re.search(r"holds (\d+) %", line[0]).group(1))
+    assert share > 60 and np.isfinite(share)
