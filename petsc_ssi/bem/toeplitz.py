@@ -710,31 +710,60 @@ def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
     frequency-major buffers (slab, W, c), double or single; real weights on the real and imaginary parts:
     per span of ``_spans`` and frequency one real matrix product of the weights with the span's states,
     read in place), then (b x 9k)(9k x n9) and (b x 18k)(18k x n18) products with the anchors' kernels: (slab, b, n9 + n18) complex, columns as
-    ``history_products``. Frequencies in chunks so the weighted states stay small."""
+    ``history_products``. Frequencies in chunks so the weighted states stay small.
+
+    A span's weights (b k rows, its states as columns) have a low numerical rank where one polynomial
+    weighs them (Chebyshev: each row a polynomial of degree k - 1 in the state, apart from the few states
+    at the ends of the steps' windows, which move with the step: rank about k + 2 (b + 2) of b k rows):
+    there the product goes through the weights' singular vectors, C = (U s) W, W the rank's rows of V^T,
+    the singular values below ``RANK_RTOL`` of the largest dropped (round-off: the dropped part of C is
+    below that of its largest entry), when the rank is at most half the rows and the states: ``_low_rank``."""
     slab, n9, n18 = A9.shape[0], A9.shape[2], A18.shape[2]
     b, k, _ = C.shape
     out = np.zeros((slab, b, n9 + n18), np.complex128)
     spans = _spans(C)
     if not spans:
         return out
+    facs = [_low_rank(C[:, j0:j1, a:e].reshape(-1, e - a)) for j0, j1, a, e in spans]
     for f0 in range(0, slab, fchunk):
         f1 = min(slab, f0 + fchunk)
         fc = f1 - f0
         S9 = np.zeros((fc, b, k, 9), np.complex128)
         S18 = np.zeros((fc, b, k, 18), np.complex128)
-        for j0, j1, a, e in spans:
-            Cj = C[:, j0:j1, a:e].reshape(-1, e - a)
+        for (j0, j1, a, e), (Cj, US, W) in zip(spans, facs):
             for V, S in ((V9, S9), (V18, S18)):
                 c = V.shape[2]
                 Vf = V[f0:f1, r0 + a:r0 + e].view(V.real.dtype)                   # (fc, e - a, 2 c): a view
-                w = np.matmul(Cj, Vf).view(np.complex128)                        # (fc, b (j1 - j0), c)
-                S[:, :, j0:j1, :] = w.reshape(fc, b, j1 - j0, c)
+                if W is None:
+                    w = np.matmul(Cj, Vf)                                        # (fc, b (j1 - j0), 2 c)
+                else:
+                    w = np.matmul(US, np.matmul(W, Vf))
+                S[:, :, j0:j1, :] = w.view(np.complex128).reshape(fc, b, j1 - j0, c)
         np.matmul(S9.reshape(fc, b, 9 * k), A9[f0:f1], out=out[f0:f1, :, :n9])
         np.matmul(S18.reshape(fc, b, 18 * k), A18[f0:f1], out=out[f0:f1, :, n9:])
     if log is not None:
         log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
-                             + 2.0 * 54 * b * sum((j1 - j0) * (e - a) for j0, j1, a, e in spans)))
+                             + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
+                                              for Cj, US, W in facs)))
     return out
+
+
+# the singular values of a span's weights kept for its low-rank product (``interp_products``): above this
+# share of the largest
+RANK_RTOL = 1e-15
+
+
+def _low_rank(Cj):
+    """(Cj, U s, W) with Cj = (U s) W to round-off (``RANK_RTOL``) when the rank r is at most half of both
+    dimensions (U s: rows x r, W: r x states), else (Cj, None, None)."""
+    m, n = Cj.shape
+    if min(m, n) < 16 or not Cj.any():
+        return Cj, None, None
+    U, sv, Vt = np.linalg.svd(Cj, full_matrices=False)
+    r = int(np.count_nonzero(sv > RANK_RTOL * sv[0]))
+    if 2 * r > min(m, n):
+        return Cj, None, None
+    return Cj, np.ascontiguousarray(U[:, :r] * sv[:r]), np.ascontiguousarray(Vt[:r])
 
 
 # the history products' window copies, per chunk of frequencies: at most about this many bytes (the

@@ -211,6 +211,37 @@ def test_interp_products_match_the_sum(widths, dtype):
         assert got.dtype == np.complex128 and np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
 
 
+def test_interp_products_low_rank_chebyshev_weights():
+    """Chebyshev interpolation's weights (each anchor's Lagrange polynomial of degree k - 1 in the lag on
+    Chebyshev points, over the windows of b steps whose ends move with the step) have a low numerical rank:
+    ``interp_products`` takes them through their singular vectors (``_low_rank``: rank about k + 2 (b + 2)
+    of b k rows) and equals the plain sum to 1e-13 of its largest value."""
+    from petsc_ssi.bem.toeplitz import interp_products, _low_rank
+    rng = np.random.default_rng(11)
+    slab, k, b, lx, L = 23, 20, 8, 10, 150
+    t = 0.5 * (lx + 1 + L) + 0.5 * (L - lx - 1) * np.cos(np.pi * (np.arange(k) + 0.5) / k)   # Chebyshev lags
+    lag = lambda d, j: np.prod([(d - t[i]) / (t[j] - t[i]) for i in range(k) if i != j], axis=0)
+    n0, lo = 200, 200 + 1 - L                   # the block's steps n0 + 1 .. n0 + b read states lo .. n0
+    ns = n0 - lo + 1
+    C = np.zeros((b, k, ns))
+    for r in range(b):
+        m = np.arange(lo, n0 + 1)
+        d = n0 + 1 + r - m
+        ok = (d >= lx + 1) & (d <= L)
+        for j in range(k):
+            C[r, j, ok] = lag(d[ok].astype(float), j)
+    _, US, W = _low_rank(C.reshape(b * k, ns))
+    assert W is not None and W.shape[0] <= k + 2 * (b + 2), None if W is None else W.shape
+    cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
+    Axy, Az = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4)
+    Vz, Vxy = cz(slab, ns + 7, 9), cz(slab, ns + 7, 18)
+    got = interp_products(Axy, Az, Vz, Vxy, C, 7, fchunk=8)
+    Sz = np.einsum("bjm,fmc->fbjc", C, Vz[:, 7:]).reshape(slab, b, 9 * k)
+    Sxy = np.einsum("bjm,fmc->fbjc", C, Vxy[:, 7:]).reshape(slab, b, 18 * k)
+    ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)
+    assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), np.abs(got - ref).max() / np.abs(ref).max()
+
+
 def test_history_products_match_the_sum():
     """``history_products`` (sliding windows of the kept states times the stacked kernels) against the plain
     sum over steps and time distances, for the H side's (8, 4) and the G side's (4, 8) output widths, kept
