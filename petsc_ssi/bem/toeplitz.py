@@ -199,8 +199,8 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
     over the run's blocks in products anchor by anchor, the same in products over all anchors' common span)
     of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block: the code's own choice;
     multi-linear weights go anchor by anchor, small products, Chebyshev's over the common span, one larger
-    product a frequency: their rates differ, ``RATES`` r_sums and r_sums_span); (0, 0, 0) without
-    interpolation. The terms of a block's own states (T_L within a block) are left out (a few states a step)."""
+    product a frequency, or its two products through the weights' rank where ``_low_rank`` takes them:
+    their rates differ, ``RATES`` r_sums and r_sums_span); (0, 0, 0) without interpolation. The terms of a block's own states (T_L within a block) are left out (a few states a step)."""
     if plan is None or not plan.active:
         return 0, 0.0, 0.0
     from .interp import state_weights
@@ -221,7 +221,9 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
         sp = _spans(C)
         w = block * sum((j1 - j0) * (e - a) for j0, j1, a, e in sp)
         if len(sp) == 1 and sp[0][1] - sp[0][0] > 1:
-            span += w
+            j0, j1, a, e = sp[0]
+            _, _, W = _low_rank(C[:, j0:j1, a:e].reshape(-1, e - a))       # (the product through its rank)
+            span += w if W is None else W.shape[0] * (block * (j1 - j0) + e - a)
         else:
             work += w
     return steps, work, span

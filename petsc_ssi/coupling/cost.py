@@ -11,10 +11,12 @@ assembles it). What the coupling adds is counted here, in three parts:
   set-up       solve of the factors (petsc.solve_columns): a column costs r_mms times one BEM step
                solve (bem.cost.bem_solve_seconds, the BEM model's solve) and, implicit, r_mms times
                one solve with D (t_fs); plus the bonded interface system's LU (2/3 (3 n_I)^3 flops,
-               replicated) at r_cpl flop/s. (Until 2026-11-29 it also priced 3 n_I products with Z's
+               replicated) at r_cpl flop/s. On a region around the interface (coupling/columns.py,
+               N_Z of the N soil nodes, ``estimated_region_nodes``) the BEM solve is the model's for N_Z
+               nodes and the region's LU (c_fac N_Z^1.5) is added. (Until 2026-11-29 it also priced 3 n_I products with Z's
                local rows, which the set-up does not make: 45 s of the uniform 72 m building's 68 s.)
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products
-               (Z's local rows: 2 (3 N / p) (3 n_I) flops, and, implicit, D^-1 T^T's: 2 (n_fem / p)
+               (Z's local rows: 2 (3 N_Z / p) (3 n_I) flops, and, implicit, D^-1 T^T's: 2 (n_fem / p)
                (3 n_I); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
                residual (a product with the step matrix, and H_s's kept interface columns times the
                interface change: part of c_cstep), the contact law and
@@ -22,7 +24,7 @@ assembles it). What the coupling adds is counted here, in three parts:
   memory       the interface matrices (``interface_bytes``) and the structure's measured growth
                times the ranks
 
-with n_I the interface nodes and N the soil nodes. The constants r_cpl and c_cstep come from
+with n_I the interface nodes, N the soil nodes and N_Z those of Z's rows (N, or the region's). The constants r_cpl and c_cstep come from
 ``estimate_constants.json`` ("coupled"), fitted to the coupled runs' logs by
 ``jobscripts/long_record.py --fit``."""
 import statistics
@@ -48,6 +50,8 @@ class CoupledCounts:
         from ..fem.integrators import make_model_integrator
         mpi = comm.tompi4py()
         self.nI, self.N, self.steps = iface.n, prob.mesh.n_nodes, prob.n_steps
+        from .columns import estimated_region_nodes
+        self.NZ = estimated_region_nodes(cfg, prob, iface.be_nodes)     # Z's rows: the region's nodes
         self.implicit = cfg.coupling == "implicit"
         self.n_fem = model.dofmap.size
         self.ranks_measured = comm.getSize()
@@ -69,9 +73,13 @@ class CoupledCounts:
         k = dict(FALLBACK)
         k.update(c or {})
         n = 3 * self.nI
-        setup = self.fem_setup_s + n * k["r_mms"] * (bem_solve_s + (self.fem_solve_s if self.implicit else 0.0)) \
+        col_s, fac_s = bem_solve_s, 0.0
+        if self.NZ < self.N and "c_sol_nlogn" in k:      # the columns on the region: its own LU and solves
+            from ..bem.cost import bem_solve_seconds
+            col_s, fac_s = bem_solve_seconds(k, self.NZ, p), k.get("c_fac", 0.0) * self.NZ ** 1.5
+        setup = self.fem_setup_s + fac_s + n * k["r_mms"] * (col_s + (self.fem_solve_s if self.implicit else 0.0)) \
             + 2.0 / 3.0 * n ** 3 / k["r_cpl"]
-        per_step = step_seconds(c, self.nI, self.N, p, self.fem_solve_s, self.n_fem if self.implicit else 0)
+        per_step = step_seconds(c, self.nI, self.NZ, p, self.fem_solve_s, self.n_fem if self.implicit else 0)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
                 "cpl_bytes": self._iface_bytes(p) + self.fem_bytes * p / max(self.ranks_measured, 1)}
 

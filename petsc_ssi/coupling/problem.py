@@ -110,8 +110,10 @@ class SSITransient(TransientProblem):
             from .cost import solve_seconds, step_seconds
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
+            from .columns import estimated_region_nodes
             self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
-                                             prob.mesh.n_nodes, comm.getSize(), self.fem_solve_s,
+                                             estimated_region_nodes(cfg, prob, self.iface.be_nodes), comm.getSize(),
+                                             self.fem_solve_s,
                                              self.model.dofmap.size if cfg.coupling == "implicit" else 0)
         self.print_loop_line()
         with staged("SSI BEM assembly"):
