@@ -229,6 +229,79 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
     return steps, work, span
 
 
+def measure_rates(D, plan=None, n_steps=0, block=8, workers=1, stabilized=True, single=False, freqs=512,
+                  repeats=3):
+    """The history sum's two rates measured on this machine now (``petsc-ssi estimate``: the machine's speed
+    moves between hours and between machines, the fitted ``RATES`` do not): r_products, the flop/s of
+    ``history_products`` on random kernels and states of the run's shapes (D exact lags, blocks of
+    ``block`` steps, ``freqs`` frequencies: 64 MB of kernels a worker at D = 54, beyond the caches, as the
+    run's 0.3-0.7 GB a rank), and, with a Chebyshev ``plan``, r_sums_span, the flop/s of the weighted states
+    of ``interp_products`` on the weights of the run's last block (its low-rank path where the run takes it),
+    its anchors' products taken off at the measured r_products, both as ``estimate`` counts them. ``workers``
+    threads run the same work at once (the ranks that share a node's memory bus; numpy's products release
+    the GIL): the slowest's time of the best of ``repeats``. About 0.2-0.5 s. Returns a dict for
+    ``estimate``'s ``rates``."""
+    import threading
+    rng = np.random.default_rng(0)
+    vt = np.complex64 if single else np.complex128
+    D = max(int(D), 1)
+    cz = lambda *s: (rng.standard_normal(s) + 1j * rng.standard_normal(s))
+    k = int(plan.k) if plan is not None and plan.active else 0
+    C = None
+    if k and n_steps > 0:
+        from .interp import state_weights
+        R = int(plan.L)
+        n0 = block * max(0, (int(n_steps) - 1) // block)
+        C = np.zeros((block, k, R))
+        lo = n0 + 1 - R
+        for i in range(block):
+            coef = state_weights(plan, n0 + 1 + i, stabilized)
+            if coef is None:
+                continue
+            m = np.arange(max(lo, 1), min(n0, n0 + i) + 1)
+            C[i][:, m - lo] = coef[m].T
+        sp = _spans(C)
+        if not (len(sp) == 1 and sp[0][1] - sp[0][0] > 1):
+            C = None                        # (multi-linear: anchor by anchor, r_sums kept)
+    W = D + block + (C.shape[2] if C is not None else 0) + 2
+    data = []
+    for _ in range(max(1, int(workers))):
+        d = {"K9": cz(freqs, 9 * D, 8), "K18": cz(freqs, 18 * D, 4),
+             "V9": cz(freqs, W, 9).astype(vt), "V18": cz(freqs, W, 18).astype(vt)}
+        if C is not None:
+            d["A9"], d["A18"] = cz(freqs, 9 * k, 8), cz(freqs, 18 * k, 4)
+        data.append(d)
+
+    def timed(fn):
+        best = np.inf
+        for _ in range(max(1, int(repeats))):
+            times = [0.0] * len(data)
+
+            def run(i):
+                t0 = time.perf_counter()
+                fn(data[i])
+                times[i] = time.perf_counter() - t0
+            th = [threading.Thread(target=run, args=(i,)) for i in range(len(data))]
+            for t in th:
+                t.start()
+            for t in th:
+                t.join()
+            best = min(best, max(times))
+        return best
+
+    t_p = timed(lambda d: history_products(d["K9"], d["K18"], d["V9"], d["V18"], 0, block, D))
+    out = {"r_products": 8.0 * 144 * block * D * freqs / t_p}
+    if C is not None:
+        j0, j1, a, e = _spans(C)[0]
+        _, _, Wr = _low_rank(C[:, j0:j1, a:e].reshape(-1, e - a))
+        work = block * (j1 - j0) * (e - a) if Wr is None else Wr.shape[0] * (block * (j1 - j0) + e - a)
+        t_i = timed(lambda d: interp_products(d["A9"], d["A18"], d["V9"], d["V18"], C, 0))
+        t_s = t_i - 8.0 * 144 * block * k * freqs / out["r_products"]
+        if t_s > 0:
+            out["r_sums_span"] = 2.0 * 54 * freqs * work / t_s
+    return out
+
+
 def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
              glat=None, single=False):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
