@@ -17,10 +17,6 @@ register("estimate_cores_per_node", "int", 0, "", "estimate: cores per node (0: 
          "cores on a node are oversubscribed", G, validator=lambda v: None if v >= 0 else "must be >= 0")
 register("estimate_node_memory", "real", 0.0, "GB", "estimate: memory of one node (0: this machine's)", G,
          validator=lambda v: None if v >= 0 else "must be >= 0")
-register("estimate_probe", "bool", True, "", "estimate on the toeplitz lag store: measure the history sum's "
-         "product rates on this machine now (about half a second, as many threads at once as ranks share a node) "
-         "instead of the rates fitted to the development machine's logs (bem/toeplitz.py RATES, measure_rates): "
-         "a machine's speed moves between hours and between machines", G)
 
 
 def parse_ranks(text):
@@ -150,7 +146,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     the step matrix's factorisation (the dense model's c_fac N^1.5) and the steps' solves in the total; the
     assembly of lags 1-2 (seconds on the 72 m building) is not modelled."""
     from ..bem.halfspace import HalfSpace
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, RATES
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
     from ..bem.lagset import load_kernels
     from ..sysmem import process_rss
     from ..petsc import SSIError
@@ -192,25 +188,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         lines.insert(2, describe(cc))
         lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s coupling_setup_s coupling_loop_s total | GB "
                      "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
-    live = {}                           # measured history rates by the number of ranks sharing a node's bus
-    block = int(cfg.history_block) or 8
-    hdr = len(lines) - 1                # (the rates' lines go above the table's header)
     for p in ranks:
-        rates = None
-        if cfg.get("estimate_probe", True):
-            w = max(1, min(p, q, cores))
-            if w not in live:
-                from ..bem.toeplitz import measure_rates
-                live[w] = measure_rates(plan.Lx if plan.active else prob.L, plan, prob.n_steps, block, w,
-                                        cfg.scheme.startswith("stabili"), single)
-                hdr += 1
-                lines.insert(hdr - 1, f"[ssi]   history rates measured now with {w} thread(s) at once (-ssi_estimate_probe; "
-                             f"fitted RATES in brackets): products {live[w]['r_products'] / 1e9:.3g} GFlop/s a rank "
-                             f"({RATES['r_products'] / 1e9:.3g})"
-                             + (f", the far states' weighting {live[w]['r_sums_span'] / 1e9:.3g} GFlop/s "
-                                f"({RATES['r_sums_span'] / 1e9:.3g})" if "r_sums_span" in live[w] else ""))
-            rates = live[w]
-        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block, 3 * N, g, rates=rates, plan=plan,
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
         cpl = ""
         if cc is not None:            # the structure, the interface matrices and the coupled steps

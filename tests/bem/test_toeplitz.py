@@ -242,33 +242,6 @@ def test_interp_products_low_rank_chebyshev_weights():
     assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max(), np.abs(got - ref).max() / np.abs(ref).max()
 
 
-def test_measure_rates_counts_as_the_estimate_does():
-    """``measure_rates`` (``petsc-ssi estimate``'s live probe of the history's rates): positive rates of the
-    kinds the estimate reads, the far states' weighting only with a Chebyshev plan (multi-linear weights go
-    anchor by anchor, r_sums kept), and its flops those ``estimate`` counts for the same work: the estimate
-    with the measured rates prices one block's products at the probe's own measured seconds (within the
-    spread of two timings: a factor of 3)."""
-    import time
-    from petsc_ssi.bem import interp
-    from petsc_ssi.bem.toeplitz import measure_rates, history_products
-    cheb = interp.Plan("chebyshev", 0.005, 80, 0.15, 8)
-    lin = interp.Plan("linear", 0.005, 80, 0.15, 8)
-    r = measure_rates(cheb.Lx, cheb, 120, 8, workers=2, freqs=128, repeats=2)
-    assert r["r_products"] > 1e8 and r.get("r_sums_span", 0) > 1e8, r
-    r_lin = measure_rates(lin.Lx, lin, 120, 8, workers=1, freqs=128, repeats=2)
-    assert "r_sums_span" not in r_lin and r_lin["r_products"] > 1e8
-    # the products of one block, timed directly: flops as counted (8 x 144 per frequency and kernel pair)
-    rng = np.random.default_rng(1)
-    D, f, b = cheb.Lx, 128, 8
-    cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
-    K9, K18, V9, V18 = cz(f, 9 * D, 8), cz(f, 18 * D, 4), cz(f, D + b + 2, 9), cz(f, D + b + 2, 18)
-    t0 = time.perf_counter()
-    history_products(K9, K18, V9, V18, 0, b, D)
-    t = time.perf_counter() - t0
-    model = 8.0 * 144 * b * D * f / r_lin["r_products"]
-    assert model / 3 < t < 3 * model, (t, model)
-
-
 def test_history_products_match_the_sum():
     """``history_products`` (sliding windows of the kept states times the stacked kernels) against the plain
     sum over steps and time distances, for the H side's (8, 4) and the G side's (4, 8) output widths, kept
@@ -436,9 +409,6 @@ def test_the_estimate_of_a_coupled_run_on_the_toeplitz_store():
     assert row, r.stdout
     kern, hist, fac, solve, setup, loop = (float(row.group(i)) for i in range(1, 7))
     assert kern > 0 and hist > 0 and fac > 0 and solve > 0 and setup > 0 and loop > 0
-    assert "history rates measured now with 1 thread(s)" in r.stdout      # the live probe (-ssi_estimate_probe)
-    fixed = cli(["estimate"] + SSI + TZ + ["-ssi_estimate_ranks", "1", "-ssi_estimate_probe", "0"]).stdout
-    assert "history rates measured now" not in fixed and "estimate of this coupled run" in fixed
     gb = float(row.group(8))
     soil_gb = float(re.search(r"\[ssi\]\s+1 \|\s+\S+\s+\S+ \|\s+(\S+) \|", soil).group(1))
     assert gb > soil_gb, (gb, soil_gb)
