@@ -258,9 +258,9 @@ def option_value(db, key, allopts=None):
 
 
 def _is_petsc_object_option(name):
-    # -ssi_bem_ksp_type, -ssi_fem_pc_type, ...: options of PETSc objects that
+    # -ssi_bem_ksp_type, -ssi_fem_pc_type, -ssi_bem_columns_pc_type (coupling/columns.py), ...: options of PETSc objects that
     # carry a petsc_ssi prefix belong to PETSc, not to this registry.
-    for pfx in ("bem_", "fem_", "coupling_", "modes_"):
+    for pfx in ("bem_columns_", "bem_", "fem_", "coupling_", "modes_"):
         if name.startswith(pfx):
             rest = name[len(pfx):]
             if rest.split("_")[0] in ("ksp", "pc", "mat", "eps", "st", "snes", "vec", "redundant", "sub"):
