@@ -2,7 +2,10 @@
 """Fit the toeplitz store's time rates (petsc_ssi/bem/toeplitz.py RATES) to -log_view logs of toeplitz
 runs (jobscripts/toeplitz_bench.sh), and print the model against each log.
 
-    python jobscripts/toeplitz_fit.py [--check] LOG...     (--check: the committed RATES, no fit)
+    python jobscripts/toeplitz_fit.py [--check] [--products-rate R] LOG...
+        (--check: the committed RATES, no fit; --products-rate: r_products held at R flop/s a rank, the other
+        history terms fitted to what the products leave: on a few logs the products' and the per-step terms'
+        counts are nearly collinear, and the free fit put r_products at infinity on 2026-11-29's)
 
 Each log's option table rebuilds its set-up in this process (no assembly: the lattice, the interpolation
 plan, the traction window), as `petsc-ssi estimate` does; ``toeplitz.estimate`` is then evaluated with one
@@ -77,7 +80,7 @@ def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
     return sum(8.0 * m * g.F * plan.k * isteps for g, m in ((lat, 144), (glat, 180)) if g is not None) / ranks
 
 
-def main(logs, check=False):
+def main(logs, check=False, products_rate=None):
     """Fit the rates to ``logs`` and print the fitted model against each; ``check``: no fit, the committed
     RATES (and the step solve, cost.bem_solve_seconds with the committed constants) against each log."""
     from petsc_ssi.bem.cost import bem_solve_seconds, load_constants
@@ -105,8 +108,14 @@ def main(logs, check=False):
         fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
                                      "g_pair_factor")}
     else:
-        A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
-        inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
+        if products_rate:           # r_products held (the fit's products and per-step terms are nearly collinear
+            prod = np.array([t["prod"] for *_, t in runs]) / products_rate      # on few logs), the rest fitted
+            A = np.array([[t["dof"], t["grid"], t["elem"]] for *_, t in runs])
+            t_dof, t_grid, t_elem = _nnls(A, hist - sums - prod)
+            inv_r = 1.0 / products_rate
+        else:
+            A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
+            inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
         fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
                "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
                "t_pair_lag": float(_nnls(np.array([[t["pairs_h"]] for *_, t in runs]), kh)[0])}
@@ -142,4 +151,9 @@ def main(logs, check=False):
 
 if __name__ == "__main__":
     args = sys.argv[1:]
-    main([a for a in args if a != "--check"], check="--check" in args)
+    rate = None
+    if "--products-rate" in args:           # r_products held at this rate (flop/s a rank), the rest fitted
+        i = args.index("--products-rate")
+        rate = float(args[i + 1])
+        args = args[:i] + args[i + 2:]
+    main([a for a in args if a != "--check"], check="--check" in args, products_rate=rate)
