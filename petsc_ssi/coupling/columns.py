@@ -3,11 +3,11 @@ r"""The interface columns Z = A^{-1} H_s E_I of the coupled step on a region aro
 
 A is the soil's step matrix (lags 1-2: a node couples only to the nodes of the elements a wave reaches
 within a step or two, the *reach* r, read off A's pattern). Its inverse decays geometrically away from
-the diagonal: on the paper's building on the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs) the
-soil's displacement response to a unit interface displacement falls from 0.16 just outside the footprint
-to 1e-14 at 12 m and 2e-18 at 15 m (by a factor of about 6 per node spacing). So the columns' rows beyond
-a margin of a few reaches are zero to round-off, and the kept rows are the solution of the same equations
-restricted to the region Omega of the DOFs within the margin of an interface node:
+the diagonal: on the paper's building on the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs, reach
+3.5 m) the truncation residual below falls by about five orders of magnitude per reach of margin
+(``jobscripts/columns_margin.sh``). So the columns' rows beyond a margin of a few reaches are zero to
+round-off, and the kept rows are the solution of the same equations restricted to the region Omega of the
+DOFs within the margin of an interface node:
 
     A_{Omega Omega} Z_Omega = (H_s E_I)_Omega,     Z = Z_Omega on Omega, 0 elsewhere,
 
@@ -157,7 +157,8 @@ def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
             line = (f"[ssi] interface columns: on the {reg.n_region} soil DOFs within {margin:.3g} m of the "
                     f"interface ({100 * share:.0f} % of {reg.n_all}; margin {margin / reach:.3g} x the step "
                     f"matrix's reach {reach:.3g} m), their own LU; truncation residual {reg.residual:.2e} of "
-                    f"the right-hand sides (<= {TOL:g}; -ssi_interface_columns)")
+                    f"the right-hand sides (<= {TOL:g}; -ssi_interface_columns)"
+                    + (f"; tried first: {', '.join(tried)}" if tried else ""))
             return reg.rows, reg.Z, line
         tried.append(f"{margin:.3g} m: residual {reg.residual:.2e}"
                      + (", a right-hand side outside" if reg.rhs_outside else ""))

@@ -55,14 +55,18 @@ def test_region_columns_equal_the_full_solve(tmp_path):
 
 def test_a_margin_too_small_is_doubled(tmp_path):
     """A first margin of one reach leaves a residual above round-off: the margin is doubled until it is
-    not (the log line's margin), and the bonded run equals the full solve to 1e-12."""
+    not (the log line's margin and its first try's residual), and the bonded run equals the full solve to
+    1e-12; the region's KSP takes options under its own prefix (-ssi_bem_columns_)."""
     full, reg = str(tmp_path / "full.h5"), str(tmp_path / "reg.h5")
     bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.2"]
     cli(bonded + ["-ssi_output", full, "-ssi_interface_columns", "full"])
     out = cli(bonded + ["-ssi_output", reg, "-ssi_interface_columns", "region",
-                     "-ssi_interface_columns_margin", "1"]).stdout
+                        "-ssi_interface_columns_margin", "1",
+                        "-ssi_bem_columns_pc_factor_mat_solver_type", "mumps"]).stdout     # (its KSP's own prefix)
     m = region_line(out)
     assert float(m.group(5)) >= 2.0 and float(m.group(7)) <= 1e-14
+    first = re.search(r"tried first: ([\d.]+) m: residual ([\d.e+-]+)", out)
+    assert first and float(first.group(2)) > 1e-14, out[-2000:]
     same(full, reg)                                  # (bonded: no free flight)
 
 
