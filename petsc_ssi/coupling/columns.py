@@ -129,7 +129,12 @@ class RegionColumns:
         self.Z = Z
         for o in (ksp, AR, AQ, tmpl, rq):
             o.destroy()
+        self.destroy()
         return self
+
+    def destroy(self):
+        for o in (self.is_r, self.is_ring):
+            o.destroy()
 
 
 def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
@@ -147,6 +152,7 @@ def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
         reg = RegionColumns(march, X, nodes_I, margin, log)
         share = reg.n_region / max(reg.n_all, 1)
         if share > share_max:
+            reg.destroy()
             why = (f"the region within {margin:.3g} m of the interface holds {100 * share:.0f} % of the soil's "
                    f"DOFs")
             printf("[ssi] interface columns: with the step matrix's factors (" + why
