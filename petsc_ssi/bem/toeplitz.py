@@ -758,17 +758,29 @@ def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
 RANK_RTOL = 1e-15
 
 
+_LOW_RANK_CACHE = {}         # the last few weights' factors: once the window is full every block's C is the same
+
+
 def _low_rank(Cj):
     """(Cj, U s, W) with Cj = (U s) W to round-off (``RANK_RTOL``) when the rank r is at most half of both
-    dimensions (U s: rows x r, W: r x states), else (Cj, None, None)."""
+    dimensions (U s: rows x r, W: r x states), else (Cj, None, None). The factors of the last few distinct
+    weights are kept (keyed by their bytes): the blocks past the history's reach, and both sides, have the
+    same weights."""
     m, n = Cj.shape
     if min(m, n) < 16 or not Cj.any():
         return Cj, None, None
-    U, sv, Vt = np.linalg.svd(Cj, full_matrices=False)
-    r = int(np.count_nonzero(sv > RANK_RTOL * sv[0]))
-    if 2 * r > min(m, n):
-        return Cj, None, None
-    return Cj, np.ascontiguousarray(U[:, :r] * sv[:r]), np.ascontiguousarray(Vt[:r])
+    Cj = np.ascontiguousarray(Cj)
+    key = (m, n, Cj.tobytes())
+    got = _LOW_RANK_CACHE.get(key)
+    if got is None:
+        U, sv, Vt = np.linalg.svd(Cj, full_matrices=False)
+        r = int(np.count_nonzero(sv > RANK_RTOL * sv[0]))
+        got = (None, None) if 2 * r > min(m, n) else (np.ascontiguousarray(U[:, :r] * sv[:r]),
+                                                      np.ascontiguousarray(Vt[:r]))
+        if len(_LOW_RANK_CACHE) >= 8:
+            _LOW_RANK_CACHE.pop(next(iter(_LOW_RANK_CACHE)))
+        _LOW_RANK_CACHE[key] = got
+    return (Cj,) + got
 
 
 # the history products' window copies, per chunk of frequencies: at most about this many bytes (the

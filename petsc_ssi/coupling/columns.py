@@ -2,10 +2,10 @@ r"""The interface columns Z = A^{-1} H_s E_I of the coupled step on a region aro
 (``-ssi_interface_columns``; issue 41's building on a large uniform grid).
 
 A is the soil's step matrix (lags 1-2: a node couples only to the nodes of the elements a wave reaches
-within a step or two, the *reach* r, read off A's pattern). Its inverse decays geometrically away from
+within a step or two, at most the *reach* r = c_p t + the largest element diameter apart, ``geometric_reach``). Its inverse decays geometrically away from
 the diagonal: on the paper's building on the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs, reach
-3.5 m) the truncation residual below falls by about five orders of magnitude per reach of margin
-(``jobscripts/columns_margin.sh``). So the columns' rows beyond a margin of a few reaches are zero to
+3.5 m) the truncation residual below falls by about four orders of magnitude per reach of margin
+(``jobscripts/columns_margin.sh``; about three and a half on a quarter model with symmetry planes). So the columns' rows beyond a margin of a few reaches are zero to
 round-off, and the kept rows are the solution of the same equations restricted to the region Omega of the
 DOFs within the margin of an interface node:
 
@@ -30,16 +30,16 @@ TOL = 1e-14
 AUTO_SHARE = 0.6
 
 
-def step_reach(A, X, comm):
-    """Collective: the largest distance [m] between the nodes of a row and a column that the step matrix
-    A couples (DOF 3 k + c at node k of X), over every rank's rows."""
-    r0, r1 = A.getOwnershipRange()
-    ip, jj, _ = A.getValuesCSR()
-    ip = np.asarray(ip, np.int64)
-    rows = (r0 + np.repeat(np.arange(r1 - r0), np.diff(ip))) // 3
-    d = np.linalg.norm(X[rows] - X[np.asarray(jj, np.int64) // 3], axis=1) if rows.size else np.zeros(1)
-    from mpi4py import MPI
-    return float(comm.tompi4py().allreduce(float(d.max()) if d.size else 0.0, op=MPI.MAX))
+def geometric_reach(cfg, prob):
+    """The step matrix's reach from the geometry [m]: c_p t + the largest element diameter (t = 2 dt
+    stabilised, dt plain: the last lag of the step matrix; an element a wave reaches within t couples all its
+    nodes), an upper bound of the distance A couples (3.78 m against 3.5 m read off A on the uniform 72 m
+    building, 2.46 against 2.12 m on the 24 m test grid). The run and the estimate both size the region with
+    it, so that they take the same region."""
+    X, cells = prob.mesh.nodes, prob.mesh.cells
+    diam = float(np.linalg.norm(X[cells].max(axis=1) - X[cells].min(axis=1), axis=1).max()) if len(cells) else 0.0
+    t = (2.0 if str(cfg.scheme).startswith("stabili") else 1.0) * prob.dt
+    return prob.mat.cp * t + diam
 
 
 def region_nodes(X, nodes_I, margin):
@@ -125,7 +125,9 @@ class RegionColumns:
         with np.errstate(divide="ignore", invalid="ignore"):
             rel = np.where(bmax > 0, rmax / np.where(bmax > 0, bmax, 1.0), rmax)
         self.residual = float(rel.max()) if rel.size else 0.0
-        self.ok = (not self.rhs_outside) and self.residual <= TOL
+        if not np.all(np.isfinite(rmax)):     # (a NaN is not a residual within the bound; MAX may drop it)
+            self.residual = float("nan")
+        self.ok = (not self.rhs_outside) and bool(np.isfinite(self.residual)) and self.residual <= TOL
         self.Z = Z
         for o in (ksp, AR, AQ, tmpl, rq):
             o.destroy()
@@ -137,21 +139,22 @@ class RegionColumns:
             o.destroy()
 
 
-def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
+def region_columns(cfg, march, prob, nodes_I, cols, n_cols, rhs, log=printf):
     """Collective: Z's columns on a region around the interface when ``-ssi_interface_columns`` (auto or
     region) allows it: (rows, Z, line) with ``line`` the log's account, or None (the caller solves with A's
     factors: full, a region holding most of the grid, or no region within the margins tried)."""
     mode = str(cfg.get("interface_columns") or "auto").lower()
     if mode == "full":
         return None
-    reach = step_reach(march.A, X, march.comm)
+    X = prob.mesh.nodes
+    reach = geometric_reach(cfg, prob)
     margin = float(cfg.get("interface_columns_margin") or 4.0) * reach
     share_max = 1.0 if mode == "region" else AUTO_SHARE
     tried = []
     while True:
         reg = RegionColumns(march, X, nodes_I, margin, log)
         share = reg.n_region / max(reg.n_all, 1)
-        if share > share_max:
+        if share > share_max or reg.n_region == reg.n_all:     # (the whole grid: A's own factors serve)
             reg.destroy()
             why = (f"the region within {margin:.3g} m of the interface holds {100 * share:.0f} % of the soil's "
                    f"DOFs")
@@ -162,7 +165,7 @@ def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
         if reg.ok:
             line = (f"[ssi] interface columns: on the {reg.n_region} soil DOFs within {margin:.3g} m of the "
                     f"interface ({100 * share:.0f} % of {reg.n_all}; margin {margin / reach:.3g} x the step "
-                    f"matrix's reach {reach:.3g} m), their own LU; truncation residual {reg.residual:.2e} of "
+                    f"matrix's reach {reach:.3g} m, c_p t + the largest element), their own LU; truncation residual {reg.residual:.2e} of "
                     f"the right-hand sides (<= {TOL:g}; -ssi_interface_columns)"
                     + (f"; tried first: {', '.join(tried)}" if tried else ""))
             return reg.rows, reg.Z, line
@@ -173,21 +176,15 @@ def region_columns(cfg, march, X, nodes_I, cols, n_cols, rhs, log=printf):
 
 def estimated_region_nodes(cfg, prob, be_nodes):
     """The soil nodes whose rows of Z the run keeps, before it runs (``petsc-ssi estimate``, the memory
-    check, the run's first line): the region of ``region_columns`` at its first margin, with the step
-    matrix's reach from the geometry, c_p t + the largest element diameter (t = 2 dt stabilised, dt plain:
-    the last lag of the step matrix; 3.78 m against 3.5 m read off the matrix on the uniform 72 m
-    building); every node where the columns go with the step matrix's factors (full, or auto past
-    ``AUTO_SHARE``). A doubled margin (a residual above round-off) is not foreseen."""
+    check, the run's first line): the region of ``region_columns`` at its first margin (the same
+    ``geometric_reach``); every node where the columns go with the step matrix's factors (full, or auto past
+    ``AUTO_SHARE``, or a region of every node). A doubled margin (a residual above round-off) is not foreseen."""
     N = prob.mesh.n_nodes
     mode = str(cfg.get("interface_columns") or "auto").lower()
     if mode == "full":
         return N
-    X = prob.mesh.nodes
-    cells = prob.mesh.cells
-    diam = float(np.linalg.norm(X[cells].max(axis=1) - X[cells].min(axis=1), axis=1).max()) if len(cells) else 0.0
-    t = (2.0 if str(cfg.scheme).startswith("stabili") else 1.0) * prob.dt
-    margin = float(cfg.get("interface_columns_margin") or 4.0) * (prob.mat.cp * t + diam)
-    n = int(region_nodes(X, np.asarray(be_nodes), margin).sum())
-    if mode == "auto" and n > AUTO_SHARE * N:
+    margin = float(cfg.get("interface_columns_margin") or 4.0) * geometric_reach(cfg, prob)
+    n = int(region_nodes(prob.mesh.nodes, np.asarray(be_nodes), margin).sum())
+    if (mode == "auto" and n > AUTO_SHARE * N) or n == N:
         return N
     return n

@@ -67,12 +67,18 @@ def build_coupled(cfg, comm):
 
 def interface_bytes(cfg, prob, model, iface, ranks):
     """Estimated bytes of the coupling's dense interface matrices over all ranks: the local rows
-    of Z = A^-1 H_s E_I (soil dofs x 3 n_I; the region's, ``columns.estimated_region_nodes``) and, implicit, of D^-1 T^T (structure dofs x 3 n_I);
+    of Z = A^-1 H_s E_I (soil dofs x 3 n_I; the region's, ``columns.estimated_region_nodes``, and then the
+    region's LU factors, fill_bytes n ln n of its n DOFs, toeplitz.RATES) and, implicit, of D^-1 T^T (structure dofs x 3 n_I);
     on every rank Z_II, M3, C (3 n_I)^2 each and the interface LUs (one bonded; a cache of at
     most 512 MB with unilateral contact)."""
     from .columns import estimated_region_nodes
     n = 3 * iface.n
-    b = 8.0 * 3 * estimated_region_nodes(cfg, prob, iface.be_nodes) * n + 3 * 8.0 * n * n * ranks
+    nz = estimated_region_nodes(cfg, prob, iface.be_nodes)
+    b = 8.0 * 3 * nz * n + 3 * 8.0 * n * n * ranks
+    if nz < prob.mesh.n_nodes:          # the region's own LU beside the step matrix's, during the set-up
+        import math
+        from ..bem.toeplitz import RATES
+        b += RATES["fill_bytes"] * 3 * nz * math.log(max(3 * nz, 2))
     if cfg.coupling == "implicit":
         b += 8.0 * model.dofmap.size * n + 8.0 * n * n * ranks
     lu = 8.0 * n * n

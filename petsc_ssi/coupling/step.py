@@ -256,8 +256,8 @@ class Coupler:
         from .columns import region_columns
         rows = None
         with event("SSI_BEM_Solve"):
-            got = region_columns(self.cfg, m, self.prob.mesh.nodes, np.asarray(self.iface.be_nodes), cols,
-                                 3 * self.nI, full_block)
+            got = region_columns(self.cfg, m, self.prob, np.asarray(self.iface.be_nodes), cols, 3 * self.nI,
+                                 full_block)
             if got is not None:
                 rows, Z, line = got
                 printf(line)

@@ -63,7 +63,9 @@ RUN_CONTROL = frozenset((
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
     "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
-    "huge_pages", "disk_check", "debug"))
+    "huge_pages", "disk_check", "debug",
+    # how the interface columns are solved (region or full: equal to round-off, as the solvers' options)
+    "interface_columns", "interface_columns_margin"))
 
 
 def _file_digest(path):

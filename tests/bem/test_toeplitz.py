@@ -211,7 +211,7 @@ def test_interp_products_match_the_sum(widths, dtype):
         assert got.dtype == np.complex128 and np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
 
 
-def test_interp_products_low_rank_chebyshev_weights():
+def test_interp_products_low_rank_chebyshev_weights(monkeypatch):
     """Chebyshev interpolation's weights (each anchor's Lagrange polynomial of degree k - 1 in the lag on
     Chebyshev points, over the windows of b steps whose ends move with the step) have a low numerical rank:
     ``interp_products`` takes them through their singular vectors (``_low_rank``: rank about k + 2 (b + 2)
@@ -235,7 +235,12 @@ def test_interp_products_low_rank_chebyshev_weights():
     cz = lambda *s: rng.standard_normal(s) + 1j * rng.standard_normal(s)
     Axy, Az = cz(slab, 9 * k, 8), cz(slab, 18 * k, 4)
     Vz, Vxy = cz(slab, ns + 7, 9), cz(slab, ns + 7, 18)
+    from petsc_ssi.bem import toeplitz
+    used = []
+    real = toeplitz._low_rank
+    monkeypatch.setattr(toeplitz, "_low_rank", lambda Cj: used.append(real(Cj)[2] is not None) or real(Cj))
     got = interp_products(Axy, Az, Vz, Vxy, C, 7, fchunk=8)
+    assert used == [True]                       # the product went through the weights' rank
     Sz = np.einsum("bjm,fmc->fbjc", C, Vz[:, 7:]).reshape(slab, b, 9 * k)
     Sxy = np.einsum("bjm,fmc->fbjc", C, Vxy[:, 7:]).reshape(slab, b, 18 * k)
     ref = np.concatenate([Sz @ Axy, Sxy @ Az], axis=2)

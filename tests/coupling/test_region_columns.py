@@ -1,5 +1,5 @@
 """The interface columns Z = A^-1 H_s E_I on a region around the interface (coupling/columns.py,
--ssi_interface_columns): the coupled run with unilateral contact (it lifts off) on a grid whose region
+-ssi_interface_columns): the coupled run with unilateral contact (it lifts off) on a 28 m grid whose region
 holds about half the soil's DOFs equals the run with the step matrix's factors (every row) to 1e-10 of
 each field's scale at -n 1 and -n 2 (the bound tests/bem/test_toeplitz.py allows the contact case's free
 flight, whose round-off grows: 1.5e-12 seen), and a bonded run to 1e-12; a first margin too small for round-off is doubled (the log says
@@ -19,8 +19,8 @@ from test_history_block import SSI, same  # noqa: E402
 
 pytestmark = pytest.mark.mpi
 
-# a 2 m x 2 m footing (4 soil elements) on a 24 m x 24 m grid of 1 m elements (7203 DOFs), toeplitz store
-BIG = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "24,24",
+# a 2 m x 2 m footing (4 soil elements) on a 28 m x 28 m grid of 1 m elements (9747 DOFs), toeplitz store
+BIG = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "28,28",
        "-ssi_mesh_h", "1", "-ssi_mesh_patch", "2,2", "-ssi_fem_box_cells", "4,4,1", "-ssi_fem_box_size", "2,2,0.25",
        "-ssi_fem_box_origin", "-1,-1,0", "-ssi_fem_E", "3e8", "-ssi_fem_rho", "2000", "-ssi_dt", "0.0125",
        "-ssi_t_end", "0.5", "-ssi_fem_load_group", "top", "-ssi_fem_load_p0", "1000", "-ssi_fem_load_history",
@@ -30,7 +30,8 @@ BIG = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "180
 
 def region_line(out):
     m = re.search(r"interface columns: on the (\d+) soil DOFs within ([\d.]+) m of the interface \((\d+) % of "
-                  r"(\d+); margin ([\d.]+) x the step matrix's reach ([\d.]+) m\).*truncation residual ([\d.e+-]+)",
+                  r"(\d+); margin ([\d.]+) x the step matrix's reach ([\d.]+) m[^)]*\).*truncation residual "
+                  r"([\d.e+-]+)",
                   out)
     assert m, out[-3000:]
     return m
@@ -43,7 +44,7 @@ def test_region_columns_equal_the_full_solve(tmp_path):
     out = cli(BIG + ["-ssi_output", reg]).stdout                 # auto: the region
     m = region_line(out)
     n_reg, share, n_all, mult = int(m.group(1)), int(m.group(3)), int(m.group(4)), float(m.group(5))
-    assert n_all == 7203 and 0.3 * n_all < n_reg < 0.6 * n_all and mult == 4.0
+    assert n_all == 9747 and 0.3 * n_all < n_reg < 0.6 * n_all and mult == 4.0
     assert float(m.group(7)) <= 1e-14
     same(full, reg, rtol=1e-10)
     with h5py.File(reg) as f:
@@ -78,3 +79,39 @@ def test_auto_keeps_the_full_solve_on_a_small_grid(tmp_path):
     assert line and "with the step matrix's factors" in line[0] and "% of the soil's DOFs" in line[0]
     share = float(re.search(r"holds (\d+) %", line[0]).group(1))
     assert share > 60 and np.isfinite(share)
+
+
+# the quarter of BIG's footing and grid with the symmetry planes x = 0 and y = 0 (their zero DOFs)
+QUARTER = [a for a in BIG] + ["-ssi_symmetry", "x=sym,y=sym"]
+for k, v in (("-ssi_fem_box_cells", "2,2,1"), ("-ssi_fem_box_size", "1,1,0.25"), ("-ssi_fem_box_origin", "0,0,0"),
+             ("-ssi_contact", "bonded"), ("-ssi_t_end", "0.1")):
+    QUARTER[QUARTER.index(k) + 1] = v
+
+
+def test_a_quarter_model_on_two_ranks(tmp_path):
+    """Symmetry planes (their zero DOFs in the region's matrix) on 2 ranks, the region near the corner of the
+    quarter grid (a rank may hold few of its rows or of its ring's), a first margin of one reach doubled twice:
+    equal to the full solve to 1e-12."""
+    full, reg = str(tmp_path / "full.h5"), str(tmp_path / "reg.h5")
+    cli(QUARTER + ["-ssi_output", full, "-ssi_interface_columns", "full"], nranks=2)
+    out = cli(QUARTER + ["-ssi_output", reg, "-ssi_interface_columns", "region", "-ssi_interface_columns_margin",
+                         "1"], nranks=2).stdout
+    m = region_line(out)
+    assert int(m.group(4)) == 2523 and int(m.group(1)) < 2523 and float(m.group(5)) == 4.0
+    same(full, reg)
+
+
+def test_auto_falls_back_to_the_full_solve_after_a_doubled_margin(tmp_path):
+    """auto with a first margin of 2 reaches: its residual is above round-off, the doubled margin's region
+    holds more than 60 % of the DOFs, so the columns go with the step matrix's factors (the log names the
+    first try's residual), and the run equals the full solve's bit for bit up to round-off (1e-12)."""
+    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.1"]
+    bonded[bonded.index("-ssi_mesh_size") + 1] = "24,24"     # (a 24 m grid: 64 % of it within the doubled margin)
+    full, auto = str(tmp_path / "full.h5"), str(tmp_path / "auto.h5")
+    cli(bonded + ["-ssi_output", full, "-ssi_interface_columns", "full"])
+    out = cli(bonded + ["-ssi_output", auto, "-ssi_interface_columns_margin", "2"]).stdout
+    line = [x for x in out.splitlines() if "interface columns:" in x]
+    assert line and "with the step matrix's factors" in line[0], out[-2000:]
+    first = re.search(r"([\d.]+) m: residual ([\d.e+-]+)", line[0])
+    assert first and float(first.group(2)) > 1e-14 and int(re.search(r"holds (\d+) %", line[0]).group(1)) > 60
+    same(full, auto)
