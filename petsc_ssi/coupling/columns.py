@@ -28,6 +28,21 @@ from ..petsc import init, printf, solve_columns, set_default_options, direct_sol
 TOL = 1e-14
 # auto: the region when it holds at most this share of the soil's DOFs (the full solve otherwise)
 AUTO_SHARE = 0.6
+# the region's MUMPS LU: percentage of workspace beyond the analysis' estimate (MUMPS's default 20)
+ICNTL14 = 60
+
+
+def _mumps_failure(ksp):
+    """'' or what failed in a MUMPS factorisation of the KSP's PC (INFOG(1) < 0: PETSc does not raise it
+    at set-up; the solves then stop with INFOG(1) = -3)."""
+    pc = ksp.getPC()
+    try:
+        if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+            return ""
+        v = int(pc.getFactorMatrix().getMumpsInfog(1))
+    except Exception:                   # (no MUMPS accessor in this petsc4py: nothing to check)
+        return ""
+    return f"MUMPS's LU failed, INFOG(1) = {v}" if v < 0 else ""
 
 
 def geometric_reach(cfg, prob):
@@ -87,10 +102,22 @@ class RegionColumns:
         AQ = A.createSubMatrix(self.is_ring, self.is_r)
         ksp = PETSc.KSP().create(comm=self.comm)
         ksp.setOptionsPrefix("ssi_bem_columns_")
-        set_default_options("ssi_bem_columns_", direct_solver_defaults(self.comm, soil=True), self.log)
+        defaults = dict(direct_solver_defaults(self.comm, soil=True))
+        if defaults.get("pc_factor_mat_solver_type") == "mumps":
+            # MUMPS's workspace relaxation: a region's submatrix pivots more than A (its cut rows), and
+            # its LU ran out of the default 20 % (INFOG(1) = -9) at 3.5 reaches on the uniform 72 m building
+            defaults["mat_mumps_icntl_14"] = str(ICNTL14)
+        set_default_options("ssi_bem_columns_", defaults, self.log)
         ksp.setOperators(AR)
         ksp.setFromOptions()
         ksp.setUp()
+        self.failed = _mumps_failure(ksp)
+        if self.failed:                         # (every rank: INFOG is global)
+            self.ok, self.residual, self.rhs_outside, self.Z = False, float("nan"), False, None
+            for o in (ksp, AR, AQ):
+                o.destroy()
+            self.destroy()
+            return self
         tmpl = AR.createVecRight()
         rq = AQ.createVecLeft()
         Z = np.zeros((self.rows.size, n_cols))
@@ -162,6 +189,11 @@ def region_columns(cfg, march, prob, nodes_I, cols, n_cols, rhs, log=printf):
                    + (f"; {', '.join(tried)}" if tried else "") + "; -ssi_interface_columns)")
             return None
         reg.solve(cols, n_cols, rhs)
+        if reg.failed:
+            printf(f"[ssi] interface columns: with the step matrix's factors (the region's own LU within {margin:.3g} m "
+                   f"of the interface: {reg.failed}; -ssi_bem_columns_mat_mumps_icntl_14 more workspace, "
+                   "-ssi_interface_columns)")
+            return None
         if reg.ok:
             line = (f"[ssi] interface columns: on the {reg.n_region} soil DOFs within {margin:.3g} m of the "
                     f"interface ({100 * share:.0f} % of {reg.n_all}; margin {margin / reach:.3g} x the step "

@@ -115,3 +115,17 @@ def test_auto_falls_back_to_the_full_solve_after_a_doubled_margin(tmp_path):
     first = re.search(r"([\d.]+) m: residual ([\d.e+-]+)", line[0])
     assert first and float(first.group(2)) > 1e-14 and int(re.search(r"holds (\d+) %", line[0]).group(1)) > 60
     same(full, auto)
+
+
+def test_a_failed_region_lu_falls_back_to_the_full_solve(tmp_path):
+    """MUMPS does not raise a failed factorisation at set-up (its solves then stop with INFOG(1) = -3: seen at
+    3.5 reaches on the uniform 72 m building, INFOG(1) = -9, before the region's workspace relaxation): the
+    region's LU is checked, and a failure (here forced: 1 MB of working memory, INFOG(1) = -19) is said in
+    one line and the columns go with the step matrix's factors, equal to the full solve's."""
+    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.05"]
+    full, reg = str(tmp_path / "full.h5"), str(tmp_path / "reg.h5")
+    cli(bonded + ["-ssi_output", full, "-ssi_interface_columns", "full"])
+    out = cli(bonded + ["-ssi_output", reg, "-ssi_bem_columns_mat_mumps_icntl_23", "1"]).stdout
+    line = [x for x in out.splitlines() if "interface columns:" in x]
+    assert line and "MUMPS's LU failed, INFOG(1) = -" in line[0] and "with the step matrix's factors" in line[0]
+    same(full, reg)
