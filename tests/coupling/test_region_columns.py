@@ -122,7 +122,7 @@ def test_a_failed_region_lu_falls_back_to_the_full_solve(tmp_path):
     3.5 reaches on the uniform 72 m building, INFOG(1) = -9, before the region's workspace relaxation): the
     region's LU is checked, and a failure (here forced: 1 MB of working memory, INFOG(1) = -19) is said in
     one line and the columns go with the step matrix's factors, equal to the full solve's."""
-    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.05"]
+    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.1"]
     full, reg = str(tmp_path / "full.h5"), str(tmp_path / "reg.h5")
     cli(bonded + ["-ssi_output", full, "-ssi_interface_columns", "full"])
     out = cli(bonded + ["-ssi_output", reg, "-ssi_bem_columns_mat_mumps_icntl_23", "1"]).stdout
