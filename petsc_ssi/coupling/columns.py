@@ -2,12 +2,13 @@ r"""The interface columns Z = A^{-1} H_s E_I of the coupled step on a region aro
 (``-ssi_interface_columns``; issue 41's building on a large uniform grid).
 
 A is the soil's step matrix (lags 1-2: a node couples only to the nodes of the elements a wave reaches
-within a step or two, at most the *reach* r = c_p t + the largest element diameter apart, ``geometric_reach``). Its inverse decays geometrically away from
-the diagonal: on the paper's building on the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs, reach
-3.5 m) the truncation residual below falls by about four orders of magnitude per reach of margin
-(``jobscripts/columns_margin.sh``; about three and a half on a quarter model with symmetry planes). So the columns' rows beyond a margin of a few reaches are zero to
-round-off, and the kept rows are the solution of the same equations restricted to the region Omega of the
-DOFs within the margin of an interface node:
+within a step or two, at most the *reach* r = c_p t + the largest element diameter apart,
+``geometric_reach``). Its inverse decays geometrically away from the diagonal: on the paper's building on
+the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs, reach 3.78 m) the truncation residual below
+falls by about four orders of magnitude per reach of margin (``jobscripts/columns_margin.sh``; about three
+and a half on a quarter model with symmetry planes). So the columns' rows beyond a margin of a few reaches
+are zero to round-off, and the kept rows are the solution of the same equations restricted to the region
+Omega of the DOFs within the margin of an interface node:
 
     A_{Omega Omega} Z_Omega = (H_s E_I)_Omega,     Z = Z_Omega on Omega, 0 elsewhere,
 
