@@ -364,6 +364,20 @@ def direct_solver_defaults(comm, soil=False):
                    "run on one rank or choose an iterative solver with -ssi_*_ksp_type/-pc_type")
 
 
+def mumps_failure(ksp):
+    """'' or what failed in a MUMPS factorisation of the KSP's PC (INFOG(1) < 0, the same on every rank):
+    PETSc does not raise it at set-up, and the solves then stop with MUMPS's INFOG(1) = -3, which does not
+    name the cause (-9, -8: the workspace too small after pivoting; -13, -19: memory; -10: singular)."""
+    pc = ksp.getPC()
+    try:
+        if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+            return ""
+        v = int(pc.getFactorMatrix().getMumpsInfog(1))
+    except Exception:                   # (no MUMPS accessor in this petsc4py: nothing to check)
+        return ""
+    return f"MUMPS's LU failed, INFOG(1) = {v}" if v < 0 else ""
+
+
 def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     """Collective: x_j = A^-1 b_j for j = 0 .. m-1 with the KSP's operator A. ``fill(j, b)`` writes
     right-hand side j into the Vec b (layout of ``template``), ``take(j, x)`` receives its solution

@@ -62,3 +62,18 @@ def test_a_threshold_time_before_the_rayleigh_arrival_is_warned(tmp_path):
         and "T_L = 0.02373 s" in w[0], r.stdout[-3000:]
     r = cli(base + ["-ssi_interp_tl", "0.03", "-ssi_output", str(tmp_path / "b.h5")])
     assert "warning: -ssi_interp_tl" not in r.stdout, r.stdout[-3000:]
+
+
+def test_a_failed_step_matrix_lu_is_named():
+    """MUMPS's failed factorisation of the soil's step matrix (here forced: 1 MB of working memory per rank)
+    is one line naming INFOG(1) and the options that give MUMPS room, on every rank, not the -3 of the first
+    solve's MUMPS call with a traceback."""
+    args = ["-ssi_problem", "bem", "-ssi_mesh_size", "6,6", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "1,1",
+            "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025", "-ssi_t_end", "0.01",
+            "-ssi_bem_mat_mumps_icntl_23", "1"]
+    for n in (1, 2):
+        r = cli(args, nranks=n, check=False)
+        text = r.stdout + r.stderr
+        assert r.returncode != 0 and "Traceback" not in text, text[-2000:]
+        assert text.count("the soil's step matrix") == 1 and "MUMPS's LU failed, INFOG(1) = -" in text
+        assert "-ssi_bem_mat_mumps_icntl_14" in text

@@ -25,7 +25,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ..petsc import init, set_default_options, direct_solver_defaults, printf, check_reproducible_solver
+from ..petsc import (init, set_default_options, direct_solver_defaults, printf, check_reproducible_solver,
+                     mumps_failure, SSIError)
 from ..monitor import event
 from . import bsr
 
@@ -152,6 +153,11 @@ class Marcher:
         self.ksp.setOperators(self.A)
         self.ksp.setFromOptions()
         self.ksp.setUp()
+        failed = mumps_failure(self.ksp)        # (INFOG is global: every rank raises)
+        if failed:
+            raise SSIError(f"the soil's step matrix ({self.A.getSize()[0]} DOFs): {failed}; more workspace with "
+                           "-ssi_bem_mat_mumps_icntl_14 <percent> (default 20), more memory with "
+                           "-ssi_bem_mat_mumps_icntl_23 <MB per rank>, or fewer DOFs")
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)

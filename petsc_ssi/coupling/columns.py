@@ -22,7 +22,7 @@ themselves are unchanged (the run's residual check, ``bem_residual``, measures t
 """
 import numpy as np
 
-from ..petsc import init, printf, solve_columns, set_default_options, direct_solver_defaults
+from ..petsc import init, printf, solve_columns, set_default_options, direct_solver_defaults, mumps_failure
 
 # the largest residual of the region's columns, over the column's right-hand side (both in the
 # infinity norm), that keeps the region: round-off of the step equations' own size
@@ -31,19 +31,6 @@ TOL = 1e-14
 AUTO_SHARE = 0.6
 # the region's MUMPS LU: percentage of workspace beyond the analysis' estimate (MUMPS's default 20)
 ICNTL14 = 60
-
-
-def _mumps_failure(ksp):
-    """'' or what failed in a MUMPS factorisation of the KSP's PC (INFOG(1) < 0: PETSc does not raise it
-    at set-up; the solves then stop with INFOG(1) = -3)."""
-    pc = ksp.getPC()
-    try:
-        if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
-            return ""
-        v = int(pc.getFactorMatrix().getMumpsInfog(1))
-    except Exception:                   # (no MUMPS accessor in this petsc4py: nothing to check)
-        return ""
-    return f"MUMPS's LU failed, INFOG(1) = {v}" if v < 0 else ""
 
 
 def geometric_reach(cfg, prob):
@@ -112,7 +99,7 @@ class RegionColumns:
         ksp.setOperators(AR)
         ksp.setFromOptions()
         ksp.setUp()
-        self.failed = _mumps_failure(ksp)
+        self.failed = mumps_failure(ksp)
         if self.failed:                         # (every rank: INFOG is global)
             self.ok, self.residual, self.rhs_outside, self.Z = False, float("nan"), False, None
             for o in (ksp, AR, AQ):
