@@ -268,9 +268,7 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         per_lag = m * g.Mx * g.My * 8.0
         kern = 16.0 * F * m * (D + k)
         build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
-        # the kernels, the kept transforms, and the recent copies of ``_recent_products`` (the first b - 1
-        # lags' kernels, the last b states)
-        nbytes += kern * (1.0 + min(block - 1, D) / max(D + k, 1)) + vbytes * F * 27 * (W + block)
+        nbytes += kern + vbytes * F * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
         flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
@@ -442,7 +440,7 @@ class ToeplitzHistory:
             S = rfft2(Kp, axes=(-2, -1), workers=1).reshape(Kp.shape[:4] + (-1,))
             Kp = None
             for i in range(c_hi - c_lo + 1):
-                yield c_lo + i, S[i, ..., self.f0:self.f1]         # (a view: ``_add_kernel`` reads it in place)
+                yield c_lo + i, np.ascontiguousarray(S[i, ..., self.f0:self.f1])
             S = None
 
     def _terms(self, march):
@@ -501,16 +499,6 @@ class ToeplitzHistory:
         self.W = self.R + 3 * self.block + 8
         self.V9 = np.zeros((slab, self.W, 9), self.vdtype)
         self.V18 = np.zeros((slab, self.W, 18), self.vdtype)
-        # the step's own products (``_recent_products``: the block's states before it, d = 1 .. b - 1) read
-        # copies laid out lag by lag and state by state, contiguous over the frequencies: Kr9 (b - 1, slab,
-        # 9, n9) and Kr18 the kernels of d = 1 .. b - 1, Vr9 (b, slab, 9) and Vr18 the last b states'
-        # transforms (state m in slot m mod b)
-        nr = min(self.block - 1, D)
-        self.Kr9 = np.ascontiguousarray(self.K9[:, 9 * (D - nr):].reshape(slab, nr, 9, n9)[:, ::-1].transpose(1, 0, 2, 3))
-        self.Kr18 = np.ascontiguousarray(self.K18[:, 18 * (D - nr):].reshape(slab, nr, 18, n18)[:, ::-1]
-                                         .transpose(1, 0, 2, 3))
-        self.Vr9 = np.zeros((self.block, slab, 9), self.vdtype)
-        self.Vr18 = np.zeros((self.block, slab, 18), self.vdtype)
         self.base = -self.R
         self._setup_state_maps(march)
         from ..sysmem import release_freed
@@ -518,8 +506,7 @@ class ToeplitzHistory:
         self.t_build = time.perf_counter() - t0
         mpi = self.comm.tompi4py()
         self.nev = mpi.allreduce(self.nev)
-        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18,
-                                                          self.Kr9, self.Kr18, self.Vr9, self.Vr18)))
+        self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18)))
         return self
 
     def _setup_state_maps(self, march):
@@ -561,14 +548,12 @@ class ToeplitzHistory:
         i = m - self.base
         self.V9[:, i] = S[:, 2, :].T
         self.V18[:, i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
-        self.Vr9[m % self.block] = self.V9[:, i]
-        self.Vr18[m % self.block] = self.V18[:, i]
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
         self.upto, self.base, self._blk = 0, -self.R, None
-        for B in (self.V9, self.V18, self.Vr9, self.Vr18):
-            B[...] = 0.0
+        self.V9[...] = 0.0
+        self.V18[...] = 0.0
 
     def _room(self, n0):
         """Before the block of steps n0 + 1 .. n0 + b: the buffers hold states n0 + 1 - R .. n0 + b (R the
@@ -644,8 +629,8 @@ class ToeplitzHistory:
         D = self.D
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
-            _recent_products(self.Kr9, self.Vr9, n, k, acc, 0)
-            _recent_products(self.Kr18, self.Vr18, n, k, acc, self.spec["n9"])
+            acc += history_products(self.K9[:, 9 * (D - k):], self.K18[:, 18 * (D - k):], self.V9, self.V18,
+                                    n - k - self.base, 1, k)[:, 0]
             march.PETSc.Log.logFlops(8.0 * k * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * (self.f1 - self.f0))
         if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
             C = self._weights(march, n, n0 + 1, n - 1)[None]
@@ -690,31 +675,19 @@ class ToeplitzHistory:
             arr += vals.ravel()
 
 
-@njit(cache=True)
 def _add_kernel(K9, K18, r, c, S):
     """Rows r of K9 (9 a row) and K18 (18) += c S: S (4, 9, m, slab) one lag's kernel spectra (class,
-    slot, pattern entry, frequency; a view of the chunk's transforms, the frequency axis of unit stride);
-    m = 4 the H pattern (xz, yz, zx, zy: K9 columns (class, xz/yz), K18 rows (slot, zx/zy) columns
-    class), m = 5 the G pattern (xx, xy, yx, yy, zz: K9 columns class (zz), K18 rows (slot, input
-    component q) columns (class, output component p), entry 2 p + q). Compiled, frequencies in blocks of
-    32: each entry's run of frequencies read contiguously, the block's kernel rows kept in cache (the
-    numpy transposes of the whole slab took three times as long: 17 ms a lag on the 72 m building)."""
-    m, slab = S.shape[2], S.shape[3]
-    for f0 in range(0, slab, 32):
-        f1 = min(slab, f0 + 32)
-        for t in range(4):
-            for a in range(9):
-                if m == 4:
-                    for e in range(2):
-                        for f in range(f0, f1):
-                            K9[f, 9 * r + a, 2 * t + e] += c * S[t, a, e, f]
-                            K18[f, 18 * r + 2 * a + e, t] += c * S[t, a, 2 + e, f]
-                else:
-                    for f in range(f0, f1):
-                        K9[f, 9 * r + a, t] += c * S[t, a, 4, f]
-                    for e in range(4):
-                        for f in range(f0, f1):
-                            K18[f, 18 * r + 2 * a + e % 2, 2 * t + e // 2] += c * S[t, a, e, f]
+    slot, pattern entry, frequency); m = 4 the H pattern (xz, yz, zx, zy: K9 columns (class, xz/yz), K18
+    rows (slot, zx/zy) columns class), m = 5 the G pattern (xx, xy, yx, yy, zz: K9 columns class (zz), K18
+    rows (slot, input component q) columns (class, output component p), entry 2 p + q)."""
+    slab = S.shape[-1]
+    if S.shape[2] == 4:
+        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
+        K18[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
+    else:
+        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 4, :].transpose(2, 1, 0)
+        G = S[:, :, 0:4, :].reshape(4, 9, 2, 2, slab)             # (class, slot, p, q, frequency)
+        K18[:, 18 * r:18 * (r + 1), :] += c * G.transpose(4, 1, 3, 0, 2).reshape(slab, 18, 8)
 
 
 def _spans(C):
@@ -845,26 +818,6 @@ def history_products(K9, K18, V9, V18, p0, b, D, fchunk=None):
         np.matmul(a9, K9[f0:f1], out=out[f0:f1, :, :n9])
         np.matmul(a18, K18[f0:f1], out=out[f0:f1, :, n9:])
     return out
-
-
-@njit(cache=True)
-def _recent_products(Kr, Vr, n, k, out, j0):
-    """out[f, j0 + j] += sum_{d = 1..k} sum_c Vr[(n - d) mod b, f, c] Kr[d - 1, f, c, j]: step n's products with
-    its k newest states (``ToeplitzHistory._step_products``; Kr (>= k, slab, C, n) the kernels of lags
-    d = 1, 2, .., Vr (b, slab, C) the last b states' transforms, state m in slot m mod b). Compiled, over
-    copies contiguous in the frequencies: per frequency these are products of one row by 9 k or 18 k kernel
-    rows, which BLAS took as one gemv call each from the frequency-major kernels (their calls' overhead and
-    a page a frequency: 9 ms a side and step at k = 1 on the 72 m building's slab, 0.9 ms here). A
-    frequency's sum in the same order on any number of ranks."""
-    b = Vr.shape[0]
-    slab, C, nn = Kr.shape[1], Kr.shape[2], Kr.shape[3]
-    for d in range(1, k + 1):
-        s = (n - d) % b
-        for f in range(slab):
-            for c in range(C):
-                v = np.complex128(Vr[s, f, c])
-                for j in range(nn):
-                    out[f, j0 + j] += v * Kr[d - 1, f, c, j]
 
 
 def mpi_in_place():

@@ -183,8 +183,7 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     bg, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat)
     assert abs((bg - b) / 1e9 - g_stored) <= 0.01 * g_stored + 5e-6, (bg - b, g_stored)
     bs, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat, single=True)
-    # kept states halved: the buffer's L + 3 b + 8 and the last b states' copy (``_recent_products``)
-    assert bs < bg and abs((bg - bs) - 8.0 * 27 * (24 + 3 * 8 + 8 + 8) * (Lat.F + GLat.F)) < 1.0
+    assert bs < bg and abs((bg - bs) - 8.0 * 27 * (24 + 3 * 8 + 8) * (Lat.F + GLat.F)) < 1.0   # kept states halved
 
 
 @pytest.mark.parametrize("widths,dtype", [((8, 4), np.complex128), ((4, 8), np.complex128), ((4, 8), np.complex64)])
