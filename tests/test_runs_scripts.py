@@ -35,3 +35,21 @@ def test_seismic_report_writes_into_the_run_directory(tmp_path, capsys):
     report.main(str(tmp_path))
     assert os.path.getsize(tmp_path / "roof.png") > 1000
     assert _digest(kept) == before
+
+
+@pytest.mark.parametrize("lags,block", [(11, 4), (5, 8), (16, 4)])
+def test_history_time_fft_equals_the_direct_products(lags, block):
+    """jobscripts/history_time_fft.py (the README's measurement of a fast convolution in time): its
+    overlap-save blocks give the direct block products (``toeplitz.history_products``) to round-off, for
+    D a multiple of b, D < b and D not a multiple of b, on a small slab."""
+    import re
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "jobscripts", "history_time_fft.py"), "--slab", "40",
+                        "--lags", str(lags), "--block", str(block), "--repeat", "1"],
+                       capture_output=True, text=True, timeout=600, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    assert r.returncode == 0, r.stderr[-2000:]
+    row = [ln for ln in r.stdout.splitlines() if re.match(r"\| 0 \|", ln)]
+    assert len(row) == 1, r.stdout
+    err = float(row[0].strip("|").split("|")[-1])
+    assert err <= 1e-13, row[0]
