@@ -91,6 +91,17 @@ def test_toeplitz_two_ranks_equal_one(tmp_path):
     same(one, two)
 
 
+def test_toeplitz_three_ranks_equal_one(tmp_path):
+    """Three ranks (oversubscribed): the kernels' planes and the frequencies split unevenly over the ranks
+    (``_reduce_transform``: each rank transforms its planes, the spectra sent to the ranks of their
+    frequencies), -n 3 equals -n 1 to 1e-12."""
+    args = BEM + INTERP
+    one, three = (str(tmp_path / f"{k}.h5") for k in ("one", "three"))
+    cli(args + TZ + ["-ssi_output", one])
+    cli(args + TZ + ["-ssi_output", three, "-ssi_reproducible"], nranks=3)
+    same(one, three)
+
+
 def test_toeplitz_restart_is_bitwise(tmp_path):
     """A checkpoint after step 10 of 60: the restart makes the kept transforms again from the
     checkpoint's states, and every dataset is the uninterrupted run's bit for bit."""
