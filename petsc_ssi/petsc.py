@@ -364,6 +364,26 @@ def direct_solver_defaults(comm, soil=False):
                    "run on one rank or choose an iterative solver with -ssi_*_ksp_type/-pc_type")
 
 
+# MUMPS's ordering of the soil's matrices (the step matrix, the interface region's): PETSc hands MUMPS a
+# matrix of block size 3 (a node's DOFs) with ICNTL(15) = -3, MUMPS then orders the graph of the nodes,
+# whose 3 x 3 blocks are half empty on a flat surface (the H pattern's zx/zy and xz/yz, not xy): on the
+# uniform 72 m building (44 649 DOFs) its LU held 106.4 M entries with PORD (the automatic choice of a
+# MUMPS without METIS or SCOTCH, as Debian's), 77.6 M with ICNTL(15) 0 and AMD (ICNTL(7) 0; PORD
+# without the blocks 92.8 M): its factorisation 4.96 -> 3.35 s, 100 step solves 6.19 -> 5.74 s; the
+# graded 36 m building 6.20 -> 5.77 M, the paper's Lamb quarter model 2.70 -> 1.77 M (runs/building/README.md).
+# A MUMPS with METIS may order better still: -ssi_bem_mat_mumps_icntl_7 5.
+SOIL_MUMPS = {"mat_mumps_icntl_15": "0", "mat_mumps_icntl_7": "0"}
+
+
+def soil_solver_defaults(comm):
+    """``direct_solver_defaults(comm, soil=True)`` and, when that is MUMPS, the soil's ordering
+    (``SOIL_MUMPS``)."""
+    d = dict(direct_solver_defaults(comm, soil=True))
+    if d.get("pc_factor_mat_solver_type") == "mumps":
+        d.update(SOIL_MUMPS)
+    return d
+
+
 def mumps_failure(ksp):
     """'' or what failed in a MUMPS factorisation of the KSP's PC (INFOG(1) < 0, the same on every rank):
     PETSc does not raise it at set-up, and the solves then stop with MUMPS's INFOG(1) = -3, which does not

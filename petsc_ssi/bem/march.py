@@ -25,7 +25,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ..petsc import (init, set_default_options, direct_solver_defaults, printf, check_reproducible_solver,
+from ..petsc import (init, set_default_options, soil_solver_defaults, printf, check_reproducible_solver,
                      mumps_failure, SSIError)
 from ..monitor import event
 from . import bsr
@@ -148,7 +148,7 @@ class Marcher:
         self.zero_local = zd - r0
         self.ksp = PETSc.KSP().create(comm=comm)
         self.ksp.setOptionsPrefix("ssi_bem_")
-        set_default_options("ssi_bem_", direct_solver_defaults(comm, soil=True), log)
+        set_default_options("ssi_bem_", soil_solver_defaults(comm), log)
         check_reproducible_solver("ssi_bem_", comm, "the soil's step matrix")
         self.ksp.setOperators(self.A)
         self.ksp.setFromOptions()

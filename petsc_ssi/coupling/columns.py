@@ -22,7 +22,7 @@ themselves are unchanged (the run's residual check, ``bem_residual``, measures t
 """
 import numpy as np
 
-from ..petsc import init, printf, solve_columns, set_default_options, direct_solver_defaults, mumps_failure
+from ..petsc import init, printf, solve_columns, set_default_options, soil_solver_defaults, mumps_failure
 
 # the largest residual of the region's columns, over the column's right-hand side (both in the
 # infinity norm), that keeps the region: round-off of the step equations' own size
@@ -90,7 +90,7 @@ class RegionColumns:
         AQ = A.createSubMatrix(self.is_ring, self.is_r)
         ksp = PETSc.KSP().create(comm=self.comm)
         ksp.setOptionsPrefix("ssi_bem_columns_")
-        defaults = dict(direct_solver_defaults(self.comm, soil=True))
+        defaults = soil_solver_defaults(self.comm)
         if defaults.get("pc_factor_mat_solver_type") == "mumps":
             # MUMPS's workspace relaxation: a region's submatrix pivots more than A (its cut rows), and
             # its LU ran out of the default 20 % (INFOG(1) = -9) at 3.5 reaches on the uniform 72 m building
