@@ -366,12 +366,13 @@ def direct_solver_defaults(comm, soil=False):
 
 # MUMPS's ordering of the soil's matrices (the step matrix, the interface region's): PETSc hands MUMPS a
 # matrix of block size 3 (a node's DOFs) with ICNTL(15) = -3, MUMPS then orders the graph of the nodes,
-# whose 3 x 3 blocks are half empty on a flat surface (the H pattern's zx/zy and xz/yz, not xy): on the
-# uniform 72 m building (44 649 DOFs) its LU held 106.4 M entries with PORD (the automatic choice of a
-# MUMPS without METIS or SCOTCH, as Debian's), 77.6 M with ICNTL(15) 0 and AMD (ICNTL(7) 0; PORD
-# without the blocks 92.8 M): its factorisation 4.96 -> 3.35 s, 100 step solves 6.19 -> 5.74 s; the
-# graded 36 m building 6.20 -> 5.77 M, the paper's Lamb quarter model 2.70 -> 1.77 M (runs/building/README.md).
-# A MUMPS with METIS may order better still: -ssi_bem_mat_mumps_icntl_7 5.
+# whose 3 x 3 blocks are half empty on a flat surface (the H pattern's zx/zy and xz/yz, not xy). The uniform
+# 72 m building (jobscripts/building_uniform.sh's uniform-72 options, -ssi_bem_ksp_view ::ascii_info_detail,
+# INFOG(29)): 106.4 M entries in the LU with the nodes' graph and PORD (the automatic choice of a MUMPS without
+# METIS or SCOTCH, as Debian's), 77.6 M with ICNTL(15) 0 and AMD (ICNTL(7) 0; PORD without the blocks
+# 92.8 M); the graded 36 m building 6.20 -> 5.77 M, the paper's Lamb quarter model 2.70 -> 1.77 M. The whole
+# 72 m run (runs/building/README.md): factorisation 5.11 -> 4.31 s, step solves 20.2 -> 19.5 s, peak
+# 6.07 -> 5.81 GB. A MUMPS with METIS may order better still: -ssi_bem_mat_mumps_icntl_7 5.
 SOIL_MUMPS = {"mat_mumps_icntl_15": "0", "mat_mumps_icntl_7": "0"}
 
 
