@@ -399,6 +399,26 @@ def mumps_failure(ksp):
     return f"MUMPS's LU failed, INFOG(1) = {v}" if v < 0 else ""
 
 
+MUMPS_ORDERINGS = {0: "AMD", 1: "given", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD"}
+
+
+def mumps_factor_info(ksp):
+    """'' or the size of a MUMPS LU of the KSP's PC and the ordering MUMPS used (INFOG(29): entries in
+    the factors, negative in millions; INFOG(7)), for the run's log: the factors' bytes bound each step's
+    solve."""
+    pc = ksp.getPC()
+    try:
+        if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+            return ""
+        F = pc.getFactorMatrix()
+        n, o = int(F.getMumpsInfog(29)), int(F.getMumpsInfog(7))
+    except Exception:                   # (no MUMPS accessor in this petsc4py)
+        return ""
+    entries = -n * 1e6 if n < 0 else float(n)
+    return (f"MUMPS LU, {entries / 1e6:.4g} M entries in the factors ({8 * entries / 1e9:.3g} GB), ordering "
+            f"{MUMPS_ORDERINGS.get(o, o)} (INFOG(7) = {o})")
+
+
 def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     """Collective: x_j = A^-1 b_j for j = 0 .. m-1 with the KSP's operator A. ``fill(j, b)`` writes
     right-hand side j into the Vec b (layout of ``template``), ``take(j, x)`` receives its solution

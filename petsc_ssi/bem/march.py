@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..petsc import (init, set_default_options, soil_solver_defaults, printf, check_reproducible_solver,
-                     mumps_failure, SSIError)
+                     mumps_failure, mumps_factor_info, SSIError)
 from ..monitor import event
 from . import bsr
 
@@ -159,6 +159,9 @@ class Marcher:
                            "-ssi_bem_mat_mumps_icntl_14 <percent> (default 20), more memory with "
                            "-ssi_bem_mat_mumps_icntl_23 <MB per rank>, or fewer DOFs")
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
+        info = mumps_factor_info(self.ksp)
+        if info:                # (one line, monitor or not: the factors' bytes bound each step's solve)
+            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs, {info}")
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)

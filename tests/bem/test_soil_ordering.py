@@ -3,7 +3,7 @@ its block size 3 and ICNTL(15) = -3 (the graph of the nodes), whose 3 x 3 blocks
 surface; the defaults order the DOFs' own graph with AMD (ICNTL(15) 0, ICNTL(7) 0), which fills less. On a
 16 m x 16 m grid of 1 m elements: fewer factor entries than the node graph with PORD (MUMPS's automatic
 choice without METIS or SCOTCH; 3.69 M against 4.71 M seen), the same answer to 1e-12, and a user's
-explicit options win over the defaults."""
+explicit options win over the defaults; the run's log line gives the factors' size and ordering."""
 import os
 import re
 import sys
@@ -31,8 +31,15 @@ def _mumps(out):
 
 def test_the_soils_ordering_fills_less_and_a_users_choice_wins(tmp_path):
     a, b = str(tmp_path / "default.h5"), str(tmp_path / "blocks.h5")
-    o7, o15, n_default = _mumps(cli(GRID + ["-ssi_output", a]).stdout)
+    out = cli(GRID + ["-ssi_output", a]).stdout
+    o7, o15, n_default = _mumps(out)
     assert (o7, o15) == (0, 0)
+    # the run's own line (petsc.mumps_factor_info) says the factors' size MUMPS reports and its ordering
+    line = re.search(r"\[ssi\] step matrix: 3267 DOFs, MUMPS LU, ([\d.]+) M entries in the factors \(([\d.]+) GB\), "
+                     r"ordering AMD \(INFOG\(7\) = 0\)", out)
+    assert line, out[-3000:]
+    assert abs(float(line.group(1)) * 1e6 - n_default) <= 5e-4 * n_default
+    assert abs(float(line.group(2)) * 1e9 - 8 * n_default) <= 5e-3 * 8 * n_default
     u7, u15, n_blocks = _mumps(cli(GRID + ["-ssi_output", b, "-ssi_bem_mat_mumps_icntl_15", "-3",
                                            "-ssi_bem_mat_mumps_icntl_7", "4"]).stdout)
     assert (u7, u15) == (4, -3)                     # (the user's options, not the defaults)
