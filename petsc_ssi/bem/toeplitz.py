@@ -449,9 +449,10 @@ class ToeplitzHistory:
         kernels, Kp (nl, 4, 9, m, Mx, My) this rank's offsets' share. The planes (a lag, class, slot and
         pattern entry each) are split over the ranks: each rank receives the sum of its planes
         (Reduce_scatter), transforms them, and the spectra go to the ranks of their frequencies (Alltoallv):
-        each rank makes 1/p of the transforms (every rank made all of them before: the kernels' build
-        did not scale, 1.37 x from 1 to 2 ranks on the paper's whole Lamb case), and no rank holds a whole
-        chunk's spectra."""
+        each rank makes 1/p of the transforms (every rank made all of them before), and no rank holds a
+        whole chunk's spectra. On the 2-core machine the kernels' build went from 1.37 to 1.39 x from 1 to
+        2 ranks on the paper's whole Lamb case: the transforms were not what held it back there; the memory
+        per rank, and the transforms' share at many ranks, are what this changes."""
         from scipy.fft import rfft2
         from mpi4py import MPI
         lat = self.lat
