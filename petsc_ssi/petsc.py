@@ -389,14 +389,21 @@ def mumps_failure(ksp):
     """'' or what failed in a MUMPS factorisation of the KSP's PC (INFOG(1) < 0, the same on every rank):
     PETSc does not raise it at set-up, and the solves then stop with MUMPS's INFOG(1) = -3, which does not
     name the cause (-9, -8: the workspace too small after pivoting; -13, -19: memory; -10: singular)."""
+    v = _mumps_infog(ksp, 1)
+    return f"MUMPS's LU failed, INFOG(1) = {v[0]}" if v and v[0] < 0 else ""
+
+
+def _mumps_infog(ksp, *which):
+    """(INFOG(i) for i in ``which``) of the KSP's PC's MUMPS factorisation, or None when the PC is not a
+    MUMPS LU or Cholesky or this petsc4py has no MUMPS accessor."""
     pc = ksp.getPC()
     try:
         if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
-            return ""
-        v = int(pc.getFactorMatrix().getMumpsInfog(1))
-    except Exception:                   # (no MUMPS accessor in this petsc4py: nothing to check)
-        return ""
-    return f"MUMPS's LU failed, INFOG(1) = {v}" if v < 0 else ""
+            return None
+        F = pc.getFactorMatrix()
+        return tuple(int(F.getMumpsInfog(i)) for i in which)
+    except Exception:                   # (no MUMPS accessor in this petsc4py: nothing to say)
+        return None
 
 
 MUMPS_ORDERINGS = {0: "AMD", 1: "given", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD"}
@@ -406,14 +413,10 @@ def mumps_factor_info(ksp):
     """'' or the size of a MUMPS LU of the KSP's PC and the ordering MUMPS used (INFOG(29): entries in
     the factors, negative in millions; INFOG(7)), for the run's log: the factors' bytes bound each step's
     solve."""
-    pc = ksp.getPC()
-    try:
-        if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
-            return ""
-        F = pc.getFactorMatrix()
-        n, o = int(F.getMumpsInfog(29)), int(F.getMumpsInfog(7))
-    except Exception:                   # (no MUMPS accessor in this petsc4py)
+    v = _mumps_infog(ksp, 29, 7)
+    if v is None:
         return ""
+    n, o = v
     entries = -n * 1e6 if n < 0 else float(n)
     return (f"MUMPS LU, {entries / 1e6:.4g} M entries in the factors ({8 * entries / 1e9:.3g} GB), ordering "
             f"{MUMPS_ORDERINGS.get(o, o)} (INFOG(7) = {o})")
