@@ -59,7 +59,7 @@ if "numba" not in __import__("sys").modules:
 
 # the modules with numba kernels cached on disk (njit(cache=True)); see numba_cache_status
 KERNEL_MODULES = ("petsc_ssi.bem.kernels", "petsc_ssi.bem.quadrature", "petsc_ssi.bem.assemble",
-                  "petsc_ssi.bem.lagmats", "petsc_ssi.bem.bsr")
+                  "petsc_ssi.bem.lagmats", "petsc_ssi.bem.bsr", "petsc_ssi.bem.lanes")
 
 
 def numba_cache_status():

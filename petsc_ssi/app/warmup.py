@@ -81,7 +81,8 @@ def _shared_cache_kernels(PETSc):
 
 def _single_kernels():
     """The block-sparse kernels on float32 values (-ssi_lag_single_from; numba compiles one version
-    per value type) and on a read-only x (the python Mat's products; without this the first coupled
+    per value type), the toeplitz store's lane products on single kept states (-ssi_toeplitz_precision
+    single), and the block-sparse kernels on a read-only x (the python Mat's products; without this the first coupled
     run compiled one)."""
     import numpy as np
     from ..bem import bsr
@@ -95,6 +96,9 @@ def _single_kernels():
                 bsr.matvec(m, indptr, cols, data, xx, np.zeros(3))
             for w in (2, bsr.PAIR_FROM):
                 bsr.panel(m, indptr, cols, data, np.ones((3, w)), np.zeros((3, w)), 1.0)
+    from ..bem.lanes import lane_products, FW
+    K, out = np.zeros((1, 9, 1, 2, FW)), np.zeros((1, 1, 1, 2, FW))
+    lane_products(K, 0, np.zeros((1, 1, 9, 2, FW), np.float32), 0, 1, 1, 1, 1, out, 0)   # (single kept states)
     diag = np.ones((1, 3, 3))
     bsr._diag_add(diag, 0, x, np.zeros(3), 1.0)
     bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)

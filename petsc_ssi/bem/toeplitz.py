@@ -23,14 +23,17 @@ linear combination of lag kernels the scheme's terms give (``Marcher._step_terms
 multi-linear or Chebyshev interpolation beyond T_L alike). Each state u^m is transformed once (27
 real FFTs: nine node slots, three components) and kept while a kernel reads it; per step the
 products sum over d in Fourier space and four classes x three components go back by inverse FFTs.
+Kernels and kept transforms are stored in frequency lanes (``lanes``: 32 frequencies side by side, real
+and imaginary parts apart) so that the products compile to vector instructions without copies.
 
 Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
 and of every kept state's transform: memory divided by the ranks); the kernels' integrals are split by
 offset and their planes' transforms by plane (summed onto the plane's rank, its spectra sent to the
 ranks of their frequencies: MPI's Reduce_scatter and Alltoallv); each rank transforms the new state
 (gathered: the data a dense MatMult gathers anyway) and keeps its slab; the summed slabs are gathered
-and transformed back. A frequency's products are summed in the same order on any number of ranks, so
-``-n 2`` gives ``-n 1``'s bits.
+and transformed back. A frequency's products are summed in the same order on any number of ranks; the
+kernels are sums over the ranks' offsets in MPI's order, so ``-n 2`` equals ``-n 1`` to round-off (the
+tests: 1e-12 relative; two ``-n 3`` runs differed by 3.6e-16).
 
 G (traction columns) stays as the dense path stores it (N x n_t, small when the tractions live on a
 footprint or a load patch); the step matrix (lags 1 and 2) is assembled and factorised as before.
@@ -44,6 +47,7 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
+from .lanes import FW, n_groups, padded, to_lanes, from_lanes, history_lanes, interp_lanes
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -267,10 +271,11 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         if g is None:
             continue
         F = g.F
+        Fl = padded(F, ranks)               # (each rank's slab in whole lane groups)
         per_lag = m * g.Mx * g.My * 8.0
-        kern = 16.0 * F * m * (D + k)
+        kern = 16.0 * Fl * m * (D + k)
         build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
-        nbytes += kern + vbytes * F * 27 * W
+        nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
         flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
@@ -349,7 +354,7 @@ def _windows(pts, X, c0, R0, h0, reach, alpha, beta, dt, L, lag_lo, toff, tol, n
 # and the 18-row (x, y input) kernels, and the sign of its terms in the history sum
 SIDES = {"u": {"m": 4, "n9": 8, "n18": 4, "sign": -1.0, "what": "H"},
          "p": {"m": 5, "n9": 4, "n18": 8, "sign": 1.0, "what": "G"}}
-PRECISIONS = {"double": np.complex128, "single": np.complex64}
+PRECISIONS = {"double": np.float64, "single": np.float32}
 
 
 class ToeplitzHistory:
@@ -511,28 +516,36 @@ class ToeplitzHistory:
         # output component): K9 (z in; H: x, y out, entries xz, yz; G: z out, zz), K18 (x, y in; H: z out,
         # zx, zy; G: x, y out, xx, xy, yx, yy): the flat pattern's entries of every block, no zeros (``_add_kernel``);
         # the anchors' A9, A18 the same with rows (anchor j, slot, input component)
-        self.K9 = np.zeros((slab, D * 9, n9), np.complex128)
-        self.K18 = np.zeros((slab, D * 18, n18), np.complex128)
-        self.A9 = np.zeros((slab, self.k * 9, n9), np.complex128)
-        self.A18 = np.zeros((slab, self.k * 18, n18), np.complex128)
+        # (in frequency lanes, ``lanes.to_lanes``: (groups, rows, columns, 2, FW) real)
+        G = n_groups(slab)
+        self.K9 = np.zeros((G, D * 9, n9, 2, FW))
+        self.K18 = np.zeros((G, D * 18, n18, 2, FW))
+        self.A9 = np.zeros((G, self.k * 9, n9, 2, FW))
+        self.A18 = np.zeros((G, self.k * 18, n18, 2, FW))
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
-                for d, c in by_key.get(("x", lag), ()):
-                    _add_kernel(self.K9, self.K18, D - d, c, S)
+                terms = by_key.get(("x", lag), ())
+                if terms:
+                    L9, L18 = (to_lanes(B) for B in _kernel_blocks(S))
+                    for d, c in terms:
+                        self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
+                        self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
         for i in range(self.k):
             if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
-                _add_kernel(self.A9, self.A18, i, 1.0, S)
+                L9, L18 = (to_lanes(B) for B in _kernel_blocks(S))
+                self.A9[:, 9 * i:9 * (i + 1)] += L9
+                self.A18[:, 18 * i:18 * (i + 1)] += L18
         # the kept states' transforms, in time order (state m at m - base; frequency-major, so that a
         # frequency's run of states is contiguous: a step's window of D states is one contiguous row of the
         # history products): z (slab, W, 9), x and y (slab, W, 18); states before the first are zeros, as
         # are those not yet made
         self.W = self.R + 3 * self.block + 8
-        self.V9 = np.zeros((slab, self.W, 9), self.vdtype)
-        self.V18 = np.zeros((slab, self.W, 18), self.vdtype)
+        self.V9 = np.zeros((G, self.W, 9, 2, FW), self.vdtype)
+        self.V18 = np.zeros((G, self.W, 18, 2, FW), self.vdtype)
         self.base = -self.R
         self._setup_state_maps(march)
         from ..sysmem import release_freed
@@ -580,8 +593,8 @@ class ToeplitzHistory:
                 f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
         S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
         i = m - self.base
-        self.V9[:, i] = S[:, 2, :].T
-        self.V18[:, i] = S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18)
+        self.V9[:, i] = to_lanes(S[:, 2, :].T, self.vdtype)
+        self.V18[:, i] = to_lanes(S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18), self.vdtype)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
@@ -600,11 +613,12 @@ class ToeplitzHistory:
         k = keep.stop - keep.start
         s = keep.start                          # (the states dropped: the move's shift)
         for B in (self.V9, self.V18):
-            # in chunks of frequencies, and within a chunk in pieces of s states that do not overlap their
-            # source: numpy copies an overlapping source whole before the move (35 MB a rank for V18 on the
-            # paper's quarter case when it was one copy; half the time of a chunk's overlapping copy)
-            for f0 in range(0, B.shape[0], 64):
-                blk = B[f0:f0 + 64]
+            # in chunks of frequencies (two lane groups: 64), and within a chunk in pieces of s states that do
+            # not overlap their source: numpy copies an overlapping source whole before the move (35 MB a rank
+            # for V18 on the paper's quarter case when it was one copy; half the time of a chunk's overlapping
+            # copy)
+            for f0 in range(0, B.shape[0], 2):
+                blk = B[f0:f0 + 2]
                 for j in range(0, k if s else 0, s or 1):
                     blk[:, j:min(k, j + s)] = blk[:, j + s:min(k, j + s) + s]
                 blk[:, k:] = 0.0
@@ -636,25 +650,27 @@ class ToeplitzHistory:
             self._blk = (n0, self._block_products(n0, march))
             ev.end()
         self._catch_up(n - 1, march)
-        acc = self._blk[1][:, n - n0 - 1].copy()            # (slab, 12)
+        i = n - n0 - 1
+        acc = self._blk[1][:, i:i + 1].copy()              # (groups, 1, 12, 2, FW): lanes
         self._step_products(n, n0, march, acc)
         self._apply(acc, out_u)
 
     def _block_products(self, n0, march):
-        """(slab, b, 12): the terms of the states m <= n0 in the history sums of steps n0 + 1 .. n0 + b."""
+        """(groups, b, 12, 2, FW) lanes: the terms of the states m <= n0 in the history sums of steps
+        n0 + 1 .. n0 + b."""
         b, D, slab = self.block, self.D, self.f1 - self.f0
         flops = 8.0 * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * slab     # complex products a (d, step)
+        acc = np.zeros((self.K9.shape[0], b, 12, 2, FW))
         if D:
-            acc = history_products(self.K9, self.K18, self.V9, self.V18, n0 + 1 - D - self.base, b, D)
+            history_lanes(self.K9, self.K18, self.V9, self.V18, n0 + 1 - D - self.base, b, D, out=acc)
             march.PETSc.Log.logFlops(b * D * flops)
-        else:
-            acc = np.zeros((slab, b, 12), np.complex128)
         if self.k:
             lo = n0 + 1 - self.R                         # the oldest state the block reads
             C = np.stack([self._weights(march, n0 + 1 + i, lo, n0) for i in range(b)])
             ev = event("SSI_BEM_HistInterp")
             ev.begin()
-            acc += interp_products(self.A9, self.A18, self.V9, self.V18, C, lo - self.base, march.PETSc.Log)
+            acc += interp_lanes(self.A9, self.A18, self.V9, self.V18, C, lo - self.base, _low_rank, _spans(C),
+                                march.PETSc.Log)
             ev.end()
         return acc
 
@@ -663,14 +679,13 @@ class ToeplitzHistory:
         D = self.D
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
-            acc += history_products(self.K9[:, 9 * (D - k):], self.K18[:, 18 * (D - k):], self.V9, self.V18,
-                                    n - k - self.base, 1, k)[:, 0]
+            history_lanes(self.K9, self.K18, self.V9, self.V18, n - k - self.base, 1, k, out=acc, r0=D - k)
             march.PETSc.Log.logFlops(8.0 * k * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * (self.f1 - self.f0))
         if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
             C = self._weights(march, n, n0 + 1, n - 1)[None]
             if C.any():
-                acc += interp_products(self.A9, self.A18, self.V9, self.V18, C, n0 + 1 - self.base,
-                                       march.PETSc.Log)[:, 0]
+                acc += interp_lanes(self.A9, self.A18, self.V9, self.V18, C, n0 + 1 - self.base, _low_rank,
+                                    _spans(C), march.PETSc.Log)
 
     def _weights(self, march, n, m_lo, m_hi):
         """(k, m_hi - m_lo + 1): the weight of state m_lo + i in the interpolated history s_j^n of step n
@@ -691,6 +706,7 @@ class ToeplitzHistory:
         lat = self.lat
         full = np.empty((lat.F, 12), np.complex128)
         mpi = self.comm.tompi4py()
+        acc = from_lanes(acc[:, 0], self.f1 - self.f0)          # (slab, 12) complex
         mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
                                                    MPI.C_DOUBLE_COMPLEX])
         # columns: the K9 products' then the K18 products'; (class t, x or y) for the 8-wide, z of class t
@@ -709,19 +725,18 @@ class ToeplitzHistory:
             arr += vals.ravel()
 
 
-def _add_kernel(K9, K18, r, c, S):
-    """Rows r of K9 (9 a row) and K18 (18) += c S: S (4, 9, m, slab) one lag's kernel spectra (class,
-    slot, pattern entry, frequency); m = 4 the H pattern (xz, yz, zx, zy: K9 columns (class, xz/yz), K18
-    rows (slot, zx/zy) columns class), m = 5 the G pattern (xx, xy, yx, yy, zz: K9 columns class (zz), K18
-    rows (slot, input component q) columns (class, output component p), entry 2 p + q)."""
+def _kernel_blocks(S):
+    """(B9 (slab, 9, n9), B18 (slab, 18, n18)) complex: one lag's row blocks of K9 (z inputs, 9 rows)
+    and K18 (x, y inputs, 18) from S (4, 9, m, slab), its kernel spectra (class, slot, pattern entry,
+    frequency); m = 4 the H pattern (xz, yz, zx, zy: K9 columns (class, xz/yz), K18 rows (slot, zx/zy)
+    columns class), m = 5 the G pattern (xx, xy, yx, yy, zz: K9 columns class (zz), K18 rows (slot, input
+    component q) columns (class, output component p), entry 2 p + q)."""
     slab = S.shape[-1]
     if S.shape[2] == 4:
-        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8)
-        K18[:, 18 * r:18 * (r + 1), :] += c * S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4)
-    else:
-        K9[:, 9 * r:9 * (r + 1), :] += c * S[:, :, 4, :].transpose(2, 1, 0)
-        G = S[:, :, 0:4, :].reshape(4, 9, 2, 2, slab)             # (class, slot, p, q, frequency)
-        K18[:, 18 * r:18 * (r + 1), :] += c * G.transpose(4, 1, 3, 0, 2).reshape(slab, 18, 8)
+        return (S[:, :, 0:2, :].transpose(3, 1, 0, 2).reshape(slab, 9, 8),
+                S[:, :, 2:4, :].transpose(3, 1, 2, 0).reshape(slab, 18, 4))
+    G = S[:, :, 0:4, :].reshape(4, 9, 2, 2, slab)             # (class, slot, p, q, frequency)
+    return S[:, :, 4, :].transpose(2, 1, 0), G.transpose(4, 1, 3, 0, 2).reshape(slab, 18, 8)
 
 
 def _spans(C):
@@ -744,7 +759,8 @@ def _spans(C):
 
 
 def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
-    """The interpolated lags' part of the history sum in Fourier space for b steps: per frequency the
+    """(The reference of ``lanes.interp_lanes``, which the store runs.) The interpolated lags' part of the
+    history sum in Fourier space for b steps: per frequency the
     weighted states s_j = sum_m C[step, j, m] v^m of the kept transforms (states r0 + m of the
     frequency-major buffers (slab, W, c), double or single; real weights on the real and imaginary parts:
     per span of ``_spans`` and frequency one real matrix product of the weights with the span's states,
@@ -832,8 +848,9 @@ def history_products(K9, K18, V9, V18, p0, b, D, fchunk=None):
     contiguous run of states p0 + k .. p0 + k + D - 1 of a frequency: the windows are overlapping rows of
     one strided view, copied row by row (BLAS takes no overlapping rows): 9-24 % less time than
     gathering them from a time-major buffer (jobscripts/history_window_layout.py). The kept states double or single (the windows'
-    copies in double). Array inputs and ``matmul`` only (the one function a GPU array module would take
-    over); frequencies in chunks so the windows' copies stay small."""
+    copies in double); frequencies in chunks so the windows' copies stay small. The store itself takes these
+    products in frequency lanes (``lanes.history_lanes``, compiled, no window copies); this ``matmul`` form is
+    their reference (tests/bem/test_lanes.py) and the jobscripts' baseline."""
     from numpy.lib.stride_tricks import as_strided
     slab, n9, n18 = K9.shape[0], K9.shape[2], K18.shape[2]
     for V, c in ((V9, 9), (V18, 18)):       # (the strided windows read within each frequency's states only)

@@ -1,0 +1,153 @@
+r"""Frequency lanes: the toeplitz store's spectra laid out for compiled products (issue 41).
+
+The history sum in Fourier space is, per frequency, a small complex matrix product: b steps' windows
+of kept states (b x 9D, b x 18D) times the stacked kernels (9D x 8, 18D x 4 on the H side). Done with
+``matmul`` per frequency (``toeplitz.history_products``) each product is one BLAS call on matrices of
+8 rows and 4-8 columns: the calls' overhead and the windows' copies (overlapping rows, which BLAS does
+not take) cost more than the flops; on the 72 m building's slab it ran at 7-9 GFlop/s a process where
+a large GEMM runs at about 60.
+
+Here the arrays keep ``FW`` frequencies side by side as the last axis, real and imaginary parts apart:
+a (slab, ...) complex array becomes (groups, ..., 2, FW) real (``to_lanes``; the slab padded with
+zeros to whole groups). Every operation of the products is then the same on FW consecutive
+numbers, which the compiler turns into vector instructions (``lane_products``: the loop over the lanes
+innermost, a window a row offset into the kept states, so no copy). The sums over the windows' rows run
+in the same order as ``matmul``'s reference loop only up to round-off (``fastmath`` "contract": fused
+multiply-adds, no reassociation): the products equal ``history_products`` to about 1e-15 of their
+size (tests/bem/test_lanes.py).
+
+``history_lanes`` and ``interp_lanes`` are the two products the store takes (the exact lags' windows
+and the interpolating matrices' weighted states), with array inputs only; a GPU array module would
+take them over with its own kernel on the same layout (one thread a lane and output).
+"""
+import numpy as np
+from numba import njit
+
+# frequencies a lane group holds: 32 doubles, four 256-bit vectors an operand (16 and 64 were slower on
+# the 72 m building's slab, jobscripts/history_lanes.py)
+FW = 32
+
+
+def n_groups(n):
+    """The lane groups of n frequencies."""
+    return -(-int(n) // FW)
+
+
+def padded(F, ranks=1):
+    """Frequencies stored over ``ranks`` for a spectrum of F: each rank's slab in whole lane groups."""
+    p = max(1, int(ranks))
+    return FW * sum(n_groups((F * (q + 1)) // p - (F * q) // p) for q in range(p))
+
+
+def to_lanes(X, dtype=np.float64):
+    """(slab, *rest) complex -> (groups, *rest, 2, FW) ``dtype``: frequency g FW + q at lane q of group
+    g, real part then imaginary part; the last group padded with zeros."""
+    X = np.asarray(X)
+    slab, rest = X.shape[0], X.shape[1:]
+    G = n_groups(slab)
+    P = np.zeros((G * FW,) + rest, np.complex128)
+    P[:slab] = X
+    P = P.reshape((G, FW) + rest)
+    Y = np.empty((G,) + rest + (2, FW), dtype)
+    Y[..., 0, :] = np.moveaxis(P.real, 1, -1)
+    Y[..., 1, :] = np.moveaxis(P.imag, 1, -1)
+    return Y
+
+
+def from_lanes(Y, slab):
+    """(groups, *rest, 2, FW) real -> (slab, *rest) complex128 (``to_lanes``'s inverse)."""
+    Z = Y[..., 0, :] + 1j * Y[..., 1, :]                     # (G, *rest, FW)
+    Z = np.moveaxis(Z, -1, 1)
+    return Z.reshape((Z.shape[0] * Z.shape[1],) + Z.shape[2:])[:slab]
+
+
+@njit(cache=True, fastmath={"contract"}, boundscheck=False)
+def lane_products(K, j0, X, p0, ss, sd, b, D, out, o0):
+    """out[g, s, o0 + o] += sum_{r < D, a < c} X[g, p0 + s ss + r sd, a] K[g, j0 + r c + a, o] for the b
+    steps s, complex per lane (K (G, J, no, 2, FW), X (G, rows, c, 2, FW) float64 or float32, out (G,
+    b', n_out, 2, FW) float64): a window of rows of X times a run of D x c rows of K, per lane. The exact
+    lags: X the kept states, row p0 + s + r (ss = sd = 1); the interpolating matrices: X the weighted
+    states of the b steps, row s k + r (ss = k, sd = 1, D = k). A group's sums go into a small buffer of
+    their own (the compiler keeps its loads and stores apart from the inputs': 25 % faster than summing
+    into ``out``)."""
+    G, _, no, _, fw = K.shape
+    c = X.shape[2]
+    acc = np.zeros((b, no, 2, fw))
+    for g in range(G):
+        acc[:] = 0.0
+        for r in range(D):
+            for a in range(c):
+                j = j0 + r * c + a
+                for s in range(b):
+                    row = p0 + s * ss + r * sd
+                    for o in range(no):
+                        for q in range(fw):
+                            xr = X[g, row, a, 0, q]
+                            xi = X[g, row, a, 1, q]
+                            kr = K[g, j, o, 0, q]
+                            ki = K[g, j, o, 1, q]
+                            acc[s, o, 0, q] += xr * kr - xi * ki
+                            acc[s, o, 1, q] += xr * ki + xi * kr
+        for s in range(b):
+            for o in range(no):
+                for t in range(2):
+                    for q in range(fw):
+                        out[g, s, o0 + o, t, q] += acc[s, o, t, q]
+
+
+def _check(V, p0, rows, c, what):
+    if V.ndim != 5 or V.shape[2] != c or V.shape[3] != 2 or V.shape[4] != FW or not V.flags.c_contiguous:
+        raise ValueError(f"{what}: states of shape {V.shape} (C-contiguous {V.flags.c_contiguous}), not "
+                         f"(groups, W, {c}, 2, {FW}) lanes")
+    if p0 < 0 or p0 + rows > V.shape[1]:
+        raise ValueError(f"{what}: states {p0}..{p0 + rows - 1} of a buffer of {V.shape[1]}")
+
+
+def history_lanes(K9, K18, V9, V18, p0, b, D, out=None, r0=0):
+    """The exact lags' products for b steps in lanes: out[g, k] (+)= sum_{r < D} V[state p0 + k + r] K'
+    rows (r0 + r) of K9 (z inputs, 9 a row block) and K18 (x, y inputs, 18): (G, b, n9 + n18, 2, FW),
+    columns as ``toeplitz.history_products`` (which this equals to round-off). ``r0`` skips the first row
+    blocks (a step's products with the last D of the D0 lags: r0 = D0 - D). Added to ``out`` when given."""
+    G, n9, n18 = K9.shape[0], K9.shape[2], K18.shape[2]
+    for V, c in ((V9, 9), (V18, 18)):
+        _check(V, p0, b - 1 + D, c, "history_lanes")
+    if out is None:
+        out = np.zeros((G, b, n9 + n18, 2, FW))
+    if D > 0:
+        lane_products(K9, 9 * r0, V9, p0, 1, 1, b, D, out, 0)
+        lane_products(K18, 18 * r0, V18, p0, 1, 1, b, D, out, n9)
+    return out
+
+
+def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2):
+    """The interpolated lags' products for b steps in lanes: the weighted states s_j = sum_m C[step, j, m]
+    v^m (states r0 + m of the kept lanes) per span of ``spans`` (``toeplitz._spans``; ``low_rank`` its
+    factors, ``toeplitz._low_rank``: one real matrix product a lane group over all its lanes, components
+    and real and imaginary parts at once), then the anchors' kernels: (G, b, n9 + n18, 2, FW), as
+    ``toeplitz.interp_products`` to round-off."""
+    G, n9, n18 = A9.shape[0], A9.shape[2], A18.shape[2]
+    b, k, _ = C.shape
+    out = np.zeros((G, b, n9 + n18, 2, FW))
+    if not spans:
+        return out
+    facs = [low_rank(C[:, j0:j1, a:e].reshape(-1, e - a)) for j0, j1, a, e in spans]
+    for V, c in ((V9, 9), (V18, 18)):
+        for j0, j1, a, e in spans:
+            _check(V, r0 + a, e - a, c, "interp_lanes")
+    for g0 in range(0, G, gchunk):              # (groups in chunks: the weighted states stay small)
+        g1 = min(G, g0 + gchunk)
+        for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):
+            S = np.zeros((g1 - g0, b, k, c * 2 * FW))
+            for (j0, j1, a, e), (Cj, US, W) in zip(spans, facs):
+                Vf = V[g0:g1, r0 + a:r0 + e].reshape(g1 - g0, e - a, c * 2 * FW)      # (a view)
+                if Vf.dtype != np.float64:
+                    Vf = Vf.astype(np.float64)
+                w = np.matmul(Cj, Vf) if W is None else np.matmul(US, np.matmul(W, Vf))
+                S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
+            lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, 1, b, k, out[g0:g1], o0)
+    if log is not None:
+        slab = G * FW
+        log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
+                             + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
+                                              for Cj, US, W in facs)))
+    return out

@@ -1,0 +1,92 @@
+"""The toeplitz store's products in frequency lanes (bem/lanes.py) against the per-frequency ``matmul``
+reference (``toeplitz.history_products``, ``interp_products``) and a plain sum."""
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.unit
+
+
+def _c(rng, *shape):
+    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+
+@pytest.mark.parametrize("slab", [1, 31, 32, 70])
+def test_lanes_round_trip_and_padding(slab):
+    """``to_lanes`` puts frequency g FW + q at lane q of group g, real then imaginary, the last group
+    zero-padded; ``from_lanes`` gives the array back exactly; ``padded`` counts each rank's whole groups."""
+    from petsc_ssi.bem.lanes import FW, to_lanes, from_lanes, padded, n_groups
+    rng = np.random.default_rng(slab)
+    X = _c(rng, slab, 3, 2)
+    Y = to_lanes(X)
+    assert Y.shape == (n_groups(slab), 3, 2, 2, FW)
+    f = slab - 1
+    assert Y[f // FW, 1, 0, 0, f % FW] == X[f, 1, 0].real and Y[f // FW, 1, 0, 1, f % FW] == X[f, 1, 0].imag
+    assert not from_lanes(Y, FW * n_groups(slab))[slab:].any()          # the padding lanes: zeros
+    assert np.array_equal(from_lanes(Y, slab), X)
+    assert padded(slab) == FW * n_groups(slab)
+    assert padded(100, 3) == FW * (n_groups(33) + n_groups(33) + n_groups(34))
+
+
+@pytest.mark.parametrize("side", [(8, 4), (4, 8)])        # H's columns (n9, n18), G's
+@pytest.mark.parametrize("vdtype", [np.float64, np.float32])
+def test_history_lanes_equal_the_matmul_products(side, vdtype):
+    """The exact lags' block products (b steps, D lags) and a step's products with the last k lags
+    (``r0``) in lanes equal ``history_products`` to 1e-14 of their size, with double and single kept
+    states, on a slab that is not a whole number of groups."""
+    from petsc_ssi.bem.lanes import to_lanes, from_lanes, history_lanes
+    from petsc_ssi.bem.toeplitz import history_products
+    n9, n18 = side
+    rng = np.random.default_rng(3)
+    slab, D, b, W = 45, 7, 4, 20
+    K9, K18 = _c(rng, slab, 9 * D, n9), _c(rng, slab, 18 * D, n18)
+    V9, V18 = _c(rng, slab, W, 9), _c(rng, slab, W, 18)
+    if vdtype == np.float32:
+        V9, V18 = V9.astype(np.complex64), V18.astype(np.complex64)
+    L = dict(K9=to_lanes(K9), K18=to_lanes(K18), V9=to_lanes(V9, vdtype), V18=to_lanes(V18, vdtype))
+    ref = history_products(K9, K18, V9, V18, 2, b, D, fchunk=8)
+    got = from_lanes(history_lanes(L["K9"], L["K18"], L["V9"], L["V18"], 2, b, D), slab)
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+    k = 3                                                  # a step's last k lags, added to what is there
+    ref1 = history_products(K9[:, 9 * (D - k):], K18[:, 18 * (D - k):], V9, V18, 11, 1, k)
+    acc = np.ones((L["K9"].shape[0], 1, n9 + n18, 2, 32))
+    history_lanes(L["K9"], L["K18"], L["V9"], L["V18"], 11, 1, k, out=acc, r0=D - k)
+    got1 = from_lanes(acc, slab)[:, 0] - (1 + 1j)
+    assert np.abs(got1 - ref1[:, 0]).max() <= 1e-14 * np.abs(ref1).max()
+    # and a plain sum for one frequency and step
+    f, s = 17, 2
+    plain = sum(V9[f, 2 + s + r] @ K9[f, 9 * r:9 * r + 9] for r in range(D))
+    assert np.abs(got[f, s, :n9] - plain).max() <= 1e-13 * np.abs(plain).max()
+
+
+def test_history_lanes_refuse_states_out_of_range():
+    from petsc_ssi.bem.lanes import history_lanes, FW
+    K9, K18 = np.zeros((1, 18, 8, 2, FW)), np.zeros((1, 36, 4, 2, FW))
+    V9, V18 = np.zeros((1, 5, 9, 2, FW)), np.zeros((1, 5, 18, 2, FW))
+    with pytest.raises(ValueError, match="states 3..6 of a buffer of 5"):
+        history_lanes(K9, K18, V9, V18, 3, 3, 2)
+    with pytest.raises(ValueError, match="not .* lanes"):
+        history_lanes(K9, K18, V9[..., :16], V18, 0, 1, 2)
+
+
+@pytest.mark.parametrize("weights", ["chebyshev", "linear"])
+def test_interp_lanes_equal_the_matmul_products(weights):
+    """The interpolating matrices' products in lanes (weighted states per span, through the weights' rank
+    where ``_low_rank`` takes it) equal ``interp_products`` to 1e-14 of their size."""
+    from petsc_ssi.bem.lanes import to_lanes, from_lanes, interp_lanes
+    from petsc_ssi.bem.toeplitz import interp_products, _spans, _low_rank
+    rng = np.random.default_rng(5)
+    slab, b, k, ns, W = 40, 8, 6, 32, 40
+    A9, A18 = _c(rng, slab, 9 * k, 8), _c(rng, slab, 18 * k, 4)
+    V9, V18 = _c(rng, slab, W, 9), _c(rng, slab, W, 18)
+    if weights == "chebyshev":        # polynomial weights: low rank
+        t = np.linspace(-1, 1, ns)
+        C = np.stack([np.stack([np.polynomial.chebyshev.chebval(t + 0.01 * s, np.eye(k)[j]) for j in range(k)])
+                      for s in range(b)])
+    else:                             # hat functions: one product per anchor
+        C = np.zeros((b, k, ns))
+        for j in range(k):
+            C[:, j, 5 * j:5 * j + 6] = rng.random((b, 6))
+    ref = interp_products(A9, A18, V9, V18, C, 4, fchunk=16)
+    got = from_lanes(interp_lanes(to_lanes(A9), to_lanes(A18), to_lanes(V9), to_lanes(V18), C, 4, _low_rank,
+                                  _spans(C)), slab)
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
