@@ -7,7 +7,7 @@ of kept states (b x 9D, b x 18D) times the stacked kernels (9D x 8, 18D x 4 on t
 not take) cost more than the flops; on the 72 m building's slab it ran at 7-9 GFlop/s a process where
 a large GEMM runs at about 60.
 
-Here the arrays keep ``FW`` frequencies side by side as the last axis, real and imaginary parts apart:
+Here the arrays keep ``FW`` (64) frequencies side by side as the last axis, real and imaginary parts apart:
 a (slab, ...) complex array becomes (groups, ..., 2, FW) real (``to_lanes``; the slab padded with
 zeros to whole groups). Every operation of the products is then the same on FW consecutive
 numbers, which the compiler turns into vector instructions (``lane_products``: the loop over the lanes
@@ -23,9 +23,11 @@ take them over with its own kernel on the same layout (one thread a lane and out
 import numpy as np
 from numba import njit
 
-# frequencies a lane group holds: 32 doubles, four 256-bit vectors an operand (16 and 64 were slower on
-# the 72 m building's slab, jobscripts/history_lanes.py)
-FW = 32
+# frequencies a lane group holds: 64 doubles, sixteen 256-bit vectors an operand. On the 72 m building's
+# slab, both ranks at once (`mpirun -n 2 ... jobscripts/history_lanes.py`, 2026-11-29 23:05): a block's
+# products 123 ms with 64 lanes, 127-128 with 32, 135 with 16, 150 with matmul; the interpolating
+# matrices' 123-129, 135-136, 138-139 and 148-150 ms
+FW = 64
 
 
 def n_groups(n):
@@ -137,13 +139,17 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2):
     for g0 in range(0, G, gchunk):              # (groups in chunks: the weighted states stay small)
         g1 = min(G, g0 + gchunk)
         for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):
-            S = np.zeros((g1 - g0, b, k, c * 2 * FW))
+            whole = len(spans) == 1 and spans[0][:2] == (0, k)       # (Chebyshev: one span, every anchor)
+            S = None if whole else np.zeros((g1 - g0, b, k, c * 2 * FW))
             for (j0, j1, a, e), (Cj, US, W) in zip(spans, facs):
                 Vf = V[g0:g1, r0 + a:r0 + e].reshape(g1 - g0, e - a, c * 2 * FW)      # (a view)
                 if Vf.dtype != np.float64:
                     Vf = Vf.astype(np.float64)
                 w = np.matmul(Cj, Vf) if W is None else np.matmul(US, np.matmul(W, Vf))
-                S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
+                if whole:
+                    S = w                       # (rows (step, anchor): the weighted states as they are)
+                else:
+                    S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
             lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, 1, b, k, out[g0:g1], o0)
     if log is not None:
         slab = G * FW

@@ -23,7 +23,7 @@ linear combination of lag kernels the scheme's terms give (``Marcher._step_terms
 multi-linear or Chebyshev interpolation beyond T_L alike). Each state u^m is transformed once (27
 real FFTs: nine node slots, three components) and kept while a kernel reads it; per step the
 products sum over d in Fourier space and four classes x three components go back by inverse FFTs.
-Kernels and kept transforms are stored in frequency lanes (``lanes``: 32 frequencies side by side, real
+Kernels and kept transforms are stored in frequency lanes (``lanes``: 64 frequencies side by side, real
 and imaginary parts apart) so that the products compile to vector instructions without copies.
 
 Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel

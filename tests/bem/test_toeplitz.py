@@ -207,7 +207,7 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     bg, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat)
     assert abs((bg - b) / 1e9 - g_stored) <= 0.01 * g_stored + 5e-6, (bg - b, g_stored)
     bs, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat, single=True)
-    from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups: 40 -> 64, 24 -> 32)
+    from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups of 64: 40 and 24 -> 64)
     assert bs < bg and abs((bg - bs) - 8.0 * 27 * (24 + 3 * 8 + 8) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
 
 
