@@ -37,6 +37,24 @@ def test_seismic_report_writes_into_the_run_directory(tmp_path, capsys):
     assert _digest(kept) == before
 
 
+def test_history_lanes_script_equals_the_matmul_products():
+    """jobscripts/history_lanes.py (the README's measurement of the lane products): every lane width's
+    block, step and interpolating products equal the matmul ones to round-off on a small slab that is not a
+    whole number of groups."""
+    import re
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "jobscripts", "history_lanes.py"), "--slab", "70",
+                        "--lags", "6", "--block", "4", "--anchors", "5", "--states", "40", "--own", "2",
+                        "--fw", "16,64", "--repeat", "1"],
+                       capture_output=True, text=True, timeout=600, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    assert r.returncode == 0, r.stderr[-2000:]
+    rows = [ln for ln in r.stdout.splitlines() if re.match(r"\| 0 \| lanes", ln)]
+    assert len(rows) == 2, r.stdout
+    for ln in rows:
+        assert float(ln.strip("|").split("|")[-1]) <= 1e-13, ln
+
+
 @pytest.mark.parametrize("lags,block", [(11, 4), (5, 8), (16, 4)])
 def test_history_time_fft_equals_the_direct_products(lags, block):
     """jobscripts/history_time_fft.py (the README's measurement of a fast convolution in time): its
