@@ -105,6 +105,20 @@ def _check(V, p0, rows, c, what):
         raise ValueError(f"{what}: states {p0}..{p0 + rows - 1} of a buffer of {V.shape[1]}")
 
 
+def _check_kernel(K, V, r0, D, c, out, b, o0, what):
+    """The kernel's rows (r0 + D row blocks of c), the output's shape and the groups of the three agree (the
+    compiled loop does not check its indices)."""
+    if K.ndim != 5 or K.shape[3:] != (2, FW) or not K.flags.c_contiguous or K.shape[0] != V.shape[0]:
+        raise ValueError(f"{what}: kernels of shape {K.shape}, not (groups {V.shape[0]}, rows, columns, 2, {FW}) "
+                         "C-contiguous lanes")
+    if r0 < 0 or c * (r0 + D) > K.shape[1]:
+        raise ValueError(f"{what}: kernel row blocks {r0}..{r0 + D - 1} of {K.shape[1] // c}")
+    if (out.ndim != 5 or out.dtype != np.float64 or out.shape[0] != K.shape[0] or out.shape[1] < b
+            or out.shape[2] < o0 + K.shape[2] or out.shape[3:] != (2, FW) or not out.flags.c_contiguous):
+        raise ValueError(f"{what}: output of shape {out.shape} ({out.dtype}), not (groups {K.shape[0]}, >= {b} "
+                         f"steps, >= {o0 + K.shape[2]} columns, 2, {FW}) C-contiguous float64 lanes")
+
+
 def history_lanes(K9, K18, V9, V18, p0, b, D, out=None, r0=0):
     """The exact lags' products for b steps in lanes: out[g, k] (+)= sum_{r < D} V[state p0 + k + r] K'
     rows (r0 + r) of K9 (z inputs, 9 a row block) and K18 (x, y inputs, 18): (G, b, n9 + n18, 2, FW),
@@ -115,13 +129,15 @@ def history_lanes(K9, K18, V9, V18, p0, b, D, out=None, r0=0):
         _check(V, p0, b - 1 + D, c, "history_lanes")
     if out is None:
         out = np.zeros((G, b, n9 + n18, 2, FW))
+    _check_kernel(K9, V9, r0, D, 9, out, b, 0, "history_lanes")
+    _check_kernel(K18, V18, r0, D, 18, out, b, n9, "history_lanes")
     if D > 0:
         lane_products(K9, 9 * r0, V9, p0, 1, 1, b, D, out, 0)
         lane_products(K18, 18 * r0, V18, p0, 1, 1, b, D, out, n9)
     return out
 
 
-def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2):
+def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2, slab=None):
     """The interpolated lags' products for b steps in lanes: the weighted states s_j = sum_m C[step, j, m]
     v^m (states r0 + m of the kept lanes) per span of ``spans`` (``toeplitz._spans``; ``low_rank`` its
     factors, ``toeplitz._low_rank``: one real matrix product a lane group over all its lanes, components
@@ -133,9 +149,10 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2):
     if not spans:
         return out
     facs = [low_rank(C[:, j0:j1, a:e].reshape(-1, e - a)) for j0, j1, a, e in spans]
-    for V, c in ((V9, 9), (V18, 18)):
+    for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):
         for j0, j1, a, e in spans:
             _check(V, r0 + a, e - a, c, "interp_lanes")
+        _check_kernel(A, V, 0, k, c, out, b, o0, "interp_lanes")
     for g0 in range(0, G, gchunk):              # (groups in chunks: the weighted states stay small)
         g1 = min(G, g0 + gchunk)
         for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):
@@ -151,8 +168,8 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2):
                 else:
                     S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
             lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, 1, b, k, out[g0:g1], o0)
-    if log is not None:
-        slab = G * FW
+    if log is not None:                         # (flops over the rank's frequencies ``slab``, not the padding)
+        slab = G * FW if slab is None else slab
         log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
                              + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
                                               for Cj, US, W in facs)))

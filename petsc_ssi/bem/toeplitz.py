@@ -244,7 +244,8 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
     elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
     each exact lag (D: L, or the ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept
-    transforms 27 per frequency and kept state (L + 3 b + 8; complex64 with ``single``); the build's
+    transforms 27 per frequency and kept state (L + 3 b + 8; float32 pairs with ``single``), each rank's slab
+    in whole lane groups (``lanes.padded``: the products run over the padding too); the build's
     transients per rank (a chunk of kernels, its spectra, its integrals: the larger side's), ``g_bytes``
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
     step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
@@ -278,9 +279,9 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
-        flops += 8.0 * m * F * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
-        sums += 2.0 * 54 * F * iwork
-        sums_span += 2.0 * 54 * F * ispan
+        flops += 8.0 * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
+        sums += 2.0 * 54 * Fl * iwork
+        sums_span += 2.0 * 54 * Fl * ispan
     # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
     # transforms over the FFT grids of both sides (t_step_grid a grid point) and the transforms' inputs
     # element by element (t_step_elem a virtual element: a symmetric model's images count, so its step
@@ -514,7 +515,7 @@ class ToeplitzHistory:
         n9, n18 = self.spec["n9"], self.spec["n18"]
         # per frequency two dense matrices, rows (d descending, slot, input component), columns (class,
         # output component): K9 (z in; H: x, y out, entries xz, yz; G: z out, zz), K18 (x, y in; H: z out,
-        # zx, zy; G: x, y out, xx, xy, yx, yy): the flat pattern's entries of every block, no zeros (``_add_kernel``);
+        # zx, zy; G: x, y out, xx, xy, yx, yy): the flat pattern's entries of every block, no zeros (``_kernel_blocks``);
         # the anchors' A9, A18 the same with rows (anchor j, slot, input component)
         # (in frequency lanes, ``lanes.to_lanes``: (groups, rows, columns, 2, FW) real)
         G = n_groups(slab)
@@ -539,10 +540,10 @@ class ToeplitzHistory:
                 L9, L18 = (to_lanes(B) for B in _kernel_blocks(S))
                 self.A9[:, 9 * i:9 * (i + 1)] += L9
                 self.A18[:, 18 * i:18 * (i + 1)] += L18
-        # the kept states' transforms, in time order (state m at m - base; frequency-major, so that a
-        # frequency's run of states is contiguous: a step's window of D states is one contiguous row of the
-        # history products): z (slab, W, 9), x and y (slab, W, 18); states before the first are zeros, as
-        # are those not yet made
+        # the kept states' transforms, in time order (state m at m - base), in lanes: z (groups, W, 9, 2, FW),
+        # x and y (groups, W, 18, 2, FW); a step's window of D states is a run of rows of each group (a row
+        # offset for ``lanes.lane_products``, no copy); states before the first are zeros, as are those not
+        # yet made
         self.W = self.R + 3 * self.block + 8
         self.V9 = np.zeros((G, self.W, 9, 2, FW), self.vdtype)
         self.V18 = np.zeros((G, self.W, 18, 2, FW), self.vdtype)
@@ -613,7 +614,7 @@ class ToeplitzHistory:
         k = keep.stop - keep.start
         s = keep.start                          # (the states dropped: the move's shift)
         for B in (self.V9, self.V18):
-            # in chunks of frequencies (two lane groups: 64), and within a chunk in pieces of s states that do
+            # in chunks of frequencies (two lane groups: 128), and within a chunk in pieces of s states that do
             # not overlap their source: numpy copies an overlapping source whole before the move (35 MB a rank
             # for V18 on the paper's quarter case when it was one copy; half the time of a chunk's overlapping
             # copy)
@@ -638,7 +639,7 @@ class ToeplitzHistory:
         rows; v the side's state, sign -1 for H on u, +1 for G on p; s_j^n = sum_m c_j(n, m) v^m the
         interpolated lags' weighted states). Time-blocked: at the first step of each block of b steps
         (n0 + 1, n0 a multiple of b, also after a restart) the terms of the states m <= n0 for all b steps
-        at once (``history_products``, ``interp_products``: the kernels read once for the b steps); each
+        at once (``lanes.history_lanes``, ``lanes.interp_lanes``: the kernels read once for the b steps); each
         step adds those of the block's states before it (m > n0)."""
         b = self.block
         n0 = b * ((n - 1) // b)
@@ -670,7 +671,7 @@ class ToeplitzHistory:
             ev = event("SSI_BEM_HistInterp")
             ev.begin()
             acc += interp_lanes(self.A9, self.A18, self.V9, self.V18, C, lo - self.base, _low_rank, _spans(C),
-                                march.PETSc.Log)
+                                march.PETSc.Log, slab=slab)
             ev.end()
         return acc
 
@@ -685,7 +686,7 @@ class ToeplitzHistory:
             C = self._weights(march, n, n0 + 1, n - 1)[None]
             if C.any():
                 acc += interp_lanes(self.A9, self.A18, self.V9, self.V18, C, n0 + 1 - self.base, _low_rank,
-                                    _spans(C), march.PETSc.Log)
+                                    _spans(C), march.PETSc.Log, slab=self.f1 - self.f0)
 
     def _weights(self, march, n, m_lo, m_hi):
         """(k, m_hi - m_lo + 1): the weight of state m_lo + i in the interpolated history s_j^n of step n

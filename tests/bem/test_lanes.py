@@ -66,18 +66,41 @@ def test_history_lanes_refuse_states_out_of_range():
         history_lanes(K9, K18, V9, V18, 3, 3, 2)
     with pytest.raises(ValueError, match="not .* lanes"):
         history_lanes(K9, K18, V9[..., :16], V18, 0, 1, 2)
+    # the compiled loop checks no index: kernel rows and the output's shape are checked before it
+    with pytest.raises(ValueError, match="kernel row blocks 1..2 of 2"):
+        history_lanes(K9, K18, V9, V18, 0, 1, 2, r0=1)
+    with pytest.raises(ValueError, match="output of shape"):
+        history_lanes(K9, K18, V9, V18, 0, 3, 2, out=np.zeros((1, 1, 12, 2, FW)))
 
 
-@pytest.mark.parametrize("weights", ["chebyshev", "linear"])
-def test_interp_lanes_equal_the_matmul_products(weights):
+def test_lanes_of_an_empty_slab():
+    """A rank without frequencies: empty lanes, empty products of the right shape."""
+    from petsc_ssi.bem.lanes import to_lanes, from_lanes, history_lanes, FW
+    z = np.zeros((0, 18, 8), np.complex128)
+    K9, K18 = to_lanes(z[:, :18]), to_lanes(np.zeros((0, 36, 4), np.complex128))
+    V9, V18 = to_lanes(np.zeros((0, 6, 9), np.complex128)), to_lanes(np.zeros((0, 6, 18), np.complex128))
+    assert K9.shape == (0, 18, 8, 2, FW)
+    assert from_lanes(history_lanes(K9, K18, V9, V18, 1, 3, 2), 0).shape == (0, 3, 12)
+
+
+@pytest.mark.parametrize("weights,side,vdtype,gchunk", [("chebyshev", (8, 4), np.float64, 2),
+                                                         ("linear", (8, 4), np.float64, 2),
+                                                         ("chebyshev", (4, 8), np.float32, 1),
+                                                         ("linear", (4, 8), np.float32, 3)])
+def test_interp_lanes_equal_the_matmul_products(weights, side, vdtype, gchunk):
     """The interpolating matrices' products in lanes (weighted states per span, through the weights' rank
-    where ``_low_rank`` takes it) equal ``interp_products`` to 1e-14 of their size."""
-    from petsc_ssi.bem.lanes import to_lanes, from_lanes, interp_lanes
+    where ``_low_rank`` takes it; one span over every anchor used as the product gives it) equal
+    ``interp_products`` to 1e-14 of their size: H's and G's columns, double and single kept states, the
+    groups in chunks of 1, 2 and 3 on a slab of 3 groups."""
+    from petsc_ssi.bem.lanes import to_lanes, from_lanes, interp_lanes, FW
     from petsc_ssi.bem.toeplitz import interp_products, _spans, _low_rank
     rng = np.random.default_rng(5)
-    slab, b, k, ns, W = 40, 8, 6, 32, 40
-    A9, A18 = _c(rng, slab, 9 * k, 8), _c(rng, slab, 18 * k, 4)
+    n9, n18 = side
+    slab, b, k, ns, W = 2 * FW + 5, 8, 6, 32, 40
+    A9, A18 = _c(rng, slab, 9 * k, n9), _c(rng, slab, 18 * k, n18)
     V9, V18 = _c(rng, slab, W, 9), _c(rng, slab, W, 18)
+    if vdtype == np.float32:
+        V9, V18 = V9.astype(np.complex64), V18.astype(np.complex64)
     if weights == "chebyshev":        # polynomial weights: low rank
         t = np.linspace(-1, 1, ns)
         C = np.stack([np.stack([np.polynomial.chebyshev.chebval(t + 0.01 * s, np.eye(k)[j]) for j in range(k)])
@@ -87,6 +110,6 @@ def test_interp_lanes_equal_the_matmul_products(weights):
         for j in range(k):
             C[:, j, 5 * j:5 * j + 6] = rng.random((b, 6))
     ref = interp_products(A9, A18, V9, V18, C, 4, fchunk=16)
-    got = from_lanes(interp_lanes(to_lanes(A9), to_lanes(A18), to_lanes(V9), to_lanes(V18), C, 4, _low_rank,
-                                  _spans(C)), slab)
+    got = from_lanes(interp_lanes(to_lanes(A9), to_lanes(A18), to_lanes(V9, vdtype), to_lanes(V18, vdtype), C, 4,
+                                  _low_rank, _spans(C), gchunk=gchunk), slab)
     assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
