@@ -70,8 +70,8 @@ def lane_products(K, j0, X, p0, ss, sd, b, D, out, o0):
     b', n_out, 2, FW) float64): a window of rows of X times a run of D x c rows of K, per lane. The exact
     lags: X the kept states, row p0 + s + r (ss = sd = 1); the interpolating matrices: X the weighted
     states of the b steps, row s k + r (ss = k, sd = 1, D = k). A group's sums go into a small buffer of
-    their own (the compiler keeps its loads and stores apart from the inputs': 25 % faster than summing
-    into ``out``)."""
+    their own (the compiler keeps its loads and stores apart from the inputs', which summing straight into
+    ``out`` did not)."""
     G, _, no, _, fw = K.shape
     c = X.shape[2]
     acc = np.zeros((b, no, 2, fw))
@@ -169,8 +169,14 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2, s
                     S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
             lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, 1, b, k, out[g0:g1], o0)
     if log is not None:                         # (flops over the rank's frequencies ``slab``, not the padding)
-        slab = G * FW if slab is None else slab
-        log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
-                             + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
-                                              for Cj, US, W in facs)))
+        log.logFlops(interp_flops(G * FW if slab is None else slab, b, k, n9, n18, facs))
     return out
+
+
+def interp_flops(slab, b, k, n9, n18, facs):
+    """Flops of the interpolated lags' products over ``slab`` frequencies (``interp_lanes`` and its
+    reference ``toeplitz.interp_products``): the anchors' complex products and the weighted states' real
+    ones (``facs``: each span's (C, U s, W) of ``toeplitz._low_rank``)."""
+    return slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
+                   + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
+                                    for Cj, US, W in facs))

@@ -47,7 +47,7 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
-from .lanes import FW, n_groups, padded, to_lanes, from_lanes, history_lanes, interp_lanes
+from .lanes import FW, n_groups, padded, to_lanes, from_lanes, history_lanes, interp_lanes, interp_flops
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -798,9 +798,7 @@ def interp_products(A9, A18, V9, V18, C, r0, log=None, fchunk=64):
         np.matmul(S9.reshape(fc, b, 9 * k), A9[f0:f1], out=out[f0:f1, :, :n9])
         np.matmul(S18.reshape(fc, b, 18 * k), A18[f0:f1], out=out[f0:f1, :, n9:])
     if log is not None:
-        log.logFlops(slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
-                             + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
-                                              for Cj, US, W in facs)))
+        log.logFlops(interp_flops(slab, b, k, n9, n18, facs))
     return out
 
 
