@@ -42,7 +42,7 @@ def main(argv=None):
     ap.add_argument("--anchors", type=int, default=20)
     ap.add_argument("--states", type=int, default=153, help="states the interpolating matrices weigh")
     ap.add_argument("--own", type=int, default=3, help="a step's own states in its block")
-    ap.add_argument("--fw", default="16,32,64", help="lane widths to time")
+    ap.add_argument("--fw", default="8,16,64", help="lane widths to time (multiples of lanes.VL)")
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args(argv)
     slab, D, b, k, ns, kk = a.slab, a.lags, a.block, a.anchors, a.states, a.own

@@ -7,27 +7,45 @@ of kept states (b x 9D, b x 18D) times the stacked kernels (9D x 8, 18D x 4 on t
 not take) cost more than the flops; on the 72 m building's slab it ran at 7-9 GFlop/s a process where
 a large GEMM runs at about 60.
 
-Here the arrays keep ``FW`` (64) frequencies side by side as the last axis, real and imaginary parts apart:
+Here the arrays keep ``FW`` (8) frequencies side by side as the last axis, real and imaginary parts apart:
 a (slab, ...) complex array becomes (groups, ..., 2, FW) real (``to_lanes``; the slab padded with
 zeros to whole groups). Every operation of the products is then the same on FW consecutive
-numbers, which the compiler turns into vector instructions (``lane_products``: the loop over the lanes
-innermost, a window a row offset into the kept states, so no copy). The sums over the windows' rows run
-in the same order as ``matmul``'s reference loop only up to round-off (``fastmath`` "contract": fused
-multiply-adds, no reassociation): the products equal ``history_products`` to about 1e-15 of their
-size (tests/bem/test_lanes.py).
+numbers: one vector instruction. ``lane_products`` runs, per lane group, a register-blocked micro-kernel
+(``simd.cmac_tile``): a tile of steps x outputs whose complex sums stay in vector registers while it walks
+the window's rows (a window is a row offset into the kept states, so no copy), each term four fused
+multiply-adds. The sums run in the order of ``matmul``'s reference loop only up to round-off: the
+products equal ``history_products`` to about 1e-15 of their size (tests/bem/test_lanes.py).
 
 ``history_lanes`` and ``interp_lanes`` are the two products the store takes (the exact lags' windows
 and the interpolating matrices' weighted states), with array inputs only; a GPU array module would
-take them over with its own kernel on the same layout (one thread a lane and output).
+take them over with its own kernel on the same layout (one thread a lane and tile).
 """
 import numpy as np
 from numba import njit
 
-# frequencies a lane group holds: 64 doubles, sixteen 256-bit vectors an operand. On the 72 m building's
-# slab, both ranks at once (`mpirun -n 2 ... jobscripts/history_lanes.py`, 2026-11-29 23:05): a block's
-# products 123 ms with 64 lanes, 127-128 with 32, 135 with 16, 150 with matmul; the interpolating
-# matrices' 123-129, 135-136, 138-139 and 148-150 ms
-FW = 64
+from .simd import cmac_tile
+
+# frequencies a lane group holds: one 512-bit vector of doubles (two 256-bit ones). The products' micro-kernel
+# (``simd.cmac_tile``) walks the kernels' and states' rows of one group, so a group's rows lie 1 KB apart,
+# not 8 KB as with 64 lanes (which mapped every row into the same L1 sets)
+FW = 8
+
+
+def _vector_tile():
+    """(VL, MS, MO): the micro-kernel's vector width in doubles and its tile of steps x outputs, whose 2 MS MO
+    complex sums stay in vector registers: 8-wide and 4 x 2 (16 of the 32 512-bit registers) where numba
+    compiles for AVX-512, else 4-wide and 2 x 2 (8 of 16 256-bit registers)."""
+    from numba.core import config
+    feats = config.CPU_FEATURES
+    if feats is None:
+        if config.CPU_NAME not in (None, "host"):
+            return 4, 2, 2
+        from llvmlite import binding
+        feats = binding.get_host_cpu_features().flatten()
+    return (8, 4, 2) if "+avx512f" in feats.split(",") else (4, 2, 2)
+
+
+VL, MS, MO = _vector_tile()
 
 
 def n_groups(n):
@@ -63,38 +81,49 @@ def from_lanes(Y, slab):
     return Z.reshape((Z.shape[0] * Z.shape[1],) + Z.shape[2:])[:slab]
 
 
-@njit(cache=True, fastmath={"contract"}, boundscheck=False)
-def lane_products(K, j0, X, p0, ss, sd, b, D, out, o0):
-    """out[g, s, o0 + o] += sum_{r < D, a < c} X[g, p0 + s ss + r sd, a] K[g, j0 + r c + a, o] for the b
-    steps s, complex per lane (K (G, J, no, 2, FW), X (G, rows, c, 2, FW) float64 or float32, out (G,
-    b', n_out, 2, FW) float64): a window of rows of X times a run of D x c rows of K, per lane. The exact
-    lags: X the kept states, row p0 + s + r (ss = sd = 1); the interpolating matrices: X the weighted
-    states of the b steps, row s k + r (ss = k, sd = 1, D = k). A group's sums go into a small buffer of
-    their own (the compiler keeps its loads and stores apart from the inputs', which summing straight into
-    ``out`` did not)."""
-    G, _, no, _, fw = K.shape
+@njit(cache=True, boundscheck=False)
+def lane_products(K, j0, X, p0, ss, b, D, out, o0):
+    """out[g, s, o0 + o] += sum_{r < D, a < c} X[g, p0 + s ss + r, a] K[g, j0 + r c + a, o] for the b steps
+    s, complex per lane (K (G, J, no, 2, FW), X (G, rows, c, 2, FW) float64 or float32, out (G, b', n_out,
+    2, FW) float64, all C-contiguous): a window of rows of X times a run of D x c rows of K, per lane. The
+    exact lags: X the kept states, row p0 + s + r (ss = 1); the interpolating matrices: X the weighted states
+    of the b steps, row s k + r (ss = k, D = k). Rows r and a of X are consecutive in memory as rows r c + a
+    of K are, so the sum runs over one index i = r c + a: per group and vector of VL lanes, tiles of MS steps
+    x MO outputs held in registers over the D c terms (``simd.cmac_tile``), the edges in smaller tiles."""
+    G, J, no, _, fw = K.shape
     c = X.shape[2]
-    acc = np.zeros((b, no, 2, fw))
+    n = D * c
+    T2 = 2 * fw
+    KJ, XR, OS = no * T2, c * T2, out.shape[2] * T2
+    Kg, Xg, Og = J * KJ, X.shape[1] * XR, out.shape[1] * OS
     for g in range(G):
-        acc[:] = 0.0
-        for r in range(D):
-            for a in range(c):
-                j = j0 + r * c + a
-                for s in range(b):
-                    row = p0 + s * ss + r * sd
-                    for o in range(no):
-                        for q in range(fw):
-                            xr = X[g, row, a, 0, q]
-                            xi = X[g, row, a, 1, q]
-                            kr = K[g, j, o, 0, q]
-                            ki = K[g, j, o, 1, q]
-                            acc[s, o, 0, q] += xr * kr - xi * ki
-                            acc[s, o, 1, q] += xr * ki + xi * kr
-        for s in range(b):
-            for o in range(no):
-                for t in range(2):
-                    for q in range(fw):
-                        out[g, s, o0 + o, t, q] += acc[s, o, t, q]
+        for v in range(0, fw, VL):
+            kb = g * Kg + j0 * KJ + v
+            xb = g * Xg + p0 * XR + v
+            ob = g * Og + o0 * T2 + v
+            s = 0
+            while s + MS <= b:
+                o = 0
+                while o + MO <= no:
+                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
+                              fw, MS, MO, VL)
+                    o += MO
+                while o < no:
+                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
+                              fw, MS, 1, VL)
+                    o += 1
+                s += MS
+            while s < b:
+                o = 0
+                while o + MO <= no:
+                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
+                              fw, 1, MO, VL)
+                    o += MO
+                while o < no:
+                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
+                              fw, 1, 1, VL)
+                    o += 1
+                s += 1
 
 
 def _check(V, p0, rows, c, what):
@@ -132,12 +161,12 @@ def history_lanes(K9, K18, V9, V18, p0, b, D, out=None, r0=0):
     _check_kernel(K9, V9, r0, D, 9, out, b, 0, "history_lanes")
     _check_kernel(K18, V18, r0, D, 18, out, b, n9, "history_lanes")
     if D > 0:
-        lane_products(K9, 9 * r0, V9, p0, 1, 1, b, D, out, 0)
-        lane_products(K18, 18 * r0, V18, p0, 1, 1, b, D, out, n9)
+        lane_products(K9, 9 * r0, V9, p0, 1, b, D, out, 0)
+        lane_products(K18, 18 * r0, V18, p0, 1, b, D, out, n9)
     return out
 
 
-def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2, slab=None):
+def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=None, slab=None):
     """The interpolated lags' products for b steps in lanes: the weighted states s_j = sum_m C[step, j, m]
     v^m (states r0 + m of the kept lanes) per span of ``spans`` (``toeplitz._spans``; ``low_rank`` its
     factors, ``toeplitz._low_rank``: one real matrix product a lane group over all its lanes, components
@@ -153,7 +182,8 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2, s
         for j0, j1, a, e in spans:
             _check(V, r0 + a, e - a, c, "interp_lanes")
         _check_kernel(A, V, 0, k, c, out, b, o0, "interp_lanes")
-    for g0 in range(0, G, gchunk):              # (groups in chunks: the weighted states stay small)
+    gchunk = gchunk or max(1, 128 // FW)
+    for g0 in range(0, G, gchunk):              # (128 frequencies at a time: the weighted states stay small)
         g1 = min(G, g0 + gchunk)
         for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):
             whole = len(spans) == 1 and spans[0][:2] == (0, k)       # (Chebyshev: one span, every anchor)
@@ -167,7 +197,7 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=2, s
                     S = w                       # (rows (step, anchor): the weighted states as they are)
                 else:
                     S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
-            lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, 1, b, k, out[g0:g1], o0)
+            lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, b, k, out[g0:g1], o0)
     if log is not None:                         # (flops over the rank's frequencies ``slab``, not the padding)
         log.logFlops(interp_flops(G * FW if slab is None else slab, b, k, n9, n18, facs))
     return out

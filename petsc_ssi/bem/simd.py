@@ -175,3 +175,76 @@ def block_rows4_pair(typingctx, a0, a1, a2, e0, e1, e2, t, cp, cq, x0, x1, x2):
         _rows4_update(context, builder, signature, args, (3, 4, 5), 8, u, tt, m)
         return context.get_dummy_value()
     return sig, codegen
+
+
+def _lit(x, lo, hi):
+    return isinstance(x, types.IntegerLiteral) and lo <= x.literal_value <= hi
+
+
+@intrinsic
+def cmac_tile(typingctx, K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl):
+    """A register tile of complex multiply-adds in frequency lanes (``lanes.lane_products``' micro-kernel):
+    for the ms x mo outputs (s, o) and the vl lanes q0..q0+vl-1,
+        out[ob + s OS + o 2T + t T + q] += sum_{i < n} X[xb + s XS + i 2T + .] K[kb + i KJ + o 2T + .]
+    complex (t = 0 the real part, t = 1 the imaginary part, T elements apart), the ms mo complex sums kept
+    in vector registers over the n terms (4 fused multiply-adds a term and output, in the order i, as the
+    scalar loop with contraction sums them). K and out are C-contiguous float64 arrays, X float64 or
+    float32 (widened exactly); offsets are flat element indices, not checked. ms, mo, vl literal ints."""
+    if not (_lit(ms, 1, 8) and _lit(mo, 1, 8) and vl in (types.IntegerLiteral(4), types.IntegerLiteral(8))
+            and all(isinstance(a, types.Array) and a.layout == "C" for a in (K, X, out))
+            and K.dtype == types.float64 and out.dtype == types.float64 and X.dtype in (types.float64, types.float32)
+            and all(isinstance(a, types.Integer) for a in (kb, KJ, xb, XS, ob, OS, n, T))):
+        return None
+    MS, MO, VL = ms.literal_value, mo.literal_value, vl.literal_value
+    sig = types.void(K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl)
+
+    def codegen(context, builder, signature, args):
+        st = signature.args
+        i64 = ir.IntType(64)
+        vd = ir.VectorType(ir.DoubleType(), VL)
+        single = st[3].dtype == types.float32
+        vx = ir.VectorType(ir.FloatType() if single else ir.DoubleType(), VL)
+        fma = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vd, [vd, vd, vd]), f"llvm.fma.v{VL}f64")
+
+        def idx(k):
+            return context.cast(builder, args[k], st[k], types.intp)
+        Kd = context.make_array(st[0])(context, builder, args[0]).data
+        Xd = context.make_array(st[3])(context, builder, args[3]).data
+        Od = context.make_array(st[6])(context, builder, args[6]).data
+        kb_, KJ_, xb_, XS_, ob_, OS_, n_, T_ = (idx(k) for k in (1, 2, 4, 5, 7, 8, 9, 10))
+        T2 = builder.mul(T_, ir.Constant(i64, 2))
+
+        def vload(data, off, vt):
+            return builder.load(builder.bitcast(builder.gep(data, [off]), vt.as_pointer()), align=8)
+        zero = ir.Constant(vd, [0.0] * VL)
+        accs = [[[cgutils.alloca_once_value(builder, zero) for _ in range(2)] for _ in range(MO)] for _ in range(MS)]
+        with cgutils.for_range(builder, n_) as loop:
+            i = loop.index
+            ko = builder.add(kb_, builder.mul(i, KJ_))
+            xo = builder.add(xb_, builder.mul(i, T2))
+            kv = []
+            for o in range(MO):
+                base = builder.add(ko, builder.mul(ir.Constant(i64, o), T2))
+                kv.append((vload(Kd, base, vd), vload(Kd, builder.add(base, T_), vd)))
+            for s in range(MS):
+                base = builder.add(xo, builder.mul(ir.Constant(i64, s), XS_))
+                xr, xi = vload(Xd, base, vx), vload(Xd, builder.add(base, T_), vx)
+                if single:
+                    xr, xi = builder.fpext(xr, vd), builder.fpext(xi, vd)
+                nxi = builder.fneg(xi)
+                for o in range(MO):
+                    kr, ki = kv[o]
+                    pr, pi = accs[s][o]
+                    ar = builder.call(fma, [nxi, ki, builder.call(fma, [xr, kr, builder.load(pr)])])
+                    ai = builder.call(fma, [xi, kr, builder.call(fma, [xr, ki, builder.load(pi)])])
+                    builder.store(ar, pr)
+                    builder.store(ai, pi)
+        for s in range(MS):
+            for o in range(MO):
+                base = builder.add(builder.add(ob_, builder.mul(ir.Constant(i64, s), OS_)),
+                                   builder.mul(ir.Constant(i64, o), T2))
+                for t, off in enumerate((base, builder.add(base, T_))):
+                    ptr = builder.bitcast(builder.gep(Od, [off]), vd.as_pointer())
+                    builder.store(builder.fadd(builder.load(ptr, align=8), builder.load(accs[s][o][t])), ptr, align=8)
+        return context.get_dummy_value()
+    return sig, codegen

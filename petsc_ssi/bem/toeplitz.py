@@ -614,12 +614,13 @@ class ToeplitzHistory:
         k = keep.stop - keep.start
         s = keep.start                          # (the states dropped: the move's shift)
         for B in (self.V9, self.V18):
-            # in chunks of frequencies (two lane groups: 128), and within a chunk in pieces of s states that do
+            # in chunks of frequencies (128), and within a chunk in pieces of s states that do
             # not overlap their source: numpy copies an overlapping source whole before the move (35 MB a rank
             # for V18 on the paper's quarter case when it was one copy; half the time of a chunk's overlapping
             # copy)
-            for f0 in range(0, B.shape[0], 2):
-                blk = B[f0:f0 + 2]
+            step = max(1, 128 // FW)
+            for f0 in range(0, B.shape[0], step):
+                blk = B[f0:f0 + step]
                 for j in range(0, k if s else 0, s or 1):
                     blk[:, j:min(k, j + s)] = blk[:, j + s:min(k, j + s) + s]
                 blk[:, k:] = 0.0

@@ -65,7 +65,7 @@ def test_history_lanes_refuse_states_out_of_range():
     with pytest.raises(ValueError, match="states 3..6 of a buffer of 5"):
         history_lanes(K9, K18, V9, V18, 3, 3, 2)
     with pytest.raises(ValueError, match="not .* lanes"):
-        history_lanes(K9, K18, V9[..., :16], V18, 0, 1, 2)
+        history_lanes(K9, K18, V9[..., :FW // 2], V18, 0, 1, 2)
     # the compiled loop checks no index: kernel rows and the output's shape are checked before it
     with pytest.raises(ValueError, match="kernel row blocks 1..2 of 2"):
         history_lanes(K9, K18, V9, V18, 0, 1, 2, r0=1)
