@@ -113,3 +113,45 @@ def test_interp_lanes_equal_the_matmul_products(weights, side, vdtype, gchunk):
     got = from_lanes(interp_lanes(to_lanes(A9), to_lanes(A18), to_lanes(V9, vdtype), to_lanes(V18, vdtype), C, 4,
                                   _low_rank, _spans(C), gchunk=gchunk), slab)
     assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("b,no,ss,vdtype", [(7, 3, 1, np.float64), (5, 5, 3, np.float32), (1, 1, 2, np.float64)])
+def test_lane_products_tile_edges_equal_a_plain_sum(b, no, ss, vdtype):
+    """The micro-kernel's tiles (``lanes.MS`` steps x ``lanes.MO`` outputs) and their edges: step counts and
+    output columns that are not multiples of the tile, a row stride ss > 1 (the interpolating matrices'),
+    single kept states, a kernel row offset and an output column offset; against a plain loop per
+    frequency, to 1e-14 of the sums' size, and nothing written outside the output's columns."""
+    from petsc_ssi.bem.lanes import to_lanes, from_lanes, lane_products, n_groups, FW
+    rng = np.random.default_rng(b * 10 + no)
+    slab, c, D, j0, p0, o0 = 2 * FW + 3, 9, 4, 2, 1, 2
+    K = _c(rng, slab, j0 + c * D + c, no)
+    X = _c(rng, slab, p0 + ss * (b - 1) + D + 2, c)
+    if vdtype == np.float32:
+        X = X.astype(np.complex64)
+    out = np.zeros((n_groups(slab), b, o0 + no + 1, 2, FW))
+    lane_products(to_lanes(K), j0, to_lanes(X, vdtype), p0, ss, b, D, out, o0)
+    got = from_lanes(out, slab)
+    ref = np.zeros((slab, b, o0 + no + 1), np.complex128)
+    for s in range(b):
+        for r in range(D):
+            row = X[:, p0 + s * ss + r].astype(np.complex128)                        # (slab, c)
+            ref[:, s, o0:o0 + no] += np.einsum("fa,fao->fo", row, K[:, j0 + r * c:j0 + (r + 1) * c])
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+    assert not got[..., :o0].any() and not got[..., o0 + no:].any()
+
+
+def test_lane_products_on_a_machine_without_avx512(tmp_path):
+    """Compiled for a CPU without AVX-512 (NUMBA_CPU_NAME=haswell: 4-wide vectors, 2 x 2 tiles), the tile and
+    edge test above passes too (a cluster's older nodes take that branch of ``lanes._vector_tile``)."""
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ, NUMBA_CPU_NAME="haswell", NUMBA_CACHE_DIR=str(tmp_path))
+    code = ("from petsc_ssi.bem import lanes; assert (lanes.VL, lanes.MS, lanes.MO) == (4, 2, 2), "
+            "(lanes.VL, lanes.MS, lanes.MO)")
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    r = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr[-2000:]
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-k", "tile_edges or equal_the_matmul",
+                        os.path.abspath(__file__)], env=env, cwd=root, capture_output=True, text=True)
+    assert r.returncode == 0 and " passed" in r.stdout, r.stdout[-2000:] + r.stderr[-2000:]
