@@ -96,9 +96,11 @@ def _single_kernels():
                 bsr.matvec(m, indptr, cols, data, xx, np.zeros(3))
             for w in (2, bsr.PAIR_FROM):
                 bsr.panel(m, indptr, cols, data, np.ones((3, w)), np.zeros((3, w)), 1.0)
-    from ..bem.lanes import lane_products, FW
+    from ..bem.lanes import lane_products, put_state, FW
     K, out = np.zeros((1, 9, 1, 2, FW)), np.zeros((1, 1, 1, 2, FW))
     lane_products(K, 0, np.zeros((1, 1, 9, 2, FW), np.float32), 0, 1, 1, 1, out, 0)   # (single kept states)
+    put_state(np.zeros((9, 3, 2), complex)[..., :1], np.zeros((1, 1, 9, 2, FW), np.float32),
+              np.zeros((1, 1, 18, 2, FW), np.float32), 0)
     diag = np.ones((1, 3, 3))
     bsr._diag_add(diag, 0, x, np.zeros(3), 1.0)
     bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)

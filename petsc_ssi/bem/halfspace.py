@@ -497,6 +497,10 @@ class HalfSpace:
             printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, -ssi_partition "
                    f"{self.cfg.partition} (estimated work max/mean {ls.balance[0]:.3f}; equal node counts "
                    f"{ls.balance[1]:.3f})")
+        elif len(ls.ranges) > 1:
+            n = [b - a for a, b in ls.ranges]
+            printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, equal node counts "
+                   "(-ssi_lag_store toeplitz splits the history sum by frequency; -ssi_partition to choose)")
         if self.lattice is None:
             self.check_memory(ls, plan, extra_bytes, extra_what)
         else:
@@ -619,7 +623,12 @@ class HalfSpace:
         from ..petsc import lag_small_pages
         plan = plan if plan is not None else self.interp_plan()
         interp = [plan.kernel_time(j)[0] for j in range(plan.k)] if plan.active else []
-        opts = dict(self.quad_options(), partition=self.cfg.partition, work_lags=plan.Lx,
+        # a toeplitz run's history is split over the ranks by frequency, not by node: the nodes go in equal
+        # ranges (the step matrix's rows), without the dense lags' work estimate (unless -ssi_partition is given)
+        part, weigh = self.cfg.partition, True
+        if self.cfg.get("lag_store", "dense") == "toeplitz" and not self.cfg.user_set("partition"):
+            part, weigh = "equal", False
+        opts = dict(self.quad_options(), partition=part, weigh=weigh, work_lags=plan.Lx,
                     block_pattern=self.cfg.get("lag_pattern", "auto"),
                     small_pages=lag_small_pages(self.cfg.get("huge_pages", "auto")),
                     lag_weights=lag_weights(plan.Lx, self.L, self.cfg.scheme.startswith("stabili"), interp))

@@ -368,16 +368,20 @@ class LagSet:
         self.in_plane = KERNELS[(self.kind, (self.mH, self.mG))][0] == PLANE
         self._plane = None
         self.Vc, self.VR, self.Vh = bounding_spheres(VX)
-        from .partition import node_ranges, lag_weights
+        from .partition import node_ranges, lag_weights, equal_ranges
         # the nodes (rows) of each rank: contiguous ranges of equal estimated work (-ssi_partition);
         # opts "lag_weights": uses of the matrices by lag (partition.lag_weights), "work_lags": the
         # exact lags (default: a stabilised run of L steps storing every lag)
         Lx = int(opts.get("work_lags") or L)
         lw = opts.get("lag_weights")
-        self.ranges, self.balance = node_ranges(comm, opts.get("partition", "balanced"), mesh.nodes, self.Vc,
-                                                self.VR, mat, dt, len(self.Vc) // mesh.n_cells,
-                                                np.asarray(lw, float) if lw is not None else lag_weights(Lx, L, True),
-                                                Lx, regions.n_t)
+        if opts.get("partition") == "equal" and not opts.get("weigh", True):
+            # (no estimate of the lags' work to report: the toeplitz store's history is split by frequency)
+            self.ranges, self.balance = equal_ranges(mesh.n_nodes, comm.getSize()), None
+        else:
+            self.ranges, self.balance = node_ranges(comm, opts.get("partition", "balanced"), mesh.nodes, self.Vc,
+                                                    self.VR, mat, dt, len(self.Vc) // mesh.n_cells,
+                                                    np.asarray(lw, float) if lw is not None
+                                                    else lag_weights(Lx, L, True), Lx, regions.n_t)
         self.node_range = self.ranges[comm.getRank()]
         self.rows = np.arange(*self.node_range, dtype=np.int64)
         from .freeterm import free_terms

@@ -210,3 +210,60 @@ def interp_flops(slab, b, k, n9, n18, facs):
     return slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
                    + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
                                     for Cj, US, W in facs))
+
+
+@njit(cache=True, boundscheck=False)
+def scatter_slots(U, vnode, vsign, ix, iy, f):
+    """f[a, c, ix[v], iy[v]] = U[vnode[v, a], c] vsign[v, c] for the input elements v and their 9 slots a
+    (a slot without a column, vnode -1, gives 0): a state's values on the FFT grid, one plane a slot and
+    component (``ToeplitzHistory._transform``; f's other entries are not touched)."""
+    for v in range(vnode.shape[0]):
+        x, y = ix[v], iy[v]
+        for a in range(9):
+            nd = vnode[v, a]
+            for c in range(3):
+                f[a, c, x, y] = U[nd, c] * vsign[v, c] if nd >= 0 else 0.0
+
+
+@njit(cache=True, boundscheck=False)
+def put_state(S, V9, V18, i):
+    """Row i of the kept transforms in lanes from a state's slab S (9 slots, 3 components, slab) complex:
+    V9[.., i, a] the z components, V18[.., i, 2 a + c] the x and y ones (``to_lanes`` of ``S[:, 2].T`` and of
+    ``S[:, :2]`` (slab, 18), without the copies); padding lanes zero."""
+    slab = S.shape[2]
+    G, fw = V9.shape[0], V9.shape[4]
+    for g in range(G):
+        for q in range(fw):
+            f = g * fw + q
+            for a in range(9):
+                z = S[a, 2, f] if f < slab else 0j
+                V9[g, i, a, 0, q] = z.real
+                V9[g, i, a, 1, q] = z.imag
+                for c in range(2):
+                    w = S[a, c, f] if f < slab else 0j
+                    V18[g, i, 2 * a + c, 0, q] = w.real
+                    V18[g, i, 2 * a + c, 1, q] = w.imag
+
+
+@njit(cache=True, boundscheck=False)
+def take_step(acc, j, slab, out):
+    """out[f, o] = acc[g, j, o] at lane q (f = g FW + q < slab), complex: step j's sums of a block's lanes as
+    a (slab, n_out) complex array (``from_lanes(acc[:, j], slab)`` without the copies)."""
+    fw = acc.shape[4]
+    for f in range(slab):
+        g, q = f // fw, f % fw
+        for o in range(acc.shape[2]):
+            out[f, o] = acc[g, j, o, 0, q] + 1j * acc[g, j, o, 1, q]
+
+
+@njit(cache=True, boundscheck=False)
+def unpack_sums(full, n9, out):
+    """out[t, p, f] (4 classes, 3 components, F) from the gathered sums full (F, 12): columns the K9 products'
+    then the K18 products'; for n9 = 8 (H) the 8 K9 columns are (class t, x or y) and the 4 K18 ones z of
+    class t, for n9 = 4 (G) the other way round."""
+    xy0, z0 = (0, 8) if n9 == 8 else (4, 0)
+    for f in range(full.shape[0]):
+        for t in range(4):
+            out[t, 0, f] = full[f, xy0 + 2 * t]
+            out[t, 1, f] = full[f, xy0 + 2 * t + 1]
+            out[t, 2, f] = full[f, z0 + t]

@@ -47,7 +47,8 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
-from .lanes import FW, n_groups, padded, to_lanes, from_lanes, history_lanes, interp_lanes, interp_flops
+from .lanes import (FW, n_groups, padded, to_lanes, history_lanes, interp_lanes, interp_flops,
+                    scatter_slots, put_state, take_step, unpack_sums)
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -584,18 +585,18 @@ class ToeplitzHistory:
 
     # ---------------------------------------------------------------- per step
     def _transform(self, u_all, m):
+        """State m's transform, this rank's slab, into row m - base of the kept lanes: the state's values on
+        the FFT grid per slot and component (``lanes.scatter_slots``), 27 real 2-D FFTs (every rank makes all
+        of them; the slab is a run of the flattened spectrum), the slab put into lanes (``lanes.put_state``)."""
         from scipy.fft import rfft2
         lat = self.lat
-        U = np.concatenate([u_all.reshape(-1, 3), np.zeros((1, 3))])     # (row -1: no traction column)
-        f = np.zeros((9, 3, lat.Mx, lat.My))
+        U = np.concatenate([u_all.reshape(-1, 3), np.zeros((1, 3))])
+        if getattr(self, "_grid", None) is None:            # (only the slots' cells are written: zeros stay)
+            self._grid = np.zeros((9, 3, lat.Mx, lat.My))
         ix, iy = self.vpos
-        for a in range(9):
-            for c in range(3):
-                f[a, c, ix, iy] = U[self.vnode[:, a], c] * self.vsign[:, c]
-        S = rfft2(f, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
-        i = m - self.base
-        self.V9[:, i] = to_lanes(S[:, 2, :].T, self.vdtype)
-        self.V18[:, i] = to_lanes(S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18), self.vdtype)
+        scatter_slots(U, self.vnode, self.vsign, ix, iy, self._grid)
+        S = rfft2(self._grid, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
+        put_state(S, self.V9, self.V18, m - self.base)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
@@ -708,16 +709,13 @@ class ToeplitzHistory:
         lat = self.lat
         full = np.empty((lat.F, 12), np.complex128)
         mpi = self.comm.tompi4py()
-        acc = from_lanes(acc[:, 0], self.f1 - self.f0)          # (slab, 12) complex
-        mpi.Allgatherv(np.ascontiguousarray(acc), [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
-                                                   MPI.C_DOUBLE_COMPLEX])
-        # columns: the K9 products' then the K18 products'; (class t, x or y) for the 8-wide, z of class t
-        # for the 4-wide -> (t, component)
-        n9 = self.spec["n9"]
-        xy, z = (full[:, :8], full[:, 8:]) if n9 == 8 else (full[:, 4:], full[:, :4])
+        slab = self.f1 - self.f0
+        mine = np.empty((slab, 12), np.complex128)
+        take_step(acc, 0, slab, mine)
+        mpi.Allgatherv(mine, [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
+                              MPI.C_DOUBLE_COMPLEX])
         out = np.empty((4, 3, lat.F), np.complex128)
-        out[:, 0:2, :] = xy.T.reshape(4, 2, lat.F)
-        out[:, 2, :] = z.T
+        unpack_sums(full, self.spec["n9"], out)            # (class t, component)
         phys = irfft2(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
         vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
         arr = out_u.getArray()

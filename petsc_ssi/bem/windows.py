@@ -50,6 +50,34 @@ def plane_heights(VX, n_images=1):
     return np.where(np.all(z == z[:, :1], axis=1), z[:, 0], np.nan)
 
 
+def near_pairs(xc, Vc, VR, L, mat, dt, n_images=1):
+    """``pair_windows`` over the pairs that can reach a lag 1..L only: (point, element, lo, hi) of the pairs
+    whose union over the element's symmetry images has hi >= lo, found by a k-d tree within the P wave's
+    L dt reach of the bounding spheres (a pair farther apart starts after lag L: lo > L). Equal to
+    ``pair_windows``' valid pairs; O(points x elements near) instead of O(points x elements)."""
+    from scipy.spatial import cKDTree
+    E = len(Vc) // n_images
+    r = float(np.max(VR)) + mat.cp * dt * L
+    lists = cKDTree(Vc).query_ball_point(xc, r)
+    cnt = np.fromiter((len(x) for x in lists), np.int64, len(lists))
+    pt = np.repeat(np.arange(len(xc)), cnt)
+    vc = np.fromiter((j for x in lists for j in x), np.int64, int(cnt.sum()))
+    d = np.linalg.norm(xc[pt] - Vc[vc], axis=1)
+    lo = np.maximum(1, np.floor(np.maximum(d - VR[vc], 0) / (mat.cp * dt)) + 1)
+    hi = np.minimum(L, np.floor((d + VR[vc]) / (mat.cs * dt)) + 2)
+    v = hi >= lo
+    key = pt[v] * E + vc[v] % E                       # (the union over an element's images)
+    o = np.argsort(key, kind="stable")
+    key, lo, hi = key[o], lo[v][o], hi[v][o]
+    first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    return (key[first] // E, key[first] % E, np.minimum.reduceat(lo, first) if len(first) else lo[:0],
+            np.maximum.reduceat(hi, first) if len(first) else hi[:0])
+
+
+# near_pairs instead of the all-pairs windows when the reach's share of the surface's pairs is below this
+NEAR_SHARE = 0.2
+
+
 def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256, plane_z=None):
     """Estimated number of non-zero 3x3 blocks of each H lag (array, index
     l-1) in ``rows``: for each (row, element) the lags its wave window touches
@@ -57,12 +85,26 @@ def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256, pla
     columns), times four nodes per element (a node is shared by about four).
     ``plane_z`` (``plane_heights``): only the pairs whose point lies in the element's horizontal plane
     (the blocks H keeps in the flat pattern on a surface that is not one plane, ``lagset.SplitBuckets``;
-    a column also met by elements of another plane, at an edge, is counted as theirs)."""
+    a column also met by elements of another plane, at an edge, is counted as theirs). Where the lags'
+    reach covers a small share of the surface (the step matrix's lags 1-2), only the pairs within it are
+    visited (``near_pairs``: the same counts)."""
     diff = np.zeros(L + 2)
+    pts = xnodes[rows]
+    area = np.prod(np.ptp(Vc[:, :2], axis=0) + 2 * float(np.max(VR))) if len(Vc) else 0.0
+    reach = float(np.max(VR)) + mat.cp * dt * L if len(Vc) else 0.0
+    if len(Vc) and np.pi * reach ** 2 < NEAR_SHARE * area:
+        for s in range(0, len(rows), 16 * chunk):
+            pt, e, lo, hi = near_pairs(pts[s:s + 16 * chunk], Vc, VR, L, mat, dt, n_images)
+            if plane_z is not None:
+                keep = pts[s + pt, 2] == plane_z[e]
+                lo, hi = lo[keep], hi[keep]
+            diff += 4.0 * np.bincount(lo.astype(np.int64), minlength=L + 2)[:L + 2]
+            diff -= 4.0 * np.bincount(hi.astype(np.int64) + 1, minlength=L + 2)[:L + 2]
+        return np.cumsum(diff)[1:L + 1]
     for s in range(0, len(rows), chunk):
-        lo, hi, ok = pair_windows(xnodes[rows[s:s + chunk]], Vc, VR, L, mat, dt, n_images)
+        lo, hi, ok = pair_windows(pts[s:s + chunk], Vc, VR, L, mat, dt, n_images)
         if plane_z is not None:
-            ok = ok & (xnodes[rows[s:s + chunk], 2][:, None] == plane_z[None, :])
+            ok = ok & (pts[s:s + chunk, 2][:, None] == plane_z[None, :])
         # counts of window starts and ends (np.add.at of 4.0 per pair summed the same integers, slowly)
         diff += 4.0 * np.bincount(lo[ok].astype(np.int64), minlength=L + 2)[:L + 2]
         diff -= 4.0 * np.bincount(hi[ok].astype(np.int64) + 1, minlength=L + 2)[:L + 2]

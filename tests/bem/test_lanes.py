@@ -155,3 +155,45 @@ def test_lane_products_on_a_machine_without_avx512(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-k", "tile_edges or equal_the_matmul",
                         os.path.abspath(__file__)], env=env, cwd=root, capture_output=True, text=True)
     assert r.returncode == 0 and " passed" in r.stdout, r.stdout[-2000:] + r.stderr[-2000:]
+
+
+@pytest.mark.parametrize("vdtype", [np.float64, np.float32])
+def test_per_step_helpers_equal_their_numpy_forms(vdtype):
+    """The store's compiled per-step helpers against the numpy they replaced, exactly: ``put_state`` (a
+    state's slab into lanes: ``to_lanes`` of the z components and of the x, y ones), ``take_step`` (a step
+    of a block's lanes: ``from_lanes``), ``unpack_sums`` (the gathered sums into (class, component)) and
+    ``scatter_slots`` (a state onto the FFT grid, a slot without a column giving 0)."""
+    from petsc_ssi.bem.lanes import (to_lanes, from_lanes, put_state, take_step, unpack_sums, scatter_slots,
+                                     n_groups, FW)
+    rng = np.random.default_rng(9)
+    slab = 2 * FW + 5
+    full = _c(rng, 9, 3, 3 * slab)
+    S = full[..., slab:2 * slab]                                      # (a view, as the run's slab)
+    G = n_groups(slab)
+    V9, V18 = np.full((G, 4, 9, 2, FW), 7.0, vdtype), np.full((G, 4, 18, 2, FW), 7.0, vdtype)
+    put_state(S, V9, V18, 2)
+    assert np.array_equal(V9[:, 2], to_lanes(S[:, 2, :].T, vdtype))
+    assert np.array_equal(V18[:, 2], to_lanes(S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18), vdtype))
+    assert (V9[:, 1] == 7.0).all() and (V18[:, 3] == 7.0).all()      # (other rows untouched)
+    acc = to_lanes(_c(rng, slab, 3, 12))                             # (groups, b = 3, 12, 2, FW)
+    out = np.empty((slab, 12), np.complex128)
+    take_step(acc, 1, slab, out)
+    assert np.array_equal(out, from_lanes(acc[:, 1], slab))
+    F = 11
+    g = _c(rng, F, 12)
+    for n9 in (8, 4):
+        u = np.empty((4, 3, F), np.complex128)
+        unpack_sums(g, n9, u)
+        xy, z = (g[:, :8], g[:, 8:]) if n9 == 8 else (g[:, 4:], g[:, :4])
+        assert np.array_equal(u[:, 0:2], xy.T.reshape(4, 2, F)) and np.array_equal(u[:, 2], z.T)
+    U = np.r_[rng.standard_normal((6, 3)), np.zeros((1, 3))]
+    vnode = rng.integers(-1, 6, (5, 9))
+    vsign = rng.choice([-1.0, 1.0], (5, 3))
+    ix, iy = np.array([0, 1, 2, 3, 4]), np.array([4, 3, 2, 1, 0])
+    f = np.zeros((9, 3, 6, 5))
+    scatter_slots(U, vnode, vsign, ix, iy, f)
+    ref = np.zeros_like(f)
+    for a in range(9):
+        for c in range(3):
+            ref[a, c, ix, iy] = U[vnode[:, a], c] * vsign[:, c]
+    assert np.array_equal(f, ref)

@@ -158,3 +158,30 @@ def test_sampled_weights_for_large_meshes(monkeypatch):
     for p in (2, 4):
         ib = partition.imbalance(exact, partition.balanced_ranges(sampled, p))
         assert ib - 1 <= p * exact.max() / exact.sum() + 0.05, (p, ib)
+
+
+@pytest.mark.parametrize("L", [1, 2, 5, 12])
+def test_near_pairs_count_as_the_all_pairs_windows(L, monkeypatch):
+    """``estimate_blocks`` through the k-d tree's near pairs (``windows.near_pairs``: the step matrix's short
+    reach on a large surface) counts what the all-pairs windows count, on a quarter model (symmetry
+    images folded) and with the in-plane filter; the near pairs are exactly the valid all-pairs windows."""
+    from petsc_ssi.bem import windows
+    from petsc_ssi.bem.windows import estimate_blocks, near_pairs, pair_windows, plane_heights
+    PETSc = petsc()
+    mesh, ls = _small_lagset(PETSc)
+    nimg = len(ls.Vc) // mesh.n_cells
+    rows = np.arange(mesh.n_nodes)
+    pz = plane_heights(ls.VX, nimg)
+    got = {}
+    for share in (0.0, 1e9):                  # all pairs; always the tree
+        monkeypatch.setattr(windows, "NEAR_SHARE", share)
+        got[share] = (estimate_blocks(mesh.nodes, rows, ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg),
+                      estimate_blocks(mesh.nodes, rows, ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg, plane_z=pz))
+    assert got[0.0][0].sum() > 0
+    for a, b in zip(got[0.0], got[1e9]):
+        assert np.array_equal(a, b)
+    lo, hi, ok = pair_windows(mesh.nodes, ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg)
+    pt, e, nlo, nhi = near_pairs(mesh.nodes, ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg)
+    i, j = np.nonzero(ok)
+    assert np.array_equal(pt, i) and np.array_equal(e, j)
+    assert np.array_equal(nlo, lo[i, j]) and np.array_equal(nhi, hi[i, j])
