@@ -69,9 +69,10 @@ def near_pairs(xc, Vc, VR, L, mat, dt, n_images=1):
     key = pt[v] * E + vc[v] % E                       # (the union over an element's images)
     o = np.argsort(key, kind="stable")
     key, lo, hi = key[o], lo[v][o], hi[v][o]
+    if not len(key):                                  # (no element within reach of these points)
+        return key, key, lo, hi
     first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    return (key[first] // E, key[first] % E, np.minimum.reduceat(lo, first) if len(first) else lo[:0],
-            np.maximum.reduceat(hi, first) if len(first) else hi[:0])
+    return key[first] // E, key[first] % E, np.minimum.reduceat(lo, first), np.maximum.reduceat(hi, first)
 
 
 # near_pairs instead of the all-pairs windows when the reach's share of the surface's pairs is below this

@@ -185,3 +185,8 @@ def test_near_pairs_count_as_the_all_pairs_windows(L, monkeypatch):
     i, j = np.nonzero(ok)
     assert np.array_equal(pt, i) and np.array_equal(e, j)
     assert np.array_equal(nlo, lo[i, j]) and np.array_equal(nhi, hi[i, j])
+    # points out of every element's reach (the traction elements' window seen from far nodes): no pairs
+    far = mesh.nodes[:3] + np.array([1e3, 0.0, 0.0])
+    assert all(len(a) == 0 for a in near_pairs(far, ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg))
+    monkeypatch.setattr(windows, "NEAR_SHARE", 1e9)
+    assert not estimate_blocks(far, np.arange(3), ls.Vc, ls.VR, L, ls.mat, ls.dt, nimg).any()
