@@ -10,6 +10,8 @@
 #   uniform-36     -ssi_mesh grid 36 x 37.2 m of equal 1.2 m nine-node cells (node spacing 0.6 m = the slab's
 #                  shell nodes; y edges at +-18.6 so that +-5.4 are cell edges), toeplitz, the same load
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
+#   uniform-72-fullrank (not by default) uniform-72 with the step matrix's MUMPS LU in full rank (-ssi_step_blr 0;
+#                  by default, from 20 000 DOFs on, it is block low-rank at 1e-15 and checked: bem/march.py)
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
 #                  T_L and k, kept transforms in single precision): what the history sum's options save
 #   uniform-72-blr (not by default) uniform-72 with the step matrix's MUMPS LU in block low-rank form (BLR:
@@ -52,6 +54,7 @@ for r in $RUNS; do
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
     uniform-72-fast) run uniform-72-fast "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $FAST ;;
+    uniform-72-fullrank) run uniform-72-fullrank "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 -ssi_step_blr 0 ;;
     uniform-72-blr) run uniform-72-blr "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 -ssi_bem_mat_mumps_icntl_35 2 \
                       -ssi_bem_mat_mumps_cntl_7 "$BLR_EPS" ;;
     # the exactness check on this case: uniform-36's first 6 steps (lags still block-sparse) dense and toeplitz

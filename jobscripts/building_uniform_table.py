@@ -37,6 +37,7 @@ MESH = {"today": "graded 36 x 36 m (building_soil.geo), 1 m load at x = 14.5",
         "today-load15": "graded 36 x 36 m (building_soil.geo), 1.2 m load at x = 15",
         "uniform-36": "uniform 36 x 37.2 m, 1.2 m cells, 1.2 m load at x = 15",
         "uniform-72": "uniform 72 x 73.2 m, 1.2 m cells, 1.2 m load at x = 15",
+        "uniform-72-fullrank": "as uniform-72, the step matrix's LU in full rank (-ssi_step_blr 0)",
         "uniform-72-fast": "as uniform-72, multi-linear far lags, single-precision transforms",
         "uniform-72-blr": "as uniform-72, the step matrix's MUMPS LU block low-rank (ICNTL(35) 2, CNTL(7) {eps})",
         "check-dense": "uniform 36 x 37.2 m, 6 steps", "check-toeplitz": "uniform 36 x 37.2 m, 6 steps"}
@@ -46,7 +47,8 @@ PAIRS = [("uniform-72", "today", "uniform 72 m (toeplitz) vs today"),
          ("uniform-72", "uniform-36", "extent 72 m vs 36 m (edge reflections), uniform both"),
          ("uniform-72", "today-load15", "uniform 72 m vs graded 36 m, same load"),
          ("uniform-72-fast", "uniform-72", "multi-linear far lags, single transforms vs Chebyshev, double"),
-         ("uniform-72-blr", "uniform-72", "block low-rank LU ({eps}) vs full-rank LU of the step matrix")]
+         ("uniform-72-blr", "uniform-72", "block low-rank LU ({eps}) vs the run's default (1e-15) of the step matrix"),
+         ("uniform-72", "uniform-72-fullrank", "the step matrix's LU block low-rank at 1e-15 (auto) vs full rank")]
 
 
 def blr_eps(outdir):

@@ -59,7 +59,7 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx, single_from=single)
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
-    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
     with event("SSI_BEM_LagMats"):
         H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
@@ -151,7 +151,7 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc,
                                     single_from=int(cfg.lag_single_from),
                                     interp_lags=[plan.kernel_time(j)[0] for j in range(plan.k if plan.active else 0)])
-    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
     if not nt:
         G = [None] * plan.Lx
@@ -210,7 +210,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     r0, r1 = ls.node_range
     ls.assemble(monitor=cfg.monitor, lag_hi=2)
     nev = ls.kernel_evaluations
-    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log,
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))
     k = plan.k if plan.active else 0
     with event("SSI_BEM_LagMats"):

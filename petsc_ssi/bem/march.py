@@ -115,13 +115,30 @@ def step_matrix(comm, lagset, scheme, pres_node_mask):
     return M
 
 
+# -ssi_step_blr auto: MUMPS's block low-rank LU (ICNTL(35) 2, CNTL(7) BLR_EPS) for step matrices of at least
+# BLR_FROM DOFs, where its step solves are faster (jobscripts/building_uniform.sh, uniform-72 against
+# uniform-72-fullrank: runs/building/README.md); the factors are checked on a test right-hand side
+BLR_EPS = 1e-15
+BLR_FROM = 20000
+# the largest residual of the block low-rank factors on a test right-hand side: else the full-rank LU
+BLR_TOL = 1e-12
+
+
+def blr_precision(opt, n_dofs):
+    """The BLR precision of the step matrix's LU (0: full rank) for -ssi_step_blr ``opt`` (-1 auto:
+    ``BLR_EPS`` from ``BLR_FROM`` DOFs on, full rank below; 0 full rank; > 0 that precision)."""
+    if opt < 0:
+        return BLR_EPS if n_dofs >= BLR_FROM else 0.0
+    return float(opt)
+
+
 class Marcher:
     """Collective: steps the BEM in time. ``H``, ``G``: lists of Mats (lag 1..L)."""
 
-    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=(), A=None):
+    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=(), A=None, blr=0.0):
         """Collective: step matrix and its factorisation (from the lag-1 and
         lag-2 triplets of ``lagset``, or ``A`` as saved, ``bem.lagstore``); ``set_lags`` then
-        hands over the Mats."""
+        hands over the Mats. ``blr``: -ssi_step_blr (``blr_precision``)."""
         PETSc = init()
         self.PETSc = PETSc
         self.comm = comm
@@ -146,22 +163,15 @@ class Marcher:
         zd = zd[(zd >= r0) & (zd < r1)]
         self.A.zeroRowsColumns(zd.astype(PETSc.IntType), diag=1.0)
         self.zero_local = zd - r0
-        self.ksp = PETSc.KSP().create(comm=comm)
-        self.ksp.setOptionsPrefix("ssi_bem_")
         set_default_options("ssi_bem_", soil_solver_defaults(comm), log)
         check_reproducible_solver("ssi_bem_", comm, "the soil's step matrix")
-        self.ksp.setOperators(self.A)
-        self.ksp.setFromOptions()
-        self.ksp.setUp()
-        failed = mumps_failure(self.ksp)        # (INFOG is global: every rank raises)
-        if failed:
-            raise SSIError(f"the soil's step matrix ({self.A.getSize()[0]} DOFs): {failed}; more workspace with "
-                           "-ssi_bem_mat_mumps_icntl_14 <percent> (default 20), more memory with "
-                           "-ssi_bem_mat_mumps_icntl_23 <MB per rank>, or fewer DOFs")
+        eps = blr_precision(blr, self.A.getSize()[0])
+        eps = eps if self._factorise(eps) else 0.0
+        blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
         info = mumps_factor_info(self.ksp)
         if info:                # (one line, monitor or not: the factors' bytes bound each step's solve)
-            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs, {info}")
+            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs, {info}{blr_note}")
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)
@@ -169,6 +179,57 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
         self.toeplitz = []          # bem/toeplitz.ToeplitzHistory per side: the H (and G) lags >= 3 as FFT kernels
+
+    def _factorise(self, eps=0.0):
+        """Collective: the KSP of the step matrix, set up (factorised) with the ssi_bem_ options; with ``eps``
+        > 0 and a MUMPS LU whose ICNTL(35) the user did not set, in block low-rank form at precision eps (set on
+        the factor, not in the options database: the next run in the process starts from full rank). Returns
+        whether the factors are block low-rank."""
+        PETSc = self.PETSc
+        self.ksp = PETSc.KSP().create(comm=self.comm)
+        self.ksp.setOptionsPrefix("ssi_bem_")
+        self.ksp.setOperators(self.A)
+        self.ksp.setFromOptions()
+        pc = self.ksp.getPC()
+        blr = (eps > 0.0 and self.ksp.getType() == "preonly" and pc.getType() == "lu"
+               and pc.getFactorSolverType() == "mumps" and not PETSc.Options().hasName("ssi_bem_mat_mumps_icntl_35"))
+        if blr:
+            pc.setFactorSetUpSolverType()
+            F = pc.getFactorMatrix()
+            F.setMumpsIcntl(35, 2)
+            F.setMumpsCntl(7, eps)
+        self.ksp.setUp()
+        failed = mumps_failure(self.ksp)        # (INFOG is global: every rank raises)
+        if failed:
+            raise SSIError(f"the soil's step matrix ({self.A.getSize()[0]} DOFs): {failed}; more workspace with "
+                           "-ssi_bem_mat_mumps_icntl_14 <percent> (default 20), more memory with "
+                           "-ssi_bem_mat_mumps_icntl_23 <MB per rank>, or fewer DOFs")
+        return blr
+
+    def _check_blr(self, eps, blr):
+        """Collective: the block low-rank factors checked on a fixed test right-hand side (the same on any
+        rank count): ||A x - b|| / ||b|| at most ``BLR_TOL`` (or 100 eps for a precision the user chose),
+        else the full-rank LU instead, said in one line. Returns the log's note."""
+        b = self.A.createVecLeft()
+        r0, r1 = b.getOwnershipRange()
+        b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
+        if self.zero_local.size:
+            b.getArray()[self.zero_local] = 0.0
+        x, r = b.duplicate(), b.duplicate()
+        self.ksp.solve(b, x)
+        self.A.mult(x, r)
+        r.axpy(-1.0, b)
+        res = r.norm() / b.norm()
+        tol = BLR_TOL if blr < 0 else max(BLR_TOL, 100.0 * eps)
+        for v in (b, x, r):
+            v.destroy()
+        if not res <= tol:                       # (NaN too)
+            printf(f"[ssi] step matrix: the block low-rank LU at eps {eps:g} left a residual {res:.3g} > {tol:g} on "
+                "a test right-hand side; factorised in full rank instead (-ssi_step_blr)")
+            self.ksp.destroy()
+            self._factorise()
+            return ""
+        return f", block low-rank at eps {eps:g} (-ssi_step_blr; test residual {res:.2g})"
 
     def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =

@@ -55,6 +55,11 @@ register("history_block", "int", 0, "steps", "time-blocked history sum: the know
          "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
          "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes)", "bem",
          validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
+register("step_blr", "real", -1.0, "", "the step matrix's MUMPS LU in block low-rank form (ICNTL(35) 2) at this "
+         "precision CNTL(7): faster step solves on large grids, the factors checked on a test right-hand side "
+         "(residual <= 1e-12, else full rank, said in one line); 0: full rank; -1 (auto): 1e-15 from 20 000 DOFs on, "
+         "full rank below (bem/march.py)", "bem",
+         validator=lambda v: None if v == -1 or 0 <= v < 1e-3 else "must be -1 (auto), 0 (full rank) or in (0, 1e-3)")
 register("history_sub", "int", 0, "steps", "sub-blocks of the time-blocked history sum: at each sub-block's "
          "start the terms of the block's states known by then are formed as panel products too, so only lags up to "
          "about s + 2 stay in per-step products (s >= -ssi_history_block: one level; 0: automatic, with the block "

@@ -65,7 +65,9 @@ RUN_CONTROL = frozenset((
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
     "huge_pages", "disk_check", "debug",
     # how the interface columns are solved (region or full: equal to round-off, as the solvers' options)
-    "interface_columns", "interface_columns_margin"))
+    "interface_columns", "interface_columns_margin",
+    # the step matrix's LU in block low-rank form (its factors checked to 1e-12 on a test right-hand side)
+    "step_blr"))
 
 
 def _file_digest(path):
