@@ -23,8 +23,9 @@ linear combination of lag kernels the scheme's terms give (``Marcher._step_terms
 multi-linear or Chebyshev interpolation beyond T_L alike). Each state u^m is transformed once (27
 real FFTs: nine node slots, three components) and kept while a kernel reads it; per step the
 products sum over d in Fourier space and four classes x three components go back by inverse FFTs.
-Kernels and kept transforms are stored in frequency lanes (``lanes``: 64 frequencies side by side, real
-and imaginary parts apart) so that the products compile to vector instructions without copies.
+Kernels and kept transforms are stored in frequency lanes (``lanes``: 8 frequencies side by side, real
+and imaginary parts apart) so that the products compile to a register-blocked vector micro-kernel without
+copies.
 
 Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
 and of every kept state's transform: memory divided by the ranks); the kernels' integrals are split by
@@ -167,30 +168,28 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # 27 + 12 transforms and their inputs element by element, images included), t_pair_lag (seconds per H
 # kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
 # displacement kernel's integrals beside the traction kernel's) are fitted by `python
-# jobscripts/toeplitz_fit.py --products-rate 1.13e10` (r_products held at its earlier fit: free, the fit put
-# it at infinity, the products' and per-step counts being nearly collinear on these logs) to the logs of
-# `PARTS="paper grid" bash jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the
-# paper's quarter and whole models) and of the building on the uniform 36 m grid (`bash jobscripts/quiet.sh
-# env RUNS=... bash jobscripts/building_uniform.sh`), 2026-11-29 16:05-16:17, 2 ranks, every other process
-# paused: kernels within 23 % and history within 26 % of each of those 7 logs; held out, the building on the
-# uniform 72 m grid of the same hour: kernels -12 %, history +10 %. (The fit before, 04:41 on 7 logs of
-# that hour, put the 72 m building's history at +83 % in this hour: the machine's speed moves between
-# hours.) The kernels
-# are fitted per side (the log's H and G seconds; the fit before 2026-11-29 04:40 compared the H side's
-# seconds alone with the model's H + G, which put g_pair_factor at 1.6 and a 625-traction-node patch's
-# kernels at +55 %). r_sums, the real flops per second of the interpolated lags' weighted states
+# jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
+# their split is loose, their sum is what the logs fix) to the logs of `PARTS="paper grid" bash
+# jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
+# models; 2026-11-30 01:19-01:21) and of the building on the uniform 36 and 72 m grids (`bash jobscripts/quiet.sh
+# env RUNS=... bash jobscripts/building_uniform.sh`, 01:22-01:33), 2 ranks, every other process paused, with
+# the register-blocked lane products (cc22fec) and the compiled per-step helpers: history from -11 % to +25 %
+# (the 72 m building) of each of those 8 logs, kernels from -12 % to +13 % but -44 % on the 36 m building
+# (jobscripts/README.md). Fitted without the 72 m building, the model put its history at +30 %. The kernels are fitted per side (the log's H and G
+# seconds). r_sums, the real flops per second of the interpolated lags' weighted states
 # (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
 # weighted states over its rate of the exact products, times the idle r_products of the time; median of
 # 3.44, 6.67, 4.69 GFlop/s), is not refitted: it prices the multi-linear weights, anchor by anchor (small
 # products). r_sums_span prices Chebyshev's, every anchor over the common span of states (one larger product a
-# frequency, or two through the weights' rank, ``_low_rank``): the fit above on the uniform 36 m building's
-# log (the span's flops, as ``interp_work`` counts them, over the event SSI_BEM_HistInterp less its anchors'
-# kernel products; 10:51 the same day, before the low-rank products: 17.8 and 20.2 GFlop/s a rank). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
+# frequency, or two through the weights' rank, ``_low_rank``): the median over the logs that have it of the
+# span's flops, as ``interp_work`` counts them, over the event SSI_BEM_HistInterp less its anchors' modelled
+# kernel products (a model rate above dgemm's: the anchors' products are priced at r_products, slower than
+# they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 1.13e10, "t_step_dof": 0.0, "t_step_grid": 0.0, "t_step_elem": 5.83e-6,
-         "t_pair_lag": 2.83e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.984,
-         "r_sums_span": 4.19e10}
+RATES = {"r_products": 8.45e9, "t_step_dof": 4.07e-8, "t_step_grid": 6.69e-7, "t_step_elem": 1.19e-6,
+         "t_pair_lag": 3.08e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.957,
+         "r_sums_span": 6.17e10}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
