@@ -166,7 +166,11 @@ class Marcher:
         set_default_options("ssi_bem_", soil_solver_defaults(comm), log)
         check_reproducible_solver("ssi_bem_", comm, "the soil's step matrix")
         eps = blr_precision(blr, self.A.getSize()[0])
-        eps = eps if self._factorise(eps) else 0.0
+        if not self._factorise(eps):
+            if blr > 0:                 # (asked for, not possible: said, not silently full rank)
+                printf(f"[ssi] -ssi_step_blr {blr:g}: the step matrix is not factorised by MUMPS's LU here, or "
+                       "-ssi_bem_mat_mumps_icntl_35 is given: its own solver options decide")
+            eps = 0.0
         blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
         info = mumps_factor_info(self.ksp)

@@ -52,17 +52,14 @@ def plane_heights(VX, n_images=1):
 
 def near_pairs(xc, Vc, VR, L, mat, dt, n_images=1):
     """``pair_windows`` over the pairs that can reach a lag 1..L only: (point, element, lo, hi) of the pairs
-    whose union over the element's symmetry images has hi >= lo, found by a k-d tree within the P wave's
+    whose union over the element's symmetry images has hi >= lo, found by k-d trees within the P wave's
     L dt reach of the bounding spheres (a pair farther apart starts after lag L: lo > L). Equal to
     ``pair_windows``' valid pairs; O(points x elements near) instead of O(points x elements)."""
     from scipy.spatial import cKDTree
     E = len(Vc) // n_images
     r = float(np.max(VR)) + mat.cp * dt * L
-    lists = cKDTree(Vc).query_ball_point(xc, r)
-    cnt = np.fromiter((len(x) for x in lists), np.int64, len(lists))
-    pt = np.repeat(np.arange(len(xc)), cnt)
-    vc = np.fromiter((j for x in lists for j in x), np.int64, int(cnt.sum()))
-    d = np.linalg.norm(xc[pt] - Vc[vc], axis=1)
+    sd = cKDTree(xc).sparse_distance_matrix(cKDTree(Vc), r, output_type="ndarray")
+    pt, vc, d = sd["i"].astype(np.int64), sd["j"].astype(np.int64), sd["v"]
     lo = np.maximum(1, np.floor(np.maximum(d - VR[vc], 0) / (mat.cp * dt)) + 1)
     hi = np.minimum(L, np.floor((d + VR[vc]) / (mat.cs * dt)) + 2)
     v = hi >= lo
@@ -75,8 +72,10 @@ def near_pairs(xc, Vc, VR, L, mat, dt, n_images=1):
     return key[first] // E, key[first] % E, np.minimum.reduceat(lo, first), np.maximum.reduceat(hi, first)
 
 
-# near_pairs instead of the all-pairs windows when the reach's share of the surface's pairs is below this
+# near_pairs instead of the all-pairs windows when the reach's share of the surface's pairs is below this;
+# about NEAR_PAIRS point-element pairs a call
 NEAR_SHARE = 0.2
+NEAR_PAIRS = 2e6
 
 
 def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256, plane_z=None):
@@ -94,8 +93,10 @@ def estimate_blocks(xnodes, rows, Vc, VR, L, mat, dt, n_images=1, chunk=256, pla
     area = np.prod(np.ptp(Vc[:, :2], axis=0) + 2 * float(np.max(VR))) if len(Vc) else 0.0
     reach = float(np.max(VR)) + mat.cp * dt * L if len(Vc) else 0.0
     if len(Vc) and np.pi * reach ** 2 < NEAR_SHARE * area:
-        for s in range(0, len(rows), 16 * chunk):
-            pt, e, lo, hi = near_pairs(pts[s:s + 16 * chunk], Vc, VR, L, mat, dt, n_images)
+        # (points a call: about NEAR_PAIRS pairs, from the elements' mean density within the reach)
+        step = int(np.clip(NEAR_PAIRS / max(1.0, len(Vc) * np.pi * reach ** 2 / area), 64, 16 * chunk))
+        for s in range(0, len(rows), step):
+            pt, e, lo, hi = near_pairs(pts[s:s + step], Vc, VR, L, mat, dt, n_images)
             if plane_z is not None:
                 keep = pts[s + pt, 2] == plane_z[e]
                 lo, hi = lo[keep], hi[keep]

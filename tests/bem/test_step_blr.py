@@ -59,3 +59,11 @@ def test_step_blr_check_falls_back_to_full_rank(tmp_path, monkeypatch, capfd):
 def test_step_blr_option_refuses_bad_values(tmp_path):
     r = cli(BEM + ["-ssi_step_blr", "0.5", "-ssi_output", str(tmp_path / "x.h5")], check=False)
     assert r.returncode != 0 and "-ssi_step_blr" in (r.stdout + r.stderr) and "must be -1" in (r.stdout + r.stderr)
+
+
+def test_step_blr_asked_for_but_the_user_sets_mumps(tmp_path):
+    """-ssi_step_blr with the user's own -ssi_bem_mat_mumps_icntl_35: their options decide, said in one line."""
+    out = cli(BEM + ["-ssi_t_end", "0.01", "-ssi_step_blr", "1e-15", "-ssi_bem_mat_mumps_icntl_35", "0",
+                     "-ssi_output", str(tmp_path / "x.h5")]).stdout
+    assert "-ssi_step_blr 1e-15: the step matrix is not factorised by MUMPS's LU here, or" in out
+    assert "block low-rank at eps" not in out
