@@ -46,6 +46,9 @@ def _vector_tile():
 
 
 VL, MS, MO = _vector_tile()
+# lane groups of about 128 frequencies: the chunks of the interpolating matrices' weighted states and of the
+# kept transforms' moves (``toeplitz._room``)
+CHUNK_GROUPS = max(1, 128 // FW)
 
 
 def n_groups(n):
@@ -182,7 +185,7 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=None
         for j0, j1, a, e in spans:
             _check(V, r0 + a, e - a, c, "interp_lanes")
         _check_kernel(A, V, 0, k, c, out, b, o0, "interp_lanes")
-    gchunk = gchunk or max(1, 128 // FW)
+    gchunk = gchunk or CHUNK_GROUPS
     for g0 in range(0, G, gchunk):              # (128 frequencies at a time: the weighted states stay small)
         g1 = min(G, g0 + gchunk)
         for V, A, c, o0 in ((V9, A9, 9, 0), (V18, A18, 18, n9)):

@@ -49,7 +49,7 @@ from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
 from .lanes import (FW, n_groups, padded, to_lanes, history_lanes, interp_lanes, interp_flops,
-                    scatter_slots, put_state, take_step, unpack_sums)
+                    scatter_slots, put_state, take_step, unpack_sums, CHUNK_GROUPS)
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -589,7 +589,7 @@ class ToeplitzHistory:
         of them; the slab is a run of the flattened spectrum), the slab put into lanes (``lanes.put_state``)."""
         from scipy.fft import rfft2
         lat = self.lat
-        U = np.concatenate([u_all.reshape(-1, 3), np.zeros((1, 3))])
+        U = u_all.reshape(-1, 3)                           # (a slot without a column, -1: 0 in scatter_slots)
         if getattr(self, "_grid", None) is None:            # (only the slots' cells are written: zeros stay)
             self._grid = np.zeros((9, 3, lat.Mx, lat.My))
         ix, iy = self.vpos
@@ -618,7 +618,7 @@ class ToeplitzHistory:
             # not overlap their source: numpy copies an overlapping source whole before the move (35 MB a rank
             # for V18 on the paper's quarter case when it was one copy; half the time of a chunk's overlapping
             # copy)
-            step = max(1, 128 // FW)
+            step = CHUNK_GROUPS
             for f0 in range(0, B.shape[0], step):
                 blk = B[f0:f0 + step]
                 for j in range(0, k if s else 0, s or 1):
