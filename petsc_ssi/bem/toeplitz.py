@@ -381,11 +381,12 @@ class ToeplitzHistory:
 
     # ---------------------------------------------------------------- kernels
     def _integrate(self, lag_lo, c_lo, c_hi, toff, L, sel):
-        """The element integrals of the offsets ``sel`` (indices into kernel_offsets) for lags
-        c_lo..c_hi at kernel time l dt + toff, with the windows, subdivisions and singular treatment
-        of the dense assembly of lags lag_lo..L (``_pair_window``); a singular pair (its point a node
-        of the element) from lag_lo on, as that assembly integrates it. Returns (offsets kept, meta,
-        pool offsets, pool): the H integrals' (P) pool on the u side, the G integrals' (U) on the p side."""
+        """The element integrals at the mirror offsets ``sel`` (indices into ``self.mirror``: offsets in
+        half element sizes, both >= 0, ``mirror_offsets``) for lags c_lo..c_hi at kernel time l dt + toff,
+        with the windows, subdivisions and singular treatment of the dense assembly of lags lag_lo..L
+        (``_pair_window``); a singular pair (its point a node of the element) from lag_lo on, as that
+        assembly integrates it. Returns (mirror offsets kept, meta, pool offsets, pool): the H integrals' (P)
+        pool on the u side, the G integrals' (U) on the p side."""
         from .assemble import integrate_records, SING_TOL, plane
         ls, lat = self.ls, self.lat
         o = ls.opts
@@ -397,7 +398,7 @@ class ToeplitzHistory:
         mat, dt = ls.mat, ls.dt
         reach = mat.cp * (dt * L + toff)
         pts = np.zeros((len(sel), 3))
-        off = self.offsets[sel]
+        off = self.mirror[sel]
         pts[:, 0] = c0[0] + off[:, 0] * 0.5 * lat.h[0]
         pts[:, 1] = c0[1] + off[:, 1] * 0.5 * lat.h[1]
         pts[:, 2] = c0[2]
@@ -428,8 +429,8 @@ class ToeplitzHistory:
         m = self.spec["m"]
         mpi = self.comm.tompi4py()
         p, r = mpi.Get_size(), mpi.Get_rank()
-        n_off = len(self.offsets)
-        sel = np.arange(r, n_off, p)
+        sel = np.arange(r, len(self.mirror), p)          # (each mirror offset integrated by one rank)
+        mine = np.full(len(self.mirror), -1, np.int64)
         per_lag = 4 * 9 * m * lat.Mx * lat.My * 8
         # (the same chunk on every rank: each chunk is one Reduce_scatter, and the ranks' slabs may differ by a
         # frequency, so their own kernels' bytes may not give the same chunk)
@@ -442,8 +443,11 @@ class ToeplitzHistory:
         for c_lo in range(lag_lo, lag_hi + 1, chunk):
             c_hi = min(lag_hi, c_lo + chunk - 1)
             idx, meta, offP, P = self._integrate(lag_lo, c_lo, c_hi, toff, L, sel)
+            mine[:] = -1
+            mine[idx] = np.arange(len(idx))
             Kp = np.zeros((c_hi - c_lo + 1, 4, 9, m, lat.Mx, lat.My))
-            _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, lat.code0)
+            _scatter_kernels(Kp, c_lo, mine[self.mirror_of], self.flip, meta, offP, P, t, kx, ky, lat.code0,
+                             MIRROR_SLOTS, self.mirror_signs)
             S = self._reduce_transform(Kp)
             Kp = None
             for i in range(c_hi - c_lo + 1):
@@ -504,6 +508,9 @@ class ToeplitzHistory:
         t0 = time.perf_counter()
         self.offsets = kernel_offsets(self.lat)
         self.lat.n_offsets = len(self.offsets)
+        self.mirror, self.mirror_of, self.flip = mirror_offsets(self.offsets)
+        hp, hq, gp, gq = self.ls.pattern()[:4]
+        self.mirror_signs = mirror_signs(*((hp, hq) if self.side == "u" else (gp, gq)))
         self.nev = 0
         by_key = self._terms(march)
         D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
@@ -868,19 +875,58 @@ def history_products(K9, K18, V9, V18, p0, b, D, fchunk=None):
     return out
 
 
+def mirror_offsets(offsets):
+    """The element's mirror symmetry (``_scatter_kernels``): (mirror (n_m, 2) the distinct offsets |o| in
+    half element sizes, mirror_of (n,) each offset's row of it, flip (n,) 1 where o_x < 0 plus 2 where
+    o_y < 0) of ``kernel_offsets``' rows."""
+    o = np.asarray(offsets)[:, :2]
+    mirror, mirror_of = np.unique(np.abs(o), axis=0, return_inverse=True)
+    flip = (o[:, 0] < 0).astype(np.int64) + 2 * (o[:, 1] < 0).astype(np.int64)
+    return mirror.astype(np.int64), np.asarray(mirror_of, np.int64).ravel(), flip
+
+
+# the slot (SLOTS) of each slot mirrored: flip 0 none, 1 x -> -x, 2 y -> -y, 3 both
+MIRROR_SLOTS = np.array([[SLOTS.index((sx * dx, sy * dy)) for dx, dy in SLOTS]
+                         for sx, sy in ((1, 1), (-1, 1), (1, -1), (-1, -1))], np.int64)
+
+
+def mirror_signs(p, q):
+    """(4, m): the sign of each pattern entry (p[e], q[e]) of a 3 x 3 block under the mirrors of
+    MIRROR_SLOTS: a reflection x -> -x turns a tensor's entry by -1 per x index (s_p s_q), y likewise; the
+    surface's normal (z) stays."""
+    p, q = np.asarray(p), np.asarray(q)
+    out = np.ones((4, len(p)))
+    for f, (fx, fy) in enumerate(((0, 0), (1, 0), (0, 1), (1, 1))):
+        s = np.array([-1.0 if fx else 1.0, -1.0 if fy else 1.0, 1.0])
+        out[f] = s[p] * s[q]
+    return out
+
+
 @njit(cache=True)
-def _scatter_kernels(Kp, c_lo, idx, meta, offP, P, t, kx, ky, code0):
-    """Kp[l - c_lo, t, code0[a], e, kx, ky] = the integrals of lag l of offset idx[r] (pool layout of
+def _scatter_kernels(Kp, c_lo, rec, flip, meta, offP, P, t, kx, ky, code0, mslot, msign):
+    """Kp[l - c_lo, t[o], mslot[flip[o], code0[a]], e, kx[o], ky[o]] = msign[flip[o], e] x the integrals of
+    lag l of offset o's mirror offset |o|, record rec[o] (-1: integrated by another rank; pool layout of
     ``assemble._compact``: lag slot, local node a of the reference element, entry e of m = Kp.shape[3]),
-    for lags of the chunk (slot code0[a]: the node's position)."""
+    for the lags of the chunk (slot code0[a]: the node's position).
+
+    The element is symmetric about its centre lines and the surface is flat: with the reflection
+    x -> -x, the integral of the node at slot a at the offset o is the mirrored node's at the mirrored
+    offset, each entry (p, q) times s_p s_q (-1 per x index): K_a(Rx o) = S_x K_{Rx a}(o), and likewise in
+    y. The Gauss points, the subdivisions and the lags' windows are symmetric too, so one integral at |o|
+    serves the four offsets (+-o_x, +-o_y): a quarter of the integrals, each the same to round-off
+    (tests/bem/test_toeplitz_mirror.py)."""
     nl_c = Kp.shape[0]
     m = Kp.shape[3]
-    for r in range(idx.shape[0]):
-        o = idx[r]
+    for o in range(rec.shape[0]):
+        r = rec[o]
+        if r < 0:
+            continue
+        f = flip[o]
         lo, hi = meta[r, 0], meta[r, 1]
         base = offP[r]
         for l in range(max(lo, c_lo), min(hi, c_lo + nl_c - 1) + 1):
             s = base + (l - lo) * 9 * m
             for a in range(9):
+                sl = mslot[f, code0[a]]
                 for e in range(m):
-                    Kp[l - c_lo, t[o], code0[a], e, kx[o], ky[o]] = P[s + m * a + e]
+                    Kp[l - c_lo, t[o], sl, e, kx[o], ky[o]] = msign[f, e] * P[s + m * a + e]
