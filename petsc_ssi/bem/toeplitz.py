@@ -15,7 +15,8 @@ of four classes, each a 3x3 block with the flat surface's H pattern (4 entries, 
 stored as the 2-D real FFTs of its kernels on a zero-padded grid Mx x My >= 2 nx x 2 ny (so the
 circular convolution is the linear one on the lattice), O(N) numbers instead of O(N^2). The kernels
 are the same integrals the dense path computes (``assemble.integrate_records`` on one element of the
-grid at every offset), so the answer is the dense path's to round-off.
+grid at every offset; by the element's mirror symmetry one integral at |o| serves the four offsets
+(+-o_x, +-o_y), ``_scatter_kernels``), so the answer is the dense path's to round-off.
 
 The history sum of the marching scheme (``march``) over the exact lags 2..Lx and the interpolating
 matrices is one stationary convolution in time, sum_d K'_d u^{n-d}, whose kernel K'_d (d = 1..D) is the
@@ -171,11 +172,11 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
 # their split is loose, their sum is what the logs fix) to the logs of `PARTS="paper grid" bash
 # jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
-# models; 2026-11-30 01:19-01:21) and of the building on the uniform 36 and 72 m grids (`bash jobscripts/quiet.sh
-# env RUNS=... bash jobscripts/building_uniform.sh`, 01:22-01:33), 2 ranks, every other process paused, with
-# the register-blocked lane products (cc22fec) and the compiled per-step helpers: history from -11 % to +25 %
-# (the 72 m building) of each of those 8 logs, kernels from -12 % to +13 % but -44 % on the 36 m building
-# (jobscripts/README.md). Fitted without the 72 m building, the model put its history at +30 %. The kernels are fitted per side (the log's H and G
+# models) and of the building on the uniform 36 and 72 m grids (`bash jobscripts/quiet.sh env RUNS=... bash
+# jobscripts/building_uniform.sh`, and a second uniform-72 run of OUT=/tmp/pair1), 2 ranks, every other process
+# paused, 2026-11-30 05:00-05:30, with the kernels integrated at the mirror offsets only (e2101d8): history
+# from -17 % to +23 % of each of those 9 logs, kernels from -22 % (the 36 m building) to +13 %
+# (t_step_grid fitted to 0: collinear with the other per-step terms). The kernels are fitted per side (the log's H and G
 # seconds). r_sums, the real flops per second of the interpolated lags' weighted states
 # (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
 # weighted states over its rate of the exact products, times the idle r_products of the time; median of
@@ -187,9 +188,9 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 8.45e9, "t_step_dof": 4.07e-8, "t_step_grid": 6.69e-7, "t_step_elem": 1.19e-6,
-         "t_pair_lag": 3.08e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.957,
-         "r_sums_span": 6.17e10}
+RATES = {"r_products": 8.05e9, "t_step_dof": 3.96e-8, "t_step_grid": 0.0, "t_step_elem": 2.64e-6,
+         "t_pair_lag": 2.58e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.916,
+         "r_sums_span": 5.3e10}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
