@@ -174,7 +174,7 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
 # models) and of the building on the uniform 36 and 72 m grids (`bash jobscripts/quiet.sh env RUNS=... bash
 # jobscripts/building_uniform.sh`, and a second uniform-72 run of OUT=/tmp/pair1), 2 ranks, every other process
-# paused, 2026-11-30 05:00-05:30, with the kernels integrated at the mirror offsets only (e2101d8): history
+# paused, 2026-11-30 03:38-03:52, with the kernels integrated at the mirror offsets only (e2101d8): history
 # from -17 % to +23 % of each of those 9 logs, kernels from -22 % (the 36 m building) to +13 %
 # (t_step_grid fitted to 0: collinear with the other per-step terms). The kernels are fitted per side (the log's H and G
 # seconds). r_sums, the real flops per second of the interpolated lags' weighted states
