@@ -245,7 +245,7 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
     elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
     each exact lag (D: L, or the ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept
-    transforms 27 per frequency and kept state (L + 3 b + 8; float32 pairs with ``single``), each rank's slab
+    transforms 27 per frequency and kept state (``kept_rows``; float32 pairs with ``single``), each rank's slab
     in whole lane groups (``lanes.padded``: the products run over the padding too); the build's
     transients per rank (a chunk of kernels, its spectra, its integrals: the larger side's), ``g_bytes``
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
@@ -258,7 +258,7 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     active = plan is not None and plan.active
     D = int(plan.Lx) if active else int(L)
     k = int(plan.k) if active else 0
-    W = int(L) + 3 * block + 8
+    W = kept_rows(int(L), block)
     # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
     # rank's copies of the states lags 1-2's panel products read (``_replicate``, ``rep_depth``: 2 + 3 + 32):
     # 8 bytes a DOF and state
@@ -292,6 +292,15 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
               + n_steps * (n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]))
     return nbytes + build, t_build, t_hist
+
+
+def kept_rows(R, b):
+    """Rows of the kept transforms' buffers (``ToeplitzHistory._room``) for a history of reach R and blocks of b
+    steps: the R states a block reads back, its own b, and a slack that sets how often the kept ones move to the
+    start (R rows copied each time): every 2 b + 9 + E steps with 3 b + 8 + E rows beyond R, E = min(R / 2, 8 b)
+    (the 72 m building: R = 207, E = 64, every 89 steps instead of every 25 with E = 0, for 64 more rows of both
+    sides' transforms, 0.29 GB over the ranks)."""
+    return int(R) + 3 * int(b) + 8 + min(int(R) // 2, 8 * int(b))
 
 
 def kernel_offsets(lat):
@@ -552,7 +561,7 @@ class ToeplitzHistory:
         # x and y (groups, W, 18, 2, FW); a step's window of D states is a run of rows of each group (a row
         # offset for ``lanes.lane_products``, no copy); states before the first are zeros, as are those not
         # yet made
-        self.W = self.R + 3 * self.block + 8
+        self.W = kept_rows(self.R, self.block)
         self.V9 = np.zeros((G, self.W, 9, 2, FW), self.vdtype)
         self.V18 = np.zeros((G, self.W, 18, 2, FW), self.vdtype)
         self.base = -self.R

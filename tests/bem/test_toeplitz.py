@@ -207,8 +207,10 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     bg, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat)
     assert abs((bg - b) / 1e9 - g_stored) <= 0.01 * g_stored + 5e-6, (bg - b, g_stored)
     bs, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat, single=True)
-    from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups of 64: 40 and 24 -> 64)
-    assert bs < bg and abs((bg - bs) - 8.0 * 27 * (24 + 3 * 8 + 8) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
+    from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups)
+    from petsc_ssi.bem.toeplitz import kept_rows
+    assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 8 b) more)
+    assert bs < bg and abs((bg - bs) - 8.0 * 27 * kept_rows(24, 8) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
 
 
 @pytest.mark.parametrize("widths,dtype", [((8, 4), np.complex128), ((4, 8), np.complex128), ((4, 8), np.complex64)])
