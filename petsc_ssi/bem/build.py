@@ -250,7 +250,9 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            + f" ({th.bytes / 1e9:.3g} GB with the kept states' transforms; kernels "
            f"{sum(t.t_build for t in march.toeplitz):.3g} s){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations; kept transforms in "
-           f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)")
+           f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)"
+           + "".join(f"; {t.spec['what']} kernels real (point-symmetric offsets: half the products)"
+                     for t in march.toeplitz if t.real))
     printf(f"[ssi] history sum: in Fourier space, time-blocked, {th.block} steps per block (-ssi_history_block)")
     return march, {"t_asm": t_asm, "mem_exact": mem, "mem_interp": 0.0, "ndense": 0, "nbaij": 0, "nsingle": 0,
                    "fill": float("nan"), "mem": mem}

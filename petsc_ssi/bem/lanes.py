@@ -77,6 +77,12 @@ def to_lanes(X, dtype=np.float64):
     return Y
 
 
+def to_lanes_real(X):
+    """(slab, *rest) real -> (groups, *rest, 1, FW) float64: ``to_lanes`` of a real array, its one part (the
+    real kernels of ``lane_products``)."""
+    return np.ascontiguousarray(to_lanes(np.asarray(X, np.float64))[..., :1, :])
+
+
 def from_lanes(Y, slab):
     """(groups, *rest, 2, FW) real -> (slab, *rest) complex128 (``to_lanes``'s inverse)."""
     Z = Y[..., 0, :] + 1j * Y[..., 1, :]                     # (G, *rest, FW)
@@ -87,17 +93,28 @@ def from_lanes(Y, slab):
 @njit(cache=True, boundscheck=False)
 def lane_products(K, j0, X, p0, ss, b, D, out, o0):
     """out[g, s, o0 + o] += sum_{r < D, a < c} X[g, p0 + s ss + r, a] K[g, j0 + r c + a, o] for the b steps
-    s, complex per lane (K (G, J, no, 2, FW), X (G, rows, c, 2, FW) float64 or float32, out (G, b', n_out,
-    2, FW) float64, all C-contiguous): a window of rows of X times a run of D x c rows of K, per lane. The
-    exact lags: X the kept states, row p0 + s + r (ss = 1); the interpolating matrices: X the weighted states
-    of the b steps, row s k + r (ss = k, D = k). Rows r and a of X are consecutive in memory as rows r c + a
-    of K are, so the sum runs over one index i = r c + a: per group and vector of VL lanes, tiles of MS steps
-    x MO outputs held in registers over the D c terms (``simd.cmac_tile``), the edges in smaller tiles."""
+    s, complex per lane (K (G, J, no, 2, FW) complex or (G, J, no, 1, FW) real, X (G, rows, c, 2, FW) float64
+    or float32, out (G, b', n_out, 2, FW) float64, all C-contiguous): a window of rows of X times a run of D x c
+    rows of K, per lane. The exact lags: X the kept states, row p0 + s + r (ss = 1); the interpolating
+    matrices: X the weighted states of the b steps, row s k + r (ss = k, D = k). Rows r and a of X are
+    consecutive in memory as rows r c + a of K are, so the sum runs over one index i = r c + a: per group and
+    vector of VL lanes, tiles of MS steps x MO outputs held in registers over the D c terms
+    (``simd.cmac_tile``), the edges in smaller tiles. A real K (``toeplitz``'s kernels of a point-symmetric
+    grid) takes half the multiply-adds and half the bytes."""
+    if K.shape[3] == 1:
+        _lane_products(K, j0, X, p0, ss, b, D, out, o0, 1)
+    else:
+        _lane_products(K, j0, X, p0, ss, b, D, out, o0, 2)
+
+
+@njit(cache=True, boundscheck=False)
+def _lane_products(K, j0, X, p0, ss, b, D, out, o0, kp):
     G, J, no, _, fw = K.shape
     c = X.shape[2]
     n = D * c
     T2 = 2 * fw
-    KJ, XR, OS = no * T2, c * T2, out.shape[2] * T2
+    KC = kp * fw                    # (a kernel column: both parts, or the one of a real kernel)
+    KJ, XR, OS = no * KC, c * T2, out.shape[2] * T2
     Kg, Xg, Og = J * KJ, X.shape[1] * XR, out.shape[1] * OS
     for g in range(G):
         for v in range(0, fw, VL):
@@ -108,25 +125,34 @@ def lane_products(K, j0, X, p0, ss, b, D, out, o0):
             while s + MS <= b:
                 o = 0
                 while o + MO <= no:
-                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
-                              fw, MS, MO, VL)
+                    _tile(K, kb + o * KC, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n, fw,
+                          MS, MO, kp)
                     o += MO
                 while o < no:
-                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
-                              fw, MS, 1, VL)
+                    _tile(K, kb + o * KC, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n, fw,
+                          MS, 1, kp)
                     o += 1
                 s += MS
             while s < b:
                 o = 0
                 while o + MO <= no:
-                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
-                              fw, 1, MO, VL)
+                    _tile(K, kb + o * KC, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n, fw,
+                          1, MO, kp)
                     o += MO
                 while o < no:
-                    cmac_tile(K, kb + o * T2, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n,
-                              fw, 1, 1, VL)
+                    _tile(K, kb + o * KC, KJ, X, xb + s * ss * XR, ss * XR, out, ob + s * OS + o * T2, OS, n, fw,
+                          1, 1, kp)
                     o += 1
                 s += 1
+
+
+@njit(inline="always")
+def _tile(K, kb, KJ, X, xb, XS, out, ob, OS, n, fw, ms, mo, kp):
+    """``simd.cmac_tile`` with the literal kernel parts kp (1 real, 2 complex) the intrinsic takes."""
+    if kp == 1:
+        cmac_tile(K, kb, KJ, X, xb, XS, out, ob, OS, n, fw, ms, mo, VL, 1)
+    else:
+        cmac_tile(K, kb, KJ, X, xb, XS, out, ob, OS, n, fw, ms, mo, VL, 2)
 
 
 def _check(V, p0, rows, c, what):
@@ -140,9 +166,10 @@ def _check(V, p0, rows, c, what):
 def _check_kernel(K, V, r0, D, c, out, b, o0, what):
     """The kernel's rows (r0 + D row blocks of c), the output's shape and the groups of the three agree (the
     compiled loop does not check its indices)."""
-    if K.ndim != 5 or K.shape[3:] != (2, FW) or not K.flags.c_contiguous or K.shape[0] != V.shape[0]:
-        raise ValueError(f"{what}: kernels of shape {K.shape}, not (groups {V.shape[0]}, rows, columns, 2, {FW}) "
-                         "C-contiguous lanes")
+    if K.ndim != 5 or K.shape[3] not in (1, 2) or K.shape[4] != FW or not K.flags.c_contiguous \
+            or K.shape[0] != V.shape[0]:
+        raise ValueError(f"{what}: kernels of shape {K.shape}, not (groups {V.shape[0]}, rows, columns, 2 or 1, "
+                         f"{FW}) C-contiguous lanes")
     if r0 < 0 or c * (r0 + D) > K.shape[1]:
         raise ValueError(f"{what}: kernel row blocks {r0}..{r0 + D - 1} of {K.shape[1] // c}")
     if (out.ndim != 5 or out.dtype != np.float64 or out.shape[0] != K.shape[0] or out.shape[1] < b
@@ -202,15 +229,16 @@ def interp_lanes(A9, A18, V9, V18, C, r0, low_rank, spans, log=None, gchunk=None
                     S[:, :, j0:j1] = w.reshape(g1 - g0, b, j1 - j0, c * 2 * FW)
             lane_products(A[g0:g1], 0, S.reshape(g1 - g0, b * k, c, 2, FW), 0, k, b, k, out[g0:g1], o0)
     if log is not None:                         # (flops over the rank's frequencies ``slab``, not the padding)
-        log.logFlops(interp_flops(G * FW if slab is None else slab, b, k, n9, n18, facs))
+        log.logFlops(interp_flops(G * FW if slab is None else slab, b, k, n9, n18, facs, A9.shape[3]))
     return out
 
 
-def interp_flops(slab, b, k, n9, n18, facs):
+def interp_flops(slab, b, k, n9, n18, facs, kp=2):
     """Flops of the interpolated lags' products over ``slab`` frequencies (``interp_lanes`` and its
     reference ``toeplitz.interp_products``): the anchors' complex products and the weighted states' real
-    ones (``facs``: each span's (C, U s, W) of ``toeplitz._low_rank``)."""
-    return slab * (8.0 * b * k * 9 * (n9 + 2 * n18)
+    ones (``facs``: each span's (C, U s, W) of ``toeplitz._low_rank``); kp 1: real anchors' kernels (4 flops
+    an entry's product, not 8)."""
+    return slab * (4.0 * kp * b * k * 9 * (n9 + 2 * n18)
                    + 2.0 * 54 * sum(Cj.size if W is None else W.shape[0] * (Cj.shape[0] + Cj.shape[1])
                                     for Cj, US, W in facs))
 

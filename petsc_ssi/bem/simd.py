@@ -182,21 +182,24 @@ def _lit(x, lo, hi):
 
 
 @intrinsic
-def cmac_tile(typingctx, K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl):
+def cmac_tile(typingctx, K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl, kp):
     """A register tile of complex multiply-adds in frequency lanes (``lanes.lane_products``' micro-kernel):
     for the ms x mo outputs (s, o) and the vl lanes q0..q0+vl-1,
-        out[ob + s OS + o 2T + t T + q] += sum_{i < n} X[xb + s XS + i 2T + .] K[kb + i KJ + o 2T + .]
+        out[ob + s OS + o 2T + t T + q] += sum_{i < n} X[xb + s XS + i 2T + .] K[kb + i KJ + o kp T + .]
     complex (t = 0 the real part, t = 1 the imaginary part, T elements apart), the ms mo complex sums kept
     in vector registers over the n terms (4 fused multiply-adds a term and output, in the order i, as the
-    scalar loop with contraction sums them). K and out are C-contiguous float64 arrays, X float64 or
-    float32 (widened exactly); offsets are flat element indices, not checked. ms, mo, vl literal ints."""
+    scalar loop with contraction sums them). kp = 2: K complex (its parts T apart); kp = 1: K real (one part a
+    column: 2 fused multiply-adds a term, the real and the imaginary part of X times it). K and out are
+    C-contiguous float64 arrays, X float64 or float32 (widened exactly); offsets are flat element indices,
+    not checked. ms, mo, vl, kp literal ints."""
     if not (_lit(ms, 1, 8) and _lit(mo, 1, 8) and vl in (types.IntegerLiteral(4), types.IntegerLiteral(8))
+            and _lit(kp, 1, 2)
             and all(isinstance(a, types.Array) and a.layout == "C" for a in (K, X, out))
             and K.dtype == types.float64 and out.dtype == types.float64 and X.dtype in (types.float64, types.float32)
             and all(isinstance(a, types.Integer) for a in (kb, KJ, xb, XS, ob, OS, n, T))):
         return None
-    MS, MO, VL = ms.literal_value, mo.literal_value, vl.literal_value
-    sig = types.void(K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl)
+    MS, MO, VL, KP = ms.literal_value, mo.literal_value, vl.literal_value, kp.literal_value
+    sig = types.void(K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl, kp)
 
     def codegen(context, builder, signature, args):
         st = signature.args
@@ -224,8 +227,8 @@ def cmac_tile(typingctx, K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl):
             xo = builder.add(xb_, builder.mul(i, T2))
             kv = []
             for o in range(MO):
-                base = builder.add(ko, builder.mul(ir.Constant(i64, o), T2))
-                kv.append((vload(Kd, base, vd), vload(Kd, builder.add(base, T_), vd)))
+                base = builder.add(ko, builder.mul(ir.Constant(i64, o), T2 if KP == 2 else T_))
+                kv.append((vload(Kd, base, vd), vload(Kd, builder.add(base, T_), vd) if KP == 2 else None))
             for s in range(MS):
                 base = builder.add(xo, builder.mul(ir.Constant(i64, s), XS_))
                 xr, xi = vload(Xd, base, vx), vload(Xd, builder.add(base, T_), vx)
@@ -235,8 +238,12 @@ def cmac_tile(typingctx, K, kb, KJ, X, xb, XS, out, ob, OS, n, T, ms, mo, vl):
                 for o in range(MO):
                     kr, ki = kv[o]
                     pr, pi = accs[s][o]
-                    ar = builder.call(fma, [nxi, ki, builder.call(fma, [xr, kr, builder.load(pr)])])
-                    ai = builder.call(fma, [xi, kr, builder.call(fma, [xr, ki, builder.load(pi)])])
+                    if KP == 1:             # (a real kernel: its product with X's two parts)
+                        ar = builder.call(fma, [xr, kr, builder.load(pr)])
+                        ai = builder.call(fma, [xi, kr, builder.load(pi)])
+                    else:
+                        ar = builder.call(fma, [nxi, ki, builder.call(fma, [xr, kr, builder.load(pr)])])
+                        ai = builder.call(fma, [xi, kr, builder.call(fma, [xr, ki, builder.load(pi)])])
                     builder.store(ar, pr)
                     builder.store(ai, pi)
         for s in range(MS):

@@ -49,7 +49,7 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
-from .lanes import (FW, n_groups, padded, to_lanes, history_lanes, interp_lanes, interp_flops,
+from .lanes import (FW, n_groups, padded, to_lanes, to_lanes_real, history_lanes, interp_lanes, interp_flops,
                     scatter_slots, put_state, take_step, unpack_sums, CHUNK_GROUPS)
 
 # the nine node positions of an element relative to its centre, in half element sizes
@@ -275,12 +275,13 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         F = g.F
         Fl = padded(F, ranks)               # (each rank's slab in whole lane groups)
         per_lag = m * g.Mx * g.My * 8.0
-        kern = 16.0 * Fl * m * (D + k)
+        kp = 1.0 if is_point_symmetric(g) else 2.0          # (real kernels: half the bytes and the flops)
+        kern = 8.0 * kp * Fl * m * (D + k)
         build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
         nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
         t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
-        flops += 8.0 * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
+        flops += 4.0 * kp * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
     # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
@@ -292,6 +293,40 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
     t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
               + n_steps * (n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]))
     return nbytes + build, t_build, t_hist
+
+
+# the largest part of a point-symmetric grid's rotated kernels that the symmetry makes zero, over their largest
+# entry (round-off of the transforms; checked after the build, ``ToeplitzHistory._lanes``)
+REAL_TOL = 1e-11
+
+
+def point_sign(offsets, msigns):
+    """The sign s of the kernels under the point reflection o -> -o (``mirror_signs``' flip 3, the same for every
+    pattern entry: -1 for H's, +1 for G's) when the offsets (``kernel_offsets``) are the same set reflected, else
+    0: a whole grid's H side (every node reads every element) is; a symmetric model's quarter of nodes, or a
+    traction window off the grid's centre, is not."""
+    o = np.asarray(offsets)[:, :2]
+    s = np.unique(np.asarray(msigns)[3])
+    if s.size != 1 or not len(o):
+        return 0
+    a = np.unique(o, axis=0)
+    b = np.unique(-o, axis=0)
+    return int(s[0]) if a.shape == b.shape and np.array_equal(a, b) else 0
+
+
+def is_point_symmetric(lat):
+    """Whether a side's grid (``Lattice``, or the traction window's) has point-symmetric kernel offsets, so that
+    its kernels are real (``point_sign``; H's sign, with the flat pattern's every entry alike); kept on the
+    lattice (``point_symmetric``) once known."""
+    got = getattr(lat, "point_symmetric", None)
+    if got is None:
+        o = kernel_offsets(lat)
+        got = bool(len(o)) and np.array_equal(np.unique(o[:, :2], axis=0), np.unique(-o[:, :2], axis=0))
+        try:
+            lat.point_symmetric = got
+        except AttributeError:
+            pass
+    return got
 
 
 def kept_rows(R, b):
@@ -521,6 +556,12 @@ class ToeplitzHistory:
         self.mirror, self.mirror_of, self.flip = mirror_offsets(self.offsets)
         hp, hq, gp, gq = self.ls.pattern()[:4]
         self.mirror_signs = mirror_signs(*((hp, hq) if self.side == "u" else (gp, gq)))
+        # the kernels real where the offsets are point-symmetric (``point_sign``): per slot pair (a, 8 - a) the
+        # real parts of the rotated sum and difference spectra, the states as their sums and differences
+        self.sg = point_sign(self.offsets, self.mirror_signs)
+        self.real = self.sg != 0
+        self.rot_k = self._rotation(+1) if self.real else None
+        self.dropped = self.kept = 0.0
         self.nev = 0
         by_key = self._terms(march)
         D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
@@ -536,16 +577,17 @@ class ToeplitzHistory:
         # the anchors' A9, A18 the same with rows (anchor j, slot, input component)
         # (in frequency lanes, ``lanes.to_lanes``: (groups, rows, columns, 2, FW) real)
         G = n_groups(slab)
-        self.K9 = np.zeros((G, D * 9, n9, 2, FW))
-        self.K18 = np.zeros((G, D * 18, n18, 2, FW))
-        self.A9 = np.zeros((G, self.k * 9, n9, 2, FW))
-        self.A18 = np.zeros((G, self.k * 18, n18, 2, FW))
+        kp = 1 if self.real else 2                  # (a real kernel: one part a column)
+        self.K9 = np.zeros((G, D * 9, n9, kp, FW))
+        self.K18 = np.zeros((G, D * 18, n18, kp, FW))
+        self.A9 = np.zeros((G, self.k * 9, n9, kp, FW))
+        self.A18 = np.zeros((G, self.k * 18, n18, kp, FW))
         exact = sorted(j for kind, j in by_key if kind == "x")
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 terms = by_key.get(("x", lag), ())
                 if terms:
-                    L9, L18 = (to_lanes(B) for B in _kernel_blocks(S))
+                    L9, L18 = self._lanes(S)
                     for d, c in terms:
                         self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
                         self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
@@ -554,7 +596,7 @@ class ToeplitzHistory:
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
-                L9, L18 = (to_lanes(B) for B in _kernel_blocks(S))
+                L9, L18 = self._lanes(S)
                 self.A9[:, 9 * i:9 * (i + 1)] += L9
                 self.A18[:, 18 * i:18 * (i + 1)] += L18
         # the kept states' transforms, in time order (state m at m - base), in lanes: z (groups, W, 9, 2, FW),
@@ -566,6 +608,15 @@ class ToeplitzHistory:
         self.V18 = np.zeros((G, self.W, 18, 2, FW), self.vdtype)
         self.base = -self.R
         self._setup_state_maps(march)
+        if self.real:
+            from mpi4py import MPI
+            mpi = self.comm.tompi4py()
+            dropped, kept = mpi.allreduce(self.dropped, op=MPI.MAX), mpi.allreduce(self.kept, op=MPI.MAX)
+            if not dropped <= REAL_TOL * kept:          # (every rank: the same numbers)
+                raise SSIError(f"-ssi_lag_store toeplitz: the {self.spec['what']} kernels of a point-symmetric grid "
+                               f"have a part {dropped:.3g} ({dropped / max(kept, 1e-300):.3g} of their largest) "
+                               "that should be zero; report this with the mesh")
+            self.rot_out = self._rotation(-1, whole=True)
         from ..sysmem import release_freed
         release_freed()         # the chunks' integrals and spectra, freed into the C heap: not resident in the run
         self.t_build = time.perf_counter() - t0
@@ -573,6 +624,56 @@ class ToeplitzHistory:
         self.nev = mpi.allreduce(self.nev)
         self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18)))
         return self
+
+    def _rotation(self, sign, whole=False):
+        """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab (or the whole spectrum),
+        psi_t(f) = pi (f_x (2 lo_x - t_x) / M_x + f_y (2 lo_y - t_y) / M_y): the point reflection o -> -o of class
+        t's offsets maps the FFT grid's index j to 2 lo - t - j (lo: the inputs' lattice box ``in_lo``), so a
+        slot's spectrum and its mirror's are K_{8-a}(f) = s exp(-2 i psi_t(f)) conj(K_a(f)); exp(i psi) K is
+        then real on the pairs' sums (``_lanes``)."""
+        lat = self.lat
+        f = np.arange(lat.F) if whole else np.arange(self.f0, self.f1)
+        fx, fy = f // (lat.My // 2 + 1), f % (lat.My // 2 + 1)
+        out = np.empty((4, f.size), np.complex128)
+        for t, (tx, ty) in enumerate(CLASSES):
+            psi = np.pi * (fx * (2 * lat.in_lo[0] - tx) / lat.Mx + fy * (2 * lat.in_lo[1] - ty) / lat.My)
+            out[t] = np.exp(sign * 1j * psi)
+        return out
+
+    def _lanes(self, S):
+        """(K9, K18) lanes of one lag's spectra S (4 classes, 9 slots, m entries, slab): complex (``to_lanes`` of
+        ``_kernel_blocks``), or on a point-symmetric grid real: with h = exp(i psi_t) (``_rotation``) and the
+        sign s of the point reflection (``point_sign``), rows 2 a and 2 a + 1 of the pair (a, 8 - a), a < 4, the
+        real part of h (K_a + s K_{8-a}) / 2 and the imaginary part of h (K_a - s K_{8-a}) / 2, row 8 the
+        centre's h K_4, real part (s = 1) or imaginary (s = -1): the parts that are zero by the symmetry are
+        left (their largest kept in ``dropped``, checked after the build)."""
+        if not self.real:
+            return tuple(to_lanes(B) for B in _kernel_blocks(S))
+        h = self.rot_k[:, None, None, :]                                  # (4, 1, 1, slab)
+        R = np.empty(S.shape)
+        sg = self.sg
+        for a in range(4):
+            al = 0.5 * h[:, 0] * (S[:, a] + sg * S[:, 8 - a])
+            ga = 0.5 * h[:, 0] * (S[:, a] - sg * S[:, 8 - a])
+            R[:, 2 * a], R[:, 2 * a + 1] = al.real, ga.imag
+            self.dropped = max(self.dropped, float(np.abs(al.imag).max(initial=0.0)),
+                               float(np.abs(ga.real).max(initial=0.0)))
+        c = h[:, 0] * S[:, 4]
+        R[:, 8] = c.real if sg > 0 else c.imag
+        self.dropped = max(self.dropped, float(np.abs(c.imag if sg > 0 else c.real).max(initial=0.0)))
+        self.kept = max(self.kept, float(np.abs(R).max(initial=0.0)))
+        return tuple(to_lanes_real(B) for B in _kernel_blocks(R))
+
+    def _pairs(self, S):
+        """A state's slab S (9 slots, 3 components, slab) as the real kernels read it: rows 2 a, 2 a + 1 the
+        pair (a, 8 - a)'s v_a + s v_{8-a} and i (v_a - s v_{8-a}), row 8 the centre's v_4 (s = 1) or i v_4."""
+        sg = self.sg
+        P = np.empty_like(S)
+        for a in range(4):
+            P[2 * a] = S[a] + sg * S[8 - a]
+            P[2 * a + 1] = 1j * (S[a] - sg * S[8 - a])
+        P[8] = S[4] if sg > 0 else 1j * S[4]
+        return P
 
     def _setup_state_maps(self, march):
         """The gather of this side's state (u or p) to every rank, and per input element of the grid its
@@ -612,7 +713,7 @@ class ToeplitzHistory:
         ix, iy = self.vpos
         scatter_slots(U, self.vnode, self.vsign, ix, iy, self._grid)
         S = rfft2(self._grid, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
-        put_state(S, self.V9, self.V18, m - self.base)
+        put_state(self._pairs(S) if self.real else S, self.V9, self.V18, m - self.base)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
@@ -678,7 +779,7 @@ class ToeplitzHistory:
         """(groups, b, 12, 2, FW) lanes: the terms of the states m <= n0 in the history sums of steps
         n0 + 1 .. n0 + b."""
         b, D, slab = self.block, self.D, self.f1 - self.f0
-        flops = 8.0 * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * slab     # complex products a (d, step)
+        flops = self._cflops() * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * slab     # a (d, step)
         acc = np.zeros((self.K9.shape[0], b, 12, 2, FW))
         if D:
             history_lanes(self.K9, self.K18, self.V9, self.V18, n0 + 1 - D - self.base, b, D, out=acc)
@@ -699,12 +800,17 @@ class ToeplitzHistory:
         k = min(n - n0 - 1, D)
         if k:                       # the block's states n - k .. n - 1 (d = k .. 1; k < n - n0 - 1 when D < b - 1)
             history_lanes(self.K9, self.K18, self.V9, self.V18, n - k - self.base, 1, k, out=acc, r0=D - k)
-            march.PETSc.Log.logFlops(8.0 * k * 9 * (self.spec["n9"] + 2 * self.spec["n18"]) * (self.f1 - self.f0))
+            march.PETSc.Log.logFlops(self._cflops() * k * 9 * (self.spec["n9"] + 2 * self.spec["n18"])
+                                     * (self.f1 - self.f0))
         if self.k and n - 1 > n0:   # the interpolated lags' terms of the block's states (T_L within b steps)
             C = self._weights(march, n, n0 + 1, n - 1)[None]
             if C.any():
                 acc += interp_lanes(self.A9, self.A18, self.V9, self.V18, C, n0 + 1 - self.base, _low_rank,
                                     _spans(C), march.PETSc.Log, slab=self.f1 - self.f0)
+
+    def _cflops(self):
+        """Flops of a kernel entry's product with a state's entry: 8 complex, 4 with a real kernel."""
+        return 4.0 if self.real else 8.0
 
     def _weights(self, march, n, m_lo, m_hi):
         """(k, m_hi - m_lo + 1): the weight of state m_lo + i in the interpolated history s_j^n of step n
@@ -732,6 +838,8 @@ class ToeplitzHistory:
                               MPI.C_DOUBLE_COMPLEX])
         out = np.empty((4, 3, lat.F), np.complex128)
         unpack_sums(full, self.spec["n9"], out)            # (class t, component)
+        if self.real:                                       # (the real kernels' sums, rotated back)
+            out *= self.rot_out[:, None, :]
         phys = irfft2(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
         vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
         arr = out_u.getArray()

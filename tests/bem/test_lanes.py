@@ -115,21 +115,25 @@ def test_interp_lanes_equal_the_matmul_products(weights, side, vdtype, gchunk):
     assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("real", [False, True])
 @pytest.mark.parametrize("b,no,ss,vdtype", [(7, 3, 1, np.float64), (5, 5, 3, np.float32), (1, 1, 2, np.float64)])
-def test_lane_products_tile_edges_equal_a_plain_sum(b, no, ss, vdtype):
+def test_lane_products_tile_edges_equal_a_plain_sum(b, no, ss, vdtype, real):
     """The micro-kernel's tiles (``lanes.MS`` steps x ``lanes.MO`` outputs) and their edges: step counts and
     output columns that are not multiples of the tile, a row stride ss > 1 (the interpolating matrices'),
-    single kept states, a kernel row offset and an output column offset; against a plain loop per
-    frequency, to 1e-14 of the sums' size, and nothing written outside the output's columns."""
-    from petsc_ssi.bem.lanes import to_lanes, from_lanes, lane_products, n_groups, FW
+    single kept states, a kernel row offset and an output column offset, complex and real kernels
+    (``to_lanes_real``: one part a column); against a plain loop per frequency, to 1e-14 of the sums' size,
+    and nothing written outside the output's columns."""
+    from petsc_ssi.bem.lanes import to_lanes, to_lanes_real, from_lanes, lane_products, n_groups, FW
     rng = np.random.default_rng(b * 10 + no)
     slab, c, D, j0, p0, o0 = 2 * FW + 3, 9, 4, 2, 1, 2
     K = _c(rng, slab, j0 + c * D + c, no)
+    if real:
+        K = K.real.copy()
     X = _c(rng, slab, p0 + ss * (b - 1) + D + 2, c)
     if vdtype == np.float32:
         X = X.astype(np.complex64)
     out = np.zeros((n_groups(slab), b, o0 + no + 1, 2, FW))
-    lane_products(to_lanes(K), j0, to_lanes(X, vdtype), p0, ss, b, D, out, o0)
+    lane_products(to_lanes_real(K) if real else to_lanes(K), j0, to_lanes(X, vdtype), p0, ss, b, D, out, o0)
     got = from_lanes(out, slab)
     ref = np.zeros((slab, b, o0 + no + 1), np.complex128)
     for s in range(b):

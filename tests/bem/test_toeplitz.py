@@ -200,6 +200,10 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
         F = 6 * 4
         nx = ny = 4
         cell = np.arange(4)
+    # the sides whose offsets are point-symmetric keep real kernels (half the bytes): as the run found them
+    Lat.point_symmetric = "H kernels real (point-symmetric" in out
+    GLat.point_symmetric = "G kernels real (point-symmetric" in out
+    assert Lat.point_symmetric                          # (a whole grid's H side)
     plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
     b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
     build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes
