@@ -26,7 +26,11 @@ real FFTs: nine node slots, three components) and kept while a kernel reads it; 
 products sum over d in Fourier space and four classes x three components go back by inverse FFTs.
 Kernels and kept transforms are stored in frequency lanes (``lanes``: 8 frequencies side by side, real
 and imaginary parts apart) so that the products compile to a register-blocked vector micro-kernel without
-copies.
+copies. Where the kernels' offsets are point-symmetric (a whole grid's H side, ``point_sign``), a slot's
+spectrum and its point mirror's are conjugate up to a known phase, K_{8-a}(f) = s exp(-2 i psi_t(f))
+conj(K_a(f)): the pairs' sum and difference, rotated by exp(i psi_t), are real, so the kernels are stored
+real (half the bytes, half the multiply-adds) and the states as the pairs' sums and differences
+(``ToeplitzHistory._lanes``, ``_pairs``, ``_rotation``).
 
 Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
 and of every kept state's transform: memory divided by the ranks); the kernels' integrals are split by
@@ -699,20 +703,26 @@ class ToeplitzHistory:
         self.row_t = (2 * tx + ty).astype(np.int64)
         self.row_x = np.mod((nf[:, 0] - tx) // 2, lat.Mx)
         self.row_y = np.mod((nf[:, 1] - ty) // 2, lat.My)
+        self.xrows, self.row_xi = np.unique(self.row_x, return_inverse=True)     # (the inverse transforms' rows)
+        self.row_xi = self.row_xi.ravel()
 
     # ---------------------------------------------------------------- per step
     def _transform(self, u_all, m):
         """State m's transform, this rank's slab, into row m - base of the kept lanes: the state's values on
         the FFT grid per slot and component (``lanes.scatter_slots``), 27 real 2-D FFTs (every rank makes all
-        of them; the slab is a run of the flattened spectrum), the slab put into lanes (``lanes.put_state``)."""
-        from scipy.fft import rfft2
+        of them; the slab is a run of the flattened spectrum), the slab put into lanes (``lanes.put_state``).
+        The inputs fill the grid's first in_n rows and columns only: the transform along y runs on those rows
+        (the zero padding's rows transform to zeros), then along x with the padding (``rfft2``'s two passes,
+        the first one pruned)."""
+        from scipy.fft import rfft, fft
         lat = self.lat
         U = u_all.reshape(-1, 3)                           # (a slot without a column, -1: 0 in scatter_slots)
         if getattr(self, "_grid", None) is None:            # (only the slots' cells are written: zeros stay)
-            self._grid = np.zeros((9, 3, lat.Mx, lat.My))
+            self._grid = np.zeros((9, 3) + tuple(lat.in_n))
         ix, iy = self.vpos
         scatter_slots(U, self.vnode, self.vsign, ix, iy, self._grid)
-        S = rfft2(self._grid, axes=(-2, -1), workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
+        S = fft(rfft(self._grid, n=lat.My, axis=-1, workers=1), n=lat.Mx, axis=-2,
+                workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
         put_state(self._pairs(S) if self.real else S, self.V9, self.V18, m - self.base)
 
     def reset(self):
@@ -826,7 +836,7 @@ class ToeplitzHistory:
     def _apply(self, acc, out_u):
         """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows added to out_u with
         the side's sign."""
-        from scipy.fft import irfft2
+        from scipy.fft import ifft, irfft
         from mpi4py import MPI
         lat = self.lat
         full = np.empty((lat.F, 12), np.complex128)
@@ -840,8 +850,10 @@ class ToeplitzHistory:
         unpack_sums(full, self.spec["n9"], out)            # (class t, component)
         if self.real:                                       # (the real kernels' sums, rotated back)
             out *= self.rot_out[:, None, :]
-        phys = irfft2(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), s=(lat.Mx, lat.My), axes=(-2, -1), workers=1)
-        vals = phys[self.row_t, :, self.row_x, self.row_y]          # (rows, 3)
+        # (``irfft2``'s two passes, the second on the grid rows that hold this rank's nodes only)
+        B = ifft(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), axis=-2, workers=1)[:, :, self.xrows]
+        phys = irfft(B, n=lat.My, axis=-1, workers=1)
+        vals = phys[self.row_t, :, self.row_xi, self.row_y]          # (rows, 3)
         arr = out_u.getArray()
         if self.spec["sign"] < 0:
             arr -= vals.ravel()
