@@ -480,7 +480,7 @@ class ToeplitzHistory:
         p, r = mpi.Get_size(), mpi.Get_rank()
         sel = np.arange(r, len(self.mirror), p)          # (each mirror offset integrated by one rank)
         mine = np.full(len(self.mirror), -1, np.int64)
-        per_lag = 4 * 9 * m * lat.Mx * lat.My * 8
+        per_lag = 4 * (5 if self.real else 9) * m * lat.Mx * lat.My * 8
         # (the same chunk on every rank: each chunk is one Reduce_scatter, and the ranks' slabs may differ by a
         # frequency, so their own kernels' bytes may not give the same chunk)
         from mpi4py import MPI
@@ -494,7 +494,7 @@ class ToeplitzHistory:
             idx, meta, offP, P = self._integrate(lag_lo, c_lo, c_hi, toff, L, sel)
             mine[:] = -1
             mine[idx] = np.arange(len(idx))
-            Kp = np.zeros((c_hi - c_lo + 1, 4, 9, m, lat.Mx, lat.My))
+            Kp = np.zeros((c_hi - c_lo + 1, 4, 5 if self.real else 9, m, lat.Mx, lat.My))
             _scatter_kernels(Kp, c_lo, mine[self.mirror_of], self.flip, meta, offP, P, t, kx, ky, lat.code0,
                              MIRROR_SLOTS, self.mirror_signs)
             S = self._reduce_transform(Kp)
@@ -646,23 +646,21 @@ class ToeplitzHistory:
 
     def _lanes(self, S):
         """(K9, K18) lanes of one lag's spectra S (4 classes, 9 slots, m entries, slab): complex (``to_lanes`` of
-        ``_kernel_blocks``), or on a point-symmetric grid real: with h = exp(i psi_t) (``_rotation``) and the
-        sign s of the point reflection (``point_sign``), rows 2 a and 2 a + 1 of the pair (a, 8 - a), a < 4, the
-        real part of h (K_a + s K_{8-a}) / 2 and the imaginary part of h (K_a - s K_{8-a}) / 2, row 8 the
-        centre's h K_4, real part (s = 1) or imaginary (s = -1): the parts that are zero by the symmetry are
-        left (their largest kept in ``dropped``, checked after the build)."""
+        ``_kernel_blocks``), or on a point-symmetric grid real from the slots 0..4 only (S (4, 5, m, slab)): with
+        h = exp(i psi_t) (``_rotation``) and the sign s of the point reflection (``point_sign``), the pair
+        (a, 8 - a), a < 4, has h (K_a + s K_{8-a}) / 2 = Re(h K_a) and h (K_a - s K_{8-a}) / 2 = i Im(h K_a)
+        (s K_{8-a} = exp(-2 i psi_t) conj(K_a)): rows 2 a and 2 a + 1 are the real and the imaginary part of
+        h K_a, row 8 the centre's h K_4, real part (s = 1) or imaginary (s = -1); the centre's other part is zero
+        by the symmetry (its largest kept in ``dropped``, checked after the build: the phases' and signs' check)."""
         if not self.real:
             return tuple(to_lanes(B) for B in _kernel_blocks(S))
-        h = self.rot_k[:, None, None, :]                                  # (4, 1, 1, slab)
-        R = np.empty(S.shape)
+        h = self.rot_k[:, None, :]                                        # (4, 1, slab)
+        R = np.empty(S.shape[:1] + (9,) + S.shape[2:])
         sg = self.sg
         for a in range(4):
-            al = 0.5 * h[:, 0] * (S[:, a] + sg * S[:, 8 - a])
-            ga = 0.5 * h[:, 0] * (S[:, a] - sg * S[:, 8 - a])
-            R[:, 2 * a], R[:, 2 * a + 1] = al.real, ga.imag
-            self.dropped = max(self.dropped, float(np.abs(al.imag).max(initial=0.0)),
-                               float(np.abs(ga.real).max(initial=0.0)))
-        c = h[:, 0] * S[:, 4]
+            z = h * S[:, a]
+            R[:, 2 * a], R[:, 2 * a + 1] = z.real, z.imag
+        c = h * S[:, 4]
         R[:, 8] = c.real if sg > 0 else c.imag
         self.dropped = max(self.dropped, float(np.abs(c.imag if sg > 0 else c.real).max(initial=0.0)))
         self.kept = max(self.kept, float(np.abs(R).max(initial=0.0)))
@@ -1046,6 +1044,7 @@ def _scatter_kernels(Kp, c_lo, rec, flip, meta, offP, P, t, kx, ky, code0, mslot
     serves the four offsets (+-o_x, +-o_y): a quarter of the integrals, each the same to round-off
     (tests/bem/test_toeplitz_mirror.py)."""
     nl_c = Kp.shape[0]
+    ns = Kp.shape[2]                # (the first ns slots: 5 for real kernels, whose mirrors 5..8 are not needed)
     m = Kp.shape[3]
     for o in range(rec.shape[0]):
         r = rec[o]
@@ -1058,5 +1057,7 @@ def _scatter_kernels(Kp, c_lo, rec, flip, meta, offP, P, t, kx, ky, code0, mslot
             s = base + (l - lo) * 9 * m
             for a in range(9):
                 sl = mslot[f, code0[a]]
+                if sl >= ns:
+                    continue
                 for e in range(m):
                     Kp[l - c_lo, t[o], sl, e, kx[o], ky[o]] = msign[f, e] * P[s + m * a + e]
