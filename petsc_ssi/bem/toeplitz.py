@@ -99,6 +99,16 @@ class Lattice:
         ix, iy = self.cell[sel] // self.ny, self.cell[sel] % self.ny
         w.in_lo = (int(ix.min()), int(iy.min()))
         w.in_n = (int(ix.max()) - w.in_lo[0] + 1, int(iy.max()) - w.in_lo[1] + 1)
+        w.point_symmetric = None
+        w._fft_grid()
+        return w
+
+    def window_box(self, lo, n):
+        """A copy of this grid whose inputs are the lattice box lo .. lo + n - 1 (``window``'s, given)."""
+        import copy
+        w = copy.copy(self)
+        w.in_lo, w.in_n = (int(lo[0]), int(lo[1])), (int(n[0]), int(n[1]))
+        w.point_symmetric = None
         w._fft_grid()
         return w
 
@@ -363,13 +373,27 @@ def kernel_offsets(lat):
     return np.concatenate(out)
 
 
+# the G side's window is widened to the lattice's centred box when its FFT grid then grows by at most this factor:
+# its kernels become real (``point_sign``), half the bytes and products a frequency
+CENTRED_GROWTH = 1.5
+
+
 def traction_grid(lat, VT):
     """The G side's grid: ``lat``'s window on the virtual elements with a traction column (VT: their
-    traction columns, -1 none), its kernel offsets counted (``n_offsets``); None without tractions."""
+    traction columns, -1 none), its kernel offsets counted (``n_offsets``); None without tractions. Where the
+    window centred on the lattice that holds it has point-symmetric offsets (the outputs a whole grid's
+    nodes) and an FFT grid at most ``CENTRED_GROWTH`` times the window's, that window (its kernels real, the
+    elements without tractions in it read as zeros)."""
     sel = np.any(np.asarray(VT) >= 0, axis=1)
     if not sel.any():
         return None
     g = lat.window(sel)
+    lo = [min(g.in_lo[ax], n - g.in_lo[ax] - g.in_n[ax]) for ax, n in enumerate((lat.nx, lat.ny))]
+    if min(lo) >= 0 and (tuple(lo) != tuple(g.in_lo)
+                         or any(2 * lo[ax] + g.in_n[ax] != n for ax, n in enumerate((lat.nx, lat.ny)))):
+        c = lat.window_box(lo, [n - 2 * lo[ax] for ax, n in enumerate((lat.nx, lat.ny))])
+        if c.F <= CENTRED_GROWTH * g.F and is_point_symmetric(c):
+            g = c
     g.n_offsets = len(kernel_offsets(g))
     return g
 
