@@ -58,12 +58,15 @@ def terms(opts, ranks):
     kw = dict(plan=plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
               single=cfg.get("toeplitz_precision", "double") == "single")
     zero = {"r_products": big, "r_sums": big, "r_sums_span": big, "t_step_dof": 0.0, "t_step_grid": 0.0,
-            "t_step_elem": 0.0, "t_pair_lag": 0.0}
+            "t_step_elem": 0.0, "t_pair_lag": 0.0, "t_pair_int": 0.0}
     one = lambda **r: estimate(*args, rates=dict(zero, **r), **kw)
     # the kernels' build per side: H's offsets and lags (glat=None) and G's, unweighted (g_pair_factor 1)
+    # (two terms: the planes' work, t_pair_lag, 5 of 9 slots with real kernels, and the integrals', t_pair_int)
     pairs_h = estimate(*args, rates=dict(zero, t_pair_lag=1.0), **dict(kw, glat=None))[1]
     pairs_g = one(t_pair_lag=1.0, g_pair_factor=1.0)[1] - pairs_h
-    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
+    int_h = estimate(*args, rates=dict(zero, t_pair_int=1.0), **dict(kw, glat=None))[1]
+    int_g = one(t_pair_int=1.0, g_pair_factor=1.0)[1] - int_h
+    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "int_h": int_h, "int_g": int_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2],
             "sums": one(r_sums=RATES["r_sums"], r_sums_span=RATES["r_sums_span"])[2],
             # the weighted states over the anchors' common span (Chebyshev), flops a rank, and the anchors'
@@ -72,12 +75,15 @@ def terms(opts, ranks):
 
 
 def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
-    """Flops a rank of the interpolating matrices' kernel products (8 m F k per step that reads them)."""
+    """Flops a rank of the interpolating matrices' kernel products (8 m F k per step that reads them, 4 with real
+    kernels)."""
     from petsc_ssi.bem.toeplitz import interp_work
     if plan is None or not plan.active:
         return 0.0
     isteps = interp_work(plan, n_steps, int(cfg.history_block) or 8, kw["stabilized"])[0]
-    return sum(8.0 * m * g.F * plan.k * isteps for g, m in ((lat, 144), (glat, 180)) if g is not None) / ranks
+    from petsc_ssi.bem.toeplitz import is_point_symmetric
+    return sum((4.0 if is_point_symmetric(g) else 8.0) * m * g.F * plan.k * isteps
+               for g, m in ((lat, 144), (glat, 180)) if g is not None) / ranks
 
 
 def main(logs, check=False, products_rate=None):
@@ -106,7 +112,7 @@ def main(logs, check=False, products_rate=None):
     sums = np.array([t["sums"] for *_, t in runs])
     if check:
         fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
-                                     "g_pair_factor")}
+                                     "t_pair_int", "g_pair_factor")}
     else:
         if products_rate:           # r_products held (the fit's products and per-step terms are nearly collinear
             prod = np.array([t["prod"] for *_, t in runs]) / products_rate      # on few logs), the rest fitted
@@ -118,11 +124,14 @@ def main(logs, check=False, products_rate=None):
             inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
         fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
                "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
-               "t_pair_lag": float(_nnls(np.array([[t["pairs_h"]] for *_, t in runs]), kh)[0])}
-        # G's offsets against the G side's own seconds (the logs that print them)
+               }
+        fit["t_pair_lag"], fit["t_pair_int"] = (float(v) for v in _nnls(
+            np.array([[t["pairs_h"], t["int_h"]] for *_, t in runs]), kh))
+        # G's offsets against the G side's own seconds (the logs that print them): one factor on both terms
         gsel = [i for i, (*_, t) in enumerate(runs) if t["pairs_g"] > 0 and kg[i] > 0]
-        t_g = float(_nnls(np.array([[runs[i][2]["pairs_g"]] for i in gsel]), kg[gsel])[0]) if gsel else 0.0
-        fit["g_pair_factor"] = t_g / fit["t_pair_lag"] if gsel and fit["t_pair_lag"] > 0 else RATES["g_pair_factor"]
+        gx = np.array([[fit["t_pair_lag"] * runs[i][2]["pairs_g"] + fit["t_pair_int"] * runs[i][2]["int_g"]]
+                       for i in gsel])
+        fit["g_pair_factor"] = float(_nnls(gx, kg[gsel])[0]) if gsel and gx.any() else RATES["g_pair_factor"]
     # r_sums_span from the logs whose far lags weigh states over a common span (Chebyshev): the span's flops
     # over the event SSI_BEM_HistInterp less its anchors' kernel products at r_products; the median of the logs
     spans = []
@@ -139,7 +148,8 @@ def main(logs, check=False, products_rate=None):
           "model [ms] |")
     print("|---|---|---|---|---|---|")
     for (path, r, t), k, h in zip(runs, kern, hist):
-        mk = fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
+        mk = (fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
+              + fit["t_pair_int"] * (t["int_h"] + fit["g_pair_factor"] * t["int_g"]))
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
               + fit["t_step_elem"] * t["elem"] + t["sums"] + t["span"] * (1.0 / fit["r_sums_span"]
                                                                           - 1.0 / RATES["r_sums_span"]))

@@ -248,7 +248,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            + (f" and the {th.k} interpolating matrices' kernels (the far lags' states weighted per step, {th.R} "
               "steps kept)" if th.k else "")
            + f" ({th.bytes / 1e9:.3g} GB with the kept states' transforms; kernels "
-           f"{sum(t.t_build for t in march.toeplitz):.3g} s){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
+           f"{th.t_build:.3g} s){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations; kept transforms in "
            f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)"
            + "".join(f"; {t.spec['what']} kernels real (point-symmetric offsets: half the products)"

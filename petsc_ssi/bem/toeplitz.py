@@ -203,7 +203,7 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
 RATES = {"r_products": 8.05e9, "t_step_dof": 3.96e-8, "t_step_grid": 0.0, "t_step_elem": 2.64e-6,
-         "t_pair_lag": 2.58e-6, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.916,
+         "t_pair_lag": 2.58e-6, "t_pair_int": 0.0, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.916,
          "r_sums_span": 5.3e10}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
@@ -294,7 +294,10 @@ def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=Non
         build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
         nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
-        t_build += r["t_pair_lag"] * pairs * (D + k) / ranks * (r["g_pair_factor"] if m == 180 else 1.0)
+        # (an offset and lag: its share of the integrals, a quarter at the mirror offsets, t_pair_int, and its
+        # planes' scatter, transforms and exchange, t_pair_lag for 9 slots: 5 of them with real kernels)
+        t_build += ((r["t_pair_lag"] * (5.0 if kp == 1.0 else 9.0) / 9.0 + r["t_pair_int"]) * pairs * (D + k) / ranks
+                    * (r["g_pair_factor"] if m == 180 else 1.0))
         flops += 4.0 * kp * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
