@@ -186,11 +186,12 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
 # their split is loose, their sum is what the logs fix) to the logs of `PARTS="paper grid" bash
 # jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
-# models) and of the building on the uniform 36 and 72 m grids (`bash jobscripts/quiet.sh env RUNS=... bash
-# jobscripts/building_uniform.sh`, and a second uniform-72 run of OUT=/tmp/pair1), 2 ranks, every other process
-# paused, 2026-11-30 03:38-03:52, with the kernels integrated at the mirror offsets only (e2101d8): history
-# from -17 % to +23 % of each of those 9 logs, kernels from -22 % (the 36 m building) to +13 %
-# (t_step_grid fitted to 0: collinear with the other per-step terms). The kernels are fitted per side (the log's H and G
+# models) and of the building on the uniform 36 and 72 m grids (`OUT=/tmp/fitlogs RUNS="uniform-36 uniform-72" bash
+# jobscripts/quiet.sh bash jobscripts/building_uniform.sh`), 2 ranks, every other process paused, 2026-11-30
+# 04:55-05:00 at d649a2c (mirror integrals, real kernels on point-symmetric sides): kernels from -3 % to +4 %,
+# history from -6 % to +10 % of each of those 8 logs (t_step_dof fitted to 0: collinear with the other
+# per-step terms). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
+# and exchange (9 slots; 5 on a real side), t_pair_int its share of the integrals. The kernels are fitted per side (the log's H and G
 # seconds). r_sums, the real flops per second of the interpolated lags' weighted states
 # (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
 # weighted states over its rate of the exact products, times the idle r_products of the time; median of
@@ -202,9 +203,9 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 8.05e9, "t_step_dof": 3.96e-8, "t_step_grid": 0.0, "t_step_elem": 2.64e-6,
-         "t_pair_lag": 2.58e-6, "t_pair_int": 0.0, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 0.916,
-         "r_sums_span": 5.3e10}
+RATES = {"r_products": 8.41e9, "t_step_dof": 0.0, "t_step_grid": 3.24e-7, "t_step_elem": 2.07e-6,
+         "t_pair_lag": 1.52e-6, "t_pair_int": 2.77e-7, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.33,
+         "r_sums_span": 4.33e10}
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
