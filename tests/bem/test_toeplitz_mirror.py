@@ -2,8 +2,8 @@
 element of the flat uniform grid is symmetric about its centre lines, so the integral of a node at the offset
 (-o_x, o_y) is the mirrored node's at (o_x, o_y), each block entry (p, q) times s_p s_q (-1 per x index), and
 likewise in y. The kernels built that way equal the ones integrated at every offset to round-off (H and G,
-exact lags and Chebyshev's interpolating matrices, a load patch off the grid's centre: a G window that is not
-symmetric), with about a quarter of the kernel evaluations."""
+exact lags and Chebyshev's interpolating matrices, a load patch off the grid's centre, whose G window is widened
+to the lattice's centred box: both sides' kernels real), with about a quarter of the kernel evaluations."""
 import numpy as np
 import pytest
 
