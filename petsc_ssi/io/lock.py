@@ -2,9 +2,10 @@
 -ssi_output (or -ssi_checkpoint pattern, or -ssi_lags_save) would write into one file together
 and leave it unreadable.
 
-``acquire`` (collective, before any heavy work) makes ``FILE.lock`` beside each file on rank 0
-with ``O_CREAT | O_EXCL`` (atomic on local file systems and on NFS v3+), holding the host, the
-pid and the start time. A second run finds it and is refused in one line on every rank. A lock
+``acquire`` (collective, before any heavy work) makes ``FILE.lock`` beside each file on rank 0,
+holding the host, the pid and the start time: written to a file of its own and hard-linked to the
+lock's name (atomic on local file systems and on NFS, and never seen empty), or with
+``O_CREAT | O_EXCL`` where there are no hard links (a lock found empty is then read again for a moment). A second run finds it and is refused in one line on every rank. A lock
 whose pid is no longer alive on this host (a run killed by SIGKILL or by the node) is stale: it
 is taken over with a warning. A lock of another host cannot be checked: refused, the message says
 which run holds it and that the file may be removed if that run is gone.
@@ -55,15 +56,57 @@ def _read(lockfile):
     return info
 
 
+# a lock found without host and pid is read again this often, this far apart, before it counts as foreign: a run
+# that made its lock with O_EXCL (``_make`` where the file system has no hard links) writes it right after
+EMPTY_RETRIES, EMPTY_WAIT = 20, 0.05
+
+
+def _make(lockfile, text):
+    """Make ``lockfile`` holding ``text``, atomically where the file system allows: written to a file of this
+    process's own, then hard-linked to the lock's name (the link fails if the lock exists), so that no run can
+    find the lock empty; where there are no hard links, O_CREAT | O_EXCL and the text written after. Raises
+    FileExistsError if the lock exists, OSError otherwise."""
+    tmp = f"{lockfile}.{platform.node()}.{os.getpid()}.tmp"
+    try:
+        with open(tmp, "w") as fh:
+            fh.write(text)
+        try:
+            os.link(tmp, lockfile)
+            return
+        except FileExistsError:
+            raise
+        except OSError:
+            pass                                    # (no hard links here: O_EXCL below)
+    finally:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+    fd = os.open(lockfile, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+
+
+def _read_settled(lockfile):
+    """``_read``, again for a while when the lock has neither host nor pid yet (being written)."""
+    info = _read(lockfile)
+    for _ in range(EMPTY_RETRIES):
+        if "host" in info and "pid" in info or not os.path.exists(lockfile):
+            break
+        time.sleep(EMPTY_WAIT)
+        info = _read(lockfile)
+    return info
+
+
 def _create(lockfile, holder):
     """Rank 0: make ``lockfile``; returns (error message or None, warning or None)."""
     host, pid = platform.node(), os.getpid()
     note = None
     for _ in range(3):
         try:
-            fd = os.open(lockfile, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            _make(lockfile, f"host {host}\npid {pid}\nstarted {time.strftime('%Y-%m-%dT%H:%M:%S%z')}\n")
         except FileExistsError:
-            info = _read(lockfile)
+            info = _read_settled(lockfile)
             try:
                 opid = int(info.get("pid", "-1"))
             except ValueError:
@@ -94,8 +137,6 @@ def _create(lockfile, holder):
             continue
         except OSError as exc:
             return f"cannot create the lock {lockfile} ({exc.strerror or exc})", None
-        with os.fdopen(fd, "w") as fh:
-            fh.write(f"host {host}\npid {pid}\nstarted {time.strftime('%Y-%m-%dT%H:%M:%S%z')}\n")
         _HELD[lockfile] = weakref.ref(holder) if holder is not None else (lambda: True)
         return None, note
     return f"cannot take the lock {lockfile} (it keeps coming back)", None
