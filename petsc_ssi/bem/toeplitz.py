@@ -94,17 +94,12 @@ class Lattice:
         """A copy of this grid whose inputs are the virtual elements ``sel`` (bool) only: their lattice box
         is the input range and the FFT grid is sized for it (the G side, whose inputs are the elements
         carrying traction columns)."""
-        import copy
-        w = copy.copy(self)
         ix, iy = self.cell[sel] // self.ny, self.cell[sel] % self.ny
-        w.in_lo = (int(ix.min()), int(iy.min()))
-        w.in_n = (int(ix.max()) - w.in_lo[0] + 1, int(iy.max()) - w.in_lo[1] + 1)
-        w.point_symmetric = None
-        w._fft_grid()
-        return w
+        lo = (int(ix.min()), int(iy.min()))
+        return self.window_box(lo, (int(ix.max()) - lo[0] + 1, int(iy.max()) - lo[1] + 1))
 
     def window_box(self, lo, n):
-        """A copy of this grid whose inputs are the lattice box lo .. lo + n - 1 (``window``'s, given)."""
+        """A copy of this grid whose inputs are the lattice box lo .. lo + n - 1 (its point symmetry unknown)."""
         import copy
         w = copy.copy(self)
         w.in_lo, w.in_n = (int(lo[0]), int(lo[1])), (int(n[0]), int(n[1]))
@@ -323,13 +318,15 @@ def point_sign(offsets, msigns):
     pattern entry: -1 for H's, +1 for G's) when the offsets (``kernel_offsets``) are the same set reflected, else
     0: a whole grid's H side (every node reads every element) is; a symmetric model's quarter of nodes, or a
     traction window off the grid's centre, is not."""
-    o = np.asarray(offsets)[:, :2]
     s = np.unique(np.asarray(msigns)[3])
-    if s.size != 1 or not len(o):
-        return 0
-    a = np.unique(o, axis=0)
-    b = np.unique(-o, axis=0)
-    return int(s[0]) if a.shape == b.shape and np.array_equal(a, b) else 0
+    return int(s[0]) if s.size == 1 and _reflected_alike(offsets) else 0
+
+
+def _reflected_alike(offsets):
+    """Whether the offsets (``kernel_offsets``' rows, in half element sizes) are the same set reflected through
+    the origin."""
+    o = np.asarray(offsets)[:, :2]
+    return bool(len(o)) and np.array_equal(np.unique(o, axis=0), np.unique(-o, axis=0))
 
 
 def is_point_symmetric(lat):
@@ -338,8 +335,7 @@ def is_point_symmetric(lat):
     lattice (``point_symmetric``) once known."""
     got = getattr(lat, "point_symmetric", None)
     if got is None:
-        o = kernel_offsets(lat)
-        got = bool(len(o)) and np.array_equal(np.unique(o[:, :2], axis=0), np.unique(-o[:, :2], axis=0))
+        got = _reflected_alike(kernel_offsets(lat))
         try:
             lat.point_symmetric = got
         except AttributeError:
@@ -392,10 +388,11 @@ def traction_grid(lat, VT):
     if not sel.any():
         return None
     g = lat.window(sel)
-    lo = [min(g.in_lo[ax], n - g.in_lo[ax] - g.in_n[ax]) for ax, n in enumerate((lat.nx, lat.ny))]
-    if min(lo) >= 0 and (tuple(lo) != tuple(g.in_lo)
-                         or any(2 * lo[ax] + g.in_n[ax] != n for ax, n in enumerate((lat.nx, lat.ny)))):
-        c = lat.window_box(lo, [n - 2 * lo[ax] for ax, n in enumerate((lat.nx, lat.ny))])
+    N = (lat.nx, lat.ny)
+    lo = tuple(min(g.in_lo[ax], N[ax] - g.in_lo[ax] - g.in_n[ax]) for ax in (0, 1))     # (the centred box)
+    n = tuple(N[ax] - 2 * lo[ax] for ax in (0, 1))
+    if (lo, n) != (tuple(g.in_lo), tuple(g.in_n)):
+        c = lat.window_box(lo, n)
         if c.F <= CENTRED_GROWTH * g.F and is_point_symmetric(c):
             g = c
     g.n_offsets = len(kernel_offsets(g))
