@@ -422,7 +422,7 @@ def mumps_factor_info(ksp):
             f"{MUMPS_ORDERINGS.get(o, o)} (INFOG(7) = {o})")
 
 
-def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
+def solve_columns(ksp, template, m, fill, take, chunk=256, block=None, Q=None):
     """Collective: x_j = A^-1 b_j for j = 0 .. m-1 with the KSP's operator A. ``fill(j, b)`` writes
     right-hand side j into the Vec b (layout of ``template``), ``take(j, x)`` receives its solution
     (a Vec, valid during the call); ``block(j0, j1)``, if given, returns the local rows of the
@@ -432,9 +432,20 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     one multi-right-hand-side solve of the factors (MatMatSolve: the triangular solves done for
     many columns at once, 3-10x fewer seconds than one solve per column; the solutions equal to
     round-off). Otherwise (an iterative solver, a redundant PC, SuperLU_dist) one ``ksp.solve`` per
-    column, whose divergence raises SSIError."""
+    column, whose divergence raises SSIError. ``Q`` (an orthogonal AIJ Mat: the template's rows): the KSP's
+    operator is Q^T A Q (the step matrix's mirror-symmetric blocks, ``bem.mirror``), x_j = Q (Q^T A Q)^-1 Q^T b_j."""
     PETSc = init()
     b, x = template.duplicate(), template.duplicate()
+    if Q is not None:
+        bq, xq = Q.createVecRight(), Q.createVecRight()
+
+        def qsolve(bv, xv):
+            Q.multTranspose(bv, bq)
+            ksp.solve(bq, xq)
+            Q.mult(xq, xv)
+    else:
+        def qsolve(bv, xv):
+            ksp.solve(bv, xv)
     F = None
     pc = ksp.getPC()
     if ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky"):
@@ -467,7 +478,7 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
                         fill(j, b)
                     else:
                         b.getArray()[:] = blk[:, j - j0]
-                    ksp.solve(b, x)
+                    qsolve(b, x)
                     if ksp.getConvergedReason() < 0:
                         raise SSIError(f"a solve for column {j} of {m} diverged (KSP reason {ksp.getConvergedReason()})")
                     take(j, x)
@@ -487,7 +498,16 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
                 fill(j0 + c, b)
                 Ba[:, c] = b.getArray(readonly=True)
             B.assemble()
-            F.matSolve(B, X)
+            if Q is None:
+                F.matSolve(B, X)
+            else:                                   # (in the blocks' basis: Q^T B solved, Q times the solutions)
+                Bq = Q.transposeMatMult(B)
+                Xq = Bq.duplicate()
+                F.matSolve(Bq, Xq)
+                X.destroy()
+                X = Q.matMult(Xq)
+                for o in (Bq, Xq):
+                    o.destroy()
             Xa = X.getDenseArray()
             for c in range(w):
                 x.getArray()[:] = Xa[:, c]
@@ -497,3 +517,6 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None):
     finally:
         b.destroy()
         x.destroy()
+        if Q is not None:
+            bq.destroy()
+            xq.destroy()

@@ -246,6 +246,66 @@ def _diag_panel(diag, r0, XT, RT, sign):
                                             + diag[i, p, 2] * XT[c + 2, t])
 
 
+@njit(cache=True)
+def block_csr(rows, cols, vals, nloc, r0):
+    """Scalar CSR (indptr, indices, data) of the sum of 3 x 3 node blocks (local node row ``rows``, global
+    node column ``cols``, values ``vals`` (nb, 3, 3)): blocks at the same (row, column) summed in input order,
+    each row's columns ascending, exact zeros left out except diagonal entries (kept, zero or not:
+    MatZeroRowsColumns of the symmetry planes' DOFs needs them); ``r0`` the first local row's node. The step
+    matrix's build (``march.step_matrix``): one pass a block, where a scalar COO with duplicates took about
+    2 s on a 45 000-DOF grid."""
+    nb = rows.size
+    cnt = np.zeros(nloc + 1, np.int64)
+    for k in range(nb):
+        cnt[rows[k] + 1] += 1
+    for r in range(nloc):
+        cnt[r + 1] += cnt[r]
+    order = np.empty(nb, np.int64)
+    pos = cnt[:nloc].copy()
+    for k in range(nb):                      # (stable: a row's blocks in input order)
+        order[pos[rows[k]]] = k
+        pos[rows[k]] += 1
+    indptr = np.zeros(3 * nloc + 1, np.int64)
+    indices = np.empty(9 * nb, np.int64)
+    data = np.empty(9 * nb)
+    n = 0
+    for r in range(nloc):
+        a, e = cnt[r], cnt[r + 1]
+        ks = order[a:e]
+        cs = cols[ks]
+        srt = np.argsort(cs, kind="mergesort")          # (stable: duplicates summed in input order)
+        # merged blocks of the row: (column, summed values)
+        nm = 0
+        mc = np.empty(e - a, np.int64)
+        mv = np.zeros((e - a, 3, 3))
+        for i in range(e - a):
+            k = ks[srt[i]]
+            c = cs[srt[i]]
+            if nm == 0 or mc[nm - 1] != c:
+                mc[nm] = c
+                for p in range(3):
+                    for q in range(3):
+                        mv[nm, p, q] = vals[k, p, q]
+                nm += 1
+            else:
+                for p in range(3):
+                    for q in range(3):
+                        mv[nm - 1, p, q] += vals[k, p, q]
+        for p in range(3):
+            row = 3 * r + p
+            diag = 3 * (r + r0) + p
+            for i in range(nm):
+                for q in range(3):
+                    col = 3 * mc[i] + q
+                    v = mv[i, p, q]
+                    if v != 0.0 or col == diag:
+                        indices[n] = col
+                        data[n] = v
+                        n += 1
+            indptr[row + 1] = n
+    return indptr, indices[:n].copy(), data[:n].copy()
+
+
 def matvec(m, indptr, indices, data, x, y):
     """y = A x for pattern m."""
     KERNELS[m][0](indptr, indices, data, x, y)

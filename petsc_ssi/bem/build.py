@@ -60,6 +60,7 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                    mirror=cfg.get("step_mirror", "auto"),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))  # step matrix first
     with event("SSI_BEM_LagMats"):
         H, hinfo = lagmats.build(comm, ls.H, plan.Lx, ls.node_range, N, N, r1 - r0, cfg.lag_storage,
@@ -152,6 +153,7 @@ def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
                                     single_from=int(cfg.lag_single_from),
                                     interp_lags=[plan.kernel_time(j)[0] for j in range(plan.k if plan.active else 0)])
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                    mirror=cfg.get("step_mirror", "auto"),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h), A=A)
     if not nt:
         G = [None] * plan.Lx
@@ -211,6 +213,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     ls.assemble(monitor=cfg.monitor, lag_hi=2)
     nev = ls.kernel_evaluations
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                    mirror=cfg.get("step_mirror", "auto"),
                     zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))
     k = plan.k if plan.active else 0
     with event("SSI_BEM_LagMats"):

@@ -23,10 +23,9 @@ stored lags with past states in a ring buffer of fixed length.
 import time
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..petsc import (init, set_default_options, soil_solver_defaults, printf, check_reproducible_solver,
-                     mumps_failure, mumps_factor_info, SSIError)
+                     mumps_failure, mumps_factor_info, solve_columns, SSIError)
 from ..monitor import event
 from . import bsr
 
@@ -64,17 +63,6 @@ def block_terms(n, lags, b, s, stabilized=True):
     return int(np.count_nonzero(step)), b * len(np.unique(n0[known])), wsub
 
 
-def _expand(trip, r0, coef, colmap=None):
-    """Scalar COO entries of node-block triplets (local rows)."""
-    row, _, col, val = trip
-    if colmap is not None:
-        col = colmap[col]
-    p, q = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
-    R = (3 * (row - r0))[:, None, None] + p
-    C = (3 * col)[:, None, None] + q
-    return R.ravel(), C.ravel(), (coef * val).ravel()
-
-
 def step_matrix(comm, lagset, scheme, pres_node_mask):
     """Collective: AIJ step matrix from the lag-1 and lag-2 triplets."""
     PETSc = init()
@@ -89,28 +77,18 @@ def step_matrix(comm, lagset, scheme, pres_node_mask):
     for lag, c in coefs.items():
         hr, hc, hv = H.peek(lag)
         m = ~pres_node_mask[hc]
-        r, cc, v = _expand((hr[m], None, hc[m], hv[m]), r0, c)
-        Rs.append(r); Cs.append(cc); Vs.append(v)
+        Rs.append(hr[m]); Cs.append(hc[m]); Vs.append(c * hv[m])
         if reg.n_disp:
             gr, gc, gv = G.peek(lag)
             m = gc >= reg.n_load
-            r, cc, v = _expand((gr[m], None, gc[m], gv[m]), r0, -c, colmap=reg.tnode)
-            Rs.append(r); Cs.append(cc); Vs.append(v)
-    R = np.concatenate(Rs); C = np.concatenate(Cs); V = np.concatenate(Vs)
-    A = sp.csr_matrix((V, (R, C)), shape=(3 * nloc, 3 * N))
-    A.sum_duplicates()
-    A.sort_indices()
-    # the flat surface's exact zeros in the 3 x 3 blocks (H: 5 of 9) left out of the factorisation
-    # (measured: 15-20 % less LU and solve time on a uniform grid); diagonal entries kept, zero or
-    # not (MatZeroRowsColumns of the symmetry planes' DOFs needs them)
-    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
-    keep = (A.data != 0.0) | (A.indices == rows + 3 * r0)
-    if not keep.all():
-        A = sp.csr_matrix((A.data[keep], A.indices[keep], np.concatenate(([0], np.cumsum(
-            np.bincount(rows[keep], minlength=A.shape[0]))))), shape=A.shape)
+            Rs.append(gr[m]); Cs.append(reg.tnode[gc[m]]); Vs.append(-c * gv[m])
+    # (the flat surface's exact zeros in the 3 x 3 blocks (H: 5 of 9) left out of the factorisation,
+    # measured: 15-20 % less LU and solve time on a uniform grid; diagonal entries kept: bsr.block_csr)
+    from .bsr import block_csr
+    ip, ix, dv = block_csr(np.concatenate(Rs).astype(np.int64) - r0, np.concatenate(Cs).astype(np.int64),
+                           np.ascontiguousarray(np.concatenate(Vs).reshape(-1, 3, 3), dtype=float), nloc, r0)
     M = PETSc.Mat().createAIJ(size=((3 * nloc, 3 * N), (3 * nloc, 3 * N)), bsize=3,
-                              csr=(A.indptr.astype(np.int32), A.indices.astype(np.int32), A.data),
-                              comm=comm)
+                              csr=(ip.astype(PETSc.IntType), ix.astype(PETSc.IntType), dv), comm=comm)
     M.assemble()
     return M
 
@@ -135,10 +113,12 @@ def blr_precision(opt, n_dofs):
 class Marcher:
     """Collective: steps the BEM in time. ``H``, ``G``: lists of Mats (lag 1..L)."""
 
-    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=(), A=None, blr=0.0):
+    def __init__(self, comm, lagset, scheme, known_u, known_p, log=printf, zero_dofs=(), A=None, blr=0.0,
+                 mirror="auto"):
         """Collective: step matrix and its factorisation (from the lag-1 and
         lag-2 triplets of ``lagset``, or ``A`` as saved, ``bem.lagstore``); ``set_lags`` then
-        hands over the Mats. ``blr``: -ssi_step_blr (``blr_precision``)."""
+        hands over the Mats. ``blr``: -ssi_step_blr (``blr_precision``); ``mirror``: -ssi_step_mirror (auto:
+        the LU of the mirror-symmetric blocks where the surface has mirror planes, ``bem.mirror``; off)."""
         PETSc = init()
         self.PETSc = PETSc
         self.comm = comm
@@ -166,16 +146,33 @@ class Marcher:
         set_default_options("ssi_bem_", soil_solver_defaults(comm), log)
         check_reproducible_solver("ssi_bem_", comm, "the soil's step matrix")
         eps = blr_precision(blr, self.A.getSize()[0])
+        self.mirror = None
+        mirror_note = self._mirror_blocks(lagset, str(mirror).lower(), zd.size)
         if not self._factorise(eps):
             if blr > 0:                 # (asked for, not possible: said, not silently full rank)
                 printf(f"[ssi] -ssi_step_blr {blr:g}: the step matrix is not factorised by MUMPS's LU here, or "
                        "-ssi_bem_mat_mumps_icntl_35 is given: its own solver options decide")
             eps = 0.0
         blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
+        if self.mirror is not None:
+            res = self._test_residual()
+            if not res <= BLR_TOL:               # (NaN too): A's own LU, said
+                printf(f"[ssi] step matrix: its mirror-symmetric blocks left a residual {res:.3g} > {BLR_TOL:g} on a "
+                       "test right-hand side; factorised as it is instead (-ssi_step_mirror)")
+                self._drop_mirror()
+                self.ksp.destroy()
+                mirror_note = ""
+                if not self._factorise(eps):
+                    eps = 0.0
+                blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
+            else:
+                mirror_note += f"; test residual {res:.2g})"
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
         info = mumps_factor_info(self.ksp)
         if info:                # (one line, monitor or not: the factors' bytes bound each step's solve)
-            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs, {info}{blr_note}")
+            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs, {info}{blr_note}{mirror_note}")
+        elif mirror_note:
+            printf(f"[ssi] step matrix: {self.A.getSize()[0]} DOFs{mirror_note}")
         ev.end()
         self.known_u = known_u      # callable(n) -> prescribed u values at disp DOFs (3*n_disp,)
         self.known_p = known_p      # callable(n) -> traction at load DOFs (3*n_load,)
@@ -183,6 +180,32 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
         self.toeplitz = []          # bem/toeplitz.ToeplitzHistory per side: the H (and G) lags >= 3 as FFT kernels
+
+    def _mirror_blocks(self, lagset, mode, n_zero):
+        """Collective: with -ssi_step_mirror auto and a surface with mirror planes (``bem.mirror``), the block
+        diagonal Q^T A Q that ``_factorise`` factorises (``self.mirror``); returns the log's note ('' when not
+        used, with a line saying why when the surface's nodes mirror but A does not)."""
+        nimg = getattr(lagset, "n_images", None) or len(lagset.Vc) // max(lagset.mesh.n_cells, 1)
+        if mode == "off" or n_zero or nimg > 1:
+            return ""                           # (symmetry planes: the model is already reduced)
+        from .mirror import MirrorBlocks
+        reg = self.reg
+        mb = MirrorBlocks(self.PETSc, self.comm, self.A, lagset.mesh.nodes, self.pres,
+                          np.asarray(reg.tnode)[reg.n_load:] if reg.n_t else [])
+        if mb.why:
+            if mb.defect == mb.defect:          # (the nodes mirror: say why A's own LU)
+                printf(f"[ssi] step matrix: factorised as it is: {mb.why} (-ssi_step_mirror)")
+            mb.destroy()
+            return ""
+        self.mirror = mb
+        self._yb, self._yx = mb.Ap.createVecRight(), mb.Ap.createVecRight()
+        return (f", mirror-symmetric about {mb.planes}: {len(mb.sizes)} independent blocks of "
+                f"{'/'.join(str(n) for n in mb.sizes)} DOFs (-ssi_step_mirror; commutation defect {mb.defect:.2g}")
+
+    def _drop_mirror(self):
+        for o in (self.mirror, self._yb, self._yx):
+            o.destroy()
+        self.mirror = None
 
     def _factorise(self, eps=0.0):
         """Collective: the KSP of the step matrix, set up (factorised) with the ssi_bem_ options; with ``eps``
@@ -192,7 +215,7 @@ class Marcher:
         PETSc = self.PETSc
         self.ksp = PETSc.KSP().create(comm=self.comm)
         self.ksp.setOptionsPrefix("ssi_bem_")
-        self.ksp.setOperators(self.A)
+        self.ksp.setOperators(self.A if self.mirror is None else self.mirror.Ap)
         self.ksp.setFromOptions()
         pc = self.ksp.getPC()
         blr = (eps > 0.0 and self.ksp.getType() == "preonly" and pc.getType() == "lu"
@@ -210,23 +233,29 @@ class Marcher:
                            "-ssi_bem_mat_mumps_icntl_23 <MB per rank>, or fewer DOFs")
         return blr
 
-    def _check_blr(self, eps, blr):
-        """Collective: the block low-rank factors checked on a fixed test right-hand side (the same on any
-        rank count): ||A x - b|| / ||b|| at most ``BLR_TOL`` (or 100 eps for a precision the user chose),
-        else the full-rank LU instead, said in one line. Returns the log's note."""
+    def _test_residual(self):
+        """Collective: ||A x - b|| / ||b|| of the step solve (``solve``'s path, its factors) on a fixed test
+        right-hand side (the same on any rank count), A the step matrix itself."""
         b = self.A.createVecLeft()
         r0, r1 = b.getOwnershipRange()
         b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
         if self.zero_local.size:
             b.getArray()[self.zero_local] = 0.0
         x, r = b.duplicate(), b.duplicate()
-        self.ksp.solve(b, x)
+        self._solve(b, x)
         self.A.mult(x, r)
         r.axpy(-1.0, b)
         res = r.norm() / b.norm()
-        tol = BLR_TOL if blr < 0 else max(BLR_TOL, 100.0 * eps)
         for v in (b, x, r):
             v.destroy()
+        return res
+
+    def _check_blr(self, eps, blr):
+        """Collective: the block low-rank factors checked on a fixed test right-hand side (``_test_residual``):
+        at most ``BLR_TOL`` (or 100 eps for a precision the user chose), else the full-rank LU instead, said
+        in one line. Returns the log's note."""
+        res = self._test_residual()
+        tol = BLR_TOL if blr < 0 else max(BLR_TOL, 100.0 * eps)
         if not res <= tol:                       # (NaN too)
             printf(f"[ssi] step matrix: the block low-rank LU at eps {eps:g} left a residual {res:.3g} > {tol:g} on "
                 "a test right-hand side; factorised in full rank instead (-ssi_step_blr)")
@@ -739,8 +768,23 @@ class Marcher:
         """Collective: x = A^{-1} b with the factorised step matrix."""
         ev = event("SSI_BEM_Solve")
         ev.begin()
-        self.ksp.solve(b, x)
+        self._solve(b, x)
         ev.end()
+
+    def _solve(self, b, x):
+        """x = A^{-1} b: with the mirror-symmetric blocks, x = Q A'^{-1} Q^T b (``bem.mirror``)."""
+        if self.mirror is None:
+            self.ksp.solve(b, x)
+            return
+        self.mirror.Q.multTranspose(b, self._yb)
+        self.ksp.solve(self._yb, self._yx)
+        self.mirror.Q.mult(self._yx, x)
+
+    def solve_columns(self, m, fill, take, block=None):
+        """Collective: ``petsc.solve_columns`` with the step matrix's factors (through the mirror-symmetric
+        blocks' basis where they are used)."""
+        solve_columns(self.ksp, self.u_tmpl, m, fill, take, block=block,
+                      Q=None if self.mirror is None else self.mirror.Q)
 
     def store(self, n, x):
         """Collective: u^n, p^n into the history buffers from the unknowns x (u at

@@ -55,6 +55,11 @@ register("history_block", "int", 0, "steps", "time-blocked history sum: the know
          "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
          "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes)", "bem",
          validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
+register("step_mirror", "enum", "auto", "", "auto: where the soil surface, its prescribed-displacement and traction "
+         "nodes mirror about x = c and/or y = c (c the mesh's mid-point) and the step matrix commutes with the "
+         "reflections, its LU is that of the 2 or 4 independent blocks of the symmetric and antisymmetric parts (fewer "
+         "entries in the factors: faster step solves; checked on a test right-hand side, else the matrix as it is, "
+         "said in one line; bem/mirror.py); off: the matrix as it is", "bem", choices=("auto", "off"))
 register("step_blr", "real", -1.0, "", "the step matrix's MUMPS LU in block low-rank form (ICNTL(35) 2) at this "
          "precision CNTL(7): faster step solves on large grids, the factors checked on a test right-hand side "
          "(residual <= 1e-12, else full rank, said in one line); 0: full rank; -1 (auto): 1e-15 from 20 000 DOFs on, "

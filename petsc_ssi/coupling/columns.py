@@ -65,7 +65,9 @@ class RegionColumns:
         self.PETSc, self.march, self.comm = PETSc, march, march.comm
         A = march.A
         r0, r1 = A.getOwnershipRange()
-        inside = np.repeat(region_nodes(X, nodes_I, margin), 3)
+        self.inside_nodes = region_nodes(X, nodes_I, margin)
+        inside = np.repeat(self.inside_nodes, 3)
+        self.X = X
         self.margin = margin
         self.keep = inside[r0:r1]
         self.rows = np.flatnonzero(self.keep)
@@ -96,13 +98,15 @@ class RegionColumns:
             # its LU ran out of the default 20 % (INFOG(1) = -9) at 3.5 reaches on the uniform 72 m building
             defaults["mat_mumps_icntl_14"] = str(ICNTL14)
         set_default_options("ssi_bem_columns_", defaults, self.log)
-        ksp.setOperators(AR)
+        mb = self._mirror(AR)
+        self.mirrored = mb is not None
+        ksp.setOperators(AR if mb is None else mb.Ap)
         ksp.setFromOptions()
         ksp.setUp()
         self.failed = mumps_failure(ksp)
         if self.failed:                         # (every rank: INFOG is global)
             self.ok, self.residual, self.rhs_outside, self.Z = False, float("nan"), False, None
-            for o in (ksp, AR, AQ):
+            for o in (ksp, AR, AQ) + (() if mb is None else (mb,)):
                 o.destroy()
             self.destroy()
             return self
@@ -131,7 +135,7 @@ class RegionColumns:
             a = rq.getArray(readonly=True)
             rmax[i] = np.abs(a).max() if a.size else 0.0
 
-        solve_columns(ksp, tmpl, len(cols), fill, take, block=block)
+        solve_columns(ksp, tmpl, len(cols), fill, take, block=block, Q=None if mb is None else mb.Q)
         from mpi4py import MPI
         mpi = self.comm.tompi4py()
         mpi.Allreduce(MPI.IN_PLACE, bmax, op=MPI.MAX)
@@ -144,10 +148,29 @@ class RegionColumns:
             self.residual = float("nan")
         self.ok = (not self.rhs_outside) and bool(np.isfinite(self.residual)) and self.residual <= TOL
         self.Z = Z
-        for o in (ksp, AR, AQ, tmpl, rq):
+        for o in (ksp, AR, AQ, tmpl, rq) + (() if mb is None else (mb,)):
             o.destroy()
         self.destroy()
         return self
+
+    def _mirror(self, AR):
+        """Collective: the region's matrix in mirror-symmetric blocks (``bem.mirror``) when the step matrix's LU
+        is (the region around a mirror-symmetric interface is mirror-symmetric too), else None. The columns
+        are checked as always (their ring residual), and the blocks' commutation before."""
+        m = self.march
+        if getattr(m, "mirror", None) is None:
+            return None
+        from ..bem.mirror import MirrorBlocks
+        nodes = np.flatnonzero(self.inside_nodes)
+        where = -np.ones(len(self.X), np.int64)
+        where[nodes] = np.arange(nodes.size)
+        reg = m.reg
+        tn = where[np.asarray(reg.tnode)[reg.n_load:]] if reg.n_t else np.zeros(0, np.int64)
+        mb = MirrorBlocks(self.PETSc, self.comm, AR, self.X[nodes], m.pres[nodes], tn[tn >= 0])
+        if mb.why:
+            mb.destroy()
+            return None
+        return mb
 
     def destroy(self):
         for o in (self.is_r, self.is_ring):
@@ -185,7 +208,8 @@ def region_columns(cfg, march, prob, nodes_I, cols, n_cols, rhs, log=printf):
         if reg.ok:
             line = (f"[ssi] interface columns: on the {reg.n_region} soil DOFs within {margin:.3g} m of the "
                     f"interface ({100 * share:.0f} % of {reg.n_all}; margin {margin / reach:.3g} x the step "
-                    f"matrix's reach {reach:.3g} m, c_p t + the largest element), their own LU; truncation residual {reg.residual:.2e} of "
+                    f"matrix's reach {reach:.3g} m, c_p t + the largest element), their own LU"
+                    f"{' (mirror-symmetric blocks, as the step matrix)' if reg.mirrored else ''}; truncation residual {reg.residual:.2e} of "
                     f"the right-hand sides (<= {TOL:g}; -ssi_interface_columns)"
                     + (f"; tried first: {', '.join(tried)}" if tried else ""))
             return reg.rows, reg.Z, line

@@ -267,7 +267,7 @@ class Coupler:
 
                 def take(i, z):
                     Z[:, cols[i]] = z.getArray(readonly=True)
-                solve_columns(m.ksp, m.u_tmpl, len(cols), by_product, take, block=block)
+                m.solve_columns(len(cols), by_product, take, block=block)
         unit.destroy()
         tmp.destroy()
         # (local rows, 3 n_I): H_s e_j of the interface DOFs (symmetry-zero ones: no column); None where a
