@@ -141,10 +141,10 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     counts are not made: its element-pair tables hold every (node, element) pair (O(N^2) on a whole
     grid: minutes and GBs on a 60 m site), and the run does not store those matrices. Coupled
     (``coupled``: build_coupled's tuple, ``cc``: its CoupledCounts, ``c``: the constants), the soil is the
-    coupled set-up's and the coupling's set-up and steps are added (``CoupledCounts.predict``, its BEM
-    solve the dense model's ``bem_solve_seconds``: the step matrix is the same sparse lag-0/1 matrix), with
-    the step matrix's factorisation (the dense model's c_fac N^1.5) and the steps' solves in the total; the
-    assembly of lags 1-2 (seconds on the 72 m building) is not modelled."""
+    coupled set-up's and the coupling's set-up and steps are added (``CoupledCounts.predict``), with the step
+    matrix's factorisation and the steps' solves in the total (``toeplitz.step_lu``: the factors' entries on
+    a uniform grid, in the mirror-symmetric blocks the run would use, ``mirror.blocks_of``); the assembly of
+    lags 1-2 (seconds on the 72 m building) is not modelled."""
     from ..bem.halfspace import HalfSpace
     from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
     from ..bem.lagset import load_kernels
@@ -188,15 +188,25 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         lines.insert(2, describe(cc))
         lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s coupling_setup_s coupling_loop_s total | GB "
                      "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
+    if cc is not None:                  # the step matrix's LU (toeplitz.step_lu): its entries, mirror blocks
+        from ..bem.mirror import blocks_of
+        from ..bem.toeplitz import step_lu
+        from ..coupling.columns import geometric_reach
+        nblk = blocks_of(prob)
+        rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
+        ent = step_lu(3 * N, rho, nblk)[0]
+        lines.insert(3, f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach "
+                        f"{rho:.3g} node spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1
+                                                      else "") + "; toeplitz.step_lu)")
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
         cpl = ""
         if cc is not None:            # the structure, the interface matrices and the coupled steps
-            add = cc.predict(c, p, bem_solve_seconds(c, N, p))
+            _, fac, one = step_lu(3 * N, rho, nblk, p, kappa=c.get("kappa", 0.107))
+            add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
-            steps_s = prob.n_steps * bem_solve_seconds(c, N, p)
-            fac = c["c_fac"] * N ** 1.5             # the step matrix's LU (the dense model's term: the same matrix)
+            steps_s = prob.n_steps * one
             cpl = (f" {fac:8.3g} {steps_s:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
                    f"{fmt_time(tb + th + fac + add['cpl_setup'] + add['cpl_loop'] + steps_s):>7}")
         tot = b + p * rss

@@ -60,6 +60,20 @@ def reflections(X, pres, tnodes, tol=1e-9):
     return out
 
 
+def blocks_of(prob):
+    """The number of independent blocks the step matrix of ``prob`` (a HalfSpace) would split into (1, 2 or 4),
+    from its nodes and regions alone (``reflections``; the commutation, which only the matrix can show, assumed:
+    ``petsc-ssi estimate``)."""
+    reg = prob.regions
+    N = prob.mesh.n_nodes
+    pres = np.zeros(N, bool)
+    pres[np.asarray(reg.disp_nodes, np.int64)] = True
+    tn = np.asarray(reg.tnode)[reg.n_load:] if reg.n_t else []
+    if getattr(prob, "planes", None):
+        return 1
+    return 1 << len(reflections(prob.mesh.nodes, pres, tn))
+
+
 def group(refl):
     """(maps (|G|, N) node maps, signs (|G|, 3) component signs, chars (|G|, |G|) sigma(g) per character
     row) of the group the reflections generate (generators' products in binary order)."""
@@ -194,7 +208,7 @@ def _signed_permutation(PETSc, comm, nmap, sign, r0, r1):
 
 def commutation_defect(PETSc, comm, A, refl):
     """Collective: max over the reflections of ||A R v - R A v||_inf / ||A v||_inf, v_j = sin(0.7 j + 0.3) over
-    the global DOFs (the same on any rank count)."""
+    the global DOFs."""
     r0, r1 = A.getOwnershipRange()
     v = A.createVecRight()
     v.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)

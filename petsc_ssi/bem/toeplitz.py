@@ -201,6 +201,30 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 RATES = {"r_products": 8.41e9, "t_step_dof": 0.0, "t_step_grid": 3.24e-7, "t_step_elem": 2.07e-6,
          "t_pair_lag": 1.52e-6, "t_pair_int": 2.77e-7, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.33,
          "r_sums_span": 4.33e10}
+# The step matrix's LU on a uniform grid (``step_lu``: the coupled estimate's factor_s and solve_s, where the dense
+# model's c_fac N^1.5 and c_sol N ln N, fitted on small graded meshes, put the 72 m building's at 7.7 and 21.3 s
+# against 5.3 and 12.1 s measured before the mirror blocks): entries in the factors E = step_fill n rho^2
+# ln(n / rho^2) per independent block of n DOFs (rho = the step matrix's reach over the node spacing: the
+# coupled columns' ``geometric_reach``; a mirror-symmetric surface's 2 or 4 blocks, ``bem.mirror``), a step's
+# solve t_solve_entry s an entry on 2 ranks (block low-rank from 20 000 DOFs, full rank below), the assembly and
+# factorisation t_factor_entry s an entry. Fitted to the building's uniform grids (2026-11-30 06:33-06:38,
+# jobscripts/building_uniform.sh, logs out/bench/building_uniform/uniform-36, -72, -72-fullrank; step_fill the
+# geometric mean of E over the law on uniform-36 and -72 with and without the mirror blocks: 4.4-6.2)
+STEP_RATES = {"step_fill": 5.3, "t_solve_entry": 5.8e-10, "t_factor_entry": 5.5e-8}
+
+
+def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
+    """(entries, factor seconds, seconds a solve) of the step matrix's LU (``STEP_RATES``) for ``n_dofs`` DOFs in
+    ``blocks`` independent blocks, reach ``rho`` node spacings, on ``ranks`` ranks (a solve's time grows by
+    1 + kappa (p - 1), the dense model's, relative to 2 ranks)."""
+    r = dict(STEP_RATES, **(rates or {}))
+    nb = n_dofs / max(int(blocks), 1)
+    rho2 = max(float(rho), 1.0) ** 2
+    entries = max(int(blocks), 1) * r["step_fill"] * nb * rho2 * np.log(max(nb / rho2, 2.0))
+    solve = entries * r["t_solve_entry"] * (1.0 + kappa * (ranks - 1)) / (1.0 + kappa)
+    return entries, entries * r["t_factor_entry"], solve
+
+
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 

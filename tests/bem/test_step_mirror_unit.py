@@ -120,3 +120,30 @@ def test_mirror_blocks_solve_and_refusals():
     assert "not mirror-symmetric" in mb.why and np.isnan(mb.defect)
     for o in (M, Mp):
         o.destroy()
+
+
+def test_step_lu_model_and_blocks_of():
+    """The estimate's model of the step matrix's LU (toeplitz.step_lu): more entries with more DOFs and a longer
+    reach, fewer in mirror blocks; on the 72 m building's numbers (44 649 DOFs, reach 6.3 node spacings, 4
+    blocks) within 30 % of the 50.3 M entries MUMPS reported (runs/building/README.md). ``mirror.blocks_of``: 4 for
+    a centred rigid footing, 2 for one centred in y only, 1 for neither (from the nodes and regions alone)."""
+    from types import SimpleNamespace
+    from petsc_ssi.bem.toeplitz import step_lu
+    from petsc_ssi.bem.mirror import blocks_of
+    e1, f1, s1 = step_lu(44649, 6.3, 1)
+    e4, f4, s4 = step_lu(44649, 6.3, 4)
+    assert e4 < e1 and f4 < f1 and s4 < s1
+    assert step_lu(44649, 4.0, 4)[0] < e4 < step_lu(60000, 6.3, 4)[0]
+    assert abs(e4 / 50.33e6 - 1) < 0.3
+    assert step_lu(44649, 6.3, 4, ranks=4)[2] > s4          # (MUMPS's solve does not speed up with ranks)
+    X = _nodes(9, 9, 0.5)
+    X[:, 1] -= X[:, 1].mean()
+
+    def prob(sel):
+        nodes = np.flatnonzero(sel)
+        reg = SimpleNamespace(disp_nodes=nodes, tnode=nodes, n_load=0, n_t=nodes.size)
+        return SimpleNamespace(regions=reg, mesh=SimpleNamespace(nodes=X, n_nodes=len(X)), planes=[])
+    x, y = np.round(X[:, 0], 9), np.round(X[:, 1], 9)
+    assert blocks_of(prob((abs(x) <= 0.5) & (abs(y) <= 0.5))) == 4
+    assert blocks_of(prob((x >= 0.5) & (x <= 1.5) & (abs(y) <= 0.5))) == 2
+    assert blocks_of(prob((x >= 0.5) & (x <= 1.5) & (y >= 0) & (y <= 1.0))) == 1
