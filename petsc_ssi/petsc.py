@@ -487,9 +487,11 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None, Q=None):
         for j0 in range(0, m, chunk):
             w = min(chunk, m - j0)
             B = PETSc.Mat().createDense(size=((nloc, n), (None, w)), comm=template.getComm())
-            X = PETSc.Mat().createDense(size=((nloc, n), (None, w)), comm=template.getComm())
+            X = None if Q is not None else PETSc.Mat().createDense(size=((nloc, n), (None, w)),
+                                                                   comm=template.getComm())
             B.setUp()
-            X.setUp()
+            if X is not None:
+                X.setUp()
             Ba = B.getDenseArray()
             blk = rhs(j0, j0 + w)
             if blk is not None:
@@ -503,11 +505,12 @@ def solve_columns(ksp, template, m, fill, take, chunk=256, block=None, Q=None):
             else:                                   # (in the blocks' basis: Q^T B solved, Q times the solutions)
                 Bq = Q.transposeMatMult(B)
                 Xq = Bq.duplicate()
-                F.matSolve(Bq, Xq)
-                X.destroy()
-                X = Q.matMult(Xq)
-                for o in (Bq, Xq):
-                    o.destroy()
+                try:
+                    F.matSolve(Bq, Xq)
+                    X = Q.matMult(Xq)
+                finally:
+                    for o in (Bq, Xq):
+                        o.destroy()
             Xa = X.getDenseArray()
             for c in range(w):
                 x.getArray()[:] = Xa[:, c]

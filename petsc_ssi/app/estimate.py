@@ -192,7 +192,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         from ..bem.mirror import blocks_of
         from ..bem.toeplitz import step_lu
         from ..coupling.columns import geometric_reach
-        nblk = blocks_of(prob)
+        nblk = blocks_of(prob) if str(cfg.get("step_mirror", "auto")).lower() != "off" else 1
         rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
         ent = step_lu(3 * N, rho, nblk)[0]
         lines.insert(3, f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach "

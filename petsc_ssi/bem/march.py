@@ -147,24 +147,25 @@ class Marcher:
         check_reproducible_solver("ssi_bem_", comm, "the soil's step matrix")
         eps = blr_precision(blr, self.A.getSize()[0])
         self.mirror = None
-        mirror_note = self._mirror_blocks(lagset, str(mirror).lower(), zd.size)
+        mirror_note = self._mirror_blocks(lagset, str(mirror).lower(), len(zero_dofs))
         if not self._factorise(eps):
             if blr > 0:                 # (asked for, not possible: said, not silently full rank)
                 printf(f"[ssi] -ssi_step_blr {blr:g}: the step matrix is not factorised by MUMPS's LU here, or "
                        "-ssi_bem_mat_mumps_icntl_35 is given: its own solver options decide")
             eps = 0.0
-        blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
+        blr_note, eps = self._check_blr(eps, blr) if eps > 0.0 else ("", 0.0)
         if self.mirror is not None:
             res = self._test_residual()
-            if not res <= BLR_TOL:               # (NaN too): A's own LU, said
-                printf(f"[ssi] step matrix: its mirror-symmetric blocks left a residual {res:.3g} > {BLR_TOL:g} on a "
+            tol = self._test_tol(eps, blr)
+            if not res <= tol:                   # (NaN too): A's own LU, said
+                printf(f"[ssi] step matrix: its mirror-symmetric blocks left a residual {res:.3g} > {tol:g} on a "
                        "test right-hand side; factorised as it is instead (-ssi_step_mirror)")
                 self._drop_mirror()
                 self.ksp.destroy()
                 mirror_note = ""
                 if not self._factorise(eps):
                     eps = 0.0
-                blr_note = self._check_blr(eps, blr) if eps > 0.0 else ""
+                blr_note, eps = self._check_blr(eps, blr) if eps > 0.0 else ("", 0.0)
             else:
                 mirror_note += f"; test residual {res:.2g})"
         self.t_factor = time.perf_counter() - t0       # step matrix + factorisation
@@ -188,6 +189,10 @@ class Marcher:
         nimg = getattr(lagset, "n_images", None) or len(lagset.Vc) // max(lagset.mesh.n_cells, 1)
         if mode == "off" or n_zero or nimg > 1:
             return ""                           # (symmetry planes: the model is already reduced)
+        db = self.PETSc.Options()               # (a direct solve only: the defaults' preonly + LU, or the user's)
+        if (db.getString("ssi_bem_ksp_type", "preonly") != "preonly"
+                or db.getString("ssi_bem_pc_type", "lu") not in ("lu", "cholesky")):
+            return ""
         from .mirror import MirrorBlocks
         reg = self.reg
         mb = MirrorBlocks(self.PETSc, self.comm, self.A, lagset.mesh.nodes, self.pres,
@@ -205,7 +210,7 @@ class Marcher:
     def _drop_mirror(self):
         for o in (self.mirror, self._yb, self._yx):
             o.destroy()
-        self.mirror = None
+        self.mirror = self._yb = self._yx = None
 
     def _factorise(self, eps=0.0):
         """Collective: the KSP of the step matrix, set up (factorised) with the ssi_bem_ options; with ``eps``
@@ -250,19 +255,24 @@ class Marcher:
             v.destroy()
         return res
 
+    @staticmethod
+    def _test_tol(eps, blr):
+        """The test residual's bound: ``BLR_TOL``, or 100 eps for a block low-rank precision the user chose."""
+        return BLR_TOL if (blr < 0 or eps <= 0.0) else max(BLR_TOL, 100.0 * eps)
+
     def _check_blr(self, eps, blr):
         """Collective: the block low-rank factors checked on a fixed test right-hand side (``_test_residual``):
-        at most ``BLR_TOL`` (or 100 eps for a precision the user chose), else the full-rank LU instead, said
-        in one line. Returns the log's note."""
+        at most ``_test_tol``, else the full-rank LU instead, said in one line. Returns (the log's note, the
+        precision the factors have: eps, or 0 after the fallback)."""
         res = self._test_residual()
-        tol = BLR_TOL if blr < 0 else max(BLR_TOL, 100.0 * eps)
+        tol = self._test_tol(eps, blr)
         if not res <= tol:                       # (NaN too)
             printf(f"[ssi] step matrix: the block low-rank LU at eps {eps:g} left a residual {res:.3g} > {tol:g} on "
                 "a test right-hand side; factorised in full rank instead (-ssi_step_blr)")
             self.ksp.destroy()
             self._factorise()
-            return ""
-        return f", block low-rank at eps {eps:g} (-ssi_step_blr; test residual {res:.2g})"
+            return "", 0.0
+        return f", block low-rank at eps {eps:g} (-ssi_step_blr; test residual {res:.2g})", eps
 
     def set_lags(self, H, G, plan=None, HI=(), GI=(), block=1, sub=None):
         """Collective: the exact lag Mats H_l, G_l (lists, index l-1; None =

@@ -18,7 +18,7 @@ A' is folded from the representatives' rows of A (``fold``, compiled): row (sigm
 (n_o, c) of A Q_sigma over q_{sigma,o,c}(n_o, c), exact when A commutes with G. A computed A commutes to
 round-off only: on a flat surface the self blocks' in-plane/normal entries, zero by symmetry, come out of
 the singular integration as about 4e-13 (against a diagonal of 2), which the reflection maps to their
-negatives. So the commutation is checked before (``commutes``: A R v against R A v on a fixed vector, to
+negatives. So the commutation is checked before (``commutation_defect``: A R v against R A v on a fixed vector, to
 ``TOL`` of A v), the factors' solve against A itself after (the test residual of ``march``, at most
 ``march.BLR_TOL``), and each step's residual check (``bem_residual``) uses A, not the folded blocks; a
 check that fails puts A's own LU back, said in one line.
@@ -243,6 +243,11 @@ class MirrorBlocks:
             self.why = "the surface, its prescribed-displacement or traction nodes are not mirror-symmetric"
             return
         self.planes = " and ".join(f"{'xy'[a]} = {c:.6g}" for a, c, _ in refl)
+        r0, r1 = A.getOwnershipRange()
+        from mpi4py import MPI
+        if not comm.tompi4py().allreduce(int(r0 % 3 == 0 and r1 % 3 == 0), op=MPI.MIN):
+            self.why = "the step matrix's rows are not whole nodes on every rank"     # (the blocks' rows assume it)
+            return
         self.defect = commutation_defect(PETSc, comm, A, refl)
         if not self.defect <= TOL:
             self.why = (f"the nodes mirror about {self.planes} but the step matrix does not commute with the "
@@ -254,7 +259,6 @@ class MirrorBlocks:
         if rep_dof.size != n:                    # (cannot happen: Q is square and orthogonal)
             self.why = f"the symmetric basis has {rep_dof.size} columns for {n} DOFs"
             return
-        r0, r1 = A.getOwnershipRange()
         own = (rep_dof >= r0) & (rep_dof < r1)
         k = np.flatnonzero(own)
         k0, k1 = (int(k[0]), int(k[-1]) + 1) if k.size else (int(np.count_nonzero(rep_dof < r0)),) * 2

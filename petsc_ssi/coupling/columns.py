@@ -99,11 +99,21 @@ class RegionColumns:
             defaults["mat_mumps_icntl_14"] = str(ICNTL14)
         set_default_options("ssi_bem_columns_", defaults, self.log)
         mb = self._mirror(AR)
-        self.mirrored = mb is not None
         ksp.setOperators(AR if mb is None else mb.Ap)
         ksp.setFromOptions()
         ksp.setUp()
         self.failed = mumps_failure(ksp)
+        if mb is not None and not self.failed and not self._blocks_solve(ksp, AR, mb):
+            mb.destroy()                        # (the blocks' solve off AR's: the region's matrix as it is)
+            mb = None
+            ksp.destroy()
+            ksp = PETSc.KSP().create(comm=self.comm)
+            ksp.setOptionsPrefix("ssi_bem_columns_")
+            ksp.setOperators(AR)
+            ksp.setFromOptions()
+            ksp.setUp()
+            self.failed = mumps_failure(ksp)
+        self.mirrored = mb is not None
         if self.failed:                         # (every rank: INFOG is global)
             self.ok, self.residual, self.rhs_outside, self.Z = False, float("nan"), False, None
             for o in (ksp, AR, AQ) + (() if mb is None else (mb,)):
@@ -171,6 +181,29 @@ class RegionColumns:
             mb.destroy()
             return None
         return mb
+
+    def _blocks_solve(self, ksp, AR, mb):
+        """Collective: whether the region's blocks solve AR x = b on a fixed right-hand side (the same as the
+        step matrix's test, ``march._test_residual``) to the step matrix's test bound, ``march.BLR_TOL``."""
+        from ..bem.march import BLR_TOL
+        b = AR.createVecLeft()
+        r0, r1 = b.getOwnershipRange()
+        b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
+        x, r = b.duplicate(), b.duplicate()
+        yb, yx = mb.Ap.createVecRight(), mb.Ap.createVecRight()
+        mb.Q.multTranspose(b, yb)
+        ksp.solve(yb, yx)
+        mb.Q.mult(yx, x)
+        AR.mult(x, r)
+        r.axpy(-1.0, b)
+        res = r.norm() / b.norm()
+        for v in (b, x, r, yb, yx):
+            v.destroy()
+        if not res <= BLR_TOL:
+            self.log(f"[ssi] interface columns: the region's mirror-symmetric blocks left a residual {res:.3g} > "
+                     f"{BLR_TOL:g} on a test right-hand side; its matrix as it is instead")
+            return False
+        return True
 
     def destroy(self):
         for o in (self.is_r, self.is_ring):

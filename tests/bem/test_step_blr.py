@@ -46,7 +46,7 @@ def test_step_blr_check_falls_back_to_full_rank(tmp_path, monkeypatch, capfd):
     monkeypatch.setattr(march, "BLR_FROM", 0)          # (auto takes BLR on this small grid)
     monkeypatch.setattr(march, "BLR_TOL", -1.0)        # (no residual passes)
     kw = dict(mesh_size="6,6", mesh_h=1.0, mesh_patch="1,1", load_group="load", load_p0=1000, dt=0.0025,
-              t_end=0.02, receivers="0,0,0;2,0,0", output_stride=0, warn_beta=0)
+              t_end=0.02, receivers="0,0,0;2,0,0", output_stride=0, warn_beta=0, step_mirror="off")
     a = run_bem(**kw, output=tmp_path / "a.h5")
     out = capfd.readouterr().out
     assert "left a residual" in out and "factorised in full rank instead (-ssi_step_blr)" in out, out[-3000:]

@@ -7,9 +7,10 @@ other plane only; one whose prescribed nodes do not mirror keeps the matrix as i
 import os
 import sys
 
+import numpy as np
 import pytest
 
-from helpers import cli
+from helpers import cli, run_bem
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from test_history_block import BEM, DISP, SSI, same  # noqa: E402
@@ -65,11 +66,14 @@ def test_coupled_box_with_contact_and_region_columns(tmp_path):
 
 def test_prescribed_nodes_that_do_not_mirror_keep_the_matrix(tmp_path):
     """A rigid footing off the grid's centre in x and y: its prescribed nodes do not mirror, so no blocks
-    (nothing said beyond the usual line); -ssi_step_mirror takes auto and off only."""
+    (nothing said beyond the usual line), while the same footing centred has them; -ssi_step_mirror takes auto
+    and off only."""
     case = DISP[:]
     case[case.index("load")] = "box:0.5,1.5,0,0.5"
     out = cli(case + ["-ssi_t_end", "0.01", "-ssi_output", str(tmp_path / "x.h5")]).stdout
-    assert "mirror" not in out
+    assert "mirror" not in out and "[ssi] step matrix:" in out
+    out = cli(DISP + ["-ssi_t_end", "0.01", "-ssi_output", str(tmp_path / "z.h5")]).stdout
+    assert "4 independent blocks" in _line(out)
     r = cli(BEM + ["-ssi_step_mirror", "on", "-ssi_output", str(tmp_path / "y.h5")], check=False)
     assert r.returncode != 0 and "-ssi_step_mirror" in (r.stdout + r.stderr)
 
@@ -88,3 +92,23 @@ def test_region_columns_through_the_blocks(tmp_path):
     assert "their own LU (mirror-symmetric blocks, as the step matrix)" in out, out[-3000:]
     assert "independent blocks" in _line(out)
     same(ref, got, rtol=1e-12)
+
+
+def test_blocks_that_fail_their_test_put_the_matrix_back(tmp_path, monkeypatch, capfd):
+    """Blocks whose test residual exceeds the bound (the bound set below any residual) are replaced by the LU of
+    the matrix as it is, said in one line, and the answer is -ssi_step_mirror off's bit for bit; a user's
+    iterative solver keeps the matrix as it is without trying the blocks."""
+    from petsc_ssi.bem import march
+    kw = dict(mesh_size="6,6", mesh_h=1.0, mesh_patch="1,1", load_group="load", load_p0=1000, dt=0.0025,
+              t_end=0.02, receivers="0,0,0;2,0,0", output_stride=0, warn_beta=0)
+    monkeypatch.setattr(march, "BLR_TOL", -1.0)        # (no residual passes)
+    a = run_bem(**kw, output=tmp_path / "a.h5")
+    out = capfd.readouterr().out
+    assert "its mirror-symmetric blocks left a residual" in out and "factorised as it is instead" in out, out[-3000:]
+    assert "independent blocks" not in out
+    b = run_bem(**kw, step_mirror="off", output=tmp_path / "b.h5")
+    assert np.abs(a["u"]).max() > 0 and np.array_equal(a["u"], b["u"])
+    capfd.readouterr()
+    out = cli(BEM + ["-ssi_t_end", "0.01", "-ssi_bem_ksp_type", "gmres", "-ssi_bem_pc_type", "lu",
+                     "-ssi_output", str(tmp_path / "c.h5")]).stdout
+    assert "mirror" not in out
