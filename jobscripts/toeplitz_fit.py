@@ -13,8 +13,8 @@ rate at a time to get each term's count, and the rates are fitted by non-negativ
 relative errors: the kernels' build per side (t_pair_lag, seconds per H kernel offset and lag, against the
 H side's 'kernels ... s'; g_pair_factor, a G offset's seconds over an H offset's, against the G side's), the
 history sum (event SSI_BEM_History) against the products (1 / r_products), the
-per-step DOF term (t_step_dof) and the per-step FFT-grid term (t_step_grid); r_sums (the interpolated lags'
-weighted states anchor by anchor) is kept as it is; r_sums_span (over the anchors' common span: Chebyshev)
+per-step DOF term (t_step_dof), the per-step FFT-grid term (t_step_grid) and r_sums (the interpolated lags'
+weighted states anchor by anchor: multi-linear hats, the sites); r_sums_span (over the anchors' common span: Chebyshev)
 is the median over the logs that have it of the span's flops over the event SSI_BEM_HistInterp less its
 anchors' kernel products. Oversubscribed runs are left out. The printed RATES line goes into
 toeplitz.py by hand, with the logs' names and date in its comment.
@@ -69,6 +69,8 @@ def terms(opts, ranks):
     return {"pairs_h": pairs_h, "pairs_g": pairs_g, "int_h": int_h, "int_g": int_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2],
             "sums": one(r_sums=RATES["r_sums"], r_sums_span=RATES["r_sums_span"])[2],
+            # the weighted states anchor by anchor (multi-linear hats), flops a rank
+            "sums1": one(r_sums=1.0)[2],
             # the weighted states over the anchors' common span (Chebyshev), flops a rank, and the anchors'
             # kernel products of the same event (SSI_BEM_HistInterp), flops a rank (at r_products in the model)
             "span": one(r_sums_span=1.0)[2], "interp_prod": _interp_products(lat, glat, plan, prob.n_steps, ranks, kw, cfg)}
@@ -109,22 +111,25 @@ def main(logs, check=False, products_rate=None):
     kh = np.array([r.get("kernels_h_s", r["kernels_s"]) for _, r, _ in runs], float)
     kg = np.array([r.get("kernels_g_s", 0.0) for _, r, _ in runs], float)
     hist = np.array([r["history_s"] for _, r, _ in runs], float)
-    sums = np.array([t["sums"] for *_, t in runs])
     if check:
         fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
-                                     "t_pair_int", "g_pair_factor")}
+                                     "t_pair_int", "g_pair_factor", "r_sums")}
     else:
+        # the history less the weighted states over a common span (Chebyshev, at the committed r_sums_span, refitted
+        # below from its own event); the anchor-by-anchor weighted states (multi-linear: the sites) fitted as r_sums
+        span_s = np.array([t["span"] for *_, t in runs]) / RATES["r_sums_span"]
+        S1 = np.array([[t["sums1"]] for *_, t in runs])
         if products_rate:           # r_products held (the fit's products and per-step terms are nearly collinear
             prod = np.array([t["prod"] for *_, t in runs]) / products_rate      # on few logs), the rest fitted
-            A = np.array([[t["dof"], t["grid"], t["elem"]] for *_, t in runs])
-            t_dof, t_grid, t_elem = _nnls(A, hist - sums - prod)
+            A = np.hstack([np.array([[t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
+            t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s - prod)
             inv_r = 1.0 / products_rate
         else:
-            A = np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs])
-            inv_r, t_dof, t_grid, t_elem = _nnls(A, hist - sums)
+            A = np.hstack([np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
+            inv_r, t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s)
         fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
                "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
-               }
+               "r_sums": 1.0 / inv_s if inv_s > 0 else RATES["r_sums"]}
         fit["t_pair_lag"], fit["t_pair_int"] = (float(v) for v in _nnls(
             np.array([[t["pairs_h"], t["int_h"]] for *_, t in runs]), kh))
         # G's offsets against the G side's own seconds (the logs that print them): one factor on both terms
@@ -137,7 +142,7 @@ def main(logs, check=False, products_rate=None):
     spans = []
     for path, r, t in runs:
         m = re.search(r"^SSI_BEM_HistInterp\s+(\d+)\s+\S+\s+(\S+)", open(path, errors="replace").read(), re.M)
-        if m and t["span"] > 0:
+        if m and t["span"] > 1.0:          # (a run without a common span counts ~1e-290 of it: the zero rates' 1e300)
             left = float(m.group(2)) - t["interp_prod"] / fit["r_products"]
             spans.append((os.path.relpath(path, ROOT), t["span"] / left if left > 0 else float("nan")))
     for name, rate in spans:
@@ -151,8 +156,7 @@ def main(logs, check=False, products_rate=None):
         mk = (fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
               + fit["t_pair_int"] * (t["int_h"] + fit["g_pair_factor"] * t["int_g"]))
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
-              + fit["t_step_elem"] * t["elem"] + t["sums"] + t["span"] * (1.0 / fit["r_sums_span"]
-                                                                          - 1.0 / RATES["r_sums_span"]))
+              + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"])
         ms = 1e3 * bem_solve_seconds(c, int(r["dofs"]) // 3, int(r["ranks"]))
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
               f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")

@@ -179,28 +179,28 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
 # kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
 # displacement kernel's integrals beside the traction kernel's) are fitted by `python
 # jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
-# their split is loose, their sum is what the logs fix) to the logs of `PARTS="paper grid" bash
+# their split is loose, their sum is what the logs fix) to the 14 logs of `PARTS="paper grid scale site" bash
 # jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
-# models) and of the building on the uniform 36 and 72 m grids (`OUT=/tmp/fitlogs RUNS="uniform-36 uniform-72" bash
-# jobscripts/quiet.sh bash jobscripts/building_uniform.sh`), 2 ranks, every other process paused, 2026-11-30
-# 04:55-05:00 at d649a2c (mirror integrals, real kernels on point-symmetric sides): kernels from -3 % to +4 %,
-# history from -6 % to +10 % of each of those 8 logs (t_step_dof fitted to 0: collinear with the other
-# per-step terms). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
+# models, the sites of 40-100 m with multi-linear far lags and single-precision transforms, the 40 m one also
+# exact; out/bench/toeplitz, 06:46-06:48 and 07:01-07:07) and of the building on the uniform 36 and 72 m grids
+# (`bash jobscripts/quiet.sh env RUNS="... uniform-36 uniform-72 ..." bash jobscripts/building_uniform.sh`,
+# 06:33-06:38), 2 ranks, every other process paused, 2026-11-30, code at b5579b9-e4fdc58: kernels from -21 % to
+# +11 %, history from -10 % to +6 % of each log (t_step_grid fitted to 0: collinear with the other per-step
+# terms). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
 # and exchange (9 slots; 5 on a real side), t_pair_int its share of the integrals. The kernels are fitted per side (the log's H and G
-# seconds). r_sums, the real flops per second of the interpolated lags' weighted states
-# (``interp_products``), from the 40, 60 and 80 m sites on the shared machine (each run's rate of the
-# weighted states over its rate of the exact products, times the idle r_products of the time; median of
-# 3.44, 6.67, 4.69 GFlop/s), is not refitted: it prices the multi-linear weights, anchor by anchor (small
-# products). r_sums_span prices Chebyshev's, every anchor over the common span of states (one larger product a
+# seconds). r_sums, the real flops per second of the interpolated lags' weighted states anchor by anchor
+# (``interp_products``: the multi-linear weights, small products), fitted with the history's other terms
+# (the sites' logs; 4.69e9 before, from three sites on a shared machine, which left the sites' history +66 to
+# +80 % over the measured). r_sums_span prices Chebyshev's, every anchor over the common span of states (one larger product a
 # frequency, or two through the weights' rank, ``_low_rank``): the median over the logs that have it of the
 # span's flops, as ``interp_work`` counts them, over the event SSI_BEM_HistInterp less its anchors' modelled
 # kernel products (a model rate above dgemm's: the anchors' products are priced at r_products, slower than
 # they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 8.41e9, "t_step_dof": 0.0, "t_step_grid": 3.24e-7, "t_step_elem": 2.07e-6,
-         "t_pair_lag": 1.52e-6, "t_pair_int": 2.77e-7, "r_sums": 4.69e9, "fill_bytes": 1620.0, "g_pair_factor": 1.33,
-         "r_sums_span": 4.33e10}
+RATES = {"r_products": 1.14e10, "t_step_dof": 1.04e-7, "t_step_grid": 0.0, "t_step_elem": 1.87e-6,
+         "t_pair_lag": 1.13e-6, "t_pair_int": 3.3e-7, "r_sums": 1.83e10, "fill_bytes": 1620.0, "g_pair_factor": 1.31,
+         "r_sums_span": 4.82e10}
 # The step matrix's LU on a uniform grid (``step_lu``: the coupled estimate's factor_s and solve_s, where the dense
 # model's c_fac N^1.5 and c_sol N ln N, fitted on small graded meshes, put the 72 m building's at 7.7 and 21.3 s
 # against 5.3 and 12.1 s measured before the mirror blocks): entries in the factors E = step_fill n rho^2
