@@ -11,17 +11,20 @@ the orthonormal columns of Q (3 N x 3 N, at most |G| nonzeros a row):
 
 and Q^T A Q = diag(A_sigma) is block diagonal. Each step's solve is x = Q A'^{-1} Q^T b with A' = diag(A_sigma)
 factorised once: MUMPS's ordering finds the blocks, and the top separators along the mirror lines, the
-largest fronts of a grid's nested dissection, are gone (the paper's building on the uniform 72 m grid: 50.4 M
-entries in the factors against 77.6 M, a step's solve 26 % faster: runs/building/README.md).
+largest fronts of a grid's nested dissection, are gone (the paper's building on the uniform 72 m grid: 50.3 M
+entries in the factors against 77.6 M, a step's solve 27 ms against 38-40: runs/building/README.md).
 
 A' is folded from the representatives' rows of A (``fold``, compiled): row (sigma, o, c) of A' is row
 (n_o, c) of A Q_sigma over q_{sigma,o,c}(n_o, c), exact when A commutes with G. A computed A commutes to
 round-off only: on a flat surface the self blocks' in-plane/normal entries, zero by symmetry, come out of
 the singular integration as about 4e-13 (against a diagonal of 2), which the reflection maps to their
 negatives. So the commutation is checked before (``commutation_defect``: A R v against R A v on a fixed vector, to
-``TOL`` of A v), the factors' solve against A itself after (the test residual of ``march``, at most
-``march.BLR_TOL``), and each step's residual check (``bem_residual``) uses A, not the folded blocks; a
-check that fails puts A's own LU back, said in one line.
+``TOL`` of A v), the factors' solve against A itself after (``Marcher._test_residual``, at most
+``march.BLR_TOL``, or 100 eps with a block low-rank precision the user chose), and each step's residual
+check (``bem_residual``) uses A, not the folded blocks; a check that fails puts A's own LU back, said in one
+line. The blocks are tried for a direct solve only (the ssi_bem_ KSP preonly with an LU or Cholesky), never
+with symmetry planes (the model is already reduced); the interface columns' region (``coupling.columns``) goes
+through its own blocks, checked the same way against its own matrix.
 """
 import numpy as np
 from numba import njit
