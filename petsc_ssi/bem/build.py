@@ -51,10 +51,10 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
         from .lagset import announce_compile
         announce_compile()
     t0 = time.perf_counter()
-    if cfg.get("lags_load"):
-        return _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
     if getattr(prob, "lattice", None) is not None:
         return _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
+    if cfg.get("lags_load"):
+        return _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0)
     single = int(cfg.lag_single_from)
     ls.assemble(monitor=cfg.monitor, lag_hi=plan.Lx, single_from=single)
     N = prob.mesh.n_nodes
@@ -80,14 +80,21 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     march.set_lags(H, G, plan, HI, GI, block=b, sub=sub)
     _say_block(march)
     ls.H = ls.G = None   # the triplets are in the Mats now
-    if cfg.get("lags_save"):
-        from . import lagstore
-        t1 = time.perf_counter()
-        size, t_crc = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
-        printf(f"[ssi] lag matrices saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
-               f"{fmt_time(time.perf_counter() - t1)}, of which {t_crc:.2f} s the CRC32 checksums of its content; "
-               f"-ssi_lags_load {cfg.lags_save} reuses them)")
+    _save_lags(cfg, comm, prob, plan, march)
     return march, info
+
+
+def _save_lags(cfg, comm, prob, plan, march):
+    """Collective: -ssi_lags_save (``lagstore.save``: the matrices, and the toeplitz store's kernels), one line."""
+    if not cfg.get("lags_save"):
+        return
+    from . import lagstore
+    t1 = time.perf_counter()
+    size, t_crc = lagstore.save(cfg.lags_save, comm, march, lagstore.lag_key(cfg, prob, plan))
+    what = "lag matrices and toeplitz kernels" if march.toeplitz else "lag matrices"
+    printf(f"[ssi] {what} saved to {cfg.lags_save} ({size / 1e9:.3g} GB in "
+           f"{fmt_time(time.perf_counter() - t1)}, of which {t_crc:.2f} s the CRC32 checksums of its content; "
+           f"-ssi_lags_load {cfg.lags_save} reuses them)")
 
 
 def _interpolating_lags(cfg, comm, prob, plan, ls, tcol_loc):
@@ -206,24 +213,43 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     """Collective: build_marcher on a uniform flat grid (-ssi_lag_store toeplitz, ``bem.toeplitz``):
     lags 1 and 2 assembled as always (H and, with tractions, G: the step matrix and the known values'
     terms), the H lags of the history sum beyond them as FFT kernels on the grid, the G lags as FFT
-    kernels on the window of the traction elements (``toeplitz.traction_grid``)."""
+    kernels on the window of the traction elements (``toeplitz.traction_grid``). With -ssi_lags_load the step
+    matrix, lags 1-2 and the kernels are read back from a file a toeplitz run on as many ranks saved
+    (``lagstore``), nothing assembled or integrated."""
     from .toeplitz import ToeplitzHistory, traction_grid
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
-    ls.assemble(monitor=cfg.monitor, lag_hi=2)
-    nev = ls.kernel_evaluations
-    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
-                    mirror=cfg.get("step_mirror", "auto"),
-                    zero_dofs=symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h))
     k = plan.k if plan.active else 0
-    with event("SSI_BEM_LagMats"):
-        H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
-        H = list(H) + [None] * (plan.Lx - 2)
-        G = [None] * plan.Lx
-        if prob.regions.n_t:
-            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), cfg.lag_storage, prob.lag_fill)
-            G[:len(g)] = g
-            nev += tl.kernel_evaluations
+    kern = None
+    zero = symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h)
+    if cfg.get("lags_load"):
+        from . import lagstore
+        PETSc = init()
+        nt = prob.regions.n_t
+        tcol_loc = 0
+        if nt:
+            pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+            tcol_loc = pl.getLocalSize() // 3
+            pl.destroy()
+        A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
+        march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                        mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero, A=A)
+        H, G = list(H) + [None] * (plan.Lx - len(H)), list(G) + [None] * (plan.Lx - len(G))
+        nev = 0
+        ls.cache_hits, ls.cache_bytes = 0, 0.0
+    else:
+        ls.assemble(monitor=cfg.monitor, lag_hi=2)
+        nev = ls.kernel_evaluations
+        march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                        mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero)
+        with event("SSI_BEM_LagMats"):
+            H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
+            H = list(H) + [None] * (plan.Lx - 2)
+            G = [None] * plan.Lx
+            if prob.regions.n_t:
+                g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), cfg.lag_storage, prob.lag_fill)
+                G[:len(g)] = g
+                nev += tl.kernel_evaluations
     ls.H = ls.G = None
     b, sub = _block_of(cfg, comm, H, G, [None] * k, [])
     march.set_lags(H, G, plan, [None] * k, [None] * k if prob.regions.n_t else [], block=b, sub=sub)
@@ -235,7 +261,9 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         for side, lat in grids:
             march.toeplitz.append(ToeplitzHistory(comm, ls, lat, log, block=int(cfg.history_block) or 8, side=side,
                                                   precision=cfg.get("toeplitz_precision", "double"))
-                                  .build(march, plan, monitor=cfg.monitor))
+                                  .build(march, plan, monitor=cfg.monitor,
+                                         kernels=None if kern is None else {n.split(":")[1]: a for n, a in
+                                                                            kern.items() if n.startswith(side + ":")}))
     th = march.toeplitz[0]
     ls.kernel_evaluations = nev + sum(t.nev for t in march.toeplitz)
     t_asm = time.perf_counter() - t0
@@ -257,5 +285,9 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            + "".join(f"; {t.spec['what']} kernels real (point-symmetric offsets: half the products)"
                      for t in march.toeplitz if t.real))
     printf(f"[ssi] history sum: in Fourier space, time-blocked, {th.block} steps per block (-ssi_history_block)")
+    if kern is not None:
+        printf(f"[ssi] lag matrices and toeplitz kernels loaded from {cfg.lags_load} (no assembly, no kernel "
+               "integrals)")
+    _save_lags(cfg, comm, prob, plan, march)
     return march, {"t_asm": t_asm, "mem_exact": mem, "mem_interp": 0.0, "ndense": 0, "nbaij": 0, "nsingle": 0,
                    "fill": float("nan"), "mem": mem}

@@ -519,10 +519,7 @@ class HalfSpace:
         if store == "dense":
             return None
         why = None
-        if self.cfg.get("lags_load") or self.cfg.get("lags_save"):
-            why = ("-ssi_lags_save/-ssi_lags_load store lag matrices, which this store does not keep (its kernels "
-                   "are built in seconds); use -ssi_lag_store dense")
-        elif int(self.cfg.lag_single_from):
+        if int(self.cfg.lag_single_from):
             why = "-ssi_lag_single_from keeps lag matrices in single precision; use -ssi_lag_store dense"
         elif not ls.flat:
             z = self.mesh.cell_coords()[:, :, 2]

@@ -21,6 +21,12 @@ first entry that differs, or the file and the byte offset of the damaged piece);
 matrices load on any number of ranks (rows by the run's node ranges). A run with loaded matrices
 is bitwise the run that saved them when the solves are deterministic (one rank, or
 -ssi_reproducible; ``tests/bem/test_lagstore.py``).
+
+On the toeplitz store (``bem.toeplitz``) the file holds the step matrix, lags 1-2 (H and G) and, after them,
+each side's kernels (the exact lags' K9, K18 and the interpolating matrices' anchors A9, A18) as one MPI Vec
+each: every rank's frequency slab in rank order, its shape in ``FILE.json``. The slabs are the rank count's,
+so the key holds the store and the rank count and another count is refused in one line; the loading run
+integrates nothing (``tests/bem/test_toeplitz.py``).
 """
 import hashlib
 import json
@@ -57,6 +63,9 @@ def lag_key(cfg, prob, plan):
         key["interp_times"] = " ".join(f"{lag}:{toff!r}" for lag, toff in (plan.kernel_time(j) for j in range(plan.k)))
     else:
         key["interp"] = "none"
+    if getattr(prob, "lattice", None) is not None:      # the toeplitz store: its kernels in this rank count's slabs
+        key["lag_store"] = "toeplitz"
+        key["ranks"] = str(prob.comm.getSize())
     return key
 
 
@@ -174,10 +183,19 @@ def save(path, comm, march, key):
                     A = make()
                     A.view(viewer)
                     A.destroy()
+    kernels = _kernel_arrays(march)
+
+    def write_kernels():
+        for _, a in kernels:                    # (each rank's slab of a side's kernels, as one MPI Vec)
+            v = PETSc.Vec().createWithArray(np.ascontiguousarray(a, dtype=float).ravel(), comm=comm)
+            v.view(viewer)
+            v.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
+    collective_io(write_kernels, f"-ssi_lags_save {path}: writing the toeplitz kernels", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     import time
     from ..io.integrity import file_crcs, CHUNK
+    kshapes = [comm.tompi4py().gather(list(a.shape), root=0) for _, a in kernels]    # (every rank's slab shape)
     t0 = time.perf_counter()
     crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
     t_crc = time.perf_counter() - t0
@@ -192,6 +210,8 @@ def save(path, comm, march, key):
             size = os.path.getsize(path)
             manifest = {"format": FORMAT, "key": key, "mats": [[n, _kind(M)] for n, M in mats],
                         "ranks": comm.getSize(), "bytes": size, "crc32_chunk": CHUNK, "crc32": crcs}
+            if kernels:
+                manifest["kernels"] = [[n, shapes] for (n, _), shapes in zip(kernels, kshapes)]
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
@@ -244,6 +264,31 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
             M.setType(types[kind])
             M.load(viewer)
             out[group].append(M)
+    kernels = {}
+
+    def read_kernels():
+        r = comm.getRank()
+        for name, shapes in manifest.get("kernels", []):
+            shape = tuple(shapes[r])
+            v = PETSc.Vec().create(comm=comm)
+            v.setSizes((int(np.prod(shape)), PETSc.DECIDE))
+            v.setType(PETSc.Vec.Type.MPI)
+            v.load(viewer)
+            kernels[name] = v.getArray(readonly=True).reshape(shape).copy()
+            v.destroy()
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
+    collective_io(read_kernels, f"-ssi_lags_load {path}: reading the toeplitz kernels (a truncated or changed file?)",
+                  comm)
     viewer.destroy()
+    if manifest.get("kernels"):
+        return out["A"][0], out["H"], out["G"], out["HI"], out["GI"], kernels
     return out["A"][0], out["H"], out["G"], out["HI"], out["GI"]
+
+
+def _kernel_arrays(march):
+    """[(name, this rank's array)] of the toeplitz store's kernels (``bem.toeplitz``: per side u and p, K9, K18
+    of the exact lags and A9, A18 of the interpolating matrices' anchors), in file order; [] on the dense store."""
+    out = []
+    for tz in getattr(march, "toeplitz", []):
+        out += [(f"{tz.side}:{n}", getattr(tz, n)) for n in ("K9", "K18", "A9", "A18")]
+    return out

@@ -597,12 +597,13 @@ class ToeplitzHistory:
             by_key.setdefault(key, []).append((nbig - m, c))
         return by_key
 
-    def build(self, march, plan, monitor=False):
+    def build(self, march, plan, monitor=False, kernels=None):
         """Collective: the kernels K'_d (d = 1..D) of the march's exact lags and the kernels A_j of the
         interpolating lags (``plan``: the far lags' matrices are sum_j w_j(l) M(T_j), so their part of the
         history sum is sum_j A_j (sum_m c_j(n, m) v^m), the weights c of ``Marcher._interp_coef``, formed
         per block over the kept transforms: only the exact and the anchors' kernels are stored), in this
-        rank's frequency slab."""
+        rank's frequency slab. ``kernels``: {K9, K18, A9, A18} this rank's arrays as a run saved them
+        (-ssi_lags_load, ``lagstore``): taken as they are, nothing integrated (their shapes checked)."""
         t0 = time.perf_counter()
         self.offsets = kernel_offsets(self.lat)
         self.lat.n_offsets = len(self.offsets)
@@ -636,6 +637,18 @@ class ToeplitzHistory:
         self.A9 = np.zeros((G, self.k * 9, n9, kp, FW))
         self.A18 = np.zeros((G, self.k * 18, n18, kp, FW))
         exact = sorted(j for kind, j in by_key if kind == "x")
+        if kernels is not None:
+            bad = [n for n in ("K9", "K18", "A9", "A18") if n not in kernels
+                   or kernels[n].shape != getattr(self, n).shape]
+            from mpi4py import MPI
+            if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
+                raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "
+                               "(saved by another version of petsc-ssi?): save them again with -ssi_lags_save")
+            for n in ("K9", "K18", "A9", "A18"):
+                getattr(self, n)[...] = kernels[n]
+            exact, plan_k = [], 0
+        else:
+            plan_k = self.k
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 terms = by_key.get(("x", lag), ())
@@ -644,7 +657,7 @@ class ToeplitzHistory:
                     for d, c in terms:
                         self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
                         self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
-        for i in range(self.k):
+        for i in range(plan_k):
             if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
                 continue
             lag, toff = plan.kernel_time(i)

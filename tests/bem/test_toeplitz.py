@@ -319,7 +319,7 @@ def test_history_products_match_the_sum():
 
 def test_toeplitz_refusals_and_auto(tmp_path):
     """A grid whose patch edges cut the elements (0.75 m and 1 m columns) is refused in one line naming an
-    element; auto falls back to the dense matrices and says why; -ssi_lags_save is refused."""
+    element; auto falls back to the dense matrices and says why; -ssi_lag_single_from is refused."""
     bad = ["-ssi_problem", "bem", "-ssi_mesh_size", "6,6", "-ssi_mesh_h", "1", "-ssi_mesh_patch", "0.75,0.75",
            "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.0025", "-ssi_t_end", "0.01",
            "-ssi_warn_beta", "0"]
@@ -330,9 +330,8 @@ def test_toeplitz_refusals_and_auto(tmp_path):
     assert "Traceback" not in r.stderr
     r = cli(bad + ["-ssi_lag_store", "auto", "-ssi_output", str(tmp_path / "b.h5")])
     assert "lag store: dense lag matrices (" in r.stdout
-    r = cli(BEM + TZ + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_lags_save", str(tmp_path / "lags")],
-            check=False)
-    assert r.returncode != 0 and "-ssi_lags_save" in r.stdout + r.stderr and "Traceback" not in r.stderr
+    r = cli(BEM + TZ + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_lag_single_from", "5"], check=False)
+    assert r.returncode != 0 and "-ssi_lag_single_from" in r.stdout + r.stderr and "Traceback" not in r.stderr
     # single-precision kept transforms where no store keeps them: the dense store, and auto falling back to it
     for store in ("dense", "auto"):
         r = cli(bad + ["-ssi_lag_store", store, "-ssi_toeplitz_precision", "single", "-ssi_output",
@@ -500,3 +499,35 @@ def test_toeplitz_rectangular_cells_equal_dense(tmp_path):
     out = cli(args + TZ + ["-ssi_output", tz], nranks=2).stdout
     assert "lattice of 1 x 0.75 m elements" in out, out[-3000:]
     same(ref, tz)
+
+
+def test_toeplitz_lags_save_and_load(tmp_path):
+    """-ssi_lags_save on the toeplitz store writes the step matrix, lags 1-2 and both sides' kernels (exact lags
+    and the interpolating matrices' anchors: a rigid footing with a traction side, far lags interpolated); a
+    run that loads them integrates nothing and is the saving run bit for bit (one rank: deterministic solves);
+    the file is refused in one line at another rank count (its kernels are in that count's frequency slabs) and
+    by the dense store."""
+    case = DISP + INTERP + TZ
+    lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
+    out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags]).stdout
+    assert "lag matrices and toeplitz kernels saved to" in out, out[-2000:]
+    out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
+    assert "toeplitz kernels loaded from" in out and "content checked against its CRC32s" in out, out[-2000:]
+    assert " 0 kernel evaluations" in out
+    A, B = fields(a), fields(b)
+    assert set(A) == set(B) and any(np.abs(v).max() > 0 for v in A.values())
+    for k in A:
+        assert np.array_equal(A[k], B[k]), k
+    lags2, c2, d2 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5"), str(tmp_path / "d2.h5")
+    cli(case + ["-ssi_output", c2, "-ssi_lags_save", lags2], nranks=2)          # (each rank's slab, one file)
+    out = cli(case + ["-ssi_output", d2, "-ssi_lags_load", lags2], nranks=2).stdout
+    assert "toeplitz kernels loaded from" in out
+    same(c2, d2)
+    same(a, d2)
+    for extra, nranks, what in ((["-ssi_output", str(tmp_path / "c.h5")], 2, "ranks differs"),
+                                (["-ssi_output", str(tmp_path / "d.h5"), "-ssi_lag_store", "dense"], 1,
+                                 "lag_store differs")):
+        args = [x for x in case if x not in TZ] + (TZ if "-ssi_lag_store" not in extra else []) + extra
+        r = cli(args + ["-ssi_lags_load", lags], nranks=nranks, check=False)
+        err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
+        assert r.returncode != 0 and err and what in err[0] and "Traceback" not in r.stderr, (what, r.stderr[-2000:])
