@@ -209,6 +209,44 @@ def _traction_g(comm, prob, plan, ls, lag_hi, storage, fill, lag_lo=1, toff=0.0)
     return lagmats.build(comm, gb, lag_hi, ls.node_range, N, nt, tcol_loc, storage, fill)[0], tl
 
 
+def _toeplitz_loaded(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
+    """Collective: (march, H, G, kernels) of -ssi_lags_load on the toeplitz store: the step matrix and lags 1-2
+    read back, the kernels' arrays as ``lagstore.load`` gives them ({side:name: this rank's slab})."""
+    from . import lagstore
+    PETSc = init()
+    N, nt = prob.mesh.n_nodes, prob.regions.n_t
+    tcol_loc = 0
+    if nt:
+        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+        tcol_loc = pl.getLocalSize() // 3
+        pl.destroy()
+    A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                    mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero, A=A)
+    ls.cache_hits, ls.cache_bytes = 0, 0.0
+    return march, list(H) + [None] * (plan.Lx - len(H)), list(G) + [None] * (plan.Lx - len(G)), kern
+
+
+def _toeplitz_assembled(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
+    """Collective: (march, H, G, kernel evaluations) of the toeplitz store's lags 1-2, assembled: the step
+    matrix factorised, H's and (with tractions) G's lags 1-2 as Mats, the later lags None (kernels)."""
+    N = prob.mesh.n_nodes
+    r0, r1 = ls.node_range
+    ls.assemble(monitor=cfg.monitor, lag_hi=2)
+    nev = ls.kernel_evaluations
+    march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
+                    mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero)
+    with event("SSI_BEM_LagMats"):
+        H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
+        H = list(H) + [None] * (plan.Lx - 2)
+        G = [None] * plan.Lx
+        if prob.regions.n_t:
+            g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), cfg.lag_storage, prob.lag_fill)
+            G[:len(g)] = g
+            nev += tl.kernel_evaluations
+    return march, H, G, nev
+
+
 def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     """Collective: build_marcher on a uniform flat grid (-ssi_lag_store toeplitz, ``bem.toeplitz``):
     lags 1 and 2 assembled as always (H and, with tractions, G: the step matrix and the known values'
@@ -217,39 +255,14 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     matrix, lags 1-2 and the kernels are read back from a file a toeplitz run on as many ranks saved
     (``lagstore``), nothing assembled or integrated."""
     from .toeplitz import ToeplitzHistory, traction_grid
-    N = prob.mesh.n_nodes
-    r0, r1 = ls.node_range
     k = plan.k if plan.active else 0
-    kern = None
     zero = symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h)
     if cfg.get("lags_load"):
-        from . import lagstore
-        PETSc = init()
-        nt = prob.regions.n_t
-        tcol_loc = 0
-        if nt:
-            pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-            tcol_loc = pl.getLocalSize() // 3
-            pl.destroy()
-        A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
-        march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
-                        mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero, A=A)
-        H, G = list(H) + [None] * (plan.Lx - len(H)), list(G) + [None] * (plan.Lx - len(G))
+        march, H, G, kern = _toeplitz_loaded(cfg, comm, prob, plan, ls, known_u, known_p, log, zero)
         nev = 0
-        ls.cache_hits, ls.cache_bytes = 0, 0.0
     else:
-        ls.assemble(monitor=cfg.monitor, lag_hi=2)
-        nev = ls.kernel_evaluations
-        march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
-                        mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero)
-        with event("SSI_BEM_LagMats"):
-            H, _ = lagmats.build(comm, ls.H, 2, ls.node_range, N, N, r1 - r0, cfg.lag_storage, prob.lag_fill)
-            H = list(H) + [None] * (plan.Lx - 2)
-            G = [None] * plan.Lx
-            if prob.regions.n_t:
-                g, tl = _traction_g(comm, prob, plan, ls, min(2, plan.Lx), cfg.lag_storage, prob.lag_fill)
-                G[:len(g)] = g
-                nev += tl.kernel_evaluations
+        march, H, G, nev = _toeplitz_assembled(cfg, comm, prob, plan, ls, known_u, known_p, log, zero)
+        kern = None
     ls.H = ls.G = None
     b, sub = _block_of(cfg, comm, H, G, [None] * k, [])
     march.set_lags(H, G, plan, [None] * k, [None] * k if prob.regions.n_t else [], block=b, sub=sub)

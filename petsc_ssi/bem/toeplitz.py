@@ -636,35 +636,7 @@ class ToeplitzHistory:
         self.K18 = np.zeros((G, D * 18, n18, kp, FW))
         self.A9 = np.zeros((G, self.k * 9, n9, kp, FW))
         self.A18 = np.zeros((G, self.k * 18, n18, kp, FW))
-        exact = sorted(j for kind, j in by_key if kind == "x")
-        if kernels is not None:
-            bad = [n for n in ("K9", "K18", "A9", "A18") if n not in kernels
-                   or kernels[n].shape != getattr(self, n).shape]
-            from mpi4py import MPI
-            if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
-                raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "
-                               "(saved by another version of petsc-ssi?): save them again with -ssi_lags_save")
-            for n in ("K9", "K18", "A9", "A18"):
-                getattr(self, n)[...] = kernels[n]
-            exact, plan_k = [], 0
-        else:
-            plan_k = self.k
-        if exact:
-            for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
-                terms = by_key.get(("x", lag), ())
-                if terms:
-                    L9, L18 = self._lanes(S)
-                    for d, c in terms:
-                        self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
-                        self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
-        for i in range(plan_k):
-            if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
-                continue
-            lag, toff = plan.kernel_time(i)
-            for _, S in self._spectra(lag, lag, toff, lag):
-                L9, L18 = self._lanes(S)
-                self.A9[:, 9 * i:9 * (i + 1)] += L9
-                self.A18[:, 18 * i:18 * (i + 1)] += L18
+        self._fill_kernels(by_key, plan, kernels)
         # the kept states' transforms, in time order (state m at m - base), in lanes: z (groups, W, 9, 2, FW),
         # x and y (groups, W, 18, 2, FW); a step's window of D states is a run of rows of each group (a row
         # offset for ``lanes.lane_products``, no copy); states before the first are zeros, as are those not
@@ -690,6 +662,41 @@ class ToeplitzHistory:
         self.nev = mpi.allreduce(self.nev)
         self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18)))
         return self
+
+    def _fill_kernels(self, by_key, plan, kernels=None):
+        """Collective: K9, K18 (the exact lags' kernels, ``by_key``'s terms ("x", lag): [(d, c)], each lag's
+        spectra weighted into the time distances d it serves) and A9, A18 (the interpolating matrices' anchors,
+        ("i", j)), integrated and transformed chunk by chunk (``_spectra``); or ``kernels`` as a run saved
+        them (-ssi_lags_load), their shapes checked on every rank."""
+        D = self.D
+        exact = sorted(j for kind, j in by_key if kind == "x")
+        plan_k = self.k
+        if kernels is not None:
+            bad = [n for n in ("K9", "K18", "A9", "A18") if n not in kernels
+                   or kernels[n].shape != getattr(self, n).shape]
+            from mpi4py import MPI
+            if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
+                raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "
+                               "(saved by another version of petsc-ssi?): save them again with -ssi_lags_save")
+            for n in ("K9", "K18", "A9", "A18"):
+                getattr(self, n)[...] = kernels[n]
+            exact, plan_k = [], 0
+        if exact:
+            for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
+                terms = by_key.get(("x", lag), ())
+                if terms:
+                    L9, L18 = self._lanes(S)
+                    for d, c in terms:
+                        self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
+                        self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
+        for i in range(plan_k):
+            if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
+                continue
+            lag, toff = plan.kernel_time(i)
+            for _, S in self._spectra(lag, lag, toff, lag):
+                L9, L18 = self._lanes(S)
+                self.A9[:, 9 * i:9 * (i + 1)] += L9
+                self.A18[:, 18 * i:18 * (i + 1)] += L18
 
     def _rotation(self, sign, whole=False):
         """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab (or the whole spectrum),
