@@ -42,10 +42,20 @@ def _say_block(march):
         printf("[ssi] history sum: step by step (-ssi_history_block 1)")
 
 
+def _traction_cols_local(comm, nt):
+    """This rank's traction nodes of G's columns (PETSc's default split of 3 nt DOFs in blocks of 3)."""
+    if not nt:
+        return 0
+    PETSc = init()
+    pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
+    n = pl.getLocalSize() // 3
+    pl.destroy()
+    return n
+
+
 def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     """Collective: assemble the lag matrices (exact and interpolating), factorise
     the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
-    PETSc = init()
     from .. import numba_cache_warm
     if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
         from .lagset import announce_compile
@@ -67,9 +77,7 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
                                  prob.lag_fill)
         nt = prob.regions.n_t
         if nt:
-            pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-            tcol_loc = pl.getLocalSize() // 3
-            pl.destroy()
+            tcol_loc = _traction_cols_local(comm, nt)
             G, ginfo = lagmats.build(comm, ls.G, plan.Lx, ls.node_range, N, nt, tcol_loc, "dense")
         else:
             G = [None] * plan.Lx
@@ -146,15 +154,10 @@ def _assembly_report(cfg, comm, plan, ls, N, mats, hinfo, t_asm):
 
 def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     """Collective: build_marcher with the matrices of -ssi_lags_load (checked in ``prepare``)."""
-    PETSc = init()
     from . import lagstore
     N = prob.mesh.n_nodes
     nt = prob.regions.n_t
-    tcol_loc = 0
-    if nt:
-        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-        tcol_loc = pl.getLocalSize() // 3
-        pl.destroy()
+    tcol_loc = _traction_cols_local(comm, nt)
     # (the file holds float32 values as doubles, PETSc's scalar: float32 again as each is read)
     A, H, G, HI, GI = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc,
                                     single_from=int(cfg.lag_single_from),
@@ -198,10 +201,7 @@ def _traction_g(comm, prob, plan, ls, lag_hi, storage, fill, lag_lo=1, toff=0.0)
     MatMults 2.9 -> 1.4 s and the lags' panel products, 1.8 s, gone: jobscripts/README.md)."""
     nt = prob.regions.n_t
     tl = ls.restricted(np.any(ls.VT >= 0, axis=1))
-    PETSc = init()
-    pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-    tcol_loc = pl.getLocalSize() // 3
-    pl.destroy()
+    tcol_loc = _traction_cols_local(comm, nt)
     _, gb = tl.assemble(monitor=False, lag_lo=lag_lo, lag_hi=lag_hi, toff=toff, quiet=True, keep_h=False)
     N = prob.mesh.n_nodes
     if lag_lo == lag_hi and lag_lo > 1:
@@ -213,13 +213,8 @@ def _toeplitz_loaded(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
     """Collective: (march, H, G, kernels) of -ssi_lags_load on the toeplitz store: the step matrix and lags 1-2
     read back, the kernels' arrays as ``lagstore.load`` gives them ({side:name: this rank's slab})."""
     from . import lagstore
-    PETSc = init()
     N, nt = prob.mesh.n_nodes, prob.regions.n_t
-    tcol_loc = 0
-    if nt:
-        pl = PETSc.Vec().createMPI((PETSc.DECIDE, 3 * nt), bsize=3, comm=comm)
-        tcol_loc = pl.getLocalSize() // 3
-        pl.destroy()
+    tcol_loc = _traction_cols_local(comm, nt)
     A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
                     mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero, A=A)

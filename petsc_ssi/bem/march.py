@@ -203,14 +203,12 @@ class Marcher:
             mb.destroy()
             return ""
         self.mirror = mb
-        self._yb, self._yx = mb.Ap.createVecRight(), mb.Ap.createVecRight()
         return (f", mirror-symmetric about {mb.planes}: {len(mb.sizes)} independent blocks of "
                 f"{'/'.join(str(n) for n in mb.sizes)} DOFs (-ssi_step_mirror; commutation defect {mb.defect:.2g}")
 
     def _drop_mirror(self):
-        for o in (self.mirror, self._yb, self._yx):
-            o.destroy()
-        self.mirror = self._yb = self._yx = None
+        self.mirror.destroy()
+        self.mirror = None
 
     def _factorise(self, eps=0.0):
         """Collective: the KSP of the step matrix, set up (factorised) with the ssi_bem_ options; with ``eps``
@@ -240,20 +238,9 @@ class Marcher:
 
     def _test_residual(self):
         """Collective: ||A x - b|| / ||b|| of the step solve (``solve``'s path, its factors) on a fixed test
-        right-hand side (the same on any rank count), A the step matrix itself."""
-        b = self.A.createVecLeft()
-        r0, r1 = b.getOwnershipRange()
-        b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
-        if self.zero_local.size:
-            b.getArray()[self.zero_local] = 0.0
-        x, r = b.duplicate(), b.duplicate()
-        self._solve(b, x)
-        self.A.mult(x, r)
-        r.axpy(-1.0, b)
-        res = r.norm() / b.norm()
-        for v in (b, x, r):
-            v.destroy()
-        return res
+        right-hand side (``mirror.solve_residual``), A the step matrix itself."""
+        from .mirror import solve_residual
+        return solve_residual(self.A, self._solve, self.zero_local)
 
     @staticmethod
     def _test_tol(eps, blr):
@@ -785,10 +772,8 @@ class Marcher:
         """x = A^{-1} b: with the mirror-symmetric blocks, x = Q A'^{-1} Q^T b (``bem.mirror``)."""
         if self.mirror is None:
             self.ksp.solve(b, x)
-            return
-        self.mirror.Q.multTranspose(b, self._yb)
-        self.ksp.solve(self._yb, self._yx)
-        self.mirror.Q.mult(self._yx, x)
+        else:
+            self.mirror.solve(self.ksp, b, x)
 
     def solve_columns(self, m, fill, take, block=None):
         """Collective: ``petsc.solve_columns`` with the step matrix's factors (through the mirror-symmetric

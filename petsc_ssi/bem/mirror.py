@@ -12,13 +12,12 @@ the orthonormal columns of Q (3 N x 3 N, at most |G| nonzeros a row):
 and Q^T A Q = diag(A_sigma) is block diagonal. Each step's solve is x = Q A'^{-1} Q^T b with A' = diag(A_sigma)
 factorised once: MUMPS's ordering finds the blocks, and the top separators along the mirror lines, the
 largest fronts of a grid's nested dissection, are gone (the paper's building on the uniform 72 m grid: 50.3 M
-entries in the factors against 77.6 M, a step's solve 27 ms against 38-40: runs/building/README.md).
+entries in the factors against 77.6 M, a step's solve 29 ms against 45: jobscripts/step_mirror_check.sh).
 
 A' is folded from the representatives' rows of A (``fold``, compiled): row (sigma, o, c) of A' is row
 (n_o, c) of A Q_sigma over q_{sigma,o,c}(n_o, c), exact when A commutes with G. A computed A commutes to
 round-off only: on a flat surface the self blocks' in-plane/normal entries, zero by symmetry, come out of
-the singular integration as about 4e-13 (against a diagonal of 2), which the reflection maps to their
-negatives. So the commutation is checked before (``commutation_defect``: A R v against R A v on a fixed vector, to
+the singular integration at round-off level, which the reflection maps to their negatives. So the commutation is checked before (``commutation_defect``: A R v against R A v on a fixed vector, to
 ``TOL`` of A v), the factors' solve against A itself after (``Marcher._test_residual``, at most
 ``march.BLR_TOL``, or 100 eps with a block low-rank precision the user chose), and each step's residual
 check (``bem_residual``) uses A, not the folded blocks; a check that fails puts A's own LU back, said in one
@@ -30,7 +29,7 @@ import numpy as np
 from numba import njit
 
 # the largest commutation defect ||A R v - R A v||_inf / ||A v||_inf accepted: the step equations' round-off (4e-13
-# on the paper's building on the uniform 72 m grid, whose blocks' test residual is then 1.8e-13; 3.9e-12 on
+# on the paper's building on the uniform 72 m grid, whose blocks' test residual is then 1.8e-13; 3.4e-12 on
 # today's graded 36 m grid, where the blocks left 1.2e-12 > march.BLR_TOL: refused before factorising; a
 # surface that is not symmetric gives order 1)
 TOL = 1e-12
@@ -199,6 +198,25 @@ def fold(ip, jj, aa, r0, k0, src, sig, col, val):
     return indptr, indices[:n].copy(), data[:n].copy()
 
 
+def solve_residual(A, solve, zero_local=()):
+    """Collective: ||A x - b|| / ||b|| of ``solve(b, x)`` on the fixed right-hand side b_i = sin(0.7 i + 0.3)
+    over the global rows (zero at ``zero_local``, this rank's symmetry-zero rows): the check of a factorised
+    step matrix (``Marcher._test_residual``: block low-rank, the blocks) and of the region's blocks."""
+    b = A.createVecLeft()
+    r0, r1 = b.getOwnershipRange()
+    b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
+    if len(zero_local):
+        b.getArray()[zero_local] = 0.0
+    x, r = b.duplicate(), b.duplicate()
+    solve(b, x)
+    A.mult(x, r)
+    r.axpy(-1.0, b)
+    res = r.norm() / b.norm()
+    for v in (b, x, r):
+        v.destroy()
+    return res
+
+
 def _signed_permutation(PETSc, comm, nmap, sign, r0, r1):
     """The reflection's DOF map as an AIJ Mat (rows r0..r1 of 3 N): (R v)(n, c) = s(c) v(m(n), c)."""
     d = np.arange(r0, r1)
@@ -285,7 +303,17 @@ class MirrorBlocks:
         self.sizes = [int(np.count_nonzero(sig_of == s)) for s in range(len(chars))]
         self.why = ""
 
+    def solve(self, ksp, b, x):
+        """x = Q Ap^-1 Q^T b, ``ksp`` the factorised blocks (its work vectors made at the first call)."""
+        if getattr(self, "_y", None) is None:
+            self._y = (self.Ap.createVecRight(), self.Ap.createVecRight())
+        yb, yx = self._y
+        self.Q.multTranspose(b, yb)
+        ksp.solve(yb, yx)
+        self.Q.mult(yx, x)
+
     def destroy(self):
-        for M in (self.Q, self.Ap):
+        for M in (self.Q, self.Ap) + tuple(getattr(self, "_y", None) or ()):
             if M is not None:
                 M.destroy()
+        self._y = None

@@ -186,19 +186,8 @@ class RegionColumns:
         """Collective: whether the region's blocks solve AR x = b on a fixed right-hand side (the same as the
         step matrix's test, ``march._test_residual``) to the step matrix's test bound, ``march.BLR_TOL``."""
         from ..bem.march import BLR_TOL
-        b = AR.createVecLeft()
-        r0, r1 = b.getOwnershipRange()
-        b.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
-        x, r = b.duplicate(), b.duplicate()
-        yb, yx = mb.Ap.createVecRight(), mb.Ap.createVecRight()
-        mb.Q.multTranspose(b, yb)
-        ksp.solve(yb, yx)
-        mb.Q.mult(yx, x)
-        AR.mult(x, r)
-        r.axpy(-1.0, b)
-        res = r.norm() / b.norm()
-        for v in (b, x, r, yb, yx):
-            v.destroy()
+        from ..bem.mirror import solve_residual
+        res = solve_residual(AR, lambda b, x: mb.solve(ksp, b, x))
         if not res <= BLR_TOL:
             self.log(f"[ssi] interface columns: the region's mirror-symmetric blocks left a residual {res:.3g} > "
                      f"{BLR_TOL:g} on a test right-hand side; its matrix as it is instead")
