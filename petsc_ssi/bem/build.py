@@ -55,7 +55,18 @@ def _traction_cols_local(comm, nt):
 
 def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
     """Collective: assemble the lag matrices (exact and interpolating), factorise
-    the step matrix and hand the Mats to a Marcher. Returns (marcher, info)."""
+    the step matrix and hand the Mats to a Marcher, with the area loads' lag vectors
+    (``bem.area``, -ssi_load_area). Returns (marcher, info)."""
+    march, info = _build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log)
+    areas = getattr(prob, "areas", [])
+    if areas:
+        from .area import build as build_areas
+        with event("SSI_BEM_Area"):
+            march.area = build_areas(ls, areas, prob.n_steps, march.zero_local)
+    return march, info
+
+
+def _build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log):
     from .. import numba_cache_warm
     if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
         from .lagset import announce_compile

@@ -12,7 +12,7 @@ from ..petsc import SSIError, collective, printf, warn
 from ..mesh import surface
 from .. import timegrid
 from . import symmetry, receivers as rec
-from ..sources import from_options, is_motion
+from ..sources import from_options, is_motion, is_area
 from ..sources.traction import check_sources
 from .lagset import Material, Regions, LagSet
 from .windows import causal_lags
@@ -170,7 +170,8 @@ class HalfSpace:
         self._load_warnings(wave)
         # histories are built (and tables read and checked) before any heavy work
         given = list(from_options(cfg, self.mesh) if sources is None else sources)
-        self.sources = [s for s in given if not is_motion(s)]          # tractions: summed (``known_p``)
+        self.areas = [s for s in given if is_area(s)]                 # area loads: their own lag vectors (bem.area)
+        self.sources = [s for s in given if not is_motion(s) and not is_area(s)]   # tractions: summed (``known_p``)
         self.motion = self._motion_source([s for s in given if is_motion(s)], interface)
         disp = interface.be_elems if interface is not None else self.motion.elements if self.motion else ()
         self._excavation = self._interface_ff = None
@@ -192,7 +193,10 @@ class HalfSpace:
         if interface is not None and not np.array_equal(self.regions.disp_nodes, interface.be_nodes):
             raise SSIError("interface: internal error, node order of the soil regions differs")
         self.bind_sources()
-        for src in self.sources if sources is not None else [self._excavation] if self._excavation else ():
+        for src in self.areas:
+            src.check(self.mesh.nodes, self.planes)
+        for src in (self.sources if sources is not None else [self._excavation] if self._excavation else []) + \
+                self.areas:
             printf(f"[ssi] source: {src.describe()}")
         self.massless = self.motion is not None and self.motion.massless
         if self.motion is not None:       # (a massless footing with no soil around it is refused here)
@@ -220,7 +224,7 @@ class HalfSpace:
         for src in (self._excavation, self._interface_ff):
             if src is not None:
                 src.attach(seismic)
-        loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources) or self._excavation is not None
+        loaded = any(np.any(s.amplitudes() != 0.0) for s in self.sources + self.areas) or self._excavation is not None
         if interface is None and self.motion is None and not loaded:
             # nothing scatters the wave: the scattered field is zero at every step (issue 44: it was
             # marched, assembly and all, and the output held zeros beside the closed-form free field)
@@ -235,9 +239,9 @@ class HalfSpace:
         soil itself; the prescribed motion's options: ``sources.rigid.rigid_motion``) and for a soil whose
         c_s or rho looks like a wrong unit (``soil_plausibility``)."""
         cfg = self.cfg
-        if cfg.load_group and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
+        if (cfg.load_group or cfg.get("load_area", "")) and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
             warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
-        if cfg.user_set("load_p0") and not cfg.load_group:
+        if cfg.user_set("load_p0") and not cfg.load_group and not cfg.get("load_area", ""):
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
         odd = soil_plausibility(cfg.cs, cfg.rho)
         if odd:

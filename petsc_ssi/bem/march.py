@@ -181,6 +181,7 @@ class Marcher:
         self.u_tmpl = self.A.createVecRight()
         self.n = 0
         self.toeplitz = []          # bem/toeplitz.ToeplitzHistory per side: the H (and G) lags >= 3 as FFT kernels
+        self.area = None            # bem/area.AreaHistory: the area loads' terms of each step (-ssi_load_area)
 
     def _mirror_blocks(self, lagset, mode, n_zero):
         """Collective: with -ssi_step_mirror auto and a surface with mirror planes (``bem.mirror``), the block
@@ -734,6 +735,8 @@ class Marcher:
         ev = event("SSI_BEM_History")
         ev.begin()
         self.history(n, self._b)
+        if self.area is not None:
+            self.area.add(n, self, self._b)
         ev.end()
         return n
 

@@ -91,7 +91,10 @@ register("lag_single_from", "int", 0, "lag", "store the lags from this one on in
 register("memory_limit", "real", 0.0, "GB", "refuse runs whose lag matrices need more than this per node (0: 80% of this machine's memory); the run's estimated peak is shared by its ranks", "bem",
          validator=lambda v: None if v >= 0 else "must be >= 0")
 register("load_group", "str", "", "", "loaded elements: a physical group name, or 'box:x0,x1,y0,y1' (element centres inside)", "bem")
-register("load_p0", "real", 0.0, "N/m^2", "uniform pressure on the loaded elements (p0 > 0 pushes the surface down)", "bem")
+register("load_area", "str", "", "m", "a loaded rectangle 'x0,x1,y0,y1' of the surface z = 0, integrated as it is "
+         "whatever the cells (it need not follow them; sources/area.py); instead of -ssi_load_group, with its p0 "
+         "and history", "bem")
+register("load_p0", "real", 0.0, "N/m^2", "uniform pressure on the loaded elements or -ssi_load_area (p0 > 0 pushes the surface down)", "bem")
 register("load_history", "enum", "heaviside", "", "time history of the load: heaviside, box (p0 on [0, t0)), table", "bem",
          choices=("heaviside", "box", "table"))
 register("load_t0", "real", 0.025, "s", "duration of the box pulse", "bem", validator=positive)
@@ -196,7 +199,18 @@ def _bem_checks(cfg):
     if cfg.get("toeplitz_precision", "double") != "double" and cfg.get("lag_store", "dense") == "dense":
         return ("-ssi_toeplitz_precision single: the kept transforms are the toeplitz store's; add -ssi_lag_store "
                 "toeplitz (or auto on a uniform flat grid)")
-    if cfg.load_history == "table" and cfg.load_group and not os.path.isfile(cfg.load_table):
+    if cfg.load_group and cfg.get("load_area", ""):
+        return ("-ssi_load_group and -ssi_load_area: give one of them (the area is the loaded rectangle itself, "
+                "the group its cells)")
+    if cfg.get("load_area", ""):
+        from ..petsc import SSIError
+        from ..sources.area import parse_rect
+        try:
+            parse_rect(cfg.load_area)
+        except SSIError as exc:
+            return str(exc)
+    loaded = cfg.load_group or cfg.get("load_area", "")
+    if cfg.load_history == "table" and loaded and not os.path.isfile(cfg.load_table):
         return f"-ssi_load_table '{cfg.load_table}': no such file"
     return None
 

@@ -24,6 +24,10 @@ The structure's load (``nodal.NodalLoad``): F a(t) with F the nodal forces of th
 and point loads, sampled per step by the integrator's rule ('cell' or 'step'); the fixed base and
 the coupled run both take it (their load() methods had each written the sampling).
 
+An area load (``area.AreaTraction``, -ssi_load_area) is a surface traction on a rectangle that need not
+follow the cells: the soil integrates its kernels over the rectangle itself (``bem.area``) and adds its terms
+to every step's right-hand side; it has ``rect``, ``f``, ``step_mean(m, dt)`` (a scalar) and ``check``.
+
 The soil's prescribed motion (``rigid.PrescribedRigidMotion``, h(t) [u0 + theta0 x (x - x_ref)] on a
 region) and the massless footing (``rigid.MasslessRigidFooting``, whose rigid motion is the unknown of
 every step) are sources too: they load the soil through the displacement of a region of elements
@@ -38,18 +42,21 @@ soil takes the sources the options describe (``from_options``).
 from .traction import SurfaceTraction, uniform_patch, soil_sources
 from .nodal import NodalLoad
 from .rigid import PrescribedRigidMotion, MasslessRigidFooting, rigid_motion
+from .area import AreaTraction, is_area
+from . import area as _area
 
 __all__ = ["SurfaceTraction", "uniform_patch", "soil_sources", "NodalLoad", "PrescribedRigidMotion",
-           "MasslessRigidFooting", "rigid_motion", "from_options", "is_motion"]
+           "MasslessRigidFooting", "rigid_motion", "from_options", "is_motion", "AreaTraction", "is_area"]
 
 
 def from_options(cfg, mesh):
-    """The soil's sources the options describe: the surface traction of -ssi_load_* and the rigid
-    motion of -ssi_disp_* (prescribed or a massless footing); a list, empty when nothing loads the
-    soil."""
+    """The soil's sources the options describe: the surface traction of -ssi_load_* (cells, or the
+    rectangle of -ssi_load_area) and the rigid motion of -ssi_disp_* (prescribed or a massless footing);
+    a list, empty when nothing loads the soil."""
     tractions = soil_sources(cfg, mesh)
+    area = _area.from_options(cfg)
     motion = rigid_motion(cfg, mesh)
-    return tractions + ([motion] if motion is not None else [])
+    return tractions + ([area] if area is not None else []) + ([motion] if motion is not None else [])
 
 
 def is_motion(source):

@@ -1,0 +1,213 @@
+"""The soil's side of an area load (``sources.area``): its lag vectors g_l on the rows a rank owns, and
+their terms in each step's right-hand side.
+
+Integration. The rectangle is tiled into pieces no larger than the mesh's largest element (a piece is
+a flat nine-node element of the plane z = 0, nodes ordered as the mesh's, normal +z). Each (collocation
+point, piece) pair is integrated as the assembly integrates a pair (``assemble._pair_window``: the lags
+its wave window touches, the near-field subdivisions; ``assemble.integrate_records``): a point at one of
+the piece's nine nodes is that node's singular pair. A point inside a piece (or on its edge) that is not
+one of its nodes splits the piece, for that point only, into two or four pieces with the point at their
+common corner, each a singular pair. So a rectangle that is one mesh cell is integrated exactly as that
+cell (the cell's ``SurfaceTraction`` gives the same vectors to round-off), and any other rectangle as
+if the mesh had a cell there.
+
+Lags: 1 .. the last the run reaches (n_steps + 1) or the rectangle's causal limit, whichever is
+smaller; g_l = sum over the pieces and their nine nodes of the U^l blocks times f.
+
+Right-hand side (``AreaHistory.add``, called by ``Marcher.begin_step``): the load enters the step
+equations E_n exactly as a known traction on a cell does (``march``'s module docstring): plain, g_1 a_n
++ sum_{j>=2} g_j a_{n-j+1}; stabilised, (4 g_1 + g_2) a_n + sum_{j>=2} g_j q_j(a). One product a step
+of the (rows x lags) block with the weights of the lags.
+"""
+import math
+import time
+
+import numpy as np
+from numba import njit
+
+from ..petsc import SSIError, printf
+from .assemble import _pair_window, integrate_records, plane, SING_TOL
+from .windows import bounding_spheres
+
+_NXI = np.array([-1., 1., 1., -1., 0., 1., 0., -1., 0.])
+_NET = np.array([-1., -1., 1., 1., -1., 0., 1., 0., 0.])
+CHUNK_BYTES = 64e6      # the integrals of at most this many bytes at a time per rank
+
+
+def piece(x0, x1, y0, y1, z=0.0):
+    """The nine nodes (9, 3) of the rectangle as a nine-node element (the mesh's node order, normal +z)."""
+    X = np.empty((9, 3))
+    X[:, 0] = 0.5 * (x0 + x1) + 0.5 * (x1 - x0) * _NXI
+    X[:, 1] = 0.5 * (y0 + y1) + 0.5 * (y1 - y0) * _NET
+    X[:, 2] = z
+    return X
+
+
+def tiles(rect, hmax):
+    """The rectangle tiled into equal pieces no longer than ``hmax`` on a side: (k, 4) rows (x0, x1, y0, y1)."""
+    x0, x1, y0, y1 = rect
+    nx, ny = (max(1, int(math.ceil((b - a) / hmax * (1 - 1e-12)))) for a, b in ((x0, x1), (y0, y1)))
+    xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+    return np.array([(xs[i], xs[i + 1], ys[j], ys[j + 1]) for i in range(nx) for j in range(ny)])
+
+
+def split(r, p):
+    """The pieces of rectangle r = (x0, x1, y0, y1) cut at the point p's lines x = p_x, y = p_y (those
+    strictly inside it): 1, 2 or 4 rectangles with p at a corner of each."""
+    x0, x1, y0, y1 = r
+    xs = [x0] + ([p[0]] if x0 < p[0] < x1 else []) + [x1]
+    ys = [y0] + ([p[1]] if y0 < p[1] < y1 else []) + [y1]
+    return [(xs[i], xs[i + 1], ys[j], ys[j + 1]) for i in range(len(xs) - 1) for j in range(len(ys) - 1)]
+
+
+@njit(cache=True)
+def _windows(pts, VX, Vc, VR, Vh, reach, cp, cs, dt, L, tol, ns_base, ns_max, near):
+    """meta (points x pieces, 6) of ``integrate_records`` (lo, hi, sing, ns, want_u = 1, piece), and
+    inside[i, k]: point i lies in piece k's closed rectangle without being one of its nodes (split)."""
+    n, k = pts.shape[0], VX.shape[0]
+    meta = np.zeros((n * k, 6), np.int64)
+    inside = np.zeros((n, k), np.bool_)
+    for i in range(n):
+        for e in range(k):
+            lo, hi, sing, ns = _pair_window(pts[i], VX[e], Vc[e], VR[e], Vh[e], reach, cp, cs, dt, L, 1, 0.0, tol,
+                                            ns_base, ns_max, near)
+            r = i * k + e
+            meta[r, 0] = lo
+            meta[r, 1] = hi
+            meta[r, 2] = sing
+            meta[r, 3] = ns
+            meta[r, 4] = 1
+            meta[r, 5] = e
+            eps = tol * Vh[e]
+            if sing < 0 and VX[e, 0, 0] - eps <= pts[i, 0] <= VX[e, 2, 0] + eps and \
+                    VX[e, 0, 1] - eps <= pts[i, 1] <= VX[e, 2, 1] + eps:
+                inside[i, e] = True
+    return meta, inside
+
+
+@njit(cache=True)
+def _reduce(g, rows, meta, offU, U, f, gp, gq):
+    """g[3 rows[r] + p, l - 1] += sum_a U(l, a, p, q) f_q over the records r (the pool's compacted pattern
+    entries (gp, gq): ``assemble._compact``'s layout)."""
+    m = gp.shape[0]
+    for r in range(meta.shape[0]):
+        lo, hi = meta[r, 0], meta[r, 1]
+        k = offU[r]
+        for li in range(hi - lo + 1):
+            for a in range(9):
+                for j in range(m):
+                    g[3 * rows[r] + gp[j], lo + li - 1] += U[k] * f[gq[j]]
+                    k += 1
+
+
+def _records(pts, rect, hmax, ls, L):
+    """(meta, points, pieces VX) of every (owned point, piece) pair that reaches a lag, the pieces that
+    hold a point (not at one of their nodes) split for that point."""
+    o, mat, dt = ls.opts, ls.mat, ls.dt
+    base = [piece(*t) for t in tiles(rect, hmax)]
+    VX = np.array(base)
+    c, R, h = bounding_spheres(VX)
+    reach = mat.cp * dt * L + 1e-9
+    args = (SING_TOL, int(o["subdivisions"]), int(o["max_subdivisions"]), float(o["near_factor"]))
+    meta, inside = _windows(pts, VX, c, R, h, reach, mat.cp, mat.cs, dt, L, *args)
+    point = np.repeat(np.arange(len(pts)), len(VX))
+    keep = (meta[:, 1] >= meta[:, 0]) & ~inside.ravel()
+    meta, point = meta[keep], point[keep]
+    extra_meta, extra_pt, extra_X = [], [], []
+    for i, e in zip(*np.nonzero(inside)):        # (the few points on the rectangle)
+        x0, x1, y0, y1 = VX[e, 0, 0], VX[e, 2, 0], VX[e, 0, 1], VX[e, 2, 1]
+        subs = np.array([piece(*s) for s in split((x0, x1, y0, y1), pts[i])])
+        sc, sR, sh = bounding_spheres(subs)
+        m, _ = _windows(pts[i:i + 1], subs, sc, sR, sh, reach, mat.cp, mat.cs, dt, L, *args)
+        if np.any(m[:, 2] < 0):
+            raise SSIError(f"-ssi_load_area: the point ({pts[i, 0]:g}, {pts[i, 1]:g}) is not a node of the pieces "
+                           "cut at it; report this with the mesh")
+        m[:, 5] += len(VX) + len(extra_X)
+        extra_meta.append(m)
+        extra_pt += [i] * len(m)
+        extra_X += list(subs)
+    if extra_meta:
+        meta = np.concatenate([meta] + extra_meta)
+        point = np.concatenate([point, np.array(extra_pt, np.int64)])
+        VX = np.concatenate([VX, np.array(extra_X)])
+    return meta, point, VX
+
+
+def lag_vectors(ls, src, n_steps):
+    """Collective: (g (3 owned rows, lags), seconds): the area load ``src``'s lag vectors on this rank's
+    rows (module docstring). Every rank agrees on the lag count (the largest any row reaches)."""
+    from mpi4py import MPI
+    t0 = time.perf_counter()
+    mpi = ls.comm.tompi4py()
+    o, mat = ls.opts, ls.mat
+    pts = np.ascontiguousarray(ls.mesh.nodes[ls.rows], float)
+    L = int(n_steps) + 1
+    meta, point, VX = _records(pts, src.rect, float(ls.Vh.max()), ls, L)
+    Ls = mpi.allreduce(int(meta[:, 1].max()) if len(meta) else 0, op=MPI.MAX)
+    g = np.zeros((3 * len(pts), max(Ls, 1)))
+    gq_, gw_ = np.polynomial.legendre.leggauss(o["gauss"])
+    gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
+    pat = ls.pattern()
+    geo = plane(ls.in_plane, VX, int(o["subdivisions"]), gq_, gw_, int(o["max_subdivisions"]))
+    dropped = np.zeros(2)
+    per = 8.0 * 9 * len(pat[2]) * np.maximum(meta[:, 1] - meta[:, 0] + 1, 0)
+    ends = np.searchsorted(np.cumsum(per), np.arange(1, int(per.sum() // CHUNK_BYTES) + 2) * CHUNK_BYTES)
+    start = 0
+    for end in np.unique(np.append(ends, len(meta))):
+        if end <= start:
+            continue
+        mm = np.ascontiguousarray(meta[start:end])
+        _, _, offU, U, _ = integrate_records(mm, pts[point[start:end]], VX, Ls, ls.dt, mat.cp, mat.cs, mat.rho,
+                                             mat.nu, gq_, gw_, gr, gwr, 0.0, float(ls.Vh.min()), pat, dropped,
+                                             int(o["subdivisions"]), geo)
+        _reduce(g, point[start:end], mm, offU, U, src.f, pat[2], pat[3])
+        start = end
+    lost = mpi.allreduce(float(dropped.max()), op=MPI.MAX)
+    if lost > 1e-12 * max(mpi.allreduce(float(np.abs(g).max()) if g.size else 0.0, op=MPI.MAX), 1e-300):
+        raise SSIError(f"-ssi_load_area: a block entry outside the surface's pattern is {lost:.3g}, not 0; "
+                       "report this with the mesh")
+    return g, time.perf_counter() - t0
+
+
+class AreaHistory:
+    """The area loads' terms of each step's right-hand side (module docstring): ``add(n, march, b)``."""
+
+    def __init__(self, sources, gs, dt, zero_local):
+        self.sources, self.dt, self.gs = sources, dt, gs
+        self.zero_local = zero_local
+
+    def weights(self, src, n, march, Ls):
+        """w[j - 1]: the weight of g_j in step n's right-hand side (the scheme's terms, ``Marcher._terms``)."""
+        a = lambda m: src.step_mean(m, self.dt)       # noqa: E731
+        w = np.zeros(Ls)
+        coef = dict(march.coefficients())
+        for lag, c in coef.items():
+            if lag <= Ls:
+                w[lag - 1] += c * a(n)
+        for j in range(2, min(Ls, n + 1) + 1):
+            w[j - 1] += sum(c * a(m) for m, c in march._terms(n, j))
+        return w
+
+    def add(self, n, march, b):
+        """b += the area loads' terms of step n (b: this rank's rows)."""
+        arr = b.getArray()
+        for src, g in zip(self.sources, self.gs):
+            if g.shape[0]:
+                arr += g @ self.weights(src, n, march, g.shape[1])
+        if self.zero_local.size:
+            arr[self.zero_local] = 0.0
+
+
+def build(ls, sources, n_steps, zero_local):
+    """Collective: the AreaHistory of ``sources`` (area loads) on this rank's rows, with one log line each
+    (monitor or not: its memory and time)."""
+    from mpi4py import MPI
+    mpi = ls.comm.tompi4py()
+    gs = []
+    for src in sources:
+        g, sec = lag_vectors(ls, src, n_steps)
+        gb = mpi.allreduce(8.0 * g.size, op=MPI.SUM) / 1e9
+        printf(f"[ssi] {src.name}: its lag vectors integrated over the rectangle in {sec:.2f} s ({g.shape[1]} lags, "
+            f"{gb:.3g} GB over the ranks)")
+        gs.append(g)
+    return AreaHistory(sources, gs, ls.dt, zero_local)

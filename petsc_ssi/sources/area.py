@@ -1,0 +1,98 @@
+"""A surface traction on a rectangle that need not follow the mesh: t(x, t) = f a(t) on
+[x0, x1] x [y0, y1] of the surface z = 0, zero elsewhere (-ssi_load_area).
+
+``traction.SurfaceTraction`` loads the nodes of mesh cells: its rectangle must be a union of cells. On
+a uniform grid whose nodes are a slab's (the building's 0.6 m nodes) no set of cells is the paper's
+1 m x 1 m patch at x = 14.5 m (runs/building/README.md). An area source is not nodal values: the soil
+integrates its lag kernels over the rectangle itself (``bem.area``), for every collocation point it
+owns, and adds
+
+    sum_m g_{n-m+1} a_m,      g_l(x_i) = int_rect U^l(x - x_i) f dGamma,
+
+to the right-hand side of each step equation (through the scheme's own combination of equations:
+plain or stabilised, ``bem.area.AreaHistory``). The rectangle is a traction of the surface the mesh
+stands for; its own displacement is the mesh's (the points inside it are collocation points like any
+other). It is not in the output's nodal traction field (the cells' loads and the contact tractions are):
+its nodal values are not defined where its edges cross cells. Its lags are exact to the last one the run reaches (no interpolation beyond T_L, no
+truncation): a rank keeps (its rows) x (lags) numbers, in the run's log.
+
+    f      the traction [Pa], the soil's convention t = sigma n with n = +z: a pressure p0 pushing the
+           surface down is f = (0, 0, -p0)
+    a(t)   a scalar history (``petsc_ssi.histories.History``), step m carrying its mean over
+           ((m-1) dt, m dt] as every traction of the soil
+"""
+import numpy as np
+
+from ..petsc import SSIError
+from ..histories import History
+
+
+def parse_rect(text, option="-ssi_load_area"):
+    """(x0, x1, y0, y1) [m] from 'x0,x1,y0,y1'; SSIError naming ``option`` otherwise."""
+    try:
+        r = tuple(float(v) for v in str(text).split(","))
+    except ValueError:
+        r = ()
+    if len(r) != 4 or not all(np.isfinite(r)):
+        raise SSIError(f"{option} {text}: give the rectangle as x0,x1,y0,y1 [m]")
+    if not (r[0] < r[1] and r[2] < r[3]):
+        raise SSIError(f"{option} {text}: needs x0 < x1 and y0 < y1")
+    return r
+
+
+class AreaTraction:
+    """f a(t) on the rectangle ``rect`` = (x0, x1, y0, y1) [m] of z = 0 (module docstring)."""
+
+    elements = np.zeros(0, np.int64)        # (no mesh cells: the soil's loaded region does not include it)
+
+    def __init__(self, rect, amplitude, history, name="area load"):
+        self.rect = tuple(float(v) for v in rect)
+        self.f = np.asarray(amplitude, float).reshape(3)
+        self.history, self.name = history, name
+
+    def step_mean(self, m, dt):
+        """a's mean over step m, ((m-1) dt, m dt] (a scalar; f is in the lag vectors)."""
+        return self.history.mean((m - 1) * dt, m * dt) if m >= 1 else 0.0
+
+    def check(self, nodes, planes):
+        """SSIError unless the rectangle lies on the meshed surface: inside the nodes' extent, every node
+        in it at z = 0, and no symmetry plane (the images of an area are not built: mesh the whole surface)."""
+        x0, x1, y0, y1 = self.rect
+        lo, hi = nodes[:, :2].min(axis=0), nodes[:, :2].max(axis=0)
+        if x0 < lo[0] or x1 > hi[0] or y0 < lo[1] or y1 > hi[1]:
+            raise SSIError(f"{self.name}: the rectangle {x0:g}..{x1:g} x {y0:g}..{y1:g} m is not inside the soil "
+                           f"mesh ({lo[0]:g}..{hi[0]:g} x {lo[1]:g}..{hi[1]:g} m)")
+        inside = (nodes[:, 0] >= x0) & (nodes[:, 0] <= x1) & (nodes[:, 1] >= y0) & (nodes[:, 1] <= y1)
+        if np.any(np.abs(nodes[inside, 2]) > 1e-9 * (1.0 + np.abs(nodes[:, :2]).max())):
+            raise SSIError(f"{self.name}: the surface under the rectangle is not the plane z = 0 (an excavation?): "
+                           "an area load is a traction of z = 0; load the cells (-ssi_load_group) instead")
+        if planes:
+            raise SSIError(f"{self.name}: not with symmetry planes (-ssi_symmetry): the area's images are not "
+                           "built; mesh the whole surface (-ssi_symmetry none)")
+
+    def amplitudes(self):
+        return self.f[None, :]
+
+    def describe(self):
+        x0, x1, y0, y1 = self.rect
+        return (f"{self.name}: the rectangle {x0:g}..{x1:g} x {y0:g}..{y1:g} m, traction "
+                f"({self.f[0]:.6g}, {self.f[1]:.6g}, {self.f[2]:.6g}) Pa, history {self.history.kind}, "
+                "integrated over the rectangle itself (not the mesh's cells)")
+
+
+def from_options(cfg):
+    """The options' area load (-ssi_load_area with -ssi_load_p0, -ssi_load_history, -ssi_load_t0,
+    -ssi_load_table), or None."""
+    if not cfg.get("load_area", ""):
+        return None
+    rect = parse_rect(cfg.load_area)
+    try:
+        hist = History(cfg.load_history, cfg.load_t0, cfg.load_table if cfg.load_history == "table" else None)
+    except SSIError as exc:
+        raise SSIError(f"-ssi_load_history {cfg.load_history}: {exc}") from None
+    return AreaTraction(rect, (0.0, 0.0, -cfg.load_p0), hist, name=f"-ssi_load_area {cfg.load_area}")
+
+
+def is_area(source):
+    """Whether ``source`` is an area load (its kernels integrated over its rectangle: ``bem.area``)."""
+    return isinstance(source, AreaTraction)
