@@ -10,6 +10,12 @@
 #   uniform-36     -ssi_mesh grid 36 x 37.2 m of equal 1.2 m nine-node cells (node spacing 0.6 m = the slab's
 #                  shell nodes; y edges at +-18.6 so that +-5.4 are cell edges), toeplitz, the same load
 #   uniform-72     the same grid, 72 x 73.2 m (at least twice today's extent in each direction), toeplitz
+#   today-exact    today without interpolated far lags (-ssi_interp none: all 103 lags exact, dense)
+#   uniform-72-area  uniform-72 with today's load as it is: the 1 m x 1 m square at x = 14.5 m as an area load
+#                  (-ssi_load_area 14,15,-0.5,0.5, sources/area.py: integrated over the square, which no cell holds)
+#   uniform-72-area-exact, uniform-36-area-exact  the same on 72 m and 36 m, every lag exact (-ssi_interp none;
+#                  207 and 103 lags): with today-exact, the split of the difference to today into the far lags'
+#                  interpolation, the cells and the extent (runs/building/README.md)
 #   uniform-72-fullrank (not by default) uniform-72 with the step matrix's MUMPS LU in full rank (-ssi_step_blr 0;
 #                  by default, from 20 000 DOFs on, it is block low-rank at 1e-15 and checked: bem/march.py)
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
@@ -32,7 +38,8 @@ set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
 RANKS=${RANKS:-2}
 OUT=${OUT:-out/bench/building_uniform}
-RUNS=${RUNS:-"today today-load15 uniform-36 uniform-72"}
+RUNS=${RUNS:-"today today-load15 uniform-36 uniform-72 today-exact uniform-72-area uniform-72-area-exact
+      uniform-36-area-exact"}
 T_END=${T_END:-}
 EXTRA=${EXTRA:-}
 FAST=${FAST:-"-ssi_interp linear -ssi_toeplitz_precision single"}
@@ -43,6 +50,9 @@ B=(-options_file runs/building/ssi-full-bonded.opts ${T_END:+-ssi_t_end "$T_END"
 P15=(-ssi_load_p0 694.4444444444445)          # 1000 N over the 1.44 m^2 cell
 U=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14.9,15.1,-0.1,0.1 "${P15[@]}"
    -ssi_lag_store toeplitz)
+A=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group "" -ssi_load_area 14,15,-0.5,0.5
+   -ssi_lag_store toeplitz)
+X=(-ssi_interp none)
 run() { sampled_run "$@"; }
 for r in $RUNS; do
   case $r in
@@ -53,6 +63,13 @@ for r in $RUNS; do
     # shellcheck disable=SC2086
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
+    today-exact) run today-exact "${B[@]}" "${X[@]}" ;;
+    # shellcheck disable=SC2086
+    uniform-72-area) run uniform-72-area "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
+    # shellcheck disable=SC2086
+    uniform-72-area-exact) run uniform-72-area-exact "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 "${X[@]}" $EXTRA ;;
+    # shellcheck disable=SC2086
+    uniform-36-area-exact) run uniform-36-area-exact "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" $EXTRA ;;
     uniform-72-fast) run uniform-72-fast "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $FAST ;;
     uniform-72-fullrank) run uniform-72-fullrank "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 -ssi_step_blr 0 ;;
     uniform-72-blr) run uniform-72-blr "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 -ssi_bem_mat_mumps_icntl_35 2 \

@@ -71,3 +71,21 @@ def test_history_time_fft_equals_the_direct_products(lags, block):
     assert len(row) == 1, r.stdout
     err = float(row[0].strip("|").split("|")[-1])
     assert err <= 1e-13, row[0]
+
+
+def test_building_soil_exact_reference_is_the_box_of_the_step_solution():
+    """jobscripts/building_soil_exact.py's reference: the 25 ms box of Lamb's step solution over the square. Before
+    the box ends it is the step solution itself; long after every arrival it returns to zero (the two steps'
+    static offsets cancel), to 1e-3 of its peak."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    import building_soil_exact as bse
+    from petsc_ssi.analytic.pekeris import patch_displacement
+    t = np.linspace(0.0, 0.024, 25)
+    ux, uz = bse.exact(10.0, 0.0, t, 14.5, 0.5, 1000.0)
+    sx, _, sz = patch_displacement(10.0 - 14.5, 0.0, t, 0.5, 0.5, 1000.0, bse.CS, bse.CP, bse.RHO)
+    assert np.array_equal(ux, sx) and np.array_equal(uz, sz)
+    tt = np.linspace(0.0, 3.0, 1201)
+    ux, uz = bse.exact(10.0, 0.0, tt, 14.5, 0.5, 1000.0)
+    peak = np.abs(uz).max()
+    assert peak > 0 and np.abs(uz[tt > 2.5]).max() < 1e-3 * peak and np.abs(ux[tt > 2.5]).max() < 1e-3 * peak
