@@ -11,6 +11,9 @@ common corner, each a singular pair. So a rectangle that is one mesh cell is int
 cell (the cell's ``SurfaceTraction`` gives the same vectors to round-off), and any other rectangle as
 if the mesh had a cell there.
 
+With symmetry planes the rectangle's part in the meshed region and its mirror images are integrated, each
+with its mirrored traction S f (``sources.area.AreaTraction.images``), and summed.
+
 Lags: 1 .. the last the run reaches (n_steps + 1) or the rectangle's causal limit, whichever is
 smaller; g_l = sum over the pieces and their nine nodes of the U^l blocks times f.
 
@@ -135,14 +138,24 @@ def _records(pts, rect, hmax, ls, L):
 
 def lag_vectors(ls, src, n_steps):
     """Collective: (g (3 owned rows, lags), seconds): the area load ``src``'s lag vectors on this rank's
-    rows (module docstring). Every rank agrees on the lag count (the largest any row reaches)."""
-    from mpi4py import MPI
+    rows, summed over its rectangle's symmetry images (``src.images``; the rectangle alone without planes).
+    Every rank agrees on the lag count (the largest any row reaches)."""
     t0 = time.perf_counter()
+    parts = [_lag_vectors(ls, rect, f, n_steps) for rect, f in src.images(ls.planes)]
+    g = np.zeros((parts[0].shape[0], max(p.shape[1] for p in parts)))
+    for p in parts:
+        g[:, :p.shape[1]] += p
+    return g, time.perf_counter() - t0
+
+
+def _lag_vectors(ls, rect, f, n_steps):
+    """Collective: the lag vectors (3 owned rows, lags) of the traction f [Pa] on ``rect``."""
+    from mpi4py import MPI
     mpi = ls.comm.tompi4py()
     o, mat = ls.opts, ls.mat
     pts = np.ascontiguousarray(ls.mesh.nodes[ls.rows], float)
     L = int(n_steps) + 1
-    meta, point, VX = _records(pts, src.rect, float(ls.Vh.max()), ls, L)
+    meta, point, VX = _records(pts, rect, float(ls.Vh.max()), ls, L)
     Ls = mpi.allreduce(int(meta[:, 1].max()) if len(meta) else 0, op=MPI.MAX)
     g = np.zeros((3 * len(pts), max(Ls, 1)))
     gq_, gw_ = np.polynomial.legendre.leggauss(o["gauss"])
@@ -160,13 +173,13 @@ def lag_vectors(ls, src, n_steps):
         _, _, offU, U, _ = integrate_records(mm, pts[point[start:end]], VX, Ls, ls.dt, mat.cp, mat.cs, mat.rho,
                                              mat.nu, gq_, gw_, gr, gwr, 0.0, float(ls.Vh.min()), pat, dropped,
                                              int(o["subdivisions"]), geo)
-        _reduce(g, point[start:end], mm, offU, U, src.f, pat[2], pat[3])
+        _reduce(g, point[start:end], mm, offU, U, np.asarray(f, float), pat[2], pat[3])
         start = end
     lost = mpi.allreduce(float(dropped.max()), op=MPI.MAX)
     if lost > 1e-12 * max(mpi.allreduce(float(np.abs(g).max()) if g.size else 0.0, op=MPI.MAX), 1e-300):
         raise SSIError(f"-ssi_load_area: a block entry outside the surface's pattern is {lost:.3g}, not 0; "
                        "report this with the mesh")
-    return g, time.perf_counter() - t0
+    return g
 
 
 class AreaHistory:

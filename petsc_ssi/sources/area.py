@@ -12,7 +12,9 @@ owns, and adds
 to the right-hand side of each step equation (through the scheme's own combination of equations:
 plain or stabilised, ``bem.area.AreaHistory``). The rectangle is a traction of the surface the mesh
 stands for; its own displacement is the mesh's (the points inside it are collocation points like any
-other). It is not in the output's nodal traction field (the cells' loads and the contact tractions are):
+other). With symmetry planes (-ssi_symmetry) its part in the meshed region and that part's mirror images
+are integrated (``AreaTraction.images``): a rectangle across a plane must be mirror-symmetric about it. It is
+not in the output's nodal traction field (the cells' loads and the contact tractions are):
 its nodal values are not defined where its edges cross cells. Its lags are exact to the last one the run reaches (no interpolation beyond T_L, no
 truncation): a rank keeps (its rows) x (lags) numbers, in the run's log.
 
@@ -54,10 +56,46 @@ class AreaTraction:
         """a's mean over step m, ((m-1) dt, m dt] (a scalar; f is in the lag vectors)."""
         return self.history.mean((m - 1) * dt, m * dt) if m >= 1 else 0.0
 
+    def images(self, planes):
+        """[(rect, f), ...]: the rectangles the soil integrates and their tractions. Without symmetry planes
+        the rectangle itself. With planes (``bem.symmetry``: the part x >= 0, y >= 0 is meshed, a field is
+        S-mirrored across each plane) the rectangle's part in the meshed region and its mirror images, each
+        with its traction S f: a rectangle that crosses a plane must be mirror-symmetric about it and its
+        traction allowed there (f = S f on the plane: a vertical load on a 'sym' plane, not on an 'anti'
+        one). SSIError otherwise."""
+        from ..bem.symmetry import images, sign_matrix
+        r = list(self.rect)
+        for ax, kind in planes:
+            lo, hi = r[2 * ax], r[2 * ax + 1]
+            name = "xy"[ax]
+            if hi <= 0.0:
+                raise SSIError(f"{self.name}: the rectangle lies in {name} < 0, the mirror image of the meshed part "
+                               f"(-ssi_symmetry meshes {name} >= 0): give it there")
+            if lo < 0.0:
+                if abs(lo + hi) > 1e-9 * max(abs(lo), abs(hi)):
+                    raise SSIError(f"{self.name}: the rectangle crosses the symmetry plane {name} = 0 but is not "
+                                   f"mirror-symmetric about it ({lo:g}..{hi:g}): the model mirrors every load there")
+                if np.any(self.f * (1.0 - sign_matrix(ax, kind)) != 0.0):
+                    raise SSIError(f"{self.name}: the traction ({', '.join(f'{v:g}' for v in self.f)}) Pa on the "
+                                   f"plane {name} = 0 is not allowed by -ssi_symmetry {name}="
+                                   f"{'sym' if kind > 0 else 'anti'} (it would be mirrored into its opposite)")
+                r[2 * ax] = 0.0
+        out = []
+        for axes, sgn in images(planes):
+            q = list(r)
+            for ax in axes:
+                q[2 * ax], q[2 * ax + 1] = -r[2 * ax + 1], -r[2 * ax]
+            out.append((tuple(q), sgn * self.f))
+        return out
+
     def check(self, nodes, planes):
-        """SSIError unless the rectangle lies on the meshed surface: inside the nodes' extent, every node
-        in it at z = 0, and no symmetry plane (the images of an area are not built: mesh the whole surface)."""
+        """SSIError unless the rectangle lies on the meshed surface (inside the nodes' extent, every node in
+        it at z = 0; with symmetry planes its part in the meshed region) and agrees with the planes
+        (``images``)."""
+        self.images(planes)
         x0, x1, y0, y1 = self.rect
+        for ax, _ in planes:                # (its part in the meshed region)
+            x0, y0 = (max(x0, 0.0), y0) if ax == 0 else (x0, max(y0, 0.0))
         lo, hi = nodes[:, :2].min(axis=0), nodes[:, :2].max(axis=0)
         if x0 < lo[0] or x1 > hi[0] or y0 < lo[1] or y1 > hi[1]:
             raise SSIError(f"{self.name}: the rectangle {x0:g}..{x1:g} x {y0:g}..{y1:g} m is not inside the soil "
@@ -66,9 +104,6 @@ class AreaTraction:
         if np.any(np.abs(nodes[inside, 2]) > 1e-9 * (1.0 + np.abs(nodes[:, :2]).max())):
             raise SSIError(f"{self.name}: the surface under the rectangle is not the plane z = 0 (an excavation?): "
                            "an area load is a traction of z = 0; load the cells (-ssi_load_group) instead")
-        if planes:
-            raise SSIError(f"{self.name}: not with symmetry planes (-ssi_symmetry): the area's images are not "
-                           "built; mesh the whole surface (-ssi_symmetry none)")
 
     def amplitudes(self):
         return self.f[None, :]

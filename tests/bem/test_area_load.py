@@ -7,6 +7,8 @@
 - Where it is not, it converges to the exact solution of the half-space: a 1 m square that no cell holds, on
   a grid of 1.2 m cells, against Lamb's problem for that square (``analytic.pekeris.patch_displacement``), as
   close as the same square on a grid whose cells do hold it.
+- With symmetry planes its meshed part and mirror images are integrated: equal to the cells' load of a quarter
+  model.
 - Bad input: one line before any work."""
 import os
 import sys
@@ -58,6 +60,22 @@ def test_area_of_cells_equals_the_cells_load(tmp_path, store, nranks, scheme):
               nranks=nranks).stdout
     assert "-ssi_load_area -1,1,-1,1: its lag vectors integrated over the rectangle" in out, out
     same(ref, got, rtol=1e-12)
+
+
+@pytest.mark.parametrize("store,nranks", [("dense", 1), ("toeplitz", 2)])
+def test_quarter_model_area_equals_cells(tmp_path, store, nranks):
+    """Two symmetry planes (the quarter of BEM's grid meshed): the 2 m x 2 m patch across both planes as an
+    area (its quarter and three mirror images integrated) equals its cells' load to 1e-12; and a patch beside
+    the planes (its images only) too."""
+    case = BEM + NONE + ["-ssi_lag_store", store, "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_history", "box",
+                         "-ssi_load_t0", "0.02"]
+    for cells, area in (("load", "-1,1,-1,1"), ("box:2.1,2.9,1.1,1.9", "2,3,1,2")):
+        ref, got = str(tmp_path / "cells.h5"), str(tmp_path / "area.h5")
+        cli(_swap(case, "-ssi_load_group", ["-ssi_load_group", cells]) + ["-ssi_output", ref, "-ssi_output_overwrite"],
+            nranks=nranks)
+        cli(_swap(case, "-ssi_load_group", ["-ssi_load_area", area]) + ["-ssi_output", got, "-ssi_output_overwrite"],
+            nranks=nranks)
+        same(ref, got, rtol=1e-12)
 
 
 def test_coupled_box_area_equals_cells(tmp_path):
@@ -113,7 +131,9 @@ def test_area_off_the_cells_converges_to_lamb(tmp_path):
     (["-ssi_load_area", "1,0,0,1"], "needs x0 < x1"),
     (["-ssi_load_area", "0,1,0"], "x0,x1,y0,y1"),
     (["-ssi_load_area", "0,1,0,20"], "is not inside the soil mesh"),
-    (["-ssi_load_area", "0,1,0,1", "-ssi_symmetry", "x=sym"], "not with symmetry planes"),
+    (["-ssi_load_area", "-0.5,1,0,1", "-ssi_symmetry", "x=sym"], "not mirror-symmetric about it"),
+    (["-ssi_load_area", "-2,-1,0,1", "-ssi_symmetry", "x=sym"], "the mirror image of the meshed part"),
+    (["-ssi_load_area", "0,1,-1,1", "-ssi_symmetry", "y=anti"], "is not allowed by -ssi_symmetry y=anti"),
     (["-ssi_load_area", "0,1,0,1", "-ssi_load_group", "load"], "-ssi_load_group and -ssi_load_area")])
 def test_bad_area_refused_in_one_line(tmp_path, extra, words):
     case = [a for a in BEM if a not in ("-ssi_load_group", "load")]
