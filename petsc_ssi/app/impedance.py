@@ -298,7 +298,7 @@ def main():
                        "mode once")
     if not cfg0.disp_group:
         raise SSIError("petsc-ssi impedance needs the footing as -ssi_disp_group (a group or 'box:x0,x1,y0,y1')")
-    for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group", "disp_rigid"):
+    for name in ("disp_value", "disp_rotation", "disp_history", "symmetry", "load_group", "load_area", "disp_rigid"):
         if cfg0.user_set(name):
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
     want = _a0_range(cfg0.impedance_a0)

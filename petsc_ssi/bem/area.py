@@ -1,7 +1,7 @@
 """The soil's side of an area load (``sources.area``): its lag vectors g_l on the rows a rank owns, and
 their terms in each step's right-hand side.
 
-Integration. The rectangle is tiled into pieces no larger than the mesh's largest element (a piece is
+Integration. The rectangle is tiled into pieces no larger than the smallest element that reaches it (a piece is
 a flat nine-node element of the plane z = 0, nodes ordered as the mesh's, normal +z). Each (collocation
 point, piece) pair is integrated as the assembly integrates a pair (``assemble._pair_window``: the lags
 its wave window touches, the near-field subdivisions; ``assemble.integrate_records``): a point at one of
@@ -54,12 +54,13 @@ def tiles(rect, hmax):
     return np.array([(xs[i], xs[i + 1], ys[j], ys[j + 1]) for i in range(nx) for j in range(ny)])
 
 
-def split(r, p):
+def split(r, p, eps=0.0):
     """The pieces of rectangle r = (x0, x1, y0, y1) cut at the point p's lines x = p_x, y = p_y (those
-    strictly inside it): 1, 2 or 4 rectangles with p at a corner of each."""
+    inside it by more than ``eps``: a point that close to an edge is on it, no sliver is cut): 1, 2 or 4
+    rectangles with p at (within eps of) a corner of each."""
     x0, x1, y0, y1 = r
-    xs = [x0] + ([p[0]] if x0 < p[0] < x1 else []) + [x1]
-    ys = [y0] + ([p[1]] if y0 < p[1] < y1 else []) + [y1]
+    xs = [x0] + ([p[0]] if x0 + eps < p[0] < x1 - eps else []) + [x1]
+    ys = [y0] + ([p[1]] if y0 + eps < p[1] < y1 - eps else []) + [y1]
     return [(xs[i], xs[i + 1], ys[j], ys[j + 1]) for i in range(len(xs) - 1) for j in range(len(ys) - 1)]
 
 
@@ -103,9 +104,21 @@ def _reduce(g, rows, meta, offU, U, f, gp, gq):
                     k += 1
 
 
+def tile_size(ls, rect):
+    """The size of the rectangle's pieces: the smallest element whose bounding sphere reaches the rectangle
+    (its cells' size on a graded mesh, not the mesh's largest), the largest element if none does."""
+    x0, x1, y0, y1 = rect
+    c = ls.Vc
+    dx = np.maximum(np.maximum(x0 - c[:, 0], c[:, 0] - x1), 0.0)
+    dy = np.maximum(np.maximum(y0 - c[:, 1], c[:, 1] - y1), 0.0)
+    near = np.hypot(dx, dy) <= ls.VR
+    return float(ls.Vh[near].min()) if np.any(near) else float(ls.Vh.max())
+
+
 def _records(pts, rect, hmax, ls, L):
-    """(meta, points, pieces VX) of every (owned point, piece) pair that reaches a lag, the pieces that
-    hold a point (not at one of their nodes) split for that point."""
+    """(meta, points, pieces VX, bad) of every (owned point, piece) pair that reaches a lag, the pieces that
+    hold a point (not at one of their nodes) split for that point; ``bad``: a point whose cut pieces do not
+    have it as a node (0 or 1, for a collective error)."""
     o, mat, dt = ls.opts, ls.mat, ls.dt
     base = [piece(*t) for t in tiles(rect, hmax)]
     VX = np.array(base)
@@ -117,14 +130,15 @@ def _records(pts, rect, hmax, ls, L):
     keep = (meta[:, 1] >= meta[:, 0]) & ~inside.ravel()
     meta, point = meta[keep], point[keep]
     extra_meta, extra_pt, extra_X = [], [], []
+    bad = 0
     for i, e in zip(*np.nonzero(inside)):        # (the few points on the rectangle)
         x0, x1, y0, y1 = VX[e, 0, 0], VX[e, 2, 0], VX[e, 0, 1], VX[e, 2, 1]
-        subs = np.array([piece(*s) for s in split((x0, x1, y0, y1), pts[i])])
+        eps = 0.25 * SING_TOL * min(x1 - x0, y1 - y0)
+        subs = np.array([piece(*s) for s in split((x0, x1, y0, y1), pts[i], eps)])
         sc, sR, sh = bounding_spheres(subs)
         m, _ = _windows(pts[i:i + 1], subs, sc, sR, sh, reach, mat.cp, mat.cs, dt, L, *args)
-        if np.any(m[:, 2] < 0):
-            raise SSIError(f"-ssi_load_area: the point ({pts[i, 0]:g}, {pts[i, 1]:g}) is not a node of the pieces "
-                           "cut at it; report this with the mesh")
+        m = m[m[:, 1] >= m[:, 0]]
+        bad = max(bad, int(np.any(m[:, 2] < 0)))
         m[:, 5] += len(VX) + len(extra_X)
         extra_meta.append(m)
         extra_pt += [i] * len(m)
@@ -133,7 +147,7 @@ def _records(pts, rect, hmax, ls, L):
         meta = np.concatenate([meta] + extra_meta)
         point = np.concatenate([point, np.array(extra_pt, np.int64)])
         VX = np.concatenate([VX, np.array(extra_X)])
-    return meta, point, VX
+    return meta, point, VX, bad
 
 
 def lag_vectors(ls, src, n_steps):
@@ -155,7 +169,10 @@ def _lag_vectors(ls, rect, f, n_steps):
     o, mat = ls.opts, ls.mat
     pts = np.ascontiguousarray(ls.mesh.nodes[ls.rows], float)
     L = int(n_steps) + 1
-    meta, point, VX = _records(pts, rect, float(ls.Vh.max()), ls, L)
+    meta, point, VX, bad = _records(pts, rect, tile_size(ls, rect), ls, L)
+    if mpi.allreduce(bad, op=MPI.MAX):          # (every rank: no hang)
+        raise SSIError(f"-ssi_load_area: a collocation point on the rectangle {rect} is not a node of the pieces cut "
+                       "at it; report this with the mesh")
     Ls = mpi.allreduce(int(meta[:, 1].max()) if len(meta) else 0, op=MPI.MAX)
     g = np.zeros((3 * len(pts), max(Ls, 1)))
     gq_, gw_ = np.polynomial.legendre.leggauss(o["gauss"])
@@ -185,28 +202,35 @@ def _lag_vectors(ls, rect, f, n_steps):
 class AreaHistory:
     """The area loads' terms of each step's right-hand side (module docstring): ``add(n, march, b)``."""
 
-    def __init__(self, sources, gs, dt, zero_local):
+    def __init__(self, sources, gs, dt, zero_local, n_steps):
         self.sources, self.dt, self.gs = sources, dt, gs
         self.zero_local = zero_local
+        # a[m]: each source's step mean of step m (a[0] = 0), once for the run
+        self.a = [np.array([0.0] + [s.step_mean(m, dt) for m in range(1, n_steps + 2)]) for s in sources]
 
-    def weights(self, src, n, march, Ls):
-        """w[j - 1]: the weight of g_j in step n's right-hand side (the scheme's terms, ``Marcher._terms``)."""
-        a = lambda m: src.step_mean(m, self.dt)       # noqa: E731
+    @staticmethod
+    def weights(a, n, march, Ls):
+        """w[j - 1]: the weight of g_j in step n's right-hand side, a[m] the step means (the known traction's
+        lags 1, 2 with the step matrix's coefficients, ``Marcher.add_known``; the history's q_j(a) of j >= 2,
+        ``Marcher._terms``: states 1..n-1)."""
         w = np.zeros(Ls)
-        coef = dict(march.coefficients())
-        for lag, c in coef.items():
+        for lag, c in march.coefficients():
             if lag <= Ls:
-                w[lag - 1] += c * a(n)
-        for j in range(2, min(Ls, n + 1) + 1):
-            w[j - 1] += sum(c * a(m) for m, c in march._terms(n, j))
+                w[lag - 1] += c * a[n]
+        j = np.arange(2, min(Ls, n + 1) + 1)
+        offs = ((2, 1.0), (1, 2.0), (0, 1.0)) if march.scheme == "stabilized" else ((1, 1.0),)
+        for off, c in offs:
+            m = n - j + off
+            ok = (m >= 1) & (m <= n - 1)
+            w[j[ok] - 1] += c * a[m[ok]]
         return w
 
     def add(self, n, march, b):
         """b += the area loads' terms of step n (b: this rank's rows)."""
         arr = b.getArray()
-        for src, g in zip(self.sources, self.gs):
+        for a, g in zip(self.a, self.gs):
             if g.shape[0]:
-                arr += g @ self.weights(src, n, march, g.shape[1])
+                arr += g @ self.weights(a, n, march, g.shape[1])
         if self.zero_local.size:
             arr[self.zero_local] = 0.0
 
@@ -223,4 +247,4 @@ def build(ls, sources, n_steps, zero_local):
         printf(f"[ssi] {src.name}: its lag vectors integrated over the rectangle in {sec:.2f} s ({g.shape[1]} lags, "
             f"{gb:.3g} GB over the ranks)")
         gs.append(g)
-    return AreaHistory(sources, gs, ls.dt, zero_local)
+    return AreaHistory(sources, gs, ls.dt, zero_local, n_steps)

@@ -195,6 +195,9 @@ class HalfSpace:
         self.bind_sources()
         for src in self.areas:
             src.check(self.mesh.nodes, self.planes)
+            if len(disp):
+                what = "the structure's interface" if interface is not None else "the footing (-ssi_disp_group)"
+                src.check_free(self.mesh.cell_coords()[np.asarray(disp, np.int64)][:, :, :2], what)
         for src in (self.sources if sources is not None else [self._excavation] if self._excavation else []) + \
                 self.areas:
             printf(f"[ssi] source: {src.describe()}")
@@ -397,9 +400,9 @@ class HalfSpace:
         reach any of ``points`` (e.g. a receiver, or the structure's interface nodes), path load ->
         edge -> point at c_p; ``warn_diffraction`` (from ``prepare``) says in one line which
         arrive before t_end. Returns that time (None without a load or an edge)."""
-        if not self.regions.n_load or not len(points):
+        src = self._load_points()
+        if not len(src) or not len(points):
             return None
-        src = self.mesh.nodes[self.regions.load_nodes]
         edge = self._edge_points()
         if not len(edge):
             return None
@@ -470,11 +473,18 @@ class HalfSpace:
         self.plan = plan
         return plan
 
+    def _load_points(self):
+        """Where the soil's loads start their waves: the loaded cells' nodes and the area loads' corners and
+        centres (their meshed parts); (0, 3) without a load."""
+        parts = [self.mesh.nodes[self.regions.load_nodes]] if self.regions.n_load else []
+        parts += [a.points(self.planes) for a in getattr(self, "areas", [])]
+        return np.vstack(parts) if parts else np.zeros((0, 3))
+
     def _auto_tl(self, tau_l=1.5):
         """The paper's rule (``interp.auto``, tau_L = c_s T_L / r) for this problem's points of interest:
         (T_L, k, why); T_L None where it would reach T_N."""
-        src = (self.mesh.nodes[self.regions.load_nodes].mean(0) if self.regions.n_load
-               else np.zeros(3))
+        pts0 = self._load_points()
+        src = pts0.mean(0) if len(pts0) else np.zeros(3)
         for ax, _ in self.planes:      # the whole (mirrored) load is centred on the plane
             src[ax] = 0.0
         sites = getattr(self, "sites", np.zeros((0, 3)))

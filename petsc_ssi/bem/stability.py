@@ -117,7 +117,7 @@ def surrogate(cfg, prob, h):
     vals = dict(cfg.as_dict())
     size = 2 * SURROGATE_ELEMENTS * h
     vals.update(mesh="grid", mesh_size=f"{size:.12g},{size:.12g}", mesh_h=h, mesh_patch=f"{h:.12g},{h:.12g}",
-                symmetry="x=sym,y=sym", load_group="load", load_p0=1000.0, load_history="heaviside",
+                symmetry="x=sym,y=sym", load_group="load", load_area="", load_p0=1000.0, load_history="heaviside",
                 disp_group="", receivers="", output_stride=0, plot=False, warn_beta=False,
                 check_stability=False, guard=True, guard_factor=cfg.guard_factor)
     if cfg.interp == "auto":

@@ -116,8 +116,10 @@ def _checks(cfg):
         return f"-ssi_seismic_angle {cfg.seismic_angle:g}: must lie in [0, 90) degrees"
     if w in ("vertical", "rayleigh") and cfg.user_set("seismic_angle") and cfg.seismic_angle != 0.0:
         return f"-ssi_seismic_angle {cfg.seismic_angle:g}: not used by -ssi_seismic {w}"
-    if cfg.get("load_group") and cfg.get("load_p0", 0.0) != 0.0 and cfg.seismic_combine == "refuse":
-        return ("-ssi_load_group with -ssi_seismic: say how the soil load and the wave combine "
+    if (cfg.get("load_group") or cfg.get("load_area")) and cfg.get("load_p0", 0.0) != 0.0 \
+            and cfg.seismic_combine == "refuse":
+        which = "-ssi_load_group" if cfg.get("load_group") else "-ssi_load_area"
+        return (f"{which} with -ssi_seismic: say how the soil load and the wave combine "
                 "(-ssi_seismic_combine superpose)")
     return None
 

@@ -14,9 +14,10 @@ plain or stabilised, ``bem.area.AreaHistory``). The rectangle is a traction of t
 stands for; its own displacement is the mesh's (the points inside it are collocation points like any
 other). With symmetry planes (-ssi_symmetry) its part in the meshed region and that part's mirror images
 are integrated (``AreaTraction.images``): a rectangle across a plane must be mirror-symmetric about it. It is
-not in the output's nodal traction field (the cells' loads and the contact tractions are):
-its nodal values are not defined where its edges cross cells. Its lags are exact to the last one the run reaches (no interpolation beyond T_L, no
-truncation): a rank keeps (its rows) x (lags) numbers, in the run's log.
+not in the output's nodal traction field (the cells' loads and the contact tractions are): its nodal values
+are not defined where its edges cross cells. Its lags are exact to the last one the run reaches (no
+interpolation beyond T_L, no truncation): a rank keeps (its rows) x (lags) numbers, in the run's log. It may
+not overlap the soil cells whose traction is an unknown (a structure's interface, a footing): refused.
 
     f      the traction [Pa], the soil's convention t = sigma n with n = +z: a pressure p0 pushing the
            surface down is f = (0, 0, -p0)
@@ -88,14 +89,40 @@ class AreaTraction:
             out.append((tuple(q), sgn * self.f))
         return out
 
+    def meshed_rect(self, planes):
+        """(x0, x1, y0, y1): the rectangle's part in the meshed region (x >= 0, y >= 0 with the planes)."""
+        x0, x1, y0, y1 = self.rect
+        for ax, _ in planes:
+            x0, y0 = (max(x0, 0.0), y0) if ax == 0 else (x0, max(y0, 0.0))
+        return x0, x1, y0, y1
+
+    def points(self, planes):
+        """(5, 3) [m]: the corners and the centre of the rectangle's meshed part (where waves start from: the
+        soil's diffraction warning and its automatic T_L)."""
+        x0, x1, y0, y1 = self.meshed_rect(planes)
+        return np.array([[x0, y0, 0.0], [x1, y0, 0.0], [x1, y1, 0.0], [x0, y1, 0.0],
+                         [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0]])
+
+    def check_free(self, cell_xy, what):
+        """SSIError when the rectangle overlaps the inside of a cell whose traction is an unknown (``cell_xy``:
+        (cells, 9, 2) [m], the structure's interface or a prescribed footing's): the load would go into the
+        soil's right-hand side while the structure or footing there never felt it."""
+        if not len(cell_xy):
+            return
+        x0, x1, y0, y1 = self.rect
+        lo, hi = cell_xy.min(axis=1), cell_xy.max(axis=1)
+        eps = 1e-9 * (1.0 + np.abs(cell_xy).max())
+        over = (lo[:, 0] < x1 - eps) & (hi[:, 0] > x0 + eps) & (lo[:, 1] < y1 - eps) & (hi[:, 1] > y0 + eps)
+        if np.any(over):
+            raise SSIError(f"{self.name}: the rectangle overlaps {int(over.sum())} of the soil cells of {what}, whose "
+                           "traction is an unknown; load the structure (-ssi_fem_load_*) or keep the area beside it")
+
     def check(self, nodes, planes):
         """SSIError unless the rectangle lies on the meshed surface (inside the nodes' extent, every node in
         it at z = 0; with symmetry planes its part in the meshed region) and agrees with the planes
         (``images``)."""
         self.images(planes)
-        x0, x1, y0, y1 = self.rect
-        for ax, _ in planes:                # (its part in the meshed region)
-            x0, y0 = (max(x0, 0.0), y0) if ax == 0 else (x0, max(y0, 0.0))
+        x0, x1, y0, y1 = self.meshed_rect(planes)
         lo, hi = nodes[:, :2].min(axis=0), nodes[:, :2].max(axis=0)
         if x0 < lo[0] or x1 > hi[0] or y0 < lo[1] or y1 > hi[1]:
             raise SSIError(f"{self.name}: the rectangle {x0:g}..{x1:g} x {y0:g}..{y1:g} m is not inside the soil "

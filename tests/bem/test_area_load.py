@@ -53,7 +53,7 @@ def _swap(case, old, new):
 def test_area_of_cells_equals_the_cells_load(tmp_path, store, nranks, scheme):
     """The 2 m x 2 m patch of BEM's grid (4 cells of 1 m) as cells and as an area: every field to 1e-12."""
     case = BEM + NONE + ["-ssi_lag_store", store, "-ssi_scheme", scheme, "-ssi_load_history", "box",
-                         "-ssi_load_t0", "0.02"]
+                         "-ssi_load_t0", "0.02", "-ssi_t_end", "0.06"]
     ref, got = str(tmp_path / "cells.h5"), str(tmp_path / "area.h5")
     cli(case + ["-ssi_output", ref], nranks=nranks)
     out = cli(_swap(case, "-ssi_load_group", ["-ssi_load_area", "-1,1,-1,1"]) + ["-ssi_output", got],
@@ -68,7 +68,7 @@ def test_quarter_model_area_equals_cells(tmp_path, store, nranks):
     area (its quarter and three mirror images integrated) equals its cells' load to 1e-12; and a patch beside
     the planes (its images only) too."""
     case = BEM + NONE + ["-ssi_lag_store", store, "-ssi_symmetry", "x=sym,y=sym", "-ssi_load_history", "box",
-                         "-ssi_load_t0", "0.02"]
+                         "-ssi_load_t0", "0.02", "-ssi_t_end", "0.06"]
     for cells, area in (("load", "-1,1,-1,1"), ("box:2.1,2.9,1.1,1.9", "2,3,1,2")):
         ref, got = str(tmp_path / "cells.h5"), str(tmp_path / "area.h5")
         cli(_swap(case, "-ssi_load_group", ["-ssi_load_group", cells]) + ["-ssi_output", ref, "-ssi_output_overwrite"],
@@ -87,6 +87,36 @@ def test_coupled_box_area_equals_cells(tmp_path):
     cli(case + ["-ssi_load_group", "box:1.1,1.4,-0.4,-0.1", "-ssi_output", ref])
     cli(case + ["-ssi_load_area", "1,1.5,-0.5,0", "-ssi_output", got], nranks=2)
     same(ref, got, rtol=1e-12)
+
+
+class _March:
+    """The pieces of ``march.Marcher`` the weights read (its scheme's coefficients and history terms)."""
+
+    def __init__(self, scheme):
+        from petsc_ssi.bem.march import Marcher
+        self.scheme = scheme
+        self.coefficients = lambda: Marcher.coefficients(self)
+        self._terms = lambda n, j: Marcher._terms(self, n, j)
+
+
+@pytest.mark.parametrize("scheme", ["stabilized", "plain"])
+def test_area_weights_are_the_schemes_terms(scheme):
+    """AreaHistory.weights (vectorised) against the scheme's own terms term by term: the known traction's lags 1
+    and 2 (``Marcher.coefficients``) and the history's q_j of every j >= 2 (``Marcher._terms``), steps 1..40, for
+    a history with no two equal step means, with fewer and more lags than the step reaches."""
+    from petsc_ssi.bem.area import AreaHistory
+    march = _March(scheme)
+    a = np.r_[0.0, np.cos(0.37 * np.arange(1, 45)) + 0.1 * np.arange(1, 45)]
+    for Ls in (3, 17, 60):
+        for n in range(1, 41):
+            ref = np.zeros(Ls)
+            for lag, c in march.coefficients():
+                if lag <= Ls:
+                    ref[lag - 1] += c * a[n]
+            for j in range(2, min(Ls, n + 1) + 1):
+                ref[j - 1] += sum(c * a[m] for m, c in march._terms(n, j))
+            assert np.array_equal(AreaHistory.weights(a, n, march, Ls), ref) or \
+                np.allclose(AreaHistory.weights(a, n, march, Ls), ref, rtol=1e-15, atol=1e-15), (Ls, n)
 
 
 LAMB = ["-ssi_problem", "bem", "-ssi_cp", "548", "-ssi_cs", "316", "-ssi_rho", "2000", "-ssi_mesh", "grid",
@@ -134,7 +164,9 @@ def test_area_off_the_cells_converges_to_lamb(tmp_path):
     (["-ssi_load_area", "-0.5,1,0,1", "-ssi_symmetry", "x=sym"], "not mirror-symmetric about it"),
     (["-ssi_load_area", "-2,-1,0,1", "-ssi_symmetry", "x=sym"], "the mirror image of the meshed part"),
     (["-ssi_load_area", "0,1,-1,1", "-ssi_symmetry", "y=anti"], "is not allowed by -ssi_symmetry y=anti"),
-    (["-ssi_load_area", "0,1,0,1", "-ssi_load_group", "load"], "-ssi_load_group and -ssi_load_area")])
+    (["-ssi_load_area", "0,1,0,1", "-ssi_load_group", "load"], "-ssi_load_group and -ssi_load_area"),
+    (["-ssi_load_area", "0.5,1.5,0,1", "-ssi_disp_group", "load", "-ssi_disp_value", "0,0,1e-6"],
+     "overlaps 1 of the soil cells of the footing")])
 def test_bad_area_refused_in_one_line(tmp_path, extra, words):
     case = [a for a in BEM if a not in ("-ssi_load_group", "load")]
     r = cli(case + extra + ["-ssi_output", str(tmp_path / "x.h5")], nranks=2, check=False)

@@ -217,6 +217,7 @@ def _fem_only(opts):
     (["-ssi_seismic", "vertical", "-ssi_symmetry", "x=sym"], "-ssi_symmetry x=sym"),
     (["-ssi_seismic", "sh", "-ssi_seismic_azimuth", "0", "-ssi_symmetry", "x=sym"], "travels across this plane"),
     (["-ssi_seismic", "vertical", "-ssi_load_group", "load", "-ssi_load_p0", "1"], "-ssi_seismic_combine"),
+    (["-ssi_seismic", "vertical", "-ssi_load_area", "0,1,0,1", "-ssi_load_p0", "1"], "-ssi_load_area with -ssi_seismic"),
     (["-ssi_seismic", "vertical", "-ssi_seismic_units", "furlong"], "furlong"),
     (["-ssi_seismic", "vertical", "-ssi_seismic_record", "SHORT"], "less than one step"),
     (["-ssi_seismic", "vertical", "-ssi_seismic_record", "TRUNC"], "NPTS"),
