@@ -473,6 +473,19 @@ class HalfSpace:
         self.plan = plan
         return plan
 
+    def area_bytes(self):
+        """Bytes of the area loads' lag vectors over the ranks (``bem.area``: 3 rows a node, one column a lag up
+        to the last the run reaches or the rectangle's causal limit, per symmetry image), an upper bound."""
+        from .windows import causal_lags
+        total = 0.0
+        nodes = self.mesh.nodes[:, :2]
+        for a in getattr(self, "areas", []):
+            for (x0, x1, y0, y1), _ in a.images(self.planes):
+                far = np.max(np.hypot(np.maximum(np.abs(nodes[:, 0] - x0), np.abs(nodes[:, 0] - x1)),
+                                      np.maximum(np.abs(nodes[:, 1] - y0), np.abs(nodes[:, 1] - y1))))
+                total += 8.0 * 3 * self.mesh.n_nodes * min(self.n_steps + 1, causal_lags(far, self.mat, self.dt))
+        return total
+
     def _load_points(self):
         """Where the soil's loads start their waves: the loaded cells' nodes and the area loads' corners and
         centres (their meshed parts); (0, 3) without a load."""
@@ -515,6 +528,10 @@ class HalfSpace:
             n = [b - a for a, b in ls.ranges]
             printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, equal node counts "
                    "(-ssi_lag_store toeplitz splits the history sum by frequency; -ssi_partition to choose)")
+        ab = self.area_bytes()
+        if ab:
+            extra_bytes += ab
+            extra_what = (extra_what + " and " if extra_what else "") + "the area loads' lag vectors"
         if self.lattice is None:
             self.check_memory(ls, plan, extra_bytes, extra_what)
         else:
