@@ -33,13 +33,15 @@ def same(a, b, rtol=1e-12):
     A, B = fields(a), fields(b)
     assert set(A) == set(B) and any("displacement" in k for k in A)
     S = scales(A)
-    moving = 0
+    moving, worst = 0, 0.0
     for k in A:
         if k.startswith("traction"):
             continue
         moving += np.abs(A[k]).max() > 0
+        worst = max(worst, np.abs(A[k] - B[k]).max() / S[k])
         assert np.abs(A[k] - B[k]).max() <= rtol * S[k], (k, np.abs(A[k] - B[k]).max() / S[k])
     assert moving >= 3
+    print(f"area against cells: largest difference {worst:.2g} of a field's scale")
 
 
 def _swap(case, old, new):
