@@ -78,3 +78,13 @@ sampled_run() {
   echo "# sampled peak RSS over the ranks: $(awk -v k="$peak" 'BEGIN {printf "%.2f", k / 1e6}') GB" >> "$OUT/$name.log"
   echo "# load average after the run: $(cat /proc/loadavg)" >> "$OUT/$name.log"
 }
+
+# tables_or_print DEFAULT_OUT SCRIPT: the tables of SCRIPT from $OUT, written into the READMEs and CSVs when $OUT is the
+# script's default directory, printed only for another $OUT (building_uniform.sh, building_soil_exact.sh)
+tables_or_print() {
+  if [[ "$OUT" == "$1" ]]; then
+    "$PY" "$2" "$OUT"
+  else
+    "$PY" "$2" "$OUT" --print
+  fi
+}

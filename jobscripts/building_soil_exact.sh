@@ -60,8 +60,4 @@ for r in $RUNS; do
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
-if [[ "$OUT" == out/bench/building_soil_exact ]]; then
-  "$PY" jobscripts/building_soil_exact.py "$OUT"
-else
-  "$PY" jobscripts/building_soil_exact.py "$OUT" --print
-fi
+tables_or_print out/bench/building_soil_exact jobscripts/building_soil_exact.py

@@ -86,8 +86,4 @@ for r in $RUNS; do
   esac
 done
 # the READMEs' tables and the CSVs from the default directory only (another OUT: printed)
-if [[ "$OUT" == out/bench/building_uniform ]]; then
-  "$PY" jobscripts/building_uniform_table.py "$OUT"
-else
-  "$PY" jobscripts/building_uniform_table.py "$OUT" --print
-fi
+tables_or_print out/bench/building_uniform jobscripts/building_uniform_table.py

@@ -30,10 +30,9 @@ from numba import njit
 
 from ..petsc import SSIError, printf
 from .assemble import _pair_window, integrate_records, plane, SING_TOL
+from .quadrature import _NXI, _NET
 from .windows import bounding_spheres
 
-_NXI = np.array([-1., 1., 1., -1., 0., 1., 0., -1., 0.])
-_NET = np.array([-1., -1., 1., 1., -1., 0., 1., 0., 0.])
 CHUNK_BYTES = 64e6      # the integrals of at most this many bytes at a time per rank
 
 
@@ -66,27 +65,41 @@ def split(r, p, eps=0.0):
 
 @njit(cache=True)
 def _windows(pts, VX, Vc, VR, Vh, reach, cp, cs, dt, L, tol, ns_base, ns_max, near):
-    """meta (points x pieces, 6) of ``integrate_records`` (lo, hi, sing, ns, want_u = 1, piece), and
-    inside[i, k]: point i lies in piece k's closed rectangle without being one of its nodes (split)."""
+    """The (point, piece) pairs that reach a lag, compacted (two passes: no points x pieces array): (meta
+    (m, 6) of ``integrate_records``: lo, hi, sing, ns, want_u = 1, piece; point (m,); inside (q, 2): the
+    (point, piece) pairs whose point lies in the piece's closed rectangle without being one of its nodes,
+    to be cut, not in meta)."""
     n, k = pts.shape[0], VX.shape[0]
-    meta = np.zeros((n * k, 6), np.int64)
-    inside = np.zeros((n, k), np.bool_)
-    for i in range(n):
-        for e in range(k):
-            lo, hi, sing, ns = _pair_window(pts[i], VX[e], Vc[e], VR[e], Vh[e], reach, cp, cs, dt, L, 1, 0.0, tol,
-                                            ns_base, ns_max, near)
-            r = i * k + e
-            meta[r, 0] = lo
-            meta[r, 1] = hi
-            meta[r, 2] = sing
-            meta[r, 3] = ns
-            meta[r, 4] = 1
-            meta[r, 5] = e
-            eps = tol * Vh[e]
-            if sing < 0 and VX[e, 0, 0] - eps <= pts[i, 0] <= VX[e, 2, 0] + eps and \
-                    VX[e, 0, 1] - eps <= pts[i, 1] <= VX[e, 2, 1] + eps:
-                inside[i, e] = True
-    return meta, inside
+    counts = np.zeros(2, np.int64)
+    for fill in range(2):
+        if fill:
+            meta = np.zeros((counts[0], 6), np.int64)
+            point = np.zeros(counts[0], np.int64)
+            inside = np.zeros((counts[1], 2), np.int64)
+            counts[:] = 0
+        for i in range(n):
+            for e in range(k):
+                lo, hi, sing, ns = _pair_window(pts[i], VX[e], Vc[e], VR[e], Vh[e], reach, cp, cs, dt, L, 1, 0.0,
+                                                tol, ns_base, ns_max, near)
+                eps = tol * Vh[e]
+                if sing < 0 and VX[e, 0, 0] - eps <= pts[i, 0] <= VX[e, 2, 0] + eps and \
+                        VX[e, 0, 1] - eps <= pts[i, 1] <= VX[e, 2, 1] + eps:
+                    if fill:
+                        inside[counts[1], 0] = i
+                        inside[counts[1], 1] = e
+                    counts[1] += 1
+                elif hi >= lo:
+                    if fill:
+                        r = counts[0]
+                        meta[r, 0] = lo
+                        meta[r, 1] = hi
+                        meta[r, 2] = sing
+                        meta[r, 3] = ns
+                        meta[r, 4] = 1
+                        meta[r, 5] = e
+                        point[r] = i
+                    counts[0] += 1
+    return meta, point, inside
 
 
 @njit(cache=True)
@@ -125,20 +138,16 @@ def _records(pts, rect, hmax, ls, L):
     c, R, h = bounding_spheres(VX)
     reach = mat.cp * dt * L + 1e-9
     args = (SING_TOL, int(o["subdivisions"]), int(o["max_subdivisions"]), float(o["near_factor"]))
-    meta, inside = _windows(pts, VX, c, R, h, reach, mat.cp, mat.cs, dt, L, *args)
-    point = np.repeat(np.arange(len(pts)), len(VX))
-    keep = (meta[:, 1] >= meta[:, 0]) & ~inside.ravel()
-    meta, point = meta[keep], point[keep]
+    meta, point, inside = _windows(pts, VX, c, R, h, reach, mat.cp, mat.cs, dt, L, *args)
     extra_meta, extra_pt, extra_X = [], [], []
     bad = 0
-    for i, e in zip(*np.nonzero(inside)):        # (the few points on the rectangle)
+    for i, e in inside:                          # (the few points on the rectangle)
         x0, x1, y0, y1 = VX[e, 0, 0], VX[e, 2, 0], VX[e, 0, 1], VX[e, 2, 1]
         eps = 0.25 * SING_TOL * min(x1 - x0, y1 - y0)
         subs = np.array([piece(*s) for s in split((x0, x1, y0, y1), pts[i], eps)])
         sc, sR, sh = bounding_spheres(subs)
-        m, _ = _windows(pts[i:i + 1], subs, sc, sR, sh, reach, mat.cp, mat.cs, dt, L, *args)
-        m = m[m[:, 1] >= m[:, 0]]
-        bad = max(bad, int(np.any(m[:, 2] < 0)))
+        m, _, cut = _windows(pts[i:i + 1], subs, sc, sR, sh, reach, mat.cp, mat.cs, dt, L, *args)
+        bad = max(bad, int(len(cut) > 0 or np.any(m[:, 2] < 0)))
         m[:, 5] += len(VX) + len(extra_X)
         extra_meta.append(m)
         extra_pt += [i] * len(m)
