@@ -16,6 +16,9 @@
 #   uniform-72-area-exact, uniform-36-area-exact  the same on 72 m and 36 m, every lag exact (-ssi_interp none;
 #                  207 and 103 lags): with today-exact, the split of the difference to today into the far lags'
 #                  interpolation, the cells and the extent (runs/building/README.md)
+#   today-fine     (not by default) today's graded mesh refined, every lag exact (-ssi_mesh_params
+#                  g=1.15,hm=1.5,hr=1.0,hq=1.0: cells of at most 1.5 m, the slab's 1.2 m and the 1 m patch kept; 9333 DOFs):
+#                  against today-exact, how far today's own answer moves when its mesh is refined
 #   uniform-72-fullrank (not by default) uniform-72 with the step matrix's MUMPS LU in full rank (-ssi_step_blr 0;
 #                  by default, from 20 000 DOFs on, it is block low-rank at 1e-15 and checked: bem/march.py)
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
@@ -64,6 +67,7 @@ for r in $RUNS; do
     uniform-72) run uniform-72 "${B[@]}" "${U[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
     today-exact) run today-exact "${B[@]}" "${X[@]}" ;;
+    today-fine) run today-fine "${B[@]}" "${X[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
     # shellcheck disable=SC2086
     uniform-72-area) run uniform-72-area "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
