@@ -7,7 +7,7 @@ Per run: the step matrix's factor entries (its log line), the events SSI_BEM_Fac
 the blocks and the LU) and the time loop's SSI_BEM_Solve (seconds a solve), the assembly stage's MatLUFactorNum
 and MatMatSolve (both LUs; the interface columns' multi-right-hand-side solves), the assembly line's seconds and
 the largest bem_residual. Then the largest difference of every recorded field (the soil's and the structure's
-HDF5 files) of mirror against off and of load against save, over that field's largest absolute value."""
+HDF5 files) of mirror against off and of load and load-other (another rank count) against save, over that field's largest absolute value."""
 import os
 import re
 import sys
@@ -57,7 +57,8 @@ def largest(out, a, b):
 
 
 def main(out):
-    rows = [row(out, n) for n in ("mirror", "off", "save", "load")]
+    names = [n for n in ("mirror", "off", "save", "load", "load-other") if os.path.exists(os.path.join(out, n + ".log"))]
+    rows = [row(out, n) for n in names]
     keys = list(rows[0])
     print("| " + " | ".join(keys) + " |")
     print("|" + "---|" * len(keys))
@@ -65,7 +66,9 @@ def main(out):
         print("| " + " | ".join(f"{r[k]:.4g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
     size = os.path.getsize(os.path.join(out, "lags")) / 1e9
     print(f"\nlag file: {size:.3g} GB")
-    for a, b in (("mirror", "off"), ("load", "save")):
+    for a, b in (("mirror", "off"), ("load", "save"), ("load-other", "save")):
+        if a not in names or b not in names:
+            continue
         w = largest(out, a, b)
         k = max(w, key=w.get)
         print(f"{a} against {b}: largest difference {w[k]:.3g} of the field's largest value ({k}; {len(w)} fields)")

@@ -258,7 +258,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     lags 1 and 2 assembled as always (H and, with tractions, G: the step matrix and the known values'
     terms), the H lags of the history sum beyond them as FFT kernels on the grid, the G lags as FFT
     kernels on the window of the traction elements (``toeplitz.traction_grid``). With -ssi_lags_load the step
-    matrix, lags 1-2 and the kernels are read back from a file a toeplitz run on as many ranks saved
+    matrix, lags 1-2 and the kernels are read back from a file a toeplitz run saved (on any number of ranks)
     (``lagstore``), nothing assembled or integrated."""
     from .toeplitz import ToeplitzHistory, traction_grid
     k = plan.k if plan.active else 0

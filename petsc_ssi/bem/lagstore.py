@@ -24,9 +24,11 @@ is bitwise the run that saved them when the solves are deterministic (one rank, 
 
 On the toeplitz store (``bem.toeplitz``) the file holds the step matrix, lags 1-2 (H and G) and, after them,
 each side's kernels (the exact lags' K9, K18 and the interpolating matrices' anchors A9, A18) as one MPI Vec
-each: every rank's frequency slab in rank order, its shape in ``FILE.json``. The slabs are the rank count's,
-so the key holds the store and the rank count and another count is refused in one line; the loading run
-integrates nothing (``tests/bem/test_toeplitz.py``).
+each, frequency-major: (frequencies of the whole spectrum, rows, columns, parts), the lanes' padding dropped
+(``to_file``), its shape in ``FILE.json``. Each rank writes its slab and reads the slab of the loading run's
+rank count (``from_file``), so the file loads on any number of ranks, as the dense store's does; the loading
+run integrates nothing (``tests/bem/test_toeplitz.py``). A toeplitz file of the earlier layout (the saving
+run's lane groups, its rank count in the key) is refused in one line.
 """
 import hashlib
 import json
@@ -34,7 +36,7 @@ import os
 
 import numpy as np
 
-from ..petsc import init, collective, collective_error, collective_io, SSIError
+from ..petsc import init, collective, collective_io, SSIError
 
 FORMAT = 3          # 3: lags in their block pattern (2: full MPIBAIJ blocks; 1: no CRC32s; both refused)
 
@@ -63,9 +65,9 @@ def lag_key(cfg, prob, plan):
         key["interp_times"] = " ".join(f"{lag}:{toff!r}" for lag, toff in (plan.kernel_time(j) for j in range(plan.k)))
     else:
         key["interp"] = "none"
-    if getattr(prob, "lattice", None) is not None:      # the toeplitz store: its kernels in this rank count's slabs
+    if getattr(prob, "lattice", None) is not None:      # the toeplitz store: its kernels frequency-major
         key["lag_store"] = "toeplitz"
-        key["ranks"] = str(prob.comm.getSize())
+        key["toeplitz_kernels"] = "frequency-major"
     return key
 
 
@@ -123,6 +125,10 @@ def check(cfg, comm, prob, plan):
     manifest = None
     if cfg.get("lags_load"):
         manifest = _read_json(cfg.lags_load, comm, "-ssi_lags_load")
+        if manifest["key"].get("lag_store") == "toeplitz" and "ranks" in manifest["key"]:
+            raise SSIError(f"-ssi_lags_load {cfg.lags_load}: a toeplitz lag file of an older petsc-ssi (its kernels in "
+                           f"the lane groups of its {manifest['key']['ranks']} ranks; files now load on any number "
+                           "of ranks): save it again with -ssi_lags_save")
         diff = _difference(manifest["key"], lag_key(cfg, prob, plan))
         if diff:
             raise SSIError(f"-ssi_lags_load {cfg.lags_load}: the saved lag matrices are of another soil problem: "
@@ -166,7 +172,6 @@ def save(path, comm, march, key):
     PETSc = init()
     tmp = path + ".tmp"
     mats = _mats(march)
-    err = None
     viewer = PETSc.Viewer().createBinary(tmp, mode="w", comm=comm)
 
     def write():
@@ -183,11 +188,11 @@ def save(path, comm, march, key):
                     A = make()
                     A.view(viewer)
                     A.destroy()
-    kernels = _kernel_arrays(march)
+    kernels = [(n, to_file(a, slab)) for n, a, slab in _kernel_arrays(march)]
 
     def write_kernels():
-        for _, a in kernels:                    # (each rank's slab of a side's kernels, as one MPI Vec)
-            v = PETSc.Vec().createWithArray(np.ascontiguousarray(a, dtype=float).ravel(), comm=comm)
+        for _, a in kernels:                    # (each rank's frequencies of a side's kernels, one MPI Vec)
+            v = PETSc.Vec().createWithArray(a.ravel(), comm=comm)
             v.view(viewer)
             v.destroy()
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
@@ -195,7 +200,7 @@ def save(path, comm, march, key):
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     import time
     from ..io.integrity import file_crcs, CHUNK
-    kshapes = [comm.tompi4py().gather(list(a.shape), root=0) for _, a in kernels]    # (every rank's slab shape)
+    kshapes = [[comm.tompi4py().allreduce(a.shape[0])] + list(a.shape[1:]) for _, a in kernels]   # (whole spectrum)
     t0 = time.perf_counter()
     crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
     t_crc = time.perf_counter() - t0
@@ -267,14 +272,17 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
     kernels = {}
 
     def read_kernels():
-        r = comm.getRank()
-        for name, shapes in manifest.get("kernels", []):
-            shape = tuple(shapes[r])
+        r, p = comm.getRank(), comm.getSize()
+        for name, shape in manifest.get("kernels", []):
+            F = int(shape[0])
+            f0, f1 = (F * r) // p, (F * (r + 1)) // p          # (``ToeplitzHistory``'s slabs of this rank count)
+            mine = (f1 - f0,) + tuple(shape[1:])
             v = PETSc.Vec().create(comm=comm)
-            v.setSizes((int(np.prod(shape)), PETSc.DECIDE))
+            v.setSizes((int(np.prod(mine)), PETSc.DECIDE))
             v.setType(PETSc.Vec.Type.MPI)
             v.load(viewer)
-            kernels[name] = v.getArray(readonly=True).reshape(shape).copy()
+            kernels[name] = from_file(v.getArray(readonly=True).reshape(mine))
+            kernels[name.split(":")[0] + ":F"] = F      # (the side's spectrum, checked against the run's)
             v.destroy()
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
     collective_io(read_kernels, f"-ssi_lags_load {path}: reading the toeplitz kernels (a truncated or changed file?)",
@@ -286,9 +294,28 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
 
 
 def _kernel_arrays(march):
-    """[(name, this rank's array)] of the toeplitz store's kernels (``bem.toeplitz``: per side u and p, K9, K18
-    of the exact lags and A9, A18 of the interpolating matrices' anchors), in file order; [] on the dense store."""
+    """[(name, this rank's array in lanes, its frequencies)] of the toeplitz store's kernels (``bem.toeplitz``:
+    per side u and p, K9, K18 of the exact lags and A9, A18 of the interpolating matrices' anchors), in file
+    order; [] on the dense store."""
     out = []
     for tz in getattr(march, "toeplitz", []):
-        out += [(f"{tz.side}:{n}", getattr(tz, n)) for n in ("K9", "K18", "A9", "A18")]
+        out += [(f"{tz.side}:{n}", getattr(tz, n), tz.f1 - tz.f0) for n in ("K9", "K18", "A9", "A18")]
     return out
+
+
+def to_file(a, slab):
+    """A kernel's lanes (groups, rows, columns, parts, FW) -> (slab, rows, columns, parts) float64, frequency
+    g FW + q from lane q of group g, the last group's padding dropped: the file's layout, which no rank count
+    shapes."""
+    return np.ascontiguousarray(np.moveaxis(a, -1, 1).reshape((a.shape[0] * a.shape[-1],) + a.shape[1:-1])[:slab],
+                                dtype=np.float64)
+
+
+def from_file(X):
+    """``to_file``'s inverse: (slab, rows, columns, parts) -> the lanes (groups, rows, columns, parts, FW), the
+    last group padded with zeros."""
+    from .lanes import FW, n_groups
+    slab, rest = X.shape[0], X.shape[1:]
+    P = np.zeros((n_groups(slab) * FW,) + rest)
+    P[:slab] = X
+    return np.ascontiguousarray(np.moveaxis(P.reshape((-1, FW) + rest), 1, -1))

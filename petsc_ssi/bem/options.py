@@ -118,10 +118,10 @@ register("disp_rigid", "enum", "prescribed", "", "the -ssi_disp_group region's r
          choices=("prescribed", "massless"))
 register("lags_save", "str", "", "", "save the assembled lag matrices (PETSc binary FILE and FILE.json with the "
          "key of what they depend on and the CRC32 of FILE's content; on the toeplitz store the step matrix, lags 1-2 and "
-         "the kernels, in the run's frequency slabs) for -ssi_lags_load", "bem")
+         "the kernels, frequency-major: any rank count loads them) for -ssi_lags_load", "bem")
 register("lags_load", "str", "", "", "load the lag matrices a run saved with -ssi_lags_save instead of assembling "
          "them (refused, naming the difference, unless mesh, material, dt, scheme, symmetry, interpolation, "
-         "quadrature and traction nodes are the same, on the toeplitz store also the store and the rank count, and a file "
+         "quadrature and traction nodes are the same, on the toeplitz store also the store, and a file "
          "whose content differs from its CRC32s)", "bem")
 register("interp", "enum", "none", "", "lag-matrix interpolation beyond T_L: none, chebyshev (eqs. 9, 11), linear (eqs. 10, 12), auto (paper's rule)", "bem",
          choices=("none", "chebyshev", "linear", "auto"))

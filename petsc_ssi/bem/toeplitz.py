@@ -673,7 +673,8 @@ class ToeplitzHistory:
         plan_k = self.k
         if kernels is not None:
             bad = [n for n in ("K9", "K18", "A9", "A18") if n not in kernels
-                   or kernels[n].shape != getattr(self, n).shape]
+                   or kernels[n].shape != getattr(self, n).shape] + (["F"] if kernels.get("F", self.lat.F) != self.lat.F
+                                                                     else [])
             from mpi4py import MPI
             if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
                 raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "

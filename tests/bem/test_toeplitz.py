@@ -6,6 +6,7 @@ schemes, the interpolation of the far lags, symmetry planes, prescribed motion, 
 unilateral contact, at -n 1 and -n 2, and through a restart (bit for bit: the kept transforms are
 made again from the checkpoint's states). A surface that is not a uniform grid is refused in one
 line naming the first element off it."""
+import json
 import os
 import sys
 
@@ -504,13 +505,15 @@ def test_toeplitz_rectangular_cells_equal_dense(tmp_path):
 def test_toeplitz_lags_save_and_load(tmp_path):
     """-ssi_lags_save on the toeplitz store writes the step matrix, lags 1-2 and both sides' kernels (exact lags
     and the interpolating matrices' anchors: a rigid footing with a traction side, far lags interpolated); a
-    run that loads them integrates nothing and is the saving run bit for bit (one rank: deterministic solves);
-    the file is refused in one line at another rank count (its kernels are in that count's frequency slabs) and
-    by the dense store."""
+    run that loads them integrates nothing and is the saving run bit for bit (one rank: deterministic solves).
+    The kernels are frequency-major in the file, so it loads on any number of ranks: saved at -n 1, loaded at
+    -n 2 and -n 3 (uneven slabs); saved at -n 2, loaded at -n 1; all equal the saving run to 1e-12. The dense
+    store refuses the file, and a file of the earlier layout (its rank count in the key) is refused in one
+    line."""
     case = DISP + INTERP + TZ
     lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
     out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags]).stdout
-    assert "lag matrices and toeplitz kernels saved to" in out, out[-2000:]
+    assert "lag matrices and toeplitz kernels saved to" in out and "kernels real" in out, out[-2000:]
     out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
     assert "toeplitz kernels loaded from" in out and "content checked against its CRC32s" in out, out[-2000:]
     assert " 0 kernel evaluations" in out
@@ -518,16 +521,38 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     assert set(A) == set(B) and any(np.abs(v).max() > 0 for v in A.values())
     for k in A:
         assert np.array_equal(A[k], B[k]), k
-    lags2, c2, d2 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5"), str(tmp_path / "d2.h5")
+    for n in (2, 3):                            # (3: oversubscribed, the frequencies split unevenly)
+        c = str(tmp_path / f"n{n}.h5")
+        out = cli(case + ["-ssi_output", c, "-ssi_lags_load", lags], nranks=n).stdout
+        assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
+        same(a, c)
+    lags2, c2, d1 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5"), str(tmp_path / "d1.h5")
     cli(case + ["-ssi_output", c2, "-ssi_lags_save", lags2], nranks=2)          # (each rank's slab, one file)
-    out = cli(case + ["-ssi_output", d2, "-ssi_lags_load", lags2], nranks=2).stdout
+    out = cli(case + ["-ssi_output", d1, "-ssi_lags_load", lags2]).stdout
     assert "toeplitz kernels loaded from" in out
-    same(c2, d2)
-    same(a, d2)
-    for extra, nranks, what in ((["-ssi_output", str(tmp_path / "c.h5")], 2, "ranks differs"),
-                                (["-ssi_output", str(tmp_path / "d.h5"), "-ssi_lag_store", "dense"], 1,
-                                 "lag_store differs")):
-        args = [x for x in case if x not in TZ] + (TZ if "-ssi_lag_store" not in extra else []) + extra
-        r = cli(args + ["-ssi_lags_load", lags], nranks=nranks, check=False)
+    same(c2, d1)
+    same(a, d1)
+    with open(lags + ".json") as fh:
+        old = json.load(fh)
+    old["key"]["ranks"] = "1"                   # (the earlier layout's key: its rank count, no kernel layout)
+    del old["key"]["toeplitz_kernels"]
+    with open(lags + ".json", "w") as fh:
+        json.dump(old, fh)
+    for extra, lf, what in ((["-ssi_lag_store", "dense"], lags2, "lag_store differs"),
+                            (TZ, lags, "a toeplitz lag file of an older petsc-ssi")):
+        args = [x for x in case if x not in TZ] + extra + ["-ssi_output", str(tmp_path / "e.h5")]
+        r = cli(args + ["-ssi_lags_load", lf], nranks=2, check=False)
         err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
         assert r.returncode != 0 and err and what in err[0] and "Traceback" not in r.stderr, (what, r.stderr[-2000:])
+
+
+def test_toeplitz_lags_file_complex_kernels_other_rank_count(tmp_path):
+    """The half model (a symmetry plane: complex kernels, two parts a lane) saved at -n 2 and loaded at
+    -n 1: equal to the saving run to 1e-12, nothing integrated."""
+    case = DISP + INTERP + TZ + ["-ssi_symmetry", "y=sym"]
+    lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
+    out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags], nranks=2).stdout
+    assert "kernels real" not in out, out[-2000:]
+    out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
+    assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
+    same(a, b)
