@@ -316,6 +316,7 @@ def from_file(X):
     last group padded with zeros."""
     from .lanes import FW, n_groups
     slab, rest = X.shape[0], X.shape[1:]
-    P = np.zeros((n_groups(slab) * FW,) + rest)
+    G = n_groups(slab)
+    P = np.zeros((G * FW,) + rest)
     P[:slab] = X
-    return np.ascontiguousarray(np.moveaxis(P.reshape((-1, FW) + rest), 1, -1))
+    return np.ascontiguousarray(np.moveaxis(P.reshape((G, FW) + rest), 1, -1))     # (G given: rest may be empty)
