@@ -69,6 +69,7 @@ def report(cfg, comm, out=None):
         out("\n".join(tz))
         return {"counts": None, "rows": []}
     prob, plan, cnt = count_run(cfg, comm, ranks, node_mem, coupled)
+    cnt.area_bytes = ab = prob.area_bytes()
     nd = int(cnt.storage.sum())
     n1 = int(cnt.single.sum())
     ns = len(cnt.storage) - nd - n1
@@ -83,6 +84,7 @@ def report(cfg, comm, out=None):
              f"[ssi]   lag matrices {cnt.lag_bytes() / 1e9:.3g} GB; {cnt.nb_total_used().sum():.4g} blocks "
              f"assembled; node: {cores} cores, {node_mem / 1e9:.3g} GB, {q} ranks per node",
              ]
+    lines += _area_line(ab)
     if cc is not None:
         from ..coupling.cost import describe
         lines.append(describe(cc))
@@ -92,6 +94,8 @@ def report(cfg, comm, out=None):
     rows = []
     for p in ranks:
         t = predict(cnt, c, p, q, cores)
+        t["peak_bytes"] += ab               # (the area loads' vectors, beside the lags for the whole run)
+        t["peak_rank_bytes"] += ab / p
         if cc is not None:            # the structure, the interface matrices and the coupled step
             bem_solve = bem_solve_seconds(c, cnt.N, p)
             add = cc.predict(c, p, bem_solve)
@@ -167,6 +171,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     glat = traction_grid(lat, ls.VT)
     single = cfg.get("toeplitz_precision", "double") == "single"
     g = prob.toeplitz_side_bytes(ls, plan)
+    ab = prob.area_bytes()
     load_kernels()                      # the process measured with the compiled kernels it will hold
     rss = process_rss()
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * node_mem
@@ -183,6 +188,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                 f"{glat.Mx} x {glat.My})" if glat is not None else ""),
              "[ssi]   ranks | kernels_s history_s | GB over the ranks beside the processes | with the processes "
              "(this one's resident size each) | fits"]
+    for i, ln in enumerate(_area_line(ab)):
+        lines.insert(2 + i, ln)
     if cc is not None:
         from ..coupling.cost import describe
         lines.insert(2, describe(cc))
@@ -201,6 +208,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
+        b += ab
         cpl = ""
         if cc is not None:            # the structure, the interface matrices and the coupled steps
             _, fac, one = step_lu(3 * N, rho, nblk, p, kappa=c.get("kappa", 0.107))
@@ -250,7 +258,15 @@ def _refuses(cnt, p, q):
     """Whether the run's own check (HalfSpace.check_memory: the estimated peak shared
     by the ranks, the most loaded node's part against the per-node limit) refuses it."""
     used = cnt.nb_total_used()
-    return cnt.peak_rule(used, cnt.storage, p) * min(q, p) / float(p) > cnt.limit
+    return (cnt.peak_rule(used, cnt.storage, p) + getattr(cnt, "area_bytes", 0.0)) * min(q, p) / float(p) > cnt.limit
+
+
+def _area_line(ab):
+    """The estimate's line of the area loads' lag vectors (``HalfSpace.area_bytes``, the run's own count: one
+    column a lag a node row per symmetry image, an upper bound), or none."""
+    if not ab:
+        return []
+    return [f"[ssi]   area loads (-ssi_load_area): {ab / 1e9:.3g} GB of lag vectors over the ranks, in the peaks below"]
 
 
 def main():

@@ -70,6 +70,21 @@ def test_area_of_cells_equals_the_cells_load(tmp_path, store, nranks, scheme):
     same(ref, got, rtol=1e-12)
 
 
+@pytest.mark.parametrize("store", ["dense", "toeplitz"])
+def test_the_estimate_counts_the_area_vectors(tmp_path, store):
+    """petsc-ssi estimate prices the area load's lag vectors (``HalfSpace.area_bytes``, the run's own count, in
+    the estimate's peaks): its line bounds the vectors the run then holds, held <= estimated <= 1.5 held."""
+    case = _swap(BEM + NONE + ["-ssi_lag_store", store], "-ssi_load_group", ["-ssi_load_area", "-1,1,-1,1"])
+    est = cli(["estimate"] + case + ["-ssi_estimate_ranks", "1,2"]).stdout
+    line = [ln for ln in est.splitlines() if "area loads (-ssi_load_area):" in ln]
+    assert len(line) == 1, est
+    counted = float(line[0].split("):")[1].split(" GB")[0])
+    out = cli(case + ["-ssi_output", str(tmp_path / "a.h5")], nranks=2).stdout
+    run = [ln for ln in out.splitlines() if "its lag vectors integrated over the rectangle" in ln]
+    held = float(run[0].split("lags, ")[1].split(" GB")[0])
+    assert held <= counted <= 1.5 * held, (held, counted)
+
+
 @pytest.mark.parametrize("store,nranks", [("dense", 1), ("toeplitz", 2)])
 def test_quarter_model_area_equals_cells(tmp_path, store, nranks):
     """Two symmetry planes (the quarter of BEM's grid meshed): the 2 m x 2 m patch across both planes as an
