@@ -19,6 +19,10 @@
 #   today-fine     (not by default) today's graded mesh refined, every lag exact (-ssi_mesh_params
 #                  g=1.15,hm=1.5,hr=1.0,hq=1.0: cells of at most 1.5 m, the slab's 1.2 m and the 1 m patch kept; 9333 DOFs):
 #                  against today-exact, how far today's own answer moves when its mesh is refined
+#   today-smooth, uniform-36-smooth, uniform-72-smooth, today-fine-smooth  (not by default) today-exact,
+#                  uniform-36-area-exact, uniform-72-area-exact and today-fine with a smooth load history instead of
+#                  the 25 ms box: a 0.1 s Hann pulse, p0 sin^2(pi t / 0.1 s) (-ssi_load_history table, OUT/hann100ms.txt),
+#                  whose waves (up to about 20 Hz: shear waves of 5 m and longer) the cells resolve
 #   uniform-72-fullrank (not by default) uniform-72 with the step matrix's MUMPS LU in full rank (-ssi_step_blr 0;
 #                  by default, from 20 000 DOFs on, it is block low-rank at 1e-15 and checked: bem/march.py)
 #   uniform-72-fast  (not by default) uniform-72 with FAST (default: multi-linear far lags from the same
@@ -56,6 +60,10 @@ U=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14
 A=(-ssi_mesh grid -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group "" -ssi_load_area 14,15,-0.5,0.5
    -ssi_lag_store toeplitz)
 X=(-ssi_interp none)
+# the smooth load: p0 sin^2(pi t / T), T = 0.1 s, tabulated every 1 ms (linear between rows), zero after T
+"$PY" -c "import numpy as np; t = np.r_[np.arange(0, 0.1005, 0.001), 10.0]; v = np.where(t <= 0.1, np.sin(np.pi * t / 0.1) ** 2, 0.0)
+np.savetxt('$OUT/hann100ms.txt', np.c_[t, v], fmt='%.6g', header='t [s]  p / p0 [-]: a 0.1 s Hann pulse')"
+S=(-ssi_load_history table -ssi_load_table "$OUT/hann100ms.txt")
 run() { sampled_run "$@"; }
 for r in $RUNS; do
   case $r in
@@ -68,6 +76,10 @@ for r in $RUNS; do
     # shellcheck disable=SC2086
     today-exact) run today-exact "${B[@]}" "${X[@]}" ;;
     today-fine) run today-fine "${B[@]}" "${X[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
+    today-smooth) run today-smooth "${B[@]}" "${X[@]}" "${S[@]}" ;;
+    today-fine-smooth) run today-fine-smooth "${B[@]}" "${X[@]}" "${S[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
+    uniform-36-smooth) run uniform-36-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" ;;
+    uniform-72-smooth) run uniform-72-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 "${X[@]}" "${S[@]}" ;;
     # shellcheck disable=SC2086
     uniform-72-area) run uniform-72-area "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
