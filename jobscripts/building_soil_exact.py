@@ -48,16 +48,46 @@ RUNS = {"today": ("graded 36 x 36 m (building_soil.geo)", 14.5, 0.5, 1000.0, 9),
         "uniform-36": ("uniform 36 x 37.2 m, 1.2 m cells", 15.0, 0.6, P15, 9),
         "uniform-72": ("uniform 72 x 73.2 m, 1.2 m cells", 15.0, 0.6, P15, 9),
         "uniform-72-exact": ("uniform 72 x 73.2 m, 1.2 m cells" + EXACT, 15.0, 0.6, P15, 9),
-        "uniform-36-h06": ("uniform 36 x 37.2 m, 0.6 m cells, dt 2.5 ms", 15.0, 0.6, P15, 25)}
+        "uniform-36-h06": ("uniform 36 x 37.2 m, 0.6 m cells, dt 2.5 ms", 15.0, 0.6, P15, 25),
+        # the smooth load (a 0.1 s Hann pulse), every lag exact
+        "today-smooth": ("graded 36 x 36 m (building_soil.geo)" + EXACT, 14.5, 0.5, 1000.0, 9, "hann"),
+        "today-fine-smooth": ("graded 36 x 36 m refined (cells <= 1.5 m)" + EXACT, 14.5, 0.5, 1000.0, 9, "hann"),
+        "uniform-36-area-smooth": ("uniform 36 x 37.2 m, 1.2 m cells, the load as an area" + EXACT, 14.5, 0.5, 1000.0,
+                                   AREA, "hann"),
+        "uniform-72-area-smooth": ("uniform 72 x 73.2 m, 1.2 m cells, the load as an area" + EXACT, 14.5, 0.5, 1000.0,
+                                   AREA, "hann")}
+HANN_T, HANN_DT, FINE = 0.1, 1e-3, 1e-4     # s: the pulse, its table's rows (building_soil_exact.sh), the ramps' grid
 EARLY = 0.5     # s: the direct waves (t <= EARLY) and the late response (t > EARLY)
 
 
-def exact(x, y, t, xl, a, p0):
-    """(u_x, u_z) [m] of the box load at the surface point (x, y) at times t."""
+def exact(x, y, t, xl, a, p0, history="box"):
+    """(u_x, u_z) [m] of the load at the surface point (x, y) at times t: the box as two steps, or the tabulated
+    Hann pulse (``exact_table``)."""
     from petsc_ssi.analytic.pekeris import patch_displacement
+    if history == "hann":
+        return exact_table(x, y, t, xl, a, p0)
     step = lambda tt: np.array(patch_displacement(x - xl, y, np.maximum(tt, 0.0), a, a, p0, CS, CP, RHO))
     u = step(t) - np.where(t > T0, 1.0, 0.0) * step(t - T0)
     return u[0], u[2]
+
+
+def exact_table(x, y, t, xl, a, p0):
+    """(u_x, u_z) [m] under p0 p(t), p the run's table (sin^2(pi t / HANN_T) at rows HANN_DT apart, linear
+    between them): sum over the rows' segments of slope_k (R(t - t_k) - R(t - t_k+1)), R the ramp response,
+    the step response (``patch_displacement``) integrated in time on a FINE grid (trapezoids; the patch's
+    response is continuous, so the error is O(FINE^2))."""
+    from petsc_ssi.analytic.pekeris import patch_displacement
+    tf = np.arange(0.0, float(t.max()) + 1.5 * FINE, FINE)
+    U = np.array(patch_displacement(x - xl, y, tf, a, a, p0, CS, CP, RHO))
+    R = np.concatenate([np.zeros((3, 1)), np.cumsum(0.5 * FINE * (U[:, 1:] + U[:, :-1]), axis=1)], axis=1)
+    rows = np.arange(0.0, HANN_T + 0.5 * HANN_DT, HANN_DT)
+    v = np.sin(np.pi * rows / HANN_T) ** 2
+    out = np.zeros_like(R)
+    step = int(round(HANN_DT / FINE))
+    for k, s in enumerate(np.diff(v) / HANN_DT):
+        for sh, sign in ((k * step, 1.0), ((k + 1) * step, -1.0)):
+            out[:, sh:] += sign * s * R[:, :R.shape[1] - sh]
+    return np.interp(t, tf, out[0]), np.interp(t, tf, out[2])
 
 
 def check_log(outdir, name):
@@ -65,6 +95,8 @@ def check_log(outdir, name):
     text = open(os.path.join(outdir, name + ".log"), errors="replace").read()
     m = re.search(r"(\d+) DOFs;(?: (\d+) traction nodes;)? dt (\S+) s, (\d+) steps", text)
     want = RUNS[name][4]
+    if len(RUNS[name]) > 5 and "-ssi_load_history table" not in text:
+        sys.exit(f"{name}: its log does not show the tabulated load history")
     if not m or (want not in text if isinstance(want, str) else int(m.group(2) or 0) != want):
         sys.exit(f"{name}: its log does not show its load ({want!r})")
     if "(every lag exact)" in RUNS[name][0] and "lag interpolation: none" not in text:
@@ -75,16 +107,23 @@ def check_log(outdir, name):
             float(peak.group(1)) if peak else float("nan"))
 
 
+_EXACT = {}
+
+
 def errors(outdir, name):
     """Rows per receiver and component, and the series for the plot."""
-    _, xl, a, p0, _ = RUNS[name]
+    _, xl, a, p0, _ = RUNS[name][:5]
+    history = RUNS[name][5] if len(RUNS[name]) > 5 else "box"
     with h5py.File(os.path.join(outdir, name + ".h5"), "r") as f:
         if abs(float(f.attrs["load_p0"]) - p0) > 1e-9 * p0:
             sys.exit(f"{name}: load_p0 {f.attrs['load_p0']} in its output, not {p0}")
         t, u, pts = f["receivers/t"][:], f["receivers/u"][:], f["receivers/points"][:]
     rows, series = [], {}
     for i, p in enumerate(pts):
-        ux, uz = exact(p[0], p[1], t, xl, a, p0)
+        key = (float(p[0]), float(p[1]), xl, a, p0, history, len(t), float(t[-1]))
+        if key not in _EXACT:          # (the smooth runs share their receivers: their reference made once)
+            _EXACT[key] = exact(p[0], p[1], t, xl, a, p0, history)
+        ux, uz = _EXACT[key]
         for c, ref in ((0, ux), (2, uz)):
             q = f"x = {p[0]:g} m u_{'xz'[c // 2]}"
             series[q] = (t, u[:, i, c], ref)
@@ -101,8 +140,9 @@ def errors(outdir, name):
 
 def summary(outdir, name, rows):
     dofs, steps, wall, peak = check_log(outdir, name)
-    mesh, xl, a, p0, _ = RUNS[name]
-    out = {"run": name, "soil mesh": mesh, "load": f"{2 * a:g} m square at x = {xl:g} m, p0 = {p0:.4g} N/m^2",
+    mesh, xl, a, p0, _ = RUNS[name][:5]
+    hist = "0.1 s Hann pulse" if len(RUNS[name]) > 5 else "25 ms box"
+    out = {"run": name, "soil mesh": mesh, "load": f"{2 * a:g} m square at x = {xl:g} m, p0 = {p0:.4g} N/m^2, {hist}",
            "soil DOFs": dofs, "steps": steps, "wall [s]": wall, "peak RSS [GB]": peak}
     for key in (f"peak error, t <= {EARLY:g} s [%]", f"history error, t <= {EARLY:g} s [%]",
                 f"history error, t > {EARLY:g} s [%]"):

@@ -19,6 +19,12 @@
 #                   which no cell of this grid holds)
 #   *-exact         (today-exact, uniform-72-exact, uniform-72-area-exact) the same without interpolated far lags
 #                   (-ssi_interp none: every lag exact, 103 on the 36 m mesh, 207 on the 72 m grid)
+#   today-smooth, today-fine-smooth, uniform-36-area-smooth, uniform-72-area-smooth  (not by default) today's load
+#                   with a smooth history instead of the 25 ms box, a 0.1 s Hann pulse p0 sin^2(pi t / 0.1 s)
+#                   (-ssi_load_history table, OUT/hann100ms.txt, rows every 1 ms), every lag exact, on today's mesh,
+#                   today's mesh refined (-ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0: cells of at most 1.5 m) and
+#                   the building's uniform grid of 36 m and 72 m (the load as an area); the exact answer is the
+#                   tabulated pulse's (its ramps' responses summed)
 # jobscripts/building_soil_exact.py then compares each run's receivers with the exact surface displacement of
 # its own load (petsc_ssi.analytic.pekeris.patch_displacement: the point-load solution integrated over the
 # patch, general nu; the box history as the difference of two steps) and writes the table into
@@ -40,8 +46,13 @@ P15=(-ssi_load_p0 694.4444444444445)          # 1000 N over the 1.44 m^2 cell
 G=(-ssi_mesh grid -ssi_lag_store toeplitz)
 G1=("${G[@]}" -ssi_mesh_h 1.0 -ssi_mesh_patch 7,4.5 -ssi_load_group box:14.4,14.6,-0.1,0.1)
 G12=("${G[@]}" -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14.9,15.1,-0.1,0.1 "${P15[@]}")
-GA=("${G[@]}" -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_mesh_size 72,73.2 -ssi_load_group "" -ssi_load_area 14,15,-0.5,0.5)
+GA0=("${G[@]}" -ssi_mesh_h 1.2 -ssi_mesh_patch 7.2,5.4 -ssi_load_group "" -ssi_load_area 14,15,-0.5,0.5)
+GA=("${GA0[@]}" -ssi_mesh_size 72,73.2)
 X=(-ssi_interp none)
+# the smooth load (building_uniform.sh's): p0 sin^2(pi t / T), T = 0.1 s, tabulated every 1 ms, zero after T
+"$PY" -c "import numpy as np; t = np.r_[np.arange(0, 0.1005, 0.001), 10.0]; v = np.where(t <= 0.1, np.sin(np.pi * t / 0.1) ** 2, 0.0)
+np.savetxt('$OUT/hann100ms.txt', np.c_[t, v], fmt='%.6g', header='t [s]  p / p0 [-]: a 0.1 s Hann pulse')"
+H=(-ssi_load_history table -ssi_load_table "$OUT/hann100ms.txt")
 G06=("${G[@]}" -ssi_mesh_h 0.6 -ssi_mesh_patch 7.2,5.4 -ssi_load_group box:14.41,15.59,-0.59,0.59 "${P15[@]}"
      -ssi_dt 2.5e-3)
 for r in $RUNS; do
@@ -57,6 +68,10 @@ for r in $RUNS; do
     uniform-72-area) sampled_run uniform-72-area "${S[@]}" "${GA[@]}" ;;
     uniform-72-area-exact) sampled_run uniform-72-area-exact "${S[@]}" "${GA[@]}" "${X[@]}" ;;
     uniform-36-h06) sampled_run uniform-36-h06 "${S[@]}" "${G06[@]}" -ssi_mesh_size 36,37.2 ;;
+    today-smooth) sampled_run today-smooth "${S[@]}" "${X[@]}" "${H[@]}" ;;
+    today-fine-smooth) sampled_run today-fine-smooth "${S[@]}" "${X[@]}" "${H[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
+    uniform-36-area-smooth) sampled_run uniform-36-area-smooth "${S[@]}" "${GA0[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${H[@]}" ;;
+    uniform-72-area-smooth) sampled_run uniform-72-area-smooth "${S[@]}" "${GA[@]}" "${X[@]}" "${H[@]}" ;;
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
