@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tables of jobscripts/step_mirror_check.sh's runs (OUT: its directory).
 
-    python jobscripts/step_mirror_check.py OUT
+    python jobscripts/step_mirror_check.py OUT [RUNS]
 
 Per run: the step matrix's factor entries (its log line), the events SSI_BEM_Factor (the step matrix's build,
 the blocks and the LU) and the time loop's SSI_BEM_Solve (seconds a solve), the assembly stage's MatLUFactorNum
@@ -56,16 +56,20 @@ def largest(out, a, b):
     return worst
 
 
-def main(out):
-    names = [n for n in ("mirror", "off", "save", "load", "load-other") if os.path.exists(os.path.join(out, n + ".log"))]
+def main(out, runs=None):
+    """``runs``: the runs of this invocation (step_mirror_check.sh's RUNS), else every run whose log is in OUT."""
+    want = runs.split() if runs else ("mirror", "off", "save", "load", "load-other")
+    names = [n for n in want if os.path.exists(os.path.join(out, n + ".log"))]
+    if not names:
+        sys.exit(f"step_mirror_check.py: no run's log in {out}")
     rows = [row(out, n) for n in names]
     keys = list(rows[0])
     print("| " + " | ".join(keys) + " |")
     print("|" + "---|" * len(keys))
     for r in rows:
         print("| " + " | ".join(f"{r[k]:.4g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
-    size = os.path.getsize(os.path.join(out, "lags")) / 1e9
-    print(f"\nlag file: {size:.3g} GB")
+    if "save" in names and os.path.exists(os.path.join(out, "lags")):
+        print(f"\nlag file: {os.path.getsize(os.path.join(out, 'lags')) / 1e9:.3g} GB")
     for a, b in (("mirror", "off"), ("load", "save"), ("load-other", "save")):
         if a not in names or b not in names:
             continue
@@ -75,4 +79,4 @@ def main(out):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(*sys.argv[1:3])

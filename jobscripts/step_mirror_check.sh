@@ -9,7 +9,8 @@
 #               file, any rank count reads them (petsc_ssi/bem/lagstore.py)
 # Then jobscripts/step_mirror_check.py prints the factors' entries, the factorisations' and the step solves'
 # seconds, the interface columns' LU and solves, each run's largest bem_residual, and the largest difference of
-# every recorded field of mirror against off and of load against save over the field's largest value.
+# every recorded field of mirror against off and of load and load-other against save over the field's largest
+# value (of this invocation's RUNS).
 #   bash jobscripts/quiet.sh bash jobscripts/step_mirror_check.sh        (OUT=... another directory;
 #   RUNS="save load load-other" a subset: save before the loads)
 set -euo pipefail
@@ -43,4 +44,4 @@ for r in $RUNS; do
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac
 done
-"$PY" jobscripts/step_mirror_check.py "$OUT"
+"$PY" jobscripts/step_mirror_check.py "$OUT" "$RUNS"

@@ -94,8 +94,10 @@ def report(cfg, comm, out=None):
     rows = []
     for p in ranks:
         t = predict(cnt, c, p, q, cores)
-        t["peak_bytes"] += ab               # (the area loads' vectors, beside the lags for the whole run)
-        t["peak_rank_bytes"] += ab / p
+        if ab:                              # (the area loads' vectors, made after the assembly, beside the stored
+            steady = p * c["m0"] + t["lag_bytes"] + ab          # lags: the run's max(peak, lags + them))
+            t["peak_bytes"] = max(t["peak_bytes"], steady)
+            t["peak_rank_bytes"] = max(t["peak_rank_bytes"], steady / p)
         if cc is not None:            # the structure, the interface matrices and the coupled step
             bem_solve = bem_solve_seconds(c, cnt.N, p)
             add = cc.predict(c, p, bem_solve)
@@ -258,7 +260,11 @@ def _refuses(cnt, p, q):
     """Whether the run's own check (HalfSpace.check_memory: the estimated peak shared
     by the ranks, the most loaded node's part against the per-node limit) refuses it."""
     used = cnt.nb_total_used()
-    return (cnt.peak_rule(used, cnt.storage, p) + getattr(cnt, "area_bytes", 0.0)) * min(q, p) / float(p) > cnt.limit
+    peak = cnt.peak_rule(used, cnt.storage, p)
+    ab = getattr(cnt, "area_bytes", 0.0)
+    if ab:                      # (HalfSpace._lag_memory: max(the assembly's peak, the stored lags + the area vectors))
+        peak = max(peak, cnt.lag_bytes() + ab)
+    return peak * min(q, p) / float(p) > cnt.limit
 
 
 def _area_line(ab):
@@ -266,7 +272,8 @@ def _area_line(ab):
     column a lag a node row per symmetry image, an upper bound), or none."""
     if not ab:
         return []
-    return [f"[ssi]   area loads (-ssi_load_area): {ab / 1e9:.3g} GB of lag vectors over the ranks, in the peaks below"]
+    return [f"[ssi]   area loads (-ssi_load_area): {ab / 1e9:.3g} GB of lag vectors over the ranks, beside the "
+            "stored lags in the peaks below"]
 
 
 def main():

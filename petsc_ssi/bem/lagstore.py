@@ -188,19 +188,21 @@ def save(path, comm, march, key):
                     A = make()
                     A.view(viewer)
                     A.destroy()
-    kernels = [(n, to_file(a, slab)) for n, a, slab in _kernel_arrays(march)]
+    kernels = _kernel_arrays(march)
 
     def write_kernels():
-        for _, a in kernels:                    # (each rank's frequencies of a side's kernels, one MPI Vec)
-            v = PETSc.Vec().createWithArray(a.ravel(), comm=comm)
+        for _, a, slab in kernels:              # (each rank's frequencies of a side's kernels, one MPI Vec; one
+            f = to_file(a, slab)                # kernel converted at a time: a copy of one, not of all)
+            v = PETSc.Vec().createWithArray(f.ravel(), comm=comm)
             v.view(viewer)
             v.destroy()
+            del f
     collective_io(write, f"-ssi_lags_save {path}: writing the matrices", comm)
     collective_io(write_kernels, f"-ssi_lags_save {path}: writing the toeplitz kernels", comm)
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     import time
     from ..io.integrity import file_crcs, CHUNK
-    kshapes = [[comm.tompi4py().allreduce(a.shape[0])] + list(a.shape[1:]) for _, a in kernels]   # (whole spectrum)
+    kshapes = [[comm.tompi4py().allreduce(slab)] + list(a.shape[1:-1]) for _, a, slab in kernels]  # (whole spectrum)
     t0 = time.perf_counter()
     crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
     t_crc = time.perf_counter() - t0
@@ -216,7 +218,7 @@ def save(path, comm, march, key):
             manifest = {"format": FORMAT, "key": key, "mats": [[n, _kind(M)] for n, M in mats],
                         "ranks": comm.getSize(), "bytes": size, "crc32_chunk": CHUNK, "crc32": crcs}
             if kernels:
-                manifest["kernels"] = [[n, shapes] for (n, _), shapes in zip(kernels, kshapes)]
+                manifest["kernels"] = [[n, shapes] for (n, _, _), shapes in zip(kernels, kshapes)]
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
@@ -315,8 +317,9 @@ def from_file(X):
     """``to_file``'s inverse: (slab, rows, columns, parts) -> the lanes (groups, rows, columns, parts, FW), the
     last group padded with zeros."""
     from .lanes import FW, n_groups
-    slab, rest = X.shape[0], X.shape[1:]
-    G = n_groups(slab)
-    P = np.zeros((G * FW,) + rest)
-    P[:slab] = X
-    return np.ascontiguousarray(np.moveaxis(P.reshape((G, FW) + rest), 1, -1))     # (G given: rest may be empty)
+    rest = X.shape[1:]
+    out = np.zeros((n_groups(X.shape[0]),) + rest + (FW,))
+    for q in range(FW):                             # (lane q: frequencies q, q + FW, ...; no copy of the whole)
+        xs = X[q::FW]
+        out[:len(xs), ..., q] = xs
+    return out

@@ -678,9 +678,9 @@ class ToeplitzHistory:
             from mpi4py import MPI
             if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
                 raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "
-                               "(saved by another version of petsc-ssi?): save them again with -ssi_lags_save")
-            for n in ("K9", "K18", "A9", "A18"):
-                getattr(self, n)[...] = kernels[n]
+                               "or spectrum (saved by another version of petsc-ssi?): save them again with -ssi_lags_save")
+            for n in ("K9", "K18", "A9", "A18"):        # (the loaded arrays adopted: no second copy)
+                setattr(self, n, np.ascontiguousarray(kernels[n], dtype=np.float64))
             exact, plan_k = [], 0
         if exact:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):

@@ -502,18 +502,33 @@ def test_toeplitz_rectangular_cells_equal_dense(tmp_path):
     same(ref, tz)
 
 
+def _kernel_shapes(lags):
+    """{name: [frequencies of the whole spectrum, rows, columns, parts]} of a toeplitz lag file's kernels."""
+    with open(lags + ".json") as fh:
+        return {n: s for n, s in json.load(fh)["kernels"]}
+
+
+def _padded(F, n, fw=8):
+    """Whether some rank of n holds a slab of F frequencies that is not whole lane groups of fw."""
+    return any(((F * (r + 1)) // n - (F * r) // n) % fw for r in range(n))
+
+
 def test_toeplitz_lags_save_and_load(tmp_path):
     """-ssi_lags_save on the toeplitz store writes the step matrix, lags 1-2 and both sides' kernels (exact lags
     and the interpolating matrices' anchors: a rigid footing with a traction side, far lags interpolated); a
     run that loads them integrates nothing and is the saving run bit for bit (one rank: deterministic solves).
-    The kernels are frequency-major in the file, so it loads on any number of ranks: saved at -n 1, loaded at
-    -n 2 and -n 3 (uneven slabs); saved at -n 2, loaded at -n 1; all equal the saving run to 1e-12. The dense
-    store refuses the file, and a file of the earlier layout (its rank count in the key) is refused in one
-    line."""
+    The kernels are frequency-major in the file (real here: one part a lane), so it loads on any number of
+    ranks: saved at -n 1 and loaded at -n 2 (slabs that are not whole lane groups: padded as they are read);
+    saved at -n 2 (padded slabs, the padding dropped as written) and loaded at -n 1 and -n 3; all equal the
+    saving run to 1e-12. The dense store refuses the file, and a file of the earlier layout (its rank count in
+    the key) is refused in one line."""
     case = DISP + INTERP + TZ
     lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
     out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags]).stdout
     assert "lag matrices and toeplitz kernels saved to" in out and "kernels real" in out, out[-2000:]
+    ks = _kernel_shapes(lags)
+    assert all(s[3] == 1 for s in ks.values()) and ks["u:A9"][1] > 0, ks       # real; anchors kept
+    assert any(_padded(ks[f"{side}:K9"][0], 2) for side in "up"), ks
     out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
     assert "toeplitz kernels loaded from" in out and "content checked against its CRC32s" in out, out[-2000:]
     assert " 0 kernel evaluations" in out
@@ -521,17 +536,19 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     assert set(A) == set(B) and any(np.abs(v).max() > 0 for v in A.values())
     for k in A:
         assert np.array_equal(A[k], B[k]), k
-    for n in (2, 3):                            # (3: oversubscribed, the frequencies split unevenly)
-        c = str(tmp_path / f"n{n}.h5")
-        out = cli(case + ["-ssi_output", c, "-ssi_lags_load", lags], nranks=n).stdout
-        assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
-        same(a, c)
-    lags2, c2, d1 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5"), str(tmp_path / "d1.h5")
+    c = str(tmp_path / "n2.h5")
+    out = cli(case + ["-ssi_output", c, "-ssi_lags_load", lags], nranks=2).stdout
+    assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
+    same(a, c)
+    lags2, c2 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5")
     cli(case + ["-ssi_output", c2, "-ssi_lags_save", lags2], nranks=2)          # (each rank's slab, one file)
-    out = cli(case + ["-ssi_output", d1, "-ssi_lags_load", lags2]).stdout
-    assert "toeplitz kernels loaded from" in out
-    same(c2, d1)
-    same(a, d1)
+    assert _kernel_shapes(lags2) == ks                                          # (no rank count in the layout)
+    for n in (1, 3):
+        d = str(tmp_path / f"d{n}.h5")
+        out = cli(case + ["-ssi_output", d, "-ssi_lags_load", lags2], nranks=n).stdout
+        assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
+        same(c2, d)
+        same(a, d)
     with open(lags + ".json") as fh:
         old = json.load(fh)
     old["key"]["ranks"] = "1"                   # (the earlier layout's key: its rank count, no kernel layout)
@@ -554,6 +571,8 @@ def test_toeplitz_lags_file_complex_kernels_other_rank_count(tmp_path):
     lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
     out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags], nranks=2).stdout
     assert "kernels real" not in out, out[-2000:]
+    ks = _kernel_shapes(lags)
+    assert all(s[3] == 2 for s in ks.values()) and ks["u:A9"][1] == ks["p:A18"][1] == 0, ks   # complex; no anchors
     out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
     assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
     same(a, b)
