@@ -519,7 +519,7 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     run that loads them integrates nothing and is the saving run bit for bit (one rank: deterministic solves).
     The kernels are frequency-major in the file (real here: one part a lane), so it loads on any number of
     ranks: saved at -n 1 and loaded at -n 2 (slabs that are not whole lane groups: padded as they are read);
-    saved at -n 2 (padded slabs, the padding dropped as written) and loaded at -n 1 and -n 3; all equal the
+    saved at -n 2 (padded slabs, the padding dropped as written) and loaded at -n 1; all equal the
     saving run to 1e-12. The dense store refuses the file, and a file of the earlier layout (its rank count in
     the key) is refused in one line."""
     case = DISP + INTERP + TZ
@@ -543,22 +543,21 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     lags2, c2 = str(tmp_path / "lags2"), str(tmp_path / "c2.h5")
     cli(case + ["-ssi_output", c2, "-ssi_lags_save", lags2], nranks=2)          # (each rank's slab, one file)
     assert _kernel_shapes(lags2) == ks                                          # (no rank count in the layout)
-    for n in (1, 3):
-        d = str(tmp_path / f"d{n}.h5")
-        out = cli(case + ["-ssi_output", d, "-ssi_lags_load", lags2], nranks=n).stdout
-        assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
-        same(c2, d)
-        same(a, d)
+    d = str(tmp_path / "d1.h5")
+    out = cli(case + ["-ssi_output", d, "-ssi_lags_load", lags2]).stdout
+    assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
+    same(c2, d)
+    same(a, d)
     with open(lags + ".json") as fh:
         old = json.load(fh)
     old["key"]["ranks"] = "1"                   # (the earlier layout's key: its rank count, no kernel layout)
     del old["key"]["toeplitz_kernels"]
     with open(lags + ".json", "w") as fh:
         json.dump(old, fh)
-    for extra, lf, what in ((["-ssi_lag_store", "dense"], lags2, "lag_store differs"),
-                            (TZ, lags, "a toeplitz lag file of an older petsc-ssi")):
+    for extra, lf, what, n in ((["-ssi_lag_store", "dense"], lags2, "lag_store differs", 1),
+                               (TZ, lags, "a toeplitz lag file of an older petsc-ssi", 2)):   # (every rank's line)
         args = [x for x in case if x not in TZ] + extra + ["-ssi_output", str(tmp_path / "e.h5")]
-        r = cli(args + ["-ssi_lags_load", lf], nranks=2, check=False)
+        r = cli(args + ["-ssi_lags_load", lf], nranks=n, check=False)
         err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
         assert r.returncode != 0 and err and what in err[0] and "Traceback" not in r.stderr, (what, r.stderr[-2000:])
 
