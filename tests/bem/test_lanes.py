@@ -201,3 +201,27 @@ def test_per_step_helpers_equal_their_numpy_forms(vdtype):
         for c in range(3):
             ref[a, c, ix, iy] = U[vnode[:, a], c] * vsign[:, c]
     assert np.array_equal(f, ref)
+
+
+def test_lag_file_layout_is_any_rank_counts():
+    """The toeplitz lag file's kernel layout (``lagstore.to_file``/``from_file``): the ranks' slabs of P ranks,
+    each converted from lanes to frequency-major and concatenated, read back as the slabs of Q ranks are every
+    rank's own lanes exactly (real and complex kernels, empty kernels, spectra that split unevenly and slabs
+    that are not whole lane groups: F in 1, 7, 8, 9, 37, 312; P, Q in 1..5)."""
+    from petsc_ssi.bem.lagstore import to_file, from_file
+    from petsc_ssi.bem.lanes import to_lanes, to_lanes_real
+    rng = np.random.default_rng(1)
+    for F in (1, 7, 8, 9, 37, 312):
+        for rows in (0, 9):
+            for real in (True, False):
+                X = rng.standard_normal((F, rows, 4)) + (0 if real else 1j * rng.standard_normal((F, rows, 4)))
+                lanes = (lambda Y: to_lanes_real(Y.real)) if real else to_lanes
+                for P in (1, 2, 3, 5):
+                    cut = lambda n, r: ((F * r) // n, (F * (r + 1)) // n)     # noqa: E731 (ToeplitzHistory's slabs)
+                    whole = np.concatenate([to_file(lanes(X[slice(*cut(P, r))]), cut(P, r)[1] - cut(P, r)[0])
+                                            for r in range(P)])
+                    assert whole.shape == (F, rows, 4, 1 if real else 2)
+                    for Q in (1, 2, 3, 4, 5):
+                        for r in range(Q):
+                            a, b = cut(Q, r)
+                            assert np.array_equal(from_file(whole[a:b]), lanes(X[a:b])), (F, rows, real, P, Q, r)
