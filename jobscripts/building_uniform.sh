@@ -23,6 +23,8 @@
 #                  uniform-36-area-exact, uniform-72-area-exact and today-fine with a smooth load history instead of
 #                  the 25 ms box: a 0.1 s Hann pulse, p0 sin^2(pi t / 0.1 s) (-ssi_load_history table, OUT/hann100ms.txt),
 #                  whose waves (up to about 20 Hz: shear waves of 5 m and longer) the cells resolve
+#   today-smooth-dt2, uniform-36-smooth-dt2 (not by default) today-smooth and uniform-36-smooth with half the step
+#                  (-ssi_dt 2.5e-3, 600 steps): how far the time step moves each
 #   today-load15-smooth, uniform-36-load15-smooth (not by default) the Hann pulse on the 1.2 m cell at x = 15 m
 #                  (today-load15's and uniform-36's load, held by a cell on both meshes), every lag exact
 #   uniform-72-fullrank (not by default) uniform-72 with the step matrix's MUMPS LU in full rank (-ssi_step_blr 0;
@@ -81,6 +83,9 @@ for r in $RUNS; do
     today-smooth) run today-smooth "${B[@]}" "${X[@]}" "${S[@]}" ;;
     today-fine-smooth) run today-fine-smooth "${B[@]}" "${X[@]}" "${S[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
     uniform-36-smooth) run uniform-36-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" ;;
+    today-smooth-dt2) run today-smooth-dt2 "${B[@]}" "${X[@]}" "${S[@]}" -ssi_dt 2.5e-3 ;;
+    uniform-36-smooth-dt2) run uniform-36-smooth-dt2 "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" \
+                             -ssi_dt 2.5e-3 ;;
     today-load15-smooth) run today-load15-smooth "${B[@]}" -ssi_mesh_params xl=15,w=1.2 "${P15[@]}" "${X[@]}" "${S[@]}" ;;
     uniform-36-load15-smooth) run uniform-36-load15-smooth "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" ;;
     uniform-72-smooth) run uniform-72-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 "${X[@]}" "${S[@]}" ;;
