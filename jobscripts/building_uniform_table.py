@@ -146,12 +146,16 @@ def compare(ra, rb):
         if q not in ra:
             continue
         (ta, a), (tb, b) = ra[q], rb[q]
-        n = min(len(a), len(b))
-        a, b, t = a[:n], b[:n], tb[:n]
-        pb = float(np.abs(b).max()) or 1e-300
+        end = min(ta[-1], tb[-1]) + 1e-9            # (peaks: each run's own samples over the common span)
+        pa, pb = float(np.abs(a[ta <= end]).max()), float(np.abs(b[tb <= end]).max()) or 1e-300
+        # histories at the times both runs sampled (runs of another dt: every other sample of the finer one)
+        ia = np.searchsorted(ta, tb)
+        ok = (ia < len(ta)) & (tb <= end)
+        ok[ok] = np.abs(ta[ia[ok]] - tb[ok]) <= 1e-9 * max(1.0, float(tb[-1]))
+        a, b, t = a[ia[ok]], b[ok], tb[ok]
         d = np.abs(a - b)
         over = np.nonzero(d > 0.01 * pb)[0]
-        rows.append({"quantity": q, "peak diff [%]": 100 * (float(np.abs(a).max()) - pb) / pb,
+        rows.append({"quantity": q, "peak diff [%]": 100 * (pa - pb) / pb,
                      "history diff [%]": 100 * float(d.max()) / pb,
                      "first t with diff > 1 % of peak [s]": float(t[over[0]]) if len(over) else float("nan")})
     return rows
