@@ -23,8 +23,10 @@
 #                  uniform-36-area-exact, uniform-72-area-exact and today-fine with a smooth load history instead of
 #                  the 25 ms box: a 0.1 s Hann pulse, p0 sin^2(pi t / 0.1 s) (-ssi_load_history table, OUT/hann100ms.txt),
 #                  whose waves (up to about 20 Hz: shear waves of 5 m and longer) the cells resolve
-#   uniform-72-area-auto (not by default) uniform-72-area with the paper's rule for the far lags (-ssi_interp auto:
-#                  T_L from the farthest receiver, one anchor every 5 steps) instead of ssi-common.opts' T_L and k
+#   uniform-72-area-rule (not by default) uniform-72-area with the paper's rule for the far lags (T_L = 1.5 r / c_s
+#                  at the farthest receiver, r = 24.5 m: 0.3675 s; one anchor every 5 steps: k = 27; what
+#                  -ssi_interp auto chose on this grid before it kept every lag exact on the toeplitz store) instead of
+#                  ssi-common.opts' T_L and k
 #   today-smooth-dt2, uniform-36-smooth-dt2 (not by default) today-smooth and uniform-36-smooth with half the step
 #                  (-ssi_dt 2.5e-3, 600 steps): how far the time step moves each
 #   today-load15-smooth, uniform-36-load15-smooth (not by default) the Hann pulse on the 1.2 m cell at x = 15 m
@@ -85,8 +87,8 @@ for r in $RUNS; do
     today-smooth) run today-smooth "${B[@]}" "${X[@]}" "${S[@]}" ;;
     today-fine-smooth) run today-fine-smooth "${B[@]}" "${X[@]}" "${S[@]}" -ssi_mesh_params g=1.15,hm=1.5,hr=1.0,hq=1.0 ;;
     uniform-36-smooth) run uniform-36-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" ;;
-    uniform-72-area-auto) run uniform-72-area-auto "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 -ssi_interp auto \
-                            -ssi_interp_tl 0 -ssi_interp_k 0 ;;
+    uniform-72-area-rule) run uniform-72-area-rule "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 -ssi_interp chebyshev \
+                            -ssi_interp_tl 0.3675 -ssi_interp_k 27 ;;
     today-smooth-dt2) run today-smooth-dt2 "${B[@]}" "${X[@]}" "${S[@]}" -ssi_dt 2.5e-3 ;;
     uniform-36-smooth-dt2) run uniform-36-smooth-dt2 "${B[@]}" "${A[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" \
                              -ssi_dt 2.5e-3 ;;

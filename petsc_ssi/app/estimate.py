@@ -170,10 +170,13 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     except SSIError:
         return None
     lat.n_offsets = len(kernel_offsets(lat))
+    ab = prob.area_bytes()
+    chosen = prob.toeplitz_plan(ls, plan, ab, lattice=lat)        # (-ssi_interp auto: as the run chooses)
+    if chosen is not plan:
+        plan, ls = chosen, prob.lagset(chosen)
     glat = traction_grid(lat, ls.VT)
     single = cfg.get("toeplitz_precision", "double") == "single"
     g = prob.toeplitz_side_bytes(ls, plan)
-    ab = prob.area_bytes()
     load_kernels()                      # the process measured with the compiled kernels it will hold
     rss = process_rss()
     limit = cfg.memory_limit * 1e9 if cfg.memory_limit > 0 else 0.8 * node_mem

@@ -123,7 +123,8 @@ register("lags_load", "str", "", "", "load the lag matrices a run saved with -ss
          "them (refused, naming the difference, unless mesh, material, dt, scheme, symmetry, interpolation, "
          "quadrature and traction nodes are the same, on the toeplitz store also the store, and a file "
          "whose content differs from its CRC32s)", "bem")
-register("interp", "enum", "none", "", "lag-matrix interpolation beyond T_L: none, chebyshev (eqs. 9, 11), linear (eqs. 10, 12), auto (paper's rule)", "bem",
+register("interp", "enum", "none", "", "lag-matrix interpolation beyond T_L: none, chebyshev (eqs. 9, 11), linear (eqs. 10, 12), auto (paper's rule; on "
+         "the toeplitz store every lag exact where that fits the node, said in one line)", "bem",
          choices=("none", "chebyshev", "linear", "auto"))
 register("interp_tl", "real", 0.0, "s", "threshold time T_L: lags with (l-1) dt < T_L are exact (auto: chosen)", "bem",
          validator=lambda v: None if v >= 0 else "must be >= 0")

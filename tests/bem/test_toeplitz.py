@@ -575,3 +575,30 @@ def test_toeplitz_lags_file_complex_kernels_other_rank_count(tmp_path):
     out = cli(case + ["-ssi_output", b, "-ssi_lags_load", lags]).stdout
     assert "toeplitz kernels loaded from" in out and " 0 kernel evaluations" in out, out[-2000:]
     same(a, b)
+
+
+def test_interp_auto_on_the_toeplitz_store_keeps_every_lag_exact(tmp_path):
+    """-ssi_interp auto on the toeplitz store keeps every lag exact where that fits (one line says so; the run is
+    the -ssi_interp none run bit for bit on one rank), and keeps the paper's rule where every lag exact would
+    not fit -ssi_memory_limit but the rule's plan does (the limit put halfway between the two needs, as a run
+    with a tiny limit prints them)."""
+    auto, none = str(tmp_path / "auto.h5"), str(tmp_path / "none.h5")
+    out = cli(BEM + TZ + ["-ssi_interp", "auto", "-ssi_output", auto]).stdout
+    assert "-ssi_interp auto on the toeplitz store: every lag exact" in out and "lag interpolation: none" in out, out
+    cli(BEM + TZ + ["-ssi_interp", "none", "-ssi_output", none])
+    A, B = fields(auto), fields(none)
+    assert set(A) == set(B) and all(np.array_equal(A[k], B[k]) for k in A)
+    big = _swap_value(BEM, "-ssi_mesh_size", "20,20") + TZ + ["-ssi_interp", "auto", "-ssi_t_end", "0.1"]
+    r = cli(big + ["-ssi_memory_limit", "0.01", "-ssi_output", str(tmp_path / "x.h5")], check=False)
+    text = r.stdout + r.stderr
+    exact = float(text.split("every lag exact would need ")[1].split(" GB")[0])
+    rule = float(text.split("the history kernels need about ")[1].split(" GB")[0])
+    assert r.returncode != 0 and rule < exact, text[-2000:]
+    out = cli(big + ["-ssi_memory_limit", f"{0.5 * (rule + exact):.4f}", "-ssi_output", str(tmp_path / "y.h5")]).stdout
+    assert "the paper's rule stays" in out and "lag interpolation: chebyshev" in out, out[-2000:]
+
+
+def _swap_value(case, opt, value):
+    """``case`` with option ``opt``'s value replaced."""
+    i = case.index(opt)
+    return case[:i + 1] + [value] + case[i + 2:]
