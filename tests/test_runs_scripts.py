@@ -96,8 +96,7 @@ def test_building_soil_exact_table_reference_is_the_convolution_with_the_pulse()
     table's ramps' responses summed): against a direct convolution of Lamb's step solution with the analytic
     pulse's rate, u(t) = int_0^T U(t - tau) p'(tau) dtau by 400-point Gauss-Legendre, to 1e-3 of the peak (the
     table is linear between rows 1 ms apart: its difference to sin^2 is O(1e-4); the step solution's kinks at
-    the arrivals make the Gauss rule converge as n^-2: 1.1e-2 of the peak at 64 points, 1.1e-3 at 200, measured
-    when this test was written)."""
+    the arrivals make the Gauss rule converge slowly, hence its 400 points)."""
     import sys
     sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
     import building_soil_exact as bse

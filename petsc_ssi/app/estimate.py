@@ -171,9 +171,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         return None
     lat.n_offsets = len(kernel_offsets(lat))
     ab = prob.area_bytes()
-    chosen = prob.toeplitz_plan(ls, plan, ab, lattice=lat)        # (-ssi_interp auto: as the run chooses)
-    if chosen is not plan:
-        plan, ls = chosen, prob.lagset(chosen)
+    plan, ls = prob.toeplitz_plan(ls, plan, ab, lattice=lat)       # (-ssi_interp auto: as the run chooses)
     glat = traction_grid(lat, ls.VT)
     single = cfg.get("toeplitz_precision", "double") == "single"
     g = prob.toeplitz_side_bytes(ls, plan)

@@ -533,11 +533,7 @@ class HalfSpace:
             extra_bytes += ab
             extra_what = (extra_what + " and " if extra_what else "") + "the area loads' lag vectors"
         if self.lattice is not None:
-            exact = self.toeplitz_plan(ls, plan, extra_bytes)
-            if exact is not plan:
-                plan = exact
-                printf("[ssi] " + plan.describe())
-                ls = self.lagset(plan)      # (the nodes' partition weighs the stored lags: made again)
+            plan, ls = self.toeplitz_plan(ls, plan, extra_bytes)
         if self.lattice is None:
             self.check_memory(ls, plan, extra_bytes, extra_what)
         else:
@@ -610,31 +606,33 @@ class HalfSpace:
         return g + 3 * 36.0 * mpi.allreduce(float(nb.sum()))
 
     def toeplitz_plan(self, ls, plan, extra_bytes=0.0, lattice=None):
-        """Collective: the interpolation plan of a run on the toeplitz store. ``-ssi_interp auto`` there keeps
+        """Collective: (plan, LagSet) of a run on the toeplitz store (the LagSet made again for a new plan: the
+        nodes' partition weighs the stored lags). ``-ssi_interp auto`` there keeps
         every lag exact where that fits the node (one line says which): an exact lag costs O(N) memory on the
         store, not O(N^2), and on the paper's building over a 72 m grid the paper's rule moved the histories by
         up to 15 % of the structure's peaks and 47 % of the soil's, at no saving of time
         (runs/building/README.md); where every lag exact would not fit, the paper's rule stays. Other
         -ssi_interp values are kept as given."""
         if self.cfg.interp != "auto" or not plan.active:
-            return plan
+            return plan, ls
         lat = lattice if lattice is not None else self.lattice
         exact = interp.Plan("none", self.dt, self.L, None, 0, self.cfg.interp_grading)
-        est, limit, share = self._toeplitz_bytes(ls, exact, extra_bytes, lat)
+        est, limit, share, _ = self._toeplitz_bytes(ls, exact, extra_bytes, lat)
         if share * est <= limit:
             printf(f"[ssi] -ssi_interp auto on the toeplitz store: every lag exact ({share * est / 1e9:.3g} GB on the "
                    f"most loaded node, within {limit / 1e9:.3g} GB; an exact lag costs O(N) here, and the paper's rule "
                    "moved the 72 m building's histories by up to 15 % at no saving of time: runs/building/README.md)")
+            printf("[ssi] " + exact.describe())
             self.plan = exact
-            return exact
+            return exact, self.lagset(exact)
         printf(f"[ssi] -ssi_interp auto on the toeplitz store: every lag exact would need {share * est / 1e9:.3g} GB on "
                f"the most loaded node, over {limit / 1e9:.3g} GB: the paper's rule stays")
-        return plan
+        return plan, ls
 
     def _toeplitz_bytes(self, ls, plan, extra_bytes=0.0, lat=None):
-        """Collective: (bytes over the ranks, the node's limit, this node's share) of a toeplitz run with
-        ``plan`` (``toeplitz.estimate``, with the processes' resident size and ``extra_bytes``), and sets
-        ``_tz_parts`` (kernels' and history's seconds, the processes' bytes)."""
+        """Collective: (bytes over the ranks, the node's limit, this node's share, (kernels' seconds, history's
+        seconds, the processes' bytes)) of a toeplitz run with ``plan`` (``toeplitz.estimate``, with the
+        processes' resident size and ``extra_bytes``)."""
         from .toeplitz import estimate, kernel_offsets, traction_grid
         from mpi4py import MPI
         c = self.cfg
@@ -650,9 +648,8 @@ class HalfSpace:
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)
-        self._tz_parts = (t_build, t_hist, rss)
         share, _ = node_share(self.comm)
-        return est + float(extra_bytes) + rss, limit, share
+        return est + float(extra_bytes) + rss, limit, share, (t_build, t_hist, rss)
 
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
         """Collective: refuse a toeplitz run whose kernels and kept transforms would not fit the node
@@ -660,8 +657,7 @@ class HalfSpace:
         c = self.cfg
         self.lag_fill = c.lag_fill
         p = self.comm.getSize()
-        est, limit, share = self._toeplitz_bytes(ls, plan, extra_bytes)
-        t_build, t_hist, rss = self._tz_parts
+        est, limit, share, (t_build, t_hist, rss) = self._toeplitz_bytes(ls, plan, extra_bytes)
         self.mem_estimate = self.mem_peak_estimate = est
         printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
                f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
