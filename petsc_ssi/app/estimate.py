@@ -171,7 +171,11 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         return None
     lat.n_offsets = len(kernel_offsets(lat))
     ab = prob.area_bytes()
-    plan, ls = prob.toeplitz_plan(ls, plan, ab, lattice=lat)       # (-ssi_interp auto: as the run chooses)
+    beside = ab
+    if coupled is not None:             # (the coupled run decides auto's plan with its interface matrices beside)
+        from ..coupling.model import interface_bytes
+        beside += interface_bytes(cfg, prob, coupled[1], coupled[2], comm.getSize())
+    plan, ls = prob.toeplitz_plan(ls, plan, beside, lattice=lat)   # (-ssi_interp auto: as the run chooses)
     glat = traction_grid(lat, ls.VT)
     single = cfg.get("toeplitz_precision", "double") == "single"
     g = prob.toeplitz_side_bytes(ls, plan)

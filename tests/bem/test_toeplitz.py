@@ -602,3 +602,29 @@ def _swap_value(case, opt, value):
     """``case`` with option ``opt``'s value replaced."""
     i = case.index(opt)
     return case[:i + 1] + [value] + case[i + 2:]
+
+
+def test_the_estimate_decides_interp_auto_with_the_run_s_bytes(tmp_path):
+    """-ssi_interp auto on the toeplitz store decides between every lag exact and the paper's rule by the memory
+    beside the kernels: `petsc-ssi estimate` of a coupled run must weigh the same bytes as the run (its
+    interface matrices and area loads), or near the node's limit the two choose different plans. Both calls of
+    ``HalfSpace.toeplitz_plan`` recorded in one process: the estimate's and the coupled run's set-up's."""
+    import subprocess
+    from helpers import PY, ROOT
+    code = ("import sys\nfrom petsc_ssi.petsc import init\nPETSc = init(sys.argv)\n"
+            "from petsc_ssi.bem.halfspace import HalfSpace\nseen = []\nplan0 = HalfSpace.toeplitz_plan\n"
+            "def spy(self, ls, plan, extra_bytes=0.0, lattice=None):\n"
+            "    seen.append(float(extra_bytes))\n    return plan0(self, ls, plan, extra_bytes, lattice)\n"
+            "HalfSpace.toeplitz_plan = spy\n"
+            "from petsc_ssi.app import estimate, kinds\n"
+            "estimate.report(kinds.resolve('ssi', ('estimate',)), PETSc.COMM_WORLD, out=lambda m: None)\n"
+            "kinds.problem_class('ssi')(kinds.resolve('ssi'), PETSc.COMM_WORLD)\n"
+            "print('SEEN', *seen)\n")
+    args = SSI + TZ + ["-ssi_interp", "auto", "-ssi_estimate_ranks", "1", "-ssi_load_area", "0.6,0.9,-0.2,0.2",
+                       "-ssi_load_p0", "100", "-ssi_output", str(tmp_path / "x.h5")]
+    p = subprocess.run([PY, "-c", code] + args, cwd=ROOT, capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    line = [x for x in p.stdout.splitlines() if x.startswith("SEEN")]
+    assert p.returncode == 0 and line, p.stdout[-3000:] + p.stderr[-3000:]
+    est, run = (float(v) for v in line[0].split()[1:])
+    assert run > 0 and est == run, (est, run)
