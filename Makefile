@@ -16,7 +16,7 @@ export OMP_NUM_THREADS ?= 1
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
             openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
-PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy
+PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy pyflakes
 # pytest workers of `make test` (pytest-xdist, whole test files to a worker): the suite is mostly
 # serial Python and short mpiruns, so 2 workers on a 2-core machine took it from 900-940 s to 545 s.
 # The slow tier stays serial (its cases hold GBs each). TEST_JOBS=0: no workers, one process.
@@ -59,8 +59,9 @@ demo: deps
 
 # Tiers (pytest.ini, tests/conftest.py): `make test` is every tier but slow (what CI runs);
 # the slow tier holds the heavy cases and runs before a release.
+# (the 15 slowest tests listed at the end: where the suite's 15-minute budget goes, in every CI log)
 test: deps
-	$(PY) -m pytest -q -m "not slow" $(XDIST) tests
+	$(PY) -m pytest -q -m "not slow" --durations=15 $(XDIST) tests
 
 test-unit: deps
 	$(PY) -m pytest -q -m "unit and not slow" $(XDIST) tests
