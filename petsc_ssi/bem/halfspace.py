@@ -466,10 +466,12 @@ class HalfSpace:
             t_arr, _, _ = self._auto_tl(self.mat.cs / rayleigh_speed(self.mat.cs, self.mat.cp))
             if t_arr is not None and plan.TL < t_arr * (1.0 - 1e-9):
                 t_rule, _, _ = self._auto_tl()
+                rule = (f"takes T_L = {t_rule:.4g} s here (tau_L = 1.5)" if t_rule is not None else
+                        "keeps every lag exact here (its T_L, tau_L = 1.5, would reach T_N)")
                 warn(f"-ssi_interp_tl {plan.TL:g} s is before the Rayleigh wave's arrival at the farthest receiver or "
                      f"interface node ({t_arr:.4g} s): the interpolated lags then carry that arrival, where the "
                      f"interpolation is least accurate (runs/pekeris/README.md); the paper's rule, -ssi_interp auto, "
-                     f"takes T_L = {t_rule:.4g} s here (tau_L = 1.5)")
+                     + rule)
         self.plan = plan
         return plan
 
