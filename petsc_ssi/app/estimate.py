@@ -166,7 +166,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     try:
         if not ls.flat:
             raise SSIError("the surface is not flat")
-        lat = detect(ls.VX, prob.mesh.nodes)
+        lat = detect(ls.VX, prob.mesh.nodes, n_cells=prob.mesh.n_cells)
     except SSIError:
         return None
     lat.n_offsets = len(kernel_offsets(lat))
@@ -245,7 +245,7 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     try:
         if not cnt.lagset.flat:
             raise SSIError("the surface is not flat")
-        lat = detect(cnt.lagset.VX, prob.mesh.nodes)
+        lat = detect(cnt.lagset.VX, prob.mesh.nodes, n_cells=prob.mesh.n_cells)
     except SSIError as e:
         return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
     lat.n_offsets = len(kernel_offsets(lat))

@@ -567,7 +567,7 @@ class HalfSpace:
                 why = "-ssi_lag_pattern full keeps every 3x3 entry; use -ssi_lag_store dense"
         if why is None:
             try:
-                lat = detect(ls.VX, self.mesh.nodes)
+                lat = detect(ls.VX, self.mesh.nodes, n_cells=self.mesh.n_cells)
             except SSIError as e:
                 why = str(e).split(": ", 1)[-1]
                 lat = None

@@ -50,10 +50,19 @@ def images(planes):
 
 
 def check_mesh(nodes, planes, h):
+    """Refuse a mesh that crosses a symmetry plane; warn (one line) where it does not reach one: the strip
+    between the mesh and its mirror image is then left out of the surface (not traction-free), most likely a
+    mesh placed off the plane by mistake."""
+    from ..petsc import warn
     for ax, _ in planes:
+        name = "xy"[ax]
         if nodes[:, ax].min() < -1e-9 * max(h, 1.0):
-            name = "xy"[ax]
             raise SSIError(f"-ssi_symmetry: the mesh crosses the plane {name} = 0; mesh only {name} >= 0")
+        gap = float(nodes[:, ax].min()) if len(nodes) else 0.0
+        if gap > 1e-6 * h:
+            warn(f"-ssi_symmetry: the mesh does not reach the plane {name} = 0 (its nearest node at {name} = {gap:.6g} m): "
+                 f"the {2 * gap:.6g} m strip between the mesh and its mirror image is left out of the surface; mesh "
+                 f"up to the plane")
 
 
 def virtual_elements(X, cells, tcols, planes):

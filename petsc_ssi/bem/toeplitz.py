@@ -112,10 +112,11 @@ class Lattice:
                 f"{self.Mx} x {self.My})")
 
 
-def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
+def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
     """The Lattice of virtual elements VX (nv, 9, 3) and nodes (N, 3), or SSIError naming the first
     element that is not on it (a surface not in the plane z = 0, elements of another size or shape,
-    off the lattice, overlapping or turned over)."""
+    off the lattice, overlapping or turned over). ``n_cells``: the mesh's elements, VX's first rows (the
+    rest their symmetry images: the message says so)."""
     VX = np.asarray(VX, float)
     nodes = np.asarray(nodes, float)
     if VX.shape[0] == 0:
@@ -152,8 +153,16 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz"):
     off = np.abs(g - gi).max(axis=1) > 1e-9
     if np.any(off):
         v = int(np.argmax(off))
+        k = int(np.argmin(np.where(np.isclose(c[:, 0], o[0]), c[:, 1], np.inf)))    # (an element at the origin)
+        if n_cells is not None and max(v, k) >= n_cells:
+            where = (" (with -ssi_symmetry the elements' mirror images count, element n + i the image of element "
+                     f"i, {n_cells} elements: the mesh and its images must lie on one grid; does the mesh reach the "
+                     "planes?)")
+        else:
+            where = ""
         raise SSIError(f"{what}: element {v} (centre {c[v, 0]:.6g}, {c[v, 1]:.6g} m) is off the grid of "
-                       f"element 0 ({h[0]:g} x {h[1]:g} m); use -ssi_lag_store dense")
+                       f"{h[0]:g} x {h[1]:g} m cells through element {k}'s centre ({c[k, 0]:.6g}, {c[k, 1]:.6g} m)"
+                       f"{where}; use -ssi_lag_store dense")
     gi = gi.astype(np.int64)
     nx, ny = int(gi[:, 0].max()) + 1, int(gi[:, 1].max()) + 1
     cell = gi[:, 0] * ny + gi[:, 1]

@@ -53,6 +53,19 @@ def test_symmetry_plane_not_respected(tmp_path):
     assert msg is not None and "crosses the plane x = 0" in msg, msg
 
 
+def test_symmetry_plane_not_reached_is_warned(tmp_path):
+    """A mesh 0.5 m off the plane x = 0 with -ssi_symmetry x=sym leaves the 1 m strip between it and its image
+    out of the surface: one warning line says so (the run goes on: a surface may have holes)."""
+    p = tmp_path / "off.msh"
+    _write_msh(p, 2, xmin=0.5)
+    r = cli(["-ssi_mesh", str(p), "-ssi_symmetry", "x=sym", "-ssi_t_end", "0.003", "-ssi_output", str(tmp_path / "o.h5")])
+    w = [ln for ln in r.stdout.splitlines() if "does not reach the plane" in ln]
+    assert len(w) == 1 and w[0].startswith("petsc-ssi: warning: -ssi_symmetry: the mesh does not reach the plane x = 0 "
+                                           "(its nearest node at x = 0.5 m): the 1 m strip"), r.stdout[-3000:]
+    r = cli(["-ssi_mesh", str(p), "-ssi_t_end", "0.003", "-ssi_output", str(tmp_path / "n.h5")])
+    assert "does not reach the plane" not in r.stdout
+
+
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
 def test_error_under_mpirun_does_not_hang():
     """Two ranks, bad receiver: exit status 2 with the message, within the timeout."""

@@ -364,6 +364,14 @@ def test_detect_names_the_element():
         V[k] = X
         with pytest.raises(SSIError, match=f"element {k} "):
             detect(V, np.unique(V.reshape(-1, 3), axis=0))
+    # a symmetric model whose mesh stops 0.2 m short of the plane x = 0: its mirror images (the elements after the
+    # mesh's own 6) are off the mesh's grid; the message names the image that fixes the grid and says why
+    M = np.array([elem(0.7 + i, 2 * j + 1.0) for i in range(3) for j in range(2)])
+    V = np.concatenate([M, np.array([elem(-0.7 - i, 2 * j + 1.0) for i in range(3) for j in range(2)])])
+    with pytest.raises(SSIError, match=r"element 0 \(centre 0.7, 1 m\) is off the grid of 1 x 2 m cells through "
+                                       r"element 10's centre \(-2.7, 1 m\) \(with -ssi_symmetry the elements' mirror "
+                                       r"images count.*does the mesh reach the planes\?\)"):
+        detect(V, np.unique(M.reshape(-1, 3), axis=0), n_cells=6)
 
 
 def test_toeplitz_seismic_massless_footing(tmp_path):
