@@ -577,7 +577,8 @@ class HalfSpace:
             if self.cfg.get("toeplitz_precision", "double") != "double":
                 raise SSIError(f"-ssi_toeplitz_precision {self.cfg.toeplitz_precision}: -ssi_lag_store auto takes the "
                                f"dense lag matrices here ({why}), which keep no transforms")
-            printf(f"[ssi] lag store: dense lag matrices ({why})")
+            suffix = "; use -ssi_lag_store dense"        # (the refusal's advice: auto has taken it already)
+            printf(f"[ssi] lag store: dense lag matrices ({why[:-len(suffix)] if why.endswith(suffix) else why})")
             return None
         printf(f"[ssi] lag store: toeplitz, {lat.describe()}")
         return lat

@@ -73,9 +73,11 @@ def lag_key(cfg, prob, plan):
 
 def _difference(saved, now):
     """The first entry (in ``lag_key``'s order: mesh, material, dt, ...) that differs."""
+    absent = {"lag_store": "dense"}                 # (a dense store's key has no lag_store entry)
     for name in list(now) + [k for k in saved if k not in now]:
-        if saved.get(name) != now.get(name):
-            return f"{name} differs ({saved.get(name)} there, {now.get(name)} here)"
+        a, b = saved.get(name, absent.get(name)), now.get(name, absent.get(name))
+        if a != b:
+            return f"{name} differs ({a} there, {b} here)"
     return None
 
 
