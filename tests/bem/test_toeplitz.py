@@ -399,7 +399,9 @@ def test_toeplitz_seismic_massless_footing(tmp_path):
 @pytest.mark.slow
 def test_toeplitz_impedance_equals_dense(tmp_path):
     """`petsc-ssi impedance` (every mode, each on its own symmetry planes, prescribed rigid motion) on
-    the toeplitz store: K(omega) of every term equals the dense store's to 1e-10 of its largest |K|."""
+    the toeplitz store: K(omega) of every term equals the dense store's to 1e-10 of its largest |K| (the CSV's
+    8 significant digits), and every mode's recorded force and moment histories (its HDF5 file) to 1e-12 of their
+    scale (``scales``)."""
     import csv
     small = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "0.5", "-ssi_mesh_patch", "1,1",
              "-ssi_disp_group", "load", "-ssi_dt", "8e-4", "-ssi_t_end", "0.04", "-ssi_output_stride", "0",
@@ -415,6 +417,14 @@ def test_toeplitz_impedance_equals_dense(tmp_path):
     assert set(runs["dense"]) == set(runs["tz"]) and len(runs["dense"]) >= 4
     for mode, K in runs["dense"].items():
         assert np.abs(K - runs["tz"][mode]).max() <= 1e-10 * np.abs(K).max(), mode
+    h5 = sorted(p.name[len("dense-"):] for p in tmp_path.glob("dense-*.h5"))
+    assert len(h5) >= 2 and h5 == sorted(p.name[len("tz-"):] for p in tmp_path.glob("tz-*.h5")), h5
+    for name in h5:                 # (the footing's force and moment histories: scales' measure, as ``same``)
+        A, B = fields(str(tmp_path / f"dense-{name}")), fields(str(tmp_path / f"tz-{name}"))
+        S = scales(A)
+        assert set(A) == set(B) and max(np.abs(A[f"resultants/{k}"]).max() for k in ("force", "moment")) > 0, name
+        for k in A:
+            assert np.abs(A[k] - B[k]).max() <= 1e-12 * S[k], (name, k, np.abs(A[k] - B[k]).max() / S[k])
 
 
 def test_toeplitz_block_longer_than_the_lags(tmp_path):
