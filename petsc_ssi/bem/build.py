@@ -303,7 +303,8 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
            f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)"
            + "".join(f"; {t.spec['what']} kernels real (point-symmetric offsets: half the products)"
                      for t in march.toeplitz if t.real))
-    printf(f"[ssi] history sum: in Fourier space, time-blocked, {th.block} steps per block (-ssi_history_block)")
+    printf(f"[ssi] history sum: in Fourier space, time-blocked, {th.block} steps per block (-ssi_history_block)"
+           + ("; -ssi_history_sub is the dense store's and is not used here" if int(cfg.get("history_sub") or 0) else ""))
     if kern is not None:
         printf(f"[ssi] lag matrices and toeplitz kernels loaded from {cfg.lags_load} (no assembly, no kernel "
                "integrals)")

@@ -4,7 +4,7 @@ import shutil
 import numpy as np
 import pytest
 
-from helpers import resolve_error, cli, ROOT, write_surface_msh
+from helpers import resolve_error, cli, write_surface_msh
 
 pytestmark = pytest.mark.mpi
 

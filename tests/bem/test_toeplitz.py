@@ -430,12 +430,13 @@ def test_toeplitz_impedance_equals_dense(tmp_path):
 def test_toeplitz_block_longer_than_the_lags(tmp_path):
     """Blocks of 16 steps on a grid whose history has 9 lags (D < b - 1: the steps late in a block read
     only states inside it): toeplitz equals dense (a review found the in-block window started at the
-    block's first state instead of n - D)."""
+    block's first state instead of n - D). -ssi_history_sub, the dense store's sub-blocks, is said not to be used."""
     args = BEM[:] + ["-ssi_mesh_size", "4,4", "-ssi_t_end", "0.1", "-ssi_receivers", "1,0,0"]
     ref, tz = str(tmp_path / "dense.h5"), str(tmp_path / "tz.h5")
     cli(args + ["-ssi_output", ref])
-    out = cli(args + TZ + ["-ssi_history_block", "16", "-ssi_output", tz]).stdout
-    assert "lags stored 9 " in out
+    out = cli(args + TZ + ["-ssi_history_block", "16", "-ssi_history_sub", "4", "-ssi_output", tz]).stdout
+    assert "lags stored 9 " in out and "16 steps per block (-ssi_history_block); -ssi_history_sub is the dense " \
+        "store's and is not used here" in out, out[-2000:]
     same(ref, tz)
 
 
