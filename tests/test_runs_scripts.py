@@ -111,3 +111,27 @@ def test_building_soil_exact_table_reference_is_the_convolution_with_the_pulse()
     for got, want in ((ux, ref[0]), (uz, ref[2])):
         peak = np.abs(want).max()
         assert peak > 0 and np.abs(got - want).max() <= 1e-3 * peak, np.abs(got - want).max() / peak
+
+
+def test_toeplitz_sweep_script_runs_a_case(tmp_path):
+    """jobscripts/toeplitz_sweep.py (the general cases of the toeplitz store against the dense store, a benchmark
+    of its own): its cheapest case (1 x 0.9375 m cells, a load at the grid's edge, one rank) runs, its CSV row
+    says the stores agree to 1e-12, and it exits 0; a mismatch is its exit status 1 (its ``compare`` on two
+    different runs)."""
+    import csv
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "jobscripts", "toeplitz_sweep.py"), str(tmp_path), "0"],
+                       cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    rows = list(csv.reader(open(tmp_path / "toeplitz_sweep.csv")))
+    assert len(rows) == 2 and rows[1][0].startswith("1 x 0.9375 m cells") and int(rows[1][3]) >= 3, rows
+    assert float(rows[1][4]) <= 1e-12, rows
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from toeplitz_sweep import compare
+    with h5py.File(tmp_path / "case0-dense.h5") as f, h5py.File(tmp_path / "moved.h5", "w") as g:
+        for k in f:
+            f.copy(k, g)
+        d = g["receivers/u"]
+        d[...] = d[...] * (1 + 1e-8)
+    assert compare(str(tmp_path / "case0-dense.h5"), str(tmp_path / "moved.h5"))[1] > 1e-10
