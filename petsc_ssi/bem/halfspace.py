@@ -784,12 +784,18 @@ class HalfSpace:
         return est, peak, nd
 
     def bind_sources(self):
-        """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes
-        contradict (a uniform field on a patch is even: components with S = -1 must vanish)."""
+        """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes contradict
+        where they do: at a loaded node on a plane (``symmetry.zero_dofs``' tolerance) the components the
+        plane's reflection makes odd (S = -1) must vanish. A load off the plane is mirrored with those
+        components' signs flipped (under x=anti a vertical load at x > 0 and its opposite at x < 0), as
+        an area load is (``sources.area``)."""
+        nodes = self.regions.load_nodes
         for src in self.sources:
-            src.bind(self.mesh, self.regions.load_nodes)
-            for v in src.amplitudes():
-                symmetry.check_compatible(self.planes, v, None)
+            x = self.mesh.nodes[nodes[src.bind(self.mesh, nodes)]]
+            for ax, kind in self.planes:
+                on = np.abs(x[:, ax]) <= 1e-9 * max(self.h, 1.0)
+                for v in src.amplitudes(on):
+                    symmetry.check_compatible([(ax, kind)], v, None, where=" at its nodes on the plane")
 
     def known_p(self):
         """callable(n) -> the traction of step n at the loaded nodes (3 n_load,) [Pa]: the sum of

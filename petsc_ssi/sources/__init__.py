@@ -16,8 +16,10 @@ of surface load is a class with these members, or plain data given to ``SurfaceT
                              load pushing the surface down is t_z < 0] averaged over step m, the
                              interval ((m-1) dt, m dt]: the BEM's piecewise-constant traction is
                              this mean (the L2 projection, ``petsc_ssi.histories``)
-    amplitudes()             the distinct traction vectors (k, 3) [Pa] it applies: the soil refuses
-                             those its symmetry planes contradict (``bem.symmetry.check_compatible``)
+    amplitudes(at=None)      the distinct traction vectors (k, 3) [Pa] it applies (at the nodes the
+                             boolean mask ``at`` selects, in ``bind``'s order): the soil refuses those
+                             its symmetry planes contradict at the nodes on a plane
+                             (``bem.symmetry.check_compatible``; off a plane a load is mirrored)
     describe()               one line for the run's log
 
 The structure's load (``nodal.NodalLoad``): F a(t) with F the nodal forces of the options' pressures

@@ -132,7 +132,7 @@ class AreaTraction:
             raise SSIError(f"{self.name}: the surface under the rectangle is not the plane z = 0 (an excavation?): "
                            "an area load is a traction of z = 0; load the cells (-ssi_load_group) instead")
 
-    def amplitudes(self):
+    def amplitudes(self, at=None):
         return self.f[None, :]
 
     def describe(self):

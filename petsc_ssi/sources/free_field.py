@@ -83,7 +83,7 @@ class FreeFieldTraction:
         I = self.seismic.traction_integral
         return -(I(self._x, self._n, m * dt) - I(self._x, self._n, (m - 1) * dt)) / dt
 
-    def amplitudes(self):
+    def amplitudes(self, at=None):
         """None given ahead (the wave sets them): no distinct vectors to check against symmetry planes
         (a surface with an excavation takes none)."""
         return np.zeros((0, 3))

@@ -69,10 +69,11 @@ class SurfaceTraction:
         I = self.history.integral
         return self._f * ((I(b - self._t0) - I(a - self._t0)) / (b - a))[:, None]
 
-    def amplitudes(self):
-        """The distinct amplitude vectors (k, 3) [Pa] at this source's nodes (after ``bind``): the
-        soil checks them against its symmetry planes."""
-        return np.unique(self._f, axis=0) if self._f is not None and len(self._f) else np.zeros((0, 3))
+    def amplitudes(self, at=None):
+        """The distinct amplitude vectors (k, 3) [Pa] at this source's nodes (after ``bind``), or at those
+        ``at`` (a boolean mask in ``bind``'s order) selects: the soil checks those on a symmetry plane."""
+        f = self._f if self._f is None or at is None else self._f[np.asarray(at, bool)]
+        return np.unique(f, axis=0) if f is not None and len(f) else np.zeros((0, 3))
 
     def describe(self):
         f = self._f
