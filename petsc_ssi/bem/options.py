@@ -37,7 +37,10 @@ register("cache_share", "bool", True, "", "with -ssi_cache on several ranks: int
 register("partition", "enum", "balanced", "", "soil nodes per rank: contiguous ranges of equal estimated history "
          "products (bem/partition.py) or PETSc's equal node counts", "bem",
          choices=("balanced", "equal"))
-register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0", "bem")
+register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0; every load and "
+         "motion is mirrored, the components the plane makes odd (u_x on x=sym; u_y, u_z on x=anti) with their "
+         "sign flipped: a load whose nodes on the plane carry such a component is refused (a vertical patch "
+         "across x=anti), one off the plane is mirrored into its opposite", "bem")
 register("lag_store", "enum", "dense", "", "how the lags of the history sum are stored: dense (the lag matrices, "
          "-ssi_lag_storage) or toeplitz (a uniform flat grid of equal elements, with or without symmetry planes: the H "
          "lags as block-Toeplitz kernels in Fourier space, O(N) a lag instead of O(N^2), the history sum by FFTs: "
