@@ -10,6 +10,40 @@ from .petsc import init, printf
 
 _EVENTS = {}
 _STAGES = {}
+_CLOCK = time.perf_counter          # the compile clock's own (tests replace ``monitor.time.perf_counter``)
+_COMPILE = None
+
+
+def compile_seconds():
+    """Seconds this process has spent compiling numba kernels (not loading them from the cache) since
+    the first call, outermost compilations only (a kernel's callees compile inside it): numba's
+    'numba:compile' events. A loop whose kernels compile in it (the first run of a version, a kernel
+    no earlier run used) is not slow for its cost model; ``Progress`` leaves this time out of its
+    slow-run warning. 0.0 where numba has no event API."""
+    global _COMPILE
+    if _COMPILE is None:
+        try:
+            from numba.core import event as ev
+        except ImportError:
+            _COMPILE = False
+            return 0.0
+
+        class Clock(ev.Listener):
+            depth, total, t = 0, 0.0, 0.0
+
+            def on_start(self, event):
+                if self.depth == 0:
+                    self.t = _CLOCK()
+                self.depth += 1
+
+            def on_end(self, event):
+                self.depth -= 1
+                if self.depth == 0:
+                    self.total += _CLOCK() - self.t
+
+        _COMPILE = Clock()
+        ev.register("numba:compile", _COMPILE)
+    return _COMPILE.total if _COMPILE else 0.0
 
 
 def event(name):
@@ -93,9 +127,11 @@ class Progress:
 
     def expect(self, model, ranks_here=1, what="the run's prediction"):
         """Compare the measured time with ``model`` (k -> predicted seconds of items 1..k) at every
-        report, and warn once when it runs more than SLOW times above it (``slow_warning``);
-        ``ranks_here``: the ranks sharing this node's cores."""
+        report, and warn once when it runs more than SLOW times above it (``slow_warning``), the time
+        spent compiling numba kernels in the loop left out (``compile_seconds``); ``ranks_here``: the
+        ranks sharing this node's cores."""
         self.model, self.ranks_here, self.model_what = model, int(ranks_here), what
+        self.compile0 = compile_seconds()
 
     def update(self, k, extra=""):
         """Report after item ``k`` (1-based) when due (the line with -ssi_monitor; the slow-run warning
@@ -112,7 +148,8 @@ class Progress:
                    f"elapsed {fmt_time(el)} eta {fmt_time(eta)}{(' ' + extra) if extra else ''}", self.comm)
         if self.model is not None and not self.warned:
             pred = self.model(k) - self.model(self.first)
-            msg = slow_warning(el, pred, k - self.first, self.ranks_here, self.model_what, self.unit)
+            msg = slow_warning(el - (compile_seconds() - self.compile0), pred, k - self.first, self.ranks_here,
+                               self.model_what, self.unit)
             if msg:
                 self.warned = True
                 from .petsc import warn
