@@ -54,6 +54,7 @@ def previous(tmp_path_factory):
     assert os.path.exists(d / "out.h5") and os.path.exists(d / "out.json")
     write_surface_msh(d / "lifted.msh", z=1.0)            # nine-node, at z = 1
     (d / "bad.opts").write_text("-ssi_problem\nfem\n")
+    (d / "line.opts").write_text('# two options on a line\n-ssi_fem_title "a b"\n-ssi_problem fem -ssi_fem_E 1e9\n')
     return d
 
 
@@ -131,6 +132,8 @@ def _cases(d):
         "options file missing": (["-options_file", str(d / "none.opts")] + FEM, "-options_file"),
         "options file with a bare value": (["-options_file", str(d / "bad.opts")] + FEM,
                                            "line 2: 'fem' is not an option"),
+        "options file with two options on a line": (["-options_file", str(d / "line.opts")] + FEM,
+                                                    "line 3: '-ssi_fem_E' follows the option and its value"),
         # the coupling
         "no contact iteration": (SSI + ["-ssi_output", n, "-ssi_contact", "unilateral", "-ssi_contact_max_iter", "0"],
                                  "must be >= 1"),
@@ -166,7 +169,8 @@ NAMES = ["existing result", "existing result, modes", "existing result, static",
          "interpolation unknown", "negative interp_k", "memory limit too small", "fem mesh missing",
          "Poisson ratio 0.5", "negative Young's modulus", "fixed group missing", "box cells not three",
          "unknown integrator", "point load malformed", "part without an element type",
-         "options file missing", "options file with a bare value", "no contact iteration",
+         "options file missing", "options file with a bare value", "options file with two options on a line",
+         "no contact iteration",
          "unknown contact", "staggered with newmark", "interface group missing", "negative checkpoint_every",
          "inf checkpoint interval", "checkpoint name of a sidecar", "checkpoint replaces a file",
          "restart file missing", "restart from a result", "lag file missing", "lag file replaces a file"]

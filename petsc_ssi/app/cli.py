@@ -62,11 +62,14 @@ def versions():
 
 def _bad_options_file(argv):
     """One line if an -options_file is missing, unreadable, has a line PETSc would reject (a value
-    without its option: PETSc stops in PetscInitialize with a page of diagnostics) or includes itself
+    without its option, or more than one option on a line: PETSc takes one '-name value' a line, a
+    value in double quotes one token, and stops in PetscInitialize with a page of diagnostics and a
+    traceback) or includes itself
     through its own -options_file lines, directly or through other files (PETSc recurses until the
     stack overflows: a segmentation fault), else None. Included files are checked the same way;
     their paths are taken as PETSc takes them (relative to the working directory)."""
     import os
+    import re
 
     def files_in(args):
         return [args[i + 1] for i, a in enumerate(args[:-1]) if a == "-options_file"]
@@ -91,6 +94,11 @@ def _bad_options_file(argv):
             if text and not text.startswith("-") and text.split()[0] not in ("alias",):
                 return (f"petsc-ssi: error: -options_file {path}, line {k}: '{text.split()[0]}' is not an option "
                         "(one '-name value' per line)")
+            words = re.findall(r'"[^"]*"|\S+', text)
+            if len(words) > (3 if words and words[0] == "alias" else 2):
+                return (f"petsc-ssi: error: -options_file {path}, line {k}: '{words[2 + (words[0] == 'alias')]}' "
+                        "follows the option and its value: PETSc takes one '-name value' a line (a value with "
+                        "spaces in double quotes)")
             if text and not text.startswith("alias"):
                 tokens += text.split()
         chain = dict(chain)
