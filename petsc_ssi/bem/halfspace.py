@@ -794,8 +794,12 @@ class HalfSpace:
             x = self.mesh.nodes[nodes[src.bind(self.mesh, nodes)]]
             for ax, kind in self.planes:
                 on = np.abs(x[:, ax]) <= 1e-9 * max(self.h, 1.0)
-                for v in src.amplitudes(on):
-                    symmetry.check_compatible([(ax, kind)], v, None, where=" at its nodes on the plane")
+                try:
+                    vals, where = src.amplitudes(on), " at its nodes on the plane"
+                except TypeError:       # a source written for amplitudes() alone: checked everywhere, as before
+                    vals, where = src.amplitudes(), ""
+                for v in vals:
+                    symmetry.check_compatible([(ax, kind)], v, None, where=where)
 
     def known_p(self):
         """callable(n) -> the traction of step n at the loaded nodes (3 n_load,) [Pa]: the sum of

@@ -8,9 +8,9 @@ of surface load is a class with these members, or plain data given to ``SurfaceT
 
     elements                 the soil elements it loads (int array): the soil's loaded region is
                              the union of its sources' elements
-    bind(nodes, x)           called once by the soil with the region's nodes (ids, in the soil's
-                             traction-column order) and their coordinates (n, 3) [m]; returns the
-                             indices of the nodes it loads
+    bind(mesh, region_nodes) called once by the soil with its surface mesh and the loaded region's
+                             node ids (sorted: the soil's traction-column order); returns the
+                             indices in ``region_nodes`` of the nodes it loads
     step_mean(m, dt)         the traction at those nodes (k, 3) [Pa, the soil's outward normal
                              convention: t = sigma n with n = +z on the free surface z = 0, so a
                              load pushing the surface down is t_z < 0] averaged over step m, the
@@ -19,7 +19,8 @@ of surface load is a class with these members, or plain data given to ``SurfaceT
     amplitudes(at=None)      the distinct traction vectors (k, 3) [Pa] it applies (at the nodes the
                              boolean mask ``at`` selects, in ``bind``'s order): the soil refuses those
                              its symmetry planes contradict at the nodes on a plane
-                             (``bem.symmetry.check_compatible``; off a plane a load is mirrored)
+                             (``bem.symmetry.check_compatible``; off a plane a load is mirrored;
+                             a source with ``amplitudes()`` alone is checked at every node)
     describe()               one line for the run's log
 
 The structure's load (``nodal.NodalLoad``): F a(t) with F the nodal forces of the options' pressures

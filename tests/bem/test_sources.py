@@ -190,3 +190,24 @@ def test_two_rigid_motions_are_refused(tmp_path):
 
     with pytest.raises(SSIError, match="2 prescribed motions of soil regions \\(first, second\\)"):
         _run(str(tmp_path / "two.h5"), two)
+
+
+def test_a_source_of_the_older_protocol_is_checked_at_every_node(tmp_path):
+    """Under x=anti a vertical load off the plane is mirrored into its opposite (tests/bem/test_symmetry.py); a
+    source written before ``amplitudes(at)`` (``amplitudes()`` alone) cannot say which of its values lie on the
+    plane, so it is checked at every node, as before: refused in one line, not a TypeError."""
+    from petsc_ssi.sources import SurfaceTraction
+    from petsc_ssi.histories import History
+    from petsc_ssi.petsc import SSIError
+
+    class Older(SurfaceTraction):
+        def amplitudes(self):
+            return super().amplitudes()
+
+    def off_plane(kind):
+        return lambda mesh: [kind(mesh.select("box:1.4,1.6,0.4,0.6"), [0, 0, -P0], History("heaviside"))]
+
+    with pytest.raises(SSIError, match=r"x=anti: the load traction \(0.0, 0.0, -1000.0\) is not antisymmetric"):
+        _run(str(tmp_path / "older.h5"), off_plane(Older), symmetry="x=anti", t_end=0.003)
+    t, u, _ = _run(str(tmp_path / "newer.h5"), off_plane(SurfaceTraction), symmetry="x=anti", t_end=0.003)
+    assert np.abs(u).max() > 0
