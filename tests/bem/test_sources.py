@@ -12,7 +12,6 @@ given to the soil, not code in it.
   ``sources=[...]``, it equals bit for bit the run of the options that describe it (-ssi_disp_*),
   its resultants included; a second motion source is refused.
 """
-import os
 
 import h5py
 import numpy as np
