@@ -28,7 +28,7 @@ def test_options_files_in_a_cycle_are_named(tmp_path, n):
     assert line == f"petsc-ssi: error: -options_file {tmp_path}/self.opts includes itself (remove its -options_file line)"
     if n > 1:
         return                     # the rest is the same check before PETSc starts: -n 1 only (cheap tests)
-    (tmp_path / "a.opts").write_text(f"-ssi_dt 1e-3 -options_file {tmp_path}/b.opts\n")
+    (tmp_path / "a.opts").write_text(f"-ssi_dt 1e-3\n-options_file {tmp_path}/b.opts\n")
     (tmp_path / "b.opts").write_text(f"# b\n-options_file {tmp_path}/c.opts\n")
     (tmp_path / "c.opts").write_text(f"-ssi_t_end 1\n-options_file {tmp_path}/a.opts\n")
     line = one_line_error(cli(["-options_file", str(tmp_path / "a.opts")], nranks=n, check=False))
@@ -38,6 +38,15 @@ def test_options_files_in_a_cycle_are_named(tmp_path, n):
     (tmp_path / "d.opts").write_text(f"-options_file {tmp_path}/nope.opts\n")
     line = one_line_error(cli(["-options_file", str(tmp_path / "d.opts")], nranks=n, check=False))
     assert f"nope.opts (included by {tmp_path}/d.opts): No such file" in line, line
+
+
+def test_options_petsc_refuses_at_start_are_one_line(tmp_path):
+    """An options file PETSc itself refuses in PetscInitialize (here a YAML file it cannot parse, which the
+    check before PETSc starts does not read) printed PETSc's page and then a Python traceback of petsc4py's
+    init: now PETSc's message and one line, exit status 2."""
+    (tmp_path / "bad.yaml").write_text("a: [\n")
+    line = one_line_error(cli(["-options_file_yaml", str(tmp_path / "bad.yaml")], check=False))
+    assert line.startswith("petsc-ssi: error: PETSc did not start (error code "), line
 
 
 # ------------------------------------------------------------ impedance: symmetry planes of the footing

@@ -203,7 +203,14 @@ def main(argv=None):
     if cmd == "post":
         return _serial_status(lambda: _post(rest))
     from ..petsc import init, SSIError
-    PETSc = init(rest)
+    try:
+        PETSc = init(rest)
+    except Exception as exc:       # PetscInitialize refused the options (its own message above): no traceback
+        if not type(exc).__module__.startswith("petsc4py"):
+            raise
+        print(f"petsc-ssi: error: PETSc did not start (error code {getattr(exc, 'ierr', '?')}): its message above "
+              "names the option or file it refused", flush=True)
+        return 2
     from .. import options
     from . import kinds, estimate, impedance, record  # noqa: F401  (every option declared, also for -help)
     if cmd == "help" or "-help" in rest or "--help" in rest:
