@@ -1,7 +1,7 @@
 """``python -m petsc_ssi.app.warmup``: compile the numba kernels into the cache ahead of the first run.
 
 The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.py``) are compiled by numba
-the first time a version of the sources runs on a machine (about a minute) and cached under
+the first time a version of the sources runs on a machine (minutes: 468 s on a 2-core virtual machine) and cached under
 ``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
 case on one process so that they are compiled now, says so, and exits at once when the cache is
 already warm for this checkout: when the warm-up itself has finished in it for these files at this
@@ -29,7 +29,7 @@ def main():
     if petsc_ssi.numba_cache_warm():
         print(f"[warmup] numba cache partly warm ({d}): loading the kernels, compiling what a run has not", flush=True)
     else:
-        print(f"[warmup] compiling the BEM kernels with numba into {d} (about half a minute, once per version)",
+        print(f"[warmup] compiling the BEM kernels with numba into {d} (minutes, once per version of the sources)",
               flush=True)
     os.environ["PETSC_SSI_WARMUP"] = "1"       # the run below does not announce the compile again
     t0 = time.perf_counter()
