@@ -785,7 +785,7 @@ class HalfSpace:
 
     def bind_sources(self):
         """Evaluate each source at the loaded nodes; refuse amplitudes the symmetry planes contradict
-        where they do: at a loaded node on a plane (``symmetry.zero_dofs``' tolerance) the components the
+        where they do: at a loaded node on a plane (``symmetry.on_plane``, as ``zero_dofs``) the components the
         plane's reflection makes odd (S = -1) must vanish. A load off the plane is mirrored with those
         components' signs flipped (under x=anti a vertical load at x > 0 and its opposite at x < 0), as
         an area load is (``sources.area``)."""
@@ -793,7 +793,7 @@ class HalfSpace:
         for src in self.sources:
             x = self.mesh.nodes[nodes[src.bind(self.mesh, nodes)]]
             for ax, kind in self.planes:
-                on = np.abs(x[:, ax]) <= 1e-9 * max(self.h, 1.0)
+                on = symmetry.on_plane(x, ax, self.h)
                 try:
                     vals, where = src.amplitudes(on), " at its nodes on the plane"
                 except TypeError:       # a source written for amplitudes() alone: checked everywhere, as before

@@ -92,13 +92,20 @@ def map_point(p, planes):
     return p, s
 
 
+def on_plane(nodes, ax, h, tol=1e-9):
+    """Boolean mask of the nodes on the plane x_ax = 0 (within tol max(h, 1) of it, h the largest element
+    size): the nodes whose odd components a plane forces to zero (``zero_dofs``) and where a load must
+    not carry them (``halfspace.HalfSpace.bind_sources``)."""
+    return np.abs(nodes[:, ax]) <= tol * max(h, 1.0)
+
+
 def zero_dofs(nodes, planes, h, tol=1e-9):
     """DOFs that a symmetry plane forces to zero: the components of a node on
     the plane that are odd under the plane's reflection (u_x on x = 0 for
     'sym', u_y and u_z for 'anti'); the same holds for the traction there."""
     out = []
     for ax, kind in planes:
-        on = np.where(np.abs(nodes[:, ax]) <= tol * max(h, 1.0))[0]
+        on = np.where(on_plane(nodes, ax, h, tol))[0]
         odd = np.where(sign_matrix(ax, kind) < 0)[0]
         out.append((3 * on[:, None] + odd[None, :]).ravel())
     return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
