@@ -66,6 +66,50 @@ def test_symmetry_plane_not_reached_is_warned(tmp_path):
     assert "does not reach the plane" not in r.stdout
 
 
+@pytest.mark.parametrize("xmin", [1e-7, 2e-4])
+def test_mesh_near_the_plane_but_not_on_it_is_refused(tmp_path, xmin):
+    """A mesh that misses the plane x = 0 by less than 1e-3 of its element size (1e-7 m and 2e-4 m for 1 m
+    cells) was meant to reach it: refused in one line naming the nearest node, where it used to run (quiet
+    below 1e-6 h) with the plane's odd components free (test_mesh_near_the_plane_gives_a_wrong_answer)."""
+    p = tmp_path / "near.msh"
+    _write_msh(p, 2, xmin=xmin)
+    assert resolve_error(**{**SMALL, "mesh": str(p)}) is None
+    msg = resolve_error(**{**SMALL, "mesh": str(p), "symmetry": "x=sym"})
+    assert msg is not None and "m off the plane x = 0" in msg and "put them on the plane" in msg, msg
+    assert f"lies {xmin:.3g} m off" in msg, msg
+    assert "\n" not in msg
+
+
+def test_mesh_near_the_plane_gives_a_wrong_answer(monkeypatch, tmp_path):
+    """Why the refusal above: the 6 m grid's quarter model (vertical load on the central 1 m cell) with every
+    node moved 1e-7 m (1e-7 h) off x = 0, the check bypassed, is far from the model on the plane at the
+    receivers (a node and its image two free nodes 2e-7 m apart; the true change of the geometry is of
+    order 1e-7), while 1e-10 m (on the plane within its 1e-9 m tolerance) is the same model to 1e-9.
+    `pytest -s` prints both differences."""
+    from helpers import run_bem, relmax
+    import petsc_ssi.bem.halfspace as hs
+    from petsc_ssi.bem import symmetry
+    read, shift = hs.read_surface_mesh, [0.0]
+
+    def shifted(cfg, comm, planes):
+        m = read(cfg, comm, planes)
+        m.nodes[:, 0] += shift[0]
+        return m
+    monkeypatch.setattr(hs, "read_surface_mesh", shifted)
+    monkeypatch.setattr(symmetry, "check_mesh", lambda *a: None)
+    kw = dict(mesh_size="6,6", mesh_h=1.0, mesh_patch="1,1", dt=7.5e-4, t_end=0.006, output_stride=0,
+              receivers="2,1,0;-2,-1.5,0;0.5,-2.5,0;0.5,0.5,0", load_group="load", load_p0=1000,
+              symmetry="x=sym,y=sym", warn_beta=0, output=tmp_path / "q.h5")
+    ref = run_bem(**kw)["u"]
+    out = {}
+    for s in (1e-10, 1e-7):
+        shift[0] = s
+        out[s] = relmax(run_bem(**kw)["u"], ref)
+    print(f"quarter model moved off x = 0: 1e-10 m {out[1e-10]:.3g}, 1e-7 m {out[1e-7]:.3g}")
+    assert out[1e-10] <= 1e-9
+    assert out[1e-7] >= 0.01
+
+
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
 def test_error_under_mpirun_does_not_hang():
     """Two ranks, bad receiver: exit status 2 with the message, within the timeout."""
