@@ -36,7 +36,7 @@ def _lagset(planes, chunk_cache, pattern="auto", bump=0.0):
 def _literal(ls):
     """Dense H (L+1, N, N, 3, 3), G (L+1, N, nt, 3, 3) and the touched-block masks, by plain loops."""
     from petsc_ssi.bem.assemble import _pair_window, _integrate, SING_TOL
-    from petsc_ssi.bem.packs import quad
+    from petsc_ssi.bem.packs import quad, wave
     o, m = ls.opts, ls.mat
     gq, gw = np.polynomial.legendre.leggauss(o["gauss"])
     gr, gwr = np.polynomial.legendre.leggauss(o["singular_order"])
@@ -46,6 +46,9 @@ def _literal(ls):
     Ub = np.zeros((L, 9, 3, 3)); Pb = np.zeros((L, 9, 3, 3)); Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
     Pc = Uc = np.zeros(0)                                   # (the compacted blocks: not used here)
     reach = m.cp * ls.dt * L
+    # the material pack as the runs pass it (an array, packs.wave): a tuple here compiled a signature of its
+    # own, about a minute in every fresh CI
+    phys = wave(ls.dt, m.cp, m.cs, m.rho, m.nu)
     for i in ls.rows:
         xc = ls.mesh.nodes[i]
         for v in range(len(ls.VX)):
@@ -55,7 +58,7 @@ def _literal(ls):
             if lo > hi:
                 continue
             want_u = bool((ls.VT[v] >= 0).any())
-            _integrate(xc, ls.VX[v], sing, ns, lo, hi, want_u, (ls.dt, m.cp, m.cs, m.rho, m.nu, m.mu, 0.0),
+            _integrate(xc, ls.VX[v], sing, ns, lo, hi, want_u, phys,
                        quad(o["subdivisions"], 0.0, o["subdivisions"], gq, gw, gr, gwr, SING_TOL, float(ls.Vh.min())),
                        (Ub, Pb, Us, Ps, Pc, Uc))
             for li in range(hi - lo + 1):
