@@ -49,17 +49,18 @@ def images(planes):
     return out
 
 
-# A node nearer a plane than NEAR_PLANE times the largest element size but not on it (``on_plane``): the
-# mesh was meant to reach the plane and missed it by rounding or a shift. Such a node and its mirror image are
-# two free nodes a hair apart, the plane's odd components not zeroed: a vertical load on the 6 m grid's
-# quarter model with every node 1e-8 m to 1e-4 m off x = 0 gave receivers 6 % off the model on the plane, with
-# no warning below 1e-6 h (2026-11-30, tests/bem/test_errors.py -k near_the_plane).
+# A node nearer a plane than NEAR_PLANE times its elements' node spacing but not on it (``on_plane``): the mesh
+# was meant to reach the plane and missed it by rounding or a shift. Such a node and its mirror image are two
+# free nodes a hair apart, the plane's odd components not zeroed: a vertical load on the 6 m grid's quarter
+# model with every node 1e-7 m off x = 0 is 6 % off the model on the plane at its receivers, and ran without a
+# warning (below 1e-6 h) until 2026-11-30 (tests/bem/test_errors.py -k near_the_plane).
 NEAR_PLANE = 1e-3
 
 
-def check_mesh(nodes, planes, h):
+def check_mesh(nodes, planes, h, node_h=None):
     """Refuse a mesh that crosses a symmetry plane or has a node near the plane but not on it (within
-    ``NEAR_PLANE`` h: a mesh meant to reach the plane); warn (one line) where it stays farther from the plane:
+    ``NEAR_PLANE`` times its own elements' node spacing ``node_h`` (N,), h the largest, if not given: a mesh
+    meant to reach the plane); warn (one line) where it stays farther from the plane:
     the strip between the mesh and its mirror image is then left out of the surface (not traction-free), most
     likely a mesh placed off the plane by mistake."""
     from ..petsc import warn
@@ -70,14 +71,14 @@ def check_mesh(nodes, planes, h):
         x = nodes[:, ax]
         if x.min() < -1e-9 * max(h, 1.0):
             raise SSIError(f"-ssi_symmetry: the mesh crosses the plane {name} = 0; mesh only {name} >= 0")
-        near = np.where(~on_plane(nodes, ax, h) & (x <= NEAR_PLANE * h))[0]
+        near = np.where(~on_plane(nodes, ax, h) & (x <= NEAR_PLANE * (h if node_h is None else node_h)))[0]
         if len(near):
             k = int(near[np.argmin(x[near])])
-            raise SSIError(f"-ssi_symmetry: node {k} lies {x[k]:.3g} m off the plane {name} = 0 ({len(near)} node(s) "
-                           f"within {NEAR_PLANE:g} of the element size {h:.6g} m but not on it, within "
-                           f"{1e-9 * max(h, 1.0):.3g} m): put them on the plane ({name} = 0) or mesh away from it")
+            raise SSIError(f"-ssi_symmetry: node {k} lies {x[k]:.3g} m off the plane {name} = 0, nearer than "
+                           f"{NEAR_PLANE:g} of its elements' node spacing but not on it (within {1e-9 * max(h, 1.0):.3g} "
+                           f"m; {len(near)} such node(s)): put them on the plane or mesh away from it")
         gap = float(x.min())
-        if gap > NEAR_PLANE * h:
+        if gap > 1e-9 * max(h, 1.0):                      # (not on the plane, and no node near it: above)
             warn(f"-ssi_symmetry: the mesh does not reach the plane {name} = 0 (its nearest node at {name} = {gap:.6g} m): "
                  f"the {2 * gap:.6g} m strip between the mesh and its mirror image is left out of the surface; mesh "
                  f"up to the plane")

@@ -140,3 +140,20 @@ def test_non_smooth_surface_detected():
     q = grid(4.0, 4.0, 1.0, xmin=0.0)
     q.nodes[:, 2] = -0.3 * q.nodes[:, 0]
     assert len(kinks(q)[0]) == 0 and len(kinks(q, [(0, 1)])[0]) == 9
+
+
+def test_near_the_plane_is_measured_by_the_node_s_own_elements():
+    """The band is 1e-3 of the node's own elements' spacing, not of the mesh's largest: a graded mesh's
+    interior node 4 mm from the plane (its cells 5 mm apart, the largest 5 m) is a node of the mesh, not a
+    node that missed the plane; at 4 um from the plane it did miss it."""
+    from petsc_ssi.bem import symmetry
+    from petsc_ssi.petsc import SSIError
+    planes = symmetry.parse("x=sym")
+    nodes = np.array([[0.0, 0, 0], [0.004, 0, 0], [0.01, 0, 0], [10.0, 0, 0]])
+    node_h = np.array([0.005, 0.005, 0.005, 5.0])
+    symmetry.check_mesh(nodes, planes, 5.0, node_h)                       # passes: nothing said
+    with pytest.raises(SSIError, match="node 1 lies 0.004 m off the plane x = 0"):
+        symmetry.check_mesh(nodes, planes, 5.0)                             # (the largest spacing: 5 mm band)
+    nodes[1, 0] = 4e-6
+    with pytest.raises(SSIError, match=r"node 1 lies 4e-06 m off the plane x = 0.*1 such node"):
+        symmetry.check_mesh(nodes, planes, 5.0, node_h)
