@@ -40,8 +40,8 @@ register("partition", "enum", "balanced", "", "soil nodes per rank: contiguous r
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0; every load and "
          "motion is mirrored, the components the plane makes odd (u_x on x=sym; u_y, u_z on x=anti) with their "
          "sign flipped: a load whose nodes on the plane carry such a component is refused (a vertical patch "
-         "across x=anti), one off the plane is mirrored into its opposite; the mesh reaches the plane with its nodes on it (a "
-         "node within 1e-3 of the element size but not on it is refused)", "bem")
+         "across x=anti), one off the plane is mirrored into its opposite; the mesh reaches the plane with its nodes on it "
+         "(a node nearer than 1e-3 of its elements' node spacing but not on it is refused)", "bem")
 register("lag_store", "enum", "dense", "", "how the lags of the history sum are stored: dense (the lag matrices, "
          "-ssi_lag_storage) or toeplitz (a uniform flat grid of equal elements, with or without symmetry planes: the H "
          "lags as block-Toeplitz kernels in Fourier space, O(N) a lag instead of O(N^2), the history sum by FFTs: "
