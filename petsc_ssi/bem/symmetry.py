@@ -131,12 +131,13 @@ def zero_dofs(nodes, planes, h, tol=1e-9):
 
 
 def check_compatible(planes, traction, disp, where=""):
-    """Refuse loads the declared symmetry contradicts: components with S = -1 must vanish (a uniform
-    field on a patch that meets the plane is even; ``where`` says which nodes were checked)."""
+    """Refuse loads the declared symmetry contradicts: components with S = -1 must vanish, to 1e-12 of the
+    vector's largest component (a direction computed as cos(pi/2) is 6e-17, not 0; a uniform field on a patch
+    that meets the plane is even; ``where`` says which nodes were checked)."""
     for ax, kind in planes:
         s = sign_matrix(ax, kind)
         name = f"{'xy'[ax]}={'sym' if kind > 0 else 'anti'}"
         for what, v in (("the load traction", traction), ("the prescribed displacement", disp)):
-            if v is not None and np.any((s < 0) & (np.abs(v) > 0)):
+            if v is not None and np.any((s < 0) & (np.abs(v) > 1e-12 * np.abs(v).max())):
                 raise SSIError(f"-ssi_symmetry {name}: {what} {tuple(float(x) for x in v)}{where} is not "
                                f"{'symmetric' if kind > 0 else 'antisymmetric'} about this plane")

@@ -157,3 +157,16 @@ def test_near_the_plane_is_measured_by_the_node_s_own_elements():
     nodes[1, 0] = 4e-6
     with pytest.raises(SSIError, match=r"node 1 lies 4e-06 m off the plane x = 0.*1 such node"):
         symmetry.check_mesh(nodes, planes, 5.0, node_h)
+
+
+def test_an_odd_component_at_rounding_level_is_zero():
+    """A direction computed by the API (a traction turned by cos(pi/2) = 6e-17) meets x=sym; an odd component
+    of 1e-9 of the load does not."""
+    from petsc_ssi.bem import symmetry
+    from petsc_ssi.petsc import SSIError
+    planes = symmetry.parse("x=sym")
+    symmetry.check_compatible(planes, 1000.0 * np.array([np.cos(np.pi / 2), 0.0, -1.0]), None)
+    with pytest.raises(SSIError, match=r"x=sym: the load traction \(1e-06, 0.0, -1000.0\) is not symmetric"):
+        symmetry.check_compatible(planes, np.array([1e-6, 0.0, -1000.0]), None)
+    with pytest.raises(SSIError, match="the prescribed displacement"):
+        symmetry.check_compatible(symmetry.parse("y=sym"), None, np.array([0.0, 1e-6, 0.0]))
