@@ -102,10 +102,7 @@ def read_soil_surface(cfg, comm, planes):
     """Collective: the surface mesh (``read_surface_mesh``), checked against the symmetry planes."""
     mesh = read_surface_mesh(cfg, comm, planes)
     if planes and mesh.n_nodes:
-        sizes = mesh.element_sizes()
-        node_h = np.full(mesh.n_nodes, float(sizes.max()))       # each node: its elements' smallest node spacing
-        np.minimum.at(node_h, mesh.cells.ravel(), np.repeat(sizes.min(axis=1), mesh.cells.shape[1]))
-        symmetry.check_mesh(mesh.nodes, planes, float(sizes.max()), node_h)
+        symmetry.check_mesh(mesh.nodes, planes, float(mesh.element_sizes().max()), mesh.node_spacing())
     return mesh
 
 

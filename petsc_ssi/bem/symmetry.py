@@ -69,16 +69,17 @@ def check_mesh(nodes, planes, h, node_h=None):
         if len(nodes) == 0:
             continue
         x = nodes[:, ax]
-        if x.min() < -1e-9 * max(h, 1.0):
+        if x.min() < -plane_tol(h):
             raise SSIError(f"-ssi_symmetry: the mesh crosses the plane {name} = 0; mesh only {name} >= 0")
         near = np.where(~on_plane(nodes, ax, h) & (x <= NEAR_PLANE * (h if node_h is None else node_h)))[0]
         if len(near):
             k = int(near[np.argmin(x[near])])
-            raise SSIError(f"-ssi_symmetry: node {k} lies {x[k]:.3g} m off the plane {name} = 0, nearer than "
-                           f"{NEAR_PLANE:g} of its elements' node spacing but not on it (within {1e-9 * max(h, 1.0):.3g} "
+            at = ", ".join(f"{c:.6g}" for c in nodes[k])
+            raise SSIError(f"-ssi_symmetry: node {k} at ({at}) m lies {x[k]:.3g} m off the plane {name} = 0, nearer "
+                           f"than {NEAR_PLANE:g} of its elements' node spacing but not on it (within {plane_tol(h):.3g} "
                            f"m; {len(near)} such node(s)): put them on the plane or mesh away from it")
         gap = float(x.min())
-        if gap > 1e-9 * max(h, 1.0):                      # (not on the plane, and no node near it: above)
+        if gap > plane_tol(h):                            # (not on the plane, and no node near it: above)
             warn(f"-ssi_symmetry: the mesh does not reach the plane {name} = 0 (its nearest node at {name} = {gap:.6g} m): "
                  f"the {2 * gap:.6g} m strip between the mesh and its mirror image is left out of the surface; mesh "
                  f"up to the plane")
@@ -111,11 +112,26 @@ def map_point(p, planes):
     return p, s
 
 
+def plane_tol(h, tol=1e-9):
+    """How near a plane a node is on it [m]: tol max(h, 1), h the largest element size."""
+    return tol * max(h, 1.0)
+
+
 def on_plane(nodes, ax, h, tol=1e-9):
-    """Boolean mask of the nodes on the plane x_ax = 0 (within tol max(h, 1) of it, h the largest element
-    size): the nodes whose odd components a plane forces to zero (``zero_dofs``) and where a load must
-    not carry them (``halfspace.HalfSpace.bind_sources``)."""
-    return np.abs(nodes[:, ax]) <= tol * max(h, 1.0)
+    """Boolean mask of the nodes on the plane x_ax = 0 (within ``plane_tol`` of it): the nodes whose odd
+    components a plane forces to zero (``zero_dofs``) and where a load must not carry them
+    (``halfspace.HalfSpace.bind_sources``)."""
+    return np.abs(nodes[:, ax]) <= plane_tol(h, tol)
+
+
+def has_odd(v, ax, kind, rel=1e-12):
+    """Whether the 3-vector v has a component the plane's reflection makes odd (S = -1) beyond ``rel`` of its
+    largest component (a direction computed as cos(pi/2) is 6e-17, not 0); a value that is not finite counts
+    as one (it cannot be checked)."""
+    v = np.asarray(v, float)
+    if not np.all(np.isfinite(v)):
+        return True
+    return bool(np.any((sign_matrix(ax, kind) < 0) & (np.abs(v) > rel * np.abs(v).max())))
 
 
 def zero_dofs(nodes, planes, h, tol=1e-9):
@@ -131,13 +147,12 @@ def zero_dofs(nodes, planes, h, tol=1e-9):
 
 
 def check_compatible(planes, traction, disp, where=""):
-    """Refuse loads the declared symmetry contradicts: components with S = -1 must vanish, to 1e-12 of the
-    vector's largest component (a direction computed as cos(pi/2) is 6e-17, not 0; a uniform field on a patch
-    that meets the plane is even; ``where`` says which nodes were checked)."""
+    """Refuse loads the declared symmetry contradicts: components with S = -1 must vanish (``has_odd``: to
+    1e-12 of the vector's largest; a uniform field on a patch that meets the plane is even; ``where`` says which
+    nodes were checked)."""
     for ax, kind in planes:
-        s = sign_matrix(ax, kind)
         name = f"{'xy'[ax]}={'sym' if kind > 0 else 'anti'}"
         for what, v in (("the load traction", traction), ("the prescribed displacement", disp)):
-            if v is not None and np.any((s < 0) & (np.abs(v) > 1e-12 * np.abs(v).max())):
+            if v is not None and has_odd(v, ax, kind):
                 raise SSIError(f"-ssi_symmetry {name}: {what} {tuple(float(x) for x in v)}{where} is not "
                                f"{'symmetric' if kind > 0 else 'antisymmetric'} about this plane")

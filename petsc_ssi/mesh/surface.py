@@ -63,6 +63,15 @@ class SurfaceMesh:
         distorted element (an O-grid's) is measured by its longest segment, whatever its node 0."""
         return segment_sizes(self.cell_coords())
 
+    def node_spacing(self):
+        """Each node's spacing (N,) [m]: the smallest, over the elements it belongs to, of the element's size in
+        its shorter direction (``element_sizes``); the largest element's where a node belongs to none."""
+        sizes = self.element_sizes()
+        out = np.full(self.n_nodes, float(sizes.max()) if len(sizes) else 1.0)
+        if len(sizes):
+            np.minimum.at(out, self.cells.ravel(), np.repeat(sizes.min(axis=1), self.cells.shape[1]))
+        return out
+
     # ---------------------------------------------------------------- what the boundary is
     def in_plane(self, rel=1e-9):
         """Whether every node lies on the plane z = 0, within ``rel`` of the mesh's plan extent."""

@@ -64,7 +64,7 @@ class AreaTraction:
         with its traction S f: a rectangle that crosses a plane must be mirror-symmetric about it and its
         traction allowed there (f = S f on the plane: a vertical load on a 'sym' plane, not on an 'anti'
         one). SSIError otherwise."""
-        from ..bem.symmetry import images, sign_matrix
+        from ..bem.symmetry import images, has_odd
         r = list(self.rect)
         for ax, kind in planes:
             lo, hi = r[2 * ax], r[2 * ax + 1]
@@ -76,7 +76,7 @@ class AreaTraction:
                 if abs(lo + hi) > 1e-9 * max(abs(lo), abs(hi)):
                     raise SSIError(f"{self.name}: the rectangle crosses the symmetry plane {name} = 0 but is not "
                                    f"mirror-symmetric about it ({lo:g}..{hi:g}): the model mirrors every load there")
-                if np.any(self.f * (1.0 - sign_matrix(ax, kind)) != 0.0):
+                if has_odd(self.f, ax, kind):
                     raise SSIError(f"{self.name}: the traction ({', '.join(f'{v:g}' for v in self.f)}) Pa on the "
                                    f"plane {name} = 0 is not allowed by -ssi_symmetry {name}="
                                    f"{'sym' if kind > 0 else 'anti'} (it would be mirrored into its opposite)")

@@ -80,6 +80,7 @@ def test_mesh_near_the_plane_but_not_on_it_is_refused(tmp_path, xmin):
     assert "\n" not in msg
 
 
+@pytest.mark.slow                                   # (why the refusal above is there; it cannot fail if that breaks)
 def test_mesh_near_the_plane_gives_a_wrong_answer(monkeypatch, tmp_path):
     """Why the refusal above: the 6 m grid's quarter model (vertical load on the central 1 m cell) with every
     node moved 1e-7 m (1e-7 h) off x = 0, the check bypassed, is far from the model on the plane at the
@@ -152,10 +153,10 @@ def test_near_the_plane_is_measured_by_the_node_s_own_elements():
     nodes = np.array([[0.0, 0, 0], [0.004, 0, 0], [0.01, 0, 0], [10.0, 0, 0]])
     node_h = np.array([0.005, 0.005, 0.005, 5.0])
     symmetry.check_mesh(nodes, planes, 5.0, node_h)                       # passes: nothing said
-    with pytest.raises(SSIError, match="node 1 lies 0.004 m off the plane x = 0"):
+    with pytest.raises(SSIError, match=r"node 1 at \(0.004, 0, 0\) m lies 0.004 m off the plane x = 0"):
         symmetry.check_mesh(nodes, planes, 5.0)                             # (the largest spacing: 5 mm band)
     nodes[1, 0] = 4e-6
-    with pytest.raises(SSIError, match=r"node 1 lies 4e-06 m off the plane x = 0.*1 such node"):
+    with pytest.raises(SSIError, match=r"node 1 at \(4e-06, 0, 0\) m lies 4e-06 m off the plane x = 0.*1 such node"):
         symmetry.check_mesh(nodes, planes, 5.0, node_h)
 
 
@@ -170,3 +171,34 @@ def test_an_odd_component_at_rounding_level_is_zero():
         symmetry.check_compatible(planes, np.array([1e-6, 0.0, -1000.0]), None)
     with pytest.raises(SSIError, match="the prescribed displacement"):
         symmetry.check_compatible(symmetry.parse("y=sym"), None, np.array([0.0, 1e-6, 0.0]))
+
+
+def test_node_spacing_of_a_graded_grid():
+    """SurfaceMesh.node_spacing, what the near-the-plane band is measured by, against a plain loop over the
+    elements: each node's smallest element size in the element's shorter direction (a graded grid: every size
+    differs)."""
+    from petsc_ssi.mesh.surface import grid
+    m = grid(8.0, 6.0, 1.0, (1.0, 1.0), xmin=0.0, ymin=0.0, grade=1.0)
+    sizes = m.element_sizes()
+    assert np.ptp(sizes) > 0.1 * sizes.max()
+    ref = np.full(m.n_nodes, np.inf)
+    for e in range(m.n_cells):
+        for n in m.cells[e]:
+            ref[n] = min(ref[n], sizes[e].min())
+    assert np.array_equal(m.node_spacing(), ref)
+
+
+def test_area_load_and_non_finite_values_against_a_plane():
+    """The area load's own check (sources/area.py, a rectangle across the plane) takes the same rule as the
+    loads' (symmetry.has_odd): a direction turned by cos(pi/2) meets x=sym, 1e-9 of the load does not; a value
+    that is not finite is refused."""
+    from petsc_ssi.bem import symmetry
+    from petsc_ssi.petsc import SSIError
+    from petsc_ssi.sources.area import AreaTraction
+    planes = symmetry.parse("x=sym")
+    ok = AreaTraction((-1.0, 1.0, 0.5, 1.5), 1000.0 * np.array([np.cos(np.pi / 2), 0.0, -1.0]), None)
+    assert len(ok.images(planes)) == 2
+    with pytest.raises(SSIError, match="is not allowed by -ssi_symmetry x=sym"):
+        AreaTraction((-1.0, 1.0, 0.5, 1.5), [1e-6, 0.0, -1000.0], None).images(planes)
+    assert symmetry.has_odd([1e-6, 0.0, np.nan], 0, 1) and symmetry.has_odd([np.inf, 0.0, 1.0], 0, 1)
+    assert not symmetry.has_odd([0.0, 0.0, 0.0], 0, 1)
