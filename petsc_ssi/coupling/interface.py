@@ -268,7 +268,9 @@ def mass_matrix(X, conn, n, order=4):
 def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
     """FE DOFs a symmetry plane fixes: on x_a = 0, u_a and the rotations about the two
     other axes (sym), or the two other translations and the rotation about a (anti);
-    rotations only where the nodes have them. SSIError if the structure extends to x_a < 0."""
+    rotations only where the nodes have them. SSIError if the structure extends to x_a < 0, or has a node
+    nearer the plane than 1e-6 of its extent but not on it (within tol of it): a structure meant to reach the
+    plane whose node there would be left free (as ``bem.symmetry.check_mesh`` for the soil)."""
     from ..fem.dofmap import DofMap, TRANSLATIONS, ROTATIONS
     dm = dofmap if dofmap is not None else DofMap(fe_mesh.has_rotation())
     out = []
@@ -279,6 +281,14 @@ def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
             raise SSIError(f"-ssi_symmetry: the structure's mesh extends to {'xy'[ax]} = {x.min():.4g} < 0; "
                            f"with a symmetry plane {'xy'[ax]} = 0 mesh only the part {'xy'[ax]} >= 0")
         on = np.nonzero(np.abs(x) <= tol * max(h, 1.0))[0]
+        near = np.nonzero((np.abs(x) > tol * max(h, 1.0)) & (np.abs(x) <= tol * max(h, 1.0) * 1e3))[0]
+        if len(near):
+            k = int(near[np.argmin(np.abs(x[near]))])
+            at = ", ".join(f"{c:.6g}" for c in fe_mesh.coords[k])
+            raise SSIError(f"-ssi_symmetry: the structure's node {k} at ({at}) m lies {x[k]:.3g} m off the plane "
+                           f"{'xy'[ax]} = 0, nearer than 1e-6 of the structure's extent but not on it (within "
+                           f"{tol * max(h, 1.0):.3g} m; {len(near)} such node(s)): put them on the plane or away "
+                           f"from it")
         others = [c for c in range(3) if c != ax]
         names = ([TRANSLATIONS[ax]] + [ROTATIONS[c] for c in others] if kind > 0 else
                  [TRANSLATIONS[c] for c in others] + [ROTATIONS[ax]])

@@ -58,6 +58,11 @@ def test_symmetry_dofs():
     assert set(3 * on_x) <= set(d) and not set(3 * on_x + 2) & set(d)
     with pytest.raises(SSIError, match="extends to x"):
         fem_symmetry_dofs(structured_box((2, 2, 1), (1, 1, 0.25), (-0.5, -0.5, 0)), [(0, 1)])
+    for off in (1e-8, -1e-8):           # a node that missed the plane (either side): refused, not left free
+        fe = structured_box((2, 2, 1), (0.5, 0.5, 0.25), (0.0, 0.0, 0.0))
+        fe.coords[np.argmin(fe.coords[:, 0] + fe.coords[:, 1]), 0] = off
+        with pytest.raises(SSIError, match=f"the structure's node 0 at .* m lies {off:.3g} m off the plane x = 0"):
+            fem_symmetry_dofs(fe, [(0, 1)])
 
 
 def _toy(nI=3, seed=0):
