@@ -272,23 +272,24 @@ def fem_symmetry_dofs(fe_mesh, planes, tol=1e-9, dofmap=None):
     nearer the plane than 1e-6 of its extent but not on it (within tol of it): a structure meant to reach the
     plane whose node there would be left free (as ``bem.symmetry.check_mesh`` for the soil)."""
     from ..fem.dofmap import DofMap, TRANSLATIONS, ROTATIONS
+    from ..bem.symmetry import plane_tol
     dm = dofmap if dofmap is not None else DofMap(fe_mesh.has_rotation())
     out = []
     h = float(np.abs(fe_mesh.coords).max())
+    t = plane_tol(h, tol)                   # (on the plane within t; h here the structure's extent)
     for ax, kind in planes:
         x = fe_mesh.coords[:, ax]
-        if x.min() < -tol * max(h, 1.0) * 1e3:
+        if x.min() < -t * 1e3:
             raise SSIError(f"-ssi_symmetry: the structure's mesh extends to {'xy'[ax]} = {x.min():.4g} < 0; "
                            f"with a symmetry plane {'xy'[ax]} = 0 mesh only the part {'xy'[ax]} >= 0")
-        on = np.nonzero(np.abs(x) <= tol * max(h, 1.0))[0]
-        near = np.nonzero((np.abs(x) > tol * max(h, 1.0)) & (np.abs(x) <= tol * max(h, 1.0) * 1e3))[0]
+        on = np.nonzero(np.abs(x) <= t)[0]
+        near = np.nonzero((np.abs(x) > t) & (np.abs(x) <= t * 1e3))[0]
         if len(near):
             k = int(near[np.argmin(np.abs(x[near]))])
             at = ", ".join(f"{c:.6g}" for c in fe_mesh.coords[k])
             raise SSIError(f"-ssi_symmetry: the structure's node {k} at ({at}) m lies {x[k]:.3g} m off the plane "
                            f"{'xy'[ax]} = 0, nearer than 1e-6 of the structure's extent but not on it (within "
-                           f"{tol * max(h, 1.0):.3g} m; {len(near)} such node(s)): put them on the plane or away "
-                           f"from it")
+                           f"{t:.3g} m; {len(near)} such node(s)): put them on the plane or away from it")
         others = [c for c in range(3) if c != ax]
         names = ([TRANSLATIONS[ax]] + [ROTATIONS[c] for c in others] if kind > 0 else
                  [TRANSLATIONS[c] for c in others] + [ROTATIONS[ax]])
