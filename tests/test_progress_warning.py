@@ -59,11 +59,15 @@ def test_the_warning_comes_without_monitor_too(monkeypatch, capfd):
     assert capfd.readouterr().out == ""
 
 
-def _new_kernel(seed):
-    """A numba kernel no run has compiled (its source is new: the cache cannot hold it)."""
+def _new_kernel(seed, loops=1):
+    """A numba kernel no run has compiled (its source is new: the cache cannot hold it), of ``loops`` loops: its
+    compile time grows with them (0.06 s for one, 0.18 s for eight on a machine where the suite took 10 min;
+    one loop's compile fell to 0.0496 s there, under the test's 0.05 s floor)."""
     import numba
+    body = "".join(f"    for i in range(x.size):\n        s += x[i] * {seed!r} + {j}.0 * x[i] ** {j % 3 + 1}\n"
+                   for j in range(loops))
     ns = {}
-    exec(f"def k(x):\n    s = 0.0\n    for i in range(x.size):\n        s += x[i] * {seed!r}\n    return s", ns)
+    exec(f"def k(x):\n    s = 0.0\n{body}    return s", ns)
     return numba.njit(ns["k"])
 
 
@@ -85,7 +89,7 @@ def test_compiling_in_the_loop_is_not_slowness(monkeypatch, capfd):
             p.update(k)
         return capfd.readouterr().out
 
-    kernel = _new_kernel(np.random.rand())
+    kernel = _new_kernel(np.random.rand(), loops=8)     # a compile well above the 0.05 s floor and the model's 3 x 20 ms
     t0, c0 = monitor.time.perf_counter(), monitor.compile_seconds()
     out = loop(lambda: kernel(x))
     spent = monitor.compile_seconds() - c0
