@@ -62,18 +62,30 @@ def reflections(X, pres, tnodes, tol=1e-9):
     return out
 
 
-def blocks_of(prob):
-    """The number of independent blocks the step matrix of ``prob`` (a HalfSpace) would split into (1, 2 or 4),
-    from its nodes and regions alone (``reflections``; the commutation, which only the matrix can show, assumed:
-    ``petsc-ssi estimate``)."""
+def surface_reflections(prob, nodes=None):
+    """``reflections`` of the soil surface of ``prob`` (a HalfSpace) from its nodes and regions alone, or of its
+    nodes ``nodes`` (a subset: the interface columns' region, ``coupling.columns``); none with symmetry planes
+    (the model is already reduced)."""
     reg = prob.regions
     N = prob.mesh.n_nodes
     pres = np.zeros(N, bool)
     pres[np.asarray(reg.disp_nodes, np.int64)] = True
-    tn = np.asarray(reg.tnode)[reg.n_load:] if reg.n_t else []
+    tn = np.asarray(reg.tnode)[reg.n_load:] if reg.n_t else np.zeros(0, np.int64)
     if getattr(prob, "planes", None):
-        return 1
-    return 1 << len(reflections(prob.mesh.nodes, pres, tn))
+        return []
+    if nodes is None:
+        return reflections(prob.mesh.nodes, pres, tn)
+    where = -np.ones(N, np.int64)
+    where[nodes] = np.arange(len(nodes))
+    t = where[np.asarray(tn, np.int64)]
+    return reflections(prob.mesh.nodes[nodes], pres[nodes], t[t >= 0])
+
+
+def blocks_of(prob):
+    """The number of independent blocks the step matrix of ``prob`` (a HalfSpace) would split into (1, 2 or 4),
+    from its nodes and regions alone (``surface_reflections``; the commutation, which only the matrix can show,
+    assumed: ``petsc-ssi estimate``)."""
+    return 1 << len(surface_reflections(prob))
 
 
 def group(refl):
@@ -217,7 +229,7 @@ def solve_residual(A, solve, zero_local=()):
     return res
 
 
-def _signed_permutation(PETSc, comm, nmap, sign, r0, r1):
+def signed_permutation(PETSc, comm, nmap, sign, r0, r1):
     """The reflection's DOF map as an AIJ Mat (rows r0..r1 of 3 N): (R v)(n, c) = s(c) v(m(n), c)."""
     d = np.arange(r0, r1)
     cols = 3 * nmap[d // 3] + d % 3
@@ -239,7 +251,7 @@ def commutation_defect(PETSc, comm, A, refl):
     for axis, _, nmap in refl:
         s = np.ones(3)
         s[axis] = -1.0
-        R = _signed_permutation(PETSc, comm, nmap, s, r0, r1)
+        R = signed_permutation(PETSc, comm, nmap, s, r0, r1)
         R.mult(v, Rv)
         A.mult(Rv, ARv)
         R.mult(Av, RAv)
@@ -254,12 +266,13 @@ def commutation_defect(PETSc, comm, A, refl):
 class MirrorBlocks:
     """Collective: the step matrix A's mirror-symmetric form, or why not (``why``: '' when built). ``Q`` (AIJ:
     A's rows, the blocks' columns), ``Ap`` = Q^T A Q (AIJ, block diagonal), ``sizes`` the blocks' DOFs,
-    ``planes`` e.g. 'x = 0 and y = 0', ``defect`` the commutation check's value."""
+    ``planes`` e.g. 'x = 0 and y = 0', ``defect`` the commutation check's value, ``refl`` the reflections
+    (``reflections``)."""
 
     def __init__(self, PETSc, comm, A, X, pres, tnodes):
         self.Q = self.Ap = None
         self.defect = float("nan")
-        refl = reflections(X, pres, tnodes)
+        refl = self.refl = reflections(X, pres, tnodes)
         if not refl:
             self.why = "the surface, its prescribed-displacement or traction nodes are not mirror-symmetric"
             return

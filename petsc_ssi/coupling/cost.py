@@ -8,7 +8,8 @@ assembles it). What the coupling adds is counted here, in three parts:
                does (seconds on every structure this code meshes), and times solves with D
                (t_fs, the median of a few) and the growth of the resident memory (the factors)
   interface    3 n_I columns Z = A^-1 H_s e_j, solved 256 at a time by one multi-right-hand-side
-  set-up       solve of the factors (petsc.solve_columns): a column costs r_mms times one BEM step
+  set-up       solve of the factors (petsc.solve_columns; on a mirror-symmetric region the orbits'
+               representatives' only, ``columns.estimated_solved_columns``): a column costs r_mms times one BEM step
                solve (bem.cost.bem_solve_seconds, the BEM model's solve) and, implicit, r_mms times
                one solve with D (t_fs); plus the bonded interface system's LU (2/3 (3 n_I)^3 flops,
                replicated) at r_cpl flop/s. On a region around the interface (coupling/columns.py,
@@ -52,6 +53,8 @@ class CoupledCounts:
         self.nI, self.N, self.steps = iface.n, prob.mesh.n_nodes, prob.n_steps
         from .columns import estimated_region_nodes
         self.NZ = estimated_region_nodes(cfg, prob, iface.be_nodes)     # Z's rows: the region's nodes
+        from .columns import estimated_solved_columns
+        self.n_solved = estimated_solved_columns(cfg, prob, iface.be_nodes)   # (the others: mirror images)
         self.implicit = cfg.coupling == "implicit"
         self.n_fem = model.dofmap.size
         self.ranks_measured = comm.getSize()
@@ -77,7 +80,7 @@ class CoupledCounts:
         if self.NZ < self.N and "c_sol_nlogn" in k:      # the columns on the region: its own LU and solves
             from ..bem.cost import bem_solve_seconds
             col_s, fac_s = bem_solve_seconds(k, self.NZ, p), k.get("c_fac", 0.0) * self.NZ ** 1.5
-        setup = self.fem_setup_s + fac_s + n * k["r_mms"] * (col_s + (self.fem_solve_s if self.implicit else 0.0)) \
+        setup = self.fem_setup_s + fac_s + k["r_mms"] * (self.n_solved * col_s + (n * self.fem_solve_s if self.implicit else 0.0)) \
             + 2.0 / 3.0 * n ** 3 / k["r_cpl"]
         per_step = step_seconds(c, self.nI, self.NZ, p, self.fem_solve_s, self.n_fem if self.implicit else 0)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
@@ -117,7 +120,8 @@ def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0):
 
 def describe(cc):
     """One line of what the coupling's counts are."""
-    return (f"[ssi]   coupling: {cc.nI} interface nodes ({3 * cc.nI} columns), structure {cc.n_fem} dofs: "
+    solved = "" if cc.n_solved == 3 * cc.nI else f", {cc.n_solved} solved, the others mirror images"
+    return (f"[ssi]   coupling: {cc.nI} interface nodes ({3 * cc.nI} columns{solved}), structure {cc.n_fem} dofs: "
             f"factorised in {cc.fem_setup_s:.3g} s, a solve {cc.fem_solve_s * 1e3:.3g} ms (measured on "
             f"{cc.ranks_measured} rank(s)), {'implicit' if cc.implicit else 'staggered'} coupling")
 

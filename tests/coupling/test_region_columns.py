@@ -79,6 +79,40 @@ def test_a_margin_too_small_is_doubled(tmp_path):
     same(full, reg)                                  # (bonded: no free flight)
 
 
+def test_mirror_image_columns_equal_the_solved_ones(tmp_path):
+    """The footing centred on the grid: the region's interface columns fall into orbits of the mirror group
+    (x = 0, y = 0), so only an orbit's representative node's columns are solved (3 x 3 of the 5 x 5 interface
+    nodes: 27 of 75) and the others are their signed mirror images (coupling/columns.py). At -n 2 (the images
+    cross the ranks) the bonded run equals the one whose columns are all solved (-ssi_step_mirror off: no blocks,
+    no orbits) to 1e-12 of each field's scale."""
+    bonded = BIG + ["-ssi_contact", "bonded", "-ssi_t_end", "0.2"]
+    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
+    out0 = cli(bonded + ["-ssi_output", ref, "-ssi_step_mirror", "off"]).stdout
+    assert "mirror images" not in region_line(out0).group(0)
+    out = cli(bonded + ["-ssi_output", got], nranks=2).stdout
+    line = [x for x in out.splitlines() if "interface columns: on the" in x][0]
+    assert "27 of 75 columns solved, the others their mirror images" in line, line
+    same(ref, got)
+
+
+def test_an_image_right_hand_side_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
+    """Where an image column's right-hand side is not its representative's mirrored to MIRROR_TOL (forced here:
+    a negative bound), every column is solved, said in one line, and the run is the same."""
+    from helpers import run_ssi
+    from petsc_ssi.coupling import columns
+    opts = dict(zip((a[len("-ssi_"):] for a in BIG[0::2]), BIG[1::2]))
+    opts.update(contact="bonded", t_end="0.1")
+    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
+    run_ssi(**opts, output=ref)
+    assert "27 of 75 columns solved" in capfd.readouterr().out
+    monkeypatch.setattr(columns, "MIRROR_TOL", -1.0)
+    run_ssi(**opts, output=got)
+    out = capfd.readouterr().out
+    assert "differs from its mirrored representative's by" in out and "every column solved" in out, out[-2000:]
+    assert "columns solved, the others" not in out
+    same(ref, got)
+
+
 def test_auto_keeps_the_full_solve_on_a_small_grid(tmp_path):
     """The 2 m x 2 m grid under a 1 m footing: the region would hold nearly every DOF, so auto solves
     with the step matrix's factors and says why."""
