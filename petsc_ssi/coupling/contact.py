@@ -64,6 +64,7 @@ import time
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 
 def normal_frames(n):
@@ -346,7 +347,9 @@ class ImplicitSolve(LUCache):
     def __init__(self, law, Z, C, M3, a, cache_bytes=512e6):
         super().__init__(len(Z), cache_bytes)
         self.law, self.Z, self.C, self.M3, self.a = law, Z, C, M3, float(a)
-        self.CM = C @ M3
+        # C M3 with M3 = M (x) I_3 sparse (a few entries a row): the dense product's 2 (3 n_I)^3 flops were
+        # half of this set-up (0.3 s of 0.69 s with 1425 interface DOFs)
+        self.CM = np.ascontiguousarray((sp.csr_matrix(M3).T @ np.asarray(C).T).T)
         self.B = np.eye(len(Z)) - self.a * self.CM @ Z
 
     def _matrix(self, O, S=None):
