@@ -159,12 +159,13 @@ class RegionColumns:
 
         orb = None if mb is None else self._orbits(mb.refl, cols, AR)
         if orb is not None:
-            orb = self._images_hold(orb, cols, block, tmpl)
+            orb = self._images_hold(orb, cols, block, tmpl, bmax)
         if orb is None:
             solve_columns(ksp, tmpl, len(cols), fill, take, block=block, Q=None if mb is None else mb.Q)
             self.n_solved = len(cols)
         else:                                   # the representatives solved, each image R_g z s_g(c) from them
-            reps, images, R, B = orb
+            reps, images, R, Brep = orb
+            orb = None
             y = tmpl.duplicate()
 
             def take_rep(r, z):
@@ -173,12 +174,11 @@ class RegionColumns:
                     R[g].mult(z, y)
                     y.scale(sgn)
                     take(i, y)
-            solve_columns(ksp, tmpl, len(reps), None, take_rep, block=lambda a, b: np.ascontiguousarray(B[:, reps[a:b]]),
-                          Q=mb.Q)
+            solve_columns(ksp, tmpl, len(reps), None, take_rep, block=lambda a, b: Brep[:, a:b], Q=mb.Q)
             self.n_solved = len(reps)
             for o in [y] + list(R.values()):
                 o.destroy()
-            del B
+            del Brep
         from mpi4py import MPI
         mpi = self.comm.tompi4py()
         mpi.Allreduce(MPI.IN_PLACE, bmax, op=MPI.MAX)
@@ -198,8 +198,8 @@ class RegionColumns:
 
     def _orbits(self, refl, cols, AR):
         """The interface columns' orbits under the region's mirror group (``bem.mirror.group`` of ``refl``):
-        (reps, images, R) with ``reps`` the positions in ``cols`` of the columns to solve (an orbit's smallest
-        interface node, each component), ``images[r]`` the [(g, position, sign)] of the columns rep r gives
+        (reps, images, R) with ``reps`` the positions in ``cols`` of the columns to solve (the orbit's first
+        interface node in ``nodes_I``, each component), ``images[r]`` the [(g, position, sign)] of the columns rep r gives
         (Z e_(g(k), c) = s_g(c) R_g Z e_(k, c): A and H_s commute with R_g, the signed permutation of the
         region's DOFs, ``bem.mirror.signed_permutation``) and ``R`` {g: R_g}; None where an interface node's
         mirror image is not an interface node or a column's image is not among ``cols``."""
@@ -232,17 +232,20 @@ class RegionColumns:
                     done[i] = True
                     lst.append((g, i, float(signs[g, c[r]])))
             images.append(lst)
-        if not done.all():                      # (cannot happen: every orbit holds its representative)
+        if not done.all():                      # (a column among ``cols`` whose representative's is not)
             return None
         r0, r1 = AR.getOwnershipRange()
         R = {g: signed_permutation(self.PETSc, self.comm, maps[g], signs[g], r0, r1) for g in range(1, len(maps))}
         return reps, images, R
 
-    def _images_hold(self, orb, cols, rhs, tmpl):
-        """Collective: (reps, images, R, B) with B every column's right-hand side on the region's rows (``rhs``
-        in chunks: the same calls as the full solve, which record each column's size and whether it reaches
-        outside), when each image column's right-hand side is its representative's mirrored, s_g(c) R_g b_r, to
-        ``MIRROR_TOL`` of its own size; else None (every column solved), said in one line."""
+    def _images_hold(self, orb, cols, rhs, tmpl, bmax):
+        """Collective: (reps, images, R, Brep) with Brep the representatives' right-hand sides on the region's
+        rows, when each image column's right-hand side is its representative's mirrored, s_g(c) R_g b_r, to
+        ``MIRROR_TOL`` of its own size (``bmax``, this rank's largest entry of each, which ``rhs`` records); else
+        None (every column solved, its right-hand sides read again), said in one line. Every column's right-hand
+        side is read (``rhs`` in chunks: the same calls as the full solve, which record each column's size and
+        whether it reaches outside) and held for the check, a transient the size of Z's rows; only the
+        representatives' stay for the solve."""
         from mpi4py import MPI
         reps, images, R = orb
         n = len(cols)
@@ -251,7 +254,7 @@ class RegionColumns:
             i1 = min(n, i0 + 256)
             B[:, i0:i1] = rhs(i0, i1)
         diff = np.zeros(n)
-        size = np.abs(B).max(axis=0) if B.size else np.zeros(n)
+        size = bmax.copy()
         vb, vy = tmpl.duplicate(), tmpl.duplicate()
         for r, lst in zip(reps, images):
             vb.getArray()[:] = B[:, r]
@@ -273,7 +276,9 @@ class RegionColumns:
             for o in R.values():
                 o.destroy()
             return None
-        return reps, images, R, B
+        Brep = np.ascontiguousarray(B[:, reps])
+        del B
+        return reps, images, R, Brep
 
     def _mirror(self, AR):
         """Collective: the region's matrix in mirror-symmetric blocks (``bem.mirror``) when the step matrix's LU
@@ -357,7 +362,8 @@ def region_columns(cfg, march, prob, nodes_I, cols, n_cols, rhs, log=printf):
 def orbit_representatives(maps, nodes_I, where):
     """(reps, img) of the interface nodes under the node maps ``maps`` (|G|, n) of a mirror group
     (``bem.mirror.group``) on the nodes ``where`` numbers (``where[node]``: its index in the maps, -1 outside):
-    ``img[g, k]`` the interface node g(k), ``reps`` the interface nodes that are their orbit's smallest; None
+    ``img[g, k]`` the interface node g(k) (positions in ``nodes_I``), ``reps`` the positions that are their
+    orbit's smallest; None
     where an interface node's image is not an interface node (or lies outside the maps' nodes)."""
     ri = where[np.asarray(nodes_I, np.int64)]
     if np.any(ri < 0):
