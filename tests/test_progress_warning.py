@@ -61,8 +61,9 @@ def test_the_warning_comes_without_monitor_too(monkeypatch, capfd):
 
 def _new_kernel(seed, loops=1):
     """A numba kernel no run has compiled (its source is new: the cache cannot hold it), of ``loops`` loops: its
-    compile time grows with them (0.06 s for one, 0.18 s for eight on a machine where the suite took 10 min;
-    one loop's compile fell to 0.0496 s there, under the test's 0.05 s floor)."""
+    compile time grows with them (eight took a few times one's in a scratch timing on a machine where the
+    suite took 10 min; one loop's compile fell to 0.0496 s there, under the test's 0.05 s floor, in the CI of
+    61596ac)."""
     import numba
     body = "".join(f"    for i in range(x.size):\n        s += x[i] * {seed!r} + {j}.0 * x[i] ** {j % 3 + 1}\n"
                    for j in range(loops))
