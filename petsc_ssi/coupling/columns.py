@@ -77,6 +77,9 @@ class RegionColumns:
         A = march.A
         r0, r1 = A.getOwnershipRange()
         self.inside_nodes = region_nodes(X, nodes_I, margin)
+        self.nodes = np.flatnonzero(self.inside_nodes)          # the region's nodes, and each node's index in them
+        self.where = -np.ones(len(X), np.int64)
+        self.where[self.nodes] = np.arange(self.nodes.size)
         inside = np.repeat(self.inside_nodes, 3)
         self.X = X
         self.nodes_I = np.asarray(nodes_I, np.int64)
@@ -205,10 +208,7 @@ class RegionColumns:
         mirror image is not an interface node or a column's image is not among ``cols``."""
         from ..bem.mirror import group, signed_permutation
         maps, signs, _ = group(refl)
-        nodes = np.flatnonzero(self.inside_nodes)
-        where = -np.ones(len(self.X), np.int64)
-        where[nodes] = np.arange(nodes.size)
-        got = orbit_representatives(maps, self.nodes_I, where)
+        got = orbit_representatives(maps, self.nodes_I, self.where)
         if got is None:
             return None
         rep_nodes, img = got                    # (img[g, k]: the interface node g(k))
@@ -288,9 +288,7 @@ class RegionColumns:
         if getattr(m, "mirror", None) is None:
             return None
         from ..bem.mirror import MirrorBlocks
-        nodes = np.flatnonzero(self.inside_nodes)
-        where = -np.ones(len(self.X), np.int64)
-        where[nodes] = np.arange(nodes.size)
+        nodes, where = self.nodes, self.where
         reg = m.reg
         tn = where[np.asarray(reg.tnode)[reg.n_load:]] if reg.n_t else np.zeros(0, np.int64)
         mb = MirrorBlocks(self.PETSc, self.comm, AR, self.X[nodes], m.pres[nodes], tn[tn >= 0])
@@ -363,8 +361,8 @@ def orbit_representatives(maps, nodes_I, where):
     """(reps, img) of the interface nodes under the node maps ``maps`` (|G|, n) of a mirror group
     (``bem.mirror.group``) on the nodes ``where`` numbers (``where[node]``: its index in the maps, -1 outside):
     ``img[g, k]`` the interface node g(k) (positions in ``nodes_I``), ``reps`` the positions that are their
-    orbit's smallest; None
-    where an interface node's image is not an interface node (or lies outside the maps' nodes)."""
+    orbit's smallest; None where an interface node's image is not an interface node (or lies outside the maps'
+    nodes)."""
     ri = where[np.asarray(nodes_I, np.int64)]
     if np.any(ri < 0):
         return None
@@ -382,14 +380,13 @@ def estimated_solved_columns(cfg, prob, be_nodes):
     representatives on the region of ``estimated_region_nodes`` when the surface (``bem.mirror.blocks_of``)
     and the region mirror and -ssi_step_mirror allows (the commutation assumed, as the estimate's blocks)."""
     n = 3 * len(be_nodes)
-    if (str(cfg.get("step_mirror", "auto")).lower() == "off"
-            or estimated_region_nodes(cfg, prob, be_nodes) == prob.mesh.n_nodes):
+    inside = _first_region(cfg, prob, be_nodes)
+    if str(cfg.get("step_mirror", "auto")).lower() == "off" or inside is None:
         return n
     from ..bem.mirror import blocks_of, group, surface_reflections
     if blocks_of(prob) == 1:
         return n
-    margin = float(cfg.get("interface_columns_margin") or 4.0) * geometric_reach(cfg, prob)
-    nodes = np.flatnonzero(region_nodes(prob.mesh.nodes, np.asarray(be_nodes), margin))
+    nodes = np.flatnonzero(inside)
     refl = surface_reflections(prob, nodes)
     if not refl:
         return n
@@ -404,12 +401,20 @@ def estimated_region_nodes(cfg, prob, be_nodes):
     check, the run's first line): the region of ``region_columns`` at its first margin (the same
     ``geometric_reach``); every node where the columns go with the step matrix's factors (full, or auto past
     ``AUTO_SHARE``, or a region of every node). A doubled margin (a residual above round-off) is not foreseen."""
+    inside = _first_region(cfg, prob, be_nodes)
+    return prob.mesh.n_nodes if inside is None else int(inside.sum())
+
+
+def _first_region(cfg, prob, be_nodes):
+    """The mask of the soil nodes in ``region_columns``' region at its first margin, or None where the columns
+    go with the step matrix's factors (full, or auto past ``AUTO_SHARE``, or a region of every node)."""
     N = prob.mesh.n_nodes
     mode = str(cfg.get("interface_columns") or "auto").lower()
     if mode == "full":
-        return N
+        return None
     margin = float(cfg.get("interface_columns_margin") or 4.0) * geometric_reach(cfg, prob)
-    n = int(region_nodes(prob.mesh.nodes, np.asarray(be_nodes), margin).sum())
+    inside = region_nodes(prob.mesh.nodes, np.asarray(be_nodes), margin)
+    n = int(inside.sum())
     if (mode == "auto" and n > AUTO_SHARE * N) or n == N:
-        return N
-    return n
+        return None
+    return inside

@@ -51,9 +51,8 @@ class CoupledCounts:
         from ..fem.integrators import make_model_integrator
         mpi = comm.tompi4py()
         self.nI, self.N, self.steps = iface.n, prob.mesh.n_nodes, prob.n_steps
-        from .columns import estimated_region_nodes
+        from .columns import estimated_region_nodes, estimated_solved_columns
         self.NZ = estimated_region_nodes(cfg, prob, iface.be_nodes)     # Z's rows: the region's nodes
-        from .columns import estimated_solved_columns
         self.n_solved = estimated_solved_columns(cfg, prob, iface.be_nodes)   # (the others: mirror images)
         self.implicit = cfg.coupling == "implicit"
         self.n_fem = model.dofmap.size
