@@ -3,7 +3,9 @@
 general kernel (bem/quadrature.py ``integrate_pair``, all 81 entries, the geometry per point) against
 the plane's (``integrate_plane``, the element's geometry from ``plane_points`` computed once, the flat
 patterns' entries 4-wide: bem/simd.py), on the pairs of every 40th soil node with every element
-whose wave window reaches it, the exact lags 1..54; the entries both keep compared bit for bit.
+whose wave window reaches it, the exact lags 1..54; the entries both keep compared bit for bit. Then
+the plane's on the same pairs with and without the displacement kernel G (want_u) and G alone
+(want_p False: the area loads' and the toeplitz store's G side), the G of both compared bit for bit.
 Best of 3 passes each.
 
     python jobscripts/plane_kernel_rate.py
@@ -52,9 +54,9 @@ def general(xc, v, lo, hi, ns, wu):
     return integrate_pair(xc, ls.VX[v], -1, ns, lo, hi, wave(dt, al, be, rho, nu), gq, gw, Ub, Pb, wu)
 
 
-def plane(xc, v, lo, hi, ns, wu):
+def plane(xc, v, lo, hi, ns, wu, wp=True):
     P[:] = 0.0; U[:] = 0.0
-    return integrate_plane(xc, *geo[(v, ns)], len(gq) ** 2, lo, hi, wave(dt, al, be, rho, nu), P, U, wu)
+    return integrate_plane(xc, *geo[(v, ns)], len(gq) ** 2, lo, hi, wave(dt, al, be, rho, nu), P, U, wu, wp)
 
 
 for p in pairs[::50]:                                    # the same numbers (and both compiled)
@@ -67,5 +69,21 @@ for name, f in (("integrate_pair", general), ("integrate_plane", plane)):
     for _ in range(3):
         t = time.perf_counter()
         n = sum(f(*p) for p in pairs)
+        best = min(best, time.perf_counter() - t)
+    print(f"{name}: {best:.3f} s, {n:.3g} kernel evaluations, {1e9 * best / n:.1f} ns per evaluation")
+U2 = U.copy()
+for p in pairs[::50]:                                    # G alone: the same G
+    nl = p[3] - p[2] + 1
+    plane(p[0], p[1], p[2], p[3], p[4], True)
+    U2[:nl] = U[:nl]
+    plane(p[0], p[1], p[2], p[3], p[4], True, False)
+    assert np.array_equal(U[:nl], U2[:nl])
+print("every pair's G: the same bits alone as beside H on every 50th")
+for name, wu, wp in (("integrate_plane H", False, True), ("integrate_plane H and G", True, True),
+                     ("integrate_plane G alone", True, False)):
+    best = np.inf
+    for _ in range(3):
+        t = time.perf_counter()
+        n = sum(plane(p[0], p[1], p[2], p[3], p[4], wu, wp) for p in pairs)
         best = min(best, time.perf_counter() - t)
     print(f"{name}: {best:.3f} s, {n:.3g} kernel evaluations, {1e9 * best / n:.1f} ns per evaluation")

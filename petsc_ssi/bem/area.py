@@ -66,7 +66,7 @@ def split(r, p, eps=0.0):
 @njit(cache=True)
 def _windows(pts, VX, Vc, VR, Vh, reach, cp, cs, dt, L, tol, ns_base, ns_max, near):
     """The (point, piece) pairs that reach a lag, compacted (two passes: no points x pieces array): (meta
-    (m, 6) of ``integrate_records``: lo, hi, sing, ns, want_u = 1, piece; point (m,); inside (q, 2): the
+    (m, 6) of ``integrate_records``: lo, hi, sing, ns, want_u = 2 (G alone), piece; point (m,); inside (q, 2): the
     (point, piece) pairs whose point lies in the piece's closed rectangle without being one of its nodes,
     to be cut, not in meta)."""
     n, k = pts.shape[0], VX.shape[0]
@@ -95,7 +95,7 @@ def _windows(pts, VX, Vc, VR, Vh, reach, cp, cs, dt, L, tol, ns_base, ns_max, ne
                         meta[r, 1] = hi
                         meta[r, 2] = sing
                         meta[r, 3] = ns
-                        meta[r, 4] = 1
+                        meta[r, 4] = 2
                         meta[r, 5] = e
                         point[r] = i
                     counts[0] += 1

@@ -184,38 +184,41 @@ def plane(flat, VX, ns, gq, gw, ns_max):
 
 
 @njit(cache=True)
-def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG):
+def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG, want_p=True):
     """The PLANE integrator of the kernel table: a regular pair of the plane z = 0 by
-    ``integrate_plane`` into Pc[:9 mH nl] (and Uc) of ``bufs``, the element's geometry from ``plane`` at
-    the base subdivisions, else computed into its scratch. Returns the kernel evaluations."""
+    ``integrate_plane`` into Pc[:9 mH nl] (and Uc; without ``want_p`` Uc alone) of ``bufs``, the element's
+    geometry from ``plane`` at the base subdivisions, else computed into its scratch. Returns the kernel
+    evaluations."""
     _, gsub, gpts, Ntab, ssub, spts, sN = plane
     Pc, Uc = bufs[4], bufs[5]
     nl = hi - lo + 1
     ng2 = quad.gq.shape[0] ** 2
     P = Pc[:nl * 9 * mH].reshape((nl, 9, mH))
     U = Uc[:nl * 9 * mG].reshape((nl, 9, mG))
-    P[:] = 0.0
+    if want_p or not want_u:
+        P[:] = 0.0
     if want_u:
         U[:] = 0.0
     if ns == quad.ns_base:
-        return integrate_plane(xc, gsub[v], gpts[v], Ntab, ng2, lo, hi, phys, P, U, want_u)
+        return integrate_plane(xc, gsub[v], gpts[v], Ntab, ng2, lo, hi, phys, P, U, want_u, want_p)
     m = ns * ns
     plane_points(X, ns, quad.gq, quad.gw, ssub[:m], spts[:m * ng2], sN[:m * ng2])
-    return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, phys, P, U, want_u)
+    return integrate_plane(xc, ssub[:m], spts[:m * ng2], sN[:m * ng2], ng2, lo, hi, phys, P, U, want_u, want_p)
 
 
 @njit(cache=True)
-def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped):
+def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped, want_p=True):
     """A pair's integrals of lags lo..hi in the patterns' layout (``_compact``): Pc[:9 m_H nl] and, with
     ``want_u``, Uc[:9 m_G nl] of ``bufs``, by the integrator of the kernel table (``kern``, as from
-    ``kernels``): a regular pair by PLANE (``_plane_integrals``), any other by ``_integrate`` (the full
-    blocks, the entries a flat pattern drops checked into dropped[0] (H), dropped[1] (G), then
-    compacted). Returns the kernel evaluations. Packs as ``_integrate``'s."""
+    ``kernels``): a regular pair by PLANE (``_plane_integrals``; with ``want_u`` and not ``want_p`` Uc
+    alone, Pc left as it is), any other by ``_integrate`` (the full blocks, the entries a flat pattern
+    drops checked into dropped[0] (H), dropped[1] (G), then compacted; Pc always). Returns the kernel
+    evaluations. Packs as ``_integrate``'s."""
     codes, pattern, plane = kern
     hp, hq, gp, gq_, hkeep, gkeep = pattern
     mH, mG = hp.shape[0], gp.shape[0]
     if codes[0] == PLANE and sing < 0:
-        return _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG)
+        return _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG, want_p)
     Ub, Pb, _, _, Pc, Uc = bufs
     nl = hi - lo + 1
     nev = _integrate(xc, X, sing, ns, lo, hi, want_u, phys, quad, bufs)
@@ -839,8 +842,10 @@ def integrate_batch(meta, pts, VX, L, phys, quad, kern, dropped):
     """Integrals of the listed pairs (meta, points as from enumerate_pairs) of lags up to L, the
     patterns' entries (the others checked into ``dropped``, ``_check_dropped``), by the kernels of
     ``kern`` (``kernels``; its plane geometry for quad.ns_base subdivisions): (offsets (m + 1,) into
-    the P pool, P pool, offsets (m + 1,) into the U pool (only records with want_u take room), U pool,
-    kernel evaluations); a lag slot takes 9 m doubles (``_compact``)."""
+    the P pool, P pool, offsets (m + 1,) into the U pool, U pool, kernel evaluations); a lag slot takes
+    9 m doubles (``_compact``). meta[r, 4] (want_u) 0: H alone, 1: H and G, 2: G alone (the records of 1 and
+    2 take room in the U pool, those of 0 and 1 in the P pool; a regular pair of the plane alone forms no H
+    integrals for a record of 2, ``_pair_integrals``)."""
     pattern = kern[1]
     sP, sU = 9 * pattern[0].shape[0], 9 * pattern[2].shape[0]
     m = meta.shape[0]
@@ -848,8 +853,8 @@ def integrate_batch(meta, pts, VX, L, phys, quad, kern, dropped):
     uoff = np.zeros(m + 1, np.int64)
     for r in range(m):
         nl = meta[r, 1] - meta[r, 0] + 1
-        off[r + 1] = off[r] + nl * sP
-        uoff[r + 1] = uoff[r] + (nl * sU if meta[r, 4] == 1 else 0)
+        off[r + 1] = off[r] + (nl * sP if meta[r, 4] != 2 else 0)
+        uoff[r + 1] = uoff[r] + (nl * sU if meta[r, 4] >= 1 else 0)
     P = np.zeros(off[m])
     U = np.zeros(uoff[m])
     bufs = buffers(L, sP, sU)
@@ -859,10 +864,12 @@ def integrate_batch(meta, pts, VX, L, phys, quad, kern, dropped):
         lo, hi = meta[r, 0], meta[r, 1]
         nl = hi - lo + 1
         v = meta[r, 5]
-        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], lo, hi, meta[r, 4] == 1, phys, quad, kern,
-                               bufs, dropped)
-        P[off[r]:off[r] + nl * sP] = Pc[:nl * sP]
-        if meta[r, 4] == 1:
+        want_u, want_p = meta[r, 4] >= 1, meta[r, 4] != 2
+        nev += _pair_integrals(pts[r], v, VX[v], meta[r, 2], meta[r, 3], lo, hi, want_u, phys, quad, kern,
+                               bufs, dropped, want_p)
+        if want_p:
+            P[off[r]:off[r] + nl * sP] = Pc[:nl * sP]
+        if want_u:
             U[uoff[r]:uoff[r] + nl * sU] = Uc[:nl * sU]
     return off, P, uoff, U, nev
 

@@ -114,12 +114,12 @@ def _ptensor(g, n, gn, r, A, B, dA, dB, lam, mu, out):
 
 
 @njit(cache=True, inline="always")
-def _time_samples(S2, S1, r, ir, plo, phi, phys, want_u):
+def _time_samples(S2, S1, r, ir, plo, phi, phys, want_u, want_p=True):
     """At a point at distance r (ir = 1 / r), rows j - (plo - 2) of S2 = (A, B, dA, dB) of the
-    twice-integrated response at the kernel times T = j dt + toff, j = plo - 2 .. phi (zero for T <= 0),
-    and with ``want_u`` of S1 = (A, B) of the once-integrated one: the samples whose differences are the
-    lags plo..phi (``integrate_pair``, ``integrate_plane``). ``phys``: the material and the step
-    (``packs.wave``)."""
+    twice-integrated response at the kernel times T = j dt + toff, j = plo - 2 .. phi (zero for T <= 0;
+    not formed without ``want_p``), and with ``want_u`` of S1 = (A, B) of the once-integrated one: the
+    samples whose differences are the lags plo..phi (``integrate_pair``, ``integrate_plane``). ``phys``:
+    the material and the step (``packs.wave``)."""
     dt, toff, alpha, beta = phys[DT], phys[TOFF], phys[CP], phys[CS]
     ia = 1.0 / alpha
     ib = 1.0 / beta
@@ -130,8 +130,9 @@ def _time_samples(S2, S1, r, ir, plo, phi, phys, want_u):
             S2[jj, 0] = 0.0; S2[jj, 1] = 0.0; S2[jj, 2] = 0.0; S2[jj, 3] = 0.0
             S1[jj, 0] = 0.0; S1[jj, 1] = 0.0
         else:
-            a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
-            S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
+            if want_p:
+                a2, b2, da2, db2 = ab2_fast(r, ir, t, ia, ib)
+                S2[jj, 0] = a2; S2[jj, 1] = b2; S2[jj, 2] = da2; S2[jj, 3] = db2
             if want_u:
                 a1, b1 = ab1(r, t, alpha, beta)
                 S1[jj, 0] = a1; S1[jj, 1] = b1
@@ -477,13 +478,43 @@ def _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, pt_geo, mat, Nk, want_u):
     return phi - plo + 1
 
 
+@njit(cache=True, inline="always")
+def _plane_lags_u(Uf, S1, plo, phi, lo, pt_geo, s4, Nk):
+    """``_plane_lags``' U alone (``integrate_plane`` without ``want_p``: no twice-integrated samples), the same
+    values bit for bit. ``_plane_lags`` skips a lag whose twice-integrated differences are all exactly zero;
+    inside the wave window plo..phi every lag's three kernel times overlap the time between the P and S
+    arrivals, where that response is not linear, so it does not happen (tests/bem/test_plane_kernel.py compares
+    the two bit for bit); here a lag with nothing to add is skipped.
+    Returns the evaluations."""
+    g0, g1, nz, r, w = pt_geo
+    for l in range(plo, phi + 1):
+        jj = l - (plo - 2)
+        A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
+        B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
+        if A1 == 0.0 and B1 == 0.0:
+            continue
+        li = l - lo
+        u0 = (B1 * g0 * g0 + A1) * w
+        u1 = B1 * g0 * g1 * w
+        u2 = B1 * g1 * g0 * w
+        u3 = (B1 * g1 * g1 + A1) * w
+        u4 = A1 * w
+        b = li * 45
+        for c in range(9):
+            Nc = Nk[c]
+            acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
+            Uf[b + 5 * c + 4] += u4 * Nc
+    return phi - plo + 1
+
+
 @njit(cache=True)
-def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u):
+def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u, want_p=True):
     """``integrate_pair`` of a regular pair (``sing`` < 0) whose collocation point xc and element lie in
     the plane z = 0, the element given by ``plane_points`` (sub, pts, Ntab; ng2 Gauss points a
     subdivision), ``phys`` the material and the step (``packs.wave``). Accumulates lags lo..hi into
     P[l - lo, node, j] (the entries of bsr's flat H pattern: (x,z), (y,z), (z,x), (z,y)) and, with
-    ``want_u``, U[l - lo, node, j] (flat G: (x,x), (x,y), (y,x), (y,y), (z,z)); the caller zeroes them
+    ``want_u``, U[l - lo, node, j] (flat G: (x,x), (x,y), (y,x), (y,y), (z,z)); without ``want_p`` (and
+    with ``want_u``) U alone, P untouched: the H kernels are not formed (``_plane_lags_u``); the caller zeroes them
     (C-contiguous: P (>= nl, 9, 4), U (>= nl, 9, 5), updated four entries at a time by ``simd.acc4``).
     Returns the kernel evaluations.
 
@@ -519,7 +550,11 @@ def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u):
             phi = min(shi, int(math.floor((r * ib - toff) / dt)) + 2)
             if plo > phi:
                 continue
-            _time_samples(S2, S1, r, ir, plo, phi, phys, want_u)
-            nev += _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, (g0 * ir, g1 * ir, pts[k, 3], r, pts[k, 2]), mat,
-                               Ntab[k], want_u)
+            geo = (g0 * ir, g1 * ir, pts[k, 3], r, pts[k, 2])
+            if want_p or not want_u:
+                _time_samples(S2, S1, r, ir, plo, phi, phys, want_u)
+                nev += _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, geo, mat, Ntab[k], want_u)
+            else:
+                _time_samples(S2, S1, r, ir, plo, phi, phys, True, False)
+                nev += _plane_lags_u(Uf, S1, plo, phi, lo, geo, s4, Ntab[k])
     return nev

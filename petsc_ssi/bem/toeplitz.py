@@ -512,7 +512,7 @@ class ToeplitzHistory:
         meta, keep = _windows(pts, X[0], c0, R0, h0, reach, mat.cp, mat.cs, dt, L, lag_lo, toff, SING_TOL,
                               int(o["subdivisions"]), int(o["max_subdivisions"]), float(o["near_factor"]), c_lo, c_hi)
         meta, pts, idx = meta[keep], pts[keep], np.asarray(sel)[keep]
-        meta[:, 4] = 1 if self.side == "p" else 0            # (want_u: the G integrals too)
+        meta[:, 4] = 2 if self.side == "p" else 0            # (want_u: 2 the G integrals alone, 0 the H ones)
         if not hasattr(self, "_plane") or self._plane is None:
             self._plane = plane(ls.in_plane, X, int(o["subdivisions"]), gq, gw, int(o["max_subdivisions"]))
         dropped = np.zeros(2)

@@ -4,7 +4,7 @@ geometry of each element's Gauss points computed once by plane_points) against t
 (bsr.PATTERNS: H's 4, G's 5), and the general kernel's other entries exactly zero, on distorted
 nine-node elements (curved, skewed, either orientation), collocation points near and far, the
 near pairs' extra subdivisions, a kernel time between lags (the interpolating matrices) and with
-and without the displacement kernel. The assembly path that chooses between them is run whole in
+and without the displacement kernel, and the displacement kernel alone (want_p False). The assembly path that chooses between them is run whole in
 tests/bem/test_flat_pattern.py (the flat pattern against -ssi_lag_pattern full)."""
 import numpy as np
 import pytest
@@ -66,6 +66,12 @@ def test_plane_kernel_equals_the_general_kernel_bit_for_bit(want_u, toff):
             assert np.abs(U).max() > 0
             assert np.array_equal(U, Ub[:, :, gp, gqi])
             assert not Ub[:, :, ~keepG].any()
+            # G alone (want_p False: the area loads' and the toeplitz G side's integrals): the same U, P not touched
+            P2, U2 = np.full((L, 9, 4), 7.0), np.zeros((L, 9, 5))
+            n_u = integrate_plane(xc, sub, pts, Ntab, 4, lo, hi, wave(DT, CP, CS, RHO, NU, toff), P2, U2, True, False)
+            assert n_u == n_pl
+            assert np.array_equal(U2, U)
+            assert (P2 == 7.0).all()
         else:
             assert not U.any()
         checked += 1
