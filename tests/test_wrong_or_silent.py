@@ -371,3 +371,27 @@ def test_post_receivers_csv_writes_the_quantity_asked_to_the_file_named(tmp_path
     assert np.isclose(float(rows[0]["ax"]), data["acceleration"][0, 0, 0], rtol=1e-8)
     r = cli(["post", path, "--receivers", "--csv"])
     assert r.stdout.splitlines()[0] == "receiver,x,y,z,t,ux,uy,uz"
+
+
+# ------------------------------------------------------------ PETSc refuses a solver option
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_a_solver_option_petsc_refuses_is_one_line(tmp_path, n):
+    """-ssi_bem_mat_mumps_icntl_7 1 (MUMPS's user-given ordering, which PETSc's MUMPS interface refuses)
+    stopped the run at the step matrix's factorisation with a Python traceback, PETSc's own message only
+    in the stack printed at exit (lost under MPI_Abort). Now one line from each rank that met it, with where and PETSc's
+    message, no traceback, a non-zero exit (MPI_Abort on more ranks: PETSc may raise on some ranks only)."""
+    r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_bem_mat_mumps_icntl_7", "1"], nranks=n, check=False,
+            timeout=120)
+    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    # (each rank prints its line; under MPI_Abort mpirun may drop a rank's last output, so at least one)
+    assert r.returncode != 0 and 1 <= len(errs) <= n and len(set(errs)) == 1, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "Traceback" not in r.stderr, r.stderr
+    assert errs[0] == ("petsc-ssi: error: PETSc stopped with error code 63 in petsc_ssi/bem/march.py:"
+                       f"{errs[0].split('march.py:')[1].split(' ')[0]} (_factorise) at MatSetFromOptions_MUMPS(): "
+                       "Argument out of range; Valid values are 0=AMD, 2=AMF, 3=Scotch, 4=PORD, 5=Metis, 6=QAMD, and "
+                       "7=auto (-ssi_debug for the traceback)"), errs[0]
+    if n == 1:                  # -ssi_debug: the traceback as before
+        r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_bem_mat_mumps_icntl_7", "1", "-ssi_debug"],
+                check=False, timeout=120)
+        assert r.returncode != 0 and "Traceback" in r.stderr and "petsc-ssi: error:" not in r.stdout

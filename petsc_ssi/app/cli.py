@@ -249,15 +249,46 @@ def main(argv=None):
             import time
             time.sleep(0.3)
         return 2
-    except Exception:  # a bug or an I/O failure on some ranks only: never hang mpirun
+    except Exception as exc:  # a bug or an I/O failure on some ranks only: never hang mpirun
         import traceback
-        traceback.print_exc()
+        from ..petsc import debug
+        if type(exc).__module__.startswith("petsc4py") and not debug():
+            # PETSc stopped (an option's value it refuses, a failed solver set-up, ...): one line with where and
+            # PETSc's own message, on each rank that met it (maybe not all of them: then Abort)
+            print(f"petsc-ssi: error: PETSc stopped with error code {getattr(exc, 'ierr', '?')} in "
+                  f"{_where(exc)}{_petsc_message(exc)} (-ssi_debug for the traceback)", flush=True)
+        else:
+            traceback.print_exc()
         sys.stderr.flush()
         comm = PETSc.COMM_WORLD.tompi4py()
         if comm.Get_size() > 1:
             comm.Abort(1)
         return 1
     return 0
+
+
+def _petsc_message(exc):
+    """': <PETSc function>: <its messages>' of a petsc4py error (its ``_traceback_``: the call stack's
+    'F() at file:line' entries, then the message lines), '' without one."""
+    tb = [str(t).strip() for t in (getattr(exc, "_traceback_", None) or [])]
+    calls = [t for t in tb if "() at " in t]
+    msgs = [t for t in tb if t and "() at " not in t]
+    if not msgs:
+        return ""
+    at = f" at {calls[-1].split(' at ')[0]}" if calls else ""
+    return f"{at}: {'; '.join(msgs)}"
+
+
+def _where(exc):
+    """'module path:line (function)' of the innermost petsc_ssi frame of an exception's traceback."""
+    import os
+    import traceback
+    pkg = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if os.path.abspath(f.filename).startswith(pkg + os.sep)]
+    if not frames:
+        return "petsc-ssi"
+    f = frames[-1]
+    return f"{os.path.relpath(os.path.abspath(f.filename), os.path.dirname(pkg))}:{f.lineno} ({f.name})"
 
 
 if __name__ == "__main__":
