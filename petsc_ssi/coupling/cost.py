@@ -17,7 +17,8 @@ assembles it). What the coupling adds is counted here, in three parts:
                nodes and the region's LU (c_fac N_Z^1.5) is added. (Until 2026-11-29 it also priced 3 n_I products with Z's
                local rows, which the set-up does not make: 45 s of the uniform 72 m building's 68 s.)
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products
-               (Z's local rows: 2 (3 N_Z / p) (3 n_I) flops, and, implicit, D^-1 T^T's: 2 (n_fem / p)
+               (Z's local rows: 2 (3 N_Z / p) m_Z flops, m_Z = 3 n_I, or the solved columns where the others
+               are mirror images: the step reads those alone, ``columns.MirroredZ``; and, implicit, D^-1 T^T's: 2 (n_fem / p)
                (3 n_I); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
                residual (a product with the step matrix, and H_s's kept interface columns times the
                interface change: part of c_cstep), the contact law and
@@ -81,7 +82,8 @@ class CoupledCounts:
             col_s, fac_s = bem_solve_seconds(k, self.NZ, p), k.get("c_fac", 0.0) * self.NZ ** 1.5
         setup = self.fem_setup_s + fac_s + k["r_mms"] * (self.n_solved * col_s + (n * self.fem_solve_s if self.implicit else 0.0)) \
             + 2.0 / 3.0 * n ** 3 / k["r_cpl"]
-        per_step = step_seconds(c, self.nI, self.NZ, p, self.fem_solve_s, self.n_fem if self.implicit else 0)
+        per_step = step_seconds(c, self.nI, self.NZ, p, self.fem_solve_s, self.n_fem if self.implicit else 0,
+                                self.n_solved)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
                 "cpl_bytes": self._iface_bytes(p) + self.fem_bytes * p / max(self.ranks_measured, 1)}
 
@@ -105,15 +107,18 @@ def solve_seconds(integ, comm, n_solves=5):
     return float(mpi.bcast(statistics.median(times)))        # (rank 0's: every rank predicts the same)
 
 
-def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0):
+def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0, n_zcols=None):
     """Seconds the coupling adds to each step on p ranks (module docstring, 'per step'): n_fs solves with
-    D, the dense interface products at r_cpl flop/s (Z's local rows; ``n_fem`` > 0, the implicit step:
-    D^-1 T^T's) and c_cstep; ``c``: the constants (FALLBACK where they have none). ``petsc-ssi estimate``
-    and the coupled run's own prediction both use it."""
+    D, the dense interface products at r_cpl flop/s (Z's local rows, ``n_zcols`` of its columns kept, 3 n_i
+    by default: on a mirror-symmetric region the representatives', ``columns.MirroredZ``, whose one pass
+    over them serves every image; ``n_fem`` > 0, the implicit step: D^-1 T^T's) and c_cstep; ``c``: the
+    constants (FALLBACK where they have none). ``petsc-ssi estimate`` and the coupled run's own prediction
+    both use it."""
     k = dict(FALLBACK)
     k.update(c or {})
     n = 3 * n_i
-    flops = 2.0 * (3.0 * n_soil / p) * n + 2.0 * (n_fem / p) * n
+    nz = n if n_zcols is None else n_zcols
+    flops = 2.0 * (3.0 * n_soil / p) * nz + 2.0 * (n_fem / p) * n
     return k["n_fs"] * fem_solve_s + (flops + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
 
 

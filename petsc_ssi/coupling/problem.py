@@ -110,11 +110,12 @@ class SSITransient(TransientProblem):
             from .cost import solve_seconds, step_seconds
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
-            from .columns import estimated_region_nodes
+            from .columns import estimated_region_nodes, estimated_solved_columns
             self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
                                              estimated_region_nodes(cfg, prob, self.iface.be_nodes), comm.getSize(),
                                              self.fem_solve_s,
-                                             self.model.dofmap.size if cfg.coupling == "implicit" else 0)
+                                             self.model.dofmap.size if cfg.coupling == "implicit" else 0,
+                                             estimated_solved_columns(cfg, prob, self.iface.be_nodes))
         self.print_loop_line()
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)

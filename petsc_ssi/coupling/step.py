@@ -167,8 +167,11 @@ class Coupler:
         ev = event("SSI_Capacitance")
         ev.begin()
         t0 = time.perf_counter()
+        self.Zmir = None
         self.Zrows, self.Zloc = self._bem_columns()
         self.Z_II = self._gather_rows(self.Zloc, self.own_k, self._zpos(self.own_loc))
+        if self.Zmir is not None:       # the steps' products from the representatives' columns: every column dropped
+            self.Zloc = None
         self.preload = contact_preload(cfg, comm, model, iface)
         self.law = ContactLaw(iface.n_b, iface.zero, cfg.contact, cfg.contact_cohesion, cfg.contact_tol,
                               cfg.contact_max_iter, cfg.contact_open_traction, comm=comm.tompi4py(),
@@ -202,7 +205,7 @@ class Coupler:
         """Bytes of the dense interface matrices this rank holds (Z's and D^-1 T^T's local rows,
         Z_II, M3, C), and H_s's sparse interface columns (HsI)."""
         n = 3 * self.nI
-        b = self.Zloc.nbytes + self.Z_II.nbytes + self.M3.nbytes
+        b = (self.Zloc.nbytes if self.Zmir is None else self.Zmir.nbytes) + self.Z_II.nbytes + self.M3.nbytes
         H = self.HsI
         if H is not None:
             b += H.data.nbytes + H.indices.nbytes + H.indptr.nbytes
@@ -259,7 +262,7 @@ class Coupler:
             got = region_columns(self.cfg, m, self.prob, np.asarray(self.iface.be_nodes), cols, 3 * self.nI,
                                  full_block)
             if got is not None:
-                rows, Z, line = got
+                rows, Z, line, self.Zmir = got
                 printf(line)
             else:
                 parts.clear()
@@ -288,8 +291,15 @@ class Coupler:
         return pos
 
     def subtract_Z(self, x, d, O=None):
-        """x -= Z d (this rank's rows of the soil's step solution; ``O``: Z's columns d stands for, all if
-        None): on Z's rows only (``Zrows``, the region around the interface, or every row)."""
+        """Collective: x -= Z d (this rank's rows of the soil's step solution; ``O``: Z's columns d stands for,
+        all if None): on Z's rows only (``Zrows``, the region around the interface, or every row); from the
+        representatives' columns where the region's columns are mirror images (``columns.MirroredZ``)."""
+        if self.Zmir is not None:
+            full = d if O is None else np.zeros(3 * self.nI)
+            if O is not None:
+                full[O] = d
+            x[self.Zrows] -= self.Zmir.product(full)
+            return
         Zc = self.Zloc if O is None else self.Zloc[:, O]
         if self.Zrows is None:
             x -= Zc @ d
