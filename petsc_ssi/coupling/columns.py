@@ -241,6 +241,7 @@ class RegionColumns:
             return None
         r0, r1 = AR.getOwnershipRange()
         R = {g: signed_permutation(self.PETSc, self.comm, maps[g], signs[g], r0, r1) for g in range(1, len(maps))}
+        self.planes = [(int(axis), float(c)) for axis, c, _ in refl]
         return reps, images, R
 
     def _images_hold(self, orb, cols, rhs, tmpl, bmax):
@@ -360,6 +361,7 @@ def region_columns(cfg, march, prob, nodes_I, cols, n_cols, rhs, log=printf):
             mz = None
             if reg.orbits is not None:
                 mz = MirroredZ(reg.Z, *reg.orbits)
+                mz.planes = reg.planes
                 reg.orbits = None
             return reg.rows, reg.Z, line, mz
         if reg.orbits is not None:
@@ -410,6 +412,8 @@ class MirroredZ:
     copied; ``rep_cols``: their columns in Z; ``images[r]``: [(g, column, sign)]; ``R``: {g: R_g}."""
 
     def __init__(self, Z, rep_cols, images, R):
+        self.rep_cols, self.images = np.asarray(rep_cols, np.int64), images
+        self.planes = []            # the group's generators [(axis, c)], x_axis = c (``structure_reflections``)
         self.gs = sorted(R)
         self.R = [R[g] for g in self.gs]
         self.Zr = np.ascontiguousarray(Z[:, rep_cols])
@@ -454,6 +458,53 @@ class MirroredZ:
         self.vin = self.vout = None
 
 
+def structure_reflections(planes, coords, dofmap, comm, tol=1e-9):
+    """Collective: {g: R_g} of the mirror group the planes x_axis = c generate (``bem.mirror.group``'s order of g:
+    the generators' products in binary order) as signed permutations of the structure's DOFs (PETSc Mats on the
+    dof map's owned rows), or a reason (str) where the structure's nodes (``coords``) do not map onto nodes with
+    the same DOFs. A reflection about x_a = c moves a node's translations with the sign -1 on a, its rotations
+    (a pseudovector: det R R w) with -1 on the other two axes, and a released rotation triple as the first."""
+    from scipy.spatial import cKDTree
+    PETSc = init()
+    X = np.asarray(coords, float)
+    n = len(X)
+    if not planes or n == 0:
+        return "no mirror planes"
+    ext = float(np.ptp(X, axis=0).max()) or 1.0
+    tree = cKDTree(X)
+    gens = []
+    for axis, c in planes:
+        Y = X.copy()
+        Y[:, axis] = 2.0 * c - Y[:, axis]
+        d, j = tree.query(Y)
+        if d.max() > tol * ext or not np.array_equal(j[j], np.arange(n)):
+            return f"the structure is not symmetric about {'xy'[axis]} = {c:.6g} m"
+        if not (np.array_equal(dofmap.ndof[j], dofmap.ndof) and np.array_equal(dofmap.released[j], dofmap.released)):
+            return f"the structure's DOFs are not symmetric about {'xy'[axis]} = {c:.6g} m"
+        sign = np.ones(9)
+        sign[axis] = -1.0                              # translations
+        sign[[3 + k for k in range(3) if k != axis]] = -1.0       # rotations (pseudovector)
+        sign[6:9] = sign[3:6]                          # the released triple
+        gens.append((j.astype(np.int64), sign))
+    node = np.repeat(np.arange(n), dofmap.ndof)        # (every DOF's node and its index within the node)
+    local = np.arange(dofmap.size) - dofmap.offset[node]
+    r0, r1 = dofmap.r0, dofmap.r1
+    out = {}
+    for bits in range(1, 1 << len(gens)):
+        m = np.arange(n)
+        sg = np.ones(9)
+        for i, (j, sign) in enumerate(gens):
+            if bits >> i & 1:
+                m = j[m]
+                sg = sg * sign
+        d = np.arange(r0, r1)
+        cols = dofmap.offset[m[node[d]]] + local[d]
+        out[bits] = PETSc.Mat().createAIJ(size=((r1 - r0, dofmap.size), (r1 - r0, dofmap.size)), comm=comm,
+                                          csr=(np.arange(r1 - r0 + 1).astype(PETSc.IntType),
+                                               cols.astype(PETSc.IntType), sg[local[d]].astype(float)))
+    return out
+
+
 def orbit_representatives(maps, nodes_I, where):
     """(reps, img) of the interface nodes under the node maps ``maps`` (|G|, n) of a mirror group
     (``bem.mirror.group``) on the nodes ``where`` numbers (``where[node]``: its index in the maps, -1 outside):
@@ -476,21 +527,42 @@ def estimated_solved_columns(cfg, prob, be_nodes):
     orbit's representative's only, the others their images), before it runs: 3 n_I, or 3 x the orbits'
     representatives on the region of ``estimated_region_nodes`` when the surface (``bem.mirror.blocks_of``)
     and the region mirror and -ssi_step_mirror allows (the commutation assumed, as the estimate's blocks)."""
+    return estimated_orbits(cfg, prob, be_nodes)[0]
+
+
+def estimated_orbits(cfg, prob, be_nodes):
+    """(the interface columns solved, ``estimated_solved_columns``; the mirror planes [(axis, c)] of the region, []
+    where every column is solved)."""
     n = 3 * len(be_nodes)
     inside = _first_region(cfg, prob, be_nodes)
     if str(cfg.get("step_mirror", "auto")).lower() == "off" or inside is None:
-        return n
+        return n, []
     from ..bem.mirror import blocks_of, group, surface_reflections
     if blocks_of(prob) == 1:
-        return n
+        return n, []
     nodes = np.flatnonzero(inside)
     refl = surface_reflections(prob, nodes)
     if not refl:
-        return n
+        return n, []
     where = -np.ones(prob.mesh.n_nodes, np.int64)
     where[nodes] = np.arange(nodes.size)
     got = orbit_representatives(group(refl)[0], be_nodes, where)
-    return n if got is None else 3 * got[0].size
+    return (n, []) if got is None else (3 * got[0].size, [(int(a), float(c)) for a, c, _ in refl])
+
+
+def estimated_fem_solved_columns(cfg, prob, be_nodes, model, comm):
+    """Collective: the structure's interface columns the run solves (implicit coupling, ``Coupler.fem_columns``):
+    the soil's count (``estimated_solved_columns``) where the structure mirrors about the same planes
+    (``structure_reflections``; the checks on its columns assumed to pass), else 3 n_I."""
+    n_solved, planes = estimated_orbits(cfg, prob, be_nodes)
+    if not planes:
+        return 3 * len(be_nodes)
+    got = structure_reflections(planes, model.mesh.coords, model.dofmap, comm)
+    if isinstance(got, str):
+        return 3 * len(be_nodes)
+    for R in got.values():
+        R.destroy()
+    return n_solved
 
 
 def estimated_region_nodes(cfg, prob, be_nodes):

@@ -11,7 +11,8 @@ assembles it). What the coupling adds is counted here, in three parts:
   set-up       solve of the factors (petsc.solve_columns; on a mirror-symmetric region the orbits'
                representatives' only, ``columns.estimated_solved_columns``): a column costs r_mms times one BEM step
                solve (bem.cost.bem_solve_seconds, the BEM model's solve) and, implicit, r_mms times
-               one solve with D (t_fs); plus the bonded interface system's LU (2/3 (3 n_I)^3 flops,
+               one solve with D (t_fs; the representatives' only where the structure mirrors too,
+               ``columns.estimated_fem_solved_columns``); plus the bonded interface system's LU (2/3 (3 n_I)^3 flops,
                replicated) at r_cpl flop/s. On a region around the interface (coupling/columns.py,
                N_Z of the N soil nodes, ``estimated_region_nodes``) the BEM solve is the model's for N_Z
                nodes and the region's LU (c_fac N_Z^1.5) is added. (Until 2026-11-29 it also priced 3 n_I products with Z's
@@ -19,7 +20,7 @@ assembles it). What the coupling adds is counted here, in three parts:
   per step     n_fs solves with D (2: predictor and corrector), the dense interface products
                (Z's local rows: 2 (3 N_Z / p) m_Z flops, m_Z = 3 n_I, or the solved columns where the others
                are mirror images: the step reads those alone, ``columns.MirroredZ``; and, implicit, D^-1 T^T's: 2 (n_fem / p)
-               (3 n_I); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
+               m_D, m_D likewise where the structure mirrors too); M3 and Z_II: 2 (3 n_I)^2 each, replicated) at r_cpl flop/s, the step's BEM
                residual (a product with the step matrix, and H_s's kept interface columns times the
                interface change: part of c_cstep), the contact law and
                the step's bookkeeping c_cstep
@@ -52,10 +53,12 @@ class CoupledCounts:
         from ..fem.integrators import make_model_integrator
         mpi = comm.tompi4py()
         self.nI, self.N, self.steps = iface.n, prob.mesh.n_nodes, prob.n_steps
-        from .columns import estimated_region_nodes, estimated_solved_columns
+        from .columns import estimated_region_nodes, estimated_solved_columns, estimated_fem_solved_columns
         self.NZ = estimated_region_nodes(cfg, prob, iface.be_nodes)     # Z's rows: the region's nodes
         self.n_solved = estimated_solved_columns(cfg, prob, iface.be_nodes)   # (the others: mirror images)
         self.implicit = cfg.coupling == "implicit"
+        self.n_fem_solved = (estimated_fem_solved_columns(cfg, prob, iface.be_nodes, model, comm) if self.implicit
+                             else 3 * self.nI)
         self.n_fem = model.dofmap.size
         self.ranks_measured = comm.getSize()
         r0 = process_rss()
@@ -80,10 +83,11 @@ class CoupledCounts:
         if self.NZ < self.N and "c_sol_nlogn" in k:      # the columns on the region: its own LU and solves
             from ..bem.cost import bem_solve_seconds
             col_s, fac_s = bem_solve_seconds(k, self.NZ, p), k.get("c_fac", 0.0) * self.NZ ** 1.5
-        setup = self.fem_setup_s + fac_s + k["r_mms"] * (self.n_solved * col_s + (n * self.fem_solve_s if self.implicit else 0.0)) \
+        setup = self.fem_setup_s + fac_s + k["r_mms"] * (self.n_solved * col_s
+                                                         + (self.n_fem_solved * self.fem_solve_s if self.implicit else 0.0)) \
             + 2.0 / 3.0 * n ** 3 / k["r_cpl"]
         per_step = step_seconds(c, self.nI, self.NZ, p, self.fem_solve_s, self.n_fem if self.implicit else 0,
-                                self.n_solved)
+                                self.n_solved, self.n_fem_solved)
         return {"cpl_setup": setup, "cpl_loop": self.steps * per_step, "cpl_per_step": per_step,
                 "cpl_bytes": self._iface_bytes(p) + self.fem_bytes * p / max(self.ranks_measured, 1)}
 
@@ -107,24 +111,30 @@ def solve_seconds(integ, comm, n_solves=5):
     return float(mpi.bcast(statistics.median(times)))        # (rank 0's: every rank predicts the same)
 
 
-def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0, n_zcols=None):
+def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0, n_zcols=None, n_dcols=None):
     """Seconds the coupling adds to each step on p ranks (module docstring, 'per step'): n_fs solves with
     D, the dense interface products at r_cpl flop/s (Z's local rows, ``n_zcols`` of its columns kept, 3 n_i
     by default: on a mirror-symmetric region the representatives', ``columns.MirroredZ``, whose one pass
-    over them serves every image; ``n_fem`` > 0, the implicit step: D^-1 T^T's) and c_cstep; ``c``: the
+    over them serves every image; ``n_fem`` > 0, the implicit step: D^-1 T^T's, ``n_dcols`` of its columns
+    kept likewise) and c_cstep; ``c``: the
     constants (FALLBACK where they have none). ``petsc-ssi estimate`` and the coupled run's own prediction
     both use it."""
     k = dict(FALLBACK)
     k.update(c or {})
     n = 3 * n_i
     nz = n if n_zcols is None else n_zcols
-    flops = 2.0 * (3.0 * n_soil / p) * nz + 2.0 * (n_fem / p) * n
+    nd = n if n_dcols is None else n_dcols
+    flops = 2.0 * (3.0 * n_soil / p) * nz + 2.0 * (n_fem / p) * nd
     return k["n_fs"] * fem_solve_s + (flops + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
 
 
 def describe(cc):
     """One line of what the coupling's counts are."""
-    solved = "" if cc.n_solved == 3 * cc.nI else f", {cc.n_solved} solved, the others mirror images"
+    n = 3 * cc.nI
+    nf = getattr(cc, "n_fem_solved", n) if cc.implicit else cc.n_solved
+    solved = ("" if cc.n_solved == n and nf == n else
+              f", {cc.n_solved} solved, the others mirror images" if nf == cc.n_solved else
+              f", {cc.n_solved} soil and {nf} structure columns solved, the others mirror images")
     return (f"[ssi]   coupling: {cc.nI} interface nodes ({3 * cc.nI} columns{solved}), structure {cc.n_fem} dofs: "
             f"factorised in {cc.fem_setup_s:.3g} s, a solve {cc.fem_solve_s * 1e3:.3g} ms (measured on "
             f"{cc.ranks_measured} rank(s)), {'implicit' if cc.implicit else 'staggered'} coupling")

@@ -110,20 +110,26 @@ class SSITransient(TransientProblem):
             from .cost import solve_seconds, step_seconds
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
-            from .columns import estimated_region_nodes, estimated_solved_columns
+            from .columns import estimated_region_nodes, estimated_solved_columns, estimated_fem_solved_columns
+            imp = cfg.coupling == "implicit"
             self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
                                              estimated_region_nodes(cfg, prob, self.iface.be_nodes), comm.getSize(),
-                                             self.fem_solve_s,
-                                             self.model.dofmap.size if cfg.coupling == "implicit" else 0,
-                                             estimated_solved_columns(cfg, prob, self.iface.be_nodes))
+                                             self.fem_solve_s, self.model.dofmap.size if imp else 0,
+                                             estimated_solved_columns(cfg, prob, self.iface.be_nodes),
+                                             estimated_fem_solved_columns(cfg, prob, self.iface.be_nodes, self.model,
+                                                                          comm) if imp else None)
         self.print_loop_line()
         with staged("SSI BEM assembly"):
             self.march, self.info = build_marcher(cfg, comm, prob, self.plan, self.ls, None, prob.known_p(), self.log)
             self.coupler = Coupler(cfg, comm, prob, self.march, self.iface, self.integ, self.model)
+            cp, n = self.coupler, 3 * self.iface.n
+            nb = n if cp.Zmir is None else len(cp.Zmir.rep_cols)
+            nf = n if getattr(cp, "DEmir", None) is None else len(cp.DEmir.rep_cols)
+            fem = cfg.coupling == "implicit"
             printf(f"[ssi] interface matrices ({cfg.coupling} coupling, structure integrated by "
-                   f"{self.integrator}): {3 * self.iface.n} BEM"
-                   + (" and FEM" if cfg.coupling == "implicit" else "")
-                   + f" solves in {fmt_time(self.coupler.t_capacitance)} "
+                   f"{self.integrator}): {nb} BEM" + (f" and {nf} FEM" if fem else "") + " solves"
+                   + (f" (of {n} columns, the others mirror images)" if min(nb, nf if fem else nb) < n else "")
+                   + f" in {fmt_time(cp.t_capacitance)} "
                    f"(BEM step matrix factorised once in {fmt_time(self.march.t_factor)})")
         self.fn = self.model.load_vec()
         self.load_source = NodalLoad(self.model.load_vec(), self.hist)      # F a(t) (sources/nodal.py)

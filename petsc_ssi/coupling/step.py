@@ -46,6 +46,11 @@ from ..monitor import event
 from .interface import force_matrix, InterfaceOperator, interface_offsets
 from .contact import Capacitance, ContactLaw, StaggeredSolve, ImplicitSolve
 
+# a structure's mirrored interface column against the same column solved (``Coupler._fem_images_hold``), over its
+# largest entry: two solutions of the same equations by the structure's LU, apart by its round-off
+FEM_IMAGE_TOL = 1e-9
+
+
 class StaggeredStep:
     """The paper's staggered step (Table 2): FEM predictor (Green's-function integrator), the BEM
     with every interface node closed at u_b = u_f, the active-set corrections through the
@@ -93,7 +98,9 @@ class ImplicitStep:
 
     def __init__(self, cp):
         self.cp = cp
-        cp.DEloc, C = cp.fem_columns()
+        cp.DEloc, C, cp.DEmir = cp.fem_columns()
+        if cp.DEmir is not None:        # the steps' products from the representatives' columns
+            cp.DEloc = None
         self.solver = ImplicitSolve(cp.law, cp.Z_II, 2.0 * C, cp.M3, 1.0)   # midpoint: u = w + D^-1 (2 f)
         self.solver.lu(cp.law.closed)                                       # the bonded LU, now
 
@@ -121,7 +128,8 @@ class ImplicitStep:
 
     def finish(self, f_ext, fI, res):
         cp = self.cp
-        cp.du.getArray()[:] = cp.DEloc @ (2.0 * fI)                 # D^{-1} (2 f_I), midpoint form
+        cp.du.getArray()[:] = (cp.DEloc @ (2.0 * fI) if cp.DEmir is None           # D^{-1} (2 f_I), midpoint form
+                               else cp.DEmir.product(2.0 * fI))
         cp.integ.complete(cp.du)
         res["uf_check"] = cp.Top.gather(cp.integ.u)
 
@@ -210,7 +218,7 @@ class Coupler:
         if H is not None:
             b += H.data.nbytes + H.indices.nbytes + H.indptr.nbytes
         if hasattr(self, "DEloc"):
-            b += self.DEloc.nbytes + 8 * n * n
+            b += (self.DEloc.nbytes if self.DEloc is not None else self.DEmir.nbytes) + 8 * n * n
         return b
 
     def _gather_rows(self, loc, own_k, own_loc):
@@ -309,7 +317,12 @@ class Coupler:
     def fem_columns(self):
         """D^{-1} T^T e_j (local rows) and C = T D^{-1} T^T (replicated) for the interface
         dofs j (3 n_I right-hand sides, solved many at a time; T^T e_j masked: a fixed dof takes
-        no interface force)."""
+        no interface force), and a ``columns.MirroredZ`` of them or None: where the soil's columns are mirror
+        images (``Zmir``) and the structure mirrors about the same planes (``columns.structure_reflections``),
+        only the representatives' columns are solved and the others mirrored, D^{-1} T^T e_(g(k), c) =
+        s_g(c) R_g D^{-1} T^T e_(k, c), after checking every image's right-hand side against its representative's
+        mirrored and one solved image column of each reflection against its mirrored one (``_fem_images_hold``;
+        every column solved otherwise, said in one line)."""
         integ = self.integ
         out = np.zeros((integ.u.getLocalSize(), 3 * self.nI))
         C = np.zeros((3 * self.nI, 3 * self.nI))
@@ -325,8 +338,106 @@ class Coupler:
             integ.complete_solve(z)                  # (modal damping: the solve with D, not its factors')
             out[:, j] = z.getArray(readonly=True)
             C[:, j] = self.Top.gather(z)
+        R = self._fem_reflections()
+        if R is not None and self._fem_rhs_hold(R, fill):
+            mz = self.Zmir
+            y = integ.u.duplicate()
+
+            def take_rep(r, z):
+                j = int(mz.rep_cols[r])
+                take(j, z)
+                for g, i, sgn in mz.images[r]:
+                    R[g].mult(z, y)
+                    y.scale(sgn)
+                    out[:, i] = y.getArray(readonly=True)
+                    C[:, i] = self.Top.gather(y)
+            solve_columns(integ.ksp, integ.u, len(mz.rep_cols), lambda r, e: fill(int(mz.rep_cols[r]), e), take_rep)
+            y.destroy()
+            if self._fem_images_hold(R, fill, out):
+                from .columns import MirroredZ
+                return out, C, MirroredZ(out, mz.rep_cols, mz.images, R)
+        if R is not None:
+            for o in R.values():
+                o.destroy()
+        out[:] = 0.0
         solve_columns(integ.ksp, integ.u, 3 * self.nI, fill, take)
-        return out, C
+        return out, C, None
+
+    def _fem_reflections(self):
+        """Collective: the structure's {g: R_g} about the soil's mirror planes where the soil's interface columns
+        are mirror images (``Zmir``), else None (a line says why where the soil's are but the structure's are not)."""
+        if self.Zmir is None or not self.Zmir.planes:
+            return None
+        covered = np.zeros(3 * self.nI, bool)           # (every interface DOF a representative or an image)
+        covered[self.Zmir.rep_cols] = True
+        covered[[i for lst in self.Zmir.images for _, i, _ in lst]] = True
+        if not covered.all():
+            return None
+        from .columns import structure_reflections
+        got = structure_reflections(self.Zmir.planes, self.model.mesh.coords, self.model.dofmap, self.comm)
+        if isinstance(got, str):
+            printf(f"[ssi] interface columns: the structure's all solved ({got})")
+            return None
+        return got
+
+    def _fem_rhs_hold(self, R, fill):
+        """Collective: whether every image column's right-hand side T^T e_i (masked) is its representative's
+        mirrored, s R_g T^T e_r, to ``columns.MIRROR_TOL`` of its largest entry; else a line, the Mats destroyed."""
+        from .columns import MIRROR_TOL
+        mz = self.Zmir
+        b, br, y = self.integ.u.duplicate(), self.integ.u.duplicate(), self.integ.u.duplicate()
+        worst = 0.0
+        for r, lst in enumerate(mz.images):
+            fill(int(mz.rep_cols[r]), br)
+            for g, i, sgn in lst:
+                fill(i, b)
+                R[g].mult(br, y)
+                y.scale(sgn)
+                size = b.norm(self.PETSc.NormType.INFINITY)
+                y.axpy(-1.0, b)
+                worst = max(worst, y.norm(self.PETSc.NormType.INFINITY) / max(size, 1e-300))
+        for v in (b, br, y):
+            v.destroy()
+        if not worst <= MIRROR_TOL:
+            printf(f"[ssi] interface columns: the structure's all solved (an image's load differs from its "
+                   f"representative's mirrored by {worst:.3g} > {MIRROR_TOL:g} of its size)")
+            for o in R.values():
+                o.destroy()
+            return False
+        return True
+
+    def _fem_images_hold(self, R, fill, out):
+        """Collective: whether the first image column of each reflection, solved, equals its mirrored column in
+        ``out`` to ``FEM_IMAGE_TOL`` of its largest entry (two solutions of the same equations: the LU's
+        round-off apart); else a line (every column is then solved)."""
+        from mpi4py import MPI
+        mz, integ = self.Zmir, self.integ
+        first = {}
+        for lst in mz.images:
+            for g, i, _ in lst:
+                first.setdefault(g, i)
+        b, z = integ.u.duplicate(), integ.u.duplicate()
+        worst = 0.0
+        mpi = self.comm.tompi4py()
+        for g in sorted(first):
+            i = first[g]
+            fill(i, b)
+            integ.ksp.solve(b, z)
+            integ.complete_solve(z)
+            a = z.getArray(readonly=True)
+            diff = mpi.allreduce(float(np.abs(a - out[:, i]).max()) if a.size else 0.0, op=MPI.MAX)
+            size = mpi.allreduce(float(np.abs(a).max()) if a.size else 0.0, op=MPI.MAX)
+            worst = max(worst, diff / max(size, 1e-300))
+        for v in (b, z):
+            v.destroy()
+        if not worst <= FEM_IMAGE_TOL:
+            printf(f"[ssi] interface columns: the structure's all solved (a mirrored column differs from the solved "
+                   f"one by {worst:.3g} > {FEM_IMAGE_TOL:g} of its size)")
+            for o in R.values():
+                o.destroy()
+            return False
+        self.fem_image_check = worst
+        return True
 
     def step(self, f_ext, uffI=None, pffI=None):
         """Collective: one coupled step; ``uffI``: the free-field displacement of the interface

@@ -193,3 +193,42 @@ def test_mirror_images_in_the_staggered_step_with_lift_off(tmp_path):
     S = scales(A)
     for k in ("interface/p", "interface/ub", "interface/uf"):
         assert np.abs(A[k][:first] - B[k][:first]).max() <= 1e-12 * S[k], k
+
+
+def test_a_building_of_frames_and_shells_mirrors_its_columns(tmp_path):
+    """The CI building of frames and shells (tests/coupling/test_building_ci.py: a shell foundation slab, four
+    columns, a roof slab; rotations at every node) centred on a 28 m grid under an off-centre soil load: the
+    structure's columns D^-1 T^T e_j are mirror images too (their rotations mirrored as a pseudovector:
+    columns.structure_reflections), 27 of 75 solved on each side; at -n 2 the run equals the one with every
+    column solved (-ssi_step_mirror off) to 1e-12 of each field's scale."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from test_building_ci import building_msh, structure_opts, soil_opts
+    msh = building_msh(str(tmp_path / "b.msh"))
+    case = (["-ssi_problem", "ssi"] + soil_opts(size="28,28", t_end=0.05) + structure_opts(msh)
+            + ["-ssi_lag_store", "toeplitz", "-ssi_contact", "bonded", "-ssi_receivers", "0,0,0;3,0,0",
+               "-ssi_output_stride", "5"])
+    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
+    out0 = cli(case + ["-ssi_output", ref, "-ssi_step_mirror", "off"]).stdout
+    assert "mirror images" not in out0
+    out = cli(case + ["-ssi_output", got], nranks=2).stdout
+    line = [x for x in out.splitlines() if "interface matrices" in x][0]
+    assert "27 BEM and 27 FEM solves (of 75 columns, the others mirror images)" in line, out[-3000:]
+    same(ref, got)
+
+
+def test_a_structure_column_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
+    """Where a mirrored structure column is not the solved one to FEM_IMAGE_TOL (forced here: a negative bound),
+    every structure column is solved, said in one line, and the run is the same."""
+    from helpers import run_ssi
+    from petsc_ssi.coupling import step
+    opts = dict(zip((a[len("-ssi_"):] for a in BIG[0::2]), BIG[1::2]))
+    opts.update(contact="bonded", t_end="0.1")
+    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
+    run_ssi(**opts, output=ref)
+    assert "27 BEM and 27 FEM solves" in capfd.readouterr().out
+    monkeypatch.setattr(step, "FEM_IMAGE_TOL", -1.0)
+    run_ssi(**opts, output=got)
+    out = capfd.readouterr().out
+    assert "the structure's all solved (a mirrored column differs from the solved one by" in out, out[-2000:]
+    assert "27 BEM and 75 FEM solves (of 75 columns, the others mirror images)" in out, out[-2000:]
+    same(ref, got)
