@@ -320,9 +320,11 @@ class Coupler:
         no interface force), and a ``columns.MirroredZ`` of them or None: where the soil's columns are mirror
         images (``Zmir``) and the structure mirrors about the same planes (``columns.structure_reflections``),
         only the representatives' columns are solved and the others mirrored, D^{-1} T^T e_(g(k), c) =
-        s_g(c) R_g D^{-1} T^T e_(k, c), after checking every image's right-hand side against its representative's
-        mirrored and one solved image column of each reflection against its mirrored one (``_fem_images_hold``;
-        every column solved otherwise, said in one line)."""
+        s_g(c) R_g D^{-1} T^T e_(k, c), after checking that D commutes with the reflections
+        (``columns.commutation_defect``, to ``columns.MIRROR_TOL``), every image's right-hand side against its
+        representative's mirrored and one solved image column of each reflection against its mirrored one
+        (``_fem_images_hold``: the modal damping's correction too; every column solved otherwise, said in one
+        line)."""
         integ = self.integ
         out = np.zeros((integ.u.getLocalSize(), 3 * self.nI))
         C = np.zeros((3 * self.nI, 3 * self.nI))
@@ -377,6 +379,14 @@ class Coupler:
         got = structure_reflections(self.Zmir.planes, self.model.mesh.coords, self.model.dofmap, self.comm)
         if isinstance(got, str):
             printf(f"[ssi] interface columns: the structure's all solved ({got})")
+            return None
+        from .columns import commutation_defect, MIRROR_TOL
+        defect = commutation_defect(self.integ.ksp.getOperators()[0], got)    # (D: its members, masses, supports)
+        if not defect <= MIRROR_TOL:
+            printf(f"[ssi] interface columns: the structure's all solved (its matrix D commutes with the reflections "
+                   f"only to {defect:.3g} > {MIRROR_TOL:g})")
+            for o in got.values():
+                o.destroy()
             return None
         return got
 

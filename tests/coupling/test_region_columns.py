@@ -177,8 +177,9 @@ def test_mirror_images_in_the_staggered_step_with_lift_off(tmp_path):
     """The staggered step (-ssi_coupling staggered) corrects the soil by the open nodes' columns alone,
     x -= Z[:, O] delta_O, which the mirror images form from the representatives' columns (columns.MirroredZ, a
     subset O of the columns): with unilateral contact (it lifts off) the run equals the one whose columns are all
-    solved and kept (-ssi_step_mirror off) to 1e-12 of each field's scale until contact's first change of status,
-    to 1e-9 after it (the lift-off amplifies round-off: the module docstring)."""
+    solved and kept (-ssi_step_mirror off) to 1e-9 of each field's scale (the correction acts from the first open
+    node on, where the lift-off amplifies round-off: the module docstring), and to 1e-12 before it (the step
+    solves and the interface algebra)."""
     stag = BIG + ["-ssi_coupling", "staggered", "-ssi_t_end", "0.3"]
     ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
     cli(stag + ["-ssi_output", ref, "-ssi_step_mirror", "off"])
@@ -217,8 +218,9 @@ def test_a_building_of_frames_and_shells_mirrors_its_columns(tmp_path):
 
 
 def test_a_structure_column_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
-    """Where a mirrored structure column is not the solved one to FEM_IMAGE_TOL (forced here: a negative bound),
-    every structure column is solved, said in one line, and the run is the same."""
+    """Where a mirrored structure column is not the solved one to FEM_IMAGE_TOL (forced here: a negative bound), or
+    the structure's matrix does not commute with the reflections (forced), every structure column is solved, said in
+    one line, and the run is the same."""
     from helpers import run_ssi
     from petsc_ssi.coupling import step
     opts = dict(zip((a[len("-ssi_"):] for a in BIG[0::2]), BIG[1::2]))
@@ -231,4 +233,12 @@ def test_a_structure_column_off_its_mirror_solves_every_column(tmp_path, monkeyp
     out = capfd.readouterr().out
     assert "the structure's all solved (a mirrored column differs from the solved one by" in out, out[-2000:]
     assert "27 BEM and 75 FEM solves (of 75 columns, the others mirror images)" in out, out[-2000:]
+    same(ref, got)
+    # a structure whose matrix does not commute with the reflections (forced: the check's defect made 1)
+    monkeypatch.undo()
+    from petsc_ssi.coupling import columns
+    monkeypatch.setattr(columns, "commutation_defect", lambda A, R: 1.0)
+    run_ssi(**opts, output=got)
+    out = capfd.readouterr().out
+    assert "the structure's all solved (its matrix D commutes with the reflections only to 1 > 1e-12)" in out, out
     same(ref, got)
