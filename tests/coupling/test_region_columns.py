@@ -196,16 +196,19 @@ def test_mirror_images_in_the_staggered_step_with_lift_off(tmp_path):
         assert np.abs(A[k][:first] - B[k][:first]).max() <= 1e-12 * S[k], k
 
 
-def test_a_building_of_frames_and_shells_mirrors_its_columns(tmp_path):
+@pytest.mark.parametrize("release", [False, True])
+def test_a_building_of_frames_and_shells_mirrors_its_columns(tmp_path, release):
     """The CI building of frames and shells (tests/coupling/test_building_ci.py: a shell foundation slab, four
     columns, a roof slab; rotations at every node) centred on a 28 m grid under an off-centre soil load: the
     structure's columns D^-1 T^T e_j are mirror images too (their rotations mirrored as a pseudovector:
     columns.structure_reflections), 27 of 75 solved on each side; at -n 2 the run equals the one with every
-    column solved (-ssi_step_mirror off) to 1e-12 of each field's scale."""
+    column solved (-ssi_step_mirror off) to 1e-12 of each field's scale. With the roof hinged to the columns
+    (-ssi_fem_part_roof_release rotations) its corner nodes carry a second rotation triple, mirrored as the first."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from test_building_ci import building_msh, structure_opts, soil_opts
     msh = building_msh(str(tmp_path / "b.msh"))
     case = (["-ssi_problem", "ssi"] + soil_opts(size="28,28", t_end=0.05) + structure_opts(msh)
+            + (["-ssi_fem_part_roof_release", "rotations"] if release else [])
             + ["-ssi_lag_store", "toeplitz", "-ssi_contact", "bonded", "-ssi_receivers", "0,0,0;3,0,0",
                "-ssi_output_stride", "5"])
     ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
@@ -240,5 +243,5 @@ def test_a_structure_column_off_its_mirror_solves_every_column(tmp_path, monkeyp
     monkeypatch.setattr(columns, "commutation_defect", lambda A, R: 1.0)
     run_ssi(**opts, output=got)
     out = capfd.readouterr().out
-    assert "the structure's all solved (its matrix D commutes with the reflections only to 1 > 1e-12)" in out, out
+    assert "the structure's all solved (its matrix D commutes with the reflections only to 1 > 1e-10)" in out, out
     same(ref, got)
