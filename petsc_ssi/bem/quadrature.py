@@ -463,19 +463,24 @@ def _plane_lags(Pf, Uf, S2, S1, plo, phi, lo, pt_geo, mat, Nk, want_u):
         for c in range(9):
             acc4(Pf, b + 4 * c, v0, v1, v2, v3, Nk[c])
         if want_u:
-            A1 = (S1[jj, 0] - S1[jj - 1, 0]) * s4
-            B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
-            u0 = (B1 * g0 * g0 + A1) * w
-            u1 = B1 * g0 * g1 * w
-            u2 = B1 * g1 * g0 * w
-            u3 = (B1 * g1 * g1 + A1) * w
-            u4 = A1 * w
-            b = li * 45
-            for c in range(9):
-                Nc = Nk[c]
-                acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
-                Uf[b + 5 * c + 4] += u4 * Nc
+            _plane_u(Uf, li, (S1[jj, 0] - S1[jj - 1, 0]) * s4, (S1[jj, 1] - S1[jj - 1, 1]) * s4, g0, g1, w, Nk)
     return phi - plo + 1
+
+
+@njit(cache=True, inline="always")
+def _plane_u(Uf, li, A1, B1, g0, g1, w, Nk):
+    """U[li, c, 0:5] += the flat G pattern's (xx, xy, yx, yy, zz) of the displacement tensor B1 g_a g_b + A1 d_ab
+    times w N_c (``_plane_lags``, ``_plane_lags_u``)."""
+    u0 = (B1 * g0 * g0 + A1) * w
+    u1 = B1 * g0 * g1 * w
+    u2 = B1 * g1 * g0 * w
+    u3 = (B1 * g1 * g1 + A1) * w
+    u4 = A1 * w
+    b = li * 45
+    for c in range(9):
+        Nc = Nk[c]
+        acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
+        Uf[b + 5 * c + 4] += u4 * Nc
 
 
 @njit(cache=True, inline="always")
@@ -493,17 +498,7 @@ def _plane_lags_u(Uf, S1, plo, phi, lo, pt_geo, s4, Nk):
         B1 = (S1[jj, 1] - S1[jj - 1, 1]) * s4
         if A1 == 0.0 and B1 == 0.0:
             continue
-        li = l - lo
-        u0 = (B1 * g0 * g0 + A1) * w
-        u1 = B1 * g0 * g1 * w
-        u2 = B1 * g1 * g0 * w
-        u3 = (B1 * g1 * g1 + A1) * w
-        u4 = A1 * w
-        b = li * 45
-        for c in range(9):
-            Nc = Nk[c]
-            acc4(Uf, b + 5 * c, u0, u1, u2, u3, Nc)
-            Uf[b + 5 * c + 4] += u4 * Nc
+        _plane_u(Uf, l - lo, A1, B1, g0, g1, w, Nk)
     return phi - plo + 1
 
 

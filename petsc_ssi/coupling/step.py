@@ -56,6 +56,15 @@ FEM_IMAGE_TOL = 1e-9
 FEM_COMMUTE_TOL = 1e-10
 
 
+def _all_solved(R, why):
+    """One line: the structure's interface columns all solved (``Coupler.fem_columns``), and why; R's Mats
+    destroyed. Returns None (false)."""
+    printf(f"[ssi] interface columns: the structure's all solved ({why})")
+    for o in R.values():
+        o.destroy()
+    return None
+
+
 class StaggeredStep:
     """The paper's staggered step (Table 2): FEM predictor (Green's-function integrator), the BEM
     with every interface node closed at u_b = u_f, the active-set corrections through the
@@ -388,11 +397,8 @@ class Coupler:
         from .columns import commutation_defect
         defect = commutation_defect(self.integ.ksp.getOperators()[0], got)    # (D: its members, masses, supports)
         if not defect <= FEM_COMMUTE_TOL:
-            printf(f"[ssi] interface columns: the structure's all solved (its matrix D commutes with the reflections "
-                   f"only to {defect:.3g} > {FEM_COMMUTE_TOL:g})")
-            for o in got.values():
-                o.destroy()
-            return None
+            return _all_solved(got, f"its matrix D commutes with the reflections only to {defect:.3g} > "
+                                    f"{FEM_COMMUTE_TOL:g}")
         return got
 
     def _fem_rhs_hold(self, R, fill):
@@ -414,11 +420,8 @@ class Coupler:
         for v in (b, br, y):
             v.destroy()
         if not worst <= MIRROR_TOL:
-            printf(f"[ssi] interface columns: the structure's all solved (an image's load differs from its "
-                   f"representative's mirrored by {worst:.3g} > {MIRROR_TOL:g} of its size)")
-            for o in R.values():
-                o.destroy()
-            return False
+            return _all_solved(R, f"an image's load differs from its representative's mirrored by {worst:.3g} > "
+                                  f"{MIRROR_TOL:g} of its size")
         return True
 
     def _fem_images_hold(self, R, fill, out):
@@ -446,11 +449,8 @@ class Coupler:
         for v in (b, z):
             v.destroy()
         if not worst <= FEM_IMAGE_TOL:
-            printf(f"[ssi] interface columns: the structure's all solved (a mirrored column differs from the solved "
-                   f"one by {worst:.3g} > {FEM_IMAGE_TOL:g} of its size)")
-            for o in R.values():
-                o.destroy()
-            return False
+            return _all_solved(R, f"a mirrored column differs from the solved one by {worst:.3g} > "
+                                  f"{FEM_IMAGE_TOL:g} of its size")
         self.fem_image_check = worst
         return True
 
