@@ -95,21 +95,45 @@ def test_mirror_image_columns_equal_the_solved_ones(tmp_path):
     same(ref, got)
 
 
-def test_an_image_right_hand_side_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
-    """Where an image column's right-hand side is not its representative's mirrored to MIRROR_TOL (forced here:
-    a negative bound), every column is solved, said in one line, and the run is the same."""
+def _bonded_reference(tmp_path, capfd):
+    """The in-process fallback tests' case (BIG bonded, 0.1 s): (options, the reference run's file, its log)."""
     from helpers import run_ssi
-    from petsc_ssi.coupling import columns
     opts = dict(zip((a[len("-ssi_"):] for a in BIG[0::2]), BIG[1::2]))
     opts.update(contact="bonded", t_end="0.1")
-    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
+    ref = str(tmp_path / "ref.h5")
     run_ssi(**opts, output=ref)
-    assert "27 of 75 columns solved" in capfd.readouterr().out
+    return opts, ref, capfd.readouterr().out
+
+
+def test_an_image_right_hand_side_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
+    """Where an image column's right-hand side is not its representative's mirrored to MIRROR_TOL (forced here:
+    a negative bound), every column is solved, said in one line, and the run is the same. Likewise on the
+    structure's side: where a mirrored structure column is not the solved one to FEM_IMAGE_TOL (forced), or the
+    structure's matrix does not commute with the reflections (forced), every structure column is solved."""
+    from helpers import run_ssi
+    from petsc_ssi.coupling import columns, step
+    opts, ref, out = _bonded_reference(tmp_path, capfd)
+    assert "27 of 75 columns solved" in out and "27 BEM and 27 FEM solves" in out
+    got = str(tmp_path / "got.h5")
     monkeypatch.setattr(columns, "MIRROR_TOL", -1.0)
     run_ssi(**opts, output=got)
     out = capfd.readouterr().out
     assert "differs from its mirrored representative's by" in out and "every column solved" in out, out[-2000:]
     assert "columns solved, the others" not in out
+    same(ref, got)
+    monkeypatch.undo()
+    monkeypatch.setattr(step, "FEM_IMAGE_TOL", -1.0)
+    run_ssi(**opts, output=got)
+    out = capfd.readouterr().out
+    assert "the structure's all solved (a mirrored column differs from the solved one by" in out, out[-2000:]
+    assert "27 BEM and 75 FEM solves (of 75 columns, the others mirror images)" in out, out[-2000:]
+    same(ref, got)
+    # a structure whose matrix does not commute with the reflections (forced: the check's defect made 1)
+    monkeypatch.undo()
+    monkeypatch.setattr(columns, "commutation_defect", lambda A, R: 1.0)
+    run_ssi(**opts, output=got)
+    out = capfd.readouterr().out
+    assert "the structure's all solved (its matrix D commutes with the reflections only to 1 > 1e-10)" in out, out
     same(ref, got)
 
 
@@ -218,31 +242,4 @@ def test_a_building_of_frames_and_shells_mirrors_its_columns(tmp_path, release):
     out = cli(case + ["-ssi_output", got], nranks=2).stdout
     line = [x for x in out.splitlines() if "interface matrices" in x][0]
     assert "27 BEM and 27 FEM solves (of 75 columns, the others mirror images)" in line, out[-3000:]
-    same(ref, got)
-
-
-def test_a_structure_column_off_its_mirror_solves_every_column(tmp_path, monkeypatch, capfd):
-    """Where a mirrored structure column is not the solved one to FEM_IMAGE_TOL (forced here: a negative bound), or
-    the structure's matrix does not commute with the reflections (forced), every structure column is solved, said in
-    one line, and the run is the same."""
-    from helpers import run_ssi
-    from petsc_ssi.coupling import step
-    opts = dict(zip((a[len("-ssi_"):] for a in BIG[0::2]), BIG[1::2]))
-    opts.update(contact="bonded", t_end="0.1")
-    ref, got = str(tmp_path / "ref.h5"), str(tmp_path / "got.h5")
-    run_ssi(**opts, output=ref)
-    assert "27 BEM and 27 FEM solves" in capfd.readouterr().out
-    monkeypatch.setattr(step, "FEM_IMAGE_TOL", -1.0)
-    run_ssi(**opts, output=got)
-    out = capfd.readouterr().out
-    assert "the structure's all solved (a mirrored column differs from the solved one by" in out, out[-2000:]
-    assert "27 BEM and 75 FEM solves (of 75 columns, the others mirror images)" in out, out[-2000:]
-    same(ref, got)
-    # a structure whose matrix does not commute with the reflections (forced: the check's defect made 1)
-    monkeypatch.undo()
-    from petsc_ssi.coupling import columns
-    monkeypatch.setattr(columns, "commutation_defect", lambda A, R: 1.0)
-    run_ssi(**opts, output=got)
-    out = capfd.readouterr().out
-    assert "the structure's all solved (its matrix D commutes with the reflections only to 1 > 1e-10)" in out, out
     same(ref, got)
