@@ -152,7 +152,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     a uniform grid, in the mirror-symmetric blocks the run would use, ``mirror.blocks_of``); the assembly of
     lags 1-2 (seconds on the 72 m building) is not modelled."""
     from ..bem.halfspace import HalfSpace
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of
     from ..bem.lagset import load_kernels
     from ..sysmem import process_rss
     from ..petsc import SSIError
@@ -213,7 +213,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                         f"{rho:.3g} node spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1
                                                       else "") + "; toeplitz.step_lu)")
     for p in ranks:
-        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * N, g, plan=plan,
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
         b += ab
         cpl = ""
@@ -240,7 +240,7 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     and the surface is a uniform flat grid (else the reason, one line)."""
     if cfg.get("lag_store", "dense") == "dense":
         return []
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of
     from ..petsc import SSIError
     try:
         if not cnt.lagset.flat:
@@ -254,7 +254,7 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
            "beside the processes"]
     g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
     for p in ranks:
-        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, g,
+        b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single")
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")

@@ -260,7 +260,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     kernels on the window of the traction elements (``toeplitz.traction_grid``). With -ssi_lags_load the step
     matrix, lags 1-2 and the kernels are read back from a file a toeplitz run saved (on any number of ranks)
     (``lagstore``), nothing assembled or integrated."""
-    from .toeplitz import ToeplitzHistory, traction_grid
+    from .toeplitz import ToeplitzHistory, traction_grid, block_of
     k = plan.k if plan.active else 0
     zero = symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h)
     if cfg.get("lags_load"):
@@ -278,7 +278,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
         grids.append(("p", glat))
     with event("SSI_BEM_Toeplitz"):
         for side, lat in grids:
-            march.toeplitz.append(ToeplitzHistory(comm, ls, lat, log, block=int(cfg.history_block) or 8, side=side,
+            march.toeplitz.append(ToeplitzHistory(comm, ls, lat, log, block=block_of(cfg), side=side,
                                                   precision=cfg.get("toeplitz_precision", "double"))
                                   .build(march, plan, monitor=cfg.monitor,
                                          kernels=None if kern is None else {n.split(":")[1]: a for n, a in

@@ -637,14 +637,14 @@ class HalfSpace:
         """Collective: (bytes over the ranks, the node's limit, this node's share, (kernels' seconds, history's
         seconds, the processes' bytes)) of a toeplitz run with ``plan`` (``toeplitz.estimate``, with the
         processes' resident size and ``extra_bytes``)."""
-        from .toeplitz import estimate, kernel_offsets, traction_grid
+        from .toeplitz import estimate, kernel_offsets, traction_grid, block_of
         from mpi4py import MPI
         c = self.cfg
         lat = lat if lat is not None else self.lattice
         limit = c.memory_limit * 1e9 if c.memory_limit > 0 else 0.8 * machine_memory()
         lat.n_offsets = len(kernel_offsets(lat))
         p = self.comm.getSize()
-        block = int(c.history_block) or 8
+        block = block_of(c)
         g = self.toeplitz_side_bytes(ls, plan)
         est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g, plan=plan,
                                         stabilized=c.scheme.startswith("stabili"), glat=traction_grid(lat, ls.VT),

@@ -298,3 +298,36 @@ def unpack_sums(full, n9, out):
             out[t, 0, f] = full[f, xy0 + 2 * t]
             out[t, 1, f] = full[f, xy0 + 2 * t + 1]
             out[t, 2, f] = full[f, z0 + t]
+
+
+@njit(cache=True, boundscheck=False)
+def add_spectra(K, r0, src, sel, idx, c):
+    """K[g, r0 + r, j, p, q] += sum_t c[t] src[sel[t], idx[r, j], f], the terms t added one after the other (part
+    p: the real part, and for a complex K the imaginary one) at f = g FW + q < slab; K (G, rows, columns, 1 or 2,
+    FW) float64, src (slots, sources, slab) complex128 or float64, sel (terms,) int64 its slots, c (terms,)
+    float64: the lags' kernel spectra that one row block of a kernel weighs, added into its lanes in one pass
+    (``toeplitz``'s kernels: ``to_lanes`` of the blocks ``idx`` picks, times c[t], added term by term, without the
+    copies and with one read and write of the row block; the padding lanes are not touched). The same
+    operations as ``for t: K[:, r0:r0 + n] += c[t] * to_lanes(src[sel[t]][idx].T)``, so the same bits."""
+    nt, slab = sel.shape[0], src.shape[2]
+    kp, fw = K.shape[3], K.shape[4]
+    a = np.empty(fw)
+    for g in range(K.shape[0]):
+        f0 = g * fw
+        q1 = min(fw, slab - f0)
+        for r in range(idx.shape[0]):
+            for j in range(idx.shape[1]):
+                s = idx[r, j]
+                for p in range(kp):
+                    for q in range(q1):
+                        a[q] = K[g, r0 + r, j, p, q]
+                    for t in range(nt):
+                        ct, st = c[t], sel[t]
+                        if p == 0:
+                            for q in range(q1):
+                                a[q] += ct * src[st, s, f0 + q].real
+                        else:
+                            for q in range(q1):
+                                a[q] += ct * src[st, s, f0 + q].imag
+                    for q in range(q1):
+                        K[g, r0 + r, j, p, q] = a[q]

@@ -57,7 +57,8 @@ register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), spa
          choices=("auto", "dense", "sparse"))
 register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "
          "sums formed together, one matrix-panel product per stored matrix (1: step by step, the reference; 0: "
-         "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes)", "bem",
+         "automatic: the size that minimises a modelled time per step, from the stored matrices' bytes; 16 on the "
+         "toeplitz store)", "bem",
          validator=lambda v: None if 0 <= v <= 32 else "must be in [0, 32]")
 register("step_mirror", "enum", "auto", "", "auto: where the soil surface, its prescribed-displacement and traction "
          "nodes mirror about x = c and/or y = c (c the mesh's mid-point) and the step matrix commutes with the "

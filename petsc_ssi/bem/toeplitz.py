@@ -53,7 +53,7 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
-from .lanes import (FW, n_groups, padded, to_lanes, to_lanes_real, history_lanes, interp_lanes, interp_flops,
+from .lanes import (FW, n_groups, padded, add_spectra, history_lanes, interp_lanes, interp_flops,
                     scatter_slots, put_state, take_step, unpack_sums, CHUNK_GROUPS)
 
 # the nine node positions of an element relative to its centre, in half element sizes
@@ -237,6 +237,20 @@ def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
+# the toeplitz store's steps a block (-ssi_history_block 0): a block reads each kernel once for its b steps, and the
+# products are bound by the kernels' bytes at b = 8 (runs/pekeris/README.md, roofline). The 72 m building's run
+# (jobscripts/building_uniform.sh, uniform-72-area-exact, EXTRA="-ssi_history_block b", 2026-12-01 07:40): the
+# blocks' products 17.4, 11.7 and 9.3 s at b = 8, 16 and 32, the steps' own products 7.2, 8.9 and 11.0 s (a step
+# reads the states of its block that the block's pass did not), the history sum 27.9, 23.9 and 23.4 s; the peak
+# 6.17, 6.46, 6.67 GB (``kept_rows``' slack grows with b); the paper's quarter model's peak unchanged (1.42 GB)
+BLOCK = 16
+
+
+def block_of(cfg):
+    """The toeplitz store's steps a block: -ssi_history_block, or ``BLOCK`` with 0 (automatic)."""
+    return int(cfg.get("history_block") or 0) or BLOCK
+
+
 def chunk_bytes(kernel_bytes):
     """Bytes of real kernels a rank integrates and transforms at a time: a twentieth of the side's stored
     kernels on this rank (``kernel_bytes``), between 8 MB and ``CHUNK_BYTES``. The build's transients (the
@@ -247,7 +261,7 @@ def chunk_bytes(kernel_bytes):
     return float(min(CHUNK_BYTES, max(8e6, kernel_bytes / 20.0)))
 
 
-def interp_work(plan, n_steps, block=8, stabilized=True):
+def interp_work(plan, n_steps, block=BLOCK, stabilized=True):
     """(steps whose history reads an interpolating matrix, summed (anchors x states) of the weighted states
     over the run's blocks in products anchor by anchor, the same in products over all anchors' common span)
     of ``ToeplitzHistory`` with ``plan`` (``_spans`` on the weights of each block: the code's own choice;
@@ -282,7 +296,7 @@ def interp_work(plan, n_steps, block=8, stabilized=True):
     return steps, work, span
 
 
-def estimate(lat, L, n_steps, ranks=1, block=8, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
+def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
              glat=None, single=False):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
@@ -473,7 +487,7 @@ class ToeplitzHistory:
     kept states' transforms in ``precision`` (double, or single: half their memory, the products still in
     double)."""
 
-    def __init__(self, comm, ls, lat, log=printf, block=8, side="u", precision="double"):
+    def __init__(self, comm, ls, lat, log=printf, block=BLOCK, side="u", precision="double"):
         self.comm, self.ls, self.lat, self.log = comm, ls, lat, log
         self.side, self.spec = side, SIDES[side]
         self.vdtype = PRECISIONS[precision]
@@ -692,21 +706,39 @@ class ToeplitzHistory:
                 setattr(self, n, np.ascontiguousarray(kernels[n], dtype=np.float64))
             exact, plan_k = [], 0
         if exact:
+            # per time distance d its lags' weights, in lag order: a row block is written once, when its last lag's
+            # spectra are made (the stabilised scheme weighs each lag into about three distances); a lag's spectra
+            # stay in a ring of slots until the last distance that weighs it is written
+            into = {}
+            for lag in exact:
+                for d, c in by_key[("x", lag)]:
+                    into.setdefault(d, []).append((lag, float(c)))
+            last = {}
+            for d, v in into.items():
+                last.setdefault(v[-1][0], []).append(d)
+            ring = 1 + max(v[-1][0] - v[0][0] for v in into.values())
+            src = None
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
-                terms = by_key.get(("x", lag), ())
-                if terms:
-                    L9, L18 = self._lanes(S)
-                    for d, c in terms:
-                        self.K9[:, 9 * (D - d):9 * (D - d + 1)] += c * L9
-                        self.K18[:, 18 * (D - d):18 * (D - d + 1)] += c * L18
+                if ("x", lag) not in by_key:
+                    continue
+                if src is None:
+                    src = np.empty((ring,) + self._source_shape(S), np.float64 if self.real else np.complex128)
+                self._source(S, out=src[lag % ring])
+                for d in sorted(last.get(lag, ())):
+                    sel = np.array([l_ % ring for l_, _ in into[d]], np.int64)
+                    c = np.array([c for _, c in into[d]])
+                    add_spectra(self.K9, 9 * (D - d), src, sel, self._idx[0], c)
+                    add_spectra(self.K18, 18 * (D - d), src, sel, self._idx[1], c)
+            src = None
         for i in range(plan_k):
             if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
-                L9, L18 = self._lanes(S)
-                self.A9[:, 9 * i:9 * (i + 1)] += L9
-                self.A18[:, 18 * i:18 * (i + 1)] += L18
+                src = self._source(S)[None]
+                one = (np.zeros(1, np.int64), np.ones(1))
+                add_spectra(self.A9, 9 * i, src, one[0], self._idx[0], one[1])
+                add_spectra(self.A18, 18 * i, src, one[0], self._idx[1], one[1])
 
     def _rotation(self, sign, whole=False):
         """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab (or the whole spectrum),
@@ -723,18 +755,31 @@ class ToeplitzHistory:
             out[t] = np.exp(sign * 1j * psi)
         return out
 
-    def _lanes(self, S):
-        """(K9, K18) lanes of one lag's spectra S (4 classes, 9 slots, m entries, slab): complex (``to_lanes`` of
-        ``_kernel_blocks``), or on a point-symmetric grid real from the slots 0..4 only (S (4, 5, m, slab)): with
+    def _source_shape(self, S):
+        """The shape of ``_source``'s rows x slab for spectra S."""
+        return (4 * 9 * S.shape[2], S.shape[-1])
+
+    def _source(self, S, out=None):
+        """One lag's spectra S (4 classes, 9 slots, m entries, slab) as the rows (class, slot, entry) x slab that
+        ``lanes.add_spectra`` adds into the kernels' lanes by ``_idx`` (``_kernel_blocks``' rows and columns):
+        complex, or on a point-symmetric grid real from the slots 0..4 only (S (4, 5, m, slab)): with
         h = exp(i psi_t) (``_rotation``) and the sign s of the point reflection (``point_sign``), the pair
         (a, 8 - a), a < 4, has h (K_a + s K_{8-a}) / 2 = Re(h K_a) and h (K_a - s K_{8-a}) / 2 = i Im(h K_a)
-        (s K_{8-a} = exp(-2 i psi_t) conj(K_a)): rows 2 a and 2 a + 1 are the real and the imaginary part of
-        h K_a, row 8 the centre's h K_4, real part (s = 1) or imaginary (s = -1); the centre's other part is zero
-        by the symmetry (its largest kept in ``dropped``, checked after the build: the phases' and signs' check)."""
+        (s K_{8-a} = exp(-2 i psi_t) conj(K_a)): slots 2 a and 2 a + 1 are the real and the imaginary part of
+        h K_a, slot 8 the centre's h K_4, real part (s = 1) or imaginary (s = -1); the centre's other part is zero
+        by the symmetry (its largest kept in ``dropped``, checked after the build: the phases' and signs' check).
+        ``out``: the array (rows, slab) to write them into (a slot of the build's ring)."""
+        if getattr(self, "_idx", None) is None:
+            m = S.shape[2]
+            self._idx = tuple(np.ascontiguousarray(B[0], np.int64)
+                              for B in _kernel_blocks(np.arange(4 * 9 * m).reshape(4, 9, m, 1)))
         if not self.real:
-            return tuple(to_lanes(B) for B in _kernel_blocks(S))
+            if out is None:
+                return np.ascontiguousarray(S).reshape(-1, S.shape[-1])
+            out[...] = S.reshape(out.shape)
+            return out
         h = self.rot_k[:, None, :]                                        # (4, 1, slab)
-        R = np.empty(S.shape[:1] + (9,) + S.shape[2:])
+        R = np.empty(S.shape[:1] + (9,) + S.shape[2:]) if out is None else out.reshape(S.shape[:1] + (9,) + S.shape[2:])
         sg = self.sg
         for a in range(4):
             z = h * S[:, a]
@@ -743,7 +788,7 @@ class ToeplitzHistory:
         R[:, 8] = c.real if sg > 0 else c.imag
         self.dropped = max(self.dropped, float(np.abs(c.imag if sg > 0 else c.real).max(initial=0.0)))
         self.kept = max(self.kept, float(np.abs(R).max(initial=0.0)))
-        return tuple(to_lanes_real(B) for B in _kernel_blocks(R))
+        return R.reshape(-1, R.shape[-1])
 
     def _pairs(self, S):
         """A state's slab S (9 slots, 3 components, slab) as the real kernels read it: rows 2 a, 2 a + 1 the

@@ -220,16 +220,17 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     GLat.point_symmetric = "G kernels real (point-symmetric" in out
     assert Lat.point_symmetric                          # (a whole grid's H side)
     plan = interp.Plan("linear", 0.0025, 24, 0.03, 5)
-    b, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan)
+    from petsc_ssi.bem.toeplitz import BLOCK            # (the run's steps a block: -ssi_history_block 0)
+    b, _, _ = estimate(Lat, 24, 32, 1, BLOCK, 0, 0.0, plan=plan)
     build = 3 * 144 * 64 * 8.0 * 17                     # the build's transients, not in the run's bytes
     assert abs((b - build) / 1e9 - stored) <= 0.01 * stored + 5e-6, (b - build, stored)
-    bg, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat)
+    bg, _, _ = estimate(Lat, 24, 32, 1, BLOCK, 0, 0.0, plan=plan, glat=GLat)
     assert abs((bg - b) / 1e9 - g_stored) <= 0.01 * g_stored + 5e-6, (bg - b, g_stored)
-    bs, _, _ = estimate(Lat, 24, 32, 1, 8, 0, 0.0, plan=plan, glat=GLat, single=True)
+    bs, _, _ = estimate(Lat, 24, 32, 1, BLOCK, 0, 0.0, plan=plan, glat=GLat, single=True)
     from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups)
     from petsc_ssi.bem.toeplitz import kept_rows
     assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 8 b) more)
-    assert bs < bg and abs((bg - bs) - 8.0 * 27 * kept_rows(24, 8) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
+    assert bs < bg and abs((bg - bs) - 8.0 * 27 * kept_rows(24, BLOCK) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
 
 
 @pytest.mark.parametrize("widths,dtype", [((8, 4), np.complex128), ((4, 8), np.complex128), ((4, 8), np.complex64)])
