@@ -38,7 +38,7 @@ from toeplitz_table import row  # noqa: E402
 def terms(opts, ranks):
     """{term: count} of ``toeplitz.estimate`` for the case ``opts`` on ``ranks`` ranks."""
     from petsc_ssi.bem.halfspace import HalfSpace
-    from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES
+    from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES, block_of
     PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
         if opts.get("problem") == "ssi":    # a coupled run: the soil of its set-up (the interface's tractions)
@@ -54,7 +54,7 @@ def terms(opts, ranks):
     lat.n_offsets = len(kernel_offsets(lat))
     glat = traction_grid(lat, ls.VT)
     big = 1e300
-    args = (lat, prob.L, prob.n_steps, ranks, int(cfg.history_block) or 8, 3 * prob.mesh.n_nodes, 0.0)
+    args = (lat, prob.L, prob.n_steps, ranks, block_of(cfg), 3 * prob.mesh.n_nodes, 0.0)
     kw = dict(plan=plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
               single=cfg.get("toeplitz_precision", "double") == "single")
     zero = {"r_products": big, "r_sums": big, "r_sums_span": big, "t_step_dof": 0.0, "t_step_grid": 0.0,
@@ -79,10 +79,10 @@ def terms(opts, ranks):
 def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
     """Flops a rank of the interpolating matrices' kernel products (8 m F k per step that reads them, 4 with real
     kernels)."""
-    from petsc_ssi.bem.toeplitz import interp_work
+    from petsc_ssi.bem.toeplitz import interp_work, block_of
     if plan is None or not plan.active:
         return 0.0
-    isteps = interp_work(plan, n_steps, int(cfg.history_block) or 8, kw["stabilized"])[0]
+    isteps = interp_work(plan, n_steps, block_of(cfg), kw["stabilized"])[0]
     from petsc_ssi.bem.toeplitz import is_point_symmetric
     return sum((4.0 if is_point_symmetric(g) else 8.0) * m * g.F * plan.k * isteps
                for g, m in ((lat, 144), (glat, 180)) if g is not None) / ranks

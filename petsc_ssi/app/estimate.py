@@ -203,12 +203,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s coupling_setup_s coupling_loop_s total | GB "
                      "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
     if cc is not None:                  # the step matrix's LU (toeplitz.step_lu): its entries, mirror blocks
-        from ..bem.mirror import blocks_of
-        from ..bem.toeplitz import step_lu
-        from ..coupling.columns import geometric_reach
-        nblk = blocks_of(prob) if str(cfg.get("step_mirror", "auto")).lower() != "off" else 1
-        rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
-        ent = step_lu(3 * N, rho, nblk)[0]
+        from ..coupling.cost import toeplitz_step_lu
+        ent, _, _, rho, nblk = toeplitz_step_lu(cfg, prob, lat, 2)
         lines.insert(3, f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach "
                         f"{rho:.3g} node spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1
                                                       else "") + "; toeplitz.step_lu)")
@@ -218,7 +214,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         b += ab
         cpl = ""
         if cc is not None:            # the structure, the interface matrices and the coupled steps
-            _, fac, one = step_lu(3 * N, rho, nblk, p, kappa=c.get("kappa", 0.107))
+            _, fac, one, _, _ = toeplitz_step_lu(cfg, prob, lat, p, kappa=c.get("kappa", 0.107))
             add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
             steps_s = prob.n_steps * one

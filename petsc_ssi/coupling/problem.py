@@ -69,6 +69,7 @@ class SSITransient(TransientProblem):
 
     defer_loop_line = True          # (printed in setup, once the structure's solves are timed)
     cpl_per_step = None
+    soil_solve_s = 0.0              # (the toeplitz store: the step matrix's solve, toeplitz.step_lu; the dense model has it)
 
     def loop_estimate(self):
         """The soil's BEM loop and the coupling's per-step work (``coupling.cost.step_seconds``, the
@@ -78,15 +79,17 @@ class SSITransient(TransientProblem):
         if est is None or self.cpl_per_step is None:
             return est
         cpl = self.cpl_per_step * self.n_steps
-        return (est[0] + cpl, est[1] + self.cpl_per_step,
-                f"the soil's BEM {est[0]:.3g} s and the coupling {cpl:.3g} s, a solve with the structure's D "
-                f"{1e3 * self.fem_solve_s:.3g} ms as timed")
+        sol = self.soil_solve_s * self.n_steps
+        return (est[0] + sol + cpl, est[1] + self.soil_solve_s + self.cpl_per_step,
+                f"the soil's BEM {est[0] + sol:.3g} s"
+                + (f" (its step matrix's solves {sol:.3g} s, toeplitz.step_lu)" if sol else "")
+                + f" and the coupling {cpl:.3g} s, a solve with the structure's D {1e3 * self.fem_solve_s:.3g} ms as timed")
 
     def loop_model(self):
         model = super().loop_model()
         if model is None or self.cpl_per_step is None:
             return model
-        c = self.cpl_per_step
+        c = self.cpl_per_step + self.soil_solve_s
         return lambda k: model(k) + c * k
 
     def output_bytes(self):
@@ -110,9 +113,14 @@ class SSITransient(TransientProblem):
             from .cost import solve_seconds, step_seconds
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
+            consts = load_constants(cfg.get("estimate_constants", ""))[0]
+            if getattr(prob, "lattice", None) is not None:     # (the toeplitz store: its history model has no solves)
+                from .cost import toeplitz_step_lu
+                self.soil_solve_s = toeplitz_step_lu(cfg, prob, prob.lattice, comm.getSize(),
+                                                     kappa=(consts or {}).get("kappa", 0.107))[2]
             from .columns import estimated_region_nodes, estimated_solved_columns, estimated_fem_solved_columns
             imp = cfg.coupling == "implicit"
-            self.cpl_per_step = step_seconds(load_constants(cfg.get("estimate_constants", ""))[0], self.iface.n,
+            self.cpl_per_step = step_seconds(consts, self.iface.n,
                                              estimated_region_nodes(cfg, prob, self.iface.be_nodes), comm.getSize(),
                                              self.fem_solve_s, self.model.dofmap.size if imp else 0,
                                              estimated_solved_columns(cfg, prob, self.iface.be_nodes),
