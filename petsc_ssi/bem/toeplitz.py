@@ -242,7 +242,7 @@ CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most thi
 # (jobscripts/building_uniform.sh, uniform-72-area-exact, EXTRA="-ssi_history_block b", 2026-12-01 07:40): the
 # blocks' products 17.4, 11.7 and 9.3 s at b = 8, 16 and 32, the steps' own products 7.2, 8.9 and 11.0 s (a step
 # reads the states of its block that the block's pass did not), the history sum 27.9, 23.9 and 23.4 s; the peak
-# 6.17, 6.46, 6.67 GB (``kept_rows``' slack grows with b); the paper's quarter model's peak unchanged (1.42 GB)
+# 6.17, 6.46, 6.67 GB (``kept_rows``' slack grows with b); the paper's quarter model's 1.42 GB at b = 8, 1.43 GB at 16
 BLOCK = 16
 
 
