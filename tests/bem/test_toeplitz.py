@@ -229,7 +229,8 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     bs, _, _ = estimate(Lat, 24, 32, 1, BLOCK, 0, 0.0, plan=plan, glat=GLat, single=True)
     from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups)
     from petsc_ssi.bem.toeplitz import kept_rows
-    assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 8 b) more)
+    assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 64) more)
+    assert kept_rows(207, 16) == 207 + 3 * 16 + 8 + 64
     assert bs < bg and abs((bg - bs) - 8.0 * 27 * kept_rows(24, BLOCK) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
 
 
