@@ -83,7 +83,8 @@ def _single_kernels():
     """The block-sparse kernels on float32 values (-ssi_lag_single_from; numba compiles one version
     per value type), the toeplitz store's lane products on single kept states (-ssi_toeplitz_precision
     single), and the block-sparse kernels on a read-only x (the python Mat's products; without this the first coupled
-    run compiled one), and the coupled step's product with mirrored interface columns."""
+    run compiled one), the toeplitz kernels' fill from real and complex spectra (a grid's point symmetry decides
+    which a run takes), and the coupled step's product with mirrored interface columns."""
     import numpy as np
     from ..bem import bsr
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
@@ -101,6 +102,10 @@ def _single_kernels():
     lane_products(K, 0, np.zeros((1, 1, 9, 2, FW), np.float32), 0, 1, 1, 1, out, 0)   # (single kept states)
     put_state(np.zeros((9, 3, 2), complex)[..., :1], np.zeros((1, 1, 9, 2, FW), np.float32),
               np.zeros((1, 1, 18, 2, FW), np.float32), 0)
+    from ..bem.lanes import add_spectra           # (the toeplitz kernels' fill: real and complex spectra)
+    idx, sel = np.zeros((1, 1), np.int64), np.zeros(1, np.int64)
+    for kp, dt in ((1, np.float64), (2, np.complex128)):
+        add_spectra(np.zeros((1, 1, 1, kp, FW)), 0, np.zeros((1, 1, 1), dt), sel, idx, np.ones(1))
     from ..coupling.columns import _rows4         # (the coupled step's mirrored interface columns)
     _rows4(np.ones((2, 3)), np.ones((4, 3)), np.zeros((2, 4)))
     diag = np.ones((1, 3, 3))

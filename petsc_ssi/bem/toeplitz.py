@@ -30,7 +30,7 @@ copies. Where the kernels' offsets are point-symmetric (a whole grid's H side, `
 spectrum and its point mirror's are conjugate up to a known phase, K_{8-a}(f) = s exp(-2 i psi_t(f))
 conj(K_a(f)): the pairs' sum and difference, rotated by exp(i psi_t), are real, so the kernels are stored
 real (half the bytes, half the multiply-adds) and the states as the pairs' sums and differences
-(``ToeplitzHistory._lanes``, ``_pairs``, ``_rotation``).
+(``ToeplitzHistory._source``, ``_pairs``, ``_rotation``).
 
 Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
 and of every kept state's transform: memory divided by the ranks); the kernels' integrals are split by
@@ -237,12 +237,12 @@ def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
-# the toeplitz store's steps a block (-ssi_history_block 0): a block reads each kernel once for its b steps, and the
-# products are bound by the kernels' bytes at b = 8 (runs/pekeris/README.md, roofline). The 72 m building's run
-# (jobscripts/building_uniform.sh, uniform-72-area-exact, EXTRA="-ssi_history_block b", 2026-12-01 07:40): the
-# blocks' products 17.4, 11.7 and 9.3 s at b = 8, 16 and 32, the steps' own products 7.2, 8.9 and 11.0 s (a step
-# reads the states of its block that the block's pass did not), the history sum 27.9, 23.9 and 23.4 s; the peak
-# 6.17, 6.46, 6.67 GB (``kept_rows``' slack grows with b); the paper's quarter model's 1.42 GB at b = 8, 1.43 GB at 16
+# the toeplitz store's steps a block (-ssi_history_block 0): a block reads each kernel once for its b steps; with both
+# ranks on the memory bus a step's products got 1.5 x faster from b = 8 to 16 (runs/pekeris/README.md, roofline). The
+# 72 m building's run (jobscripts/building_uniform.sh, uniform-72-area-exact, EXTRA="-ssi_history_block b",
+# 2026-12-01 07:40, ``kept_rows``' slack then min(R / 2, 8 b)): the blocks' products 17.4, 11.7 and 9.3 s at b = 8,
+# 16 and 32, the steps' own products 7.2, 8.9 and 11.0 s (a step reads the states of its block that the block's pass
+# did not), the history sum 27.9, 23.9 and 23.4 s; the peak 6.17, 6.46, 6.67 GB
 BLOCK = 16
 
 
@@ -356,7 +356,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
 
 
 # the largest part of a point-symmetric grid's rotated kernels that the symmetry makes zero, over their largest
-# entry (round-off of the transforms; checked after the build, ``ToeplitzHistory._lanes``)
+# entry (round-off of the transforms; checked after the build, ``ToeplitzHistory._source``)
 REAL_TOL = 1e-11
 
 
@@ -393,11 +393,12 @@ def is_point_symmetric(lat):
 def kept_rows(R, b):
     """Rows of the kept transforms' buffers (``ToeplitzHistory._room``) for a history of reach R and blocks of b
     steps: the R states a block reads back, its own b, and a slack that sets how often the kept ones move to the
-    start (R rows copied each time): every 2 b + 9 + E steps with 3 b + 8 + E rows beyond R, E = min(R / 2, 64)
-    (the 72 m building: R = 207, E = 64, every 89 steps at b = 8 instead of every 25 with E = 0, for 64 more rows
-    of both sides' transforms, 0.29 GB over the ranks; E was min(R / 2, 8 b) until the default block became 16,
-    which took the building's peak from 6.17 to 6.46 GB and the paper's quarter model's from 1.46 to 1.50 GB)."""
-    return int(R) + 3 * int(b) + 8 + min(int(R) // 2, 64)
+    start (R rows copied each time): every 2 b + 9 + E steps with 3 b + 8 + E rows beyond R, E = min(R / 2, 8 b,
+    64) (the 72 m building: R = 207, E = 64, every 89 steps at b = 8 instead of every 25 with E = 0, for 64 more rows
+    of both sides' transforms, 0.29 GB over the ranks). The cap of 64 came with the default block of 16: E =
+    min(R / 2, 8 b) took the paper's quarter model's peak (-memory_view) from 1.46 GB at b = 8 to 1.50 GB at 16
+    (1.53 GB in a later run), over the 1.5 GB issue 41 asks; 1.476 GB in two runs with the cap."""
+    return int(R) + 3 * int(b) + 8 + min(int(R) // 2, 8 * int(b), 64)
 
 
 def kernel_offsets(lat):
@@ -731,22 +732,22 @@ class ToeplitzHistory:
                     add_spectra(self.K9, 9 * (D - d), src, sel, self._idx[0], c)
                     add_spectra(self.K18, 18 * (D - d), src, sel, self._idx[1], c)
             src = None
+        slot0, one = np.zeros(1, np.int64), np.ones(1)          # (an anchor's kernel: its one lag, weight 1)
         for i in range(plan_k):
             if ("i", i) not in by_key:          # (no lag of the run weighs this matrix: its kernel stays 0)
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
                 src = self._source(S)[None]
-                one = (np.zeros(1, np.int64), np.ones(1))
-                add_spectra(self.A9, 9 * i, src, one[0], self._idx[0], one[1])
-                add_spectra(self.A18, 18 * i, src, one[0], self._idx[1], one[1])
+                add_spectra(self.A9, 9 * i, src, slot0, self._idx[0], one)
+                add_spectra(self.A18, 18 * i, src, slot0, self._idx[1], one)
 
     def _rotation(self, sign, whole=False):
         """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab (or the whole spectrum),
         psi_t(f) = pi (f_x (2 lo_x - t_x) / M_x + f_y (2 lo_y - t_y) / M_y): the point reflection o -> -o of class
         t's offsets maps the FFT grid's index j to 2 lo - t - j (lo: the inputs' lattice box ``in_lo``), so a
         slot's spectrum and its mirror's are K_{8-a}(f) = s exp(-2 i psi_t(f)) conj(K_a(f)); exp(i psi) K is
-        then real on the pairs' sums (``_lanes``)."""
+        then real on the pairs' sums (``_source``)."""
         lat = self.lat
         f = np.arange(lat.F) if whole else np.arange(self.f0, self.f1)
         fx, fy = f // (lat.My // 2 + 1), f % (lat.My // 2 + 1)

@@ -89,7 +89,7 @@ class SSITransient(TransientProblem):
         model = super().loop_model()
         if model is None or self.cpl_per_step is None:
             return model
-        c = self.cpl_per_step + self.soil_solve_s
+        c = self.cpl_per_step
         return lambda k: model(k) + c * k
 
     def output_bytes(self):
@@ -117,7 +117,7 @@ class SSITransient(TransientProblem):
             if getattr(prob, "lattice", None) is not None:     # (the toeplitz store: its history model has no solves)
                 from .cost import toeplitz_step_lu
                 self.soil_solve_s = toeplitz_step_lu(cfg, prob, prob.lattice, comm.getSize(),
-                                                     kappa=(consts or {}).get("kappa", 0.107))[2]
+                                                     kappa=consts.get("kappa", 0.107))[2]
             from .columns import estimated_region_nodes, estimated_solved_columns, estimated_fem_solved_columns
             imp = cfg.coupling == "implicit"
             self.cpl_per_step = step_seconds(consts, self.iface.n,

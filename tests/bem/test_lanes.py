@@ -233,7 +233,8 @@ def test_add_spectra_is_the_lanes_of_the_blocks(real, m):
     """``add_spectra`` (the toeplitz build's kernels filled from the lags' spectra without copies) gives the bits of
     the arrays it replaced: ``K[:, r0:r0 + n] += c * to_lanes(block)`` of ``toeplitz._kernel_blocks``' blocks, lag
     after lag, for the H (m = 4) and G (m = 5) patterns, real and complex kernels, row blocks weighing one, two
-    and three slots of a ring (one twice) and a slab that is not whole lane groups (its padding lanes stay zero)."""
+    and three slots of a ring (one twice), a row block added to twice (adds, not overwrites) and a slab that is not
+    whole lane groups (its padding lanes stay zero)."""
     from petsc_ssi.bem.lanes import add_spectra, to_lanes, to_lanes_real, n_groups, FW
     from petsc_ssi.bem.toeplitz import _kernel_blocks
     rng = np.random.default_rng(5)
@@ -247,7 +248,7 @@ def test_add_spectra_is_the_lanes_of_the_blocks(real, m):
     for B, rows in zip(idx, (9, 18)):
         K = np.zeros((n_groups(slab), D * rows, B.shape[1], kp, FW))
         ref = K.copy()
-        for d, sel, c in ((1, [2], [0.75]), (2, [0, 1], [-1.5, 0.3]), (3, [1, 2, 1], [1.0, -0.25, 2.0])):
+        for d, sel, c in ((1, [2], [0.75]), (2, [0, 1], [-1.5, 0.3]), (3, [1, 2, 1], [1.0, -0.25, 2.0]), (1, [0], [2.0])):
             add_spectra(K, rows * d, src, np.array(sel, np.int64), B, np.array(c))
             for t, ct in zip(sel, c):
                 blk = np.stack([src[t][B, f] for f in range(slab)])     # (slab, rows, columns): the block's values

@@ -229,9 +229,66 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     bs, _, _ = estimate(Lat, 24, 32, 1, BLOCK, 0, 0.0, plan=plan, glat=GLat, single=True)
     from petsc_ssi.bem.lanes import padded             # (a rank's slab in whole lane groups)
     from petsc_ssi.bem.toeplitz import kept_rows
-    assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 64) more)
-    assert kept_rows(207, 16) == 207 + 3 * 16 + 8 + 64
+    assert kept_rows(24, 8) == 24 + 3 * 8 + 8 + 12      # (R, its block's steps, slack, min(R / 2, 8 b, 64) more)
+    assert kept_rows(207, 16) == 207 + 3 * 16 + 8 + 64 and kept_rows(207, 2) == 207 + 3 * 2 + 8 + 16
     assert bs < bg and abs((bg - bs) - 8.0 * 27 * kept_rows(24, BLOCK) * (padded(Lat.F) + padded(GLat.F))) < 1.0   # kept states halved
+
+
+@pytest.mark.parametrize("real", [True, False])
+def test_fill_kernels_equals_the_lane_arrays_lag_by_lag(monkeypatch, real):
+    """``ToeplitzHistory._fill_kernels`` (a distance's lags summed into its row block in one pass, the lags' spectra
+    in a ring of slots) gives the bits of the build it replaced: per lag in order, per term (d, c), ``K[rows of d]
+    += c * to_lanes(_kernel_blocks(spectra))``, and the anchors' kernels likewise. Spectra of 9 lags are random;
+    the terms are the stabilised scheme's shape (a lag into distances d - 1, d and d + 1, so a ring of 3 slots is
+    overwritten twice) with two terms at one distance from one lag; real (point-symmetric, rotated) and complex
+    kernels, the H pattern, a slab that is not whole lane groups."""
+    from petsc_ssi.bem import toeplitz as tz
+    from petsc_ssi.bem.lanes import to_lanes, to_lanes_real, n_groups, FW
+    rng = np.random.default_rng(11)
+    slab, m, L, k = 2 * FW + 3, 4, 9, 2
+    th = object.__new__(tz.ToeplitzHistory)
+    th.spec, th.real, th.sg, th.dropped, th.kept, th._idx = tz.SIDES["u"], real, -1, 0.0, 0.0, None
+    th.rot_k = np.exp(1j * rng.uniform(0, 6.3, (4, slab)))
+    by_key = {}
+    for lag in range(1, L + 1):
+        for d, c in ((lag - 1, -0.5), (lag, 1.25), (lag + 1, 0.375)) + (((lag, 0.5),) if lag == 4 else ()):
+            if 1 <= d <= L:
+                by_key.setdefault(("x", lag), []).append((d, c))
+    for i in range(k):
+        by_key[("i", i)] = [(0, 1.0)]
+    th.D, th.k = L, k
+    G, kp = n_groups(slab), 1 if real else 2
+    th.K9, th.K18 = np.zeros((G, 9 * L, 8, kp, FW)), np.zeros((G, 18 * L, 4, kp, FW))
+    th.A9, th.A18 = np.zeros((G, 9 * k, 8, kp, FW)), np.zeros((G, 18 * k, 4, kp, FW))
+    spectra = {}
+
+    def fake(lag_lo, lag_hi, toff, Lr):
+        for lag in range(lag_lo, lag_hi + 1):
+            S = rng.standard_normal((4, 5 if real else 9, m, slab)) + 1j * rng.standard_normal((4, 5 if real else 9, m, slab))
+            spectra[(lag, toff)] = S
+            yield lag, S
+
+    class Plan:
+        def kernel_time(self, i):
+            return 3 + i, 0.1 * (i + 1)
+    monkeypatch.setattr(th, "_spectra", fake)
+    th._fill_kernels(by_key, Plan())
+    lanes = to_lanes_real if real else to_lanes
+    ref = {n: np.zeros_like(getattr(th, n)) for n in ("K9", "K18", "A9", "A18")}
+    for (lag, toff), S in sorted(spectra.items()):
+        R = th._source(S).reshape((4, 9, m, slab))
+        B9, B18 = tz._kernel_blocks(R)
+        if toff == 0.0:
+            for d, c in by_key[("x", lag)]:
+                ref["K9"][:, 9 * (L - d):9 * (L - d + 1)] += c * lanes(B9)
+                ref["K18"][:, 18 * (L - d):18 * (L - d + 1)] += c * lanes(B18)
+        else:
+            i = lag - 3
+            ref["A9"][:, 9 * i:9 * (i + 1)] += lanes(B9)
+            ref["A18"][:, 18 * i:18 * (i + 1)] += lanes(B18)
+    for n, r in ref.items():
+        assert np.array_equal(getattr(th, n), r), n
+    assert th.K9.any() and th.A18.any()
 
 
 @pytest.mark.parametrize("widths,dtype", [((8, 4), np.complex128), ((4, 8), np.complex128), ((4, 8), np.complex64)])
