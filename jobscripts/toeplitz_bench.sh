@@ -74,5 +74,10 @@ if has site; then
       > "$OUT/site-$L.estimate" 2>&1 || true
   done
 fi
-"$PY" jobscripts/toeplitz_table.py "$OUT" runs/pekeris/README.md runs/pekeris/toeplitz_bench.csv \
-  runs/pekeris/toeplitz_cost_per_step.png jobscripts/README.md
+# the repository's tables, CSVs and plots from the default OUT only; another OUT's are printed (its CSV and plots there)
+if [[ "$OUT" == out/bench/toeplitz ]]; then
+  "$PY" jobscripts/toeplitz_table.py "$OUT" runs/pekeris/README.md runs/pekeris/toeplitz_bench.csv \
+    runs/pekeris/toeplitz_cost_per_step.png jobscripts/README.md
+else
+  "$PY" jobscripts/toeplitz_table.py "$OUT" --print
+fi

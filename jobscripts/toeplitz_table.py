@@ -5,6 +5,8 @@ history's cost per step, the wall, the peak memory over the ranks, and the run's
 whole model's receivers against the quarter model's.
 
     python jobscripts/toeplitz_table.py OUTDIR README CSV PNG [SCALING_README]
+    python jobscripts/toeplitz_table.py OUTDIR --print      (the tables printed, the CSV and plots into OUTDIR:
+                                                           toeplitz_bench.sh with another OUT than its own)
 
 A table's rows whose run has no log in OUTDIR are kept as they stand (``merge``: a partial rerun,
 PARTS=paper, does not drop the other parts' rows). The sites (runs site-<L>, issue 41's 100 m item) get their own table (between <!-- toeplitz-site:begin/end -->
@@ -257,7 +259,7 @@ def write_csv(rows, path):
 def main(outdir, readme, csvpath, png, scaling_readme=None):
     everything = [row(p) for p in sorted(glob.glob(os.path.join(outdir, "*.log")))]
     base, ext = os.path.splitext(png)
-    site_md = sites(everything, outdir, base + "_site" + ext, [readme] + ([scaling_readme] if scaling_readme else []))
+    site_md = sites(everything, outdir, base + "_site" + ext, [p for p in (readme, scaling_readme) if p])
     write_csv([r for r in everything if r["run"].startswith("site-")], os.path.splitext(csvpath)[0] + "_site.csv")
     rows = [r for r in everything if not r["run"].startswith("site-")]
     print("\n".join(site_md))
@@ -295,9 +297,14 @@ def main(outdir, readme, csvpath, png, scaling_readme=None):
         ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(png, dpi=120)
-    put(readme, BEGIN, END, md)
+    if readme:
+        put(readme, BEGIN, END, md)
     print("\n".join(md))
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:6])
+    if len(sys.argv) == 3 and sys.argv[2] == "--print":
+        main(sys.argv[1], None, os.path.join(sys.argv[1], "toeplitz_bench.csv"),
+             os.path.join(sys.argv[1], "toeplitz_cost_per_step.png"))
+    else:
+        main(*sys.argv[1:6])
