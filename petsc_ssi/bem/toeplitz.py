@@ -724,7 +724,7 @@ class ToeplitzHistory:
                 if ("x", lag) not in by_key:
                     continue
                 if src is None:
-                    src = np.empty((ring,) + self._source_shape(S), np.float64 if self.real else np.complex128)
+                    src = np.empty((ring, 4 * 9 * S.shape[2], S.shape[-1]), np.float64 if self.real else np.complex128)
                 self._source(S, out=src[lag % ring])
                 for d in sorted(last.get(lag, ())):
                     sel = np.array([l_ % ring for l_, _ in into[d]], np.int64)
@@ -756,10 +756,6 @@ class ToeplitzHistory:
             psi = np.pi * (fx * (2 * lat.in_lo[0] - tx) / lat.Mx + fy * (2 * lat.in_lo[1] - ty) / lat.My)
             out[t] = np.exp(sign * 1j * psi)
         return out
-
-    def _source_shape(self, S):
-        """The shape of ``_source``'s rows x slab for spectra S."""
-        return (4 * 9 * S.shape[2], S.shape[-1])
 
     def _source(self, S, out=None):
         """One lag's spectra S (4 classes, 9 slots, m entries, slab) as the rows (class, slot, entry) x slab that
