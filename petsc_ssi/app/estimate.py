@@ -193,8 +193,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
              f"{'single' if single else 'double'} precision transforms)"
              + (f"; G kernels on the traction elements' {glat.in_n[0]} x {glat.in_n[1]} window (FFT grid "
                 f"{glat.Mx} x {glat.My})" if glat is not None else ""),
-             "[ssi]   ranks | kernels_s history_s | GB over the ranks beside the processes | with the processes "
-             "(this one's resident size each) | fits"]
+             "[ssi]   ranks | kernels_s history_s factor_s solve_s total | GB over the ranks beside the processes | "
+             "with the processes (this one's resident size each) | fits"]
     for i, ln in enumerate(_area_line(ab)):
         lines.insert(2 + i, ln)
     if cc is not None:
@@ -202,24 +202,28 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         lines.insert(2, describe(cc))
         lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s coupling_setup_s coupling_loop_s total | GB "
                      "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
-    if cc is not None:                  # the step matrix's LU (toeplitz.step_lu): its entries, mirror blocks
-        from ..coupling.cost import toeplitz_step_lu
-        ent, _, _, rho, nblk = toeplitz_step_lu(cfg, prob, lat, 2)
-        lines.insert(3, f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach "
-                        f"{rho:.3g} node spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1
-                                                      else "") + "; toeplitz.step_lu)")
+    # the step matrix's LU (toeplitz.step_lu_of): its entries, mirror blocks; a solve a step in the loop
+    from ..bem.toeplitz import step_lu_of
+    from ..bem.cost import load_constants
+    kappa = (c if c is not None else load_constants(cfg.get("estimate_constants", ""))[0]).get("kappa", 0.107)
+    ent, _, _, rho, nblk = step_lu_of(cfg, prob, lat, 2)
+    lines.insert(3 if cc is not None else 2,
+                 f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach {rho:.3g} node "
+                 "spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1 else "")
+                 + "; toeplitz.step_lu)")
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
         b += ab
-        cpl = ""
+        _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
+        steps_s = prob.n_steps * one
         if cc is not None:            # the structure, the interface matrices and the coupled steps
-            _, fac, one, _, _ = toeplitz_step_lu(cfg, prob, lat, p, kappa=c.get("kappa", 0.107))
             add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
-            steps_s = prob.n_steps * one
             cpl = (f" {fac:8.3g} {steps_s:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
                    f"{fmt_time(tb + th + fac + add['cpl_setup'] + add['cpl_loop'] + steps_s):>7}")
+        else:
+            cpl = f" {fac:8.3g} {steps_s:7.3g} {fmt_time(tb + th + fac + steps_s):>7}"
         tot = b + p * rss
         per_node = tot / p * min(q, p)
         flag = "yes" if per_node <= limit else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
@@ -236,7 +240,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     and the surface is a uniform flat grid (else the reason, one line)."""
     if cfg.get("lag_store", "dense") == "dense":
         return []
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of, step_lu_of
+    from ..bem.cost import load_constants
     from ..petsc import SSIError
     try:
         if not cnt.lagset.flat:
@@ -246,14 +251,16 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
         return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
     lat.n_offsets = len(kernel_offsets(lat))
     glat = traction_grid(lat, cnt.lagset.VT)
-    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s | GB over the ranks "
-           "beside the processes"]
+    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s factor_s solve_s | GB over "
+           "the ranks beside the processes"]
     g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
+    kappa = load_constants(cfg.get("estimate_constants", ""))[0].get("kappa", 0.107)
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single")
-        out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} | {b / 1e9:7.3g}")
+        _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
+        out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} | {b / 1e9:7.3g}")
     return out
 
 

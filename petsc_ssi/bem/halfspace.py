@@ -635,8 +635,8 @@ class HalfSpace:
 
     def _toeplitz_bytes(self, ls, plan, extra_bytes=0.0, lat=None):
         """Collective: (bytes over the ranks, the node's limit, this node's share, (kernels' seconds, history's
-        seconds, the processes' bytes)) of a toeplitz run with ``plan`` (``toeplitz.estimate``, with the
-        processes' resident size and ``extra_bytes``)."""
+        seconds, the processes' bytes, the history's seconds step by step)) of a toeplitz run with ``plan``
+        (``toeplitz.estimate``, with the processes' resident size and ``extra_bytes``)."""
         from .toeplitz import estimate, kernel_offsets, traction_grid, block_of
         from mpi4py import MPI
         c = self.cfg
@@ -646,22 +646,27 @@ class HalfSpace:
         p = self.comm.getSize()
         block = block_of(c)
         g = self.toeplitz_side_bytes(ls, plan)
-        est, t_build, t_hist = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g, plan=plan,
-                                        stabilized=c.scheme.startswith("stabili"), glat=traction_grid(lat, ls.VT),
-                                        single=c.get("toeplitz_precision", "double") == "single")
+        est, t_build, t_hist, steps = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g,
+                                               plan=plan, stabilized=c.scheme.startswith("stabili"),
+                                               glat=traction_grid(lat, ls.VT),
+                                               single=c.get("toeplitz_precision", "double") == "single", per_step=True)
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)
         share, _ = node_share(self.comm)
-        return est + float(extra_bytes) + rss, limit, share, (t_build, t_hist, rss)
+        return est + float(extra_bytes) + rss, limit, share, (t_build, t_hist, rss, steps)
 
     def check_toeplitz_memory(self, ls, plan, extra_bytes=0.0):
         """Collective: refuse a toeplitz run whose kernels and kept transforms would not fit the node
-        (``toeplitz.estimate``), and predict its time loop (``loop_estimate``)."""
+        (``toeplitz.estimate``), and predict its time loop (``loop_estimate``, ``loop_model``: the history sum
+        step by step and a solve with the step matrix's factors each step, ``toeplitz.step_lu_of``;
+        ``step_solve_s``: that solve's seconds)."""
+        from .cost import load_constants
+        from .toeplitz import step_lu_of
         c = self.cfg
         self.lag_fill = c.lag_fill
         p = self.comm.getSize()
-        est, limit, share, (t_build, t_hist, rss) = self._toeplitz_bytes(ls, plan, extra_bytes)
+        est, limit, share, (t_build, t_hist, rss, steps) = self._toeplitz_bytes(ls, plan, extra_bytes)
         self.mem_estimate = self.mem_peak_estimate = est
         printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
                f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
@@ -671,7 +676,11 @@ class HalfSpace:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
                            "per node); use -ssi_interp, a shorter -ssi_t_end, a coarser grid or more nodes")
-        self.loop_estimate = (t_hist, t_hist / max(self.n_steps, 1))
+        kappa = load_constants(c.get("estimate_constants", ""))[0].get("kappa", 0.107)
+        one = self.step_solve_s = step_lu_of(c, self, self.lattice, p, kappa=kappa)[2]
+        cum = np.concatenate(([0.0], np.cumsum(steps)))
+        self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + one * k
+        self.loop_estimate = (t_hist + one * self.n_steps, float(steps[-1]) + one if len(steps) else one)
 
     def quad_options(self):
         c = self.cfg

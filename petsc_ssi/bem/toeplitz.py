@@ -234,6 +234,30 @@ def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
     return entries, entries * r["t_factor_entry"], solve
 
 
+def geometric_reach(cfg, prob):
+    """The step matrix's reach from the geometry [m]: c_p t + the largest element diameter (t = 2 dt
+    stabilised, dt plain: the last lag of the step matrix; an element a wave reaches within t couples all its
+    nodes), an upper bound of the distance A couples (3.78 m against 3.5 m read off A on the uniform 72 m
+    building, 2.46 against 2.12 m on the 24 m test grid). The coupled run and its estimate size the interface's
+    region with it (``coupling.columns``), so that they take the same region."""
+    X, cells = prob.mesh.nodes, prob.mesh.cells
+    diam = float(np.linalg.norm(X[cells].max(axis=1) - X[cells].min(axis=1), axis=1).max()) if len(cells) else 0.0
+    t = (2.0 if str(cfg.scheme).startswith("stabili") else 1.0) * prob.dt
+    return prob.mat.cp * t + diam
+
+
+def step_lu_of(cfg, prob, lat, ranks, kappa=0.107):
+    """(entries, factorisation seconds, seconds a solve, reach in node spacings, blocks) of the soil's step
+    matrix on the toeplitz store's uniform grid ``lat`` (``step_lu``: its reach, ``geometric_reach`` over the
+    node spacing, and the mirror-symmetric blocks the run would use, ``mirror.blocks_of``), for ``petsc-ssi
+    estimate`` and the runs' own predictions (BEM and coupled) alike."""
+    from .mirror import blocks_of
+    nblk = blocks_of(prob) if str(cfg.get("step_mirror", "auto")).lower() != "off" else 1
+    rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
+    ent, fac, one = step_lu(3 * prob.mesh.n_nodes, rho, nblk, ranks, kappa=kappa)
+    return ent, fac, one, rho, nblk
+
+
 CHUNK_BYTES = 64e6      # the kernels are integrated and transformed at most this many bytes of lags at a time per rank
 
 
@@ -297,7 +321,7 @@ def interp_work(plan, n_steps, block=BLOCK, stabilized=True):
 
 
 def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
-             glat=None, single=False):
+             glat=None, single=False, per_step=False):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
     elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
@@ -310,7 +334,9 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
     (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums`` anchor by anchor
     and ``r_sums_span`` over the anchors' common span, and
-    ``t_step_dof`` per step and DOF."""
+    ``t_step_dof`` per step and DOF. With ``per_step`` a fourth item: the history sum's seconds step by step
+    (n_steps; their sum is the third item: step n's products read min(n - 1, D) exact kernels, the
+    interpolating matrices' share and the sums spread evenly), the runs' progress model."""
     r = dict(RATES, **(rates or {}))
     active = plan is not None and plan.active
     D = int(plan.Lx) if active else int(L)
@@ -324,6 +350,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     nbytes = float(g_bytes) + ring + factors
     build = t_build = flops = sums = sums_span = 0.0
     n = np.arange(1, n_steps + 1)
+    ramp = np.zeros(n_steps)
     isteps, iwork, ispan = interp_work(plan, n_steps, block, stabilized)
     vbytes = 8.0 if single else 16.0
     for g, m in ((lat, 144), (glat, 180)):
@@ -342,6 +369,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         t_build += ((r["t_pair_lag"] * (5.0 if kp == 1.0 else 9.0) / 9.0 + r["t_pair_int"]) * pairs * (D + k) / ranks
                     * (r["g_pair_factor"] if m == 180 else 1.0))
         flops += 4.0 * kp * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
+        ramp += 4.0 * kp * m * Fl * (np.minimum(np.maximum(n - 1, 0), D) + k * isteps / max(n_steps, 1))
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
     # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
@@ -350,8 +378,12 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     # costs nearly a whole model's for a quarter of the DOFs)
     grid = sum(g.Mx * g.My for g in (lat, glat) if g is not None)
     elems = sum(g.cell.size for g in (lat, glat) if g is not None)       # virtual elements: images too
-    t_hist = (flops / (ranks * r["r_products"]) + sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
-              + n_steps * (n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]))
+    even = sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
+    each = n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]
+    t_hist = flops / (ranks * r["r_products"]) + even + n_steps * each
+    if per_step:
+        steps = ramp / (ranks * r["r_products"]) + even / max(n_steps, 1) + each
+        return nbytes + build, t_build, t_hist, steps
     return nbytes + build, t_build, t_hist
 
 

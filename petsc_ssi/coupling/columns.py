@@ -3,7 +3,7 @@ r"""The interface columns Z = A^{-1} H_s E_I of the coupled step on a region aro
 
 A is the soil's step matrix (lags 1-2: a node couples only to the nodes of the elements a wave reaches
 within a step or two, at most the *reach* r = c_p t + the largest element diameter apart,
-``geometric_reach``). Its inverse decays geometrically away from the diagonal: on the paper's building on
+``bem.toeplitz.geometric_reach``). Its inverse decays geometrically away from the diagonal: on the paper's building on
 the uniform 72 m grid (1.2 m cells, dt = 5 ms, 44 649 DOFs, reach 3.78 m) the truncation residual below
 falls by about four orders of magnitude per reach of margin (``jobscripts/columns_margin.sh``; about three
 and a half on a quarter model with symmetry planes). So the columns' rows beyond a margin of a few reaches
@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from ..petsc import init, printf, solve_columns, set_default_options, soil_solver_defaults, mumps_failure
+from ..bem.toeplitz import geometric_reach
 
 # the largest residual of the region's columns, over the column's right-hand side (both in the
 # infinity norm), that keeps the region: round-off of the step equations' own size
@@ -45,18 +46,6 @@ ICNTL14 = 60
 # a mirror image's right-hand side against its representative's mirrored (``RegionColumns._images_hold``), over
 # its largest entry: the step matrix's own commutation bound (``bem.mirror.TOL``)
 MIRROR_TOL = 1e-12
-
-
-def geometric_reach(cfg, prob):
-    """The step matrix's reach from the geometry [m]: c_p t + the largest element diameter (t = 2 dt
-    stabilised, dt plain: the last lag of the step matrix; an element a wave reaches within t couples all its
-    nodes), an upper bound of the distance A couples (3.78 m against 3.5 m read off A on the uniform 72 m
-    building, 2.46 against 2.12 m on the 24 m test grid). The run and the estimate both size the region with
-    it, so that they take the same region."""
-    X, cells = prob.mesh.nodes, prob.mesh.cells
-    diam = float(np.linalg.norm(X[cells].max(axis=1) - X[cells].min(axis=1), axis=1).max()) if len(cells) else 0.0
-    t = (2.0 if str(cfg.scheme).startswith("stabili") else 1.0) * prob.dt
-    return prob.mat.cp * t + diam
 
 
 def region_nodes(X, nodes_I, margin):

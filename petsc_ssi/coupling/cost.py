@@ -128,20 +128,6 @@ def step_seconds(c, n_i, n_soil, p, fem_solve_s, n_fem=0, n_zcols=None, n_dcols=
     return k["n_fs"] * fem_solve_s + (flops + 4.0 * n * n) / k["r_cpl"] + k["c_cstep"]
 
 
-def toeplitz_step_lu(cfg, prob, lat, ranks, kappa=0.107):
-    """(entries, factorisation seconds, seconds a solve, reach in node spacings, blocks) of the soil's step
-    matrix on the toeplitz store's uniform grid ``lat`` (``toeplitz.step_lu``: its reach, ``columns.geometric_reach``
-    over the node spacing, and the mirror-symmetric blocks the run would use, ``mirror.blocks_of``), for
-    ``petsc-ssi estimate`` and the coupled run's own prediction alike."""
-    from ..bem.mirror import blocks_of
-    from ..bem.toeplitz import step_lu
-    from .columns import geometric_reach
-    nblk = blocks_of(prob) if str(cfg.get("step_mirror", "auto")).lower() != "off" else 1
-    rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
-    ent, fac, one = step_lu(3 * prob.mesh.n_nodes, rho, nblk, ranks, kappa=kappa)
-    return ent, fac, one, rho, nblk
-
-
 def describe(cc):
     """One line of what the coupling's counts are."""
     n = 3 * cc.nI

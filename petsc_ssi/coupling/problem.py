@@ -69,7 +69,6 @@ class SSITransient(TransientProblem):
 
     defer_loop_line = True          # (printed in setup, once the structure's solves are timed)
     cpl_per_step = None
-    soil_solve_s = 0.0              # (the toeplitz store: the step matrix's solve, toeplitz.step_lu; the dense model has it)
 
     def loop_estimate(self):
         """The soil's BEM loop and the coupling's per-step work (``coupling.cost.step_seconds``, the
@@ -79,9 +78,10 @@ class SSITransient(TransientProblem):
         if est is None or self.cpl_per_step is None:
             return est
         cpl = self.cpl_per_step * self.n_steps
-        sol = self.soil_solve_s * self.n_steps
-        return (est[0] + sol + cpl, est[1] + self.soil_solve_s + self.cpl_per_step,
-                f"the soil's BEM {est[0] + sol:.3g} s"
+        # (the toeplitz store's BEM prediction holds the step matrix's solves, toeplitz.step_lu_of; the dense model's too)
+        sol = getattr(self.prob, "step_solve_s", 0.0) * self.n_steps
+        return (est[0] + cpl, est[1] + self.cpl_per_step,
+                f"the soil's BEM {est[0]:.3g} s"
                 + (f" (its step matrix's solves {sol:.3g} s, toeplitz.step_lu)" if sol else "")
                 + f" and the coupling {cpl:.3g} s, a solve with the structure's D {1e3 * self.fem_solve_s:.3g} ms as timed")
 
@@ -114,10 +114,6 @@ class SSITransient(TransientProblem):
             from ..bem.cost import load_constants
             self.fem_solve_s = solve_seconds(self.integ, comm)
             consts = load_constants(cfg.get("estimate_constants", ""))[0]
-            if getattr(prob, "lattice", None) is not None:     # (the toeplitz store: its history model has no solves)
-                from .cost import toeplitz_step_lu
-                self.soil_solve_s = toeplitz_step_lu(cfg, prob, prob.lattice, comm.getSize(),
-                                                     kappa=consts.get("kappa", 0.107))[2]
             from .columns import estimated_region_nodes, estimated_solved_columns, estimated_fem_solved_columns
             imp = cfg.coupling == "implicit"
             self.cpl_per_step = step_seconds(consts, self.iface.n,
