@@ -241,23 +241,37 @@ def signed_permutation(PETSc, comm, nmap, sign, r0, r1):
 
 def commutation_defect(PETSc, comm, A, refl):
     """Collective: max over the reflections of ||A R v - R A v||_inf / ||A v||_inf, v_j = sin(0.7 j + 0.3) over
-    the global DOFs."""
+    the global DOFs (``permutation_defect`` of their signed permutations)."""
+    r0, r1 = A.getOwnershipRange()
+    Rs = []
+    for axis, _, nmap in refl:
+        s = np.ones(3)
+        s[axis] = -1.0
+        Rs.append(signed_permutation(PETSc, comm, nmap, s, r0, r1))
+    try:
+        return permutation_defect(PETSc, A, Rs)
+    finally:
+        for R in Rs:
+            R.destroy()
+
+
+def permutation_defect(PETSc, A, Rs):
+    """Collective: max over the signed permutations ``Rs`` (Mats) of ||A R v - R A v||_inf / ||A v||_inf,
+    v_j = sin(0.7 j + 0.3) over A's global rows (the step matrix's reflections here; the interface region's
+    in ``coupling.columns``)."""
     r0, r1 = A.getOwnershipRange()
     v = A.createVecRight()
     v.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
     Av, Rv, ARv, RAv = v.duplicate(), v.duplicate(), v.duplicate(), v.duplicate()
     A.mult(v, Av)
+    size = max(Av.norm(PETSc.NormType.INFINITY), 1e-300)
     worst = 0.0
-    for axis, _, nmap in refl:
-        s = np.ones(3)
-        s[axis] = -1.0
-        R = signed_permutation(PETSc, comm, nmap, s, r0, r1)
+    for R in Rs:
         R.mult(v, Rv)
         A.mult(Rv, ARv)
         R.mult(Av, RAv)
         ARv.axpy(-1.0, RAv)
-        worst = max(worst, ARv.norm(PETSc.NormType.INFINITY) / max(Av.norm(PETSc.NormType.INFINITY), 1e-300))
-        R.destroy()
+        worst = max(worst, ARv.norm(PETSc.NormType.INFINITY) / size)
     for o in (v, Av, Rv, ARv, RAv):
         o.destroy()
     return worst

@@ -496,24 +496,9 @@ def structure_reflections(planes, coords, dofmap, comm, tol=1e-9):
 
 def commutation_defect(A, R):
     """Collective: max over the signed permutations R ({g: R_g}) of ||A R_g v - R_g A v||_inf / ||A v||_inf,
-    v_j = sin(0.7 j + 0.3) over A's global rows (``bem.mirror.commutation_defect``'s test, for given Mats)."""
-    PETSc = init()
-    r0, r1 = A.getOwnershipRange()
-    v = A.createVecRight()
-    v.getArray()[:] = np.sin(0.7 * np.arange(r0, r1) + 0.3)
-    Av, Rv, ARv, RAv = v.duplicate(), v.duplicate(), v.duplicate(), v.duplicate()
-    A.mult(v, Av)
-    size = max(Av.norm(PETSc.NormType.INFINITY), 1e-300)
-    worst = 0.0
-    for g in sorted(R):
-        R[g].mult(v, Rv)
-        A.mult(Rv, ARv)
-        R[g].mult(Av, RAv)
-        ARv.axpy(-1.0, RAv)
-        worst = max(worst, ARv.norm(PETSc.NormType.INFINITY) / size)
-    for o in (v, Av, Rv, ARv, RAv):
-        o.destroy()
-    return worst
+    v_j = sin(0.7 j + 0.3) over A's global rows (``bem.mirror.permutation_defect``)."""
+    from ..bem.mirror import permutation_defect
+    return permutation_defect(init(), A, [R[g] for g in sorted(R)])
 
 
 def orbit_representatives(maps, nodes_I, where):

@@ -295,6 +295,7 @@ class SSITransient(TransientProblem):
                    f"all ({per * 1e3:.3g} ms per status change) vs {fmt_time(march.t_factor)} for one "
                    "factorisation of the BEM step matrix")
         self.write_results(res, status=self.final_status())
+        self.coupler.destroy()
         self.integ.destroy()
         self.demands.destroy()
         printf(f"[ssi] done in {fmt_time(stats['wall_s'])}: output {cfg.output}")
