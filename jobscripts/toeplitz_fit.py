@@ -38,7 +38,8 @@ from toeplitz_table import row  # noqa: E402
 def terms(opts, ranks):
     """{term: count} of ``toeplitz.estimate`` for the case ``opts`` on ``ranks`` ranks."""
     from petsc_ssi.bem.halfspace import HalfSpace
-    from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES, block_of
+    from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES, block_of, step_lu_of
+    from petsc_ssi.bem.cost import load_constants
     PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
         if opts.get("problem") == "ssi":    # a coupled run: the soil of its set-up (the interface's tractions)
@@ -73,7 +74,9 @@ def terms(opts, ranks):
             "sums1": one(r_sums=1.0)[2],
             # the weighted states over the anchors' common span (Chebyshev), flops a rank, and the anchors'
             # kernel products of the same event (SSI_BEM_HistInterp), flops a rank (at r_products in the model)
-            "span": one(r_sums_span=1.0)[2], "interp_prod": _interp_products(lat, glat, plan, prob.n_steps, ranks, kw, cfg)}
+            "span": one(r_sums_span=1.0)[2], "interp_prod": _interp_products(lat, glat, plan, prob.n_steps, ranks, kw, cfg),
+            # a step's solve with the step matrix's factors (the runs' model, toeplitz.step_lu_of), seconds
+            "solve": step_lu_of(cfg, prob, lat, ranks, kappa=load_constants()[0].get("kappa", 0.107))[2]}
 
 
 def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
@@ -90,8 +93,7 @@ def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):
 
 def main(logs, check=False, products_rate=None):
     """Fit the rates to ``logs`` and print the fitted model against each; ``check``: no fit, the committed
-    RATES (and the step solve, cost.bem_solve_seconds with the committed constants) against each log."""
-    from petsc_ssi.bem.cost import bem_solve_seconds, load_constants
+    RATES (and a step's solve, toeplitz.step_lu_of, as the runs predict it) against each log."""
     from petsc_ssi.bem.toeplitz import RATES
     runs = []
     for path in logs:
@@ -148,7 +150,6 @@ def main(logs, check=False, products_rate=None):
     for name, rate in spans:
         print(f"[toeplitz_fit] {name}: the weighted states over the common span at {rate / 1e9:.3g} GFlop/s a rank")
     fit["r_sums_span"] = RATES["r_sums_span"] if check or not spans else float(np.nanmedian([v for _, v in spans]))
-    c, _ = load_constants()
     print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] | a step solve measured / "
           "model [ms] |")
     print("|---|---|---|---|---|---|")
@@ -157,7 +158,7 @@ def main(logs, check=False, products_rate=None):
               + fit["t_pair_int"] * (t["int_h"] + fit["g_pair_factor"] * t["int_g"]))
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
               + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"])
-        ms = 1e3 * bem_solve_seconds(c, int(r["dofs"]) // 3, int(r["ranks"]))
+        ms = 1e3 * t["solve"]
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
               f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")
     print(("committed: " if check else "fitted: ") + ", ".join(f'"{k}": {v:.3g}' for k, v in fit.items()))
