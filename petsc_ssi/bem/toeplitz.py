@@ -188,14 +188,16 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
 # displacement kernel's integrals beside the traction kernel's) are fitted by `python
 # jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
-# their split is loose, their sum is what the logs fix) to the 14 logs of `PARTS="paper grid scale site" bash
-# jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole
-# models, the sites of 40-100 m with multi-linear far lags and single-precision transforms, the 40 m one also
-# exact; out/bench/toeplitz, 06:46-06:48 and 07:01-07:07) and of the building on the uniform 36 and 72 m grids
-# (`bash jobscripts/quiet.sh env RUNS="... uniform-36 uniform-72 ..." bash jobscripts/building_uniform.sh`,
-# 06:33-06:38), 2 ranks, every other process paused, 2026-11-30, code at b5579b9-e4fdc58: kernels from -21 % to
-# +11 %, history from -10 % to +6 % of each log (t_step_grid fitted to 0: collinear with the other per-step
-# terms). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
+# their split is loose, their sum is what the logs fix) to the 10 logs of `PARTS="paper grid site" SITE_SIZES="40
+# 60 80" SITE_EXACT="" OUT=<dir> bash jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m,
+# the paper's quarter and whole models, the sites of 40-80 m with multi-linear far lags and single-precision
+# transforms) and of the building on the uniform 72 m grid (`OUT=<dir> RUNS=uniform-72-area-exact bash
+# jobscripts/quiet.sh bash jobscripts/building_uniform.sh`), 2 ranks, every other process paused, 2026-12-01
+# 23:26-23:30, code at 5543d9d (history blocks of 16 steps, the kernels filled a row block in one pass): kernels
+# from -23 % to +10 %, history from -12 % to +6 % of each log (the rates before, fitted 2026-11-30 at blocks of
+# 8, put these histories +28 % to +98 % over; t_step_grid, t_step_elem and t_pair_int fitted to 0: collinear with
+# t_step_dof and t_pair_lag). The fit holds for the machine's hour: the same runs took up to twice as long in
+# the slow spells of 2026-11-30 and 2026-12-01 (runs/building/README.md). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
 # and exchange (9 slots; 5 on a real side), t_pair_int its share of the integrals. The kernels are fitted per side (the log's H and G
 # seconds). r_sums, the real flops per second of the interpolated lags' weighted states anchor by anchor
 # (``interp_products``: the multi-linear weights, small products), fitted with the history's other terms
@@ -207,8 +209,8 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
 # ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
 # 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 1.14e10, "t_step_dof": 1.04e-7, "t_step_grid": 0.0, "t_step_elem": 1.87e-6,
-         "t_pair_lag": 1.13e-6, "t_pair_int": 3.3e-7, "r_sums": 1.83e10, "fill_bytes": 1620.0, "g_pair_factor": 1.31,
+RATES = {"r_products": 1.45e10, "t_step_dof": 2.36e-7, "t_step_grid": 0.0, "t_step_elem": 0.0,
+         "t_pair_lag": 1.43e-6, "t_pair_int": 0.0, "r_sums": 8.5e10, "fill_bytes": 1620.0, "g_pair_factor": 1.17,
          "r_sums_span": 4.82e10}
 # The step matrix's LU on a uniform grid (``step_lu``: the coupled estimate's factor_s and solve_s, where the dense
 # model's c_fac N^1.5 and c_sol N ln N, fitted on small graded meshes, put the 72 m building's at 7.7 and 21.3 s
