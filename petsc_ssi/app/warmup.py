@@ -76,7 +76,8 @@ def _shared_cache_kernels(PETSc):
     for flat in (True, False):                   # the flat surface's block patterns and the full one
         ls.mH, ls.mG = (4, 5) if flat else (9, 9)
         pk = ls.kernel_packs(1, 3, 0.0)
-        ls._share_cache(new_cache(), pk, ls.kernels(pk[3]), 1.0 / (1e-9 * float(ls.Vh.min())), np.zeros(2))
+        ls._share_cache(new_cache(), pk, ls.kernels(pk[3]), 1.0 / (1e-9 * float(ls.Vh.min())), np.zeros(2),
+                        ls.candidates(ls.rows, pk))
 
 
 def _single_kernels():

@@ -586,7 +586,7 @@ def _image_signs(Vsign, pp):
 
 
 @njit(cache=True)
-def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out):
+def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out, cand):
     """Collective-free numba kernel: the blocks of H and G of ``rows``, written where they are kept.
 
     mesh = (xnodes, VX, Vnode, Vsign, Vtcol, Vc, VR, Vh): collocation points and the virtual elements
@@ -596,7 +596,9 @@ def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out)
     (``kernels``); cache = (use_cache, cidx, ckeys, cmeta, cpoolP, cpoolU, qinv, cache_max): the element
     cache (``new_cache``); work: ``new_work``; ``dropped`` (2,) the largest dropped magnitude of H and of
     G; out = (hout, gout, loc, hflat): the per-lag block CSR arrays of H and G (``_emit_lag``), a node's place
-    among the rank's rows and those of H's flat part (``_emit_split``; hflat[5] < 0: H not split).
+    among the rank's rows and those of H's flat part (``_emit_split``; hflat[5] < 0: H not split); cand =
+    (ptr, elements, r0): row ii's candidate elements elements[ptr[r0 + ii]:ptr[r0 + ii + 1]] (``windows.candidates``,
+    ascending; an empty ptr: every element).
 
     Per row: first every pair (row, virtual element) whose wave window reaches lags lag_lo..L is
     listed with where its element integrals are (the element cache, or integrated now: into the
@@ -627,11 +629,14 @@ def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out)
     pool_n, upool_n = _pool_end(cmeta, ncache)
     key = np.zeros(27, np.int64)
     sg = (_image_signs(mesh[3], pattern[1]), _image_signs(mesh[3], pattern[3]))
+    cptr, cel, r0 = cand
+    use_c = cptr.shape[0] > 0
     for ii in range(rows.shape[0]):
         i = rows[ii]
         store = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, 0)
+        vl = cel[cptr[r0 + ii]:cptr[r0 + ii + 1]] if use_c else cel[:0]
         npair, n_ev, n_hit, store = _row_pairs(mesh[0][i], mesh, lags, phys, quad, kern, cfg, key, dropped, bufs,
-                                               pairs, store)
+                                               pairs, store, vl, use_c)
         ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, _ = store
         nev += n_ev
         hits += n_hit
@@ -642,17 +647,18 @@ def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out)
 
 
 @njit(cache=True)
-def _row_pairs(xc, mesh, lags, phys, quad, kern, cfg, key, dropped, bufs, pairs, store):
+def _row_pairs(xc, mesh, lags, phys, quad, kern, cfg, key, dropped, bufs, pairs, store, vl, use_vl):
     """The pairs (collocation point xc, virtual element) of one row whose wave window reaches lags
     lag_lo..L, listed in ``pairs`` (element, lo, hi, want_u, where (0: cache pools, 1: scratch), P slot,
     U slot) with their integrals found in the cache or integrated now and stored (``_store_pair``);
-    cfg = (use_cache, cidx, qinv, cache_max). Returns (pairs listed, kernel evaluations, cache hits,
-    ``store`` updated)."""
+    cfg = (use_cache, cidx, qinv, cache_max); the elements visited: ``vl`` (ascending) with ``use_vl``, else
+    every one. Returns (pairs listed, kernel evaluations, cache hits, ``store`` updated)."""
     VX, Vtcol = mesh[1], mesh[4]
     use_cache, cidx, qinv, _ = cfg
     reach = phys[CP] * (phys[DT] * lags[1] + phys[TOFF])
     npair = nev = hits = 0
-    for v in range(VX.shape[0]):
+    for t in range(vl.shape[0] if use_vl else VX.shape[0]):
+        v = np.int64(vl[t]) if use_vl else np.int64(t)
         lo, hi, sing, ns = _window(xc, v, mesh, reach, lags, phys, quad)
         if lo > hi:
             continue
@@ -790,11 +796,12 @@ def _row_blocks(li, npair, pairs, lags, mesh, sg, kern, src, rowbuf, out):
 # pair there.
 
 @njit(cache=True)
-def enumerate_pairs(rows, mesh, lags, phys, quad, qinv, cache_max=1 << 62, stride=81):
+def enumerate_pairs(rows, mesh, lags, phys, quad, qinv, cache_max, stride, cand):
     """The distinct pair geometries that ``assemble_rows`` with a cache would store for ``rows`` (packs
-    as its), in the order it meets them, up to the same cache cap: (keys (m, 27), hashes (m,), meta
-    (m, 6) = [lo, hi, sing, ns, want_u, element], points (m, 3)). A hash met again with a different key
-    or lag window is left out (assemble_rows integrates such pairs itself, as it does now)."""
+    as its, ``cand`` its candidate elements), in the order it meets them, up to the same cache cap: (keys
+    (m, 27), hashes (m,), meta (m, 6) = [lo, hi, sing, ns, want_u, element], points (m, 3)). A hash met
+    again with a different key or lag window is left out (assemble_rows integrates such pairs itself, as it
+    does now)."""
     VX, Vtcol = mesh[1], mesh[4]
     nv = VX.shape[0]
     cidx = Dict.empty(key_type=types.int64, value_type=types.int64)
@@ -806,9 +813,12 @@ def enumerate_pairs(rows, mesh, lags, phys, quad, qinv, cache_max=1 << 62, strid
     pool_n = 0
     key = np.zeros(27, np.int64)
     reach = phys[CP] * (phys[DT] * lags[1] + phys[TOFF])
+    cptr, cel, r0 = cand
+    use_c = cptr.shape[0] > 0
     for ii in range(rows.shape[0]):
         xc = mesh[0][rows[ii]]
-        for v in range(nv):
+        for t in range(cptr[r0 + ii + 1] - cptr[r0 + ii] if use_c else nv):
+            v = np.int64(cel[cptr[r0 + ii] + t]) if use_c else np.int64(t)
             lo, hi, sing, ns = _window(xc, v, mesh, reach, lags, phys, quad)
             if lo > hi:
                 continue

@@ -13,7 +13,7 @@ from ..petsc import SSIError, collective, printf
 from ..monitor import Progress, event
 from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes, transient_bytes, peak_bytes,
                    pair_table, cache_counts)
-from .windows import bounding_spheres, estimate_blocks, plane_heights
+from .windows import bounding_spheres, estimate_blocks, plane_heights, candidates
 from . import symmetry
 from . import packs
 from .bsr import FULL, H4
@@ -511,7 +511,17 @@ class LagSet:
         triplets the kernel once held, at least one row."""
         return chunk_rows(self.mesh.n_nodes, lag_hi, len(self.rows))
 
-    def _share_cache(self, cache, pk, kern, qinv, dropped):
+    def candidates(self, rows, pk):
+        """(ptr, elements, 0) of ``rows``' candidate elements for the packs ``pk`` (``windows.candidates``: the
+        elements within the lags' P-wave reach, where it is a small share of the surface), or empty arrays: every
+        element (the assembly kernels' ``cand``)."""
+        from .packs import CP, DT, TOFF
+        phys = pk[2]
+        got = candidates(self.mesh.nodes[rows], self.Vc, self.VR,
+                         float(phys[CP] * (phys[DT] * pk[1][1] + phys[TOFF])))
+        return (got if got is not None else (np.zeros(0, np.int64), np.zeros(0, np.int32))) + (0,)
+
+    def _share_cache(self, cache, pk, kern, qinv, dropped, cand):
         """Collective: fill this rank's element cache (``cache``: cidx, ckeys, cmeta, cpP, cpU, as from
         assemble.new_cache) for the assembly of ``pk`` (mesh, lags, phys, quad: ``kernel_packs``) with the
         kernels of ``kern`` (``kernels``) with every distinct pair geometry its rows meet,
@@ -528,7 +538,7 @@ class LagSet:
         sP, sU = 9 * len(kern[1][0]), 9 * len(kern[1][2])       # doubles a lag slot (assemble._compact)
         with collective(self.comm, "listing the element-cache geometries"):     # e.g. MemoryError on one rank
             keys, hs, meta, pts = enumerate_pairs(self.rows, mesh, lags, phys, quad, qinv, self.CACHE_MAX,
-                                                  max(sP, sU))
+                                                  max(sP, sU), cand)
         owner = np.mod(_mix64(hs), p)
         mine = [np.nonzero(owner == r)[0] for r in range(p)]
         got = mpi.alltoall([(keys[i], hs[i], meta[i], pts[i]) for i in mine])
@@ -612,10 +622,11 @@ class LagSet:
         hits = 0
         pk = self.kernel_packs(lag_lo, lag_hi, toff)
         kern = self.kernels(pk[3])
+        cand = self.candidates(rows, pk)
         if o.get("cache", True) and o.get("cache_share", True) and self.comm.getSize() > 1:
             with event("SSI_BEM_Integrate"):
                 ckeys, cmeta, cpP, cpU, nev = self._share_cache((cidx, ckeys, cmeta, cpP, cpU), pk, kern, qinv,
-                                                                dropped)
+                                                                dropped, cand)
             release_freed()         # the integrals' temporaries and messages: not resident through the assembly
         work = new_work(self.mesh.n_nodes, self.regions.n_t, len(self.VX), mH=mH, mG=mG)
         hout = H.out() if keep_h else H.out()[:5] + (-1,)
@@ -625,7 +636,8 @@ class LagSet:
         out = (hout, G.out(), H.loc, H.flat.out() if isinstance(H, SplitBuckets) else hout[:5] + (-1,))
         for s in range(0, len(rows), chunk):
             cache = (bool(o.get("cache", True)), cidx, ckeys, cmeta, cpP, cpU, qinv, self.CACHE_MAX)
-            work, n_ev, n_hit, cache = assemble_rows(rows[s:s + chunk], *pk, kern, cache, work, dropped, out)
+            work, n_ev, n_hit, cache = assemble_rows(rows[s:s + chunk], *pk, kern, cache, work, dropped, out,
+                                                     cand[:2] + (s,))
             ckeys, cmeta, cpP, cpU = cache[2:6]
             nev += n_ev
             hits += n_hit
