@@ -76,6 +76,8 @@ def near_pairs(xc, Vc, VR, L, mat, dt, n_images=1):
 # about NEAR_PAIRS point-element pairs a call
 NEAR_SHARE = 0.2
 NEAR_PAIRS = 2e6
+# the assembly's candidate lists (``candidates``) at most about this many elements over a rank's rows (64 MB)
+CANDIDATES_MAX = 16e6
 
 
 def candidates(pts, Vc, VR, reach):
@@ -84,14 +86,15 @@ def candidates(pts, Vc, VR, reach):
     1,) int64, elements int32 ascending in each point's list), found by a k-d tree over the spheres' centres
     within reach + the largest radius (a superset of the pairs the assembly keeps, by a relative 1e-9 of
     margin: the same pairs as the loop over every element, in the same order). None where the reach covers
-    NEAR_SHARE of the surface or more (the loop over every element is then as cheap): the step matrix's lags
+    NEAR_SHARE of the surface or more (the loop over every element is then as cheap), or where the lists would
+    hold more than about CANDIDATES_MAX elements (4 bytes each, not in the memory estimate): the step matrix's lags
     1-2 on a large grid visit O(points) pairs instead of O(points x elements) (the 100 m site's lags 1-2:
     its assembly grew as N^1.9 before)."""
     if not len(Vc) or not len(pts) or reach <= 0.0:      # (no pair: every sphere at distance >= reach)
         return np.zeros(len(pts) + 1, np.int64), np.zeros(0, np.int32)
     area = np.prod(np.ptp(Vc[:, :2], axis=0) + 2 * float(np.max(VR)))
     r = (float(reach) + float(np.max(VR))) * (1.0 + 1e-9) + 1e-12
-    if np.pi * r ** 2 >= NEAR_SHARE * area:
+    if np.pi * r ** 2 >= NEAR_SHARE * area or len(pts) * len(Vc) * np.pi * r ** 2 / area > CANDIDATES_MAX:
         return None
     from scipy.spatial import cKDTree
     tree = cKDTree(Vc)

@@ -195,6 +195,8 @@ def test_candidate_elements_assemble_the_arrays_of_every_element(lag_hi, monkeyp
         assert np.all(np.diff(mine) > 0)
         assert set(np.flatnonzero(d[i] - ls.VR < reach)) <= set(mine.tolist())
     assert ptr[-1] < d.size                   # (fewer than every pair)
+    monkeypatch.setattr(windows, "CANDIDATES_MAX", 0.0)     # (lists over the cap: every element, no lists)
+    assert windows.candidates(mesh.nodes, ls.Vc, ls.VR, reach) is None
 
 
 @pytest.mark.parametrize("L", [1, 2, 5, 12])
