@@ -125,12 +125,14 @@ class Progress:
         self.model = None                # k -> predicted seconds of items 1..k (``expect``)
         self.warned = False
 
-    def expect(self, model, ranks_here=1, what="the run's prediction"):
+    def expect(self, model, ranks_here=1, what="the run's prediction", fit=None):
         """Compare the measured time with ``model`` (k -> predicted seconds of items 1..k) at every
-        report, and warn once when it runs more than SLOW times above it (``slow_warning``), the time
-        spent compiling numba kernels in the loop left out (``compile_seconds``); ``ranks_here``: the
-        ranks sharing this node's cores."""
-        self.model, self.ranks_here, self.model_what = model, int(ranks_here), what
+        report, and warn once when it runs more than SLOW times above it (``slow_warning``; ``fit``: how
+        to refit the model, its default when None), the time spent compiling numba kernels in the loop
+        left out (``compile_seconds``); ``ranks_here``: the ranks sharing this node's cores. The eta of
+        the progress line then follows the model's shape (a history sum whose steps grow with the lags
+        in use) at the measured pace, not a straight line from the steps done."""
+        self.model, self.ranks_here, self.model_what, self.model_fit = model, int(ranks_here), what, fit
         self.compile0 = compile_seconds()
 
     def update(self, k, extra=""):
@@ -144,12 +146,16 @@ class Progress:
         el = time.perf_counter() - self.t0
         if self.enabled:
             eta = el / max(k - self.first, 1) * (self.total - k)
+            if self.model is not None:          # the model's remaining steps at the measured pace
+                done = self.model(k) - self.model(self.first)
+                if done > 0:
+                    eta = el * (self.model(self.total) - self.model(k)) / done
             printf(f"[ssi] {self.what}: {self.unit} {k}/{self.total} ({100.0 * k / self.total:5.1f}%) "
                    f"elapsed {fmt_time(el)} eta {fmt_time(eta)}{(' ' + extra) if extra else ''}", self.comm)
         if self.model is not None and not self.warned:
             pred = self.model(k) - self.model(self.first)
             msg = slow_warning(el - (compile_seconds() - self.compile0), pred, k - self.first, self.ranks_here,
-                               self.model_what, self.unit)
+                               self.model_what, self.unit, fit=getattr(self, "model_fit", None))
             if msg:
                 self.warned = True
                 from .petsc import warn
@@ -164,11 +170,12 @@ SLOW_MIN_S = 2.0      # ... once the loop has run this long (start-up noise) and
 
 
 def slow_warning(elapsed, predicted, items, ranks_here, what="the run's prediction", unit="step", load=None,
-                 cores=None):
+                 cores=None, fit=None):
     """The warning (one line) when ``elapsed`` seconds for ``items`` items run more than SLOW times
     above ``predicted``, naming the likely cause and what to try, or None. ``ranks_here``: the
     ranks sharing this node's cores; ``load``: the 1-minute load average and ``cores`` this machine's
-    (read here when None)."""
+    (read here when None); ``fit``: how to refit the model (default: the dense store's constants,
+    jobscripts/calibrate.py)."""
     import os
     if items < 5 or elapsed < SLOW_MIN_S or not predicted > 0 or elapsed <= SLOW * predicted:
         return None
@@ -189,7 +196,7 @@ def slow_warning(elapsed, predicted, items, ranks_here, what="the run's predicti
                        "fewer ranks (-n 1 may then be the faster)")
     return head + (f"the machine is not visibly loaded (load average {load:.1f} on {cores} cores), so the cost model's "
                    "constants may not fit it or this case: check petsc-ssi estimate, and fit the constants with "
-                   "jobscripts/calibrate.py (-ssi_estimate_constants)")
+                   + (fit or "jobscripts/calibrate.py (-ssi_estimate_constants)"))
 
 
 def fmt_time(s):

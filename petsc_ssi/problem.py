@@ -519,7 +519,8 @@ class TransientProblem:
         if model is None or rec is None or est is None:
             return
         rec.progress.progress.expect(model, getattr(prob, "ranks_here", 1),
-                                     f"the run's prediction ({est[2]}, bem/cost.py)")
+                                     f"the run's prediction ({est[2]}, {getattr(prob, 'loop_source', 'bem/cost.py')})",
+                                     getattr(prob, "loop_fit", None))
 
     def announce_loop(self):
         """Collective, before the set-up: one line with the number of steps and, where a model
@@ -545,7 +546,8 @@ class TransientProblem:
             model = self.loop_model()
             left = est[0] - (model(self.n) if model is not None and self.n else 0.0)
             line += (f"; predicted {f'{left:.3g} s' if left < 60 else fmt_time(left)} ({est[2]}: about {est[1]:.2g} s per step once every stored lag "
-                     "is in the history sum, and the field snapshots; the model of petsc-ssi estimate, bem/cost.py)")
+                     "is in the history sum, and the field snapshots; the model of petsc-ssi estimate, "
+                     f"{getattr(getattr(self, 'prob', None), 'loop_source', 'bem/cost.py')})")
         printf(line)
 
     def run(self):

@@ -42,6 +42,29 @@ def test_progress_warns_once_against_its_model(monkeypatch, capfd):
     assert "for 10 steps" in out
 
 
+def test_the_eta_follows_the_model_at_the_measured_pace(monkeypatch, capfd):
+    """With a model the progress line's eta is the model's remaining time scaled by the measured pace: a
+    history sum whose step k costs k (the lags in use grow), measured at 10 s for each unit of the model, has
+    10 x (sum 21..40 of k) = 6100 s to go after step 20, where a straight line from the steps done (2100 s for
+    20) says 2100 s;
+    without a model the straight line stays. A toeplitz run's warning names its own fit (``fit``)."""
+    import re
+    model = lambda k: 0.5 * k * (k + 1)                     # step k costs k
+    for with_model in (True, False):
+        t = {"now": 0.0}
+        monkeypatch.setattr(monitor.time, "perf_counter", lambda: t["now"])
+        p = monitor.Progress("time loop", 40, every=20)
+        if with_model:
+            p.expect(model, ranks_here=1)
+        for k in range(1, 41):
+            t["now"] = 10.0 * model(k)
+            p.update(k)
+        etas = re.findall(r"step 20/40 .* eta (\S+)", capfd.readouterr().out)
+        assert etas == (["1h41m"] if with_model else ["35m00s"]), etas         # 6100 s; 2100 s
+    msg = monitor.slow_warning(40.0, 10.0, 100, 1, load=0.2, cores=2, fit="jobscripts/toeplitz_fit.py")
+    assert "jobscripts/toeplitz_fit.py" in msg and "calibrate.py" not in msg
+
+
 def test_the_warning_comes_without_monitor_too(monkeypatch, capfd):
     """Issue 44: `-n 2` ran 3-10 times slower than `-n 1` on shared cores with no word when -ssi_monitor was
     off: the progress line stays off, the warning (once) does not."""

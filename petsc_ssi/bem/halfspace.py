@@ -681,6 +681,9 @@ class HalfSpace:
         cum = np.concatenate(([0.0], np.cumsum(steps)))
         self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + one * k
         self.loop_estimate = (t_hist + one * self.n_steps, float(steps[-1]) + one if len(steps) else one)
+        self.ranks_here = int(round(share * p))         # (the slow-run warning's oversubscription test)
+        self.loop_source = "bem/toeplitz.py estimate and step_lu"
+        self.loop_fit = "jobscripts/toeplitz_fit.py (bem/toeplitz.py RATES and STEP_RATES)"
 
     def quad_options(self):
         c = self.cfg

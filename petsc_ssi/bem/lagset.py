@@ -528,7 +528,8 @@ class LagSet:
         each integrated once over all ranks. A geometry's owner is its hash modulo the ranks; requests
         go to the owners (all-to-all of keys), the owner integrates the representative of the lowest
         requesting rank (the pair a single rank would meet first, so -n p reproduces -n 1) and sends
-        the blocks back (all-to-all-v of doubles). Returns the cache arrays and the owned evaluations."""
+        the blocks back (all-to-all-v of doubles); ``cand``: the rows' candidate elements (``candidates``,
+        as the assembly's). Returns the cache arrays and the owned evaluations."""
         cidx, ckeys, cmeta, cpP, cpU = cache
         if index_len(cidx):             # (the same on every rank: assemble() passes a new cache)
             raise RuntimeError("_share_cache fills an empty element cache only")

@@ -212,11 +212,12 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 RATES = {"r_products": 1.45e10, "t_step_dof": 2.36e-7, "t_step_grid": 0.0, "t_step_elem": 0.0,
          "t_pair_lag": 1.43e-6, "t_pair_int": 0.0, "r_sums": 8.5e10, "fill_bytes": 1620.0, "g_pair_factor": 1.17,
          "r_sums_span": 4.82e10}
-# The step matrix's LU on a uniform grid (``step_lu``: the coupled estimate's factor_s and solve_s, where the dense
+# The step matrix's LU on a uniform grid (``step_lu``, ``step_lu_of``: the estimate's factor_s and solve_s and the runs'
+# loop predictions, BEM and coupled, where the dense
 # model's c_fac N^1.5 and c_sol N ln N, fitted on small graded meshes, put the 72 m building's at 7.7 and 21.3 s
 # against 5.3 and 12.1 s measured before the mirror blocks): entries in the factors E = step_fill n rho^2
-# ln(n / rho^2) per independent block of n DOFs (rho = the step matrix's reach over the node spacing: the
-# coupled columns' ``geometric_reach``; a mirror-symmetric surface's 2 or 4 blocks, ``bem.mirror``), a step's
+# ln(n / rho^2) per independent block of n DOFs (rho = the step matrix's reach over the node spacing,
+# ``geometric_reach``; a mirror-symmetric surface's 2 or 4 blocks, ``bem.mirror``), a step's
 # solve t_solve_entry s an entry on 2 ranks (block low-rank from 20 000 DOFs, full rank below), the assembly and
 # factorisation t_factor_entry s an entry. Fitted to the building's uniform grids (2026-11-30 06:33-06:38,
 # jobscripts/building_uniform.sh, logs out/bench/building_uniform/uniform-36, -72, -72-fullrank; step_fill the

@@ -220,15 +220,15 @@ class Coupler:
         self.uffI = np.zeros(3 * nI)
 
     def destroy(self):
-        """Collective: the PETSc objects the coupler made (its vectors, scatter and interface operator, the
-        mirror images' signed permutations), at the end of the run, on every rank in the same order (not left
+        """Collective: the PETSc objects the coupler made (its force matrix, vectors, scatter and interface
+        operator, the mirror images' signed permutations), at the end of the run, on every rank in the same order (not left
         to the garbage collector, whose order the ranks need not share)."""
         for mz in (self.Zmir, getattr(self, "DEmir", None)):
             if mz is not None:
                 mz.destroy()
         self.Zmir = self.DEmir = None
         self.Top.destroy()
-        for o in (self.seq_y, self.sc_be, self.ff, self.du, self._kv_initial, self._r, self._dkv, self._t):
+        for o in (self.F, self.seq_y, self.sc_be, self.ff, self.du, self._kv_initial, self._r, self._dkv, self._t):
             o.destroy()
 
     def solver_cap(self):

@@ -178,12 +178,18 @@ def test_candidate_elements_assemble_the_arrays_of_every_element(lag_hi, monkeyp
             pk = ls.kernel_packs(1, lag_hi, 0.0)
             cand = ls.candidates(ls.rows, pk)
             assert (len(cand[0]) > 0) == (share > 0)
-            ls.assemble(lag_hi=lag_hi)
+            ls.assemble(lag_hi=lag_hi, chunk=7)          # (chunks: each call's rows from its offset in the lists)
             got[share, cache] = [B.csr(l) for B in (ls.H, ls.G) for l in range(1, lag_hi + 1)]
+        # the shared cache's listing of geometries (enumerate_pairs, more than one rank): the same with the lists
+        from petsc_ssi.bem.assemble import enumerate_pairs
+        qinv = 1.0 / (1e-9 * float(ls.Vh.min()))
+        got[share, "pairs"] = enumerate_pairs(ls.rows, *pk[:4], qinv, ls.CACHE_MAX, 81, cand)
     for cache in (True, False):
+        assert len(got[0.0, cache]) == len(got[1e9, cache])
         for a, b in zip(got[0.0, cache], got[1e9, cache]):
-            for x, y in zip(a, b):
-                assert np.array_equal(x, y)
+            assert len(a) == len(b) == 3 and all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert all(np.array_equal(x, y) for x, y in zip(got[0.0, "pairs"], got[1e9, "pairs"]))
+    assert len(got[0.0, "pairs"][0]) > 0
     assert sum(len(a[1]) for a in got[0.0, True]) > 0
     # the lists: ascending, and every element within reach + its radius of the point is in them
     phys = pk[2]
