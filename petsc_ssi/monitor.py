@@ -131,7 +131,8 @@ class Progress:
         to refit the model, its default when None), the time spent compiling numba kernels in the loop
         left out (``compile_seconds``); ``ranks_here``: the ranks sharing this node's cores. The eta of
         the progress line then follows the model's shape (a history sum whose steps grow with the lags
-        in use) at the measured pace, not a straight line from the steps done."""
+        in use) at the pace measured since the last report (the first steps' one-time costs, first
+        touches of the kept states, not extrapolated), not a straight line from the steps done."""
         self.model, self.ranks_here, self.model_what, self.model_fit = model, int(ranks_here), what, fit
         self.compile0 = compile_seconds()
 
@@ -146,10 +147,12 @@ class Progress:
         el = time.perf_counter() - self.t0
         if self.enabled:
             eta = el / max(k - self.first, 1) * (self.total - k)
-            if self.model is not None:          # the model's remaining steps at the measured pace
-                done = self.model(k) - self.model(self.first)
-                if done > 0:
-                    eta = el * (self.model(self.total) - self.model(k)) / done
+            if self.model is not None:          # the model's remaining steps at the pace of the last report's
+                k0, e0 = getattr(self, "_last", None) or (self.first, 0.0)      # steps (one-time costs behind)
+                done = self.model(k) - self.model(k0)
+                if done > 0 and el > e0:
+                    eta = (el - e0) * (self.model(self.total) - self.model(k)) / done
+            self._last = (k, el)
             printf(f"[ssi] {self.what}: {self.unit} {k}/{self.total} ({100.0 * k / self.total:5.1f}%) "
                    f"elapsed {fmt_time(el)} eta {fmt_time(eta)}{(' ' + extra) if extra else ''}", self.comm)
         if self.model is not None and not self.warned:

@@ -46,7 +46,7 @@ def test_the_eta_follows_the_model_at_the_measured_pace(monkeypatch, capfd):
     """With a model the progress line's eta is the model's remaining time scaled by the measured pace: a
     history sum whose step k costs k (the lags in use grow), measured at 10 s for each unit of the model, has
     10 x (sum 21..40 of k) = 6100 s to go after step 20, where a straight line from the steps done (2100 s for
-    20) says 2100 s;
+    20) says 2100 s; the pace is that of the steps since the last report (a one-time cost before them left out);
     without a model the straight line stays. A toeplitz run's warning names its own fit (``fit``)."""
     import re
     model = lambda k: 0.5 * k * (k + 1)                     # step k costs k
@@ -61,6 +61,16 @@ def test_the_eta_follows_the_model_at_the_measured_pace(monkeypatch, capfd):
             p.update(k)
         etas = re.findall(r"step 20/40 .* eta (\S+)", capfd.readouterr().out)
         assert etas == (["1h41m"] if with_model else ["35m00s"]), etas         # 6100 s; 2100 s
+    # a one-time cost in the first steps (1000 s before step 1): the eta after the second report is the pace of
+    # the steps since the first (10 s a unit), not diluted by it: 10 x (820 - 465) = 3550 s after step 30
+    t = {"now": 0.0}
+    p = monitor.Progress("time loop", 40, every=10)
+    p.expect(model, ranks_here=1)
+    for k in range(1, 41):
+        t["now"] = 1000.0 + 10.0 * model(k)
+        p.update(k)
+    etas = re.findall(r"step 30/40 .* eta (\S+)", capfd.readouterr().out)
+    assert etas == ["59m10s"], etas
     msg = monitor.slow_warning(40.0, 10.0, 100, 1, load=0.2, cores=2, fit="jobscripts/toeplitz_fit.py")
     assert "jobscripts/toeplitz_fit.py" in msg and "calibrate.py" not in msg
 
