@@ -39,7 +39,6 @@ def terms(opts, ranks):
     """{term: count} of ``toeplitz.estimate`` for the case ``opts`` on ``ranks`` ranks."""
     from petsc_ssi.bem.halfspace import HalfSpace
     from petsc_ssi.bem.toeplitz import detect, estimate, kernel_offsets, traction_grid, RATES, block_of, step_lu_of
-    from petsc_ssi.bem.cost import load_constants
     PETSc, cfg = case_config(opts)
     with contextlib.redirect_stdout(io.StringIO()):
         if opts.get("problem") == "ssi":    # a coupled run: the soil of its set-up (the interface's tractions)
@@ -76,7 +75,7 @@ def terms(opts, ranks):
             # kernel products of the same event (SSI_BEM_HistInterp), flops a rank (at r_products in the model)
             "span": one(r_sums_span=1.0)[2], "interp_prod": _interp_products(lat, glat, plan, prob.n_steps, ranks, kw, cfg),
             # a step's solve with the step matrix's factors (the runs' model, toeplitz.step_lu_of), seconds
-            "solve": step_lu_of(cfg, prob, lat, ranks, kappa=load_constants()[0].get("kappa", 0.107))[2]}
+            "solve": step_lu_of(cfg, prob, lat, ranks)[2]}
 
 
 def _interp_products(lat, glat, plan, n_steps, ranks, kw, cfg):

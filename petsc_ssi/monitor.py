@@ -123,6 +123,8 @@ class Progress:
         self.t0 = time.perf_counter()
         self.first = 0                   # items done before t0 (a restarted run)
         self.model = None                # k -> predicted seconds of items 1..k (``expect``)
+        self.model_fit = None            # how to refit it (``slow_warning``)
+        self._last = None                # (item, elapsed) of the last report with a model (the eta's pace)
         self.warned = False
 
     def expect(self, model, ranks_here=1, what="the run's prediction", fit=None):
@@ -148,7 +150,7 @@ class Progress:
         if self.enabled:
             eta = el / max(k - self.first, 1) * (self.total - k)
             if self.model is not None:          # the model's remaining steps at the pace of the last report's
-                k0, e0 = getattr(self, "_last", None) or (self.first, 0.0)      # steps (one-time costs behind)
+                k0, e0 = self._last or (self.first, 0.0)                         # steps (one-time costs behind)
                 done = self.model(k) - self.model(k0)
                 if done > 0 and el > e0:
                     eta = (el - e0) * (self.model(self.total) - self.model(k)) / done
@@ -158,7 +160,7 @@ class Progress:
         if self.model is not None and not self.warned:
             pred = self.model(k) - self.model(self.first)
             msg = slow_warning(el - (compile_seconds() - self.compile0), pred, k - self.first, self.ranks_here,
-                               self.model_what, self.unit, fit=getattr(self, "model_fit", None))
+                               self.model_what, self.unit, fit=self.model_fit)
             if msg:
                 self.warned = True
                 from .petsc import warn

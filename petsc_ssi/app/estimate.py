@@ -204,8 +204,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                      "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
     # the step matrix's LU (toeplitz.step_lu_of): its entries, mirror blocks; a solve a step in the loop
     from ..bem.toeplitz import step_lu_of
-    from ..bem.cost import load_constants
-    kappa = (c if c is not None else load_constants(cfg.get("estimate_constants", ""))[0]).get("kappa", 0.107)
+    kappa = c.get("kappa") if c is not None else None       # (the coupled estimate's constants, else the run's)
     ent, _, _, rho, nblk = step_lu_of(cfg, prob, lat, 2)
     lines.insert(3 if cc is not None else 2,
                  f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach {rho:.3g} node "
@@ -241,7 +240,6 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     if cfg.get("lag_store", "dense") == "dense":
         return []
     from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of, step_lu_of
-    from ..bem.cost import load_constants
     from ..petsc import SSIError
     try:
         if not cnt.lagset.flat:
@@ -254,12 +252,11 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s factor_s solve_s | GB over "
            "the ranks beside the processes"]
     g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
-    kappa = load_constants(cfg.get("estimate_constants", ""))[0].get("kappa", 0.107)
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single")
-        _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
+        _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p)
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} | {b / 1e9:7.3g}")
     return out
 

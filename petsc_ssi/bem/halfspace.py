@@ -661,7 +661,6 @@ class HalfSpace:
         (``toeplitz.estimate``), and predict its time loop (``loop_estimate``, ``loop_model``: the history sum
         step by step and a solve with the step matrix's factors each step, ``toeplitz.step_lu_of``;
         ``step_solve_s``: that solve's seconds)."""
-        from .cost import load_constants
         from .toeplitz import step_lu_of
         c = self.cfg
         self.lag_fill = c.lag_fill
@@ -676,8 +675,7 @@ class HalfSpace:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
                            "per node); use -ssi_interp, a shorter -ssi_t_end, a coarser grid or more nodes")
-        kappa = load_constants(c.get("estimate_constants", ""))[0].get("kappa", 0.107)
-        one = self.step_solve_s = step_lu_of(c, self, self.lattice, p, kappa=kappa)[2]
+        one = self.step_solve_s = step_lu_of(c, self, self.lattice, p)[2]
         cum = np.concatenate(([0.0], np.cumsum(steps)))
         self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + one * k
         self.loop_estimate = (t_hist + one * self.n_steps, float(steps[-1]) + one if len(steps) else one)

@@ -249,12 +249,16 @@ def geometric_reach(cfg, prob):
     return prob.mat.cp * t + diam
 
 
-def step_lu_of(cfg, prob, lat, ranks, kappa=0.107):
+def step_lu_of(cfg, prob, lat, ranks, kappa=None):
     """(entries, factorisation seconds, seconds a solve, reach in node spacings, blocks) of the soil's step
     matrix on the toeplitz store's uniform grid ``lat`` (``step_lu``: its reach, ``geometric_reach`` over the
     node spacing, and the mirror-symmetric blocks the run would use, ``mirror.blocks_of``), for ``petsc-ssi
-    estimate`` and the runs' own predictions (BEM and coupled) alike."""
+    estimate`` and the runs' own predictions (BEM and coupled) alike; ``kappa`` (a solve's growth with the
+    ranks): the estimate constants' (-ssi_estimate_constants) unless given."""
     from .mirror import blocks_of
+    if kappa is None:
+        from .cost import load_constants
+        kappa = load_constants(cfg.get("estimate_constants", ""))[0].get("kappa", 0.107)
     nblk = blocks_of(prob) if str(cfg.get("step_mirror", "auto")).lower() != "off" else 1
     rho = geometric_reach(cfg, prob) / (0.5 * float(min(lat.h)))
     ent, fac, one = step_lu(3 * prob.mesh.n_nodes, rho, nblk, ranks, kappa=kappa)
@@ -351,7 +355,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     ring = 8.0 * n_dofs * ((int(L) + 2 + 31) + ranks * (2 + 3 + 32))
     factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
     nbytes = float(g_bytes) + ring + factors
-    build = t_build = flops = sums = sums_span = 0.0
+    build = t_build = sums = sums_span = 0.0
     n = np.arange(1, n_steps + 1)
     ramp = np.zeros(n_steps)
     isteps, iwork, ispan = interp_work(plan, n_steps, block, stabilized)
@@ -371,7 +375,6 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         # planes' scatter, transforms and exchange, t_pair_lag for 9 slots: 5 of them with real kernels)
         t_build += ((r["t_pair_lag"] * (5.0 if kp == 1.0 else 9.0) / 9.0 + r["t_pair_int"]) * pairs * (D + k) / ranks
                     * (r["g_pair_factor"] if m == 180 else 1.0))
-        flops += 4.0 * kp * m * Fl * (float(np.minimum(np.maximum(n - 1, 0), D).sum()) + k * isteps)
         ramp += 4.0 * kp * m * Fl * (np.minimum(np.maximum(n - 1, 0), D) + k * isteps / max(n_steps, 1))
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
@@ -383,7 +386,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     elems = sum(g.cell.size for g in (lat, glat) if g is not None)       # virtual elements: images too
     even = sums / (ranks * r["r_sums"]) + sums_span / (ranks * r["r_sums_span"])
     each = n_dofs * r["t_step_dof"] + grid * r["t_step_grid"] + elems * r["t_step_elem"]
-    t_hist = flops / (ranks * r["r_products"]) + even + n_steps * each
+    t_hist = float(ramp.sum()) / (ranks * r["r_products"]) + even + n_steps * each
     if per_step:
         steps = ramp / (ranks * r["r_products"]) + even / max(n_steps, 1) + each
         return nbytes + build, t_build, t_hist, steps
