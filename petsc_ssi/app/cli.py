@@ -255,8 +255,8 @@ def main(argv=None):
         if type(exc).__module__.startswith("petsc4py") and not debug():
             # PETSc stopped (an option's value it refuses, a failed solver set-up, ...): one line with where and
             # PETSc's own message, on each rank that met it (maybe not all of them: then Abort)
-            print(f"petsc-ssi: error: PETSc stopped with error code {getattr(exc, 'ierr', '?')} in "
-                  f"{_where(exc)}{_petsc_message(exc)} (-ssi_debug for the traceback)", flush=True)
+            _whole_line(f"petsc-ssi: error: PETSc stopped with error code {getattr(exc, 'ierr', '?')} in "
+                        f"{_where(exc)}{_petsc_message(exc)} (-ssi_debug for the traceback)")
         else:
             traceback.print_exc()
         sys.stderr.flush()
@@ -265,6 +265,15 @@ def main(argv=None):
             comm.Abort(1)
         return 1
     return 0
+
+
+def _whole_line(text):
+    """``text`` and its newline to stdout in one write (Python's buffered output flushed first): each rank that
+    meets an error prints its line, and two ranks' lines came out run together, one's text straight after the
+    other's, with the line written in parts (a CI run of 1a9c676)."""
+    import os
+    sys.stdout.flush()
+    os.write(sys.stdout.fileno(), (text + "\n").encode())
 
 
 def _petsc_message(exc):
