@@ -15,8 +15,10 @@ export OMP_NUM_THREADS ?= 1
 # for make and for direct calls; `make deps` fills it (petsc_ssi/app/warmup.py)
 APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5py-mpi \
             python3-slepc4py python3-slepc4py-real3.18 python3-scipy python3-venv \
-            openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1
-PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy pyflakes
+            openmpi-bin libglu1-mesa libxcursor1 libxft2 libxinerama1 libfftw3-dev
+# mpi4py-fft: the toeplitz store's distributed FFTs (petsc_ssi/bem/pfft.py); it builds against FFTW
+# (libfftw3-dev above)
+PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy pyflakes mpi4py-fft
 # pytest workers of `make test` (pytest-xdist, whole test files to a worker): the suite is mostly
 # serial Python and short mpiruns, so 2 workers on a 2-core machine took it from 900-940 s to 545 s.
 # The slow tier stays serial (its cases hold GBs each). TEST_JOBS=0: no workers, one process.
@@ -30,7 +32,8 @@ all: test
 # System packages (PETSc 3.18 with MUMPS/hypre/HDF5 from Debian), then the venv.
 .deps/apt.stamp:
 	@mkdir -p .deps
-	@if ! /usr/bin/python3 -c "import petsc4py, mpi4py, h5py, scipy, slepc4py" 2>/dev/null; then \
+	@if ! /usr/bin/python3 -c "import petsc4py, mpi4py, h5py, scipy, slepc4py" 2>/dev/null \
+	    || [ ! -f /usr/include/fftw3.h ]; then \
 	  echo "[deps] installing Debian packages: $(APT_PKGS)"; \
 	  SUDO=$$( [ $$(id -u) -eq 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $(APT_PKGS) >/dev/null; \
@@ -48,7 +51,7 @@ $(VENV)/.stamp: .deps/apt.stamp setup.py Makefile
 	@# gmsh's pip script starts '#!/usr/bin/env python' (the system python without the venv active):
 	@# point it at the venv's python, so .venv/bin/gmsh runs as it is
 	@[ ! -f $(VENV)/bin/gmsh ] || sed -i '1s|^#!.*python.*$$|#!$(abspath $(PY))|' $(VENV)/bin/gmsh
-	@$(PY) -c "import petsc4py, mpi4py, numba, gmsh, matplotlib; print('[deps] ok: petsc4py', petsc4py.__version__, 'numba', numba.__version__, 'gmsh', gmsh.__version__)"
+	@$(PY) -c "import petsc4py, mpi4py, mpi4py_fft, numba, gmsh, matplotlib; print('[deps] ok: petsc4py', petsc4py.__version__, 'numba', numba.__version__, 'gmsh', gmsh.__version__)"
 	@touch $@
 
 deps: $(VENV)/.stamp

@@ -12,7 +12,7 @@ setup(
     description="3D non-linear time-domain FEM-BEM soil-structure interaction on PETSc",
     packages=find_packages(include=["petsc_ssi", "petsc_ssi.*"]),
     python_requires=">=3.9",
-    install_requires=["numpy", "numba", "matplotlib"],
+    install_requires=["numpy", "numba", "matplotlib", "mpi4py-fft"],
     extras_require={"mesh": ["gmsh"], "test": ["pytest"], "seismic": ["obspy"]},
     entry_points={"console_scripts": ["petsc-ssi = petsc_ssi.app.cli:main"]},
 )

@@ -24,11 +24,12 @@ is bitwise the run that saved them when the solves are deterministic (one rank, 
 
 On the toeplitz store (``bem.toeplitz``) the file holds the step matrix, lags 1-2 (H and G) and, after them,
 each side's kernels (the exact lags' K9, K18 and the interpolating matrices' anchors A9, A18) as one MPI Vec
-each, frequency-major: (frequencies of the whole spectrum, rows, columns, parts), the lanes' padding dropped
-(``to_file``), its shape in ``FILE.json``. Each rank writes its slab and reads the slab of the loading run's
+each, frequency-major: (frequencies of the whole spectrum in the k_y-major order of ``bem.pfft``, rows, columns,
+parts), the lanes' padding dropped (``to_file``), its shape and FFT grid in ``FILE.json``. Each rank writes its slab and reads the slab of the loading run's
 rank count (``from_file``), so the file loads on any number of ranks, as the dense store's does; the loading
-run integrates nothing (``tests/bem/test_toeplitz.py``). A toeplitz file of the earlier layout (the saving
-run's lane groups, its rank count in the key) is refused in one line.
+run integrates nothing (``tests/bem/test_toeplitz.py``). A toeplitz file of an earlier layout (the saving
+run's lane groups, its rank count in the key; or the k_x-major order before the transforms went over the ranks,
+key ``toeplitz_kernels`` "frequency-major") is refused in one line.
 """
 import hashlib
 import json
@@ -39,6 +40,9 @@ import numpy as np
 from ..petsc import init, collective, collective_io, SSIError
 
 FORMAT = 3          # 3: lags in their block pattern (2: full MPIBAIJ blocks; 1: no CRC32s; both refused)
+
+# the toeplitz kernels' order in the file: frequency-major, k_y-major (``bem.pfft``: each rank's slab a run of it)
+KERNEL_LAYOUT = "frequency-major, k_y-major"
 
 
 def _h(a):
@@ -67,7 +71,7 @@ def lag_key(cfg, prob, plan):
         key["interp"] = "none"
     if getattr(prob, "lattice", None) is not None:      # the toeplitz store: its kernels frequency-major
         key["lag_store"] = "toeplitz"
-        key["toeplitz_kernels"] = "frequency-major"
+        key["toeplitz_kernels"] = KERNEL_LAYOUT
     return key
 
 
@@ -193,7 +197,7 @@ def save(path, comm, march, key):
     kernels = _kernel_arrays(march)
 
     def write_kernels():
-        for _, a, slab in kernels:              # (each rank's frequencies of a side's kernels, one MPI Vec; one
+        for _, a, slab, _ in kernels:           # (each rank's frequencies of a side's kernels, one MPI Vec; one
             f = to_file(a, slab)                # kernel converted at a time: a copy of one, not of all)
             v = PETSc.Vec().createWithArray(f.ravel(), comm=comm)
             v.view(viewer)
@@ -204,7 +208,7 @@ def save(path, comm, march, key):
     collective_io(viewer.destroy, f"-ssi_lags_save {path}: closing the file", comm)
     import time
     from ..io.integrity import file_crcs, CHUNK
-    kshapes = [[comm.tompi4py().allreduce(slab)] + list(a.shape[1:-1]) for _, a, slab in kernels]  # (whole spectrum)
+    kshapes = [[comm.tompi4py().allreduce(slab)] + list(a.shape[1:-1]) for _, a, slab, _ in kernels]  # (whole spectrum)
     t0 = time.perf_counter()
     crcs = file_crcs(tmp, comm, CHUNK)           # of the bytes as written, every rank its pieces
     t_crc = time.perf_counter() - t0
@@ -220,7 +224,7 @@ def save(path, comm, march, key):
             manifest = {"format": FORMAT, "key": key, "mats": [[n, _kind(M)] for n, M in mats],
                         "ranks": comm.getSize(), "bytes": size, "crc32_chunk": CHUNK, "crc32": crcs}
             if kernels:
-                manifest["kernels"] = [[n, shapes] for (n, _, _), shapes in zip(kernels, kshapes)]
+                manifest["kernels"] = [[n, shapes, list(grid)] for (n, _, _, grid), shapes in zip(kernels, kshapes)]
             with open(path + ".json.tmp", "w") as fh:
                 json.dump(manifest, fh, indent=1)
             os.replace(path + ".json.tmp", path + ".json")
@@ -276,11 +280,11 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
     kernels = {}
 
     def read_kernels():
+        from .pfft import slab_counts
         r, p = comm.getRank(), comm.getSize()
-        for name, shape in manifest.get("kernels", []):
+        for name, shape, (Mx, My) in manifest.get("kernels", []):
             F = int(shape[0])
-            f0, f1 = (F * r) // p, (F * (r + 1)) // p          # (``ToeplitzHistory``'s slabs of this rank count)
-            mine = (f1 - f0,) + tuple(shape[1:])
+            mine = (int(slab_counts(Mx, My, p)[r]),) + tuple(shape[1:])     # (``ToeplitzHistory``'s slab here)
             v = PETSc.Vec().create(comm=comm)
             v.setSizes((int(np.prod(mine)), PETSc.DECIDE))
             v.setType(PETSc.Vec.Type.MPI)
@@ -298,12 +302,13 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
 
 
 def _kernel_arrays(march):
-    """[(name, this rank's array in lanes, its frequencies)] of the toeplitz store's kernels (``bem.toeplitz``:
+    """[(name, this rank's array in lanes, its frequencies, the FFT grid (Mx, My))] of the toeplitz store's kernels (``bem.toeplitz``:
     per side u and p, K9, K18 of the exact lags and A9, A18 of the interpolating matrices' anchors), in file
     order; [] on the dense store."""
     out = []
     for tz in getattr(march, "toeplitz", []):
-        out += [(f"{tz.side}:{n}", getattr(tz, n), tz.f1 - tz.f0) for n in ("K9", "K18", "A9", "A18")]
+        out += [(f"{tz.side}:{n}", getattr(tz, n), tz.f1 - tz.f0, (int(tz.lat.Mx), int(tz.lat.My)))
+                for n in ("K9", "K18", "A9", "A18")]
     return out
 
 

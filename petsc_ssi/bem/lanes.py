@@ -56,10 +56,10 @@ def n_groups(n):
     return -(-int(n) // FW)
 
 
-def padded(F, ranks=1):
-    """Frequencies stored over ``ranks`` for a spectrum of F: each rank's slab in whole lane groups."""
-    p = max(1, int(ranks))
-    return FW * sum(n_groups((F * (q + 1)) // p - (F * q) // p) for q in range(p))
+def padded(counts):
+    """Frequencies stored over the ranks whose slabs hold ``counts`` frequencies (``pfft.slab_counts``; an int:
+    one rank): each rank's slab in whole lane groups."""
+    return FW * sum(n_groups(c) for c in np.atleast_1d(counts))
 
 
 def to_lanes(X, dtype=np.float64):

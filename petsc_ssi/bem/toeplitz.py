@@ -53,6 +53,7 @@ from numba import njit
 from ..petsc import SSIError, printf
 from ..monitor import event
 from .assemble import _pair_window
+from .pfft import slab_counts
 from .lanes import (FW, n_groups, padded, add_spectra, history_lanes, interp_lanes, interp_flops,
                     scatter_slots, put_state, take_step, unpack_sums, CHUNK_GROUPS)
 
@@ -87,7 +88,9 @@ class Lattice:
                 i = (node_fine[:, ax] - (node_fine[:, ax] & 1)) // 2
                 span[ax] = int(i.max() - i.min() + self.in_n[ax])
         self.Mx = next_fast_len(span[0], real=True)
-        self.My = next_fast_len(span[1], real=True)
+        # (at least 3 columns: mpi4py-fft's slab transform fails on a half spectrum of My // 2 + 1 = 2 columns with
+        # My = 2, tests/bem/test_pfft.py; a larger M only pads more)
+        self.My = next_fast_len(max(span[1], 3), real=True)
         self.F = self.Mx * (self.My // 2 + 1)
 
     def window(self, sel):
@@ -363,8 +366,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     for g, m in ((lat, 144), (glat, 180)):
         if g is None:
             continue
-        F = g.F
-        Fl = padded(F, ranks)               # (each rank's slab in whole lane groups)
+        Fl = padded(slab_counts(g.Mx, g.My, ranks))     # (each rank's slab in whole lane groups)
         per_lag = m * g.Mx * g.My * 8.0
         kp = 1.0 if is_point_symmetric(g) else 2.0          # (real kernels: half the bytes and the flops)
         kern = 8.0 * kp * Fl * m * (D + k)
@@ -533,11 +535,11 @@ class ToeplitzHistory:
         self.vdtype = PRECISIONS[precision]
         self.block = max(1, int(block))     # steps whose known-state products share one pass over the kernels
         self._blk = None
-        mpi = comm.tompi4py()
-        p, r = mpi.Get_size(), mpi.Get_rank()
-        F = lat.F
-        self.f0, self.f1 = (F * r) // p, (F * (r + 1)) // p
-        self.counts = np.array([(F * (q + 1)) // p - (F * q) // p for q in range(p)], np.int64)
+        # the 2-D FFTs over the ranks (``pfft``, mpi4py-fft): this rank's rows of the grid and its frequencies
+        # (k_y-major: f0..f1 of the spectrum in that order, ``pfft.kx_ky``)
+        from .pfft import SlabFFT
+        self.fft = SlabFFT(comm.tompi4py(), lat.Mx, lat.My)
+        self.f0, self.f1, self.counts = self.fft.f0, self.fft.f1, self.fft.counts
         self.upto = 0
 
     # ---------------------------------------------------------------- kernels
@@ -617,36 +619,28 @@ class ToeplitzHistory:
 
     def _reduce_transform(self, Kp):
         """Collective: this rank's slab (nl, 4, 9, m, slab) of the 2-D real FFTs of the ranks' summed
-        kernels, Kp (nl, 4, 9, m, Mx, My) this rank's offsets' share. The planes (a lag, class, slot and
-        pattern entry each) are split over the ranks: each rank receives the sum of its planes
-        (Reduce_scatter), transforms them, and the spectra go to the ranks of their frequencies (Alltoallv):
-        each rank makes 1/p of the transforms (every rank made all of them before), and no rank holds a
-        whole chunk's spectra. On the 2-core machine the kernels' build went from 1.37 to 1.39 x from 1 to
-        2 ranks on the paper's whole Lamb case: the transforms were not what held it back there; the memory
-        per rank, and the transforms' share at many ranks, are what this changes."""
-        from scipy.fft import rfft2
+        kernels, Kp (nl, 4, 9, m, Mx, My) this rank's offsets' share. Each row block of the planes is summed
+        onto the rank of those rows (one MPI Reduce a block), and mpi4py-fft transforms the planes over the
+        ranks (``pfft.SlabFFT``: its own all-to-all between its two passes), so that each rank ends with its
+        frequencies of every plane; no rank holds a whole chunk's spectra, and each makes 1/p of the
+        transforms' work."""
         from mpi4py import MPI
-        lat = self.lat
+        lat, fft = self.lat, self.fft
         shape = Kp.shape[:4]
+        nch = int(np.prod(shape))
+        K3 = Kp.reshape(nch, lat.Mx, lat.My)
         mpi = self.comm.tompi4py()
         p, r = mpi.Get_size(), mpi.Get_rank()
         if p == 1:
-            return rfft2(Kp, axes=(-2, -1), workers=1).reshape(shape + (-1,))
-        nch, plane, slab = int(np.prod(shape)), lat.Mx * lat.My, self.f1 - self.f0
-        cnt = np.array([(nch * (q + 1)) // p - (nch * q) // p for q in range(p)], np.int64)
-        mine = np.empty((int(cnt[r]), lat.Mx, lat.My))
-        mpi.Reduce_scatter(Kp.reshape(nch, plane), mine, recvcounts=[int(c) * plane for c in cnt], op=MPI.SUM)
-        S = rfft2(mine, axes=(-2, -1), workers=1).reshape(int(cnt[r]), lat.F)
-        mine = None
-        f_lo = np.r_[0, np.cumsum(self.counts)]
-        send = np.concatenate([S[:, f_lo[q]:f_lo[q + 1]].ravel() for q in range(p)])
-        S = None
-        scount = cnt[r] * self.counts
-        rcount = cnt * slab
-        recv = np.empty(nch * slab, np.complex128)
-        mpi.Alltoallv([send, scount, np.r_[0, np.cumsum(scount)[:-1]], MPI.C_DOUBLE_COMPLEX],
-                      [recv, rcount, np.r_[0, np.cumsum(rcount)[:-1]], MPI.C_DOUBLE_COMPLEX])
-        return recv.reshape(shape + (slab,))
+            return fft.forward(K3, keep=False).reshape(shape + (-1,))
+        x0, x1 = fft.rows
+        mine = np.empty((x1 - x0, nch, lat.My))
+        for q, (a, b) in enumerate(fft.rows_of):        # (a block of rows at a time: 1/p of the chunk's copy)
+            if b > a:
+                blk = np.ascontiguousarray(K3[:, a:b].transpose(1, 0, 2))
+                mpi.Reduce(blk, mine if q == r else None, op=MPI.SUM, root=q)
+                blk = None
+        return fft.forward(np.ascontiguousarray(mine.transpose(1, 0, 2)), keep=False).reshape(shape + (-1,))
 
     def _terms(self, march):
         """{key: [(time distance d, coefficient)]}: the history terms this side takes (``Marcher._step_terms``
@@ -717,7 +711,7 @@ class ToeplitzHistory:
                 raise SSIError(f"-ssi_lag_store toeplitz: the {self.spec['what']} kernels of a point-symmetric grid "
                                f"have a part {dropped:.3g} ({dropped / max(kept, 1e-300):.3g} of their largest) "
                                "that should be zero; report this with the mesh")
-            self.rot_out = self._rotation(-1, whole=True)
+            self.rot_out = self._rotation(-1)
         from ..sysmem import release_freed
         release_freed()         # the chunks' integrals and spectra, freed into the C heap: not resident in the run
         self.t_build = time.perf_counter() - t0
@@ -780,16 +774,16 @@ class ToeplitzHistory:
                 add_spectra(self.A9, 9 * i, src, slot0, self._idx[0], one)
                 add_spectra(self.A18, 18 * i, src, slot0, self._idx[1], one)
 
-    def _rotation(self, sign, whole=False):
-        """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab (or the whole spectrum),
+    def _rotation(self, sign):
+        """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab,
         psi_t(f) = pi (f_x (2 lo_x - t_x) / M_x + f_y (2 lo_y - t_y) / M_y): the point reflection o -> -o of class
         t's offsets maps the FFT grid's index j to 2 lo - t - j (lo: the inputs' lattice box ``in_lo``), so a
         slot's spectrum and its mirror's are K_{8-a}(f) = s exp(-2 i psi_t(f)) conj(K_a(f)); exp(i psi) K is
         then real on the pairs' sums (``_source``)."""
+        from .pfft import kx_ky
         lat = self.lat
-        f = np.arange(lat.F) if whole else np.arange(self.f0, self.f1)
-        fx, fy = f // (lat.My // 2 + 1), f % (lat.My // 2 + 1)
-        out = np.empty((4, f.size), np.complex128)
+        fx, fy = kx_ky(lat.Mx, lat.My, self.f0, self.f1)
+        out = np.empty((4, fx.size), np.complex128)
         for t, (tx, ty) in enumerate(CLASSES):
             psi = np.pi * (fx * (2 * lat.in_lo[0] - tx) / lat.Mx + fy * (2 * lat.in_lo[1] - ty) / lat.My)
             out[t] = np.exp(sign * 1j * psi)
@@ -838,49 +832,72 @@ class ToeplitzHistory:
         return P
 
     def _setup_state_maps(self, march):
-        """The gather of this side's state (u or p) to every rank, and per input element of the grid its
-        lattice position (from in_lo), its 9 slots' rows of the gathered state (reshaped (-1, 3), one zero
-        row appended: -1 for a slot without a traction column) and image signs; this rank's output rows'
-        class and FFT grid position."""
+        """Per step, what this rank transforms and where its sums go (``pfft``: the rows x0..x1 of the FFT grid
+        are this rank's). In: the input elements of the grid (their lattice position from in_lo) in this rank's
+        rows, their 9 slots' rows of this rank's copy of the nodes they read (a PETSc scatter of those nodes of
+        the side's state, u or p: reshaped (-1, 3); -1 for a slot without a traction column) and image signs.
+        Out: a PETSc scatter from every rank's rows of the inverse transforms (12 planes, class t and component,
+        x0..x1 by My each) to the rows of out_u, each row's value from its class's plane at its FFT grid
+        position."""
         lat, ls = self.lat, self.ls
         PETSc = march.PETSc
+        fft = self.fft
+        x0, x1 = fft.rows
         tmpl = march.u_tmpl if self.side == "u" else march.p_tmpl
-        self.sc, self.seq = PETSc.Scatter.toAll(tmpl)
         # v_a(cell) = S_v u(VN[v, perm[v, a]]) (or S_v p(VT[v, perm[v, a]])): for every input element and slot
         src = ls.VN if self.side == "u" else ls.VT
         vidx = src[np.arange(len(src))[:, None], lat.perm]                  # (nv, 9)
-        use = np.any(vidx >= 0, axis=1)
-        self.vnode = vidx[use]
+        cell = lat.cell
+        vx = cell // lat.ny - lat.in_lo[0]
+        use = np.any(vidx >= 0, axis=1) & (vx >= x0) & (vx < x1)
+        nodes, inv = np.unique(vidx[use], return_inverse=True)
+        inv = inv.reshape(-1, 9)
+        neg = nodes < 0                                                      # (-1 first when present)
+        self.vnode = np.where(neg[inv], -1, inv - int(neg.sum())).astype(np.int64)
+        nodes = nodes[~neg]
         self.vsign = ls.VS[use]                                              # (nv, 3)
-        cell = lat.cell[use]
-        self.vpos = (cell // lat.ny - lat.in_lo[0], cell % lat.ny - lat.in_lo[1])
+        self.vpos = (vx[use] - x0, cell[use] % lat.ny - lat.in_lo[1])
+        dofs = (3 * nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+        self.seq = PETSc.Vec().createSeq(len(dofs), comm=PETSc.COMM_SELF)
+        isf = PETSc.IS().createGeneral(dofs, comm=PETSc.COMM_SELF)
+        self.sc = PETSc.Scatter().create(tmpl, isf, self.seq, None)
+        isf.destroy()
+        self._grid = np.zeros((9, 3, x1 - x0, lat.My))  # (only the slots' cells are written: zeros stay)
+        # out: row i of out_u (this rank's nodes, class t, grid position (x, y)) from plane (t, c) of the rank
+        # whose rows hold x
         r0, r1 = march.u_tmpl.getOwnershipRange()
         rows = np.arange(r0 // 3, r1 // 3)
         nf = lat.node_fine[rows]
         tx, ty = nf[:, 0] & 1, nf[:, 1] & 1
-        self.row_t = (2 * tx + ty).astype(np.int64)
-        self.row_x = np.mod((nf[:, 0] - tx) // 2, lat.Mx)
-        self.row_y = np.mod((nf[:, 1] - ty) // 2, lat.My)
-        self.xrows, self.row_xi = np.unique(self.row_x, return_inverse=True)     # (the inverse transforms' rows)
-        self.row_xi = self.row_xi.ravel()
+        row_t = (2 * tx + ty).astype(np.int64)
+        row_x = np.mod((nf[:, 0] - tx) // 2, lat.Mx)
+        row_y = np.mod((nf[:, 1] - ty) // 2, lat.My)
+        lo = np.array([a for a, _ in fft.rows_of])
+        nx = np.array([b - a for a, b in fft.rows_of])
+        start = np.r_[0, np.cumsum(12 * nx * lat.My)[:-1]]
+        k = np.searchsorted(lo, row_x, side="right") - 1   # (the rank of row x: the ranks without rows start at Mx)
+        c = np.arange(3)
+        gidx = start[k][:, None] + ((3 * row_t[:, None] + c) * nx[k][:, None] + (row_x - lo[k])[:, None]) * lat.My \
+            + row_y[:, None]
+        self._gbuf = np.zeros((12, x1 - x0, lat.My))
+        self.gvec = PETSc.Vec().createWithArray(self._gbuf.ravel(), comm=self.comm)
+        self.ovec = march.u_tmpl.duplicate()
+        isf = PETSc.IS().createGeneral(gidx.ravel().astype(PETSc.IntType), comm=self.comm)
+        ist = PETSc.IS().createStride(r1 - r0, first=r0, step=1, comm=self.comm)
+        self.osc = PETSc.Scatter().create(self.gvec, isf, self.ovec, ist)
+        isf.destroy()
+        ist.destroy()
 
     # ---------------------------------------------------------------- per step
-    def _transform(self, u_all, m):
+    def _transform(self, u_loc, m):
         """State m's transform, this rank's slab, into row m - base of the kept lanes: the state's values on
-        the FFT grid per slot and component (``lanes.scatter_slots``), 27 real 2-D FFTs (every rank makes all
-        of them; the slab is a run of the flattened spectrum), the slab put into lanes (``lanes.put_state``).
-        The inputs fill the grid's first in_n rows and columns only: the transform along y runs on those rows
-        (the zero padding's rows transform to zeros), then along x with the padding (``rfft2``'s two passes,
-        the first one pruned)."""
-        from scipy.fft import rfft, fft
-        lat = self.lat
-        U = u_all.reshape(-1, 3)                           # (a slot without a column, -1: 0 in scatter_slots)
-        if getattr(self, "_grid", None) is None:            # (only the slots' cells are written: zeros stay)
-            self._grid = np.zeros((9, 3) + tuple(lat.in_n))
+        this rank's rows of the FFT grid per slot and component (``lanes.scatter_slots``, from this rank's copy
+        of the nodes they read), 27 real 2-D FFTs over the ranks (``pfft``: this rank's frequencies), the slab
+        put into lanes (``lanes.put_state``)."""
+        U = u_loc.reshape(-1, 3)
         ix, iy = self.vpos
         scatter_slots(U, self.vnode, self.vsign, ix, iy, self._grid)
-        S = fft(rfft(self._grid, n=lat.My, axis=-1, workers=1), n=lat.Mx, axis=-2,
-                workers=1).reshape(9, 3, -1)[..., self.f0:self.f1]
+        S = self.fft.forward(self._grid.reshape(27, self._grid.shape[2], self._grid.shape[3])).reshape(9, 3, -1)
         put_state(self._pairs(S) if self.real else S, self.V9, self.V18, m - self.base)
 
     def reset(self):
@@ -992,31 +1009,24 @@ class ToeplitzHistory:
         return C
 
     def _apply(self, acc, out_u):
-        """Collective: the summed slabs gathered, back by inverse FFTs, this rank's rows added to out_u with
-        the side's sign."""
-        from scipy.fft import ifft, irfft
-        from mpi4py import MPI
-        lat = self.lat
-        full = np.empty((lat.F, 12), np.complex128)
-        mpi = self.comm.tompi4py()
+        """Collective: the summed slabs back by inverse FFTs over the ranks (``pfft``), each node's value
+        scattered from the rank whose grid rows hold it to the node's rank, added to out_u with the side's
+        sign."""
         slab = self.f1 - self.f0
         mine = np.empty((slab, 12), np.complex128)
         take_step(acc, 0, slab, mine)
-        mpi.Allgatherv(mine, [full, self.counts * 12, np.r_[0, np.cumsum(self.counts)[:-1]] * 12,
-                              MPI.C_DOUBLE_COMPLEX])
-        out = np.empty((4, 3, lat.F), np.complex128)
-        unpack_sums(full, self.spec["n9"], out)            # (class t, component)
+        out = np.empty((4, 3, slab), np.complex128)
+        unpack_sums(mine, self.spec["n9"], out)            # (class t, component)
         if self.real:                                       # (the real kernels' sums, rotated back)
             out *= self.rot_out[:, None, :]
-        # (``irfft2``'s two passes, the second on the grid rows that hold this rank's nodes only)
-        B = ifft(out.reshape(4, 3, lat.Mx, lat.My // 2 + 1), axis=-2, workers=1)[:, :, self.xrows]
-        phys = irfft(B, n=lat.My, axis=-1, workers=1)
-        vals = phys[self.row_t, :, self.row_xi, self.row_y]          # (rows, 3)
+        self._gbuf[...] = self.fft.backward(out.reshape(12, slab))
+        self.osc.scatter(self.gvec, self.ovec)
         arr = out_u.getArray()
+        vals = self.ovec.getArray(readonly=True)
         if self.spec["sign"] < 0:
-            arr -= vals.ravel()
+            arr -= vals
         else:
-            arr += vals.ravel()
+            arr += vals
 
 
 def _kernel_blocks(S):

@@ -24,7 +24,7 @@ def test_lanes_round_trip_and_padding(slab):
     assert not from_lanes(Y, FW * n_groups(slab))[slab:].any()          # the padding lanes: zeros
     assert np.array_equal(from_lanes(Y, slab), X)
     assert padded(slab) == FW * n_groups(slab)
-    assert padded(100, 3) == FW * (n_groups(33) + n_groups(33) + n_groups(34))
+    assert padded([33, 33, 34]) == FW * (n_groups(33) + n_groups(33) + n_groups(34))
 
 
 @pytest.mark.parametrize("side", [(8, 4), (4, 8)])        # H's columns (n9, n18), G's
@@ -204,27 +204,36 @@ def test_per_step_helpers_equal_their_numpy_forms(vdtype):
 
 
 def test_lag_file_layout_is_any_rank_counts():
-    """The toeplitz lag file's kernel layout (``lagstore.to_file``/``from_file``): the ranks' slabs of P ranks,
-    each converted from lanes to frequency-major and concatenated, read back as the slabs of Q ranks are every
-    rank's own lanes exactly (real and complex kernels, empty kernels, spectra that split unevenly and slabs
-    that are not whole lane groups: F in 1, 7, 8, 9, 37, 312; P, Q in 1..5)."""
+    """The toeplitz lag file's kernel layout (``lagstore.to_file``/``from_file``): the ranks' slabs of P ranks
+    (``pfft.slab_counts``: Mx times each rank's columns of the half spectrum, none beyond min(Mx, My // 2 + 1)
+    ranks), each converted from lanes to frequency-major and concatenated, read back as the slabs of Q ranks are
+    every rank's own lanes exactly (real and complex kernels, empty kernels, spectra that split unevenly, slabs
+    that are not whole lane groups and empty slabs: grids 1 x 2 to 13 x 10; P, Q in 1..5)."""
     from petsc_ssi.bem.lagstore import to_file, from_file
     from petsc_ssi.bem.lanes import to_lanes, to_lanes_real
+    from petsc_ssi.bem.pfft import slab_counts
     rng = np.random.default_rng(1)
-    for F in (1, 7, 8, 9, 37, 312):
+    seen = set()
+    for Mx, My in ((1, 2), (7, 2), (9, 4), (12, 6), (13, 10), (24, 24)):
+        F = Mx * (My // 2 + 1)
         for rows in (0, 9):
             for real in (True, False):
                 X = rng.standard_normal((F, rows, 4)) + (0 if real else 1j * rng.standard_normal((F, rows, 4)))
                 lanes = (lambda Y: to_lanes_real(Y.real)) if real else to_lanes
+
+                def cut(n, r):
+                    c = slab_counts(Mx, My, n)
+                    seen.update(["empty"] if c[r] == 0 else ["padded"] if c[r] % 8 else ["whole"])
+                    return int(c[:r].sum()), int(c[:r + 1].sum())
                 for P in (1, 2, 3, 5):
-                    cut = lambda n, r: ((F * r) // n, (F * (r + 1)) // n)     # noqa: E731 (ToeplitzHistory's slabs)
                     whole = np.concatenate([to_file(lanes(X[slice(*cut(P, r))]), cut(P, r)[1] - cut(P, r)[0])
                                             for r in range(P)])
                     assert whole.shape == (F, rows, 4, 1 if real else 2)
                     for Q in (1, 2, 3, 4, 5):
                         for r in range(Q):
                             a, b = cut(Q, r)
-                            assert np.array_equal(from_file(whole[a:b]), lanes(X[a:b])), (F, rows, real, P, Q, r)
+                            assert np.array_equal(from_file(whole[a:b]), lanes(X[a:b])), (Mx, My, rows, real, P, Q, r)
+    assert seen == {"empty", "padded", "whole"}
 
 
 @pytest.mark.parametrize("real", [True, False])

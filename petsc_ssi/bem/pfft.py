@@ -1,0 +1,119 @@
+r"""The toeplitz store's 2-D real FFTs over the ranks (issue 41: "through an existing distributed engine"):
+mpi4py-fft's slab decomposition (``mpi4py_fft.PFFT``, FFTW underneath), a batch of planes at a time.
+
+A plane of the FFT grid Mx x My is split over the ranks by rows (x) in physical space and by columns of the
+half spectrum (k_y = 0 .. My // 2) in Fourier space: mpi4py-fft transforms along y on each rank's rows, moves
+the data by its own all-to-all (MPI subarray types), and transforms along x on each rank's columns. So each
+rank holds, of every kernel and kept state, the frequencies (k_x, k_y) with k_y in its columns and every k_x:
+stored k_y-major (frequency index f = (k_y - k_y0) Mx + k_x on the rank, ``kx_ky``), so that the ranks'
+slabs, one after the other, are the whole spectrum in one order whatever the number of ranks (the lag
+files' order, ``lagstore``). A slab decomposition takes at most min(Mx, My // 2 + 1) ranks: beyond that the
+first ones transform and the others hold no rows and no frequencies (``members``).
+
+Used for the kernels' build (each rank's share of a chunk's planes summed onto the planes' row blocks,
+transformed) and per step for the new state's transform and the sums' inverse transform: no rank gathers a
+whole state or a whole spectrum (what each rank transformed in full before)."""
+import numpy as np
+
+from ..petsc import SSIError
+
+# FFTW's plan from its heuristics: the same plan, so the same bits, in every run (FFTW_MEASURE times
+# candidate plans and may pick another one run to run)
+PLANNER = "FFTW_ESTIMATE"
+
+
+def blockdist(n, size, rank):
+    """(count, start) of ``rank``'s block of n items over ``size`` ranks: mpi4py-fft's own rule
+    (``mpi4py_fft.pencil._blockdist``; checked against its local slices on every plan)."""
+    q, r = divmod(int(n), int(size))
+    return q + (1 if r > rank else 0), rank * q + min(rank, r)
+
+
+def members(Mx, My, p):
+    """The ranks that transform a plane Mx x My (the first ones): a slab decomposition splits the rows and the
+    half spectrum's columns, so at most min(Mx, My // 2 + 1) of them."""
+    return max(1, min(int(p), int(Mx), int(My) // 2 + 1))
+
+
+def slab_counts(Mx, My, p):
+    """(p,) the frequencies each rank holds of the half spectrum Mx x (My // 2 + 1): Mx times its columns."""
+    q = members(Mx, My, p)
+    return np.array([Mx * blockdist(My // 2 + 1, q, r)[0] if r < q else 0 for r in range(int(p))], np.int64)
+
+
+def kx_ky(Mx, My, f0, f1):
+    """(kx, ky) of the frequencies f0 .. f1 - 1 of the k_y-major order (f = ky Mx + kx)."""
+    f = np.arange(int(f0), int(f1))
+    return f % Mx, f // Mx
+
+
+class SlabFFT:
+    """Collective (``comm``, an mpi4py communicator): the 2-D real FFTs of batches of Mx x My planes over the
+    ranks. ``rows`` (x0, x1): this rank's rows of a plane in physical space; ``f0``, ``f1``: its frequencies
+    in the k_y-major order (``counts`` every rank's); ``forward(a)`` (nb, x1 - x0, My) real -> (nb, f1 - f0)
+    complex, unnormalised (scipy's ``rfft2``); ``backward(s)`` the inverse, normalised (``irfft2``)."""
+
+    def __init__(self, comm, Mx, My):
+        from mpi4py import MPI
+        try:
+            import mpi4py_fft  # noqa: F401
+        except ImportError as e:        # (every rank the same: one line each, before any work)
+            raise SSIError(f"-ssi_lag_store toeplitz needs mpi4py-fft ({e}): `make deps`, or `pip install mpi4py-fft` "
+                           "with FFTW's library and headers (Debian: libfftw3-dev)") from None
+        self.Mx, self.My, self.Myh = int(Mx), int(My), int(My) // 2 + 1
+        p, r = comm.Get_size(), comm.Get_rank()
+        self.q = members(Mx, My, p)
+        self.member = r < self.q
+        self.sub = comm.Split(0 if self.member else MPI.UNDEFINED, r)
+        self.rows_of = [(lambda c, s: (s, s + c))(*blockdist(Mx, self.q, k)) if k < self.q else (Mx, Mx)
+                        for k in range(p)]
+        self.rows = self.rows_of[r]
+        self.counts = slab_counts(Mx, My, p)
+        self.f0 = int(self.counts[:r].sum())
+        self.f1 = self.f0 + int(self.counts[r])
+        self.nky = self.counts[r] // self.Mx
+        self._plans = {}
+
+    def _plan(self, nb):
+        """mpi4py-fft's plan of a batch of nb planes (kept per batch size), its local slices checked."""
+        if nb not in self._plans:
+            from mpi4py_fft import PFFT
+            P = PFFT(self.sub, (nb, self.Mx, self.My), axes=(1, 2), dtype=float, grid=(1, -1, 1),
+                     planner_effort=PLANNER)
+            si, so = P.local_slice(False), P.local_slice(True)
+            if (si[1].start, si[1].stop) != self.rows or so[2].stop - so[2].start != self.nky \
+                    or so[2].start * self.Mx != self.f0:
+                raise RuntimeError(f"mpi4py-fft's decomposition {si}, {so} is not the one expected "
+                                   f"(rows {self.rows}, frequencies {self.f0}..{self.f1})")
+            self._plans[nb] = P
+        return self._plans[nb]
+
+    def forward(self, a, keep=True):
+        """(nb, x1 - x0, My) real, this rank's rows of nb planes -> (nb, f1 - f0) complex, their spectra's
+        frequencies on this rank in the k_y-major order. Collective over the members. ``keep``: the plan (and
+        its arrays) kept for the next batch of nb planes (the steps'), else freed (the kernels' chunks)."""
+        nb = a.shape[0]
+        if not self.member:
+            return np.empty((nb, 0), np.complex128)
+        S = self._plan(nb).forward(a, normalize=False)          # (nb, Mx, nky): mpi4py-fft's array
+        out = np.ascontiguousarray(S.transpose(0, 2, 1)).reshape(nb, -1)
+        if not keep:
+            self._plans.pop(nb)
+        return out
+
+    def backward(self, s):
+        """(nb, f1 - f0) complex -> (nb, x1 - x0, My) real (a new array): ``forward``'s inverse."""
+        nb = s.shape[0]
+        if not self.member:
+            return np.empty((nb, 0, self.My))
+        P = self._plan(nb)
+        P.backward.input_array[...] = s.reshape(nb, self.nky, self.Mx).transpose(0, 2, 1)
+        return P.backward(normalize=True).copy()
+
+    def destroy(self):
+        """The members' sub-communicator freed (collective over them)."""
+        from mpi4py import MPI
+        self._plans = {}
+        if self.sub is not None and self.sub != MPI.COMM_NULL:
+            self.sub.Free()
+        self.sub = None

@@ -1,0 +1,69 @@
+"""The toeplitz store's distributed 2-D real FFTs (``bem.pfft``, mpi4py-fft's slab decomposition): each rank's
+frequencies in the k_y-major order are scipy's ``rfft2`` of the whole planes there, the inverse gives each rank's
+rows back, and ranks beyond min(Mx, My // 2 + 1) hold no rows and no frequencies."""
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from helpers import PY, ROOT
+
+pytestmark = pytest.mark.mpi
+
+CODE = r'''
+import sys, json
+import numpy as np
+from mpi4py import MPI
+from scipy.fft import rfft2
+from petsc_ssi.bem.pfft import SlabFFT, slab_counts, kx_ky
+comm = MPI.COMM_WORLD
+out = []
+for Mx, My in [(12, 10), (7, 4), (5, 3)]:
+    A = np.random.default_rng(Mx).standard_normal((27, Mx, My))
+    f = SlabFFT(comm, Mx, My)
+    x0, x1 = f.rows
+    assert list(f.counts) == list(slab_counts(Mx, My, comm.size))
+    S = f.forward(np.ascontiguousarray(A[:, x0:x1]))
+    ref = rfft2(A, axes=(-2, -1))
+    kx, ky = kx_ky(Mx, My, f.f0, f.f1)
+    e_f = float(np.abs(S - ref[:, kx, ky]).max(initial=0.0) / np.abs(ref).max())
+    B = f.backward(S)
+    e_b = float(np.abs(B - A[:, x0:x1]).max(initial=0.0) / np.abs(A).max())
+    rows = comm.allgather((x0, x1))
+    freq = comm.allgather((f.f0, f.f1))
+    f.destroy()
+    out.append(dict(grid=[Mx, My], member=f.member, fwd=e_f, bwd=e_b, rows=rows, freq=freq))
+print("PFFT" + json.dumps(out), flush=True)
+'''
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_slab_fft_is_rfft2_on_each_ranks_frequencies(n):
+    """Forward: each rank's slab equals ``rfft2`` of the whole planes at its (k_x, k_y), to 1e-14 of the largest
+    coefficient; backward: the rank's rows, to 1e-14; the rows and the frequencies cover the grid and the half
+    spectrum once, in rank order; on the 5 x 3 grid (two columns of the half spectrum) a third rank holds
+    neither rows nor frequencies and the others still transform (7 x 4 at -n 3: three columns, every rank)."""
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(n), PY, "-c", CODE]
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("PFFT")]
+    assert p.returncode == 0 and len(lines) == n, p.stdout + p.stderr
+    import json
+    per_rank = [json.loads(ln[4:]) for ln in lines]
+    for r in per_rank:
+        for g in r:
+            assert g["fwd"] <= 1e-14 and g["bwd"] <= 1e-14, g
+            Mx, My = g["grid"]
+            rows, freq = g["rows"], g["freq"]
+            assert rows[0][0] == 0 and all(a[1] == b[0] for a, b in zip(rows, rows[1:]))
+            assert max(b for _, b in rows) == Mx
+            assert freq[0][0] == 0 and all(a[1] == b[0] for a, b in zip(freq, freq[1:]))
+            assert freq[-1][1] == Mx * (My // 2 + 1)
+    g53 = [g for r in per_rank for g in r if g["grid"] == [5, 3]]
+    assert sum(g["member"] for g in g53) == min(n, 2)
+    if n == 3:
+        empty = [g for g in g53 if not g["member"]]
+        assert empty[0]["rows"][2] == [5, 5] and empty[0]["freq"][2][0] == empty[0]["freq"][2][1]
