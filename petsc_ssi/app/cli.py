@@ -52,7 +52,7 @@ def versions():
         lines.append("PETSc {}.{}.{}".format(*PETSc.Sys.getVersion()) + f", petsc4py {petsc4py.__version__}")
     except Exception as exc:  # noqa: BLE001 -- report, do not fail
         lines.append(f"PETSc: not available ({exc})")
-    for mod in ("mpi4py", "numpy", "numba"):
+    for mod in ("mpi4py", "mpi4py_fft", "numpy", "numba"):
         try:
             lines.append(f"{mod} {__import__(mod).__version__}")
         except Exception:  # noqa: BLE001

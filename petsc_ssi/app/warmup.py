@@ -98,11 +98,12 @@ def _single_kernels():
                 bsr.matvec(m, indptr, cols, data, xx, np.zeros(3))
             for w in (2, bsr.PAIR_FROM):
                 bsr.panel(m, indptr, cols, data, np.ones((3, w)), np.zeros((3, w)), 1.0)
-    from ..bem.lanes import lane_products, put_state, FW
+    from ..bem.lanes import lane_products, put_state_grid, unpack_grid, FW
     K, out = np.zeros((1, 9, 1, 2, FW)), np.zeros((1, 1, 1, 2, FW))
     lane_products(K, 0, np.zeros((1, 1, 9, 2, FW), np.float32), 0, 1, 1, 1, out, 0)   # (single kept states)
-    put_state(np.zeros((9, 3, 2), complex)[..., :1], np.zeros((1, 1, 9, 2, FW), np.float32),
-              np.zeros((1, 1, 18, 2, FW), np.float32), 0)
+    for dt in (np.float64, np.float32):          # (the toeplitz store's per-step helpers; single kept states)
+        put_state_grid(np.zeros((9, 3, 1, 1), complex), np.zeros((1, 1, 9, 2, FW), dt), np.zeros((1, 1, 18, 2, FW), dt), 0)
+    unpack_grid(np.zeros((1, 1, 12, 2, FW)), 8, np.zeros((0, 0), complex), np.zeros((12, 1, 1), complex))
     from ..bem.lanes import add_spectra           # (the toeplitz kernels' fill: real and complex spectra)
     idx, sel = np.zeros((1, 1), np.int64), np.zeros(1, np.int64)
     for kp, dt in ((1, np.float64), (2, np.complex128)):

@@ -257,47 +257,44 @@ def scatter_slots(U, vnode, vsign, ix, iy, f):
 
 
 @njit(cache=True, boundscheck=False)
-def put_state(S, V9, V18, i):
-    """Row i of the kept transforms in lanes from a state's slab S (9 slots, 3 components, slab) complex:
-    V9[.., i, a] the z components, V18[.., i, 2 a + c] the x and y ones (``to_lanes`` of ``S[:, 2].T`` and of
-    ``S[:, :2]`` (slab, 18), without the copies); padding lanes zero."""
-    slab = S.shape[2]
+def put_state_grid(S, V9, V18, i):
+    """``put_state`` from a state's spectra S (9 slots, 3 components, Mx, k_y columns) as the distributed
+    transform gives them (``pfft.SlabFFT.transform``): frequency f of the slab (k_y-major) at k_x = f % Mx,
+    column f // Mx (no copy into the slab's order)."""
+    mx, nk = S.shape[2], S.shape[3]
+    slab = mx * nk
     G, fw = V9.shape[0], V9.shape[4]
     for g in range(G):
         for q in range(fw):
             f = g * fw + q
+            kx, ky = f % mx, f // mx
             for a in range(9):
-                z = S[a, 2, f] if f < slab else 0j
+                z = S[a, 2, kx, ky] if f < slab else 0j
                 V9[g, i, a, 0, q] = z.real
                 V9[g, i, a, 1, q] = z.imag
                 for c in range(2):
-                    w = S[a, c, f] if f < slab else 0j
+                    w = S[a, c, kx, ky] if f < slab else 0j
                     V18[g, i, 2 * a + c, 0, q] = w.real
                     V18[g, i, 2 * a + c, 1, q] = w.imag
 
 
 @njit(cache=True, boundscheck=False)
-def take_step(acc, j, slab, out):
-    """out[f, o] = acc[g, j, o] at lane q (f = g FW + q < slab), complex: step j's sums of a block's lanes as
-    a (slab, n_out) complex array (``from_lanes(acc[:, j], slab)`` without the copies)."""
+def unpack_grid(acc, n9, rot, out):
+    """out[3 t + p, k_x, column] (12, Mx, k_y columns) complex, the inverse transform's input
+    (``pfft.SlabFFT.backward_inputs``), from a step's sums acc (groups, 1, 12, 2, FW) lanes (slab frequency f =
+    column Mx + k_x): ``take_step`` and ``unpack_sums`` in one pass, times rot[t, f] (the real kernels'
+    rotation back) where rot has rows, none (shape (0, 0)) otherwise."""
+    mx, nk = out.shape[1], out.shape[2]
     fw = acc.shape[4]
-    for f in range(slab):
-        g, q = f // fw, f % fw
-        for o in range(acc.shape[2]):
-            out[f, o] = acc[g, j, o, 0, q] + 1j * acc[g, j, o, 1, q]
-
-
-@njit(cache=True, boundscheck=False)
-def unpack_sums(full, n9, out):
-    """out[t, p, f] (4 classes, 3 components, F) from the gathered sums full (F, 12): columns the K9 products'
-    then the K18 products'; for n9 = 8 (H) the 8 K9 columns are (class t, x or y) and the 4 K18 ones z of
-    class t, for n9 = 4 (G) the other way round."""
     xy0, z0 = (0, 8) if n9 == 8 else (4, 0)
-    for f in range(full.shape[0]):
+    for f in range(mx * nk):
+        g, q = f // fw, f % fw
+        kx, ky = f % mx, f // mx
         for t in range(4):
-            out[t, 0, f] = full[f, xy0 + 2 * t]
-            out[t, 1, f] = full[f, xy0 + 2 * t + 1]
-            out[t, 2, f] = full[f, z0 + t]
+            h = rot[t, f] if rot.shape[0] else 1.0 + 0j
+            for p in range(3):
+                o = xy0 + 2 * t + p if p < 2 else z0 + t
+                out[3 * t + p, kx, ky] = (acc[g, 0, o, 0, q] + 1j * acc[g, 0, o, 1, q]) * h
 
 
 @njit(cache=True, boundscheck=False)

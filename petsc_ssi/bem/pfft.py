@@ -13,6 +13,8 @@ first ones transform and the others hold no rows and no frequencies (``members``
 Used for the kernels' build (each rank's share of a chunk's planes summed onto the planes' row blocks,
 transformed) and per step for the new state's transform and the sums' inverse transform: no rank gathers a
 whole state or a whole spectrum (what each rank transformed in full before)."""
+import importlib
+
 import numpy as np
 
 from ..petsc import SSIError
@@ -56,7 +58,7 @@ class SlabFFT:
     def __init__(self, comm, Mx, My):
         from mpi4py import MPI
         try:
-            import mpi4py_fft  # noqa: F401
+            importlib.import_module("mpi4py_fft")
         except ImportError as e:        # (every rank the same: one line each, before any work)
             raise SSIError(f"-ssi_lag_store toeplitz needs mpi4py-fft ({e}): `make deps`, or `pip install mpi4py-fft` "
                            "with FFTW's library and headers (Debian: libfftw3-dev)") from None
@@ -75,11 +77,13 @@ class SlabFFT:
         self._plans = {}
 
     def _plan(self, nb):
-        """mpi4py-fft's plan of a batch of nb planes (kept per batch size), its local slices checked."""
+        """mpi4py-fft's plan of a batch of nb planes (kept per batch size until ``forget``), its local slices
+        checked. Its forward transform preserves its input array (FFTW_PRESERVE_INPUT), so what a caller writes
+        there stays between transforms (the per-step grid's zeros)."""
         if nb not in self._plans:
             from mpi4py_fft import PFFT
             P = PFFT(self.sub, (nb, self.Mx, self.My), axes=(1, 2), dtype=float, grid=(1, -1, 1),
-                     planner_effort=PLANNER)
+                     planner_effort=PLANNER, overwrite_input="FFTW_PRESERVE_INPUT")
             si, so = P.local_slice(False), P.local_slice(True)
             if (si[1].start, si[1].stop) != self.rows or so[2].stop - so[2].start != self.nky \
                     or so[2].start * self.Mx != self.f0:
@@ -88,27 +92,59 @@ class SlabFFT:
             self._plans[nb] = P
         return self._plans[nb]
 
+    def forget(self, keep=()):
+        """The plans (and their arrays) of every batch size but ``keep`` freed."""
+        self._plans = {nb: P for nb, P in self._plans.items() if nb in keep}
+
+    def inputs(self, nb):
+        """(nb, x1 - x0, My) float64: the forward transform's input array of nb planes (this rank's rows), to be
+        written in place; zeros when first made."""
+        if not self.member:
+            return np.zeros((nb, 0, self.My))
+        return self._plan(nb).forward.input_array
+
+    def transform(self, nb):
+        """Collective over the members: the forward transform of ``inputs(nb)`` -> (nb, Mx, k_y columns)
+        complex, unnormalised (scipy's ``rfft2``): mpi4py-fft's output array, valid until its next transform."""
+        if not self.member:
+            return np.zeros((nb, self.Mx, 0), np.complex128)
+        return self._plan(nb).forward(normalize=False)
+
     def forward(self, a, keep=True):
         """(nb, x1 - x0, My) real, this rank's rows of nb planes -> (nb, f1 - f0) complex, their spectra's
-        frequencies on this rank in the k_y-major order. Collective over the members. ``keep``: the plan (and
-        its arrays) kept for the next batch of nb planes (the steps'), else freed (the kernels' chunks)."""
+        frequencies on this rank in the k_y-major order (a new array). Collective over the members. ``keep``:
+        the plan kept for the next batch of nb planes, else freed."""
         nb = a.shape[0]
-        if not self.member:
-            return np.empty((nb, 0), np.complex128)
-        S = self._plan(nb).forward(a, normalize=False)          # (nb, Mx, nky): mpi4py-fft's array
-        out = np.ascontiguousarray(S.transpose(0, 2, 1)).reshape(nb, -1)
+        self.inputs(nb)[...] = a
+        out = np.ascontiguousarray(self.transform(nb).transpose(0, 2, 1)).reshape(nb, -1)
         if not keep:
-            self._plans.pop(nb)
+            self._plans.pop(nb, None)
         return out
 
-    def backward(self, s):
-        """(nb, f1 - f0) complex -> (nb, x1 - x0, My) real (a new array): ``forward``'s inverse."""
-        nb = s.shape[0]
+    def backward_inputs(self, nb):
+        """(nb, Mx, k_y columns) complex: the inverse transform's input array, to be written in place."""
         if not self.member:
-            return np.empty((nb, 0, self.My))
-        P = self._plan(nb)
-        P.backward.input_array[...] = s.reshape(nb, self.nky, self.Mx).transpose(0, 2, 1)
-        return P.backward(normalize=True).copy()
+            return np.zeros((nb, self.Mx, 0), np.complex128)
+        return self._plan(nb).backward.input_array
+
+    def outputs(self, nb):
+        """(nb, x1 - x0, My) float64: the inverse transform's output array (what ``run_backward`` fills)."""
+        if not self.member:
+            return np.zeros((nb, 0, self.My))
+        return self._plan(nb).backward.output_array
+
+    def run_backward(self, nb):
+        """Collective over the members: the inverse of ``backward_inputs(nb)`` (which it overwrites) into
+        ``outputs(nb)``, normalised (``irfft2``)."""
+        if self.member:
+            self._plan(nb).backward(normalize=True)
+        return self.outputs(nb)
+
+    def backward(self, s):
+        """(nb, f1 - f0) complex, k_y-major -> (nb, x1 - x0, My) real (a new array): ``forward``'s inverse."""
+        nb = s.shape[0]
+        self.backward_inputs(nb)[...] = s.reshape(nb, self.nky, self.Mx).transpose(0, 2, 1)
+        return self.run_backward(nb).copy()
 
     def destroy(self):
         """The members' sub-communicator freed (collective over them)."""

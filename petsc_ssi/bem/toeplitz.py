@@ -32,14 +32,16 @@ conj(K_a(f)): the pairs' sum and difference, rotated by exp(i psi_t), are real, 
 real (half the bytes, half the multiply-adds) and the states as the pairs' sums and differences
 (``ToeplitzHistory._source``, ``_pairs``, ``_rotation``).
 
-Parallel: the spectrum's frequencies are split over the ranks (each keeps its slab of every kernel
-and of every kept state's transform: memory divided by the ranks); the kernels' integrals are split by
-offset and their planes' transforms by plane (summed onto the plane's rank, its spectra sent to the
-ranks of their frequencies: MPI's Reduce_scatter and Alltoallv); each rank transforms the new state
-(gathered: the data a dense MatMult gathers anyway) and keeps its slab; the summed slabs are gathered
-and transformed back. A frequency's products are summed in the same order on any number of ranks; the
-kernels are sums over the ranks' offsets in MPI's order, so ``-n 2`` equals ``-n 1`` to round-off (the
-tests: 1e-12 relative; two ``-n 3`` runs differed by 3.6e-16).
+Parallel: the 2-D FFTs go over the ranks through mpi4py-fft (``pfft``: a slab decomposition, FFTW
+underneath): each rank holds the grid's rows x0..x1 in physical space and, of every kernel and kept state, the
+frequencies of its columns of the half spectrum (all k_x), stored k_y-major (memory divided by the ranks). The
+kernels' integrals are split by offset; each chunk's planes are summed onto the ranks of their rows (an MPI
+Reduce a row block) and transformed over the ranks. Per step a PETSc scatter brings each rank the nodes its
+grid rows read, mpi4py-fft transforms the 27 planes (its own all-to-all between the two passes), the products
+run on the rank's frequencies, and the 12 summed planes go back the same way, a PETSc scatter taking each
+node's value from the rank whose rows hold it: no rank gathers a whole state or spectrum. A frequency's
+products are summed in the same order on any number of ranks, so ``-n 2`` equals ``-n 1`` to round-off (the
+tests: 1e-12 relative; tests/bem/test_pfft.py for the transforms alone).
 
 G (traction columns) stays as the dense path stores it (N x n_t, small when the tractions live on a
 footprint or a load patch); the step matrix (lags 1 and 2) is assembled and factorised as before.
@@ -55,7 +57,7 @@ from ..monitor import event
 from .assemble import _pair_window
 from .pfft import slab_counts
 from .lanes import (FW, n_groups, padded, add_spectra, history_lanes, interp_lanes, interp_flops,
-                    scatter_slots, put_state, take_step, unpack_sums, CHUNK_GROUPS)
+                    scatter_slots, put_state_grid, unpack_grid, CHUNK_GROUPS)
 
 # the nine node positions of an element relative to its centre, in half element sizes
 SLOTS = [(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
@@ -630,17 +632,18 @@ class ToeplitzHistory:
         nch = int(np.prod(shape))
         K3 = Kp.reshape(nch, lat.Mx, lat.My)
         mpi = self.comm.tompi4py()
-        p, r = mpi.Get_size(), mpi.Get_rank()
-        if p == 1:
-            return fft.forward(K3, keep=False).reshape(shape + (-1,))
-        x0, x1 = fft.rows
-        mine = np.empty((x1 - x0, nch, lat.My))
-        for q, (a, b) in enumerate(fft.rows_of):        # (a block of rows at a time: 1/p of the chunk's copy)
-            if b > a:
-                blk = np.ascontiguousarray(K3[:, a:b].transpose(1, 0, 2))
-                mpi.Reduce(blk, mine if q == r else None, op=MPI.SUM, root=q)
-                blk = None
-        return fft.forward(np.ascontiguousarray(mine.transpose(1, 0, 2)), keep=False).reshape(shape + (-1,))
+        r = mpi.Get_rank()
+        In = fft.inputs(nch)                            # (the plan of a chunk's planes: kept for the build)
+        if mpi.Get_size() == 1:
+            In[...] = K3
+        else:
+            for q, (a, b) in enumerate(fft.rows_of):    # (a block of rows at a time: 1/p of the chunk's copy)
+                if b > a:
+                    blk = np.ascontiguousarray(K3[:, a:b])
+                    mpi.Reduce(blk, In if q == r else None, op=MPI.SUM, root=q)
+                    blk = None
+        S = fft.transform(nch)                          # (nch, Mx, k_y columns) -> this rank's slab, k_y-major
+        return np.ascontiguousarray(S.transpose(0, 2, 1)).reshape(shape + (-1,))
 
     def _terms(self, march):
         """{key: [(time distance d, coefficient)]}: the history terms this side takes (``Marcher._step_terms``
@@ -694,6 +697,7 @@ class ToeplitzHistory:
         self.A9 = np.zeros((G, self.k * 9, n9, kp, FW))
         self.A18 = np.zeros((G, self.k * 18, n18, kp, FW))
         self._fill_kernels(by_key, plan, kernels)
+        self.fft.forget()               # (the chunks' plans and arrays; the steps' are made with zeros below)
         # the kept states' transforms, in time order (state m at m - base), in lanes: z (groups, W, 9, 2, FW),
         # x and y (groups, W, 18, 2, FW); a step's window of D states is a run of rows of each group (a row
         # offset for ``lanes.lane_products``, no copy); states before the first are zeros, as are those not
@@ -862,7 +866,8 @@ class ToeplitzHistory:
         isf = PETSc.IS().createGeneral(dofs, comm=PETSc.COMM_SELF)
         self.sc = PETSc.Scatter().create(tmpl, isf, self.seq, None)
         isf.destroy()
-        self._grid = np.zeros((9, 3, x1 - x0, lat.My))  # (only the slots' cells are written: zeros stay)
+        # (the transform's own input array: only the slots' cells are written, the other zeros stay)
+        self._grid = fft.inputs(27).reshape(9, 3, x1 - x0, lat.My)
         # out: row i of out_u (this rank's nodes, class t, grid position (x, y)) from plane (t, c) of the rank
         # whose rows hold x
         r0, r1 = march.u_tmpl.getOwnershipRange()
@@ -879,8 +884,7 @@ class ToeplitzHistory:
         c = np.arange(3)
         gidx = start[k][:, None] + ((3 * row_t[:, None] + c) * nx[k][:, None] + (row_x - lo[k])[:, None]) * lat.My \
             + row_y[:, None]
-        self._gbuf = np.zeros((12, x1 - x0, lat.My))
-        self.gvec = PETSc.Vec().createWithArray(self._gbuf.ravel(), comm=self.comm)
+        self.gvec = PETSc.Vec().createWithArray(fft.outputs(12).reshape(-1), comm=self.comm)   # (the inverse's output)
         self.ovec = march.u_tmpl.duplicate()
         isf = PETSc.IS().createGeneral(gidx.ravel().astype(PETSc.IntType), comm=self.comm)
         ist = PETSc.IS().createStride(r1 - r0, first=r0, step=1, comm=self.comm)
@@ -893,12 +897,13 @@ class ToeplitzHistory:
         """State m's transform, this rank's slab, into row m - base of the kept lanes: the state's values on
         this rank's rows of the FFT grid per slot and component (``lanes.scatter_slots``, from this rank's copy
         of the nodes they read), 27 real 2-D FFTs over the ranks (``pfft``: this rank's frequencies), the slab
-        put into lanes (``lanes.put_state``)."""
+        put into lanes (``lanes.put_state_grid``)."""
         U = u_loc.reshape(-1, 3)
         ix, iy = self.vpos
         scatter_slots(U, self.vnode, self.vsign, ix, iy, self._grid)
-        S = self.fft.forward(self._grid.reshape(27, self._grid.shape[2], self._grid.shape[3])).reshape(9, 3, -1)
-        put_state(self._pairs(S) if self.real else S, self.V9, self.V18, m - self.base)
+        S = self.fft.transform(27)
+        S = S.reshape((9, 3) + S.shape[1:])                # (slot, component, k_x, k_y column)
+        put_state_grid(self._pairs(S) if self.real else S, self.V9, self.V18, m - self.base)
 
     def reset(self):
         """Forget every kept transform (a restart's rewind: they are made again from the march's states)."""
@@ -1009,17 +1014,11 @@ class ToeplitzHistory:
         return C
 
     def _apply(self, acc, out_u):
-        """Collective: the summed slabs back by inverse FFTs over the ranks (``pfft``), each node's value
-        scattered from the rank whose grid rows hold it to the node's rank, added to out_u with the side's
-        sign."""
-        slab = self.f1 - self.f0
-        mine = np.empty((slab, 12), np.complex128)
-        take_step(acc, 0, slab, mine)
-        out = np.empty((4, 3, slab), np.complex128)
-        unpack_sums(mine, self.spec["n9"], out)            # (class t, component)
-        if self.real:                                       # (the real kernels' sums, rotated back)
-            out *= self.rot_out[:, None, :]
-        self._gbuf[...] = self.fft.backward(out.reshape(12, slab))
+        """Collective: the summed slabs back by inverse FFTs over the ranks (``pfft``: the sums unpacked into
+        its input, ``lanes.unpack_grid``), each node's value scattered from the rank whose grid rows hold it to
+        the node's rank, added to out_u with the side's sign."""
+        unpack_grid(acc, self.spec["n9"], self.rot_out if self.real else _NO_ROT, self.fft.backward_inputs(12))
+        self.fft.run_backward(12)                           # (into the array gvec wraps)
         self.osc.scatter(self.gvec, self.ovec)
         arr = out_u.getArray()
         vals = self.ovec.getArray(readonly=True)
@@ -1027,6 +1026,9 @@ class ToeplitzHistory:
             arr -= vals
         else:
             arr += vals
+
+
+_NO_ROT = np.zeros((0, 0), np.complex128)
 
 
 def _kernel_blocks(S):

@@ -163,33 +163,40 @@ def test_lane_products_on_a_machine_without_avx512(tmp_path):
 
 @pytest.mark.parametrize("vdtype", [np.float64, np.float32])
 def test_per_step_helpers_equal_their_numpy_forms(vdtype):
-    """The store's compiled per-step helpers against the numpy they replaced, exactly: ``put_state`` (a
-    state's slab into lanes: ``to_lanes`` of the z components and of the x, y ones), ``take_step`` (a step
-    of a block's lanes: ``from_lanes``), ``unpack_sums`` (the gathered sums into (class, component)) and
-    ``scatter_slots`` (a state onto the FFT grid, a slot without a column giving 0)."""
-    from petsc_ssi.bem.lanes import (to_lanes, from_lanes, put_state, take_step, unpack_sums, scatter_slots,
-                                     n_groups, FW)
+    """The store's compiled per-step helpers against their numpy forms, exactly: ``put_state_grid`` (a
+    state's spectra as the distributed transform gives them, (slot, component, k_x, k_y column), into lanes
+    in the slab's k_y-major order: ``to_lanes`` of the z components and of the x, y ones), ``unpack_grid`` (a
+    step's sums from lanes into the inverse transform's input (class and component, k_x, column), times the
+    rotation (to 1e-15: a compiled complex product) or not) and ``scatter_slots`` (a state onto the FFT grid, a slot without a column giving 0)."""
+    from petsc_ssi.bem.lanes import to_lanes, put_state_grid, unpack_grid, scatter_slots, n_groups, FW
     rng = np.random.default_rng(9)
-    slab = 2 * FW + 5
-    full = _c(rng, 9, 3, 3 * slab)
-    S = full[..., slab:2 * slab]                                      # (a view, as the run's slab)
+    Mx, nk = 7, 3
+    slab = Mx * nk                                                    # (21: not whole lane groups)
+    S4 = _c(rng, 9, 3, Mx, nk)
+    S = S4.transpose(0, 1, 3, 2).reshape(9, 3, slab)                  # (the slab's order: k_y-major)
     G = n_groups(slab)
     V9, V18 = np.full((G, 4, 9, 2, FW), 7.0, vdtype), np.full((G, 4, 18, 2, FW), 7.0, vdtype)
-    put_state(S, V9, V18, 2)
+    put_state_grid(S4, V9, V18, 2)
     assert np.array_equal(V9[:, 2], to_lanes(S[:, 2, :].T, vdtype))
     assert np.array_equal(V18[:, 2], to_lanes(S[:, 0:2, :].transpose(2, 0, 1).reshape(-1, 18), vdtype))
     assert (V9[:, 1] == 7.0).all() and (V18[:, 3] == 7.0).all()      # (other rows untouched)
-    acc = to_lanes(_c(rng, slab, 3, 12))                             # (groups, b = 3, 12, 2, FW)
-    out = np.empty((slab, 12), np.complex128)
-    take_step(acc, 1, slab, out)
-    assert np.array_equal(out, from_lanes(acc[:, 1], slab))
-    F = 11
-    g = _c(rng, F, 12)
+    X = _c(rng, slab, 1, 12)
+    acc = to_lanes(X)                                                 # (groups, 1, 12, 2, FW)
+    rot = np.exp(1j * rng.standard_normal((4, slab)))
     for n9 in (8, 4):
-        u = np.empty((4, 3, F), np.complex128)
-        unpack_sums(g, n9, u)
-        xy, z = (g[:, :8], g[:, 8:]) if n9 == 8 else (g[:, 4:], g[:, :4])
-        assert np.array_equal(u[:, 0:2], xy.T.reshape(4, 2, F)) and np.array_equal(u[:, 2], z.T)
+        for h in (rot, np.zeros((0, 0), np.complex128)):
+            out = np.empty((12, Mx, nk), np.complex128)
+            unpack_grid(acc, n9, h, out)
+            xy, z = (X[:, 0, :8], X[:, 0, 8:]) if n9 == 8 else (X[:, 0, 4:], X[:, 0, :4])
+            ref = np.empty((4, 3, slab), np.complex128)
+            ref[:, 0:2], ref[:, 2] = xy.T.reshape(4, 2, slab), z.T
+            if h.size:
+                ref *= h[:, None, :]
+            ref = ref.reshape(12, nk, Mx).transpose(0, 2, 1)
+            if h.size:                  # (the product with the rotation compiled: to round-off, 1e-15)
+                assert np.abs(out - ref).max() <= 1e-15 * np.abs(ref).max(), (n9, np.abs(out - ref).max())
+            else:
+                assert np.array_equal(out, ref), n9
     U = np.r_[rng.standard_normal((6, 3)), np.zeros((1, 3))]
     vnode = rng.integers(-1, 6, (5, 9))
     vsign = rng.choice([-1.0, 1.0], (5, 3))
