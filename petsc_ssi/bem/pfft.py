@@ -146,6 +146,12 @@ class SlabFFT:
         self.backward_inputs(nb)[...] = s.reshape(nb, self.nky, self.Mx).transpose(0, 2, 1)
         return self.run_backward(nb).copy()
 
+    def flops(self, nb):
+        """This rank's share of nb planes' 2-D real FFTs by the usual count, 2.5 N log2 N a plane of N = Mx My
+        points (half the complex transform's 5 N log2 N): what -log_view's rate of the transforms divides."""
+        n = self.Mx * self.My
+        return nb * 2.5 * n * np.log2(max(n, 2)) / self.q if self.member else 0.0
+
     def destroy(self):
         """The members' sub-communicator freed (collective over them)."""
         from mpi4py import MPI

@@ -52,7 +52,7 @@ import time
 import numpy as np
 from numba import njit
 
-from ..petsc import SSIError, printf
+from ..petsc import SSIError, printf, init
 from ..monitor import event
 from .assemble import _pair_window
 from .pfft import slab_counts
@@ -340,7 +340,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     each exact lag (D: L, or the ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept
     transforms 27 per frequency and kept state (``kept_rows``; float32 pairs with ``single``), each rank's slab
     in whole lane groups (``lanes.padded``: the products run over the padding too); the build's
-    transients per rank (a chunk of kernels, its spectra, its integrals: the larger side's), ``g_bytes``
+    transients per rank (a chunk of kernels and its transforms' arrays: the larger side's), ``g_bytes``
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
     step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
@@ -372,7 +372,10 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         per_lag = m * g.Mx * g.My * 8.0
         kp = 1.0 if is_point_symmetric(g) else 2.0          # (real kernels: half the bytes and the flops)
         kern = 8.0 * kp * Fl * m * (D + k)
-        build = max(build, ranks * 3 * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
+        # (a rank's build transients in chunks: the chunk, its spectra and their k_y-major copy on one rank; on
+        # more, the chunk, a row block of it and mpi4py-fft's four arrays and the copy, each 1/p of the chunk)
+        copies = 3.0 if ranks == 1 else 1.0 + 6.0 / ranks
+        build = max(build, ranks * copies * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
         nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
         # (an offset and lag: its share of the integrals, a quarter at the mirror offsets, t_pair_int, and its
@@ -940,8 +943,10 @@ class ToeplitzHistory:
         PETSc = march.PETSc
         bufs = march.ubuf if self.side == "u" else march.pbuf
         for m in range(max(self.upto + 1, n - self.R + 1, 1), n + 1):
-            self.sc.scatter(bufs[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
-            self._transform(self.seq.getArray(readonly=True), m)
+            with event("SSI_BEM_HistXform"):     # (the per-step transforms with their scatters, both ways)
+                self.sc.scatter(bufs[march._slot(m)], self.seq, addv=PETSc.InsertMode.INSERT_VALUES)
+                self._transform(self.seq.getArray(readonly=True), m)
+                PETSc.Log.logFlops(self.fft.flops(27))
         self.upto = max(self.upto, n)
 
     def add(self, n, march, out_u):
@@ -1018,9 +1023,11 @@ class ToeplitzHistory:
         """Collective: the summed slabs back by inverse FFTs over the ranks (``pfft``: the sums unpacked into
         its input, ``lanes.unpack_grid``), each node's value scattered from the rank whose grid rows hold it to
         the node's rank, added to out_u with the side's sign."""
-        unpack_grid(acc, self.spec["n9"], self.rot_out if self.real else _NO_ROT, self.fft.backward_inputs(12))
-        self.fft.run_backward(12)                           # (into the array gvec wraps)
-        self.osc.scatter(self.gvec, self.ovec)
+        with event("SSI_BEM_HistXform"):
+            unpack_grid(acc, self.spec["n9"], self.rot_out if self.real else _NO_ROT, self.fft.backward_inputs(12))
+            self.fft.run_backward(12)                       # (into the array gvec wraps)
+            self.osc.scatter(self.gvec, self.ovec)
+            init().Log.logFlops(self.fft.flops(12))
         arr = out_u.getArray()
         vals = self.ovec.getArray(readonly=True)
         if self.spec["sign"] < 0:
