@@ -226,7 +226,8 @@ def _toeplitz_loaded(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
     from . import lagstore
     N, nt = prob.mesh.n_nodes, prob.regions.n_t
     tcol_loc = _traction_cols_local(comm, nt)
-    A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc)
+    A, H, G, _, _, kern = lagstore.load(cfg.lags_load, comm, prob.lags_manifest, ls.node_range, N, nt, tcol_loc,
+                                        fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
     march = Marcher(comm, ls, cfg.scheme, known_u, known_p, log=log, blr=float(cfg.step_blr),
                     mirror=cfg.get("step_mirror", "auto"), zero_dofs=zero, A=A)
     ls.cache_hits, ls.cache_bytes = 0, 0.0
@@ -279,7 +280,8 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     with event("SSI_BEM_Toeplitz"):
         for side, lat in grids:
             march.toeplitz.append(ToeplitzHistory(comm, ls, lat, log, block=block_of(cfg), side=side,
-                                                  precision=cfg.get("toeplitz_precision", "double"))
+                                                  precision=cfg.get("toeplitz_precision", "double"),
+                                                  fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
                                   .build(march, plan, monitor=cfg.monitor,
                                          kernels=None if kern is None else {n.split(":")[1]: a for n, a in
                                                                             kern.items() if n.startswith(side + ":")}))
@@ -305,6 +307,11 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
                      for t in march.toeplitz if t.real))
     printf(f"[ssi] history sum: in Fourier space, time-blocked, {th.block} steps per block (-ssi_history_block)"
            + ("; -ssi_history_sub is the dense store's and is not used here" if int(cfg.get("history_sub") or 0) else ""))
+    printf("[ssi] toeplitz transforms: mpi4py-fft slabs over the ranks, "
+           + "; ".join(f"{t.spec['what']} on {t.fft.q} of {comm.getSize()} rank(s)"
+                       + (" (-ssi_toeplitz_fft_ranks, or a slab decomposition's most, min(Mx, My // 2 + 1): the "
+                          "others hold no frequencies of this side)" if t.fft.q < comm.getSize() else "")
+                       for t in march.toeplitz))
     if kern is not None:
         printf(f"[ssi] lag matrices and toeplitz kernels loaded from {cfg.lags_load} (no assembly, no kernel "
                "integrals)")

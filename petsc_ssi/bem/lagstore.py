@@ -231,12 +231,12 @@ def save(path, comm, march, key):
     return comm.tompi4py().bcast(size, root=0), t_crc
 
 
-def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0, interp_lags=()):
+def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0, interp_lags=(), fft_ranks=0):
     """Collective: (A, H, G, HI, GI) from ``path`` in this run's layout (rows: the nodes
     ``node_range`` of ``n_nodes``; G's columns the ``n_t`` traction nodes, ``tcol_loc`` here).
     ``single_from`` > 0: block-sparse lags from it on (``interp_lags``: the lag index of each
     interpolating matrix) back to float32 as each is read, so that no more than one of them is
-    held in double at a time."""
+    held in double at a time. ``fft_ranks``: -ssi_toeplitz_fft_ranks (the toeplitz kernels' slabs, ``pfft``)."""
     PETSc = init()
     nloc = node_range[1] - node_range[0]
     types = {"dense": PETSc.Mat.Type.DENSE, "baij": PETSc.Mat.Type.BAIJ, "aij": PETSc.Mat.Type.AIJ}
@@ -284,7 +284,7 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
         r, p = comm.getRank(), comm.getSize()
         for name, shape, (Mx, My) in manifest.get("kernels", []):
             F = int(shape[0])
-            mine = (int(slab_counts(Mx, My, p)[r]),) + tuple(shape[1:])     # (``ToeplitzHistory``'s slab here)
+            mine = (int(slab_counts(Mx, My, p, fft_ranks)[r]),) + tuple(shape[1:])   # (``ToeplitzHistory``'s slab here)
             v = PETSc.Vec().create(comm=comm)
             v.setSizes((int(np.prod(mine)), PETSc.DECIDE))
             v.setType(PETSc.Vec.Type.MPI)

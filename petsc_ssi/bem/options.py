@@ -53,6 +53,10 @@ register("toeplitz_precision", "enum", "double", "", "-ssi_lag_store toeplitz: t
          "the state): double, or single (half their memory; the products still accumulate in double, the kernels "
          "stay double; the answer moves by about the single-precision rounding of the states: bem/toeplitz.py)",
          "bem", choices=("double", "single"))
+register("toeplitz_fft_ranks", "int", 0, "ranks", "-ssi_lag_store toeplitz: at most this many ranks hold frequencies "
+         "and make the 2-D FFTs (mpi4py-fft's slabs, bem/pfft.py; the others only send their nodes' states and take "
+         "their sums); 0: every rank that a slab decomposition can take, min(ranks, Mx, My // 2 + 1) (a tuning knob "
+         "where the transforms' all-to-all costs more than it divides)", "bem", validator=lambda v: None if v >= 0 else "must be >= 0")
 register("lag_storage", "enum", "auto", "", "lag matrices: dense (MATDENSE), sparse (BAIJ 3x3) or auto by fill", "bem",
          choices=("auto", "dense", "sparse"))
 register("history_block", "int", 0, "steps", "time-blocked history sum: the known part of the next b steps' history "
@@ -202,6 +206,9 @@ def _bem_checks(cfg):
         for name in ("disp_value", "disp_rotation", "disp_history", "disp_t0", "disp_table"):
             if cfg.user_set(name):
                 return f"-ssi_disp_rigid massless: the footing's motion is the unknown; drop -ssi_{name}"
+    if int(cfg.get("toeplitz_fft_ranks", 0) or 0) and cfg.get("lag_store", "dense") == "dense":
+        return ("-ssi_toeplitz_fft_ranks: the FFTs are the toeplitz store's; add -ssi_lag_store toeplitz (or auto on a "
+                "uniform flat grid)")
     if cfg.get("toeplitz_precision", "double") != "double" and cfg.get("lag_store", "dense") == "dense":
         return ("-ssi_toeplitz_precision single: the kept transforms are the toeplitz store's; add -ssi_lag_store "
                 "toeplitz (or auto on a uniform flat grid)")

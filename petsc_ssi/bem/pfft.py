@@ -31,15 +31,16 @@ def blockdist(n, size, rank):
     return q + (1 if r > rank else 0), rank * q + min(rank, r)
 
 
-def members(Mx, My, p):
+def members(Mx, My, p, limit=0):
     """The ranks that transform a plane Mx x My (the first ones): a slab decomposition splits the rows and the
-    half spectrum's columns, so at most min(Mx, My // 2 + 1) of them."""
-    return max(1, min(int(p), int(Mx), int(My) // 2 + 1))
+    half spectrum's columns, so at most min(Mx, My // 2 + 1) of them; and at most ``limit`` (> 0:
+    -ssi_toeplitz_fft_ranks)."""
+    return max(1, min(int(p), int(Mx), int(My) // 2 + 1, int(limit) if limit else int(p)))
 
 
-def slab_counts(Mx, My, p):
+def slab_counts(Mx, My, p, limit=0):
     """(p,) the frequencies each rank holds of the half spectrum Mx x (My // 2 + 1): Mx times its columns."""
-    q = members(Mx, My, p)
+    q = members(Mx, My, p, limit)
     return np.array([Mx * blockdist(My // 2 + 1, q, r)[0] if r < q else 0 for r in range(int(p))], np.int64)
 
 
@@ -55,7 +56,7 @@ class SlabFFT:
     in the k_y-major order (``counts`` every rank's); ``forward(a)`` (nb, x1 - x0, My) real -> (nb, f1 - f0)
     complex, unnormalised (scipy's ``rfft2``); ``backward(s)`` the inverse, normalised (``irfft2``)."""
 
-    def __init__(self, comm, Mx, My):
+    def __init__(self, comm, Mx, My, limit=0):
         from mpi4py import MPI
         try:
             importlib.import_module("mpi4py_fft")
@@ -64,13 +65,13 @@ class SlabFFT:
                            "with FFTW's library and headers (Debian: libfftw3-dev)") from None
         self.Mx, self.My, self.Myh = int(Mx), int(My), int(My) // 2 + 1
         p, r = comm.Get_size(), comm.Get_rank()
-        self.q = members(Mx, My, p)
+        self.q = members(Mx, My, p, limit)
         self.member = r < self.q
         self.sub = comm.Split(0 if self.member else MPI.UNDEFINED, r)
         self.rows_of = [(lambda c, s: (s, s + c))(*blockdist(Mx, self.q, k)) if k < self.q else (Mx, Mx)
                         for k in range(p)]
         self.rows = self.rows_of[r]
-        self.counts = slab_counts(Mx, My, p)
+        self.counts = slab_counts(Mx, My, p, limit)
         self.f0 = int(self.counts[:r].sum())
         self.f1 = self.f0 + int(self.counts[r])
         self.nky = self.counts[r] // self.Mx

@@ -534,7 +534,7 @@ class ToeplitzHistory:
     kept states' transforms in ``precision`` (double, or single: half their memory, the products still in
     double)."""
 
-    def __init__(self, comm, ls, lat, log=printf, block=BLOCK, side="u", precision="double"):
+    def __init__(self, comm, ls, lat, log=printf, block=BLOCK, side="u", precision="double", fft_ranks=0):
         self.comm, self.ls, self.lat, self.log = comm, ls, lat, log
         self.side, self.spec = side, SIDES[side]
         self.vdtype = PRECISIONS[precision]
@@ -543,7 +543,7 @@ class ToeplitzHistory:
         # the 2-D FFTs over the ranks (``pfft``, mpi4py-fft): this rank's rows of the grid and its frequencies
         # (k_y-major: f0..f1 of the spectrum in that order, ``pfft.kx_ky``)
         from .pfft import SlabFFT
-        self.fft = SlabFFT(comm.tompi4py(), lat.Mx, lat.My)
+        self.fft = SlabFFT(comm.tompi4py(), lat.Mx, lat.My, fft_ranks)
         self.f0, self.f1, self.counts = self.fft.f0, self.fft.f1, self.fft.counts
         self.upto = 0
 
@@ -813,7 +813,7 @@ class ToeplitzHistory:
                               for B in _kernel_blocks(np.arange(4 * 9 * m).reshape(4, 9, m, 1)))
         if not self.real:
             if out is None:
-                return np.ascontiguousarray(S).reshape(-1, S.shape[-1])
+                return np.ascontiguousarray(S).reshape(int(np.prod(S.shape[:-1])), S.shape[-1])   # (a slab may be empty)
             out[...] = S.reshape(out.shape)
             return out
         h = self.rot_k[:, None, :]                                        # (4, 1, slab)
@@ -826,7 +826,7 @@ class ToeplitzHistory:
         R[:, 8] = c.real if sg > 0 else c.imag
         self.dropped = max(self.dropped, float(np.abs(c.imag if sg > 0 else c.real).max(initial=0.0)))
         self.kept = max(self.kept, float(np.abs(R).max(initial=0.0)))
-        return R.reshape(-1, R.shape[-1])
+        return R.reshape(int(np.prod(R.shape[:-1])), R.shape[-1])
 
     def _pairs(self, S):
         """A state's slab S (9 slots, 3 components, slab) as the real kernels read it: rows 2 a, 2 a + 1 the

@@ -67,3 +67,28 @@ def test_slab_fft_is_rfft2_on_each_ranks_frequencies(n):
     if n == 3:
         empty = [g for g in g53 if not g["member"]]
         assert empty[0]["rows"][2] == [5, 5] and empty[0]["freq"][2][0] == empty[0]["freq"][2][1]
+
+
+@pytest.mark.parametrize("n, limit, h, g, rtol", [pytest.param(3, 2, 2, 2, 1e-12, id="n3-fft_ranks2"),
+                                                   pytest.param(6, 0, 5, 4, 5e-12, id="n6-beyond-the-slabs")])
+def test_coupled_run_with_ranks_without_frequencies_equals_one_rank(tmp_path, n, limit, h, g, rtol):
+    """The coupled foundation with unilateral contact on the toeplitz store at -n 3 with
+    -ssi_toeplitz_fft_ranks 2, and at -n 6, where the H side's FFT grid of 8 x 8 has 5 columns of half spectrum
+    and the G side's 4: ranks hold no frequencies (the log says so), and still send their nodes' states and take
+    their nodes' sums; every recorded field equals -n 1's to 1e-12 of the run's largest value of its kind (5e-12 at
+    -n 6: there the dense store itself moves this case's interface tractions by about 1e-12 from -n 1, its MUMPS
+    sums over six ranks and the contact's active set; the toeplitz store 0.7e-12-1.2e-12, with and without
+    -ssi_reproducible)."""
+    import sys
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from test_history_block import SSI, same
+    from helpers import cli
+    args = SSI + ["-ssi_lag_store", "toeplitz", "-ssi_t_end", "0.25"]
+    a, b = str(tmp_path / "n1.h5"), str(tmp_path / "n.h5")
+    out1 = cli(args + ["-ssi_output", a]).stdout
+    outn = cli(args + ["-ssi_output", b] + (["-ssi_toeplitz_fft_ranks", str(limit)] if limit else []), nranks=n).stdout
+    assert "H on 1 of 1 rank(s)" in out1, out1[-2000:]
+    line = [ln for ln in outn.splitlines() if "toeplitz transforms:" in ln]
+    assert line and f"H on {h} of {n} rank(s)" in line[0] and f"G on {g} of {n}" in line[0], outn[-3000:]
+    assert "hold no frequencies" in line[0]
+    same(a, b, rtol)
