@@ -77,8 +77,8 @@ def test_coupled_run_with_ranks_without_frequencies_equals_one_rank(tmp_path, n,
     and the G side's 4: ranks hold no frequencies (the log says so), and still send their nodes' states and take
     their nodes' sums; every recorded field equals -n 1's to 1e-12 of the run's largest value of its kind (5e-12 at
     -n 6: there the dense store itself moves this case's interface tractions by about 1e-12 from -n 1, its MUMPS
-    sums over six ranks and the contact's active set; the toeplitz store 0.7e-12-1.2e-12, with and without
-    -ssi_reproducible)."""
+    sums over six ranks and the contact's active set; the toeplitz store about as much, with and without
+    -ssi_reproducible: scratch comparisons)."""
     import sys
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from test_history_block import SSI, same
