@@ -212,7 +212,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                  + "; toeplitz.step_lu)")
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * N, g, plan=plan,
-                                stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single)
+                                stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single,
+                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
         b += ab
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
         steps_s = prob.n_steps * one
@@ -255,7 +256,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
-                                single=cfg.get("toeplitz_precision", "double") == "single")
+                                single=cfg.get("toeplitz_precision", "double") == "single",
+                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p)
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} | {b / 1e9:7.3g}")
     return out

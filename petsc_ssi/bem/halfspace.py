@@ -649,7 +649,8 @@ class HalfSpace:
         est, t_build, t_hist, steps = estimate(lat, self.L, self.n_steps, p, block, 3 * self.mesh.n_nodes, g,
                                                plan=plan, stabilized=c.scheme.startswith("stabili"),
                                                glat=traction_grid(lat, ls.VT),
-                                               single=c.get("toeplitz_precision", "double") == "single", per_step=True)
+                                               single=c.get("toeplitz_precision", "double") == "single", per_step=True,
+                                               fft_ranks=int(c.get("toeplitz_fft_ranks", 0) or 0))
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)
@@ -662,6 +663,8 @@ class HalfSpace:
         step by step and a solve with the step matrix's factors each step, ``toeplitz.step_lu_of``;
         ``step_solve_s``: that solve's seconds)."""
         from .toeplitz import step_lu_of
+        from .pfft import require
+        require(self.comm)                  # (mpi4py-fft on every rank, before the assembly)
         c = self.cfg
         self.lag_fill = c.lag_fill
         p = self.comm.getSize()

@@ -131,6 +131,9 @@ def check(cfg, comm, prob, plan):
     manifest = None
     if cfg.get("lags_load"):
         manifest = _read_json(cfg.lags_load, comm, "-ssi_lags_load")
+        if manifest["key"].get("lag_store") == "toeplitz" and manifest["key"].get("toeplitz_kernels") == "frequency-major":
+            raise SSIError(f"-ssi_lags_load {cfg.lags_load}: a toeplitz lag file of an older petsc-ssi (its kernels k_x-major, "
+                           "before the FFTs went over the ranks): save it again with -ssi_lags_save")
         if manifest["key"].get("lag_store") == "toeplitz" and "ranks" in manifest["key"]:
             raise SSIError(f"-ssi_lags_load {cfg.lags_load}: a toeplitz lag file of an older petsc-ssi (its kernels in "
                            f"the lane groups of its {manifest['key']['ranks']} ranks; files now load on any number "
@@ -290,7 +293,8 @@ def load(path, comm, manifest, node_range, n_nodes, n_t, tcol_loc, single_from=0
             v.setType(PETSc.Vec.Type.MPI)
             v.load(viewer)
             kernels[name] = from_file(v.getArray(readonly=True).reshape(mine))
-            kernels[name.split(":")[0] + ":F"] = F      # (the side's spectrum, checked against the run's)
+            kernels[name.split(":")[0] + ":F"] = F      # (the side's spectrum and FFT grid, checked against the run's)
+            kernels[name.split(":")[0] + ":grid"] = (int(Mx), int(My))
             v.destroy()
     collective_io(read, f"-ssi_lags_load {path}: reading the matrices (a truncated or changed file?)", comm)
     collective_io(read_kernels, f"-ssi_lags_load {path}: reading the toeplitz kernels (a truncated or changed file?)",

@@ -258,9 +258,11 @@ def scatter_slots(U, vnode, vsign, ix, iy, f):
 
 @njit(cache=True, boundscheck=False)
 def put_state_grid(S, V9, V18, i):
-    """``put_state`` from a state's spectra S (9 slots, 3 components, Mx, k_y columns) as the distributed
-    transform gives them (``pfft.SlabFFT.transform``): frequency f of the slab (k_y-major) at k_x = f % Mx,
-    column f // Mx (no copy into the slab's order)."""
+    """Row i of the kept transforms in lanes from a state's spectra S (9 slots, 3 components, Mx, k_y columns)
+    complex, as the distributed transform gives them (``pfft.SlabFFT.transform``): V9[.., i, a] the z
+    components, V18[.., i, 2 a + c] the x and y ones (``to_lanes`` of the slab's z and x, y components), frequency
+    f of the slab (k_y-major) from k_x = f % Mx, column f // Mx (no copy into the slab's order); padding lanes
+    zero."""
     mx, nk = S.shape[2], S.shape[3]
     slab = mx * nk
     G, fw = V9.shape[0], V9.shape[4]
@@ -282,8 +284,10 @@ def put_state_grid(S, V9, V18, i):
 def unpack_grid(acc, n9, rot, out):
     """out[3 t + p, k_x, column] (12, Mx, k_y columns) complex, the inverse transform's input
     (``pfft.SlabFFT.backward_inputs``), from a step's sums acc (groups, 1, 12, 2, FW) lanes (slab frequency f =
-    column Mx + k_x): ``take_step`` and ``unpack_sums`` in one pass, times rot[t, f] (the real kernels'
-    rotation back) where rot has rows, none (shape (0, 0)) otherwise."""
+    column Mx + k_x) in one pass: column o of the sums (the K9 products' then the K18 products': for n9 = 8 (H)
+    the 8 K9 columns are (class t, x or y) and the 4 K18 ones z of class t, for n9 = 4 (G) the other way round)
+    to plane 3 t + p, times rot[t, f] (the real kernels' rotation back) where rot has rows, none (shape (0, 0))
+    otherwise."""
     mx, nk = out.shape[1], out.shape[2]
     fw = acc.shape[4]
     xy0, z0 = (0, 8) if n9 == 8 else (4, 0)

@@ -50,6 +50,22 @@ def kx_ky(Mx, My, f0, f1):
     return f % Mx, f // Mx
 
 
+def require(comm):
+    """Collective (``comm`` petsc4py or mpi4py): one line on every rank if mpi4py-fft is missing on any rank,
+    before heavy work (the store's check of its memory calls it)."""
+    mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
+    try:
+        importlib.import_module("mpi4py_fft")
+        why = ""
+    except ImportError as e:
+        why = str(e)
+    bad = mpi.allgather(why)
+    missing = [f"rank {r}: {w}" for r, w in enumerate(bad) if w]
+    if missing:
+        raise SSIError(f"-ssi_lag_store toeplitz needs mpi4py-fft ({missing[0]}{' and others' if len(missing) > 1 else ''}): "
+                       "`make deps`, or `pip install mpi4py-fft` with FFTW's library and headers (Debian: libfftw3-dev)")
+
+
 class SlabFFT:
     """Collective (``comm``, an mpi4py communicator): the 2-D real FFTs of batches of Mx x My planes over the
     ranks. ``rows`` (x0, x1): this rank's rows of a plane in physical space; ``f0``, ``f1``: its frequencies
@@ -58,11 +74,7 @@ class SlabFFT:
 
     def __init__(self, comm, Mx, My, limit=0):
         from mpi4py import MPI
-        try:
-            importlib.import_module("mpi4py_fft")
-        except ImportError as e:        # (every rank the same: one line each, before any work)
-            raise SSIError(f"-ssi_lag_store toeplitz needs mpi4py-fft ({e}): `make deps`, or `pip install mpi4py-fft` "
-                           "with FFTW's library and headers (Debian: libfftw3-dev)") from None
+        require(comm)
         self.Mx, self.My, self.Myh = int(Mx), int(My), int(My) // 2 + 1
         p, r = comm.Get_size(), comm.Get_rank()
         self.q = members(Mx, My, p, limit)
@@ -86,16 +98,21 @@ class SlabFFT:
             P = PFFT(self.sub, (nb, self.Mx, self.My), axes=(1, 2), dtype=float, grid=(1, -1, 1),
                      planner_effort=PLANNER, overwrite_input="FFTW_PRESERVE_INPUT")
             si, so = P.local_slice(False), P.local_slice(True)
-            if (si[1].start, si[1].stop) != self.rows or so[2].stop - so[2].start != self.nky \
-                    or so[2].start * self.Mx != self.f0:
-                raise RuntimeError(f"mpi4py-fft's decomposition {si}, {so} is not the one expected "
-                                   f"(rows {self.rows}, frequencies {self.f0}..{self.f1})")
+            ok = ((si[1].start, si[1].stop) == self.rows and so[2].stop - so[2].start == self.nky
+                  and so[2].start * self.Mx == self.f0)
+            from mpi4py import MPI
+            if not self.sub.allreduce(ok, op=MPI.LAND):         # (every member, no hang)
+                raise SSIError(f"mpi4py-fft's slabs are not the ones expected on some rank (here {si}, {so}; rows "
+                               f"{self.rows}, frequencies {self.f0}..{self.f1}): report this with the grid {self.Mx} x "
+                               f"{self.My} and the rank count")
             self._plans[nb] = P
         return self._plans[nb]
 
     def forget(self, keep=()):
-        """The plans (and their arrays) of every batch size but ``keep`` freed."""
-        self._plans = {nb: P for nb, P in self._plans.items() if nb in keep}
+        """The plans (their arrays and communicators) of every batch size but ``keep`` freed (collective over the
+        members, which make and forget plans in the same order)."""
+        for nb in [nb for nb in self._plans if nb not in keep]:
+            self._plans.pop(nb).destroy()
 
     def inputs(self, nb):
         """(nb, x1 - x0, My) float64: the forward transform's input array of nb planes (this rank's rows), to be
@@ -119,7 +136,7 @@ class SlabFFT:
         self.inputs(nb)[...] = a
         out = np.ascontiguousarray(self.transform(nb).transpose(0, 2, 1)).reshape(nb, -1)
         if not keep:
-            self._plans.pop(nb, None)
+            self.forget(keep=[k for k in self._plans if k != nb])
         return out
 
     def backward_inputs(self, nb):
@@ -156,7 +173,7 @@ class SlabFFT:
     def destroy(self):
         """The members' sub-communicator freed (collective over them)."""
         from mpi4py import MPI
-        self._plans = {}
+        self.forget()
         if self.sub is not None and self.sub != MPI.COMM_NULL:
             self.sub.Free()
         self.sub = None

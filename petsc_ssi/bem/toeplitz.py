@@ -189,7 +189,8 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # cost model (``estimate``). The time rates r_products (the history's complex products per rank: the
 # block products' flops over this rate), the per-step work of every rank that is not split over the ranks
 # (t_step_dof a DOF, t_step_grid an FFT grid point, t_step_elem a virtual element: the state's gather, the
-# 27 + 12 transforms and their inputs element by element, images included), t_pair_lag (seconds per H
+# 27 + 12 transforms and their inputs element by element, images included; fitted while every rank made
+# every transform: since the transforms go over the ranks, ``pfft``, not refitted), t_pair_lag (seconds per H
 # kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
 # displacement kernel's integrals beside the traction kernel's) are fitted by `python
 # jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
@@ -333,14 +334,15 @@ def interp_work(plan, n_steps, block=BLOCK, stabilized=True):
 
 
 def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
-             glat=None, single=False, per_step=False):
+             glat=None, single=False, per_step=False, fft_ranks=0):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
     elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
     each exact lag (D: L, or the ``plan``'s Lx exact lags) and each of its k interpolating matrices, kept
     transforms 27 per frequency and kept state (``kept_rows``; float32 pairs with ``single``), each rank's slab
     in whole lane groups (``lanes.padded``: the products run over the padding too); the build's
-    transients per rank (a chunk of kernels and its transforms' arrays: the larger side's), ``g_bytes``
+    transients per rank (a chunk of kernels and its transforms' arrays: the larger side's; the ranks' slabs
+    counted as the largest one, ``pfft.slab_counts`` with ``fft_ranks``), ``g_bytes``
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
     step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
@@ -368,7 +370,10 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     for g, m in ((lat, 144), (glat, 180)):
         if g is None:
             continue
-        Fl = padded(slab_counts(g.Mx, g.My, ranks))     # (each rank's slab in whole lane groups)
+        # (each rank's slab in whole lane groups, ``pfft``'s whole columns of the half spectrum: the largest one on
+        # every rank, so that the busiest rank's products and the most loaded node's memory are not averaged away;
+        # -ssi_toeplitz_fft_ranks puts the frequencies on fewer ranks)
+        Fl = ranks * padded(slab_counts(g.Mx, g.My, ranks, fft_ranks).max())
         per_lag = m * g.Mx * g.My * 8.0
         kp = 1.0 if is_point_symmetric(g) else 2.0          # (real kernels: half the bytes and the flops)
         kern = 8.0 * kp * Fl * m * (D + k)
@@ -385,7 +390,8 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         ramp += 4.0 * kp * m * Fl * (np.minimum(np.maximum(n - 1, 0), D) + k * isteps / max(n_steps, 1))
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
-    # per step, on every rank: the state's gather and the G products (t_step_dof a DOF), the 27 + 12
+    # per step, on every rank (as fitted, before the transforms went over the ranks): the state's gather and the G
+    # products (t_step_dof a DOF), the 27 + 12
     # transforms over the FFT grids of both sides (t_step_grid a grid point) and the transforms' inputs
     # element by element (t_step_elem a virtual element: a symmetric model's images count, so its step
     # costs nearly a whole model's for a quarter of the DOFs)
@@ -544,7 +550,7 @@ class ToeplitzHistory:
         # (k_y-major: f0..f1 of the spectrum in that order, ``pfft.kx_ky``)
         from .pfft import SlabFFT
         self.fft = SlabFFT(comm.tompi4py(), lat.Mx, lat.My, fft_ranks)
-        self.f0, self.f1, self.counts = self.fft.f0, self.fft.f1, self.fft.counts
+        self.f0, self.f1 = self.fft.f0, self.fft.f1
         self.upto = 0
 
     # ---------------------------------------------------------------- kernels
@@ -592,7 +598,7 @@ class ToeplitzHistory:
         """Yield (lag, this rank's slab of the lag's kernel spectra (4, 9, m, slab) complex: class, slot,
         pattern entry, frequency) for lags lag_lo..lag_hi, integrated in chunks of lags (the integrals split
         over the ranks by offset, summed: each offset is integrated by one rank, so the sum is exact; the
-        sums' planes transformed by one rank each, ``_reduce_transform``)."""
+        planes summed onto the ranks of their rows and transformed over the ranks, ``_reduce_transform``)."""
         lat = self.lat
         m = self.spec["m"]
         mpi = self.comm.tompi4py()
@@ -600,8 +606,8 @@ class ToeplitzHistory:
         sel = np.arange(r, len(self.mirror), p)          # (each mirror offset integrated by one rank)
         mine = np.full(len(self.mirror), -1, np.int64)
         per_lag = 4 * (5 if self.real else 9) * m * lat.Mx * lat.My * 8
-        # (the same chunk on every rank: each chunk is one Reduce_scatter, and the ranks' slabs may differ by a
-        # frequency, so their own kernels' bytes may not give the same chunk)
+        # (the same chunk on every rank: each chunk is one set of collective reductions and transforms, and the
+        # ranks' slabs differ, so their own kernels' bytes may not give the same chunk)
         from mpi4py import MPI
         kern = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18)), op=MPI.MAX)
         chunk = max(1, min(lag_hi - lag_lo + 1, int(chunk_bytes(kern) // per_lag)))
@@ -627,8 +633,8 @@ class ToeplitzHistory:
         kernels, Kp (nl, 4, 9, m, Mx, My) this rank's offsets' share. Each row block of the planes is summed
         onto the rank of those rows (one MPI Reduce a block), and mpi4py-fft transforms the planes over the
         ranks (``pfft.SlabFFT``: its own all-to-all between its two passes), so that each rank ends with its
-        frequencies of every plane; no rank holds a whole chunk's spectra, and each makes 1/p of the
-        transforms' work."""
+        frequencies of every plane; no rank holds a whole chunk's spectra, and each of the q ranks that
+        transform (``pfft.members``) makes 1/q of the transforms' work."""
         from mpi4py import MPI
         lat, fft = self.lat, self.fft
         shape = Kp.shape[:4]
@@ -640,7 +646,8 @@ class ToeplitzHistory:
             from scipy.fft import rfft2     # arrays: 3.2 s against 4.9 s of kernels and 1.49 against 1.79 GB on the
             S = rfft2(K3, axes=(-2, -1), workers=1)     # paper's whole case, jobscripts/README.md)
         else:
-            In = fft.inputs(nch)                        # (the plan of a chunk's planes: kept for the build)
+            fft.forget(keep=(nch,))                     # (one chunk size's plan at a time: the last chunk's, the
+            In = fft.inputs(nch)                        # anchors' single lags are other sizes)
             for q, (a, b) in enumerate(fft.rows_of):    # (a block of rows at a time: 1/p of the chunk's copy)
                 if b > a:
                     blk = np.ascontiguousarray(K3[:, a:b])
@@ -739,7 +746,8 @@ class ToeplitzHistory:
         if kernels is not None:
             bad = [n for n in ("K9", "K18", "A9", "A18") if n not in kernels
                    or kernels[n].shape != getattr(self, n).shape] + (["F"] if kernels.get("F", self.lat.F) != self.lat.F
-                                                                     else [])
+                                                                     else []) \
+                + (["grid"] if tuple(kernels.get("grid", (self.lat.Mx, self.lat.My))) != (self.lat.Mx, self.lat.My) else [])
             from mpi4py import MPI
             if self.comm.tompi4py().allreduce(len(bad), op=MPI.MAX):
                 raise SSIError(f"-ssi_lags_load: the file's {self.spec['what']} kernels do not have this run's shapes "
@@ -870,8 +878,12 @@ class ToeplitzHistory:
         isf = PETSc.IS().createGeneral(dofs, comm=PETSc.COMM_SELF)
         self.sc = PETSc.Scatter().create(tmpl, isf, self.seq, None)
         isf.destroy()
-        # (the transform's own input array: only the slots' cells are written, the other zeros stay)
+        # (the transform's own input array, zeroed: only the slots' cells are written, the other zeros stay, its
+        # plan preserving its input)
         self._grid = fft.inputs(27).reshape(9, 3, x1 - x0, lat.My)
+        self._grid[...] = 0.0
+        if fft.member and not np.shares_memory(self._grid, fft.inputs(27)):
+            raise SSIError("-ssi_lag_store toeplitz: mpi4py-fft's input array is not contiguous; report this")
         # out: row i of out_u (this rank's nodes, class t, grid position (x, y)) from plane (t, c) of the rank
         # whose rows hold x
         r0, r1 = march.u_tmpl.getOwnershipRange()
@@ -889,6 +901,8 @@ class ToeplitzHistory:
         gidx = start[k][:, None] + ((3 * row_t[:, None] + c) * nx[k][:, None] + (row_x - lo[k])[:, None]) * lat.My \
             + row_y[:, None]
         self.gvec = PETSc.Vec().createWithArray(fft.outputs(12).reshape(-1), comm=self.comm)   # (the inverse's output)
+        if fft.member and not np.shares_memory(self.gvec.getArray(readonly=True), fft.outputs(12)):
+            raise SSIError("-ssi_lag_store toeplitz: the scatter's Vec does not wrap mpi4py-fft's output; report this")
         self.ovec = march.u_tmpl.duplicate()
         isf = PETSc.IS().createGeneral(gidx.ravel().astype(PETSc.IntType), comm=self.comm)
         ist = PETSc.IS().createStride(r1 - r0, first=r0, step=1, comm=self.comm)

@@ -5,7 +5,6 @@ import os
 import shutil
 import subprocess
 
-import numpy as np
 import pytest
 
 from helpers import PY, ROOT
@@ -35,7 +34,9 @@ for Mx, My in [(12, 10), (7, 4), (5, 3)]:
     freq = comm.allgather((f.f0, f.f1))
     f.destroy()
     out.append(dict(grid=[Mx, My], member=f.member, fwd=e_f, bwd=e_b, rows=rows, freq=freq))
-print("PFFT" + json.dumps(out), flush=True)
+every = comm.gather(out, root=0)          # (one line from rank 0: mpirun may run the ranks' lines together)
+if comm.rank == 0:
+    print("PFFT" + json.dumps(every), flush=True)
 '''
 
 
@@ -50,9 +51,10 @@ def test_slab_fft_is_rfft2_on_each_ranks_frequencies(n):
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300,
                        env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("PFFT")]
-    assert p.returncode == 0 and len(lines) == n, p.stdout + p.stderr
+    assert p.returncode == 0 and len(lines) == 1, p.stdout + p.stderr
     import json
-    per_rank = [json.loads(ln[4:]) for ln in lines]
+    per_rank = json.loads(lines[0][4:])
+    assert len(per_rank) == n
     for r in per_rank:
         for g in r:
             assert g["fwd"] <= 1e-14 and g["bwd"] <= 1e-14, g
@@ -69,16 +71,16 @@ def test_slab_fft_is_rfft2_on_each_ranks_frequencies(n):
         assert empty[0]["rows"][2] == [5, 5] and empty[0]["freq"][2][0] == empty[0]["freq"][2][1]
 
 
-@pytest.mark.parametrize("n, limit, h, g, rtol", [pytest.param(3, 2, 2, 2, 1e-12, id="n3-fft_ranks2"),
+@pytest.mark.parametrize("n, limit, h, g, rtol", [pytest.param(3, 2, 2, 2, 5e-12, id="n3-fft_ranks2"),
                                                    pytest.param(6, 0, 5, 4, 5e-12, id="n6-beyond-the-slabs")])
 def test_coupled_run_with_ranks_without_frequencies_equals_one_rank(tmp_path, n, limit, h, g, rtol):
     """The coupled foundation with unilateral contact on the toeplitz store at -n 3 with
     -ssi_toeplitz_fft_ranks 2, and at -n 6, where the H side's FFT grid of 8 x 8 has 5 columns of half spectrum
     and the G side's 4: ranks hold no frequencies (the log says so), and still send their nodes' states and take
-    their nodes' sums; every recorded field equals -n 1's to 1e-12 of the run's largest value of its kind (5e-12 at
-    -n 6: there the dense store itself moves this case's interface tractions by about 1e-12 from -n 1, its MUMPS
-    sums over six ranks and the contact's active set; the toeplitz store about as much, with and without
-    -ssi_reproducible: scratch comparisons)."""
+    their nodes' sums; every recorded field equals -n 1's to 5e-12 of the run's largest value of its kind (at
+    -n 3 and -n 6 the dense store itself moves this case's interface tractions by about 1e-12 from -n 1, its MUMPS
+    sums over the ranks and the contact's active set; the toeplitz store about as much, with and without
+    -ssi_reproducible, in runs just over and just under 1e-12: scratch comparisons and one failed run)."""
     import sys
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from test_history_block import SSI, same

@@ -596,8 +596,8 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     The kernels are frequency-major in the file (real here: one part a lane; k_y-major, the order of the
     ranks' slabs, ``pfft``), so it loads on any number of ranks: saved at -n 1 and loaded at -n 2, saved at
     -n 2 and loaded at -n 1 (slabs not whole lane groups, and empty ones: tests/bem/test_lanes.py); all equal the
-    saving run to 1e-12. The dense store refuses the file, and a file of the earlier layout (its rank count in
-    the key) is refused in one line."""
+    saving run to 1e-12. The dense store refuses the file, and files of the earlier layouts (its rank count in
+    the key; k_x-major kernels) are refused in one line."""
     case = DISP + INTERP + TZ
     lags, a, b = str(tmp_path / "lags"), str(tmp_path / "a.h5"), str(tmp_path / "b.h5")
     out = cli(case + ["-ssi_output", a, "-ssi_lags_save", lags]).stdout
@@ -625,12 +625,18 @@ def test_toeplitz_lags_save_and_load(tmp_path):
     same(a, d)
     with open(lags + ".json") as fh:
         old = json.load(fh)
+    import shutil
+    lags3 = str(tmp_path / "lags3")             # (the k_x-major layout before the FFTs went over the ranks)
+    shutil.copy(lags, lags3)
+    with open(lags3 + ".json", "w") as fh:
+        json.dump(dict(old, key=dict(old["key"], toeplitz_kernels="frequency-major")), fh)
     old["key"]["ranks"] = "1"                   # (the earlier layout's key: its rank count, no kernel layout)
     del old["key"]["toeplitz_kernels"]
     with open(lags + ".json", "w") as fh:
         json.dump(old, fh)
     for extra, lf, what, n in ((["-ssi_lag_store", "dense"], lags2, "lag_store differs (toeplitz there, dense here)",
-                                1), (TZ, lags, "a toeplitz lag file of an older petsc-ssi", 2)):   # (every rank's line)
+                                1), (TZ, lags, "a toeplitz lag file of an older petsc-ssi", 2),
+                               (TZ, lags3, "its kernels k_x-major", 1)):   # (every rank's line)
         args = [x for x in case if x not in TZ] + extra + ["-ssi_output", str(tmp_path / "e.h5")]
         r = cli(args + ["-ssi_lags_load", lf], nranks=n, check=False)
         err = [ln for ln in (r.stdout + r.stderr).splitlines() if "error:" in ln]
