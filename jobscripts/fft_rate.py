@@ -22,7 +22,7 @@ def main():
     a = ap.parse_args()
     comm = MPI.COMM_WORLD
     if comm.rank == 0:
-        print(f"| grid | ranks | forward, 27 planes [ms] | inverse, 12 planes [ms] | GFlop/s a rank | GFlop/s over the ranks |")
+        print("| grid | ranks | forward, 27 planes [ms] | inverse, 12 planes [ms] | GFlop/s a rank | GFlop/s over the ranks |")
         print("|---|---|---|---|---|---|")
     for g in a.grids.split(","):
         Mx, My = (int(v) for v in g.split("x"))
