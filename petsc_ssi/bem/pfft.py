@@ -135,8 +135,8 @@ class SlabFFT:
         nb = a.shape[0]
         self.inputs(nb)[...] = a
         out = np.ascontiguousarray(self.transform(nb).transpose(0, 2, 1)).reshape(nb, -1)
-        if not keep:
-            self.forget(keep=[k for k in self._plans if k != nb])
+        if not keep and nb in self._plans:
+            self._plans.pop(nb).destroy()
         return out
 
     def backward_inputs(self, nb):
