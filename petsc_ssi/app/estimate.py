@@ -213,7 +213,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single,
-                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
+                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0), reach=rho)
         b += ab
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
         steps_s = prob.n_steps * one
@@ -254,11 +254,11 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
            "the ranks beside the processes"]
     g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
     for p in ranks:
+        _, fac, one, rho, _ = step_lu_of(cfg, prob, lat, p)
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * prob.mesh.n_nodes, g,
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single",
-                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0))
-        _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p)
+                                fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0), reach=rho)
         out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} | {b / 1e9:7.3g}")
     return out
 

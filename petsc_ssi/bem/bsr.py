@@ -343,8 +343,103 @@ def panel_states(rep, rows, slots, coefs, out, transposed):
                 out[k, i] += c * rep[s, i]
 
 
+def mark_columns(ctx, mask):
+    """mask[node] = True for the column nodes this rank's rows of ``ctx`` (a BSRMat or SplitBSR) read: its blocks'
+    columns and, with a free term, its own rows' nodes; False (mask untouched) for any other context (a
+    DenseSplit reads every column)."""
+    parts = ctx.parts if isinstance(ctx, SplitBSR) else [ctx] if isinstance(ctx, BSRMat) else None
+    if parts is None:
+        return False
+    for p in parts:
+        mask[p.indices] = True
+    if ctx.diag is not None:
+        mask[ctx.row0:ctx.row0 + ctx.diag.shape[0]] = True
+    return True
+
+
+def column_nodes(ctx, n_nodes):
+    """The sorted column nodes (of ``n_nodes``) this rank's rows of ``ctx`` read (``mark_columns``), or None."""
+    mask = np.zeros(n_nodes, bool)
+    return np.flatnonzero(mask) if mark_columns(ctx, mask) else None
+
+
+def remapped(ctx, nodes):
+    """``ctx`` (a BSRMat or SplitBSR) reading its x at the positions of ``nodes`` (sorted, holding every column node
+    it reads, ``column_nodes``, ``mark_columns``) instead of at the global column nodes: the values, row pointers and free term
+    shared, the column indices (and the free term's first row) remapped; its products are the same operations
+    in the same order, the same bits. No python Mat of its own (``mat`` None)."""
+    nodes = np.asarray(nodes, np.int64)
+
+    def one(p):
+        q = BSRMat.__new__(BSRMat)
+        q.__dict__.update(p.__dict__)
+        q.indices = np.searchsorted(nodes, p.indices).astype(np.int32)
+        if q.indices.size and not np.array_equal(nodes[q.indices], p.indices):
+            raise ValueError("bsr.remapped: a column node of the matrix is not among the nodes")
+        if p.diag is not None:
+            q.row0 = int(np.searchsorted(nodes, p.row0))
+            n = p.diag.shape[0]
+            if n and not np.array_equal(nodes[q.row0:q.row0 + n], np.arange(p.row0, p.row0 + n)):
+                raise ValueError("bsr.remapped: the free term's nodes are not among the nodes")
+        q.sizes = (p.sizes[0], (3 * nodes.size, 3 * nodes.size))
+        q.mat = None
+        return q
+
+    if isinstance(ctx, SplitBSR):
+        s = SplitBSR.__new__(SplitBSR)
+        s.parts = [one(p) for p in ctx.parts]
+        s.comm, s.sizes = ctx.comm, s.parts[0].sizes
+        s.diag, s.row0 = s.parts[0].diag, s.parts[0].row0
+        s.mat = None
+        return s
+    return one(ctx)
+
+
+def reader(ctxs, tmpl, depth=1):
+    """Collective over ``tmpl``'s ranks: how this rank reads the x of the contexts ``ctxs`` (python Mats' BSRMat,
+    SplitBSR, DenseSplit; all of one column layout, ``tmpl`` a Vec of it), of which it keeps ``depth`` copies:
+    (scatter, seq Vec, [the context reading the seq Vec's array] per ``ctxs``, the DOFs it moves). The scatter moves only the
+    columns this rank's rows read (``mark_columns``' union): a short lag (the step matrix's lags 1-2, the toeplitz
+    store's only Mats) takes its rows' nodes and a halo, not the whole vector. The seq Vec holds them compacted
+    and the contexts ``remapped`` to them where the remapped column indices (4 bytes a block) cost less than the
+    ``depth`` copies of the columns left out save (24 bytes a node), on every rank; otherwise every column, of
+    which only those are written (the contexts as they are). Where a context reads every column (a DenseSplit)
+    or the union is every column: PETSc's all-gather. The products are the same bits every way."""
+    from mpi4py import MPI
+    PETSc = init()
+    N = tmpl.getSize() // 3
+    mask = np.zeros(N, bool)
+    every = False
+    for c in ctxs:                        # (stops at the first that reads every column: a far lag)
+        if not mark_columns(c, mask) or np.count_nonzero(mask) == N:
+            every = True
+            break
+    blocks = sum(c.blocks for c in ctxs) if not every else 0
+    n = int(np.count_nonzero(mask))
+    every = tmpl.getComm().tompi4py().allreduce(every or n == N, op=MPI.LOR)
+    if every:
+        sc, seq = PETSc.Scatter.toAll(tmpl)
+        return sc, seq, list(ctxs), 3 * N
+    remap = tmpl.getComm().tompi4py().allreduce(4.0 * blocks < depth * 24.0 * (N - n), op=MPI.LAND)
+    nodes = np.flatnonzero(mask)
+    dofs = (3 * nodes[:, None] + np.arange(3)).ravel().astype(PETSc.IntType)
+    iset = PETSc.IS().createGeneral(dofs, comm=PETSc.COMM_SELF)
+    if remap:
+        seq = PETSc.Vec().createSeq(dofs.size, comm=PETSc.COMM_SELF)
+        sc = PETSc.Scatter().create(tmpl, iset, seq, None)
+        read = [remapped(c, nodes) for c in ctxs]
+    else:
+        seq = PETSc.Vec().createSeq(3 * N, comm=PETSc.COMM_SELF)
+        seq.set(0.0)                      # (the columns no row reads stay zero)
+        sc = PETSc.Scatter().create(tmpl, iset, seq, iset)
+        read = list(ctxs)
+    iset.destroy()
+    return sc, seq, read, int(dofs.size)
+
+
 class _Shell:
-    """The python Mat's context: MatMult and MatMultAdd through the kernels."""
+    """The python Mat's context: MatMult and MatMultAdd through the kernels, on the columns this rank's rows
+    read (``reader``)."""
 
     def __init__(self, bsr):
         self.bsr = bsr
@@ -353,16 +448,17 @@ class _Shell:
     def _gather(self, x):
         PETSc = init()
         if self.scatter is None:
-            self.scatter, self.xall = PETSc.Scatter.toAll(x)
+            self.scatter, self.xall, (self.ctx,), _ = reader([self.bsr], x)
         self.scatter.scatter(x, self.xall, addv=PETSc.InsertMode.INSERT_VALUES)
         return self.xall.getArray(readonly=True)
 
     def mult(self, mat, x, y):
-        self.bsr.matvec(self._gather(x), y.getArray())
+        xa = self._gather(x)
+        self.ctx.matvec(xa, y.getArray())
 
     def multAdd(self, mat, x, v, y):
-        b = self.bsr
         xa = self._gather(x)
+        b = self.ctx
         tmp = np.empty(y.getLocalSize())
         b.matvec(xa, tmp)
         if v.handle != y.handle:

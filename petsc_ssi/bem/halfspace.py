@@ -637,7 +637,7 @@ class HalfSpace:
         """Collective: (bytes over the ranks, the node's limit, this node's share, (kernels' seconds, history's
         seconds, the processes' bytes, the history's seconds step by step)) of a toeplitz run with ``plan``
         (``toeplitz.estimate``, with the processes' resident size and ``extra_bytes``)."""
-        from .toeplitz import estimate, kernel_offsets, traction_grid, block_of
+        from .toeplitz import estimate, kernel_offsets, traction_grid, block_of, geometric_reach
         from mpi4py import MPI
         c = self.cfg
         lat = lat if lat is not None else self.lattice
@@ -650,7 +650,8 @@ class HalfSpace:
                                                plan=plan, stabilized=c.scheme.startswith("stabili"),
                                                glat=traction_grid(lat, ls.VT),
                                                single=c.get("toeplitz_precision", "double") == "single", per_step=True,
-                                               fft_ranks=int(c.get("toeplitz_fft_ranks", 0) or 0))
+                                               fft_ranks=int(c.get("toeplitz_fft_ranks", 0) or 0),
+                                               reach=geometric_reach(c, self) / (0.5 * float(min(lat.h))))
         from .lagset import load_kernels
         load_kernels()                      # the process measured with the compiled kernels it will hold
         rss = self.comm.tompi4py().allreduce(process_rss(), op=MPI.SUM)

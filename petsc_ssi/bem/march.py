@@ -528,12 +528,22 @@ class Marcher:
         """Collective: every rank's copies of the states m <= n0 the block reads (all-gathered once
         per state: the copies of earlier blocks stay valid, their states being final)."""
         if getattr(self, "_rep", None) is None:
-            PETSc = self.PETSc
-            self._rep = {}
+            self._rep, self._pctx, reads = {}, {}, {}
             for side, tmpl in (("u", self.u_tmpl), ("p", self.p_tmpl)):
-                sc, seq = PETSc.Scatter.toAll(tmpl)
-                self._rep[side] = (sc, seq, np.zeros((self.rep_depth, tmpl.getSize())))
+                # (the block-sparse Mats' copies hold the columns their rows hold blocks in, compacted where that
+                # saves memory: bsr.reader; a dense Mat on a side, every column)
+                Ms = self._side_mats(side)
+                ctxs = [bsr.context(M) for M in Ms]
+                if any(c is None or c.kind == "dense" for c in ctxs):
+                    sc, seq, read, moved = *self.PETSc.Scatter.toAll(tmpl), ctxs, tmpl.getSize()
+                else:
+                    sc, seq, read, moved = bsr.reader(ctxs, tmpl, self.rep_depth)
+                for M, c in zip(Ms, read):
+                    self._pctx[M.handle] = c
+                self._rep[side] = (sc, seq, np.zeros((self.rep_depth, seq.getSize())))
+                reads[side] = (moved, seq.getSize(), tmpl.getSize())
             self._rep_upto = 0
+            self._say_reads(reads)
         lo = max(self._rep_upto + 1, n0 - self.rep_depth + 1, 1)
         for m in range(lo, n0 + 1):
             for side, bufs in (("u", self.ubuf), ("p", self.pbuf)):
@@ -575,6 +585,36 @@ class Marcher:
         self._blk = (n0, rest, subs)
         self._sub_done = 0                                  # the sub-block whose panel R has last taken
 
+    def _say_reads(self, reads):
+        """Collective: one log line, once, where a rank's copies of the states hold less than the whole state
+        (``bsr.reader``): the most DOFs a rank moves a state and keeps, of every DOF, per side."""
+        if getattr(self, "_said_reads", False):
+            return
+        self._said_reads = True
+        from mpi4py import MPI
+        big = self.comm.tompi4py().allreduce([v for s in ("u", "p") for v in reads[s][:2]], op=MPI.MAX)
+        if big[0] >= reads["u"][2] and big[2] >= reads["p"][2]:
+            return                                          # (every rank all-gathers both: the dense lags)
+        printf(f"[ssi] history: the lag Mats' panel products read each rank's rows' columns: a rank moves at "
+               f"most {big[0]} and keeps {big[1]} of {reads['u'][2]} displacement DOFs, moves {big[2]} and keeps "
+               f"{big[3]} of {reads['p'][2]} traction DOFs a state, {self.rep_depth} states (bem/bsr.py reader)")
+
+    def _side_mats(self, side):
+        """The Mats the panel products take on ``side`` ('u': H's, 'p': G's): every exact lag from 2 on and the
+        interpolating matrices, those of ``_panel_kind`` (the others multiply PETSc Vecs)."""
+        keys = [("x", j) for j in range(2, len(self.H) + 1)] + [("i", i) for i in range(len(self.HI))]
+        out, seen = [], set()
+        for key in keys:
+            M = self._mat(key, side)
+            if M is not None and self._panel_kind(M) and M.handle not in seen:
+                seen.add(M.handle)
+                out.append(M)
+        return out
+
+    def _ctx(self, M):
+        """The context whose products read the every-rank copies of ``_replicate`` (``bsr.reader``)."""
+        return self._pctx[M.handle]
+
     def _panel_products(self, panel, R, upto):
         """Collective: R (w x local rows) += the panel products of ``panel`` {(key, side): [(row k
         of R, state m, coefficient)]}, states m <= ``upto`` (final) from every rank's copies."""
@@ -604,7 +644,7 @@ class Marcher:
                 else:
                     R += x @ At
             else:                                         # block-sparse: one pass over its blocks
-                ctx = bsr.context(M)                      # (bsr.BSRMat or bsr.DenseSplit)
+                ctx = self._ctx(M)                        # (bsr.BSRMat, SplitBSR or DenseSplit)
                 if RT is None:
                     RT = np.zeros((R.shape[1], w))
                 ctx.panel(x, RT, sign)
@@ -666,7 +706,7 @@ class Marcher:
                 y = A @ x
                 self.PETSc.Log.logFlops(2.0 * A.size)
             else:
-                ctx = bsr.context(M)
+                ctx = self._ctx(M)
                 y = np.empty(acc.size)
                 ctx.matvec(x, y)
                 self.PETSc.Log.logFlops(ctx.flops())

@@ -35,7 +35,8 @@ register("cache", "bool", True, "", "integrate each distinct (collocation point,
 register("cache_share", "bool", True, "", "with -ssi_cache on several ranks: integrate each distinct geometry once over all "
          "ranks (its owner rank integrates it and sends it to the ranks that meet it) instead of once per rank", "bem")
 register("partition", "enum", "balanced", "", "soil nodes per rank: contiguous ranges of equal estimated history "
-         "products (bem/partition.py) or PETSc's equal node counts", "bem",
+         "products (bem/partition.py) or PETSc's equal node counts (the default on the toeplitz store, which splits "
+         "its history by frequency, unless this option is given)", "bem",
          choices=("balanced", "equal"))
 register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=anti': mesh only x>=0 / y>=0; every load and "
          "motion is mirrored, the components the plane makes odd (u_x on x=sym; u_y, u_z on x=anti) with their "
@@ -44,8 +45,8 @@ register("symmetry", "str", "", "", "symmetry planes, e.g. 'x=sym,y=sym' or 'x=a
          "(a node nearer than 1e-3 of its elements' node spacing but not on it is refused)", "bem")
 register("lag_store", "enum", "dense", "", "how the lags of the history sum are stored: dense (the lag matrices, "
          "-ssi_lag_storage) or toeplitz (a uniform flat grid of equal elements, with or without symmetry planes: the H "
-         "lags as block-Toeplitz kernels in Fourier space, O(N) a lag instead of O(N^2), the history sum by FFTs: "
-         "bem/toeplitz.py; the same answer to round-off; refused in one line naming the first element off the grid); "
+         "and G lags from 3 on as block-Toeplitz kernels in Fourier space, O(N) a lag instead of O(N^2), the history "
+         "sum by FFTs over the ranks, lags 1-2 as Mats: bem/toeplitz.py; the same answer to round-off; refused in one line naming the first element off the grid); "
          "auto: toeplitz where the grid allows it, else dense (said in one log line)", "bem",
          choices=("dense", "toeplitz", "auto"))
 register("toeplitz_precision", "enum", "double", "", "-ssi_lag_store toeplitz: the precision of the kept states' "
@@ -127,7 +128,7 @@ register("disp_rigid", "enum", "prescribed", "", "the -ssi_disp_group region's r
          choices=("prescribed", "massless"))
 register("lags_save", "str", "", "", "save the assembled lag matrices (PETSc binary FILE and FILE.json with the "
          "key of what they depend on and the CRC32 of FILE's content; on the toeplitz store the step matrix, lags 1-2 and "
-         "the kernels, frequency-major: any rank count loads them) for -ssi_lags_load", "bem")
+         "the kernels, frequency-major, k_y-major: any rank count loads them) for -ssi_lags_load", "bem")
 register("lags_load", "str", "", "", "load the lag matrices a run saved with -ssi_lags_save instead of assembling "
          "them (refused, naming the difference, unless mesh, material, dt, scheme, symmetry, interpolation, "
          "quadrature and traction nodes are the same, on the toeplitz store also the store, and a file "

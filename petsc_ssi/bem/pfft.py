@@ -10,7 +10,7 @@ slabs, one after the other, are the whole spectrum in one order whatever the num
 files' order, ``lagstore``). A slab decomposition takes at most min(Mx, My // 2 + 1) ranks: beyond that the
 first ones transform and the others hold no rows and no frequencies (``members``).
 
-Used for the kernels' build (each rank's share of a chunk's planes summed onto the planes' row blocks,
+Used for the kernels' build on more than one rank (each rank's share of a chunk's planes summed onto the planes' row blocks,
 transformed) and per step for the new state's transform and the sums' inverse transform: no rank gathers a
 whole state or a whole spectrum (what each rank transformed in full before)."""
 import importlib

@@ -39,12 +39,13 @@ kernels' integrals are split by offset; each chunk's planes are summed onto the 
 Reduce a row block) and transformed over the ranks. Per step a PETSc scatter brings each rank the nodes its
 grid rows read, mpi4py-fft transforms the 27 planes (its own all-to-all between the two passes), the products
 run on the rank's frequencies, and the 12 summed planes go back the same way, a PETSc scatter taking each
-node's value from the rank whose rows hold it: no rank gathers a whole state or spectrum. A frequency's
+node's value from the rank whose rows hold it: the Fourier-space history gathers no whole state or spectrum
+(lags 1-2, Mats, move each rank's rows' columns and a halo: ``bsr.reader``). A frequency's
 products are summed in the same order on any number of ranks, so ``-n 2`` equals ``-n 1`` to round-off (the
 tests: 1e-12 relative; tests/bem/test_pfft.py for the transforms alone).
 
-G (traction columns) stays as the dense path stores it (N x n_t, small when the tractions live on a
-footprint or a load patch); the step matrix (lags 1 and 2) is assembled and factorised as before.
+G (traction columns): lags 1-2 are Mats as H's; its lags from 3 on are kernels too, on the traction elements'
+window (``traction_grid``, side "p"). The step matrix (lags 1 and 2) is assembled and factorised as before.
 """
 import math
 import time
@@ -289,9 +290,10 @@ def block_of(cfg):
 
 
 def chunk_bytes(kernel_bytes):
-    """Bytes of real kernels a rank integrates and transforms at a time: a twentieth of the side's stored
-    kernels on this rank (``kernel_bytes``), between 8 MB and ``CHUNK_BYTES``. The build's transients (the
-    chunk, its spectra, its integrals: about 3 chunks) then stay a small share of the run's memory: with a
+    """Bytes of real kernels a rank integrates and transforms at a time: a twentieth of ``kernel_bytes`` (the
+    side's stored kernels on the rank that holds the most, ``_spectra``), between 8 MB and ``CHUNK_BYTES``. The
+    build's transients (the chunk, its spectra, its integrals: 3 chunks on one rank, 1 + 6/p on p, ``estimate``)
+    then stay a small share of the run's memory: with a
     fixed 64 MB the paper's quarter model peaked in the build, 1.70 GB over 2 ranks against 1.55 GB with
     16 MB, its kernels' seconds unchanged (3.59, 3.41 s against 3.70, 3.29 s); a 64 m grid keeps 64 MB
     (one lag's chunk took its kernels from 7.97 to 8.78 s, its peak unchanged)."""
@@ -333,8 +335,17 @@ def interp_work(plan, n_steps, block=BLOCK, stabilized=True):
     return steps, work, span
 
 
+def copies_dofs(lat, n_dofs, ranks, reach):
+    """The DOFs of the ranks' copies of a state that lags 1-2's products read, summed over the ranks (``bsr.reader``):
+    each rank's rows' nodes and, beyond each end of its range of nodes, ``reach`` node spacings (the step matrix's
+    reach, ``geometric_reach`` over the node spacing) of rows of nodes (the longer of the lattice's two, 2 n + 1
+    nodes: a bound); at most every DOF on every rank."""
+    row = 2 * max(int(lat.nx), int(lat.ny)) + 1
+    return float(min(ranks * n_dofs, n_dofs + 3.0 * (ranks - 1) * 2.0 * math.ceil(max(float(reach), 0.0)) * row))
+
+
 def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates=None, plan=None, stabilized=True,
-             glat=None, single=False, per_step=False, fft_ranks=0):
+             glat=None, single=False, per_step=False, fft_ranks=0, reach=None):
     """(bytes over all ranks beside the processes themselves, seconds of the kernels' build, seconds of
     the history sum) of a toeplitz run. Per side (H on the grid ``lat``; G on ``glat``, the traction
     elements' window, ``traction_grid``, if any): kernels m complex per frequency (144 for H, 180 for G) for
@@ -344,7 +355,8 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     transients per rank (a chunk of kernels and its transforms' arrays: the larger side's; the ranks' slabs
     counted as the largest one, ``pfft.slab_counts`` with ``fft_ranks``), ``g_bytes``
     of G lags 1-2 and the step matrix, the march's past states (the ring and every rank's copy of it), the
-    step matrix's LU factors (``fill_bytes`` n log n); the history's complex products, 8 m flops per
+    step matrix's LU factors (``fill_bytes`` n log n), with ``reach`` (node spacings) the copies of lags 1-2's
+    columns as ``copies_dofs``; the history's complex products, 8 m flops per
     frequency and (step, kernel) pair at ``r_products`` per rank, the interpolated lags' weighted states
     (``interp_work``: 2 x 54 real flops per frequency, anchor and state) at ``r_sums`` anchor by anchor
     and ``r_sums_span`` over the anchors' common span, and
@@ -356,10 +368,12 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
     D = int(plan.Lx) if active else int(L)
     k = int(plan.k) if active else 0
     W = kept_rows(int(L), block)
-    # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and every
-    # rank's copies of the states lags 1-2's panel products read (``_replicate``, ``rep_depth``: 2 + 3 + 32):
-    # 8 bytes a DOF and state
-    ring = 8.0 * n_dofs * ((int(L) + 2 + 31) + ranks * (2 + 3 + 32))
+    # the march's ring of past states (march.Marcher: L + 2 + 31 deep, split over the ranks) and at most the
+    # ranks' copies of the columns lags 1-2's panel products read (``_replicate``, ``rep_depth``: 2 + 3 + 32 states;
+    # ``copies_dofs``: each rank's rows and a halo of ``reach`` node spacings, ``bsr.reader``; every DOF on every
+    # rank without ``reach``): 8 bytes a DOF and state
+    rep = ranks * n_dofs if reach is None else copies_dofs(lat, n_dofs, ranks, reach)
+    ring = 8.0 * (n_dofs * (int(L) + 2 + 31) + rep * (2 + 3 + 32))
     factors = r["fill_bytes"] * n_dofs * math.log(max(n_dofs, 2))
     nbytes = float(g_bytes) + ring + factors
     build = t_build = sums = sums_span = 0.0
@@ -643,7 +657,7 @@ class ToeplitzHistory:
         mpi = self.comm.tompi4py()
         r = mpi.Get_rank()
         if mpi.Get_size() == 1:         # (one rank: scipy's transform of the chunk as it is, no copy into a plan's
-            from scipy.fft import rfft2     # arrays: 3.2 s against 4.9 s of kernels and 1.49 against 1.79 GB on the
+            from scipy.fft import rfft2     # arrays: 3.2-3.8 s against 4.94 s of kernels, 1.55 against 1.79 GB on the
             S = rfft2(K3, axes=(-2, -1), workers=1)     # paper's whole case, jobscripts/README.md)
         else:
             fft.forget(keep=(nch,))                     # (one chunk size's plan at a time: the last chunk's, the

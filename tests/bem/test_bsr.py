@@ -59,3 +59,50 @@ def test_panel_states_is_the_numpy_loop_bit_for_bit():
     xt = np.zeros((301, 5))
     bsr.panel_states(rep, rows, slots, coefs, xt, True)
     assert np.array_equal(xt, ref.T)
+
+
+def _banded(rng, nrow, ncol, r0, reach, pattern=bsr.FULL, diag=True):
+    """A BSRMat of rows r0..r0+nrow-1 (of ncol column nodes) whose blocks lie within ``reach`` nodes of the row's
+    own node, columns unsorted, with a free term: a short lag's shape (the step matrix's lags 1-2)."""
+    indptr, indices = [0], []
+    for i in range(nrow):
+        g = r0 + i
+        cols = rng.permutation(np.arange(max(0, g - reach), min(ncol, g + reach + 1)))
+        indices.extend(cols)
+        indptr.append(len(indices))
+    data = rng.standard_normal((len(indices), len(bsr.PATTERNS[pattern])))
+    d = rng.standard_normal((nrow, 3, 3)) if diag else None
+    return bsr.BSRMat(None, np.array(indptr), np.array(indices), data, nrow, nrow, 4 * nrow, ncol, pattern, d, r0,
+                      shell=False)
+
+
+@pytest.mark.parametrize("pattern", [bsr.FULL, bsr.H4, bsr.G5])
+def test_a_remapped_lag_reads_its_columns_alone_bit_for_bit(pattern):
+    """``remapped`` onto the columns a rank's rows read (``column_nodes``: the blocks' columns and the free term's
+    own nodes) gives the matrix-vector and panel products of every column, bit for bit (the same operations on
+    the same values), for one matrix and for a SplitBSR of two patterns; a node left out is refused."""
+    rng = np.random.default_rng(11)
+    ncol, r0, nrow = 200, 80, 30
+    A = _banded(rng, nrow, ncol, r0, 6, pattern)
+    nodes = bsr.column_nodes(A, ncol)
+    assert nodes[0] == r0 - 6 and nodes[-1] == r0 + nrow - 1 + 6 and nodes.size == nrow + 12
+    B = _banded(rng, nrow, ncol, r0, 3, bsr.H4, diag=False)
+    S = bsr.SplitBSR.__new__(bsr.SplitBSR)        # (a SplitBSR without its python Mat: no PETSc here)
+    S.parts, S.comm, S.sizes, S.diag, S.row0, S.mat = [A, B], None, A.sizes, A.diag, A.row0, None
+    x = rng.standard_normal(3 * ncol) * 10.0 ** rng.integers(-6, 6, 3 * ncol)
+    xc = x.reshape(-1, 3)[nodes].ravel()
+    XT = np.ascontiguousarray(rng.standard_normal((3 * ncol, 9)))
+    XTc = np.ascontiguousarray(XT.reshape(ncol, 3, 9)[nodes].reshape(-1, 9))
+    for M in (A, S):
+        Mc = bsr.remapped(M, nodes)
+        y, yc = np.empty(3 * nrow), np.empty(3 * nrow)
+        M.matvec(x, y)
+        Mc.matvec(xc, yc)
+        assert np.array_equal(y, yc)
+        RT, RTc = np.zeros((3 * nrow, 9)), np.zeros((3 * nrow, 9))
+        M.panel(XT, RT, -1.0)
+        Mc.panel(XTc, RTc, -1.0)
+        assert np.array_equal(RT, RTc)
+        assert Mc.data is A.data if M is A else Mc.parts[0].data is A.data      # the values shared, not copied
+    with pytest.raises(ValueError, match="not among the nodes"):
+        bsr.remapped(A, nodes[1:])

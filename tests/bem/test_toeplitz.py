@@ -8,6 +8,7 @@ made again from the checkpoint's states). A surface that is not a uniform grid i
 line naming the first element off it."""
 import json
 import os
+import re
 import sys
 
 import h5py
@@ -103,6 +104,20 @@ def test_toeplitz_two_ranks_equal_one(tmp_path):
     cli(args + TZ + ["-ssi_output", one])
     cli(args + TZ + ["-ssi_output", two, "-ssi_reproducible"], nranks=2)
     same(ref, one)
+    same(one, two)
+
+
+def test_toeplitz_two_ranks_blocked_read_their_rows_columns(tmp_path):
+    """Lags 1-2's Mats in time blocks (-ssi_history_block 16) over 2 ranks: each rank keeps the columns its rows read
+    (its rows' nodes and a halo, ``bsr.reader``, said in one line), not every DOF, and -n 2 equals -n 1."""
+    args = BEM + TZ + ["-ssi_mesh_size", "14,14", "-ssi_dt", "0.001", "-ssi_t_end", "0.05"]    # (a short reach)
+    one, two = str(tmp_path / "one.h5"), str(tmp_path / "two.h5")
+    cli(args + ["-ssi_output", one])
+    out = cli(args + ["-ssi_history_block", "16", "-ssi_output", two, "-ssi_reproducible"], nranks=2).stdout
+    m = re.search(r"moves at most (\d+) and keeps (\d+) of (\d+) displacement DOFs", out)
+    assert m, out[-2000:]
+    moved, kept, every = map(int, m.groups())
+    assert moved == kept and every // 2 < kept < every, m.group(0)
     same(one, two)
 
 
