@@ -107,7 +107,7 @@ class SoilRecorder:
         """Collective: the receiver series (K, R, 3) on rank 0 (None elsewhere, or without receivers)."""
         if self.R is None:
             return None
-        loc = np.array(self.series).reshape(n_times, -1)
+        loc = np.array(self.series).reshape(n_times, -1) if n_times else np.zeros((0, 0))   # (a stop at step 1)
         allp = self.comm.tompi4py().gather(loc, root=0)
         if self.comm.getRank() == 0:
             return np.concatenate(allp, axis=1).reshape(n_times, len(self.prob.receivers), 3)
