@@ -153,6 +153,21 @@ def _cases(d):
         "restart from a result": (SMALL + ["-ssi_output", n, "-ssi_restart", h5], "not a petsc-ssi checkpoint"),
         "lag file missing": (SMALL + ["-ssi_output", n, "-ssi_lags_load", str(d / "none.lags")], "no such file"),
         "lag file replaces a file": (SMALL + ["-ssi_output", n, "-ssi_lags_save", h5], "exists (a previous result)"),
+        # arguments PETSc would take and not use: the run would keep the default, or drop a value
+        "an option with two dashes": (SMALL + ["-ssi_output", n, "--ssi_dt", "1e-3"],
+                                      "--ssi_dt: options take one dash (-ssi_dt)"),
+        "a second value": (SMALL + ["-ssi_output", n, "-ssi_dt", "1e-3", "2e-3"], "'2e-3' after -ssi_dt and its value"),
+        "a file name at the end": (SMALL + ["-ssi_output", n, "case.opts"], "'case.opts' after -ssi_output and its value"),
+        # a box group across a symmetry plane that would load other elements than it holds (x in [-2, 2], not
+        # [-0.5, 1.5]: the quarter's 0.5 and 1.5 mirrored)
+        "load box across a symmetry plane": (SMALL + ["-ssi_output", n, "-ssi_symmetry", "x=sym", "-ssi_mesh_patch", "",
+                                                      "-ssi_load_group", "box:-0.5,1.5,-1,1"],
+                                             "-ssi_load_group box:-0.5,1.5,-1,1: the box crosses the symmetry plane x = 0"),
+        "motion box across a symmetry plane": (["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1",
+                                                "-ssi_symmetry", "y=sym", "-ssi_disp_group", "box:-1,1,-0.5,1.5",
+                                                "-ssi_disp_value", "0,0,1e-6", "-ssi_dt", "0.005", "-ssi_t_end", "0.01",
+                                                "-ssi_output", n],
+                                               "-ssi_disp_group box:-1,1,-0.5,1.5: the box crosses the symmetry plane y = 0"),
     }
     cases.update(more)
     return cases
@@ -173,7 +188,9 @@ NAMES = ["existing result", "existing result, modes", "existing result, static",
          "no contact iteration",
          "unknown contact", "staggered with newmark", "interface group missing", "negative checkpoint_every",
          "inf checkpoint interval", "checkpoint name of a sidecar", "checkpoint replaces a file",
-         "restart file missing", "restart from a result", "lag file missing", "lag file replaces a file"]
+         "restart file missing", "restart from a result", "lag file missing", "lag file replaces a file",
+         "an option with two dashes", "a second value", "a file name at the end", "load box across a symmetry plane",
+         "motion box across a symmetry plane"]
 
 
 def test_the_table_has_every_case(previous):

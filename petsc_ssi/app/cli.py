@@ -40,6 +40,41 @@ def _bad_command(argv):
     return None
 
 
+def _is_option(tok):
+    """An option's name ('-name', not a negative number such as -1e-6 or -.5), as PETSc reads its arguments."""
+    return len(tok) > 1 and tok[0] == "-" and not (tok[1].isdigit() or tok[1] == ".")
+
+
+def _bad_args(argv):
+    """The one-line error for arguments PETSc would take without a word and not use, or None (commands that read
+    PETSc options only; ``post`` has its own --flags): an option written with two dashes (PETSc stores
+    '--ssi_dt 1e-3' under another name: the run would keep the default) and a second value after an option's
+    value (PETSc keeps the first and drops the rest: '-ssi_dt 1e-3 2e-3', or a file name at the end)."""
+    cmd, rest = _split(argv)
+    if cmd == "post":
+        return None
+    args = rest[1:]
+    if cmd == "record" and args and not _is_option(args[0]):
+        args = args[1:]                          # (its record file)
+    prev, values = None, 0
+    for tok in args:
+        if tok.startswith("--") and len(tok) > 2:
+            if tok in ("--help", "--version"):
+                prev, values = tok, 0
+                continue
+            return (f"petsc-ssi: error: {tok}: options take one dash ({tok[1:]}); with two, PETSc would keep the "
+                    "option under another name and the run would not use it")
+        if _is_option(tok):
+            prev, values = tok, 0
+            continue
+        values += 1
+        if values > 1 or prev is None:
+            where = f"after {prev} and its value" if prev is not None else "before any option"
+            return (f"petsc-ssi: error: '{tok}' {where}: an option takes one value (quote a value with spaces or "
+                    "semicolons, e.g. -ssi_receivers '1,0,0;2,0,0'); PETSc would drop it without a word")
+    return None
+
+
 def versions():
     """One line per component: petsc-ssi, Python, PETSc, petsc4py, mpi4py, numpy."""
     import platform
@@ -186,7 +221,7 @@ def _serial_status(run):
 
 def main(argv=None):
     argv = list(sys.argv if argv is None else argv)
-    bad = _bad_command(argv) or _bad_options_file(argv)
+    bad = _bad_command(argv) or _bad_args(argv) or _bad_options_file(argv)
     if bad:                    # before PETSc starts: every rank exits, rank 0 says why
         from mpi4py import MPI
         if MPI.COMM_WORLD.Get_rank() == 0:

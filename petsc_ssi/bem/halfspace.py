@@ -244,8 +244,8 @@ class HalfSpace:
         c_s or rho looks like a wrong unit (``soil_plausibility``)."""
         cfg = self.cfg
         if (cfg.load_group or cfg.get("load_area", "")) and cfg.load_p0 == 0.0 and not wave:     # (with a wave: the wave loads it)
-            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the run is load-free")
-        if cfg.user_set("load_p0") and not cfg.load_group and not cfg.get("load_area", ""):
+            warn("-ssi_load_group is set but -ssi_load_p0 is 0: the soil carries no load of its own")
+        if cfg.user_set("load_p0") and cfg.load_p0 != 0.0 and not cfg.load_group and not cfg.get("load_area", ""):
             warn("-ssi_load_p0 is set but no -ssi_load_group: nothing is loaded")
         odd = soil_plausibility(cfg.cs, cfg.rho)
         if odd:
@@ -329,7 +329,7 @@ class HalfSpace:
                                f"travels across this plane (azimuth {self.cfg.seismic_azimuth:g} deg): the free "
                                "field is not symmetric about it; model the whole surface")
         try:
-            symmetry.check_compatible(self.planes, s.direction(), None)
+            symmetry.check_compatible(self.planes, s.direction(), None, what="the free field's direction of motion")
         except SSIError as exc:
             raise SSIError(f"{exc}; here the free field of -ssi_seismic {s.kind} moves along "
                            f"{tuple(int(v) for v in s.direction())}") from None

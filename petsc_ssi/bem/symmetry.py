@@ -34,6 +34,35 @@ def parse(spec):
     return planes
 
 
+def check_box(option, spec, centres, planes):
+    """SSIError where the group ``spec`` of ``option`` is a box ('box:x0,x1,y0,y1', element centres inside) that
+    crosses a symmetry plane of ``planes`` (x0 < 0 for x = 0, y0 < 0 for y = 0) without selecting, among the meshed
+    elements (``centres``: x >= 0, y >= 0), each element's mirror image whenever it selects the element: the model
+    mirrors every element it selects, so the whole model would load (or move) other elements than the box holds.
+    A box in the meshed part (x0 >= 0) is mirrored, as every load is; one symmetric about the plane selects the
+    same elements either way."""
+    if not spec.startswith("box:") or not planes:
+        return
+    b = [float(v) for v in spec[4:].split(",")]
+    c = np.asarray(centres, float)
+
+    def inside(p):
+        return (p[:, 0] >= b[0]) & (p[:, 0] <= b[1]) & (p[:, 1] >= b[2]) & (p[:, 1] <= b[3])
+
+    for ax, _ in planes:
+        lo, hi = b[2 * ax], b[2 * ax + 1]
+        if lo >= 0.0:
+            continue
+        m = c.copy()
+        m[:, ax] = -m[:, ax]
+        if np.any(inside(c) != inside(m)):
+            name = "xy"[ax]
+            raise SSIError(f"{option} {spec}: the box crosses the symmetry plane {name} = 0 ({lo:g}..{hi:g}) but "
+                           f"does not hold the mirror image of every element it selects: the model mirrors each "
+                           f"selected element, so it would load other elements than the box; give the box in "
+                           f"{name} >= 0 (mirrored) or symmetric about the plane")
+
+
 def sign_matrix(axis, kind):
     s = np.ones(3)
     s[axis] = -1.0
@@ -146,13 +175,13 @@ def zero_dofs(nodes, planes, h, tol=1e-9):
     return np.unique(np.concatenate(out)) if out else np.zeros(0, np.int64)
 
 
-def check_compatible(planes, traction, disp, where=""):
+def check_compatible(planes, traction, disp, where="", what="the load traction"):
     """Refuse loads the declared symmetry contradicts: components with S = -1 must vanish (``has_odd``: to
     1e-12 of the vector's largest; a uniform field on a patch that meets the plane is even; ``where`` says which
-    nodes were checked)."""
+    nodes were checked; ``what``: the traction's name in the message)."""
     for ax, kind in planes:
         name = f"{'xy'[ax]}={'sym' if kind > 0 else 'anti'}"
-        for what, v in (("the load traction", traction), ("the prescribed displacement", disp)):
+        for label, v in ((what, traction), ("the prescribed displacement", disp)):
             if v is not None and has_odd(v, ax, kind):
-                raise SSIError(f"-ssi_symmetry {name}: {what} {tuple(float(x) for x in v)}{where} is not "
+                raise SSIError(f"-ssi_symmetry {name}: {label} {tuple(float(x) for x in v)}{where} is not "
                                f"{'symmetric' if kind > 0 else 'antisymmetric'} about this plane")

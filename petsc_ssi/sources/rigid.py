@@ -160,6 +160,7 @@ def rigid_motion(cfg, mesh):
                 warn(f"-ssi_{name} is set but no -ssi_disp_group: nothing is prescribed")
         return None
     elems = mesh.select(cfg.disp_group)
+    symmetry.check_box("-ssi_disp_group", cfg.disp_group, mesh.centres(), symmetry.parse(cfg.get("symmetry", "")))
     if not len(elems):
         return None
     try:

@@ -91,6 +91,8 @@ def uniform_patch(cfg, mesh):
     if not cfg.load_group:
         return None
     elems = mesh.select(cfg.load_group)
+    from ..bem import symmetry
+    symmetry.check_box("-ssi_load_group", cfg.load_group, mesh.centres(), symmetry.parse(cfg.get("symmetry", "")))
     if not len(elems):
         return None
     try:
