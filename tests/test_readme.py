@@ -47,4 +47,4 @@ def test_readme_running_block_runs_in_order(tmp_path):
     for f in ("pekeris-small.h5", "pekeris-small-n2.h5", "receivers.csv", "spectrum.csv", "block-modes.h5"):
         assert (out / f).stat().st_size > 0, f
     rows = (out / "receivers.csv").read_text().splitlines()
-    assert rows[0] == "receiver,x,y,z,t,ux,uy,uz" and len(rows) > 10
+    assert rows[0] == "receiver,x_m,y_m,z_m,t_s,ux_m,uy_m,uz_m" and len(rows) > 10

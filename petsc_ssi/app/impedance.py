@@ -71,6 +71,9 @@ MODES = {  # name: (option, motion, symmetry, resultant, component, radiation sp
     "rocking": ("disp_rotation", "0,1,0", "x=anti,y=sym", "moment", 1, "cp", "Iy"),
     "torsion": ("disp_rotation", "0,0,1", "x=anti,y=anti", "moment", 2, "cs", "J"),
 }
+# the unit of each row's K_re, K_im and K0 (the CSV's K_unit): resultant over motion; the coupling's mean N m/m = N/rad
+K_UNIT = {"vertical": "N/m", "horizontal": "N/m", "rocking": "N m/rad", "torsion": "N m/rad",
+          "horizontal-rocking": "N m/m", "rocking-horizontal": "N/rad", "coupling-mean": "N"}
 # the coupling terms each run also gives: (name, resultant, component)
 CROSS = {"horizontal": ("horizontal-rocking", "moment", 1),      # M_y per unit u_x
          "rocking": ("rocking-horizontal", "force", 0)}          # F_x per unit theta_y
@@ -392,9 +395,11 @@ def main():
         import csv
         with open(stem + "-impedance.csv", "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode", "a0", "omega_rad_s", "K_re", "K_im", "k", "c", "K0", "trusted", "k_ref", "c_ref"])
+            w.writerow(["mode", "a0", "omega_rad_s", "K_re", "K_im", "k", "c", "K0", "trusted", "k_ref", "c_ref",
+                        "K_unit"])
             for row in table:
-                w.writerow([row[0]] + [f"{v:.8g}" for v in row[1:8]] + [row[8]] + [f"{v:.6g}" for v in row[9:]])
+                w.writerow([row[0]] + [f"{v:.8g}" for v in row[1:8]] + [row[8]] + [f"{v:.6g}" for v in row[9:]]
+                           + [K_UNIT[row[0]]])
         _plot(stem + "-impedance.png", curves)
         printf(f"[impedance] wrote {stem}-impedance.csv and {stem}-impedance.png")
     comm.tompi4py().Barrier()

@@ -2,8 +2,8 @@
 
 Reads an output file with h5py (serial; no PETSc needed):
   --receivers --csv [OUT.csv]  one row per receiver and step (standard output without a
-                      name) of the --quantity or --series: header ``receiver,x,y,z,t,ux,uy,uz``
-                      [m] (vx.. [m/s], ax.. [m/s^2], rx.. [rad]; SI units)
+                      name) of the --quantity or --series: header ``receiver,x_m,y_m,z_m,t_s,ux_m,uy_m,uz_m``
+                      (vx_m_s.., ax_m_s2.., rx_rad..: each column's unit in its name; SI)
   --plot PNG          receiver time histories (with the Pekeris patch solution
                       when the run was a Lamb problem)
   --info              what the file holds
@@ -24,8 +24,8 @@ Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
   --spectrum          one-sided amplitude spectrum |X(f)| of a series, scaled so
                       that a sine of amplitude A gives a peak A (exact with
                       --window none and an integer number of periods; other
-                      windows divide out their coherent gain).  Prints the
-                      highest peaks (component,rank,f_hz,amplitude) on stdout.
+                      windows divide out their coherent gain): the series' unit.
+                      Prints the highest peaks (component,rank,f_hz,amplitude_<unit>).
   --response-spectrum response spectra (SA, PSA, PSV, SD, SV; RotD50/RotD100, ratios of
                       two spectra) of a receiver's acceleration: ``petsc-ssi post FILE.h5
                       --response-spectrum --help`` (``app/response.py``)
@@ -186,11 +186,29 @@ CSV_COLUMNS = {"receivers/u": "u", "receivers/velocity": "v", "receivers/acceler
                "receivers/rotation": "r"}
 
 
+def unit_suffix(unit):
+    """A column name's unit suffix, as the other CSVs write them (f_hz, time_s): '_m', '_m_s' for m/s, '_m_s2' for
+    m/s^2, '_rad'; '' without a unit."""
+    u = str(unit or "").strip()
+    if not u:
+        return ""
+    return "_" + u.replace("^", "").replace("/", "_").replace(" ", "_").replace("*", "")
+
+
+def series_unit(path, series):
+    """The unit a series of an output file carries (its dataset's 'unit' attribute), '' without one."""
+    with open_h5(path) as f:
+        d = f.get(series.strip("/"))
+        u = d.attrs.get("unit", "") if d is not None else ""
+    return u.decode() if isinstance(u, bytes) else str(u)
+
+
 def write_csv(path, out=None, series="receivers/u"):
     """One row per receiver and step of ``series`` (a (K, R, 3) receiver series, --quantity or
-    --series): receiver,x,y,z,t then its three components, named ux,uy,uz [m], vx,vy,vz [m/s],
-    ax,ay,az [m/s^2], rx,ry,rz [rad] (others: NAME_x,NAME_y,NAME_z in the dataset's units); SI
-    units; a receiver without rotations (not at a frame or shell node) has empty rotation cells."""
+    --series): receiver,x_m,y_m,z_m,t_s then its three components with their unit in the name, ux_m,uy_m,uz_m,
+    vx_m_s,vy_m_s,vz_m_s, ax_m_s2,ay_m_s2,az_m_s2, rx_rad,ry_rad,rz_rad (others: NAME_x,NAME_y,NAME_z with the
+    dataset's 'unit' attribute as a suffix, ``unit_suffix``); SI units; a receiver without rotations (not at a frame
+    or shell node) has empty rotation cells."""
     import h5py
     out = sys.stdout if out is None else out
     series = series.strip("/")
@@ -207,10 +225,13 @@ def write_csv(path, out=None, series="receivers/u"):
             raise PostError(f"--receivers --csv: {series} is not a receiver series (K, R, 3) with {grp}/points; "
                             "--spectrum --csv writes any series")
         pts, t = f[grp + "/points"][:], f[grp + "/t"][:]
+        units = [f[k].attrs.get("unit", "") for k in (grp + "/points", grp + "/t", series)]
+        units = [u.decode() if isinstance(u, bytes) else str(u) for u in units]
         has = f[grp + "/has_rotation"][:].astype(bool) if name == "rotation" and grp + "/has_rotation" in f else None
     p = CSV_COLUMNS.get(series)
-    cols = [p + c for c in "xyz"] if p else [f"{name}_{c}" for c in "xyz"]
-    out.write("receiver,x,y,z,t," + ",".join(cols) + "\n")
+    up, ut, ux = (unit_suffix(u) for u in units)
+    cols = [p + c + ux for c in "xyz"] if p else [f"{name}_{c}{ux}" for c in "xyz"]
+    out.write(f"receiver,x{up},y{up},z{up},t{ut}," + ",".join(cols) + "\n")
     for k, q in enumerate(pts):
         for i, ti in enumerate(t):
             vals = ",," if has is not None and not has[k] else ",".join(f"{v:.9e}" for v in x[i, k])
@@ -479,6 +500,8 @@ def spectrum_command(a, out=None):
     sep = inf["resolution"] if a.min_sep is None else a.min_sep
     fmin = inf["resolution"] if a.fmin is None else a.fmin
     found = [peaks(f, A[:, j], a.peaks, sep, fmin=fmin) for j in range(A.shape[1])]
+    unit = series_unit(a.file, a.series)
+    us = unit_suffix(unit)
     hdr = _header([
         "petsc-ssi post --spectrum: one-sided amplitude spectrum",
         f"file: {os.path.abspath(a.file)}",
@@ -489,16 +512,17 @@ def spectrum_command(a, out=None):
         f"df: {inf['df']:.9g} Hz (grid), resolution 1/(N dt): {inf['resolution']:.9g} Hz",
         f"detrend: {inf['detrend']}" + (f", fmax: {a.fmax:g} Hz" if a.fmax is not None else ""),
         f"scaling: {inf['scaling']}",
+        "unit: the amplitudes in " + (f"{unit}, the series'" if unit else "the series' unit (none stored)"),
     ])
     out.write(f"# {desc}: {inf['summary']}\n")
-    out.write("component,rank,f_hz,amplitude\n")
+    out.write(f"component,rank,f_hz,amplitude{us}\n")
     for lab, (fp, ap, _) in zip(labels, found):
         for r, (ff, aa) in enumerate(zip(fp, ap), 1):
             out.write(f"{lab},{r},{ff:.6g},{aa:.6g}\n")
     if a.csv is not None and a.csv is not False:
         fh, close = _open_out(a.csv)
         try:
-            _write_table(fh, hdr, ["f_hz"] + labels, [f] + [A[:, j] for j in range(A.shape[1])])
+            _write_table(fh, hdr, ["f_hz"] + [lab + us for lab in labels], [f] + [A[:, j] for j in range(A.shape[1])])
         finally:
             if close:
                 fh.close()
@@ -513,7 +537,7 @@ def spectrum_command(a, out=None):
                 ax.annotate(f"{ff:.3g} Hz", (ff, aa), textcoords="offset points", xytext=(3, 6),
                             fontsize=8, color=line.get_color())
         ax.set_xlabel("f [Hz]")
-        ax.set_ylabel("amplitude |X(f)|")
+        ax.set_ylabel(f"amplitude |X(f)| [{unit}]" if unit else "amplitude |X(f)|")
         ax.set_xlim(0, f[-1] if f.size else 1)
         ax.set_title(f"{os.path.basename(a.file)}: {desc.split(':', 1)[1]}\n"
                      f"window {inf['window_text']}, {inf['padding']}, df {inf['df']:.4g} Hz",

@@ -38,6 +38,10 @@ def _read(path):
     out = {}
     with open(path) as fh:
         for row in csv.DictReader(fh):
+            # each row's unit of K and K0: force or moment over displacement or rotation
+            assert row["K_unit"] == {"vertical": "N/m", "horizontal": "N/m", "rocking": "N m/rad", "torsion": "N m/rad",
+                                     "horizontal-rocking": "N m/m", "rocking-horizontal": "N/rad",
+                                     "coupling-mean": "N"}[row["mode"]], row
             out.setdefault(row["mode"], []).append([float(row[k]) for k in ("a0", "k", "c", "K0", "trusted", "k_ref",
                                                                                "c_ref")])
     return {k: np.array(v) for k, v in out.items()}
@@ -148,6 +152,10 @@ def _table(path):
     out = {}
     with open(path) as fh:
         for row in csv.DictReader(fh):
+            # each row's unit of K and K0: force or moment over displacement or rotation
+            assert row["K_unit"] == {"vertical": "N/m", "horizontal": "N/m", "rocking": "N m/rad", "torsion": "N m/rad",
+                                     "horizontal-rocking": "N m/m", "rocking-horizontal": "N/rad",
+                                     "coupling-mean": "N"}[row["mode"]], row
             out.setdefault(row["mode"], []).append(float(row["K_re"]) + 1j * float(row["K_im"]))
     return {k: np.array(v) for k, v in out.items()}
 

@@ -42,10 +42,17 @@ def test_hdf5_xdmf_json_and_post_csv(tmp_path):
     p = subprocess.run([sys.executable, "-m", "petsc_ssi", "post", str(out), "--receivers", "--csv"],
                        capture_output=True, text=True, cwd=ROOT, check=True)
     lines = p.stdout.strip().splitlines()
-    assert lines[0] == "receiver,x,y,z,t,ux,uy,uz"
+    assert lines[0] == "receiver,x_m,y_m,z_m,t_s,ux_m,uy_m,uz_m"      # (each column's unit in its name)
     assert len(lines) == 1 + 2 * 4
     row = lines[-1].split(",")
     assert row[0] == "1" and float(row[1]) == 3.0 and float(row[2]) == 1.0 and np.isclose(float(row[7]), d["u"][-1, 1, 2], rtol=1e-8)
+    # the amplitude spectrum's columns and peaks carry the series' unit too
+    spec = str(tmp_path / "spec.csv")
+    p = subprocess.run([sys.executable, "-m", "petsc_ssi", "post", str(out), "--spectrum", "--component", "z",
+                        "--csv", spec], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert "component,rank,f_hz,amplitude_m" in p.stdout.splitlines()
+    body = [ln for ln in open(spec).read().splitlines() if not ln.startswith("#")]
+    assert body[0] == "f_hz,u_z_m" and "# unit: the amplitudes in m" in open(spec).read()
 
 
 def test_help_lists_every_option():
