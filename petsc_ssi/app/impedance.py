@@ -40,6 +40,7 @@ converges as dt falls); the command prints the band.
 Also: the horizontal-rocking coupling terms (CROSS), the published curves of analytic/impedance_refs.py (k_ref,
 c_ref; -ssi_impedance_reference), and rigid_fit for the impedance of a structure coupled to the soil.
 """
+import gc
 import math
 import os
 import time
@@ -305,6 +306,7 @@ def main():
         if cfg0.user_set(name):
             raise SSIError(f"petsc-ssi impedance sets -ssi_{name} itself (per mode); drop it")
     want = _a0_range(cfg0.impedance_a0)
+    p = None
     if cfg0.impedance_symmetry:
         axes, xref, line = usable_planes(cfg0, comm)
         printf(line)
@@ -332,6 +334,10 @@ def main():
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
                f"{sym}, smooth step over {rise:.4g} s")
         t_run = time.perf_counter()
+        if p is not None:                   # (the last mode's lag Mats: their python contexts hold them back from
+            p.march.release()               # the collector, and each mode's lags had stayed: bem.march.release)
+        p = res = None
+        gc.collect()
         p = BEMTransient(cfg, comm)
         res = p.run()
         t_run = time.perf_counter() - t_run

@@ -599,6 +599,17 @@ class Marcher:
                f"most {big[0]} and keeps {big[1]} of {reads['u'][2]} displacement DOFs, moves {big[2]} and keeps "
                f"{big[3]} of {reads['p'][2]} traction DOFs a state, {self.rep_depth} states (bem/bsr.py reader)")
 
+    def release(self):
+        """Collective: destroy the lag Mats (H, G, the interpolating ones; their python contexts, which hold the Mats
+        back, with them) and the every-rank copies, so that a process that runs one problem after another
+        (``petsc-ssi impedance``'s modes) does not keep each one's lags."""
+        for Ms in (self.H, self.G, self.HI, self.GI):
+            for i, M in enumerate(Ms):
+                if M is not None:
+                    M.destroy()
+                    Ms[i] = None
+        self._rep = self._pctx = self._R = self._blk = None
+
     def _side_mats(self, side):
         """The Mats the panel products take on ``side`` ('u': H's, 'p': G's): every exact lag from 2 on and the
         interpolating matrices, those of ``_panel_kind`` (the others multiply PETSc Vecs)."""

@@ -106,3 +106,28 @@ def test_a_remapped_lag_reads_its_columns_alone_bit_for_bit(pattern):
         assert Mc.data is A.data if M is A else Mc.parts[0].data is A.data      # the values shared, not copied
     with pytest.raises(ValueError, match="not among the nodes"):
         bsr.remapped(A, nodes[1:])
+
+
+def test_release_frees_the_lag_mats_and_their_values():
+    """A python lag Mat and its BSRMat hold each other (the Mat's context; the context's ``mat``), a cycle through
+    PETSc that Python's collector does not see: ``Marcher.release`` destroys the Mats, after which their values go
+    (``petsc-ssi impedance`` calls it between its modes: each mode's lags had stayed in the process)."""
+    import gc
+    import weakref
+    from helpers import petsc
+    from petsc_ssi.bem.march import Marcher
+    PETSc = petsc()
+
+    class Lags:
+        pass
+
+    M = bsr.from_csr(PETSc.COMM_SELF, 2, 2, 2, 2, np.array([0, 1, 2]), np.array([0, 1], np.int32), np.ones((2, 9)))
+    ref = weakref.ref(bsr.context(M))
+    lags = Lags()
+    lags.H, lags.G, lags.HI, lags.GI = [None, M], [M], [], []
+    del M
+    gc.collect()
+    assert ref() is not None                # (held by the lists)
+    Marcher.release(lags)
+    gc.collect()
+    assert ref() is None and lags.H == [None, None] and lags.G == [None]
