@@ -155,6 +155,8 @@ def resolve(groups=None, comm=None):
             break
     if err is None:
         err = _unprefixed_solver_option(allopts)
+    if err is None:
+        err = _solver_type_error(allopts)
     values, sources = {}, {}
     if err is None:
         for name, opt in _REGISTRY.items():
@@ -211,6 +213,32 @@ def _unprefixed_solver_option(allopts):
     return (f"-{bad[0]}: no solver of petsc-ssi reads PETSc options without its prefix; write "
             f"-ssi_bem_{bad[0]} or -ssi_fem_{bad[0]} ({_SOLVER_HINT})"
             + (f" (also: {' '.join('-' + k for k in bad[1:])})" if len(bad) > 1 else ""))
+
+
+_TYPED = {"ksp_type": ("KSP", "Type"), "pc_type": ("PC", "Type"), "pc_factor_mat_solver_type": ("Mat", "SolverType")}
+
+
+def _solver_type_error(allopts):
+    """The error for a petsc-ssi solver's KSP, PC or factor package type that PETSc does not know
+    (-ssi_bem_pc_type foo), before any work: PETSc itself would refuse it only when the solver is made, after the
+    assembly, and on some ranks with an MPI abort. The names are petsc4py's; whether a known package was built
+    into this PETSc (MUMPS, SuperLU_dist) is still PETSc's to say."""
+    PETSc = init()
+    for key in sorted(allopts):
+        if not key.startswith(PREFIX) or not _is_petsc_object_option(key[len(PREFIX):]):
+            continue
+        what = next((t for t in _TYPED if key.endswith("_" + t)), None)
+        if what is None:
+            continue
+        cls, attr = _TYPED[what]
+        known = {v for k, v in vars(getattr(getattr(PETSc, cls), attr)).items()
+                 if not k.startswith("_") and isinstance(v, str)}
+        val = str(allopts[key]).strip()
+        if val and val.lower() not in known:
+            near = difflib.get_close_matches(val.lower(), sorted(known), n=1)
+            return (f"-{key} {val}: PETSc has no {what.replace('_', ' ')} '{val}'"
+                    + (f" (did you mean {near[0]}?)" if near else "") + f"; PETSc's are: {', '.join(sorted(known))}")
+    return None
 
 
 _READ_GROUPS = set()        # the option groups this process has resolved (a command may resolve twice)

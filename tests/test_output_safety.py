@@ -158,6 +158,13 @@ def _cases(d):
                                       "--ssi_dt: options take one dash (-ssi_dt)"),
         "a second value": (SMALL + ["-ssi_output", n, "-ssi_dt", "1e-3", "2e-3"], "'2e-3' after -ssi_dt and its value"),
         "a file name at the end": (SMALL + ["-ssi_output", n, "case.opts"], "'case.opts' after -ssi_output and its value"),
+        # a solver type PETSc does not know: refused before the assembly (PETSc itself would stop at the solver's
+        # set-up, after it, with an MPI abort)
+        "unknown preconditioner": (SMALL + ["-ssi_output", n, "-ssi_bem_pc_type", "foo"],
+                                   "-ssi_bem_pc_type foo: PETSc has no pc type 'foo'"),
+        "misspelt factor package": (FEM + ["-ssi_output", n, "-ssi_fem_pc_factor_mat_solver_type", "mumsp"],
+                                    "-ssi_fem_pc_factor_mat_solver_type mumsp: PETSc has no pc factor mat solver type "
+                                    "'mumsp' (did you mean mumps?)"),
         # a box group across a symmetry plane that would load other elements than it holds (x in [-2, 2], not
         # [-0.5, 1.5]: the quarter's 0.5 and 1.5 mirrored)
         "load box across a symmetry plane": (SMALL + ["-ssi_output", n, "-ssi_symmetry", "x=sym", "-ssi_mesh_patch", "",
@@ -190,7 +197,7 @@ NAMES = ["existing result", "existing result, modes", "existing result, static",
          "inf checkpoint interval", "checkpoint name of a sidecar", "checkpoint replaces a file",
          "restart file missing", "restart from a result", "lag file missing", "lag file replaces a file",
          "an option with two dashes", "a second value", "a file name at the end", "load box across a symmetry plane",
-         "motion box across a symmetry plane"]
+         "motion box across a symmetry plane", "unknown preconditioner", "misspelt factor package"]
 
 
 def test_the_table_has_every_case(previous):
