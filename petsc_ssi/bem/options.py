@@ -210,6 +210,9 @@ def _bem_checks(cfg):
     if int(cfg.get("toeplitz_fft_ranks", 0) or 0) and cfg.get("lag_store", "dense") == "dense":
         return ("-ssi_toeplitz_fft_ranks: the FFTs are the toeplitz store's; add -ssi_lag_store toeplitz (or auto on a "
                 "uniform flat grid)")
+    if int(cfg.get("lag_single_from", 0) or 0) and cfg.get("lag_store", "dense") == "toeplitz":
+        return ("-ssi_lag_single_from keeps lag matrices in single precision, which the toeplitz store has not "
+                "(its kernels stay double; -ssi_toeplitz_precision single rounds its kept transforms): drop one of them")
     if cfg.get("toeplitz_precision", "double") != "double" and cfg.get("lag_store", "dense") == "dense":
         return ("-ssi_toeplitz_precision single: the kept transforms are the toeplitz store's; add -ssi_lag_store "
                 "toeplitz (or auto on a uniform flat grid)")
