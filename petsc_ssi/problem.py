@@ -39,7 +39,7 @@ import time
 
 import numpy as np
 
-from .petsc import init, SSIError, printf, collective_error
+from .petsc import init, SSIError, printf, collective_error, warn
 
 SIGNALS = ("SIGTERM", "SIGINT", "SIGUSR1")
 
@@ -532,6 +532,10 @@ class TransientProblem:
             raise SSIError(f"the run to t = {self.time(self.n_steps):.6g} s with -ssi_dt {self.grid.dt:g} is "
                            f"{self.n_steps:.4g} time steps, more than -ssi_max_steps {limit}; check t_end and dt, "
                            "or raise -ssi_max_steps to run them")
+        st = int(self.cfg.get("output_stride", 0) or 0)
+        if st > self.n_steps and self.cfg.get("output") and self.cfg.user_set("output_stride"):
+            warn(f"-ssi_output_stride {st} is more than the run's {self.n_steps} steps: no field snapshot is written "
+                 "(receivers only; -ssi_output_stride 0 says so without this line)")
         if not self.defer_loop_line:
             self.print_loop_line()
 

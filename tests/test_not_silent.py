@@ -260,3 +260,14 @@ def test_obspy_warnings_reach_the_run_and_a_corrupt_record_is_refused(tmp_path, 
                 R.read_record(path, units="m/s2")
                 assert any(issubclass(w.category, R.RecordWarning) and "ObsPy: a gap of 2 samples" in str(w.message)
                            for w in caught), [str(w.message) for w in caught]
+
+
+def test_a_stride_beyond_the_last_step_is_said(tmp_path):
+    """-ssi_output_stride 100 on a 7-step run writes no field snapshot (the fields are written every 100 steps):
+    one warning line says so; a stride that writes some, or 0 (receivers only, asked for), says nothing."""
+    import os
+    from helpers import ROOT, cli
+    base = ["-options_file", os.path.join(ROOT, "runs", "pekeris", "small.opts"), "-ssi_t_end", "0.005"]
+    for stride, said in (("100", True), ("3", False), ("0", False)):
+        out = cli(base + ["-ssi_output_stride", stride, "-ssi_output", str(tmp_path / f"s{stride}.h5")]).stdout
+        assert ("no field snapshot is written" in out) == said, (stride, out[-1500:])
