@@ -862,7 +862,8 @@ class Motion:
                     f"{p['highpass_pad_s']:.4g} s of zero pads kept at each end" if p.get("highpass") else ""),
                  f"motion: {len(self.t)} samples, t {self.t_start:g} .. {self.t_end:g} s "
                  f"(duration {self.duration:g} s)",
-                 f"{'':16s}{'raw':>24s}{'processed':>24s}"]
+                 # (the raw column is the record as read times -ssi_seismic_scale (or a target's factor): said so)
+                 f"{'':16s}{'raw' if p['scale'] == 1 else 'raw x ' + format(p['scale'], '.4g'):>24s}{'processed':>24s}"]
         names = {"pga": "PGA", "pgv": "PGV", "pgd": "PGD", "v_end": "final v", "d_end": "final d",
                  "arias": "Arias", "d5_95": "D5-95"}
         for key, name in names.items():

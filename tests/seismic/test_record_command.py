@@ -29,6 +29,9 @@ def test_record_report_and_csv(rec, tmp_path):
     p = cli(["record", str(rec[0]), "-ssi_seismic_target", "pga:0.3g", "-ssi_seismic_baseline", "none",
              "-ssi_record_csv", str(out)])
     assert "PGA [m/s2]" in p.stdout and "target PGA: 2.94199 m/s^2 (0.3 g)" in p.stdout
+    # the 'raw' column holds the record times the target's factor: its head says so
+    head = [ln for ln in p.stdout.splitlines() if ln.rstrip().endswith("processed")]
+    assert len(head) == 1 and " raw x " in head[0], p.stdout[-2000:]
     rows = [ln.split(",") for ln in out.read_text().splitlines() if not ln.startswith("#")]
     assert rows[0] == ["axis", "t [s]", "acceleration [m/s^2]", "velocity [m/s]", "displacement [m]"]
     data = np.array([[float(x) for x in r[1:]] for r in rows[1:]])
