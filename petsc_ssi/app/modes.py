@@ -29,6 +29,11 @@ def main():
     return freqs
 
 
+# the log's effective heights are shown where the mode moves at least this share of the mass along the direction
+# (the output file keeps every height, NaN where the mode has no share at all: fem.modes.participation)
+HEIGHT_SHARE = 1e-4
+
+
 def _participation_lines(p, freqs):
     """The log's table of effective modal masses (share of the total, cumulative) and heights."""
     b = p["base_point"]
@@ -36,12 +41,14 @@ def _participation_lines(p, freqs):
     printf(f"[modes] modal participation (shapes of the table above; base point ({b[0]:g}, {b[1]:g}, {b[2]:g}) m; "
            f"total mass moving with the base x {tot[0]:.6g} kg, y {tot[1]:.6g} kg, z {tot[2]:.6g} kg)")
     printf("mode,frequency_hz,meff_x_kg,meff_y_kg,meff_z_kg,ratio_x,ratio_y,ratio_z,cum_x,cum_y,cum_z,"
-           "height_x_m,height_y_m")
+           f"height_x_m,height_y_m  (height '-': the mode moves under {100 * HEIGHT_SHARE:g} % of the mass along "
+           "that direction, a ratio of two near-zero sums)")
     for k, f in enumerate(freqs):
         me, r, c, h = p["effective_mass"][k], p["effective_mass_ratio"][k], p["cumulative_mass_ratio"][k], \
             p["effective_height"][k]
+        hs = ["-" if not np.isfinite(v) or not r[d] >= HEIGHT_SHARE else f"{v:.6g}" for d, v in enumerate(h)]
         printf(f"{k + 1},{f:.8g}," + ",".join(f"{v:.6g}" for v in me[:3]) + "," + ",".join(f"{v:.4f}" for v in r[:3])
-               + "," + ",".join(f"{v:.4f}" for v in c[:3]) + "," + ",".join(f"{v:.6g}" for v in h))
+               + "," + ",".join(f"{v:.4f}" for v in c[:3]) + "," + ",".join(hs))
     need = modes_for(p["cumulative_mass_ratio"])
     cum = p["cumulative_mass_ratio"][-1]
     printf("[modes] modes for 90 % of the mass: " + ", ".join(

@@ -70,6 +70,17 @@ def test_modes_command(tmp_path):
     f = np.array([float(c[1]) for c in rows])
     assert [int(c[0]) for c in rows] == [1, 2, 3, 4] and np.all(np.diff(f) >= 0) and f[0] > 10
     assert any("alpha_m = 2 zeta omega" in ln for ln in lines)
+    # the participation table: an effective height only where the mode moves at least 0.01 % of the mass that way
+    j = next(k for k, ln in enumerate(lines) if ln.startswith("mode,frequency_hz,meff_x_kg"))
+    part = [ln.split(",") for ln in lines[j + 1:j + 5]]
+    shown = 0
+    for c in part:
+        for d in (0, 1):
+            ratio, height = float(c[5 + d]), c[11 + d]
+            assert (height == "-") == (ratio < 1e-4), c
+            shown += height != "-"
+            assert height == "-" or 0.0 < float(height) <= 0.5 + 1e-9, c     # (within the 0.5 m box)
+    assert shown >= 2, part
     with h5py.File(out) as h:
         assert np.allclose(h.attrs["frequencies_hz"], f, rtol=1e-7)
         s = h["mode_shape_000000"][:]
