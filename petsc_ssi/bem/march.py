@@ -831,10 +831,12 @@ class Marcher:
         reason = self.ksp.getConvergedReason()
         if reason < 0:                      # (an iterative -ssi_bem_ksp_type that stopped short: its answer is not the step's)
             names = {v: k for k, v in vars(self.PETSc.KSP.ConvergedReason).items() if isinstance(v, int)}
+            kt, pt = self.ksp.getType(), self.ksp.getPC().getType()
+            advice = ("the direct solve itself failed" if kt == "preonly" else
+                      "leave the soil's solver to its default direct LU, or let the iterative one converge")
             raise SSIError(f"the soil's step solve did not converge at step {getattr(self, 'n', 0) + 1} "
                            f"({names.get(reason, reason)} after {self.ksp.getIterationNumber()} iterations of "
-                           f"-ssi_bem_ksp_type {self.ksp.getType()}, -ssi_bem_pc_type {self.ksp.getPC().getType()}): "
-                           "leave the soil's solver to its default direct LU, or let the iterative one converge")
+                           f"-ssi_bem_ksp_type {kt}, -ssi_bem_pc_type {pt}): {advice}")
 
     def solve_columns(self, m, fill, take, block=None):
         """Collective: ``petsc.solve_columns`` with the step matrix's factors (through the mirror-symmetric
