@@ -214,7 +214,8 @@ def test_the_table_has_every_case(previous):
 SLOW_NAMES = {"nan load", "inf density", "inf end time", "contact tolerance zero", "zero dt", "negative end time",
               "negative stride", "negative flush", "nan flush", "negative monitor_every", "nan wave speed",
               "negative interp_k", "negative checkpoint_every", "inf checkpoint interval",
-              "interpolation unknown", "unknown integrator", "unknown contact"}
+              "interpolation unknown", "unknown integrator", "unknown contact",
+              "a file name at the end", "unknown preconditioner"}     # (their siblings: "a second value", "misspelt factor package")
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=[pytest.mark.slow] if n in SLOW_NAMES else []) for n in NAMES])
