@@ -236,3 +236,16 @@ def sin4_pulse(path, T):
             for k, sg in enumerate((1, -1)))
     np.savetxt(path, np.c_[t, a], header="units: m/s2")
     return str(path)
+
+
+def ranks_json(code, n, tag, timeout=300):
+    """Run python ``code`` under ``mpirun -n n`` and return the JSON its rank 0 printed after ``tag`` on one line
+    (one line from rank 0: mpirun may run the ranks' lines together); asserts the run ended well and printed it."""
+    import json
+    import subprocess
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(n), PY, "-c", code]
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout,
+                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    lines = [ln for ln in p.stdout.splitlines() if ln.startswith(tag)]
+    assert p.returncode == 0 and len(lines) == 1, p.stdout + p.stderr
+    return json.loads(lines[0][len(tag):])

@@ -3,13 +3,11 @@ a short lag (the step matrix's lags 1-2, the toeplitz store's only Mats) takes i
 the whole vector, into a vector of every column (one copy: remapped indices would cost more than they save) or
 compacted (many copies, the march's, ``depth``); a lag whose rows read every column, PETSc's all-gather. The
 products equal the matrix's with all of x, bit for bit, every way."""
-import os
 import shutil
-import subprocess
 
 import pytest
 
-from helpers import PY, ROOT
+from helpers import ranks_json
 
 pytestmark = pytest.mark.mpi
 
@@ -70,13 +68,7 @@ if comm.rank == 0:
 @pytest.mark.skipif(shutil.which("mpirun") is None, reason="needs mpirun")
 @pytest.mark.parametrize("n", [2, 3])
 def test_a_short_lag_reads_its_halo_and_a_wide_one_every_column(n):
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(n), PY, "-c", CODE]
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300,
-                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("READS")]
-    assert p.returncode == 0 and len(lines) == 1, p.stdout + p.stderr
-    import json
-    per_rank = json.loads(lines[0][5:])
+    per_rank = ranks_json(CODE, n, "READS")
     assert len(per_rank) == n
     N = 240
     for r, got in enumerate(per_rank):

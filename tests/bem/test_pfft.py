@@ -3,11 +3,10 @@ frequencies in the k_y-major order are scipy's ``rfft2`` of the whole planes the
 rows back, and ranks beyond min(Mx, My // 2 + 1) hold no rows and no frequencies."""
 import os
 import shutil
-import subprocess
 
 import pytest
 
-from helpers import PY, ROOT
+from helpers import ranks_json
 
 pytestmark = pytest.mark.mpi
 
@@ -47,13 +46,7 @@ def test_slab_fft_is_rfft2_on_each_ranks_frequencies(n):
     coefficient; backward: the rank's rows, to 1e-14; the rows and the frequencies cover the grid and the half
     spectrum once, in rank order; on the 5 x 3 grid (two columns of the half spectrum) a third rank holds
     neither rows nor frequencies and the others still transform (7 x 4 at -n 3: three columns, every rank)."""
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(n), PY, "-c", CODE]
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300,
-                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    lines = [ln for ln in p.stdout.splitlines() if ln.startswith("PFFT")]
-    assert p.returncode == 0 and len(lines) == 1, p.stdout + p.stderr
-    import json
-    per_rank = json.loads(lines[0][4:])
+    per_rank = ranks_json(CODE, n, "PFFT")
     assert len(per_rank) == n
     for r in per_rank:
         for g in r:
