@@ -77,8 +77,10 @@ def test_coupled_cli_case_reruns_are_identical_files(tmp_path):
     for k in range(2):
         (tmp_path / f"run{k}").mkdir()
         r = cli(CASE + ["-ssi_output", str(tmp_path / f"run{k}" / "s.h5"), "-ssi_reproducible"], nranks=2)
-        # (a loaded test machine may make the loop slower than the run's prediction: that warning says so)
-        assert not [ln for ln in r.stdout.splitlines() if "warning" in ln and "times slower than" not in ln], \
+        # (a loaded test machine may make the loop slower than the run's prediction: that warning says so; and
+        # the foundation's own waves reflected at the soil mesh's edge reach the receiver: that one says so too)
+        assert not [ln for ln in r.stdout.splitlines() if "warning" in ln and "times slower than" not in ln
+                    and "diffracted at the mesh edge" not in ln], \
             r.stdout[-2000:]
     with h5py.File(tmp_path / "run0" / "s.h5") as f:
         assert f["interface/n_open"][:].max() > 0 and np.abs(f["interface/uf"][:]).max() > 0

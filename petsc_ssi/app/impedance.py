@@ -330,6 +330,8 @@ def main():
         db.setValue("ssi_disp_history", "smoothstep")
         db.setValue("ssi_disp_t0", repr(rise))
         db.setValue("ssi_output", f"{stem}-{mode}.h5")
+        if not cfg0.user_set("warn_edge"):  # (the footing's own reflections from the edge: the a0 band below says so)
+            db.setValue("ssi_warn_edge", "0")
         cfg = options.resolve(("common", "bem"))
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
                f"{sym}, smooth step over {rise:.4g} s")

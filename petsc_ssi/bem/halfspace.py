@@ -395,13 +395,16 @@ class HalfSpace:
         self._diffracted = []
         for k, p in enumerate(self.receivers):
             self.diffraction_warning(p[None], f"receiver {k} ({p[0]:g}, {p[1]:g}, {p[2]:g})")
+        if self.motion is not None:     # the footing's own reaction (an impedance, a prescribed motion's traction)
+            self.diffraction_warning(self.mesh.nodes[self.regions.disp_nodes], "the footing")
 
     def diffraction_warning(self, points, what):
-        """Note the earliest time at which waves from the load diffracted at the truncation edge
-        reach any of ``points`` (e.g. a receiver, or the structure's interface nodes), path load ->
-        edge -> point at c_p; ``warn_diffraction`` (from ``prepare``) says in one line which
-        arrive before t_end. Returns that time (None without a load or an edge)."""
-        src = self._load_points()
+        """Note the earliest time at which waves from the loads, the footing or the structure's interface
+        (``_wave_sources``) diffracted at the truncation edge reach any of ``points`` (e.g. a receiver, or
+        the structure's interface nodes), path source -> edge -> point at c_p; ``warn_diffraction`` (from
+        ``prepare``) says in one line which arrive before t_end. Returns that time (None without a source
+        or an edge)."""
+        src = self._wave_sources()[0]
         if not len(src) or not len(points):
             return None
         edge = self._edge_points()
@@ -419,9 +422,10 @@ class HalfSpace:
     def warn_diffraction(self):
         """One warning line: the earliest edge-diffracted arrival and every receiver (and the
         structure) it reaches before t_end."""
-        if self._diffracted:
+        if self._diffracted and self.cfg.get("warn_edge", True):
             t0 = min(t for _, t in self._diffracted)
-            warn(f"waves from the load diffracted at the mesh edge (path load -> edge -> point at c_p) arrive "
+            src = " and ".join(self._wave_sources()[1])
+            warn(f"waves from {src} diffracted at the mesh edge (path source -> edge -> point at c_p) arrive "
                  f"before t_end = {self.grid.t_end:g} s, the earliest at t = {t0:.4g} s, at "
                  + ", ".join(f"{w} (t = {t:.4g} s)" for w, t in self._diffracted))
         self._diffracted = []
@@ -495,6 +499,29 @@ class HalfSpace:
         parts = [self.mesh.nodes[self.regions.load_nodes]] if self.regions.n_load else []
         parts += [a.points(self.planes) for a in getattr(self, "areas", [])]
         return np.vstack(parts) if parts else np.zeros((0, 3))
+
+    def _wave_sources(self):
+        """Where the waves that the mesh edge diffracts start, and what they are in words: the loads with a
+        non-zero traction (a load-free group, -ssi_load_p0 0, starts none), a seismic wave's scattered field on
+        an excavation's faces, and the footing's or the structure's interface nodes, which radiate (a prescribed
+        or rigid motion, a structure that moves; under a seismic wave with no load, the only source).
+        Returns ((n, 3) points, [names])."""
+        parts, names = [], []
+        loads = [s for s in self.sources if s is not self._excavation and np.any(s.amplitudes() != 0.0)]
+        areas = [a for a in self.areas if np.any(a.amplitudes() != 0.0)]
+        if loads or areas:
+            names.append("the load")
+            parts += [self.mesh.nodes[np.unique(self.mesh.cells[s.elements])] for s in loads]
+            parts += [a.points(self.planes) for a in areas]
+        if self._excavation is not None:
+            names.append("the excavation's faces")
+            parts.append(self.mesh.nodes[np.unique(self.mesh.cells[self._excavation.elements])])
+        if len(self.regions.disp_nodes):
+            names.append("the footing" if self.motion is not None else "the structure's interface")
+            parts.append(self.mesh.nodes[self.regions.disp_nodes])
+        if getattr(self, "seismic", None) is not None and names:
+            names[-1] += " (the seismic wave's scattered field)"
+        return (np.vstack(parts) if parts else np.zeros((0, 3))), names
 
     def _auto_tl(self, tau_l=1.5):
         """The paper's rule (``interp.auto``, tau_L = c_s T_L / r) for this problem's points of interest:

@@ -152,6 +152,9 @@ register("check_stability_steps", "int", 400, "steps", "-ssi_check_stability: at
          "3 x the surrogate's causal lags)", "bem", validator=at_least(100))
 register("warn_beta", "bool", True, "", "warn when beta_s = c_s dt / l leaves what the stability map (runs/stability) "
          "found stable for the scheme in use", "bem")
+register("warn_edge", "bool", True, "", "warn when waves from the loads, the footing or the structure, diffracted at the "
+         "mesh's edge, reach a receiver, the footing or the structure before t_end (petsc-ssi impedance states its "
+         "a0 band instead)", "bem")
 
 
 MAX_CP = 1.0e4           # m/s: beyond any soil or rock (a P-wave speed of 1e7 m/s ran: nu -> 0.5, dt c_p / h huge)

@@ -61,7 +61,7 @@ def attrs_digest(attrs, crcs):
 RUN_CONTROL = frozenset((
     "output", "output_overwrite", "output_flush", "output_merge", "output_stride", "monitor", "monitor_every", "plot",
     "reproducible", "memory_limit", "guard", "guard_factor", "check_stability", "check_stability_steps",
-    "warn_beta", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
+    "warn_beta", "warn_edge", "cache", "cache_share", "lag_storage", "lag_fill", "history_block", "history_sub", "partition", "fem_solver", "modes_n",
     "checkpoint", "checkpoint_every", "checkpoint_interval", "restart", "lags_save", "lags_load",
     "huge_pages", "disk_check", "debug",
     # how the interface columns are solved (region or full: equal to round-off, as the solvers' options)
