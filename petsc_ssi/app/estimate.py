@@ -66,8 +66,9 @@ def report(cfg, comm, out=None):
         cc = CoupledCounts(cfg, comm, *coupled)
     tz = _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled, cc, c)
     if tz is not None:                  # a uniform flat grid: the run takes the toeplitz store
-        out("\n".join(tz))
-        return {"counts": None, "rows": []}
+        lines, rows = tz
+        out("\n".join(lines))
+        return {"counts": None, "rows": rows}
     prob, plan, cnt = count_run(cfg, comm, ranks, node_mem, coupled)
     cnt.area_bytes = ab = prob.area_bytes()
     nd = int(cnt.storage.sum())
@@ -131,14 +132,15 @@ def report(cfg, comm, out=None):
     return {"counts": cnt, "rows": rows}
 
 
-def _verdict(rows, node_mem):
+def _verdict(rows, node_mem, what="the node memory", advice="-ssi_interp, symmetry or a coarser mesh"):
+    """The estimate's last line: the fewest ranks that fit and the fastest of those, or what to change."""
     ok = [r for r in rows if r["fits"]]
     if ok:
         best = min(ok, key=lambda r: r["total"])
-        return (f"[ssi]   verdict: fits the node memory from {ok[0]['ranks']} rank(s); fastest predicted "
+        return (f"[ssi]   verdict: fits {what} from {ok[0]['ranks']} rank(s); fastest predicted "
                 f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
-    return (f"[ssi]   verdict: does NOT fit {node_mem / 1e9:.3g} GB per node at any of these rank counts: "
-            f"use fewer ranks per node, more nodes, -ssi_interp, symmetry or a coarser mesh")
+    return (f"[ssi]   verdict: does NOT fit {what} ({node_mem / 1e9:.3g} GB per node) at any of these rank counts: "
+            f"use fewer ranks per node, more nodes, {advice}")
 
 
 def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None, c=None):
@@ -210,6 +212,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                  f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach {rho:.3g} node "
                  "spacings" + (f", {nblk} mirror-symmetric blocks, bem/mirror.py" if nblk > 1 else "")
                  + "; toeplitz.step_lu)")
+    rows = []
     for p in ranks:
         b, tb, th = tz_estimate(lat, prob.L, prob.n_steps, p, block_of(cfg), 3 * N, g, plan=plan,
                                 stabilized=cfg.scheme.startswith("stabili"), glat=glat, single=single,
@@ -217,22 +220,28 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         b += ab
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
         steps_s = prob.n_steps * one
+        total = tb + th + fac + steps_s
         if cc is not None:            # the structure, the interface matrices and the coupled steps
             add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
+            total += add["cpl_setup"] + add["cpl_loop"]
             cpl = (f" {fac:8.3g} {steps_s:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
-                   f"{fmt_time(tb + th + fac + add['cpl_setup'] + add['cpl_loop'] + steps_s):>7}")
+                   f"{fmt_time(total):>7}")
         else:
-            cpl = f" {fac:8.3g} {steps_s:7.3g} {fmt_time(tb + th + fac + steps_s):>7}"
+            cpl = f" {fac:8.3g} {steps_s:7.3g} {fmt_time(total):>7}"
         tot = b + p * rss
         per_node = tot / p * min(q, p)
-        flag = "yes" if per_node <= limit else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
+        fits = per_node <= limit
+        flag = "yes" if fits else "NO: the run's memory check would refuse it (-ssi_memory_limit)"
         if min(q, p) > cores:
             flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
         lines.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g}{cpl} | {b / 1e9:7.3g} | {tot / 1e9:7.3g} | {flag}")
+        rows.append({"ranks": p, "total": total, "node_bytes": per_node, "fits": fits, "bytes": b})
+    lines.append(_verdict(rows, limit, what="the run's memory limit",
+                          advice="-ssi_toeplitz_precision single, -ssi_interp, symmetry or a coarser mesh"))
     lines.append(f"[ssi]   (model set-up took {time.perf_counter() - t0:.3g} s on {comm.getSize()} rank(s); the "
                  "node's limit: 80 % of its memory or -ssi_memory_limit, as the run's check)")
-    return lines
+    return lines, rows
 
 
 def _toeplitz_lines(cfg, prob, cnt, ranks):

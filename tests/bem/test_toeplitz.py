@@ -213,6 +213,11 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     assert "kernels: 12 exact lags + 5 interpolating (of 24 the run reaches)" in r.stdout, r.stdout
     assert "blocks assembled" not in r.stdout          # (the dense model's line)
     assert "G kernels on the traction elements' 2 x 2 window (FFT grid 6 x 6)" in r.stdout, r.stdout
+    assert "[ssi]   verdict: fits the run's memory limit from 1 rank(s); fastest predicted" in r.stdout, r.stdout
+    tight = cli(["estimate"] + args + ["-ssi_estimate_ranks", "1,2", "-ssi_memory_limit", "0.001"]).stdout
+    assert ("[ssi]   verdict: does NOT fit the run's memory limit (0.001 GB per node) at any of these rank counts"
+            in tight), tight
+    assert tight.count("NO: the run's memory check would refuse it") == 2, tight
     out = cli(args + ["-ssi_output", str(tmp_path / "tz.h5")]).stdout
     import re
     stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
