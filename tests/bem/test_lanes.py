@@ -144,6 +144,9 @@ def test_lane_products_tile_edges_equal_a_plain_sum(b, no, ss, vdtype, real):
     assert not got[..., :o0].any() and not got[..., o0 + no:].any()
 
 
+# slow tier: it compiles the lane kernels afresh for another CPU (11 s of make test's budget on 2026-12-02); its
+# siblings, the tile and edge tests above on this machine's CPU, stay in make test
+@pytest.mark.slow
 def test_lane_products_on_a_machine_without_avx512(tmp_path):
     """Compiled for a CPU without AVX-512 (NUMBA_CPU_NAME=haswell: 4-wide vectors, 2 x 2 tiles), the tile and
     edge test above passes too (a cluster's older nodes take that branch of ``lanes._vector_tile``)."""
