@@ -565,11 +565,23 @@ class TransientProblem:
         SSIError (the divergence guard, a non-finite solution) writes the results up to the last
         step with ``run_status`` 'stopped ...' before the error is raised. Other exceptions (a bug,
         PETSc or MPI failures) write nothing more. With -ssi_restart the steps start after the
-        checkpoint's. The locks of the run's files are given back at the end, whatever happened."""
+        checkpoint's. The locks of the run's files are given back at the end, whatever happened; after a
+        finished run the soil's lag matrices too (``release_lags``)."""
         try:
-            return self._run()
+            res = self._run()
         finally:
             self.release_locks()
+        self.release_lags()
+        return res
+
+    def release_lags(self):
+        """Collective: free the soil's lag matrices (``bem.march.Marcher.release``) once the run is done. Their
+        python Mats and contexts hold each other through PETSc, out of the collector's reach: a script that runs
+        problem after problem in one process (a parameter study, ``petsc-ssi impedance``'s modes, the tests)
+        kept every run's lags until exit. Not on an error, which may have stopped some ranks only."""
+        march = getattr(self, "march", None)
+        if march is not None:
+            march.release()
 
     def _run(self):
         self.announce_loop()

@@ -336,9 +336,7 @@ def main():
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
                f"{sym}, smooth step over {rise:.4g} s")
         t_run = time.perf_counter()
-        if p is not None:                   # (the last mode's lag Mats: their python contexts hold them back from
-            p.march.release()               # the collector, and each mode's lags had stayed: bem.march.release)
-        p = res = None
+        p = res = None                      # (the last mode's lag Mats were freed at the end of its run: run())
         gc.collect()
         p = BEMTransient(cfg, comm)
         res = p.run()
