@@ -205,6 +205,8 @@ def slow_warning(elapsed, predicted, items, ranks_here, what="the run's predicti
 
 
 def fmt_time(s):
+    if s < 1:                   # (a small case's estimate: '0.0s' for 0.04 s said nothing)
+        return f"{s:.3f}s"
     if s < 60:
         return f"{s:.1f}s"
     if s < 3600:

@@ -370,3 +370,15 @@ def test_the_profile_table_counts_each_function_once_a_stack(tmp_path):
     assert inc["VecScatterCreate (libpetsc.so)"] == 5 and inc["history (c.py)"] == 2
     tot, inc = table(str(prof), "VecScatterCreate")
     assert tot == 5 and inc["solve (b.py)"] == 5 and "history (c.py)" not in inc
+
+
+def test_times_below_a_second_and_the_verdict_s_nodes():
+    """The estimate's totals of a small case read '0.0s' for 0.04 s (``fmt_time``: three decimals below a second
+    now), and its verdict's fastest rank count says when it spans nodes (4 ranks on 2-core nodes: 2 nodes)."""
+    from petsc_ssi.monitor import fmt_time
+    from petsc_ssi.app.estimate import _verdict
+    assert (fmt_time(0.0437), fmt_time(3.44), fmt_time(75.0)) == ("0.044s", "3.4s", "1m15s")
+    rows = [{"ranks": 1, "nodes": 1, "total": 0.05, "fits": True}, {"ranks": 4, "nodes": 2, "total": 0.02, "fits": True}]
+    line = _verdict(rows, 8e9)
+    assert "from 1 rank(s); fastest predicted 0.020s on 4 rank(s) on 2 nodes (-ssi_estimate_ranks_per_node" in line, line
+    assert "nodes" not in _verdict(rows[:1], 8e9)

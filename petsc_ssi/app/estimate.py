@@ -137,8 +137,11 @@ def _verdict(rows, node_mem, what="the node memory", advice="-ssi_interp, symmet
     ok = [r for r in rows if r["fits"]]
     if ok:
         best = min(ok, key=lambda r: r["total"])
+        nodes = best.get("nodes", 1)
         return (f"[ssi]   verdict: fits {what} from {ok[0]['ranks']} rank(s); fastest predicted "
-                f"{fmt_time(best['total'])} on {best['ranks']} rank(s)")
+                f"{fmt_time(best['total'])} on {best['ranks']} rank(s)"
+                + (f" on {nodes} nodes (-ssi_estimate_ranks_per_node, -ssi_estimate_cores_per_node)"
+                   if nodes > 1 else ""))
     return (f"[ssi]   verdict: does NOT fit {what} ({node_mem / 1e9:.3g} GB per node) at any of these rank counts: "
             f"use fewer ranks per node, more nodes, {advice}")
 
@@ -236,7 +239,8 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         if min(q, p) > cores:
             flag += f" (oversubscribed: {min(q, p)} ranks on {cores} cores)"
         lines.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g}{cpl} | {b / 1e9:7.3g} | {tot / 1e9:7.3g} | {flag}")
-        rows.append({"ranks": p, "total": total, "node_bytes": per_node, "fits": fits, "bytes": b})
+        rows.append({"ranks": p, "nodes": int(math.ceil(p / float(q))), "total": total, "node_bytes": per_node,
+                     "fits": fits, "bytes": b})
     lines.append(_verdict(rows, limit, what="the run's memory limit",
                           advice="-ssi_toeplitz_precision single, -ssi_interp, symmetry or a coarser mesh"))
     lines.append(f"[ssi]   (model set-up took {time.perf_counter() - t0:.3g} s on {comm.getSize()} rank(s); the "

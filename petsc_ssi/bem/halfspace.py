@@ -546,9 +546,14 @@ class HalfSpace:
             printf(line)
         self.warn_diffraction()
         plan = self.interp_plan()
-        printf("[ssi] " + plan.describe())
         ls = self.lagset(plan)
         self.lattice = self._lattice(ls)
+        if self.lattice is not None and self.cfg.interp == "auto" and plan.active:
+            # (toeplitz_plan below keeps every lag exact where that fits: this is the rule's plan, not yet the run's)
+            printf("[ssi] -ssi_interp auto: the paper's rule gives " + plan.describe() + "; the toeplitz store "
+                   "decides below")
+        else:
+            printf("[ssi] " + plan.describe())
         if ls.balance is not None:
             n = [b - a for a, b in ls.ranges]
             printf(f"[ssi] soil nodes over {len(n)} ranks: {min(n)}..{max(n)} per rank, -ssi_partition "
@@ -698,9 +703,11 @@ class HalfSpace:
         p = self.comm.getSize()
         est, limit, share, (t_build, t_hist, rss, steps) = self._toeplitz_bytes(ls, plan, extra_bytes)
         self.mem_estimate = self.mem_peak_estimate = est
-        printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (history kernels, kept transforms, G "
-               f"and the build's transients {(est - rss - float(extra_bytes)) / 1e9:.3g} GB), kernels {t_build:.3g} s, history sum "
-               f"{t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
+        printf(f"[ssi] toeplitz estimate: {est / 1e9:.3g} GB over the ranks (the {p} process{'es' if p > 1 else ''} as now, "
+               f"{rss / 1e9:.3g} GB; the history kernels, kept transforms, G and the build's transients, "
+               f"{(est - rss - float(extra_bytes)) / 1e9:.3g} GB"
+               + (f"; the run's other data, {float(extra_bytes) / 1e9:.3g} GB" if extra_bytes else "")
+               + f"), kernels {t_build:.3g} s, history sum {t_hist:.3g} s on {p} rank(s) (bem/toeplitz.py estimate)")
         # the limit holds per node, as in check_memory
         if share * est > limit:
             raise SSIError(f"-ssi_lag_store toeplitz: the history kernels need about {share * est / 1e9:.3g} GB on "

@@ -96,7 +96,7 @@ class Plan:
             return f"lag interpolation: none ({self.L} exact lags)"
         return (f"lag interpolation: {self.method}, T_L = {self.TL:.5g} s ({self.Lx} exact lags), "
                 f"k = {self.k} matrices at T_j in [{self.T.min():.5g}, {self.T.max():.5g}] s, "
-                f"replacing lags {self.Lx + 1}..{self.L} (T_N = {self.TN:.5g} s)")
+                f"replacing lags {self.Lx + 1}..{self.L} (the last at {self.TN:.5g} s: T_N or the run's end, the sooner)")
 
     def kernel_time(self, j):
         """(lag l, offset) with kernel time T_j + dt = l dt + offset."""
@@ -131,9 +131,9 @@ def auto(cs, dt, L, receivers, source, tau_l=1.5, steps_per_matrix=5):
     r = float(np.max(np.linalg.norm(np.asarray(receivers)[:, :2] - np.asarray(source)[:2], axis=1)))
     TL = tau_l * r / cs
     if TL >= TN:
-        return None, 0, (f"T_L = {tau_l} r/c_s = {TL:.4g} s for r = {r:.4g} m is beyond T_N = {TN:.4g} s: "
-                         "all lags exact")
+        return None, 0, (f"T_L = {tau_l} r/c_s = {TL:.4g} s for r = {r:.4g} m is beyond the last lag, at {TN:.4g} s "
+                         "(T_N or the run's end, the sooner): all lags exact")
     k = max(2, int(math.ceil((TN - TL) / (steps_per_matrix * dt))))
     return TL, k, (f"tau_L = {tau_l} (above the Rayleigh arrival 1.09) at the farthest receiver "
                    f"r = {r:.4g} m gives T_L = {TL:.4g} s; one exact matrix every {steps_per_matrix} "
-                   f"steps over [T_L, T_N = {TN:.4g} s] gives k = {k}")
+                   f"steps over [T_L, {TN:.4g} s] (to the last lag: T_N or the run's end, the sooner) gives k = {k}")

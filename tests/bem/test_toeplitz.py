@@ -704,6 +704,11 @@ def test_interp_auto_on_the_toeplitz_store_keeps_every_lag_exact(tmp_path):
     auto, none = str(tmp_path / "auto.h5"), str(tmp_path / "none.h5")
     out = cli(BEM + TZ + ["-ssi_interp", "auto", "-ssi_output", auto]).stdout
     assert "-ssi_interp auto on the toeplitz store: every lag exact" in out and "lag interpolation: none" in out, out
+    # the rule's plan is said as the rule's, not as the run's (it was a bare 'lag interpolation: chebyshev' line
+    # before the store's 'every lag exact' and 'none')
+    plans = [ln for ln in out.splitlines() if ln.startswith("[ssi] lag interpolation:")]
+    assert plans == ["[ssi] lag interpolation: none (19 exact lags)"], plans
+    assert "the paper's rule gives lag interpolation: chebyshev" in out and "the toeplitz store decides below" in out
     cli(BEM + TZ + ["-ssi_interp", "none", "-ssi_output", none])
     A, B = fields(auto), fields(none)
     assert set(A) == set(B) and all(np.array_equal(A[k], B[k]) for k in A)
