@@ -20,10 +20,9 @@ os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 # forwarding set the timeout on their command line, which overrides this: test_checkpoint.py.)
 os.environ.setdefault("OMPI_MCA_odls_base_sigkill_timeout", "0")
 # A one-rank run started without mpirun (most of the suite's CLI tests) is an MPI singleton: OpenMPI 4 starts an
-# orted beside it unless the singleton is isolated (it then cannot MPI_Comm_spawn, which petsc-ssi never does).
-# `/usr/bin/time python -c "from mpi4py import MPI; MPI.COMM_WORLD.Barrier()"` on the 2-core machine of
-# 2026-12-02: 0.46 and 0.41 s, 0.28 s isolated; a refused run 1.63, 1.22, 1.18 s against 1.10, 1.03, 1.07 s.
-# Ignored by mpirun's ranks and by other MPIs.
+# orted beside it unless the singleton is isolated (it then cannot MPI_Comm_spawn, which petsc-ssi never does):
+# on the 2-core machine of 2026-12-02 a refused one-rank run took about a tenth of a second less (a scratch
+# timing, not a benchmark). Ignored by mpirun's ranks and by other MPIs.
 os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
 # The suite starts about a thousand petsc-ssi processes (mpirun ranks counted). Where the shell sets
 # PYTHONDONTWRITEBYTECODE (this machine and CI's do), each one compiled the ~90 modules it imports from

@@ -321,6 +321,8 @@ def main():
     rise = cfg0.impedance_rise or 4 * cfg0.dt
     nu = ((cfg0.cp / cfg0.cs) ** 2 - 2) / (2 * ((cfg0.cp / cfg0.cs) ** 2 - 1))
     table, curves, K0s, cross = [], {}, {}, {}
+    if not cfg0.user_set("warn_edge"):      # (the footing's own reflections from the edge: each mode's a0 band says so)
+        db.setValue("ssi_warn_edge", "0")
     for mode in modes:
         opt, motion, sym, what, comp, speed, measure = MODES[mode]
         for k in ("disp_value", "disp_rotation"):
@@ -330,8 +332,6 @@ def main():
         db.setValue("ssi_disp_history", "smoothstep")
         db.setValue("ssi_disp_t0", repr(rise))
         db.setValue("ssi_output", f"{stem}-{mode}.h5")
-        if not cfg0.user_set("warn_edge"):  # (the footing's own reflections from the edge: the a0 band below says so)
-            db.setValue("ssi_warn_edge", "0")
         cfg = options.resolve(("common", "bem"))
         printf(f"[impedance] mode {mode}: {opt.replace('disp_', '')} {motion} x {AMP:g}, symmetry "
                f"{sym}, smooth step over {rise:.4g} s")

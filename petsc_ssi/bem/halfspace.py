@@ -404,13 +404,10 @@ class HalfSpace:
         the structure's interface nodes), path source -> edge -> point at c_p; ``warn_diffraction`` (from
         ``prepare``) says in one line which arrive before t_end. Returns that time (None without a source
         or an edge)."""
-        src = self._wave_sources()[0]
-        if not len(src) or not len(points):
+        paths = self._edge_paths()
+        if paths is None or not len(points):
             return None
-        edge = self._edge_points()
-        if not len(edge):
-            return None
-        d_se = np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0)
+        edge, d_se = paths
         t_d = np.inf
         for p in np.atleast_2d(points):
             q, _ = symmetry.map_point(p, self.planes)
@@ -418,6 +415,17 @@ class HalfSpace:
         if t_d < self.grid.t_end:
             self._diffracted.append((what, t_d))
         return t_d
+
+    def _edge_paths(self):
+        """(edge nodes, each one's distance from the nearest wave source), made once: the sources and the edge do
+        not change after the set-up, and ``diffraction_warning`` is called for every receiver; None without a
+        source or an edge."""
+        if not hasattr(self, "_paths"):
+            src, edge = self._wave_sources()[0], self._edge_points()
+            self._paths = None
+            if len(src) and len(edge):
+                self._paths = (edge, np.linalg.norm(src[:, None, :2] - edge[None, :, :2], axis=2).min(0))
+        return self._paths
 
     def warn_diffraction(self):
         """One warning line: the earliest edge-diffracted arrival and every receiver (and the
