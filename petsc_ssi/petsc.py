@@ -124,6 +124,22 @@ def init(argv=None):
     return PETSc
 
 
+def error_line(text):
+    """``text`` and its newline to standard error in one write, the buffered standard output and error flushed
+    first (the log's lines before it stay before it; two ranks' lines are never run together). Every
+    ``petsc-ssi: error:`` line goes this way: the log stays on standard output, the reason a run stopped on
+    standard error."""
+    import os
+    sys.stdout.flush()
+    sys.stderr.flush()
+    data = (text.rstrip("\n") + "\n").encode()
+    try:
+        os.write(sys.stderr.fileno(), data)
+    except (OSError, ValueError, AttributeError):   # no file descriptor (an in-process capture): Python's stream
+        sys.stderr.write(data.decode())
+        sys.stderr.flush()
+
+
 class SSIError(RuntimeError):
     """An input or set-up error, raised on every rank with the same message."""
 
@@ -144,10 +160,8 @@ def collective_io(fn, what, comm):
         fn()
     except PETSc.Error as exc:
         import os
-        sys.stdout.write(f"petsc-ssi: error: {what} failed (PETSc error {exc.ierr} in the viewer: disk full, "
-                         f"a quota or the file system; the file may be unreadable)\n")
-        sys.stdout.flush()
-        sys.stderr.flush()
+        error_line(f"petsc-ssi: error: {what} failed (PETSc error {exc.ierr} in the viewer: disk full, "
+                   f"a quota or the file system; the file may be unreadable)")
         if comm.getSize() > 1:
             comm.tompi4py().Abort(2)
         os._exit(2)

@@ -199,7 +199,7 @@ def test_a_restart_that_changes_the_run_is_refused(tmp_path):
     for extra, msg in cases:
         p = cli(args + extra + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_output_overwrite",
                                 "-ssi_restart", ck], nranks=2, check=False)
-        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
         if msg is None:
             assert p.returncode == 0, p.stdout[-2000:]
             continue
@@ -207,7 +207,7 @@ def test_a_restart_that_changes_the_run_is_refused(tmp_path):
         assert "assembly" not in p.stdout
     for path, msg in ((str(tmp_path / "none.h5"), "no such file"), (out, "not a petsc-ssi checkpoint")):
         p = cli(args + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_restart", path], nranks=2, check=False)
-        assert p.returncode == 2 and msg in p.stdout and "Traceback" not in p.stdout + p.stderr, p.stdout[-2000:]
+        assert p.returncode == 2 and msg in p.stderr and "Traceback" not in p.stdout + p.stderr, p.stdout[-2000:]
 
 
 # slow tier: SIGTERM to mpirun under three CPU hogs: mpirun's own two timeouts (2 x 5 s) are waited out (18 s

@@ -57,7 +57,7 @@ def _run(cmd, n):
 def test_a_full_disk_stops_the_run_and_keeps_its_steps(small_disk, n):
     out = str(small_disk / "r.h5")
     r = _run([PY, "-m", "petsc_ssi"] + BEM + ["-ssi_output", out], n)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2 and len(errs) == 1 and "MB free" in errs[0], r.stdout[-2000:] + r.stderr[-2000:]
     assert "Traceback" not in r.stderr and "Segmentation" not in r.stderr + r.stdout
     with h5py.File(out) as f:
@@ -78,7 +78,7 @@ def test_a_failed_write_ends_the_job_in_one_line(small_disk, tmp_path, n):
     script = tmp_path / "no_check.py"
     script.write_text(NO_CHECK)
     r = _run([PY, str(script)] + BEM + ["-ssi_output", str(small_disk / "q.h5")], n)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2 and 1 <= len(errs) <= n, r.stdout[-2000:] + r.stderr[-2000:]
     assert "failed (PETSc error" in errs[0] and "Traceback" not in r.stderr
     assert "Segmentation" not in r.stderr + r.stdout
@@ -92,7 +92,7 @@ def test_a_run_that_cannot_fit_is_refused_before_the_assembly(small_disk):
     assert BEM[-2:] == ["-ssi_disk_check", "0"]
     base = [PY, "-m", "petsc_ssi"] + BEM[:-2] + ["-ssi_output", out]
     r = _run(base + ["-ssi_t_end", "1.0"], 2)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2 and len(errs) == 1, r.stdout[-2000:] + r.stderr[-2000:]
     assert "the run needs about 8.18 MB of disk (soil fields 6.52 MB, soil receivers 0.0096 MB;" in errs[0], errs[0]
     import re as _re

@@ -164,7 +164,7 @@ def test_estimate_command_does_not_assemble():
 def test_estimate_bad_input(args, msg):
     p = cli(["estimate", "-options_file", SMALL] + args, check=False)
     assert p.returncode == 2
-    err = [line for line in p.stdout.splitlines() if line.startswith("petsc-ssi: error:")]
+    err = [line for line in p.stderr.splitlines() if line.startswith("petsc-ssi: error:")]
     assert len(err) == 1 and msg in err[0], p.stdout
 
 

@@ -36,7 +36,7 @@ SMALL = ["-ssi_problem", "bem", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1", "-s
 
 def refused(r):
     """The one error line of a refused run (exit 2, no traceback, no step taken)."""
-    lines = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    lines = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
     assert len(lines) == 1, r.stdout[-2000:]
     assert "Traceback" not in r.stderr, r.stderr[-2000:]
@@ -213,7 +213,7 @@ def test_two_runs_started_at_once_leave_a_readable_output(tmp_path):
     for (so, se), c in zip(res, codes):
         assert "Traceback" not in se, se[-2000:]
         if c == 2:
-            assert f"{out} is being written by another run" in so, so[-2000:]
+            assert f"{out} is being written by another run" in se, se[-2000:]
     with h5py.File(out, "r") as f:
         assert str(f.attrs["run_status"]) == "completed" and f["receivers/u"].shape[0] == 20   # 0.1 s / 5 ms
     assert not os.path.exists(out + ".lock")

@@ -80,7 +80,7 @@ SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "180
 ])
 def test_coupled_errors_name_their_option(extra, expect, tmp_path):
     p = cli(SSI + extra + ["-ssi_output", str(tmp_path / "a.h5")], nranks=2, check=False)
-    errs = [ln for ln in p.stdout.splitlines() if "error" in ln]
+    errs = [ln for ln in p.stderr.splitlines() if "error" in ln]
     assert p.returncode != 0 and len(errs) == 1 and expect in errs[0], p.stdout[-2000:] + p.stderr[-2000:]
     assert not os.path.exists(tmp_path / "a.h5")
 

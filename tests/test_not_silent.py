@@ -217,7 +217,7 @@ def test_a_geo_mesh_smaller_than_its_element_size_is_refused(tmp_path, n):
     p = cli(["-ssi_problem", "bem", "-ssi_mesh", "meshes/halfspace.geo", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "10",
              "-ssi_mesh_patch", "1,1", "-ssi_load_group", "load", "-ssi_load_p0", "1000", "-ssi_dt", "0.005",
              "-ssi_t_end", "0.01", "-ssi_output", str(tmp_path / "s.h5")], nranks=n, check=False)
-    errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode != 0 and len(errs) == 1, p.stdout[-2000:]
     assert "-ssi_mesh_h 10 m is larger than the mesh meshes/halfspace.geo (4 m x 4 m)" in errs[0], errs[0]
     assert "[ssi] assembly" not in p.stdout

@@ -24,10 +24,10 @@ SSI = ["-ssi_problem", "ssi", "-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "180
 
 
 def one_line_error(r, n=2):
-    lines = [ln for ln in r.stdout.splitlines() if ln.strip()]
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     errs = [ln for ln in lines if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout + r.stderr
-    assert len(errs) == 1, r.stdout
+    assert len(errs) == 1, r.stdout + r.stderr
     assert "Traceback" not in r.stderr, r.stderr
     assert "[ssi] assembly" not in r.stdout and "[fem] alpha_m" not in r.stdout, r.stdout
     return errs[0]

@@ -83,7 +83,7 @@ def test_the_guard_stop_keeps_the_results(tmp_path):
              "-ssi_t_end", repr(700 * dt), "-ssi_receivers", "0,0,0", "-ssi_output_stride", "0", "-ssi_warn_beta", "0",
              "-ssi_scheme", "plain", "-ssi_output", out], check=False, timeout=600)
     assert r.returncode == 2, r.stdout[-2000:] + r.stderr[-2000:]
-    err = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    err = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert len(err) == 1 and "diverging at step" in err[0], r.stdout[-2000:]
     step = int(err[0].split("diverging at step ")[1].split()[0])
     g = read(out)

@@ -10,7 +10,7 @@ pytestmark = pytest.mark.run
 
 def one_line_error(r):
     """The single error line of a refused run (exit status 2, no traceback)."""
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout[-3000:] + r.stderr[-3000:]
     assert len(errs) == 1, r.stdout
     assert "Traceback" not in r.stderr, r.stderr
@@ -385,7 +385,7 @@ def test_a_solver_option_petsc_refuses_is_one_line(tmp_path, n):
             timeout=120)
     # (each rank prints its line; under MPI_Abort mpirun may drop a rank's last output, so at least one; the
     # lines are read from each "petsc-ssi: error: " on, should mpirun's relay run two ranks' lines together)
-    errs = ["petsc-ssi: error: " + part.splitlines()[0].rstrip() for part in r.stdout.split("petsc-ssi: error: ")[1:]]
+    errs = ["petsc-ssi: error: " + part.splitlines()[0].rstrip() for part in r.stderr.split("petsc-ssi: error: ")[1:]]
     assert r.returncode != 0 and 1 <= len(errs) <= n and len(set(errs)) == 1, r.stdout[-3000:] + r.stderr[-3000:]
     assert "Traceback" not in r.stderr, r.stderr
     assert errs[0] == ("petsc-ssi: error: PETSc stopped with error code 63 in petsc_ssi/bem/march.py:"
@@ -395,4 +395,4 @@ def test_a_solver_option_petsc_refuses_is_one_line(tmp_path, n):
     if n == 1:                  # -ssi_debug: the traceback as before
         r = cli(BEM + ["-ssi_output", str(tmp_path / "b.h5"), "-ssi_bem_mat_mumps_icntl_7", "1", "-ssi_debug"],
                 check=False, timeout=120)
-        assert r.returncode != 0 and "Traceback" in r.stderr and "petsc-ssi: error:" not in r.stdout
+        assert r.returncode != 0 and "Traceback" in r.stderr and "petsc-ssi: error:" not in r.stderr

@@ -16,8 +16,8 @@ Commands:
   help            list every -ssi_ option with default, unit and meaning (also -help, --help)
   --version       the versions of petsc-ssi, PETSc, petsc4py, mpi4py, numpy, numba
 
-Errors in the input end the run with one line, ``petsc-ssi: error: ...``,
-and exit status 2 on every rank.
+Errors in the input end the run with one line, ``petsc-ssi: error: ...``, on
+standard error (the run's log stays on standard output), and exit status 2 on every rank.
 """
 import sys
 
@@ -225,7 +225,7 @@ def main(argv=None):
     if bad:                    # before PETSc starts: every rank exits, rank 0 says why
         from mpi4py import MPI
         if MPI.COMM_WORLD.Get_rank() == 0:
-            print(bad, flush=True)
+            _whole_line(bad)
         return 2
     if any(a in ("--version", "-version") for a in argv[1:]):
         from ..petsc import init
@@ -243,8 +243,8 @@ def main(argv=None):
     except Exception as exc:       # PetscInitialize refused the options (its own message above): no traceback
         if not type(exc).__module__.startswith("petsc4py"):
             raise
-        print(f"petsc-ssi: error: PETSc did not start (error code {getattr(exc, 'ierr', '?')}): its message above "
-              "names the option or file it refused", flush=True)
+        _whole_line(f"petsc-ssi: error: PETSc did not start (error code {getattr(exc, 'ierr', '?')}): its message "
+                    "above names the option or file it refused")
         return 2
     from .. import options
     from . import kinds, estimate, impedance, record  # noqa: F401  (every option declared, also for -help)
@@ -274,9 +274,9 @@ def main(argv=None):
         if cmd != "estimate":
             options.warn_unused_options()
     except SSIError as exc:
-        PETSc.Sys.Print(f"petsc-ssi: error: {exc}")
-        sys.stdout.flush()
         comm = PETSc.COMM_WORLD.tompi4py()
+        if comm.Get_rank() == 0:
+            _whole_line(f"petsc-ssi: error: {exc}")
         comm.Barrier()
         if comm.Get_rank() > 0:
             # mpirun ends the job at the first non-zero exit and may drop rank 0's last output
@@ -303,12 +303,13 @@ def main(argv=None):
 
 
 def _whole_line(text):
-    """``text`` and its newline to stdout in one write (Python's buffered output flushed first): each rank that
-    meets an error prints its line, and two ranks' lines came out run together, one's text straight after the
-    other's, with the line written in parts (a CI run of 1a9c676)."""
-    import os
-    sys.stdout.flush()
-    os.write(sys.stdout.fileno(), (text + "\n").encode())
+    """``text`` and its newline to standard error in one write (Python's buffered output flushed first, so the
+    log's lines before it come before it on a terminal): each rank that meets a PETSc error prints its line, and
+    two ranks' lines came out run together, one's text straight after the other's, with the line written in parts
+    (a CI run of 1a9c676). Errors go to standard error: a user who sends the log (standard output) to a file
+    still sees why the run stopped."""
+    from ..petsc import error_line
+    error_line(text)
 
 
 def _petsc_message(exc):

@@ -117,7 +117,7 @@ def test_error_under_mpirun_does_not_hang():
     p = cli(["-ssi_mesh_size", "4,4", "-ssi_receivers", "30,0,0", "-ssi_t_end", "0.003"], nranks=2,
             timeout=120, check=False)
     assert p.returncode != 0
-    assert "petsc-ssi: error: receiver (30, 0, 0) lies off the surface mesh" in p.stdout
+    assert "petsc-ssi: error: receiver (30, 0, 0) lies off the surface mesh" in p.stderr
 
 
 @pytest.mark.parametrize("opts,expect", [
@@ -214,7 +214,7 @@ def test_an_iterative_soil_solve_that_stops_short_stops_the_run(tmp_path):
     base = ["-options_file", os.path.join(ROOT, "runs", "pekeris", "small.opts"), "-ssi_t_end", "0.005"]
     it = ["-ssi_bem_ksp_type", "gmres", "-ssi_bem_pc_type", "jacobi"]
     r = cli(base + it + ["-ssi_bem_ksp_max_it", "2", "-ssi_output", str(tmp_path / "short.h5")], nranks=2, check=False)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert r.returncode == 2 and len(errs) == 1, r.stdout[-3000:] + r.stderr[-3000:]
     assert "did not converge at step 1 (DIVERGED_MAX_IT after 2 iterations of -ssi_bem_ksp_type gmres" in errs[0], errs
     assert "Traceback" not in r.stdout + r.stderr

@@ -142,7 +142,7 @@ def test_bad_input(tmp_path):
                           (["-ssi_symmetry", "x=sym"], "sets -ssi_symmetry itself", 1),
                           (["-ssi_disp_group", ""], "needs the footing as -ssi_disp_group", 1)):
         p = cli(["impedance"] + CASE + out + extra, nranks=n, check=False)
-        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
         assert p.returncode == 2 and len(errs) == 1 and msg in errs[0], (extra, p.stdout[-1500:])
 
 
@@ -208,7 +208,7 @@ def test_requested_band_outside_the_trusted_one_warns(tmp_path):
     lo, hi = 2 * np.pi / (gamma * 8), 0.3 / (316 * 8e-4)
     assert np.array_equal(trusted, (a0 >= lo) & (a0 <= hi)) and trusted.any()
     p = cli(["impedance"] + SMALL + out + ["-ssi_impedance_a0", "1,0.5"], check=False)
-    assert p.returncode == 2 and "a0_min < a0_max" in p.stdout
+    assert p.returncode == 2 and "a0_min < a0_max" in p.stderr
 
 
 # slow tier: impedance: symmetry-reduced == full and -n 2 (11 s; the off-centre footing's planes stay), the
@@ -256,7 +256,7 @@ def test_existing_outputs_are_refused_before_the_first_run(tmp_path):
     csv_path.write_text("an earlier table\n")
     for n in (1, 2):
         p = cli(["impedance"] + SMALL + short + out, nranks=n, check=False)
-        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
         assert p.returncode == 2 and len(errs) == 1, p.stdout[-1500:]
         assert f"{csv_path} exists (a previous result); add -ssi_output_overwrite" in errs[0], errs[0]
         assert "[impedance] mode" not in p.stdout and not (tmp_path / "z-vertical.h5").exists()
@@ -264,7 +264,7 @@ def test_existing_outputs_are_refused_before_the_first_run(tmp_path):
     csv_path.unlink()
     (tmp_path / "z-rocking.h5").write_bytes(b"an earlier run")          # the second mode's result
     p = cli(["impedance"] + SMALL + short + out, nranks=2, check=False)
-    assert p.returncode == 2 and "z-rocking.h5 exists (a previous result)" in p.stdout, p.stdout[-1500:]
+    assert p.returncode == 2 and "z-rocking.h5 exists (a previous result)" in p.stderr, p.stderr[-1500:]
     assert not (tmp_path / "z-vertical.h5").exists()
     (tmp_path / "z-rocking.h5").unlink()
     csv_path.write_text("an earlier table\n")

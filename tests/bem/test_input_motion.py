@@ -182,7 +182,7 @@ def test_refusals(tmp_path):
     assert resolve_error(groups, **dict(o, symmetry="y=anti")) is None
     assert "is for the half-space alone" in resolve_error(("common", "bem", "fem", "ssi", "seismic"), **o)
     p = cli(["input-motion", "-ssi_disp_group", "box:-0.5,0.5,-0.5,0.5"], check=False)
-    assert p.returncode == 2 and "input-motion needs a seismic input" in p.stdout
+    assert p.returncode == 2 and "input-motion needs a seismic input" in p.stderr
 
 
 def seismic_input(tmp_path, wave, angle, azimuth, pts):

@@ -91,14 +91,14 @@ def test_a_changed_key_is_refused(tmp_path):
              (["-ssi_lags_save", str(tmp_path / "other.lags")], "-ssi_lags_save with -ssi_lags_load")]
     for extra, msg in cases:
         p = cli(BEM + out + ["-ssi_lags_load", lags] + extra, nranks=2, check=False)
-        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
         assert p.returncode == 2 and len(errs) == 1 and msg in errs[0], (extra, p.stdout[-1500:])
         assert "assembly" not in p.stdout and "Traceback" not in p.stderr
     open(str(tmp_path / "cut.lags"), "wb").write(b"\0" * 64)
     p = cli(BEM + out + ["-ssi_lags_load", str(tmp_path / "cut.lags")], nranks=2, check=False)
-    assert p.returncode == 2 and "cut.lags.json is missing" in p.stdout
+    assert p.returncode == 2 and "cut.lags.json is missing" in p.stderr
     p = cli(BEM + ["-ssi_output", str(tmp_path / "y.h5"), "-ssi_lags_save", lags], nranks=2, check=False)
-    assert p.returncode == 2 and "add -ssi_output_overwrite" in p.stdout
+    assert p.returncode == 2 and "add -ssi_output_overwrite" in p.stderr
 
 
 def test_a_restart_with_loaded_lags_is_bitwise(tmp_path):

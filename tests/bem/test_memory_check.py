@@ -51,6 +51,6 @@ def test_a_mesh_that_cannot_fit_is_refused_fast(tmp_path):
              "-ssi_load_group", "load", "-ssi_load_p0", "1", "-ssi_dt", "0.002", "-ssi_t_end", "0.5",
              "-ssi_warn_beta", "0", "-ssi_output", str(tmp_path / "x.h5")], nranks=2, check=False)
     wall = time.perf_counter() - t0
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2 and len(errs) == 1 and "estimated from a sample of rows" in errs[0], r.stdout[-1500:]
     assert wall < 60, wall

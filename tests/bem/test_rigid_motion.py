@@ -93,5 +93,5 @@ def test_a_motion_the_symmetry_contradicts_is_refused(tmp_path):
                            "is not antisymmetric", 1),
                           (["-ssi_disp_rotation", "0,1e-6"], "expected three numbers", 1)):
         p = cli(BASE + out + extra, nranks=n, check=False)
-        errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+        errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
         assert p.returncode == 2 and len(errs) == 1 and msg in errs[0], (extra, p.stdout[-1500:])

@@ -414,7 +414,7 @@ def test_toeplitz_refusals_and_auto(tmp_path):
     for cmd in ([], ["estimate"]):          # (the estimate of a run that would be refused is refused the same way)
         r = cli(cmd + BEM + TZ + ["-ssi_output", str(tmp_path / "c.h5"), "-ssi_lag_single_from", "5"], check=False)
         assert r.returncode == 2 and "petsc-ssi: error: -ssi_lag_single_from keeps lag matrices in single precision" \
-            in r.stdout and "Traceback" not in r.stderr, (cmd, r.stdout[-2000:])
+            in r.stderr and "Traceback" not in r.stderr, (cmd, r.stdout[-2000:])
     # single-precision kept transforms where no store keeps them: the dense store, and auto falling back to it
     for store in ("dense", "auto"):
         r = cli(bad + ["-ssi_lag_store", store, "-ssi_toeplitz_precision", "single", "-ssi_output",

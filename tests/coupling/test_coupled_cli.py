@@ -50,6 +50,6 @@ def test_two_ranks_reproduce_one(tmp_path):
 def test_bad_input_one_line_every_rank(tmp_path, extra, msg):
     p = cli(CASE + ["-ssi_output", str(tmp_path / "x.h5")] + extra, nranks=2, check=False)
     assert p.returncode == 2, p.stdout + p.stderr
-    lines = [l for l in p.stdout.splitlines() if l.startswith("petsc-ssi: error:")]
+    lines = [l for l in p.stderr.splitlines() if l.startswith("petsc-ssi: error:")]
     assert len(lines) == 1 and msg in lines[0], p.stdout
     assert "assembly" not in p.stdout

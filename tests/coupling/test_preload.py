@@ -302,7 +302,7 @@ def test_bad_preload_is_refused_in_one_line_at_two_ranks(tmp_path):
     """Under mpirun -n 2: one line, every rank stops (no hang), before any assembly."""
     p = cli(SSI + ["-ssi_output", str(tmp_path / "o.h5"), "-ssi_contact_preload", "-100"], nranks=2, check=False,
             timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert "must be a finite pressure >= 0" in errors[0], errors[0]
     assert "assembly" not in p.stdout

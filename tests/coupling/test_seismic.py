@@ -241,7 +241,7 @@ def test_bad_seismic_input_is_refused_in_one_line(tmp_path, record, extra, words
     if str(trunc) in extra:
         extra += ["-ssi_seismic_units", "auto"]               # the later value wins: the file's own units
     p = cli(args + extra, nranks=2, check=False, timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert words in errors[0], errors[0]
     assert "assembly" not in p.stdout

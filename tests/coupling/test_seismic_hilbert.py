@@ -109,7 +109,7 @@ def test_a_record_not_at_rest_is_refused(tmp_path):
             "-ssi_dt", "0.006", "-ssi_seismic", "rayleigh", "-ssi_seismic_record", str(p), "-ssi_seismic_taper", "0",
             "-ssi_seismic_baseline", "none", "-ssi_output", str(tmp_path / "o.h5"), "-ssi_warn_beta", "0"]
     r = cli(args, nranks=2, check=False, timeout=300)
-    errors = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert r.returncode == 2 and len(errors) == 1, r.stdout[-2000:] + r.stderr[-2000:]
     assert "does not return to rest" in errors[0] and "-ssi_seismic_highpass" in errors[0], errors[0]
     assert "assembly" not in r.stdout

@@ -290,7 +290,7 @@ def test_a_level_without_nodes_is_refused_in_one_line_before_assembly(msh, tmp_p
     for k, v in o.items():
         args += ["-ssi_" + k, str(v)]
     p = run_cli(args, n=2)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert "z = 4.2 m" in errors[0], errors[0]
     assert "integrator" not in p.stdout and "alpha_m" not in p.stdout       # make_model_integrator's line

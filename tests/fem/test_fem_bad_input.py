@@ -11,10 +11,10 @@ FEM = ["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_t_end", "0.01
 
 
 def one_line_error(r):
-    lines = [ln for ln in r.stdout.splitlines() if ln.strip()]
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     errs = [ln for ln in lines if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout + r.stderr
-    assert len(errs) == 1, r.stdout
+    assert len(errs) == 1, r.stdout + r.stderr
     assert "Traceback" not in r.stderr, r.stderr
     return errs[0]
 

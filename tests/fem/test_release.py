@@ -183,5 +183,5 @@ def test_released_member_free_to_twist_is_refused(tmp_path):
     _beam_msh(msh)
     o = [x.replace("root,end:ux+uy+uz+rx", "root,end:ux+uy+uz") for x in _beam_opts(msh, True, str(tmp_path / "m.h5"), 1e4)]
     r = run_cli(o)
-    errs = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error: ")]
+    errs = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2 and len(errs) == 1 and "singular" in errs[0], r.stdout[-2000:]

@@ -103,7 +103,7 @@ def test_layers_by_depth_are_layers_by_part(tmp_path):
     p = cli(common + ["-ssi_fem_parts", "column", "-ssi_fem_part_column_element", "hex8",
                       "-ssi_fem_part_column_layers", f"-1:{soft};-2:{stiff}", "-ssi_output", str(tmp_path / "x.h5")],
             check=False)
-    errs = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errs = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode != 0 and len(errs) == 1 and "lie below the last layer's bottom (z = -2 m" in errs[0], p.stdout
 
 

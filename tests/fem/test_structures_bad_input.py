@@ -32,10 +32,10 @@ def args(parts="slab,columns", drop=(), fixed="base", **extra):
 def one_line_error(r):
     if "-ssi_fem_part_pole_element" in r.args:               # the mechanism case warns first
         assert "joints are pinned" in r.stdout, r.stdout
-    lines = [ln for ln in r.stdout.splitlines() if ln.strip()]
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     errs = [ln for ln in lines if ln.startswith("petsc-ssi: error: ")]
     assert r.returncode == 2, r.stdout + r.stderr
-    assert len(errs) == 1, r.stdout
+    assert len(errs) == 1, r.stdout + r.stderr
     assert "Traceback" not in r.stderr, r.stderr
     assert "[fem] alpha_m" not in r.stdout, r.stdout
     return errs[0]

@@ -61,7 +61,7 @@ def test_each_axis_takes_its_trace(tmp_path, three, form, expect):
 def test_a_multi_trace_file_without_its_traces_is_refused_in_one_line(tmp_path, three, extra, words):
     p = cli(FEM + ["-ssi_output", str(tmp_path / "o.h5"), "-ssi_seismic_record", three] + extra, nranks=2,
             check=False, timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1, p.stdout[-2000:] + p.stderr[-2000:]
     assert words in errors[0], errors[0]
 
@@ -99,7 +99,7 @@ def test_one_column_of_a_table_cannot_drive_two_axes(tmp_path):
     assert all(abs(got[a] - v) < 1e-12 for a, v in (("x", 3.0), ("y", 2.0), ("z", 1.0))), got
     r = cli(FEM + ["-ssi_output", str(tmp_path / "r.h5"), "-ssi_seismic_record", str(tab), "-ssi_seismic_traces",
                    "x,x,x"], nranks=2, check=False, timeout=300)
-    errors = [ln for ln in r.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert r.returncode == 2 and len(errors) == 1, r.stdout[-2000:] + r.stderr[-2000:]
     assert "the column x of" in errors[0] and "drives both x and y" in errors[0], errors[0]
 

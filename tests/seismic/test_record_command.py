@@ -53,7 +53,7 @@ def test_record_report_and_csv(rec, tmp_path):
 ])
 def test_refusals_one_line_every_rank(rec, which, extra, words):
     p = cli(["record", str(rec[which])] + extra, nranks=2, check=False, timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1 and words in errors[0], p.stdout + p.stderr
 
 

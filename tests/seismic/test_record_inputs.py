@@ -54,7 +54,7 @@ def test_a_record_of_zeros_is_refused_and_an_unused_azimuth_is_said(tmp_path):
     np.savetxt(z, np.c_[np.arange(10) * 0.01, np.zeros(10)])
     p = cli(FEM + ["-ssi_seismic_record", str(z), "-ssi_output", str(tmp_path / "z.h5")], nranks=2, check=False,
             timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1 and "zero everywhere" in errors[0], p.stdout + p.stderr
     r = tmp_path / "pulse.txt"
     t = np.arange(0.0, 0.3, 0.01)

@@ -76,7 +76,7 @@ def test_the_refusal_is_one_line_on_every_rank_before_the_model(tmp_path):
     p = cli(["-ssi_problem", "fem", "-ssi_fem_box_cells", "2,2,2", "-ssi_fem_fixed", "base", "-ssi_dt", "0.01",
              "-ssi_seismic", "vertical", "-ssi_seismic_record", bad, "-ssi_output", str(tmp_path / "o.h5")],
             nranks=2, check=False, timeout=300)
-    errors = [ln for ln in p.stdout.splitlines() if ln.startswith("petsc-ssi: error:")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("petsc-ssi: error:")]
     assert p.returncode == 2 and len(errors) == 1 and "-ssi_seismic_units" in errors[0], p.stdout + p.stderr
     assert "assembl" not in p.stdout.lower()
 
