@@ -30,9 +30,13 @@ pressure at the interface.
 """
 import numpy as np
 
-from ..petsc import printf
+from ..petsc import printf, warn
 
 from .forces import COMBINATION  # noqa: F401  (the rule, stated with the member forces; the option: fem/options.py)
+
+# A structure that moves more than this fraction of its size under its own weight has a wrong unit (E in GPa
+# sagged an engineer's building 1.5 km) or a mechanism: real structures move millimetres to centimetres.
+SAG_WARN = 0.01
 
 
 def gravity_load(model, g):
@@ -107,6 +111,15 @@ class GravityCase:
         self.base_moment = np.cross(x, Fn).sum(axis=0) + Mn.sum(axis=0)
         self.coords = coords_all[self.nodes]
         umax = self.u.norm(PETSc.NormType.INFINITY)
+        tr = dm.translation_dofs(np.arange(model.mesh.n_nodes)).ravel()
+        tr = tr[(tr >= dm.r0) & (tr < dm.r1)] - dm.r0
+        ua = self.u.getArray(readonly=True)
+        sag = mpi.allreduce(float(np.abs(ua[tr]).max()) if tr.size else 0.0, op=MPI.MAX)
+        size = float(np.linalg.norm(np.ptp(coords_all, axis=0))) if len(coords_all) else 0.0
+        if size > 0 and sag > SAG_WARN * size:
+            warn(f"the structure moves {sag:.3g} m under its own weight, {100 * sag / size:.3g} % of its size "
+                 f"({size:.3g} m across): a wrong unit (E in N/m^2, sections and thicknesses in m, densities in "
+                 "kg/m^3) or a support missing; the run goes on as given", comm)
         printf(f"[fem] gravity {self.g:g} m/s^2 along -z: weight {self.weight:.6g} N (mass {self.mass:.6g} kg); "
                f"static solve: max |u_i| = {umax:.3e}; reactions of the {len(self.nodes)} supported node(s) sum to "
                f"{-self.base_force[2]:.6g} N up; combined with the earthquake as {COMBINATION.split(':')[0]}")

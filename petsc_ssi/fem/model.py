@@ -17,7 +17,7 @@ from .assembly import Material, assemble, mass_report
 from .dofmap import DofMap
 from .loads import fixed_dofs, nodal_load, point_masses
 from .mesh import load_mesh, snap_points
-from .parts import parse_parts
+from .parts import parse_parts, plausibility
 from ..points import parse_points
 
 
@@ -117,6 +117,10 @@ def build_model(cfg, comm, assemble_matrices=True, log=printf, receivers_what="-
         rel = [s.name for s in specs if s.props.released]
         log(f"[fem] released joints: {int(dofmap.released.sum())} node(s) where part(s) {', '.join(rel)} meet the "
             "other frame/shell parts carry a second rotation triple (translations tied, rotations released)")
+    odd = plausibility(specs, float(np.linalg.norm(np.ptp(mesh.coords, axis=0))) if mesh.n_nodes else 0.0)
+    if odd:
+        from ..petsc import warn
+        warn(odd, comm)
     legacy = all(s.legacy for s in specs)
     mat = Material(cfg.fem_E, cfg.fem_nu, cfg.fem_rho) if legacy else None
     if not legacy:

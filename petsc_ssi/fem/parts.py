@@ -93,6 +93,7 @@ class PartSpec:
     orientation_given: bool = False
     legacy: bool = False          # the single hex8 part of -ssi_fem_E/_nu/_rho
     layers: tuple = ()            # hex8 layered by depth: ((z_bottom [m], Props), ...), elevations falling
+    section: tuple = ()           # frame: (b, h) [m] of -ssi_fem_part_NAME_section, () when area etc. are given
 
 
 def rect_section(b, h):
@@ -257,10 +258,12 @@ def _spec(name, g):
                            + _suggest(rel, ("rotations", "none")))
         props.released = rel == "rotations"
     oriented = False
+    bh = ()
     if el == "frame":
         sec = {}
         if "section" in g:
             b, h = _numbers(g["section"], 2, opt("section"))
+            bh = (b, h)
             if not (b > 0 and h > 0):
                 raise SSIError(f"{opt('section')} '{g['section']}': b and h must be > 0")
             sec = rect_section(b, h)
@@ -283,7 +286,45 @@ def _spec(name, g):
         raise SSIError(f"part '{name}' (shell) has no mass: set {opt('rho')} > 0 or {opt('mass_per_area')}")
     if el != "shell" and props.rho == 0 and props.added_mass == 0:
         raise SSIError(f"part '{name}' ({el}) has no mass: {opt('rho')} must be > 0")
-    return PartSpec(name, el, props, orientation_given=oriented)
+    return PartSpec(name, el, props, orientation_given=oriented, section=bh)
+
+
+# Lower bounds that catch a wrong unit in a part's properties (an engineer's E in GPa ran without a word and
+# sagged 1.5 km under its weight): E in GPa or MPa puts it below 1e6 N/m^2, t/m^3 for kg/m^3 puts rho below 10.
+# Structural materials: rubber bearings near 1e6 N/m^2, timber and masonry 1e9-2e10, concrete 2-4e10, steel
+# 2.1e11; densities 300 (timber, foam concrete) to 7850 (steel). No upper bounds: rigid links and lumped
+# contents are modelled with large E, areas and densities on purpose. A warning, not a refusal (scaled and
+# non-dimensional models run as given).
+PART_E_MIN = 1e6                  # N/m^2
+PART_RHO_MIN = 10.0               # kg/m^3 (0: a massless part, its mass given otherwise)
+
+
+def plausibility(specs, size):
+    """One line naming each part property below what structures have (a wrong unit), else None.
+    ``size``: the structure's largest extent [m] (its bounding box's diagonal): a shell thicker, or a
+    frame section (-ssi_fem_part_NAME_section b,h) wider or deeper, than half of it is a length in mm or cm
+    (an area given as such is not checked: rigid links take large ones)."""
+    out = []
+    for s in specs:
+        layers = [p for _, p in s.layers] if getattr(s, "layers", None) else [s.props]
+        opt = "-ssi_fem_" if s.legacy else f"-{KEY}{s.name}_"
+        for p in layers[:1] if s.legacy else layers:
+            if not p.E >= PART_E_MIN:
+                cs = f" (c_s {np.sqrt(p.G() / p.rho):.3g} m/s)" if s.element == "hex8" and p.rho > 0 else ""
+                out.append(f"{opt}E {p.E:g} N/m^2{cs}")
+            if p.rho != 0 and not p.rho >= PART_RHO_MIN:
+                out.append(f"{opt}rho {p.rho:g} kg/m^3")
+        p = s.props
+        if size > 0 and s.element == "shell" and p.thickness > 0.5 * size:
+            out.append(f"{opt}thickness {p.thickness:g} m on a structure {size:.3g} m across")
+        if size > 0 and s.section and max(s.section) > 0.5 * size:
+            out.append(f"{opt}section {s.section[0]:g},{s.section[1]:g} m on a structure {size:.3g} m across")
+    if not out:
+        return None
+    out = list(dict.fromkeys(out))
+    return ("unusual structure: " + "; ".join(out) + f" (structures: E above {PART_E_MIN:g} N/m^2, rho above "
+            f"{PART_RHO_MIN:g} kg/m^3, sections and thicknesses well below the structure's size): check the units "
+            "(N/m^2 = Pa, kg/m^3, m); a scaled or non-dimensional model runs as given")
 
 
 def _layered_spec(name, g, opt):
