@@ -330,3 +330,35 @@ def test_given_damping_beside_the_identified(tmp_path, capsys):
     given2 = read_csv(tmp_path / "g2.csv")[q]
     for k in (1, 2):
         assert given2[k] == pytest.approx(given[k] + 0.02, rel=1e-12)
+
+
+def test_notes_base_shear_modelled_part_and_resolution(tmp_path, capsys, monkeypatch):
+    """The header says what the base shear is (the foundation's inertia included, the same on both) and whose
+    (the structure outputs' attribute symmetry: a half model's is the half's); on a series too short to
+    resolve f0 (1/T above 5 % of f0) it says the spectral ratio's peak is uncertain. The 20 s record: no such
+    warning (1/T = 0.05 Hz, 2.5 % and 1.25 % of f0); a 4 s one: both (0.25 Hz, 12.5 % and 6.2 %)."""
+    import h5py
+    import sys
+    s = write_ssi(str(tmp_path), demands=(2.0e5, 4e-3))
+    fx = write_fixed(str(tmp_path), demands=(5.0e5, 1e-2))
+    with h5py.File(s[:-3] + "_structure.h5", "a") as f:
+        f.attrs["symmetry"] = "y=sym"
+    with h5py.File(fx, "a") as f:
+        f.attrs["symmetry"] = ""
+    status, out, err = run([s, "--glance", fx], capsys)
+    assert status == 0, err
+    notes = out.splitlines()
+    assert sum(ln.startswith("base shear: ") and "foundation's own inertia included" in ln for ln in notes) == 1, out
+    assert "with SSI: modelled part: the half of the structure on the planes -ssi_symmetry 'y=sym'" in out, out
+    assert "fixed base: modelled part: the whole mesh (no -ssi_symmetry plane)" in out, out
+    assert "resolve frequencies" not in out, out
+    monkeypatch.setattr(sys.modules[__name__], "REC_T", 4.0)
+    short = tmp_path / "short"
+    short.mkdir()
+    s, fx = write_ssi(str(short)), write_fixed(str(short))
+    status, out, err = run([s, "--glance", fx], capsys)
+    assert status == 0, err
+    warn = [ln for ln in out.splitlines() if "so its spectra resolve frequencies 1/T" in ln]
+    assert len(warn) == 2 and warn[0].startswith("with SSI: warning: the series is 4") and "12 % of f0" in warn[0] \
+        and warn[1].startswith("fixed base: warning:"), warn
+    assert "base shear: " not in out                          # no demands recorded: no note

@@ -362,11 +362,38 @@ def demands_summary(path):
     return rows, mass
 
 
+BASE_SHEAR_NOTE = ("base shear: the horizontal force the structure exerts on the ground through its base, the "
+                   "foundation's own inertia included (fixed base: the supports' reactions, the supported nodes' "
+                   "m a_g with them; with SSI: the interface force), the same quantity with and without SSI; the "
+                   "members' shear at the base is V less the foundation's mass times its acceleration")
+
+
+def modelled_part_note(attrs):
+    """One line: whose base shear, overturning moment and weight the file's values are (the structure output's
+    attribute symmetry: the run's -ssi_symmetry planes)."""
+    sym = attrs.get("symmetry")
+    if sym is None:
+        return ("modelled part: not recorded (a file written before its attribute symmetry); a half (quarter) "
+                "model's base shear, overturning moment and weight are the half's (quarter's)")
+    sym = str(sym).strip()
+    if not sym:
+        return ("modelled part: the whole mesh (no -ssi_symmetry plane); a structure meshed in half by hand (e.g. "
+                "meshes/building.geo's half = 1) gives the half's base shear, overturning moment and weight")
+    n = len([p for p in sym.split(",") if p.strip()])
+    part, times = ("half", "twice") if n == 1 else ("quarter", "four times")
+    return (f"modelled part: the {part} of the structure on the planes -ssi_symmetry '{sym}': base shear, "
+            f"overturning moment and weight are the {part}'s; the whole structure's are {times} these, or zero for "
+            "a component its symmetry cancels; drift ratios are the whole's")
+
+
 def demands_csv(path, out=None):
     out = sys.stdout if out is None else out
     rows, mass = demands_summary(path)
+    with open_h5(path) as f:
+        attrs = dict(f.attrs)
     out.write(_header([f"petsc-ssi post --demands: storey demands' peaks of {os.path.abspath(path)} (group demands)",
                        "value: max over the steps of |series| per component; time_s: the first time of that peak",
+                       BASE_SHEAR_NOTE, modelled_part_note(attrs),
                        "V/W: " + ("base shear over the weight of the structure's mass attribute (the modelled part)"
                                   if mass is not None else "not given: the file records no structure_mass")]))
     out.write("quantity,storey,component,value,unit,time_s\n")

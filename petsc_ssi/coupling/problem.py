@@ -25,7 +25,7 @@ from ..bem.build import build_marcher
 from ..fem.integrators import make_model_integrator
 from ..fem.loads import load_history
 from ..sources.nodal import NodalLoad
-from ..fem.problem import damping_attrs, structure_mass
+from ..fem.problem import damping_attrs, structure_mass, symmetry_attr
 from . import options as _options  # noqa: F401  (declares the coupling's options, and the soil's and structure's)
 from .model import build_coupled, interface_bytes
 from .step import Coupler
@@ -265,7 +265,7 @@ class SSITransient(TransientProblem):
         if getattr(prob, "seismic", None) is not None:
             groups["seismic"] = prob.seismic.arrays()
         sattrs = {"problem": "ssi-structure", "dt": self.grid.dt, **damping_attrs(self.am, self.integ.a1, self.integ.modal),
-                  "structure_mass": structure_mass(model, comm)}
+                  "structure_mass": structure_mass(model, comm), "symmetry": symmetry_attr(cfg)}
         return [(self.out, {"receivers": recd, "attrs": attrs, "record": record, "groups": groups or None}),
                 (self.sout, {"receivers": srecd, "attrs": sattrs, "record": None, "groups": sgroups or None})]
 

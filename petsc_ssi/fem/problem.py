@@ -204,7 +204,7 @@ class FEMTransient(TransientProblem):
         receivers = groups.pop("receivers", None)
         dt = self.grid.dt
         attrs = {"problem": "fem", "dt": dt, **damping_attrs(am, self.integ.a1, self.integ.modal),
-                 "structure_mass": structure_mass(model, comm)}
+                 "structure_mass": structure_mass(model, comm), "symmetry": symmetry_attr(cfg)}
         if self.gravity is not None:
             attrs["gravity"] = self.gravity.g
             if comm.getRank() == 0:
@@ -252,6 +252,13 @@ class FEMTransient(TransientProblem):
             self.demands.destroy()
         self.release_locks()                    # the run is done: its files are free again
         return out
+
+
+def symmetry_attr(cfg):
+    """The run's -ssi_symmetry planes as written ('' for none): a half (quarter) model's base shear,
+    overturning moment and weight are the modelled part's (post --demands and --glance say so)."""
+    text = str(cfg.get("symmetry", "") or "").strip()
+    return "" if text.lower() == "none" else text
 
 
 def structure_mass(model, comm):

@@ -104,3 +104,18 @@ def test_demands_summary(run):
                 pytest.approx(np.abs(dr[:, s, j]).max(), rel=1e-8)
     assert by[("peak base shear / weight V/W", "", "x")][0] > 1e-3
     assert ("peak overturning moment (about y)", "", "y") in by
+    # the header says what the base shear is and whose (a whole mesh here: the attribute symmetry is '')
+    notes = [ln for ln in out.read_text().splitlines() if ln.startswith("#")]
+    assert any(ln.startswith("# base shear: ") and "the foundation's own inertia included" in ln for ln in notes), notes
+    assert any(ln.startswith("# modelled part: the whole mesh (no -ssi_symmetry plane)") for ln in notes), notes
+
+
+def test_modelled_part_note():
+    """Whose base shear and weight a structure output's are: the run's -ssi_symmetry planes (attribute symmetry)."""
+    from petsc_ssi.app.post import modelled_part_note
+    half = modelled_part_note({"symmetry": "y=sym"})
+    assert "the half of the structure" in half and "whole structure's are twice these" in half, half
+    quarter = modelled_part_note({"symmetry": "x=anti,y=sym"})
+    assert "the quarter" in quarter and "four times" in quarter, quarter
+    assert modelled_part_note({"symmetry": ""}).startswith("modelled part: the whole mesh")
+    assert modelled_part_note({}).startswith("modelled part: not recorded")
