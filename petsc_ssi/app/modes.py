@@ -39,10 +39,11 @@ def _participation_lines(p, freqs):
     b = p["base_point"]
     tot = p["total_mass"]
     printf(f"[modes] modal participation (shapes of the table above; base point ({b[0]:g}, {b[1]:g}, {b[2]:g}) m; "
-           f"total mass moving with the base x {tot[0]:.6g} kg, y {tot[1]:.6g} kg, z {tot[2]:.6g} kg)")
+           f"total mass moving with the base x {tot[0]:.6g} kg, y {tot[1]:.6g} kg, z {tot[2]:.6g} kg; a height "
+           f"'-': the mode moves under {100 * HEIGHT_SHARE:g} % of the mass along that direction, a ratio of two "
+           "near-zero sums); as CSV:")
     printf("mode,frequency_hz,meff_x_kg,meff_y_kg,meff_z_kg,ratio_x,ratio_y,ratio_z,cum_x,cum_y,cum_z,"
-           f"height_x_m,height_y_m  (height '-': the mode moves under {100 * HEIGHT_SHARE:g} % of the mass along "
-           "that direction, a ratio of two near-zero sums)")
+           "height_x_m,height_y_m")
     for k, f in enumerate(freqs):
         me, r, c, h = p["effective_mass"][k], p["effective_mass_ratio"][k], p["cumulative_mass_ratio"][k], \
             p["effective_height"][k]

@@ -195,10 +195,14 @@ def build_interface(be_mesh, fe_mesh, spec, fe_groups, tol_rel, planes=(), h=1.0
     if spec == "auto":
         elems = np.nonzero(on_fe[be_mesh.cells].all(axis=1))[0]
         if elems.size == 0:
-            near = float(d_all.min())
+            n_on = int(on_fe.sum())
+            at = np.unique(i_all[on_fe]).size
+            es = float(np.min(be_mesh.element_sizes()))
             raise SSIError(f"-ssi_interface auto: no soil element has all nine nodes on the structure's "
-                           f"'{fe_groups}' faces (closest soil node {near:.3g} m from them, tolerance "
-                           f"{tol:.3g} m): the soil mesh must have nodes at the structure's base nodes")
+                           f"'{fe_groups}' faces: {n_on} soil node(s) lie on them (within {tol:.3g} m), at {at} of "
+                           f"their {len(fnodes)} nodes (the soil's smallest element {es:.3g} m, its nodes {es / 2:.3g} "
+                           f"m apart; the faces' nodes {spacing:.3g} m); every node of a soil element under the "
+                           "structure must be one of its base nodes")
     else:
         elems = np.asarray(be_mesh.select(spec), np.int64)
     bnodes = np.unique(be_mesh.cells[elems])

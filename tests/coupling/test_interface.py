@@ -36,8 +36,15 @@ def test_matching_normals_and_consistent_forces():
 def test_unmatched_nodes_are_listed():
     be, _ = meshes()
     fe = structured_box((5, 5, 1), (1.0, 1.0, 0.25), (-0.5, -0.5, 0.0))     # 0.2 m spacing: no match
-    with pytest.raises(SSIError, match="no soil element has all nine nodes"):
+    with pytest.raises(SSIError, match="no soil element has all nine nodes") as exc:
         build_interface(be, fe, "auto", "base", 1e-6)
+    # the line counts the soil nodes that do lie on the faces (an independent count), and the spacings
+    base = fe.coords[np.abs(fe.coords[:, 2]) < 1e-12]
+    d = np.linalg.norm(be.nodes[:, None, :] - base[None, :, :], axis=2)
+    on = int((d.min(axis=1) <= 0.2e-6).sum())
+    assert 0 < on < len(base)
+    assert f": {on} soil node(s) lie on them (within 2e-07 m), at {on} of their {len(base)} nodes" in str(exc.value)
+    assert "the faces' nodes 0.2 m" in str(exc.value), str(exc.value)
     with pytest.raises(SSIError, match=r"soil node\(s\) of -ssi_interface load match no node .*\(-0\.5, -0\.25, 0\).*\(21 in all\)"):
         build_interface(be, fe, "load", "base", 1e-6)
     with pytest.raises(SSIError, match="no face group 'bottom'"):

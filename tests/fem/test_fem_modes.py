@@ -72,6 +72,8 @@ def test_modes_command(tmp_path):
     assert any("alpha_m = 2 zeta omega" in ln for ln in lines)
     # the participation table: an effective height only where the mode moves at least 0.01 % of the mass that way
     j = next(k for k, ln in enumerate(lines) if ln.startswith("mode,frequency_hz,meff_x_kg"))
+    assert lines[j] == ("mode,frequency_hz,meff_x_kg,meff_y_kg,meff_z_kg,ratio_x,ratio_y,ratio_z,cum_x,cum_y,cum_z,"
+                        "height_x_m,height_y_m"), lines[j]            # a clean CSV header: the notes on the line before
     part = [ln.split(",") for ln in lines[j + 1:j + 5]]
     shown = 0
     for c in part:
