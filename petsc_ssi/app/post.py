@@ -19,6 +19,14 @@ Reads an output file with h5py (serial; no PETSc needed):
                       peak drift ratio per storey, peak base shear, V/W (W = m g of the
                       structure's mass attribute), peak overturning moment, each with its
                       time; columns quantity,storey,component,value,unit,time_s
+  --forces [PART,...] --csv [OUT.csv]
+                      the member forces of a structure output (-ssi_structure_forces) as
+                      section resultants an engineer reads: frames at each end (N > 0
+                      tension), shells at each element's centre; per element, end and
+                      component the peak |E(t)| over every step and, with -ssi_fem_gravity,
+                      G, G + E max and G + E min in the same convention; columns
+                      part,element,end,node,x_m,y_m,z_m,component,unit,peak_abs,gravity,
+                      gravity_plus_max,gravity_plus_min (every part without a name)
 
 Frequency domain (petsc_ssi.spectrum; numpy FFT of the stored series):
   --spectrum          one-sided amplitude spectrum |X(f)| of a series, scaled so
@@ -386,6 +394,93 @@ def modelled_part_note(attrs):
             "a component its symmetry cancels; drift ratios are the whole's")
 
 
+FRAME_SECTION_NOTE = ("frames: section resultants at each end (i: node 0, j: node 1 of the element's nodes), local "
+                      "axes x' from node 0 to node 1, z' the part's orientation made normal to x', y' = z' x x'; N > 0 "
+                      "tension, V2 and V3 along y' and z', T about x', M2 > 0 stretches the +z' fibre, M3 > 0 "
+                      "compresses the +y' fibre (the file's end forces f the nodes exert on the element: -f_i at end i, "
+                      "+f_j at end j)")
+SHELL_SECTION_NOTE = ("shells: stress resultants at the element's centre in its local frame (e1, e2 in the mean plane, e3 "
+                      "the normal): N = int sigma dz [N/m] (N11 > 0 tension), M = int sigma z dz [N m/m] (M11 > 0 "
+                      "stretches the +e3 fibre), Q = int sigma_a3 dz [N/m]")
+
+
+def forces_table(path, parts=None):
+    """(header lines, rows) of the member forces of a structure output as section resultants: per part, element,
+    end (frames: i and j; shells: centre) and component (peak |E(t)|, and with gravity G, G + E max, G + E min:
+    the file's G + max_t E(t) and G + min_t E(t) of the end forces, turned at end i, where the section's
+    resultant is -f_i, into the section's min and max)."""
+    rows = []
+    with open_h5(path) as f:
+        g = f.get("forces")
+        if g is None or not hasattr(g, "keys"):
+            raise PostError(f"{path}: no group forces (member forces are written with -ssi_structure_forces PARTS "
+                            "into a structure output: FILE.h5 of -ssi_problem fem, FILE_structure.h5 of a coupled run)")
+        have = [k[:-len("_envelope")] for k in g.keys() if k.endswith("_envelope")]
+        want = have if not parts else parts
+        for p in want:
+            if p not in have:
+                raise PostError(f"--forces {p}: {path} holds no member forces of a part '{p}' (it holds: "
+                                f"{', '.join(sorted(have)) or 'none'})")
+        X = np.asarray(f["coordinates"][()], float) if "coordinates" in f else None
+        gravity = False
+        for p in want:
+            env = g[p + "_envelope"]
+            comps = str(env.attrs["components"]).split(",")
+            units = str(env.attrs["unit"]).split(",")
+            element = str(env.attrs.get("element", ""))
+            E = np.asarray(env[()], float)
+            nodes = np.asarray(g[p + "_nodes"][()], np.int64) if p + "_nodes" in g else None
+            grav = p + "_gravity" in g
+            gravity |= grav
+            G, Gmax, Gmin = ((np.asarray(g[p + s][()], float) if grav else None)
+                             for s in ("_gravity", "_gravity_plus_max", "_gravity_plus_min"))
+            if element == "frame":
+                ends = [("i", 0, -1.0, [c for c in comps if c.endswith("_i")]),
+                        ("j", 1, 1.0, [c for c in comps if c.endswith("_j")])]
+            else:
+                ends = [("centre", None, 1.0, comps)]
+            for e in range(E.shape[0]):
+                for end, which, sign, names in ends:
+                    if nodes is None:
+                        node, x = -1, (np.nan,) * 3
+                    elif which is None:
+                        node, x = -1, tuple(X[nodes[e]].mean(axis=0)) if X is not None else (np.nan,) * 3
+                    else:
+                        node = int(nodes[e, which])
+                        x = tuple(X[node]) if X is not None else (np.nan,) * 3
+                    for name in names:
+                        c = comps.index(name)
+                        row = [p, e, end, node, *x, name.rsplit("_", 1)[0] if which is not None else name, units[c],
+                               E[e, c]]
+                        if grav:
+                            a, b = sign * Gmax[e, c], sign * Gmin[e, c]
+                            row += [sign * G[e, c], max(a, b), min(a, b)]
+                        else:
+                            row += [np.nan, np.nan, np.nan]
+                        rows.append(row)
+        attrs = dict(f.attrs)
+    header = [f"petsc-ssi post --forces: member forces of {os.path.abspath(path)} (group forces) as section resultants",
+              FRAME_SECTION_NOTE, SHELL_SECTION_NOTE,
+              "peak_abs: max over every time step of |E(t)|, E the run's response (the earthquake's or the loads'); "
+              "gravity: the static self-weight case G; gravity_plus_max, gravity_plus_min: G + max_t E(t) and "
+              "G + min_t E(t) of each component in the section's convention (linear superposition, factors 1)"
+              + ("" if gravity else "; nan: the run had no -ssi_fem_gravity"),
+              modelled_part_note(attrs),
+              "x_m, y_m, z_m: the end's node (frames) or the element's centroid (shells) [m]"]
+    return header, rows
+
+
+def forces_csv(path, parts=None, out=None):
+    out = sys.stdout if out is None else out
+    header, rows = forces_table(path, parts)
+    out.write(_header(header))
+    out.write("part,element,end,node,x_m,y_m,z_m,component,unit,peak_abs,gravity,gravity_plus_max,gravity_plus_min\n")
+    for r in rows:
+        out.write(f"{r[0]},{r[1]},{r[2]},{r[3]},{r[4]:.9g},{r[5]:.9g},{r[6]:.9g},{r[7]},{r[8]},"
+                  + ",".join(f"{v:.9g}" for v in r[9:]) + "\n")
+    return rows
+
+
 def demands_csv(path, out=None):
     out = sys.stdout if out is None else out
     rows, mass = demands_summary(path)
@@ -670,6 +765,8 @@ def main(argv=None):
     ap.add_argument("--plot", metavar="PNG", help="plot receiver histories to PNG")
     ap.add_argument("--info", action="store_true")
     ap.add_argument("--demands", action="store_true", help="storey demands' summary (with --csv)")
+    ap.add_argument("--forces", nargs="?", const="", default=None, metavar="PART,...",
+                    help="member forces as section resultants, every part without a name (with --csv)")
     ap.add_argument("--spectrum", action="store_true", help="amplitude spectrum of a series")
     ap.add_argument("--transfer", nargs=2, metavar=("A", "B"), help="transfer function B/A")
     ap.add_argument("--quantity", choices=QUANTITIES, default="u")
@@ -710,7 +807,8 @@ def main(argv=None):
         plain_series = bool(a.series_given and a.csv and not (a.receivers or a.spectrum or a.transfer))
         # every file post writes, --receivers --csv's too (before: 'post X.h5 --receivers --csv X.h5' cut X.h5
         # to 0 bytes)
-        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer or plain_series or a.demands or a.receivers)
+        check_outputs([("--csv", a.csv if (a.spectrum or a.transfer or plain_series or a.demands or a.receivers
+                                           or a.forces is not None)
                         else None),
                        ("--png", a.png),
                        ("--plot", a.plot)], inputs, a.overwrite)
@@ -725,11 +823,14 @@ def main(argv=None):
         open_h5(a.file).close()
         if a.info:
             info(a.file)
-        if plain_series or (a.demands and a.csv):
+        forces = a.forces is not None
+        if plain_series or ((a.demands or forces) and a.csv):
             fh, close = _open_out(a.csv)
             try:
                 if plain_series:
                     series_csv(a.file, a.series, fh)
+                elif forces:
+                    forces_csv(a.file, [p.strip() for p in a.forces.split(",") if p.strip()], fh)
                 else:
                     demands_csv(a.file, fh)
             except BaseException:
@@ -742,6 +843,8 @@ def main(argv=None):
             return 0
         if a.demands:
             raise PostError("--demands writes a CSV: give --csv [OUT.csv]")
+        if forces:
+            raise PostError("--forces writes a CSV: give --csv [OUT.csv]")
         if a.receivers and a.csv:
             fh, close = _open_out(a.csv)            # --csv OUT.csv: that file; --csv alone: standard output
             try:
@@ -754,7 +857,8 @@ def main(argv=None):
             read_series(a.file, a.series)          # a missing series: one line, not a traceback
             receiver_plot(a.file, png=a.plot, series=a.series)
         if not (a.info or (a.receivers and a.csv) or a.plot):
-            ap.error("nothing to do: give --receivers --csv, --series G/NAME --csv, --demands --csv, --plot PNG, "
+            ap.error("nothing to do: give --receivers --csv, --series G/NAME --csv, --demands --csv, --forces --csv, "
+                     "--plot PNG, "
                      "--info, --spectrum or --transfer A B")
     except (OSError, PostError, SpectrumError) as exc:
         msg = " ".join(str(exc).split())

@@ -1,0 +1,79 @@
+"""``petsc-ssi post FILE.h5 --forces [PART,...] --csv``: the member forces as the section resultants an engineer
+reads (frames: N > 0 tension at each end; shells as stored), against the portal frame's closed form under its
+self-weight (test_gravity: slope-deflection):
+
+- the columns' base: N = -(W/2 - the base node's own weight), compression;
+- the beam (orientation 0,0,1: z' up): M2 = +M_B at the corners (hogging stretches the top fibre +z'), and
+  -(w L^2 / 8 - M_B) at midspan (sagging), within 1 % and 2 % (the lumped weight's fixed-end moments);
+- peak_abs is the file's |E| envelope; at end i the section's G + E max is minus the file's G + min_t E(t) of the
+  end forces, at end j the file's own; an unknown part and a file without forces refused in one line.
+"""
+import csv
+import io
+
+import h5py
+import numpy as np
+import pytest
+
+from fem_helpers import run_cli
+from test_gravity import AB, AC, G, H, IB, IC, L, NC, RHO, _portal
+
+pytestmark = pytest.mark.run
+
+
+def _table(text):
+    rows = [r for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
+    assert rows[0] == ["part", "element", "end", "node", "x_m", "y_m", "z_m", "component", "unit", "peak_abs",
+                       "gravity", "gravity_plus_max", "gravity_plus_min"]
+    return [dict(zip(rows[0], r)) for r in rows[1:]]
+
+
+def test_portal_section_resultants(tmp_path):
+    out, _ = _portal(tmp_path)
+    r = run_cli(["post", out, "--forces", "--csv"])
+    assert r.returncode == 0, r.stderr
+    assert "N > 0 tension" in r.stdout and "# modelled part: the whole mesh" in r.stdout
+    rows = _table(r.stdout)
+    assert {x["part"] for x in rows} == {"columns", "beam"}
+    W = G * RHO * (2 * AC * H + AB * L)
+    w = RHO * AB * G
+    MB = w * L ** 2 / (6 * ((IB / L) / (IC / H) + 2))
+    # the columns' base: compression
+    base = [x for x in rows if x["part"] == "columns" and float(x["z_m"]) == 0.0 and x["component"] == "N"]
+    assert len(base) == 2 and all(x["unit"] == "N" for x in base)
+    expect = -(W / 2 - RHO * AC * G * H / NC / 2)
+    assert all(float(x["gravity"]) == pytest.approx(expect, rel=1e-9) for x in base), (base, expect)
+    # the beam: hogging at the corners, sagging at midspan
+    m2 = [x for x in rows if x["part"] == "beam" and x["component"] == "M2"]
+    corner = [float(x["gravity"]) for x in m2 if float(x["x_m"]) in (0.0, L)]
+    mid = [float(x["gravity"]) for x in m2 if abs(float(x["x_m"]) - L / 2) < 1e-9]
+    assert len(corner) == 2 and len(mid) == 2
+    assert np.allclose(corner, MB, rtol=1e-2), (corner, MB)
+    assert np.allclose(mid, -(w * L ** 2 / 8 - MB), rtol=2e-2), (mid, w * L ** 2 / 8 - MB)
+    # against the file's end forces
+    with h5py.File(out, "r") as f:
+        comps = str(f["forces/beam_envelope"].attrs["components"]).split(",")
+        env, gmax, gmin = (f[f"forces/beam_{s}"][()] for s in ("envelope", "gravity_plus_max", "gravity_plus_min"))
+    for x in [x for x in rows if x["part"] == "beam"]:
+        e, c = int(x["element"]), comps.index(f"{x['component']}_{x['end']}")
+        assert float(x["peak_abs"]) == pytest.approx(env[e, c], rel=1e-8, abs=1e-300)
+        hi, lo = (-gmin[e, c], -gmax[e, c]) if x["end"] == "i" else (gmax[e, c], gmin[e, c])
+        assert float(x["gravity_plus_max"]) == pytest.approx(hi, rel=1e-8, abs=1e-6)
+        assert float(x["gravity_plus_min"]) == pytest.approx(lo, rel=1e-8, abs=1e-6)
+    # one part by name, to a file; refusals
+    r = run_cli(["post", out, "--forces", "beam", "--csv", str(tmp_path / "beam.csv")])
+    assert r.returncode == 0 and {x["part"] for x in _table((tmp_path / "beam.csv").read_text())} == {"beam"}
+    r = run_cli(["post", out, "--forces", "beams", "--csv"])
+    err = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.returncode == 2 and len(err) == 1 and "holds no member forces of a part 'beams' (it holds: beam, " \
+        "columns)" in err[0], r.stderr
+    r = run_cli(["post", out, "--forces"])
+    assert r.returncode == 2 and "--forces writes a CSV: give --csv" in r.stderr
+
+
+def test_forces_refused_without_the_group(tmp_path):
+    p = tmp_path / "x.h5"
+    with h5py.File(p, "w") as f:
+        f.attrs["problem"] = "fem"
+    r = run_cli(["post", str(p), "--forces", "--csv"])
+    assert r.returncode == 2 and "no group forces (member forces are written with -ssi_structure_forces" in r.stderr
