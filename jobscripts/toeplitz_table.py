@@ -88,8 +88,9 @@ def site_row(outdir, r):
     est = os.path.join(outdir, r["run"] + ".estimate")
     if os.path.exists(est):
         text = open(est).read()
-        # (ranks | kernels_s history_s [factor_s solve_s total] | GB | GB with the processes |)
-        m = re.search(r"\[ssi\]\s+\d+ \|\s+(\S+)\s+(\S+)(?:\s+\S+\s+\S+\s+\S+)? \|\s+(\S+) \|\s+(\S+) \|", text)
+        # (ranks | kernels_s history_s [factor_s solve_s [steps_s] total] | GB | GB with the processes |)
+        m = re.search(r"\[ssi\]\s+\d+ \|\s+(\S+)\s+(\S+)(?:\s+\S+\s+\S+(?:\s+\S+)?\s+\S+)? \|\s+(\S+) \|\s+(\S+) \|",
+                      text)
         if m:
             s["cli_history_s"], s["cli_GB"] = float(m.group(2)), float(m.group(4))
         m = re.search(r"model set-up took (\S+) s", text)

@@ -221,7 +221,8 @@ def test_the_coupled_toeplitz_estimate_prices_the_set_up_it_makes(tmp_path):
     out = cli(["estimate"] + args + ["-ssi_lag_store", "toeplitz", "-ssi_estimate_ranks", "1"]).stdout
     assert "estimate of this coupled run on the toeplitz lag store" in out, out
     head = re.search(r"ranks \| (kernels_s .*? total) \|", out).group(1).split()
-    assert head == ["kernels_s", "history_s", "factor_s", "solve_s", "coupling_setup_s", "coupling_loop_s", "total"]
+    assert head == ["kernels_s", "history_s", "factor_s", "solve_s", "steps_s", "coupling_setup_s", "coupling_loop_s",
+                    "total"]
     vals = dict(zip(head[:-1], map(float, re.search(r"\[ssi\]\s+1 \|\s+(.*?)\s+\S+s \|", out).group(1).split())))
     m = re.search(r"coupling: (\d+) interface nodes \((\d+) columns\), structure \d+ dofs: factorised in (\S+) s, "
                   r"a solve (\S+) ms", out)
@@ -237,17 +238,20 @@ def test_the_coupled_toeplitz_estimate_prices_the_set_up_it_makes(tmp_path):
     assert m, run[-3000:]
     bem, sol, cpl = (float(m.group(i)) for i in (1, 2, 3))
     assert sol == pytest.approx(vals["solve_s"], rel=6e-3), (sol, vals)
-    assert bem == pytest.approx(vals["history_s"] + vals["solve_s"], rel=6e-3), (bem, vals)
+    assert bem == pytest.approx(vals["history_s"] + vals["solve_s"] + vals["steps_s"], rel=6e-3), (bem, vals)
+    assert vals["steps_s"] > 0
     assert _run_prediction(run) == pytest.approx(bem + cpl, rel=6e-3)
 
 
 def test_the_toeplitz_bem_run_predicts_its_step_solves_and_its_progress(tmp_path):
     """A BEM run on the toeplitz store (no structure): the estimate's row has the step matrix's factorisation,
-    the steps' solves (``toeplitz.step_lu_of``, a solve each step) and their total beside the kernels and the
-    history, and the run's own loop line predicts history_s + solve_s (until 2026-12-02 it gave the history
-    alone: 2.22 s against 2.78 s measured on the paper's case meshed whole, 0.94 s of it solves). The
-    progress model (``loop_model``) is the history's steps summed (``toeplitz.estimate(per_step=True)``, whose
-    sum is its history seconds) plus the solves."""
+    the steps' solves (``toeplitz.step_lu_of``, a solve each step), the march's own work and the snapshots
+    (steps_s: ``toeplitz.loop_rest``, the dense model's c_step and ``cost.snapshot_seconds``) and their total
+    beside the kernels and the history, and the run's own loop line predicts history_s + solve_s + steps_s (until
+    2026-12-02 it gave the history alone: 2.22 s against 2.78 s measured on the paper's case meshed whole, 0.94 s
+    of it solves; then without steps_s: a 4 x 4 grid's loop 2-8 times its prediction). The progress model
+    (``loop_model``) is the history's steps summed (``toeplitz.estimate(per_step=True)``, whose sum is its history
+    seconds) plus the solves and the rest, evenly."""
     from petsc_ssi.bem.toeplitz import estimate, BLOCK
     from petsc_ssi.bem import interp
     args = ["-ssi_problem", "bem", "-ssi_cp", "200", "-ssi_cs", "100", "-ssi_mesh_size", "4,4", "-ssi_mesh_h", "1",
@@ -255,12 +259,15 @@ def test_the_toeplitz_bem_run_predicts_its_step_solves_and_its_progress(tmp_path
             "-ssi_t_end", "0.08", "-ssi_warn_beta", "0", "-ssi_lag_store", "toeplitz"]
     out = cli(["estimate"] + args + ["-ssi_estimate_ranks", "1"]).stdout
     head = re.search(r"ranks \| (kernels_s .*? total) \|", out).group(1).split()
-    assert head == ["kernels_s", "history_s", "factor_s", "solve_s", "total"], out
+    assert head == ["kernels_s", "history_s", "factor_s", "solve_s", "steps_s", "total"], out
     vals = dict(zip(head[:-1], map(float, re.search(r"\[ssi\]\s+1 \|\s+(.*?)\s+\S+s \|", out).group(1).split())))
     assert vals["factor_s"] > 0 and vals["solve_s"] > 0
     assert re.search(r"step matrix: [0-9.]+ M entries in its LU's factors modelled", out), out
     run = _run_prediction(cli(args + ["-ssi_output", str(tmp_path / "b.h5")]).stdout)
-    assert run == pytest.approx(vals["history_s"] + vals["solve_s"], rel=6e-3, abs=1e-3), (run, vals)
+    assert run == pytest.approx(vals["history_s"] + vals["solve_s"] + vals["steps_s"], rel=6e-3, abs=1e-3), (run, vals)
+    # steps_s: c_step a step and, at the default stride 1, a snapshot a step of the 81 nodes
+    from petsc_ssi.bem.cost import load_constants, snapshot_seconds
+    assert vals["steps_s"] == pytest.approx(32 * (load_constants()[0]["c_step"] + snapshot_seconds(81)), rel=0.02)
 
     class Lat:
         Mx = My = 8

@@ -198,18 +198,20 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
              f"{'single' if single else 'double'} precision transforms)"
              + (f"; G kernels on the traction elements' {glat.in_n[0]} x {glat.in_n[1]} window (FFT grid "
                 f"{glat.Mx} x {glat.My})" if glat is not None else ""),
-             "[ssi]   ranks | kernels_s history_s factor_s solve_s total | GB over the ranks beside the processes | "
-             "with the processes (this one's resident size each) | fits"]
+             "[ssi]   ranks | kernels_s history_s factor_s solve_s steps_s total | GB over the ranks beside the "
+             "processes | with the processes (this one's resident size each) | fits"]
     for i, ln in enumerate(_area_line(ab)):
         lines.insert(2 + i, ln)
     if cc is not None:
         from ..coupling.cost import describe
         lines.insert(2, describe(cc))
-        lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s coupling_setup_s coupling_loop_s total | GB "
-                     "over the ranks beside the processes | with the processes (this one's resident size each) | fits")
+        lines[-1] = ("[ssi]   ranks | kernels_s history_s factor_s solve_s steps_s coupling_setup_s coupling_loop_s total "
+                     "| GB over the ranks beside the processes | with the processes (this one's resident size each) | fits")
     # the step matrix's LU (toeplitz.step_lu_of): its entries, mirror blocks; a solve a step in the loop
-    from ..bem.toeplitz import step_lu_of
+    from ..bem.toeplitz import step_lu_of, loop_rest
     kappa = c.get("kappa") if c is not None else None       # (the coupled estimate's constants, else the run's)
+    # steps_s: the march's own work a step and the field snapshots (toeplitz.loop_rest)
+    rest = loop_rest(cfg, prob.n_steps, N)
     ent, _, _, rho, nblk = step_lu_of(cfg, prob, lat, 2)
     lines.insert(3 if cc is not None else 2,
                  f"[ssi]   step matrix: {ent / 1e6:.3g} M entries in its LU's factors modelled (reach {rho:.3g} node "
@@ -223,15 +225,15 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
         b += ab
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
         steps_s = prob.n_steps * one
-        total = tb + th + fac + steps_s
+        total = tb + th + fac + steps_s + rest
         if cc is not None:            # the structure, the interface matrices and the coupled steps
             add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
             total += add["cpl_setup"] + add["cpl_loop"]
-            cpl = (f" {fac:8.3g} {steps_s:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
+            cpl = (f" {fac:8.3g} {steps_s:7.3g} {rest:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
                    f"{fmt_time(total):>7}")
         else:
-            cpl = f" {fac:8.3g} {steps_s:7.3g} {fmt_time(total):>7}"
+            cpl = f" {fac:8.3g} {steps_s:7.3g} {rest:7.3g} {fmt_time(total):>7}"
         tot = b + p * rss
         per_node = tot / p * min(q, p)
         fits = per_node <= limit
@@ -253,7 +255,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
     and the surface is a uniform flat grid (else the reason, one line)."""
     if cfg.get("lag_store", "dense") == "dense":
         return []
-    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of, step_lu_of
+    from ..bem.toeplitz import detect, estimate as tz_estimate, kernel_offsets, traction_grid, block_of, step_lu_of, \
+        loop_rest
     from ..petsc import SSIError
     try:
         if not cnt.lagset.flat:
@@ -263,8 +266,9 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
         return [f"[ssi]   toeplitz lag store: not on this surface ({str(e).split(': ', 1)[-1]}); the rows above hold"]
     lat.n_offsets = len(kernel_offsets(lat))
     glat = traction_grid(lat, cnt.lagset.VT)
-    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s factor_s solve_s | GB over "
-           "the ranks beside the processes"]
+    out = [f"[ssi]   toeplitz lag store ({lat.describe()}): ranks | kernels_s history_s factor_s solve_s steps_s | GB "
+           "over the ranks beside the processes"]
+    rest = loop_rest(cfg, prob.n_steps, prob.mesh.n_nodes)
     g = prob.toeplitz_side_bytes(cnt.lagset, prob.plan)
     for p in ranks:
         _, fac, one, rho, _ = step_lu_of(cfg, prob, lat, p)
@@ -272,7 +276,8 @@ def _toeplitz_lines(cfg, prob, cnt, ranks):
                                 plan=prob.plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
                                 single=cfg.get("toeplitz_precision", "double") == "single",
                                 fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0), reach=rho)
-        out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} | {b / 1e9:7.3g}")
+        out.append(f"[ssi]   {p:5d} | {tb:9.3g} {th:9.3g} {fac:8.3g} {prob.n_steps * one:7.3g} {rest:7.3g} | "
+                   f"{b / 1e9:7.3g}")
     return out
 
 

@@ -193,7 +193,7 @@ class Counts:
         self.interp_lags = [plan.kernel_time(j)[0] for j in range(self.k)]
         self.plot = bool(cfg.plot)
         self.stabilized = cfg.scheme.startswith("stabili")
-        self.writes = (self.steps // cfg.output_stride) if cfg.output_stride else 0
+        self.writes = snapshot_writes(cfg, self.steps)
         nimg = len(ls.Vc) // prob.mesh.n_cells
         Lmax = max([self.Lx] + self.interp_lags)
         # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
@@ -373,9 +373,26 @@ def features(cnt, p, q, cores):
 
 
 # A field snapshot (u and p into the HDF5 file and its XDMF) [s], which the fitted constants do not see:
-# measured on the development machine with a 4 m x 4 m surface of 1 m elements (81 nodes), 100 steps,
-# 0.3 s of loop with -ssi_output_stride 0 and 1.7 s with stride 1. It dominates small cases only.
-SNAPSHOT_S = 1.4e-2
+# SNAPSHOT_S + SNAPSHOT_NODE_S per soil node. Measured 2026-12-02 on the development machine (2 cores, idle): the
+# event SSI_IO of the time loop over its calls, -ssi_output_stride 1, 1 m grids of 4 x 4 to 16 x 16 elements
+# (81-1089 nodes), dense and toeplitz stores, 1 and 2 ranks: 1.1-1.2 ms a snapshot at 81 nodes, 1.7 ms at 625,
+# 1.4-1.8 ms at 1089 (`mpirun -n 2 petsc-ssi -ssi_problem bem -ssi_mesh_size 12,12 -ssi_mesh_h 1 -ssi_mesh_patch
+# 1,1 -ssi_load_group load -ssi_dt 0.0025 -ssi_t_end 0.25 -ssi_output_stride 1 -log_view`). The 14 ms of an earlier
+# measurement (a loop of 0.3 s with stride 0, 1.7 s with stride 1, before the output's parts) put a small
+# case's default-stride loop at 1.49 s against 0.23 s measured. It dominates small cases only.
+SNAPSHOT_S = 1.1e-3
+SNAPSHOT_NODE_S = 6e-7
+
+
+def snapshot_seconds(n_nodes):
+    """Seconds of one field snapshot of a soil surface of ``n_nodes`` nodes (SNAPSHOT_S, SNAPSHOT_NODE_S)."""
+    return SNAPSHOT_S + SNAPSHOT_NODE_S * float(n_nodes)
+
+
+def snapshot_writes(cfg, steps):
+    """The field snapshots of a loop of ``steps`` steps (-ssi_output_stride; 0: none)."""
+    stride = int(cfg.get("output_stride", 0) or 0)
+    return (int(steps) // stride) if stride > 0 else 0
 
 
 def bem_solve_seconds(c, N, p):
@@ -387,7 +404,7 @@ def bem_solve_seconds(c, N, p):
 def loop_terms(cnt, c, p, q, cores):
     """Seconds of the BEM time loop on p ranks, q per node, ``cores`` per node (dict: history, solve,
     step, snapshots, loop): the history sums (streamed bytes, products, panel flops), the solves with
-    the step matrix's factors, c_step per step and SNAPSHOT_S per field snapshot. The one model of the
+    the step matrix's factors, c_step per step and ``snapshot_seconds`` per field snapshot. The one model of the
     loop that ``petsc-ssi estimate`` (``predict``) and the run's own first line
     (``HalfSpace.check_memory``) both evaluate (issue 43: they had been two code paths)."""
     mx, over, m = features(cnt, p, q, cores)
@@ -395,7 +412,7 @@ def loop_terms(cnt, c, p, q, cores):
                             + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
                             + panel_seconds(mx, cnt.block, cnt.sub, c, m)),
          "solve": cnt.steps * bem_solve_seconds(c, cnt.N, p),
-         "step": c["c_step"] * cnt.steps, "snapshots": SNAPSHOT_S * cnt.writes}
+         "step": c["c_step"] * cnt.steps, "snapshots": snapshot_seconds(cnt.N) * cnt.writes}
     t["loop"] = t["history"] + t["solve"] + t["step"] + t["snapshots"]
     return t
 

@@ -703,7 +703,7 @@ class HalfSpace:
         (``toeplitz.estimate``), and predict its time loop (``loop_estimate``, ``loop_model``: the history sum
         step by step and a solve with the step matrix's factors each step, ``toeplitz.step_lu_of``;
         ``step_solve_s``: that solve's seconds)."""
-        from .toeplitz import step_lu_of
+        from .toeplitz import step_lu_of, loop_rest
         from .pfft import require
         require(self.comm)                  # (mpi4py-fft on every rank, before the assembly)
         c = self.cfg
@@ -722,9 +722,12 @@ class HalfSpace:
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
                            "per node); use -ssi_interp, a shorter -ssi_t_end, a coarser grid or more nodes")
         one = self.step_solve_s = step_lu_of(c, self, self.lattice, p)[2]
+        # (the march's own work a step and the field snapshots, spread evenly: toeplitz.loop_rest)
+        rest = loop_rest(c, self.n_steps, self.mesh.n_nodes) / max(self.n_steps, 1)
         cum = np.concatenate(([0.0], np.cumsum(steps)))
-        self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + one * k
-        self.loop_estimate = (t_hist + one * self.n_steps, float(steps[-1]) + one if len(steps) else one)
+        self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + (one + rest) * k
+        self.loop_estimate = (t_hist + (one + rest) * self.n_steps,
+                              (float(steps[-1]) if len(steps) else 0.0) + one + rest)
         self.ranks_here = int(round(share * p))         # (the slow-run warning's oversubscription test)
         self.loop_source = "bem/toeplitz.py estimate and step_lu"
         self.loop_fit = "jobscripts/toeplitz_fit.py (bem/toeplitz.py RATES and STEP_RATES)"

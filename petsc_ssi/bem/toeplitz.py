@@ -244,6 +244,20 @@ def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
     return entries, entries * r["t_factor_entry"], solve
 
 
+def loop_rest(cfg, n_steps, n_nodes):
+    """Seconds of a toeplitz run's time loop beside the history sum and the step matrix's solves, as the dense
+    model counts them (``cost.loop_terms``): the march's own work a step (the constants' c_step: the right-hand
+    side, the sources, the recorder, the transforms' calls) and the field snapshots (``cost.snapshot_seconds``).
+    A seismic wave's free field on the sources and a massless footing's correction are not counted (about 2 ms
+    a step on a 12 x 12 grid, 2 ranks). Without them a small
+    grid's loop ran 2-8 times its prediction: 1 m grids of 4 x 4 and 8 x 8 elements, 200 steps, no snapshots,
+    0.085-0.21 s against 0.022-0.106 s predicted at 1 and 2 ranks (0.3-0.55 ms a step beside the modelled
+    history and solves), and the default stride's snapshots 1.1-1.8 ms a step more (2026-12-02)."""
+    from .cost import load_constants, snapshot_seconds, snapshot_writes
+    c = load_constants(cfg.get("estimate_constants", ""))[0]
+    return float(c["c_step"]) * int(n_steps) + snapshot_seconds(n_nodes) * snapshot_writes(cfg, n_steps)
+
+
 def geometric_reach(cfg, prob):
     """The step matrix's reach from the geometry [m]: c_p t + the largest element diameter (t = 2 dt
     stabilised, dt plain: the last lag of the step matrix; an element a wave reaches within t couples all its
