@@ -4,6 +4,7 @@
 # (~/.cache/petsc_ssi/numba/<hash of the sources>, README.md; NUMBA_CACHE_DIR if set: kept).
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 PY=${PY:-.venv/bin/python}
+case $PY in /*) ;; */*) PY=$PWD/$PY ;; esac   # (absolute: the scripts cd into worktrees and run dirs)
 export PETSC_DIR=${PETSC_DIR:-/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real}
 export SLEPC_DIR=${SLEPC_DIR:-/usr/lib/slepcdir/slepc3.18/x86_64-linux-gnu-real}
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
@@ -20,7 +21,7 @@ before_worktree() {
   # shellcheck disable=SC2064
   trap "git worktree remove --force '$WT'; ${2:-:}" EXIT
   export BEFORE_CACHE="$WT/.numba_cache"
-  (cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$ROOT/$PY" -m petsc_ssi.app.warmup) && "$PY" -m petsc_ssi.app.warmup
+  (cd "$WT" && NUMBA_CACHE_DIR="$BEFORE_CACHE" "$PY" -m petsc_ssi.app.warmup) && "$PY" -m petsc_ssi.app.warmup
 }
 
 # repeat_runs OUT REPEAT "CASES" VARIANT...: each case (runs/pekeris/CASE.opts) REPEAT times at 1 and at

@@ -23,7 +23,7 @@ if [[ -z "${TABLE_ONLY:-}" ]]; then
     d=$(mktemp -d /tmp/petsc_ssi-ab.XXXX)
     git worktree add --detach "$d" "$rev" > /dev/null
     WT[$rev]=$d
-    (cd "$d" && NUMBA_CACHE_DIR="$d/.numba_cache" "$ROOT/$PY" -m petsc_ssi.app.warmup > /dev/null)
+    (cd "$d" && NUMBA_CACHE_DIR="$d/.numba_cache" "$PY" -m petsc_ssi.app.warmup > /dev/null)
   done
   # shellcheck disable=SC2064
   trap "for d in ${WT[*]}; do git -C '$ROOT' worktree remove --force \$d; done" EXIT
@@ -33,7 +33,7 @@ if [[ -z "${TABLE_ONLY:-}" ]]; then
       echo "[ab] $rev, run $i -> $OUT/$rev-r$i.log" >&2
       # shellcheck disable=SC2086
       (cd "$d" && NUMBA_CACHE_DIR="$d/.numba_cache" mpirun --allow-run-as-root --oversubscribe -n "$RANKS" \
-         "$ROOT/$PY" -m petsc_ssi "${ARGS[@]}" $EXTRA -ssi_output "$OUT/$rev.h5" -ssi_output_overwrite \
+         "$PY" -m petsc_ssi "${ARGS[@]}" $EXTRA -ssi_output "$OUT/$rev.h5" -ssi_output_overwrite \
          > "$OUT/$rev-r$i.log" 2>&1)
     done
   done

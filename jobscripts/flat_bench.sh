@@ -19,7 +19,7 @@ run_before() {   # NAME OPTS-FILE [OPTIONS...]
   local name=$1 opts=$2
   shift 2
   echo "[bench] $name (code at $BEFORE)"
-  (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$ROOT/$PY" -m petsc_ssi -options_file "$opts" \
+  (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$PY" -m petsc_ssi -options_file "$opts" \
      -ssi_output "$ROOT/$OUT/$name.h5" -ssi_output_overwrite -log_view -memory_view "$@" > "$ROOT/$OUT/$name.log" 2>&1)
 }
 run_after() {

@@ -21,7 +21,7 @@ run() {  # version ranks case extra...
   [ "$version" = before ] && dir=$WT && cache=$BEFORE_CACHE
   local log="$ROOT/$OUT/$version-$case-n$n.log"
   echo "[bench] $version $case on $n rank(s) -> $log"
-  (cd "$dir" && NUMBA_CACHE_DIR="$cache" /usr/bin/time -v mpirun --allow-run-as-root --oversubscribe -n "$n" "$ROOT/$PY" -m petsc_ssi \
+  (cd "$dir" && NUMBA_CACHE_DIR="$cache" /usr/bin/time -v mpirun --allow-run-as-root --oversubscribe -n "$n" "$PY" -m petsc_ssi \
      -options_file "$ROOT/runs/pekeris/$case.opts" -ssi_output "$ROOT/$OUT/$version-$case-n$n.h5" \
      -ssi_output_overwrite -ssi_output_stride 0 -log_view -memory_view "$@") > "$log" 2>&1
 }

@@ -12,7 +12,7 @@ before_worktree "$BEFORE"
 MPI="mpirun --allow-run-as-root --oversubscribe -n 2"
 for case in small:runs/pekeris/small.opts demo-building:runs/building/demo.opts; do
   name=${case%%:*}; opts=${case#*:}
-  (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$ROOT/$PY" -m petsc_ssi -options_file "$opts" \
+  (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$PY" -m petsc_ssi -options_file "$opts" \
      -ssi_output "$ROOT/$OUT/$name-before.h5" -ssi_output_overwrite -ssi_lags_save "$ROOT/$OUT/$name-before.lags" \
      > "$ROOT/$OUT/$name-before.log" 2>&1)
   $MPI "$PY" -m petsc_ssi -options_file "$opts" -ssi_output "$OUT/$name-after.h5" -ssi_output_overwrite \

@@ -28,7 +28,7 @@ for c in "${CASES[@]}"; do
     echo "[bench] $name ($code)"
     if [ "$code" = before ]; then
       # shellcheck disable=SC2086
-      (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$ROOT/$PY" -m petsc_ssi -options_file "$opts" \
+      (cd "$WT" && PYTHONPATH="$WT" NUMBA_CACHE_DIR="$BEFORE_CACHE" $MPI "$PY" -m petsc_ssi -options_file "$opts" \
          -ssi_output "$ROOT/$OUT/before/$name.h5" -ssi_output_overwrite -ssi_reproducible -log_view $extra \
          > "$ROOT/$OUT/before/$name.log" 2>&1)
     else
