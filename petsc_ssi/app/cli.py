@@ -180,6 +180,20 @@ def _solver_help(PETSc):
 
 
 def _post(rest):
+    """The post commands; a reader that stops reading (``post X.h5 --receivers --csv | head``) ends the command
+    quietly with status 141 (128 + SIGPIPE, as a shell's own tools), not with an error line."""
+    try:
+        return _post_command(rest)
+    except BrokenPipeError:
+        import os
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # (the exit's flush must not fail again)
+        except OSError:
+            pass
+        return 141
+
+
+def _post_command(rest):
     if "--response-spectrum" in rest:          # earthquake-engineering response spectra
         from .response import main as response_main
         return response_main(rest[1:])

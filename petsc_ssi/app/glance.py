@@ -453,6 +453,8 @@ def main(argv=None, out=None):
                      f"(fixed base), receiver {a.receiver}, {a.component}")
             if a.csv != "-":
                 out.write(f"wrote {a.png}\n")
+    except BrokenPipeError:             # the reader stopped ('post ... | head'): cli._post
+        raise
     except (OSError, _post.PostError, rs.SpectrumInputError) as exc:
         print(f"{PROG}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2

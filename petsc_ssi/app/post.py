@@ -860,6 +860,8 @@ def main(argv=None):
             ap.error("nothing to do: give --receivers --csv, --series G/NAME --csv, --demands --csv, --forces --csv, "
                      "--plot PNG, "
                      "--info, --spectrum or --transfer A B")
+    except BrokenPipeError:             # the reader stopped ('post ... | head'): cli._post
+        raise
     except (OSError, PostError, SpectrumError) as exc:
         msg = " ".join(str(exc).split())
         print(f"petsc-ssi post: error: {msg}", file=sys.stderr)

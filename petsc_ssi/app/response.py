@@ -591,6 +591,8 @@ def main(argv=None, out=None):
             plot_png(a.png, specs, a.plot_quantity, title, ratio=B is not None)
             if a.csv != "-":
                 out.write(f"wrote {a.png}\n")
+    except BrokenPipeError:             # the reader stopped ('post ... | head'): cli._post
+        raise
     except (OSError, _post.PostError, rs.SpectrumInputError) as exc:
         msg = " ".join(str(exc).split())
         print(f"{PROG}: error: {msg}", file=sys.stderr)

@@ -119,3 +119,22 @@ def test_modelled_part_note():
     assert "the quarter" in quarter and "four times" in quarter, quarter
     assert modelled_part_note({"symmetry": ""}).startswith("modelled part: the whole mesh")
     assert modelled_part_note({}).startswith("modelled part: not recorded")
+
+
+def test_a_reader_that_stops_reading_ends_post_quietly(run):
+    """`post X.h5 --series ... --csv | head -1`: the reader has gone before post writes (its end of the pipe
+    closed at once), so the write fails with EPIPE; post ends with status 141 (128 + SIGPIPE, as a shell's own
+    tools) and no error line or traceback (before: 'petsc-ssi post: error: [Errno 32] Broken pipe')."""
+    import os
+    import subprocess
+    from fem_helpers import PY, ROOT
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    p = subprocess.Popen([PY, "-m", "petsc_ssi", "post", str(run / "fb.h5"), "--series", "demands/base_shear",
+                          "--csv"], cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p.stdout.close()                        # (python starts in ~1 s: the pipe is closed before the first write)
+    err = p.stderr.read()
+    assert p.wait(timeout=120) == 141, err
+    assert "error" not in err and "Traceback" not in err, err
+    # the same command into a reader that reads: every row, status 0 (the handler changes nothing else)
+    r = run_cli(["post", str(run / "fb.h5"), "--series", "demands/base_shear", "--csv"])
+    assert r.returncode == 0 and r.stderr == "" and len(_read(r.stdout)[1]) == 81, (r.returncode, r.stderr)
