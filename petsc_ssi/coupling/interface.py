@@ -197,10 +197,10 @@ def build_interface(be_mesh, fe_mesh, spec, fe_groups, tol_rel, planes=(), h=1.0
         if elems.size == 0:
             n_on = int(on_fe.sum())
             at = np.unique(i_all[on_fe]).size
-            es = float(np.min(be_mesh.element_sizes()))
+            es = float(np.min(be_mesh.element_sizes()))       # (a node-to-node segment: half an element's side)
             raise SSIError(f"-ssi_interface auto: no soil element has all nine nodes on the structure's "
                            f"'{fe_groups}' faces: {n_on} soil node(s) lie on them (within {tol:.3g} m), at {at} of "
-                           f"their {len(fnodes)} nodes (the soil's smallest element {es:.3g} m, its nodes {es / 2:.3g} "
+                           f"their {len(fnodes)} nodes (the soil's smallest element {2 * es:.3g} m, its nodes {es:.3g} "
                            f"m apart; the faces' nodes {spacing:.3g} m); every node of a soil element under the "
                            "structure must be one of its base nodes")
     else:

@@ -45,6 +45,11 @@ def test_unmatched_nodes_are_listed():
     assert 0 < on < len(base)
     assert f": {on} soil node(s) lie on them (within 2e-07 m), at {on} of their {len(base)} nodes" in str(exc.value)
     assert "the faces' nodes 0.2 m" in str(exc.value), str(exc.value)
+    # the soil's smallest element by its corners (nodes 0, 1, 3 of a nine-node cell), its nodes half that apart
+    X = be.nodes[be.cells]
+    side = min(np.linalg.norm(X[:, 1] - X[:, 0], axis=1).min(), np.linalg.norm(X[:, 3] - X[:, 0], axis=1).min())
+    assert f"the soil's smallest element {side:.3g} m, its nodes {side / 2:.3g} m apart" in str(exc.value), \
+        str(exc.value)
     with pytest.raises(SSIError, match=r"soil node\(s\) of -ssi_interface load match no node .*\(-0\.5, -0\.25, 0\).*\(21 in all\)"):
         build_interface(be, fe, "load", "base", 1e-6)
     with pytest.raises(SSIError, match="no face group 'bottom'"):
