@@ -373,7 +373,8 @@ def demands_summary(path):
 BASE_SHEAR_NOTE = ("base shear: the horizontal force the structure exerts on the ground through its base, the "
                    "foundation's own inertia included (fixed base: the supports' reactions, the supported nodes' "
                    "m a_g with them; with SSI: the interface force), the same quantity with and without SSI; the "
-                   "members' shear at the base is V less the foundation's mass times its acceleration")
+                   "members' shear at the base is V plus the foundation's mass times its acceleration (V less its inertia "
+                   "force -m a)")
 
 
 def modelled_part_note(attrs):
@@ -404,13 +405,21 @@ SHELL_SECTION_NOTE = ("shells: stress resultants at the element's centre in its 
                       "stretches the +e3 fibre), Q = int sigma_a3 dz [N/m]")
 
 
+FORCES_COLUMNS = ["part", "element", "end", "node", "x_m", "y_m", "z_m", "component", "unit", "peak_abs", "gravity",
+                  "gravity_plus_max", "gravity_plus_min"]
+STATIC_FORCES_COLUMNS = FORCES_COLUMNS[:9] + ["value"]
+
+
 def forces_table(path, parts=None):
-    """(header lines, rows) of the member forces of a structure output as section resultants: per part, element,
-    end (frames: i and j; shells: centre) and component (peak |E(t)|, and with gravity G, G + E max, G + E min:
-    the file's G + max_t E(t) and G + min_t E(t) of the end forces, turned at end i, where the section's
-    resultant is -f_i, into the section's min and max)."""
+    """(header lines, columns, rows) of the member forces of a structure output as section resultants: per part,
+    element, end (frames: i and j; shells: centre) and component (peak |E(t)|, and with gravity G, G + E max,
+    G + E min: the file's G + max_t E(t) and G + min_t E(t) of the end forces, turned at end i, where the section's
+    resultant is -f_i, into the section's min and max). A ``petsc-ssi static`` file (one solution, the
+    self-weight already in it): the signed section resultant of that solution (STATIC_FORCES_COLUMNS)."""
     rows = []
     with open_h5(path) as f:
+        attrs = dict(f.attrs)
+        static = str(attrs.get("problem", "")) == "static"
         g = f.get("forces")
         if g is None or not hasattr(g, "keys"):
             raise PostError(f"{path}: no group forces (member forces are written with -ssi_structure_forces PARTS "
@@ -434,6 +443,11 @@ def forces_table(path, parts=None):
             gravity |= grav
             G, Gmax, Gmin = ((np.asarray(g[p + s][()], float) if grav else None)
                              for s in ("_gravity", "_gravity_plus_max", "_gravity_plus_min"))
+            S = None
+            if static:                         # (the solution's end forces: its one snapshot)
+                if p not in g or g[p].shape[0] < 1:
+                    raise PostError(f"{path}: a static file without its member forces' snapshot forces/{p}")
+                S = np.asarray(g[p][-1], float)
             if element == "frame":
                 ends = [("i", 0, -1.0, [c for c in comps if c.endswith("_i")]),
                         ("j", 1, 1.0, [c for c in comps if c.endswith("_j")])]
@@ -452,29 +466,34 @@ def forces_table(path, parts=None):
                         c = comps.index(name)
                         row = [p, e, end, node, *x, name.rsplit("_", 1)[0] if which is not None else name, units[c],
                                E[e, c]]
-                        if grav:
+                        if static:
+                            row[-1] = sign * S[e, c]
+                        elif grav:
                             a, b = sign * Gmax[e, c], sign * Gmin[e, c]
                             row += [sign * G[e, c], max(a, b), min(a, b)]
                         else:
                             row += [np.nan, np.nan, np.nan]
                         rows.append(row)
-        attrs = dict(f.attrs)
+    if static:
+        what = ("value: the static solution's section resultant, signed in the section's convention: the options' "
+                "loads" + (f" plus the self-weight (-ssi_fem_gravity {float(attrs['gravity']):g} m/s^2)"
+                           if "gravity" in attrs else " (no -ssi_fem_gravity)"))
+    else:
+        what = ("peak_abs: max over every time step of |E(t)|, E the run's response (the earthquake's or the loads'); "
+                "gravity: the static self-weight case G; gravity_plus_max, gravity_plus_min: G + max_t E(t) and "
+                "G + min_t E(t) of each component in the section's convention (linear superposition, factors 1)"
+                + ("" if gravity else "; nan: the run had no -ssi_fem_gravity"))
     header = [f"petsc-ssi post --forces: member forces of {os.path.abspath(path)} (group forces) as section resultants",
-              FRAME_SECTION_NOTE, SHELL_SECTION_NOTE,
-              "peak_abs: max over every time step of |E(t)|, E the run's response (the earthquake's or the loads'); "
-              "gravity: the static self-weight case G; gravity_plus_max, gravity_plus_min: G + max_t E(t) and "
-              "G + min_t E(t) of each component in the section's convention (linear superposition, factors 1)"
-              + ("" if gravity else "; nan: the run had no -ssi_fem_gravity"),
-              modelled_part_note(attrs),
+              FRAME_SECTION_NOTE, SHELL_SECTION_NOTE, what, modelled_part_note(attrs),
               "x_m, y_m, z_m: the end's node (frames) or the element's centroid (shells) [m]"]
-    return header, rows
+    return header, (STATIC_FORCES_COLUMNS if static else FORCES_COLUMNS), rows
 
 
 def forces_csv(path, parts=None, out=None):
     out = sys.stdout if out is None else out
-    header, rows = forces_table(path, parts)
+    header, columns, rows = forces_table(path, parts)
     out.write(_header(header))
-    out.write("part,element,end,node,x_m,y_m,z_m,component,unit,peak_abs,gravity,gravity_plus_max,gravity_plus_min\n")
+    out.write(",".join(columns) + "\n")
     for r in rows:
         out.write(f"{r[0]},{r[1]},{r[2]},{r[3]},{r[4]:.9g},{r[5]:.9g},{r[6]:.9g},{r[7]},{r[8]},"
                   + ",".join(f"{v:.9g}" for v in r[9:]) + "\n")

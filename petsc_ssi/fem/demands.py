@@ -44,7 +44,7 @@ Where the forces come from:
       integrator, and in a static solve V, M are the applied loads' resultants exactly (K
       annihilates the rigid motions). (A load put on a fixed dof goes into the support and is not
       counted.) Without the base nodes' inertia, -sum_c (K u^n)_c is the shear of the members at
-      the base (columns): V minus the foundation's m a_g. Dynamically the structure's
+      the base (columns): V plus the foundation's m a_g (V less its inertia force -m a_g). Dynamically the structure's
       equilibrium ties V to the inertia forces: the Green's-function scheme (trapezoidal free
       steps between velocity impulses, ``fem/integrators.py``) satisfies on the free dofs
           M (v^n - v^{n-1})/dt + C vbar + K ubar = fbar - alpha_m dt (f^{n-1} - f^n)/4,
