@@ -74,7 +74,8 @@ def main():
         if forces is not None:
             forces.record(1.0, u, write=True)
         receivers = receiver_record(model, rec.all_arrays()) if comm.getRank() == 0 else None
-        attrs = {"problem": "static", "time_is": "load factor"}
+        from ..fem.problem import symmetry_attr
+        attrs = {"problem": "static", "time_is": "load factor", "symmetry": symmetry_attr(cfg)}
         if grav is not None:
             attrs["gravity"] = grav.g
         out.close(receivers=receivers, attrs=attrs, groups={"gravity": grav.group()} if grav is not None and

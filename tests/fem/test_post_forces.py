@@ -77,3 +77,38 @@ def test_forces_refused_without_the_group(tmp_path):
         f.attrs["problem"] = "fem"
     r = run_cli(["post", str(p), "--forces", "--csv"])
     assert r.returncode == 2 and "no group forces (member forces are written with -ssi_structure_forces" in r.stderr
+
+
+def test_static_file_signed_section_resultants(tmp_path):
+    """A `petsc-ssi static` file of the portal under its self-weight alone: one solution with the self-weight in it,
+    so --forces prints its signed section resultants (column value; before: peak_abs |value| and a header saying
+    the run had no gravity); they equal the transient run's gravity case G (its own solve, test_portal_...) to
+    1e-9, the columns' base in compression, the beam hogging at the corners; the file says what it models."""
+    from test_gravity import PORTAL
+    geo = tmp_path / "portal.geo"
+    geo.write_text(PORTAL)
+    out = str(tmp_path / "static.h5")
+    from test_gravity import _part
+    r = run_cli(["static", "-ssi_fem_mesh", str(geo), "-ssi_fem_parts", "columns,beam", "-ssi_fem_fixed", "base",
+                 "-ssi_fem_gravity", str(G), "-ssi_structure_forces", "all", "-ssi_output", out]
+                + _part("columns", AC, IC, "1,0,0") + _part("beam", AB, IB, "0,0,1"))
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = run_cli(["post", out, "--forces", "--csv"])
+    assert r.returncode == 0, r.stderr
+    assert f"the options' loads plus the self-weight (-ssi_fem_gravity {G:g} m/s^2)" in r.stdout
+    assert "# modelled part: the whole mesh" in r.stdout and "no -ssi_fem_gravity" not in r.stdout
+    rows = [x for x in csv.reader(io.StringIO(r.stdout)) if x and not x[0].startswith("#")]
+    assert rows[0] == ["part", "element", "end", "node", "x_m", "y_m", "z_m", "component", "unit", "value"]
+    static = {(x[0], x[1], x[2], x[7]): float(x[9]) for x in rows[1:]}
+    (tmp_path / "dyn").mkdir()
+    dyn, _ = _portal(tmp_path / "dyn")
+    ref = {(x["part"], x["element"], x["end"], x["component"]): float(x["gravity"])
+           for x in _table(run_cli(["post", dyn, "--forces", "--csv"]).stdout)}
+    assert set(static) == set(ref) and len(ref) > 20
+    scale = max(abs(v) for v in ref.values())
+    assert max(abs(static[k] - ref[k]) for k in ref) <= 1e-9 * scale
+    W = G * RHO * (2 * AC * H + AB * L)
+    base = [float(x[9]) for x in rows[1:] if x[0] == "columns" and x[7] == "N" and float(x[6]) == 0.0]
+    assert len(base) == 2 and np.allclose(base, -(W / 2 - RHO * AC * G * H / NC / 2), rtol=1e-9), base
+    MB = RHO * AB * G * L ** 2 / (6 * ((IB / L) / (IC / H) + 2))
+    assert max(v for (p, e, end, c), v in static.items() if p == "beam" and c == "M2") == pytest.approx(MB, rel=1e-2)
