@@ -301,9 +301,11 @@ PART_RHO_MIN = 10.0               # kg/m^3 (0: a massless part, its mass given o
 
 def plausibility(specs, size):
     """One line naming each part property below what structures have (a wrong unit), else None.
-    ``size``: the structure's largest extent [m] (its bounding box's diagonal): a shell thicker, or a
-    frame section (-ssi_fem_part_NAME_section b,h) wider or deeper, than half of it is a length in mm or cm
-    (an area given as such is not checked: rigid links take large ones)."""
+    ``size``: the structure's largest extent [m] (its bounding box's diagonal): a shell thicker than half of it,
+    or a frame section (-ssi_fem_part_NAME_section b,h) wider or deeper than all of it (a pier wall of 6 m on a
+    single-pier model 8 m across is a real section), is a length in mm or cm (an area given as such is not
+    checked: rigid links take large ones). rho is not checked where mass_per_area or added_mass carry the
+    part's mass (a token rho on a link or a shell)."""
     out = []
     for s in specs:
         layers = [p for _, p in s.layers] if getattr(s, "layers", None) else [s.props]
@@ -312,12 +314,15 @@ def plausibility(specs, size):
             if not p.E >= PART_E_MIN:
                 cs = f" (c_s {np.sqrt(p.G() / p.rho):.3g} m/s)" if s.element == "hex8" and p.rho > 0 else ""
                 out.append(f"{opt}E {p.E:g} N/m^2{cs}")
-            if p.rho != 0 and not p.rho >= PART_RHO_MIN:
+            # (a shell's mass_per_area replaces rho t, and a light link's mass may sit in added_mass: rho is then
+            # not the part's mass, and a token rho is no unit slip)
+            own = not (getattr(p, "mass_per_area", 0) > 0 or getattr(p, "added_mass", 0) > 0)
+            if own and p.rho != 0 and not p.rho >= PART_RHO_MIN:
                 out.append(f"{opt}rho {p.rho:g} kg/m^3")
         p = s.props
         if size > 0 and s.element == "shell" and p.thickness > 0.5 * size:
             out.append(f"{opt}thickness {p.thickness:g} m on a structure {size:.3g} m across")
-        if size > 0 and s.section and max(s.section) > 0.5 * size:
+        if size > 0 and s.section and max(s.section) > size:
             out.append(f"{opt}section {s.section[0]:g},{s.section[1]:g} m on a structure {size:.3g} m across")
     if not out:
         return None

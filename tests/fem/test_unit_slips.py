@@ -2,9 +2,11 @@
 ``plausibility``), and a structure that moves more than 1 % of its size under its own weight says so
 (``fem/gravity.py``): an engineer's columns with E = 25 (GPa meant) ran without a word and sagged 1.5 km.
 
-- E below 1e6 N/m^2 (GPa or MPa typed), rho below 10 kg/m^3 (t/m^3), a shell thicker or a frame section
-  (b,h) wider than half the structure (mm or cm): each named with its option; a soil region's E with its c_s;
-- nothing for the repo's building, for large areas and E (rigid links), a massless part (rho 0);
+- E below 1e6 N/m^2 (GPa or MPa typed), rho below 10 kg/m^3 (t/m^3), a shell thicker than half the structure
+  or a frame section (b,h) wider than all of it (mm or cm): each named with its option; a soil region's E with
+  its c_s;
+- nothing for the repo's building, for large areas and E (rigid links), a massless part (rho 0), a token rho
+  where mass_per_area or added_mass carry the mass, a stocky pier (a 6 m x 2 m wall on a model 8 m across);
 - the portal frame of test_gravity with its columns' E in GPa: both warnings, the run goes on (exit 0);
   with E in N/m^2 (and real areas): neither.
 """
@@ -43,6 +45,16 @@ def test_plausibility_names_each_slip():
     assert f"-ssi_fem_part_soil_E 500 N/m^2 (c_s {cs:.3g} m/s)" in line, line
     for name in ("floors", "columns", "links", "contents"):
         assert f"part_{name}_" not in line, line
+    # the part's mass elsewhere (a review found these named): a token rho beside mass_per_area (shell) or
+    # added_mass (a light link frame); a pier wall deeper than half a single-pier model, within all of it
+    assert plausibility([_spec("slab", "shell", E=30e9, nu=0.2, rho=1.0, thickness=0.3, mass_per_area=500.0),
+                         _spec("link", "frame", E=2e11, nu=0.3, rho=1.0, area=0.01, added_mass=50.0),
+                         _spec("pier", "frame", section=(6.0, 2.0), E=30e9, nu=0.2, rho=2500, area=12.0)],
+                        8.0) is None
+    assert "-ssi_fem_part_slab_rho 1 kg/m^3" in plausibility([_spec("slab", "shell", E=30e9, nu=0.2, rho=1.0,
+                                                                    thickness=0.3)], 8.0)
+    assert "section 6,2 m on a structure 5 m across" in plausibility(
+        [_spec("pier", "frame", section=(6.0, 2.0), E=30e9, nu=0.2, rho=2500, area=12.0)], 5.0)
     legacy = PartSpec("structure", "hex8", Props(E=300.0, nu=0.3, rho=2000.0), legacy=True)
     assert "-ssi_fem_E 300 N/m^2" in plausibility([legacy], 5.0)
 
