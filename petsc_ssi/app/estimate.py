@@ -224,16 +224,16 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
                                 fft_ranks=int(cfg.get("toeplitz_fft_ranks", 0) or 0), reach=rho)
         b += ab
         _, fac, one, _, _ = step_lu_of(cfg, prob, lat, p, kappa=kappa)
-        steps_s = prob.n_steps * one
-        total = tb + th + fac + steps_s + rest
+        solves_s = prob.n_steps * one
+        total = tb + th + fac + solves_s + rest
         if cc is not None:            # the structure, the interface matrices and the coupled steps
             add = cc.predict(c, p, one)
             b += add["cpl_bytes"]
             total += add["cpl_setup"] + add["cpl_loop"]
-            cpl = (f" {fac:8.3g} {steps_s:7.3g} {rest:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
+            cpl = (f" {fac:8.3g} {solves_s:7.3g} {rest:7.3g} {add['cpl_setup']:16.4g} {add['cpl_loop']:15.4g} "
                    f"{fmt_time(total):>7}")
         else:
-            cpl = f" {fac:8.3g} {steps_s:7.3g} {rest:7.3g} {fmt_time(total):>7}"
+            cpl = f" {fac:8.3g} {solves_s:7.3g} {rest:7.3g} {fmt_time(total):>7}"
         tot = b + p * rss
         per_node = tot / p * min(q, p)
         fits = per_node <= limit

@@ -248,8 +248,8 @@ def loop_rest(cfg, n_steps, n_nodes):
     """Seconds of a toeplitz run's time loop beside the history sum and the step matrix's solves, as the dense
     model counts them (``cost.loop_terms``): the march's own work a step (the constants' c_step: the right-hand
     side, the sources, the recorder, the transforms' calls) and the field snapshots (``cost.snapshot_seconds``).
-    A seismic wave's free field on the sources and a massless footing's correction are not counted (about 2 ms
-    a step on a 12 x 12 grid, 2 ranks). Without them a small
+    A seismic wave's free field on the nodes and a massless footing's correction are not counted (0.5-0.9 ms a
+    step on 1 m grids of 12 x 12 and 24 x 24 elements, 1 and 2 ranks, 2026-12-03). Without them a small
     grid's loop ran 2-8 times its prediction: 1 m grids of 4 x 4 and 8 x 8 elements, 200 steps, no snapshots,
     0.085-0.21 s against 0.022-0.106 s predicted at 1 and 2 ranks (0.3-0.55 ms a step beside the modelled
     history and solves), and the default stride's snapshots 1.1-1.8 ms a step more (2026-12-02)."""
