@@ -246,7 +246,7 @@ def test_the_coupled_toeplitz_estimate_prices_the_set_up_it_makes(tmp_path):
 def test_the_toeplitz_bem_run_predicts_its_step_solves_and_its_progress(tmp_path):
     """A BEM run on the toeplitz store (no structure): the estimate's row has the step matrix's factorisation,
     the steps' solves (``toeplitz.step_lu_of``, a solve each step), the march's own work and the snapshots
-    (steps_s: ``toeplitz.loop_rest``, the dense model's c_step and ``cost.snapshot_seconds``) and their total
+    (steps_s: ``toeplitz.loop_rest``, TZ_STEP_S and ``cost.snapshot_seconds``) and their total
     beside the kernels and the history, and the run's own loop line predicts history_s + solve_s + steps_s (until
     2026-12-02 it gave the history alone: 2.22 s against 2.78 s measured on the paper's case meshed whole, 0.94 s
     of it solves; then without steps_s: a 4 x 4 grid's loop 2-8 times its prediction). The progress model
@@ -265,9 +265,14 @@ def test_the_toeplitz_bem_run_predicts_its_step_solves_and_its_progress(tmp_path
     assert re.search(r"step matrix: [0-9.]+ M entries in its LU's factors modelled", out), out
     run = _run_prediction(cli(args + ["-ssi_output", str(tmp_path / "b.h5")]).stdout)
     assert run == pytest.approx(vals["history_s"] + vals["solve_s"] + vals["steps_s"], rel=6e-3, abs=1e-3), (run, vals)
-    # steps_s: c_step a step and, at the default stride 1, a snapshot a step of the 81 nodes
-    from petsc_ssi.bem.cost import load_constants, snapshot_seconds
-    assert vals["steps_s"] == pytest.approx(32 * (load_constants()[0]["c_step"] + snapshot_seconds(81)), rel=0.02)
+    # steps_s: the march's own work a step and, at the default stride 1, a snapshot a step of the 81 nodes
+    from petsc_ssi.bem.cost import snapshot_seconds, SEISMIC_STEP_S
+    from petsc_ssi.bem.toeplitz import TZ_STEP_S, loop_rest
+    assert vals["steps_s"] == pytest.approx(32 * (TZ_STEP_S + snapshot_seconds(81)), rel=0.02)
+    # a seismic wave adds its free field's work a step; no snapshots at stride 0, one every 5 steps at 5
+    assert loop_rest({"seismic": "sv", "output_stride": 0}, 100, 81) == pytest.approx(100 * (TZ_STEP_S + SEISMIC_STEP_S))
+    assert loop_rest({"seismic": "none", "output_stride": 5}, 100, 81) == pytest.approx(
+        100 * TZ_STEP_S + 20 * snapshot_seconds(81))
 
     class Lat:
         Mx = My = 8

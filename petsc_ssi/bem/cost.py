@@ -194,6 +194,7 @@ class Counts:
         self.plot = bool(cfg.plot)
         self.stabilized = cfg.scheme.startswith("stabili")
         self.writes = snapshot_writes(cfg, self.steps)
+        self.source_s = source_step_seconds(cfg)
         nimg = len(ls.Vc) // prob.mesh.n_cells
         Lmax = max([self.Lx] + self.interp_lags)
         # the node ranges of the ranks of every rank count, as the run cuts them (bem/partition.py)
@@ -381,7 +382,18 @@ def features(cnt, p, q, cores):
 # measurement (a loop of 0.3 s with stride 0, 1.7 s with stride 1, before the output's parts) put a small
 # case's default-stride loop at 1.49 s against 0.23 s measured. It dominates small cases only.
 SNAPSHOT_S = 1.1e-3
-SNAPSHOT_NODE_S = 6e-7
+SNAPSHOT_NODE_S = 1e-6          # (6e-7 on 2026-12-02, 1.2e-6 on 2026-12-03 at 1089-2401 nodes: the file system's hour)
+
+# A seismic wave's work a step beside the history sum, the solve and c_step [s]: the free field on the nodes
+# (the total field u_sc + u_ff of the records, halfspace.total_field) and a massless footing's correction
+# (sources/rigid.py). 0.5-0.9 ms a step on 1 m grids of 12 x 12 and 24 x 24 elements (2026-12-02) and 0.3-1.2 ms
+# on 8 x 8 and 16 x 16 (2026-12-03, jobscripts/toeplitz_loop_check.py's SV cases against its load cases).
+SEISMIC_STEP_S = 6e-4
+
+
+def source_step_seconds(cfg):
+    """Seconds a step the run's sources add to the loop beside c_step: SEISMIC_STEP_S under -ssi_seismic."""
+    return SEISMIC_STEP_S if str(cfg.get("seismic", "none") or "none").lower() != "none" else 0.0
 
 
 def snapshot_seconds(n_nodes):
@@ -404,7 +416,8 @@ def bem_solve_seconds(c, N, p):
 def loop_terms(cnt, c, p, q, cores):
     """Seconds of the BEM time loop on p ranks, q per node, ``cores`` per node (dict: history, solve,
     step, snapshots, loop): the history sums (streamed bytes, products, panel flops), the solves with
-    the step matrix's factors, c_step per step and ``snapshot_seconds`` per field snapshot. The one model of the
+    the step matrix's factors, c_step (and a seismic wave's ``source_step_seconds``) per step and
+    ``snapshot_seconds`` per field snapshot. The one model of the
     loop that ``petsc-ssi estimate`` (``predict``) and the run's own first line
     (``HalfSpace.check_memory``) both evaluate (issue 43: they had been two code paths)."""
     mx, over, m = features(cnt, p, q, cores)
@@ -412,7 +425,8 @@ def loop_terms(cnt, c, p, q, cores):
                             + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
                             + panel_seconds(mx, cnt.block, cnt.sub, c, m)),
          "solve": cnt.steps * bem_solve_seconds(c, cnt.N, p),
-         "step": c["c_step"] * cnt.steps, "snapshots": snapshot_seconds(cnt.N) * cnt.writes}
+         "step": (c["c_step"] + getattr(cnt, "source_s", 0.0)) * cnt.steps,
+         "snapshots": snapshot_seconds(cnt.N) * cnt.writes}
     t["loop"] = t["history"] + t["solve"] + t["step"] + t["snapshots"]
     return t
 

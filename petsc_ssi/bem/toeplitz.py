@@ -244,18 +244,24 @@ def step_lu(n_dofs, rho, blocks=1, ranks=2, kappa=0.107, rates=None):
     return entries, entries * r["t_factor_entry"], solve
 
 
+# The march's own work a step on the toeplitz store [s] beside its history sum and the step matrix's solve (the
+# right-hand side, the sources, the recorder, the transforms' calls): 0.3-0.55 ms on 1 m grids of 4 x 4 and 8 x 8
+# elements, 1 and 2 ranks, 2026-12-02, and 0.2-0.4 ms on 2026-12-03 (jobscripts/toeplitz_loop_check.py); the dense
+# model's fitted c_step (0.59 ms, bem/cost.py) carries the dense store's own per-step work and over-predicted these
+# loops by up to 1.8 times.
+TZ_STEP_S = 3.5e-4
+
+
 def loop_rest(cfg, n_steps, n_nodes):
-    """Seconds of a toeplitz run's time loop beside the history sum and the step matrix's solves, as the dense
-    model counts them (``cost.loop_terms``): the march's own work a step (the constants' c_step: the right-hand
-    side, the sources, the recorder, the transforms' calls) and the field snapshots (``cost.snapshot_seconds``).
-    A seismic wave's free field on the nodes and a massless footing's correction are not counted (0.5-0.9 ms a
-    step on 1 m grids of 12 x 12 and 24 x 24 elements, 1 and 2 ranks, 2026-12-03). Without them a small
+    """Seconds of a toeplitz run's time loop beside the history sum and the step matrix's solves: the march's own
+    work a step (TZ_STEP_S), a seismic wave's (``cost.source_step_seconds``: its free field on the nodes and a
+    massless footing's correction) and the field snapshots (``cost.snapshot_seconds``). Without them a small
     grid's loop ran 2-8 times its prediction: 1 m grids of 4 x 4 and 8 x 8 elements, 200 steps, no snapshots,
-    0.085-0.21 s against 0.022-0.106 s predicted at 1 and 2 ranks (0.3-0.55 ms a step beside the modelled
-    history and solves), and the default stride's snapshots 1.1-1.8 ms a step more (2026-12-02)."""
-    from .cost import load_constants, snapshot_seconds, snapshot_writes
-    c = load_constants(cfg.get("estimate_constants", ""))[0]
-    return float(c["c_step"]) * int(n_steps) + snapshot_seconds(n_nodes) * snapshot_writes(cfg, n_steps)
+    0.085-0.21 s against 0.022-0.106 s predicted at 1 and 2 ranks, and the default stride's snapshots 1.1-1.8 ms a
+    step more (2026-12-02)."""
+    from .cost import snapshot_seconds, snapshot_writes, source_step_seconds
+    return ((TZ_STEP_S + source_step_seconds(cfg)) * int(n_steps)
+            + snapshot_seconds(n_nodes) * snapshot_writes(cfg, n_steps))
 
 
 def geometric_reach(cfg, prob):
