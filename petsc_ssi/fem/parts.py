@@ -94,6 +94,7 @@ class PartSpec:
     legacy: bool = False          # the single hex8 part of -ssi_fem_E/_nu/_rho
     layers: tuple = ()            # hex8 layered by depth: ((z_bottom [m], Props), ...), elevations falling
     section: tuple = ()           # frame: (b, h) [m] of -ssi_fem_part_NAME_section, () when area etc. are given
+    speeds: bool = False          # hex8 given by its wave speeds (cp, cs, rho), not E and nu
 
 
 def rect_section(b, h):
@@ -196,7 +197,8 @@ def parse_parts(cfg, raw=None):
         if raw:
             key = sorted(raw)[0]
             raise SSIError(f"-{KEY}{key} is set but -ssi_fem_parts names no part")
-        return [PartSpec("structure", "hex8", _legacy_props(cfg), legacy=True)]
+        speeds = bool(float(cfg.get("fem_cp", 0.0) or 0.0) or float(cfg.get("fem_cs", 0.0) or 0.0))
+        return [PartSpec("structure", "hex8", _legacy_props(cfg), legacy=True, speeds=speeds)]
     if len(set(names)) != len(names):
         raise SSIError(f"-ssi_fem_parts '{cfg.fem_parts}': a part is named twice")
     given = {n: {} for n in names}
@@ -226,7 +228,8 @@ def _spec(name, g):
                            f"{', '.join(q for q in ALLOWED[el] if q != 'element')})")
     if "layers" in g:
         return _layered_spec(name, g, opt)
-    if "cp" in g or "cs" in g:
+    speeds = "cp" in g or "cs" in g
+    if speeds:
         g = _from_wave_speeds(g, opt)
     missing = [p for p in REQUIRED[el] if p not in g]
     if missing:
@@ -286,7 +289,7 @@ def _spec(name, g):
         raise SSIError(f"part '{name}' (shell) has no mass: set {opt('rho')} > 0 or {opt('mass_per_area')}")
     if el != "shell" and props.rho == 0 and props.added_mass == 0:
         raise SSIError(f"part '{name}' ({el}) has no mass: {opt('rho')} must be > 0")
-    return PartSpec(name, el, props, orientation_given=oriented, section=bh)
+    return PartSpec(name, el, props, orientation_given=oriented, section=bh, speeds=speeds)
 
 
 # Lower bounds that catch a wrong unit in a part's properties (an engineer's E in GPa ran without a word and
@@ -310,10 +313,15 @@ def plausibility(specs, size):
     for s in specs:
         layers = [p for _, p in s.layers] if getattr(s, "layers", None) else [s.props]
         opt = "-ssi_fem_" if s.legacy else f"-{KEY}{s.name}_"
-        for p in layers[:1] if s.legacy else layers:
+        for k, p in enumerate(layers[:1] if s.legacy else layers):
             if not p.E >= PART_E_MIN:
-                cs = f" (c_s {np.sqrt(p.G() / p.rho):.3g} m/s)" if s.element == "hex8" and p.rho > 0 else ""
-                out.append(f"{opt}E {p.E:g} N/m^2{cs}")
+                cs = f"c_s {np.sqrt(p.G() / p.rho):.3g} m/s" if s.element == "hex8" and p.rho > 0 else ""
+                if getattr(s, "layers", None) and cs:       # (named as the user gave it: the layer's wave speeds)
+                    out.append(f"{opt}layers layer {k + 1}: {cs} (E {p.E:g} N/m^2)")
+                elif s.speeds and cs:
+                    out.append(f"{opt}cs {cs[4:]} (E {p.E:g} N/m^2)")
+                else:
+                    out.append(f"{opt}E {p.E:g} N/m^2" + (f" ({cs})" if cs else ""))
             # (a shell's mass_per_area replaces rho t, and a light link's mass may sit in added_mass: rho is then
             # not the part's mass, and a token rho is no unit slip)
             own = not (getattr(p, "mass_per_area", 0) > 0 or getattr(p, "added_mass", 0) > 0)

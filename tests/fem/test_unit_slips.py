@@ -55,6 +55,14 @@ def test_plausibility_names_each_slip():
                                                                     thickness=0.3)], 8.0)
     assert "section 6,2 m on a structure 5 m across" in plausibility(
         [_spec("pier", "frame", section=(6.0, 2.0), E=30e9, nu=0.2, rho=2500, area=12.0)], 5.0)
+    # a region given by its wave speeds is named by them, as the user typed it (-ssi_fem_cs, a layer), with its E
+    slow = Props(E=2 * 1.3 * 2000.0 * 0.3 ** 2, nu=0.3, rho=2000.0)             # c_s 0.3 m/s (cm/s typed as m/s)
+    line = plausibility([PartSpec("structure", "hex8", slow, legacy=True, speeds=True)], 5.0)
+    assert f"-ssi_fem_cs 0.3 m/s (E {slow.E:g} N/m^2)" in line and "-ssi_fem_E" not in line, line
+    layered = PartSpec("soil", "hex8", Props(E=3e8, nu=0.3, rho=2000.0),
+                       layers=((-2.0, Props(E=3e8, nu=0.3, rho=2000.0)), (-5.0, slow)))
+    line = plausibility([layered], 5.0)
+    assert f"-ssi_fem_part_soil_layers layer 2: c_s 0.3 m/s (E {slow.E:g} N/m^2)" in line and "layer 1" not in line
     legacy = PartSpec("structure", "hex8", Props(E=300.0, nu=0.3, rho=2000.0), legacy=True)
     assert "-ssi_fem_E 300 N/m^2" in plausibility([legacy], 5.0)
 
