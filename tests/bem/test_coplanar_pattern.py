@@ -110,14 +110,16 @@ def _column_planes(ls):
 def _pair_blocks(xc, X, L=4):
     """The full 3x3 blocks P (H), U (G) of lags 1..L of the point xc and the element X, regular pair."""
     from petsc_ssi.bem.assemble import _integrate, SING_TOL
-    from petsc_ssi.bem.packs import quad
+    from petsc_ssi.bem.packs import quad, wave
     gq, gw = np.polynomial.legendre.leggauss(3)
     gr, gwr = np.polynomial.legendre.leggauss(6)
     Ub, Pb = np.zeros((L, 9, 3, 3)), np.zeros((L, 9, 3, 3))
     Us, Ps = np.zeros((9, 3, 3)), np.zeros((9, 3, 3))
     cp, cs, rho, dt = 548.0, 316.0, 2000.0, 2.5e-3
     nu = ((cp / cs) ** 2 - 2) / (2 * ((cp / cs) ** 2 - 1))
-    _integrate(xc, X, -1, 2, 1, L, True, (dt, cp, cs, rho, nu, rho * cs ** 2, 0.0),
+    # (the material as the runs pass it, packs.wave's float64 array: a tuple here made numba compile a second
+    # version of the whole integration chain, 12 s of a fresh clone's suite)
+    _integrate(xc, X, -1, 2, 1, L, True, wave(dt, cp, cs, rho, nu),
                quad(2, 0.0, 2, gq, gw, gr, gwr, SING_TOL, 1.0), (Ub, Pb, Us, Ps, np.zeros(0), np.zeros(0)))
     return Pb, Ub
 
