@@ -112,3 +112,66 @@ def test_static_file_signed_section_resultants(tmp_path):
     assert len(base) == 2 and np.allclose(base, -(W / 2 - RHO * AC * G * H / NC / 2), rtol=1e-9), base
     MB = RHO * AB * G * L ** 2 / (6 * ((IB / L) / (IC / H) + 2))
     assert max(v for (p, e, end, c), v in static.items() if p == "beam" and c == "M2") == pytest.approx(MB, rel=1e-2)
+
+
+BRACKETS = """// four cantilevers fixed at 'base', loaded at 'tip': A a 3-4-5 slope in the x-z plane, B the same (other
+// orientation), C skewed in 3D, D as A with its line drawn tip to base (x' reversed)
+Point(1) = {0, 0, 0}; Point(2) = {3, 0, 4}; Point(3) = {0, 5, 0}; Point(4) = {3, 5, 4};
+Point(5) = {10, 0, 0}; Point(6) = {12, 3, 6}; Point(7) = {0, 10, 0}; Point(8) = {3, 10, 4};
+Line(1) = {1, 2}; Line(2) = {3, 4}; Line(3) = {5, 6}; Line(4) = {8, 7};
+Transfinite Curve{1, 2, 3, 4} = 5;
+Physical Curve("A") = {1}; Physical Curve("B") = {2}; Physical Curve("C") = {3}; Physical Curve("D") = {4};
+Physical Point("base") = {1, 3, 5, 7}; Physical Point("tip") = {2, 4, 6, 8};
+"""
+
+
+def test_inclined_and_skewed_cantilevers_against_statics(tmp_path):
+    """Statically determinate 3D cantilevers (BRACKETS) under a tip force F = (200, 300, -1000) N: every section
+    resultant of `post --forces` (a static file: signed) equals statics written from the CSV header's own words
+    (x' node 0 -> 1, z' the orientation made normal to x', y' = z' x x'; the resultant on the face whose outward
+    normal points to the tip is (F, (tip - x) x F), negated where +x' points away from the tip), to 1e-9 of the
+    largest moment; the orientation moves moments between M2 and M3 and leaves N alone (A: 0,1,0; B: 0,0,1), and
+    a member drawn tip to base (D) flips V and M as its axes say. (An independent check of 2026-12-03 made this a
+    test.) At A's base by hand: N = F . (0.6, 0, 0.8) = -680 N (compression)."""
+    geo = tmp_path / "brackets.geo"
+    geo.write_text(BRACKETS)
+    out = str(tmp_path / "brackets.h5")
+    orient = {"A": "0,1,0", "B": "0,0,1", "C": "0,0,1", "D": "0,1,0"}
+    args = ["static", "-ssi_fem_mesh", str(geo), "-ssi_fem_parts", "A,B,C,D", "-ssi_fem_fixed", "base",
+            "-ssi_fem_point_load", "tip,200,300,-1000", "-ssi_structure_forces", "all", "-ssi_output", out]
+    for name, o in orient.items():
+        p = f"-ssi_fem_part_{name}_"
+        args += [p + "element", "frame", p + "E", "2e11", p + "nu", "0.3", p + "rho", "7850", p + "area", "0.01",
+                 p + "Iy", "1e-5", p + "Iz", "2e-5", p + "J", "3e-5", p + "shear_factor", "0", p + "orientation", o]
+    r = run_cli(args)
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = run_cli(["post", out, "--forces", "--csv"])
+    assert r.returncode == 0, r.stderr
+    rows = [x for x in csv.reader(io.StringIO(r.stdout)) if x and not x[0].startswith("#")]
+    rows = [dict(zip(rows[0], x)) for x in rows[1:]]
+    F = np.array([200.0, 300.0, -1000.0])
+    ends = {(x["part"], x["element"], x["end"]): np.array([float(x[k]) for k in ("x_m", "y_m", "z_m")]) for x in rows}
+    members = {"A": ((0, 0, 0), (3, 0, 4)), "B": ((0, 5, 0), (3, 5, 4)), "C": ((10, 0, 0), (12, 3, 6)),
+               "D": ((0, 10, 0), (3, 10, 4))}
+    got, hand = [], []
+    for x in rows:
+        p, e = x["part"], x["element"]
+        base, tip = (np.array(v, float) for v in members[p])
+        o = np.array([float(v) for v in orient[p].split(",")])
+        xi, xj = ends[(p, e, "i")], ends[(p, e, "j")]
+        ex = (xj - xi) / np.linalg.norm(xj - xi)
+        ez = o - (o @ ex) * ex
+        ez /= np.linalg.norm(ez)
+        ey = np.cross(ez, ex)
+        R, M = F, np.cross(tip - ends[(p, e, x["end"])], F)
+        if ex @ (tip - base) < 0:
+            R, M = -R, -M
+        hand.append({"N": R @ ex, "V2": R @ ey, "V3": R @ ez, "T": M @ ex, "M2": M @ ey, "M3": M @ ez}[x["component"]])
+        got.append(float(x["value"]))
+    assert len(got) == 4 * 4 * 2 * 6
+    scale = max(abs(v) for v in hand)
+    assert np.abs(np.array(got) - np.array(hand)).max() <= 1e-9 * scale
+    val = {(x["part"], x["element"], x["end"], x["component"]): float(x["value"]) for x in rows}
+    assert val[("A", "0", "i", "N")] == pytest.approx(-680.0, rel=1e-12)     # compression, the sign read directly
+    assert val[("B", "0", "i", "N")] == pytest.approx(-680.0, rel=1e-12)
+    assert abs(val[("A", "0", "i", "M2")]) == pytest.approx(abs(val[("B", "0", "i", "M3")]), rel=1e-9)
