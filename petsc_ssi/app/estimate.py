@@ -210,7 +210,7 @@ def _toeplitz_report(cfg, comm, ranks, cores, q, node_mem, coupled=None, cc=None
     # the step matrix's LU (toeplitz.step_lu_of): its entries, mirror blocks; a solve a step in the loop
     from ..bem.toeplitz import step_lu_of, loop_rest
     kappa = c.get("kappa") if c is not None else None       # (the coupled estimate's constants, else the run's)
-    # steps_s: the march's own work a step and the field snapshots (toeplitz.loop_rest)
+    # steps_s: the march's own work a step, a seismic wave's and the field snapshots (toeplitz.loop_rest)
     rest = loop_rest(cfg, prob.n_steps, N)
     ent, _, _, rho, nblk = step_lu_of(cfg, prob, lat, 2)
     lines.insert(3 if cc is not None else 2,

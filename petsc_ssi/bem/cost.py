@@ -425,7 +425,7 @@ def loop_terms(cnt, c, p, q, cores):
                             + (c["c_op"] + (c["c_op_mpi"] if p > 1 else 0.0)) * mx["P"]
                             + panel_seconds(mx, cnt.block, cnt.sub, c, m)),
          "solve": cnt.steps * bem_solve_seconds(c, cnt.N, p),
-         "step": (c["c_step"] + getattr(cnt, "source_s", 0.0)) * cnt.steps,
+         "step": (c["c_step"] + cnt.source_s) * cnt.steps,
          "snapshots": snapshot_seconds(cnt.N) * cnt.writes}
     t["loop"] = t["history"] + t["solve"] + t["step"] + t["snapshots"]
     return t

@@ -722,7 +722,7 @@ class HalfSpace:
                            f"the most loaded node, more than the {limit / 1e9:.3g} GB available (-ssi_memory_limit, "
                            "per node); use -ssi_interp, a shorter -ssi_t_end, a coarser grid or more nodes")
         one = self.step_solve_s = step_lu_of(c, self, self.lattice, p)[2]
-        # (the march's own work a step and the field snapshots, spread evenly: toeplitz.loop_rest)
+        # (the march's own work a step, a seismic wave's and the field snapshots, spread evenly: toeplitz.loop_rest)
         rest = loop_rest(c, self.n_steps, self.mesh.n_nodes) / max(self.n_steps, 1)
         cum = np.concatenate(([0.0], np.cumsum(steps)))
         self.loop_model = lambda k: float(cum[min(max(int(k), 0), len(cum) - 1)]) + (one + rest) * k
