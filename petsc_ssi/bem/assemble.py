@@ -448,7 +448,7 @@ def _emit_split(lag, n, cl, buf, li, out, flat):
     if n == 0 or out[5] < 0:
         return
     sel = np.empty(n, cl.dtype)
-    nf = 0
+    nf = np.int64(0)
     for k in range(n):                      # the flat blocks first, in column order
         col = cl[k]
         z = True
@@ -633,7 +633,7 @@ def assemble_rows(rows, mesh, lags, phys, quad, kern, cache, work, dropped, out,
     use_c = cptr.shape[0] > 0
     for ii in range(rows.shape[0]):
         i = rows[ii]
-        store = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, 0)
+        store = (ckeys, cmeta, cpoolP, cpoolU, pool_n, upool_n, ncache, scP, scU, np.int64(0))
         vl = cel[cptr[r0 + ii]:cptr[r0 + ii + 1]] if use_c else cel[:0]
         npair, n_ev, n_hit, store = _row_pairs(mesh[0][i], mesh, lags, phys, quad, kern, cfg, key, dropped, bufs,
                                                pairs, store, vl, use_c)
@@ -662,10 +662,11 @@ def _row_pairs(xc, mesh, lags, phys, quad, kern, cfg, key, dropped, bufs, pairs,
         lo, hi, sing, ns = _window(xc, v, mesh, reach, lags, phys, quad)
         if lo > hi:
             continue
-        want_u = False
-        for a in range(9):
+        ncol = 0                           # (want_u from a count, not a literal False: numba typed the calls
+        for a in range(9):                 # below once for Literal[bool](False), once for bool; compiled twice)
             if Vtcol[v, a] >= 0:
-                want_u = True
+                ncol += 1
+        want_u = ncol > 0
         found, fill_u, hsh = _cached(use_cache, cidx, store[0], store[1], VX[v], xc, qinv, key, lo, hi, want_u)
         where = 0
         if found >= 0:
@@ -673,7 +674,8 @@ def _row_pairs(xc, mesh, lags, phys, quad, kern, cfg, key, dropped, bufs, pairs,
             offU = store[1][found, 4]
             hits += 1
         else:
-            nev += _pair_integrals(xc, v, VX[v], sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped)
+            nev += _pair_integrals(xc, v, VX[v], sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped,
+                                   np.bool_(True))        # (a bool, as integrate_batch's: one compiled version)
             store, where, off, offU = _store_pair((fill_u, hsh, lo, hi, want_u), cfg, key, bufs, kern[1], store)
         pairs[npair, 0] = v; pairs[npair, 1] = lo; pairs[npair, 2] = hi
         pairs[npair, 3] = 1 if want_u else 0; pairs[npair, 4] = where; pairs[npair, 5] = off
@@ -759,8 +761,8 @@ def _row_blocks(li, npair, pairs, lags, mesh, sg, kern, src, rowbuf, out):
     mH, mG = pattern[0].shape[0], pattern[2].shape[0]
     sP, sU = 9 * mH, 9 * mG
     for lag in range(lags[0], lags[1] + 1):
-        nH = 0
-        nG = 0
+        nH = np.int64(0)                  # (not literal 0s: the emitters compiled once, for int64)
+        nG = np.int64(0)
         for k in range(npair):
             lo = pairs[k, 1]
             if lag < lo or lag > pairs[k, 2]:
@@ -809,7 +811,7 @@ def enumerate_pairs(rows, mesh, lags, phys, quad, qinv, cache_max, stride, cand)
     hs = np.zeros(64, np.int64)
     meta = np.zeros((64, 6), np.int64)
     pts = np.zeros((64, 3))
-    m = 0
+    m = np.int64(0)
     pool_n = 0
     key = np.zeros(27, np.int64)
     reach = phys[CP] * (phys[DT] * lags[1] + phys[TOFF])
