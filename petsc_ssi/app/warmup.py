@@ -2,8 +2,9 @@
 
 The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.py``) are compiled by numba
 the first time a version of the sources runs on a machine (minutes: 468 s on a 2-core virtual machine) and cached under
-``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs a tiny BEM
-case on one process so that they are compiled now, says so, and exits at once when the cache is
+``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs tiny BEM
+cases on one process (the block-sparse, toeplitz and dense lag stores) so that they are compiled now, while a
+second process compiles the kernels those runs do not need first (``--kernels``), says so, and exits at once when the cache is
 already warm for this checkout: when the warm-up itself has finished in it for these files at this
 path (the file ``WARM_MARK-<checkout key>`` in the cache: numba keys its index by the source file's
 path and stamps it with its mtime and size, so a second checkout of the same sources compiles
@@ -11,6 +12,7 @@ again; ``petsc_ssi.checkout_key``), not merely when some run compiled some kerne
 deps`` calls it.
 """
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -19,7 +21,12 @@ import time
 WARM_MARK = "warmup-done"
 
 
-def main():
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if argv == ["--kernels"]:                  # the helper process of a warm-up (below)
+        _single_kernels()
+        _test_kernels()
+        return 0
     import petsc_ssi
     d = os.environ.get("NUMBA_CACHE_DIR", "")
     mark = os.path.join(d, f"{WARM_MARK}-{petsc_ssi.checkout_key()}")
@@ -33,6 +40,15 @@ def main():
               flush=True)
     os.environ["PETSC_SSI_WARMUP"] = "1"       # the run below does not announce the compile again
     t0 = time.perf_counter()
+    # numba compiles on one core: the kernels no run here needs first (the block-sparse products of every
+    # pattern and value type, the toeplitz store's lanes, the unit tests' own versions) compile in a second
+    # process meanwhile (one core each; the assembly's kernels, most of the time, here). Both write the
+    # cache; what the helper compiled is loaded below, and what it did not (it failed, or numba's index
+    # lost an entry to the other process's write) is compiled then.
+    helper = None
+    if (os.cpu_count() or 1) > 1:
+        helper = subprocess.Popen([sys.executable, "-m", "petsc_ssi.app.warmup", "--kernels"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     from ..petsc import init
     PETSc = init([sys.argv[0]])
     from .. import options
@@ -40,19 +56,29 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         opts = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
                 "load_p0": 1000, "dt": 0.005, "t_end": 0.02, "output": os.path.join(tmp, "w.h5"),
-                "output_stride": 0, "warn_beta": 0,
+                "output_stride": 0, "warn_beta": 0, "output_overwrite": 1,
                 "lag_storage": "sparse", "history_block": 2}    # the block-sparse kernels (bem/bsr.py) too
         db = PETSc.Options()
         for k, v in opts.items():
             db.setValue("ssi_" + k, str(v))
         run_bem(options.resolve(("common", "bem")))
         db.setValue("ssi_lag_store", "toeplitz")              # the toeplitz store's kernels (bem/toeplitz.py)
-        db.setValue("ssi_output_overwrite", "1")
         run_bem(options.resolve(("common", "bem")))
         db.delValue("ssi_lag_store")
-        db.delValue("ssi_output_overwrite")
+        db.setValue("ssi_lag_storage", "dense")               # dense lags and a load over an area no cell holds
+        db.setValue("ssi_load_group", "")                     # (bem/lagmats.py, sources/area.py)
+        db.setValue("ssi_load_area", "0.25,0.75,0.25,0.75")
+        run_bem(options.resolve(("common", "bem")))
+        for k in list(opts) + ["load_area"]:
+            db.delValue("ssi_" + k)
         _shared_cache_kernels(PETSc)
-        _single_kernels()
+    if helper is not None:
+        _, err = helper.communicate()
+        if helper.returncode:
+            print(f"[warmup] the helper process stopped ({helper.returncode}): its kernels compile here; "
+                  f"{(err or '').strip().splitlines()[-1:] or ''}", flush=True)
+    _single_kernels()                   # loaded (compiled by the helper), or compiled now
+    _test_kernels()
     os.makedirs(d, exist_ok=True)
     with open(mark, "w") as fh:
         fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache for the "
@@ -85,7 +111,9 @@ def _single_kernels():
     per value type), the toeplitz store's lane products on single kept states (-ssi_toeplitz_precision
     single), and the block-sparse kernels on a read-only x (the python Mat's products; without this the first coupled
     run compiled one), the toeplitz kernels' fill from real and complex spectra (a grid's point symmetry decides
-    which a run takes), and the coupled step's product with mirrored interface columns."""
+    which a run takes), a dense lag of the full pattern filled (a surface that is not one plane, -ssi_lag_storage
+    dense), and the coupled step's product with mirrored interface columns. The helper process of a warm-up
+    compiles them while the runs of ``main`` compile the assembly."""
     import numpy as np
     from ..bem import bsr
     indptr, cols = np.array([0, 1], np.int64), np.zeros(1, np.int32)
@@ -108,12 +136,26 @@ def _single_kernels():
     idx, sel = np.zeros((1, 1), np.int64), np.zeros(1, np.int64)
     for kp, dt in ((1, np.float64), (2, np.complex128)):
         add_spectra(np.zeros((1, 1, 1, kp, FW)), 0, np.zeros((1, 1, 1), dt), sel, idx, np.ones(1))
+    from ..bem.lagmats import _scatter_dense      # (a dense lag of the full pattern: a surface not one plane)
+    _scatter_dense(np.zeros((3, 3), order="F"), np.zeros(1, np.int64), np.zeros(1, np.int32), np.zeros((1, 3, 3)))
     from ..coupling.columns import _rows4         # (the coupled step's mirrored interface columns)
     _rows4(np.ones((2, 3)), np.ones((4, 3)), np.zeros((2, 4)))
     diag = np.ones((1, 3, 3))
     bsr._diag_add(diag, 0, x, np.zeros(3), 1.0)
     bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)
     bsr._diag_panel(diag, 0, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
+
+def _test_kernels():
+    """The kernels the unit tests call straight from Python with no run calling them so (tests/bem/test_kernels.py
+    and others: numba compiles a function called from Python on its own, apart from its inlined copies in
+    the assembly kernels): compiled here, not in a test."""
+    import numpy as np
+    from ..bem import kernels as K
+    g, n, out = np.array([0.6, 0.8, 0.0]), np.array([0.0, 0.0, 1.0]), np.zeros((3, 3))
+    A, B, dA, dB = K.ab2(1.0, 0.01, 2.0, 1.0)                      # (r, t, alpha, beta)
+    K.f1_tensor(g, 1.0, 0.01, 2.0, 1.0, 1.0, out)                  # (g, r, t, alpha, beta, rho, out)
+    K.t2_tensor(g, n, 1.0, 0.01, 2.0, 1.0, 1.0, out)
+    K.traction_from_ab(g, n, 1.0, A, B, dA, dB, 2.0, 1.0, out)     # (g, n, r, A, B, dA, dB, lam, mu, out)
 
 if __name__ == "__main__":
     sys.exit(main())

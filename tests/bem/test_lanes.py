@@ -205,6 +205,7 @@ def test_per_step_helpers_equal_their_numpy_forms(vdtype):
     vsign = rng.choice([-1.0, 1.0], (5, 3))
     ix, iy = np.array([0, 1, 2, 3, 4]), np.array([4, 3, 2, 1, 0])
     f = np.zeros((9, 3, 6, 5))
+    U.flags.writeable = False           # as the runs pass it (a PETSc vector's array read-only)
     scatter_slots(U, vnode, vsign, ix, iy, f)
     ref = np.zeros_like(f)
     for a in range(9):

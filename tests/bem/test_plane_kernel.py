@@ -57,7 +57,7 @@ def test_plane_kernel_equals_the_general_kernel_bit_for_bit(want_u, toff):
         sub, pts, Ntab = np.zeros((ns * ns, 4)), np.zeros((ns * ns * 4, 4)), np.zeros((ns * ns * 4, 9))
         plane_points(X, ns, gq, gw, sub, pts, Ntab)
         P, U = np.zeros((L, 9, 4)), np.zeros((L, 9, 5))
-        n_pl = integrate_plane(xc, sub, pts, Ntab, 4, lo, hi, wave(DT, CP, CS, RHO, NU, toff), P, U, want_u)
+        n_pl = integrate_plane(xc, sub, pts, Ntab, 4, lo, hi, wave(DT, CP, CS, RHO, NU, toff), P, U, want_u, True)
         assert n_pl == n_gen > 0
         assert np.abs(P).max() > 0
         assert np.array_equal(P, Pb[:, :, hp, hq])                  # bit for bit

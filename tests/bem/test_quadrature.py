@@ -15,7 +15,7 @@ NU, MU = 0.25, 1.0
 def _static(X, c, order):
     g, w = np.polynomial.legendre.leggauss(order)
     Us = np.zeros((9, 3, 3)); Ps = np.zeros((9, 3, 3))
-    singular_static(X, c, order, order, g, w, g, w, NU, MU, Us, Ps)
+    singular_static(X, c, order, order, g, w, g, w, NU, MU, Us, Ps, 1.0)     # (h_ref given, as the assembly does)
     return Us, Ps
 
 
