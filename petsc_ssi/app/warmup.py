@@ -111,7 +111,8 @@ def _single_kernels():
     per value type), the toeplitz store's lane products on single kept states (-ssi_toeplitz_precision
     single), and the block-sparse kernels on a read-only x (the python Mat's products; without this the first coupled
     run compiled one), the toeplitz kernels' fill from real and complex spectra (a grid's point symmetry decides
-    which a run takes), a dense lag of the full pattern filled (a surface that is not one plane, -ssi_lag_storage
+    which a run takes), a state put on the toeplitz store's grid (read-only or not), triplets appended to a lag's
+    blocks (Buckets.add), a dense lag of the full pattern filled (a surface that is not one plane, -ssi_lag_storage
     dense), and the coupled step's product with mirrored interface columns. The helper process of a warm-up
     compiles them while the runs of ``main`` compile the assembly."""
     import numpy as np
@@ -136,6 +137,12 @@ def _single_kernels():
     idx, sel = np.zeros((1, 1), np.int64), np.zeros(1, np.int64)
     for kp, dt in ((1, np.float64), (2, np.complex128)):
         add_spectra(np.zeros((1, 1, 1, kp, FW)), 0, np.zeros((1, 1, 1), dt), sel, idx, np.ones(1))
+    from ..bem.lanes import scatter_slots         # (a state onto the toeplitz store's grid: read-only or not)
+    for xx in (np.ones((1, 3)), x.reshape(1, 3)):
+        scatter_slots(xx, np.zeros((1, 9), np.int64), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64),
+                      np.zeros((9, 3, 1, 1)))
+    from ..bem.lagset import Buckets              # (triplets appended to a lag's blocks: Buckets.add)
+    Buckets(2, np.arange(1), 1).add([0], [1], [0], np.ones((1, 9)))
     from ..bem.lagmats import _scatter_dense      # (a dense lag of the full pattern: a surface not one plane)
     _scatter_dense(np.zeros((3, 3), order="F"), np.zeros(1, np.int64), np.zeros(1, np.int32), np.zeros((1, 3, 3)))
     from ..coupling.columns import _rows4         # (the coupled step's mirrored interface columns)
