@@ -23,6 +23,8 @@
 #                  uniform-36-area-exact, uniform-72-area-exact and today-fine with a smooth load history instead of
 #                  the 25 ms box: a 0.1 s Hann pulse, p0 sin^2(pi t / 0.1 s) (-ssi_load_history table, OUT/hann100ms.txt),
 #                  whose waves (up to about 20 Hz: shear waves of 5 m and longer) the cells resolve
+#   uniform-108-smooth (not by default) uniform-72-smooth on a 108 x 109.2 m grid (three times today's extent):
+#                  whether 72 m is far enough for the building's response (extent 108 m vs 72 m)
 #   uniform-72-area-rule (not by default) uniform-72-area with the paper's rule for the far lags (T_L = 1.5 r / c_s
 #                  at the farthest receiver, r = 24.5 m: 0.3675 s; one anchor every 5 steps: k = 27; what
 #                  -ssi_interp auto chose on this grid before it kept every lag exact on the toeplitz store) instead of
@@ -95,6 +97,7 @@ for r in $RUNS; do
     today-load15-smooth) run today-load15-smooth "${B[@]}" -ssi_mesh_params xl=15,w=1.2 "${P15[@]}" "${X[@]}" "${S[@]}" ;;
     uniform-36-load15-smooth) run uniform-36-load15-smooth "${B[@]}" "${U[@]}" -ssi_mesh_size 36,37.2 "${X[@]}" "${S[@]}" ;;
     uniform-72-smooth) run uniform-72-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 "${X[@]}" "${S[@]}" ;;
+    uniform-108-smooth) run uniform-108-smooth "${B[@]}" "${A[@]}" -ssi_mesh_size 108,109.2 "${X[@]}" "${S[@]}" ;;
     # shellcheck disable=SC2086
     uniform-72-area) run uniform-72-area "${B[@]}" "${A[@]}" -ssi_mesh_size 72,73.2 $EXTRA ;;
     # shellcheck disable=SC2086
