@@ -1,7 +1,7 @@
 """``python -m petsc_ssi.app.warmup``: compile the numba kernels into the cache ahead of the first run.
 
 The BEM kernels (``bem/kernels.py``, ``quadrature.py``, ``assemble.py``, ``bsr.py``) are compiled by numba
-the first time a version of the sources runs on a machine (minutes: 468 s on a 2-core virtual machine) and cached under
+the first time a version of the sources runs on a machine (about a minute: 68 s in a fresh clone on a 2-core virtual machine, 2026-12-03) and cached under
 ``NUMBA_CACHE_DIR`` (``~/.cache/petsc_ssi/numba/<hash of the sources>``). This runs tiny BEM
 cases on one process (the block-sparse, toeplitz and dense lag stores) so that they are compiled now, while a
 second process compiles the kernels those runs do not need first (``--kernels``), says so, and exits at once when the cache is
