@@ -49,6 +49,32 @@ def main(argv=None):
     if (os.cpu_count() or 1) > 1:
         helper = subprocess.Popen([sys.executable, "-m", "petsc_ssi.app.warmup", "--kernels"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        _runs()
+    except BaseException:
+        if helper is not None:           # (the parent stopped: no helper left compiling behind it)
+            helper.kill()
+            helper.wait()
+        raise
+    if helper is not None:
+        _, err = helper.communicate()
+        if helper.returncode:
+            last = (err or "").strip().splitlines()
+            print(f"[warmup] the helper process stopped ({helper.returncode}{': ' + last[-1] if last else ''}): "
+                  "its kernels compile here", flush=True)
+    _single_kernels()                   # loaded (compiled by the helper), or compiled now
+    _test_kernels()
+    os.makedirs(d, exist_ok=True)
+    with open(mark, "w") as fh:
+        fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache for the "
+                 f"checkout {os.path.dirname(petsc_ssi.__file__)}\n")
+    print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+def _runs():
+    """The warm-up's tiny BEM runs (block-sparse, toeplitz and dense lag stores; an area load) and the shared
+    element cache's kernels, in this process."""
     from ..petsc import init
     PETSc = init([sys.argv[0]])
     from .. import options
@@ -72,19 +98,6 @@ def main(argv=None):
         for k in list(opts) + ["load_area"]:
             db.delValue("ssi_" + k)
         _shared_cache_kernels(PETSc)
-    if helper is not None:
-        _, err = helper.communicate()
-        if helper.returncode:
-            print(f"[warmup] the helper process stopped ({helper.returncode}): its kernels compile here; "
-                  f"{(err or '').strip().splitlines()[-1:] or ''}", flush=True)
-    _single_kernels()                   # loaded (compiled by the helper), or compiled now
-    _test_kernels()
-    os.makedirs(d, exist_ok=True)
-    with open(mark, "w") as fh:
-        fh.write(f"petsc_ssi {petsc_ssi.__version__}: every kernel of the warm-up is in this cache for the "
-                 f"checkout {os.path.dirname(petsc_ssi.__file__)}\n")
-    print(f"[warmup] done in {time.perf_counter() - t0:.0f} s")
-    return 0
 
 
 def _shared_cache_kernels(PETSc):
