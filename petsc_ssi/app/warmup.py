@@ -165,6 +165,7 @@ def _single_kernels():
     bsr._diag_add(diag, 0, np.ones(3), np.zeros(3), 1.0)
     bsr._diag_panel(diag, 0, np.ones((3, 2)), np.zeros((3, 2)), 1.0)
 
+
 def _test_kernels():
     """The kernels the unit tests call straight from Python with no run calling them so (tests/bem/test_kernels.py
     and others: numba compiles a function called from Python on its own, apart from its inlined copies in

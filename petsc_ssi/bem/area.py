@@ -79,8 +79,8 @@ def _windows(pts, VX, Vc, VR, Vh, reach, cp, cs, dt, L, tol, ns_base, ns_max, ne
             counts[:] = 0
         for i in range(n):
             for e in range(k):
-                lo, hi, sing, ns = _pair_window(pts[i], VX[e], Vc[e], VR[e], Vh[e], reach, cp, cs, dt, L, np.int64(1), 0.0,
-                                                tol, ns_base, ns_max, near)
+                lo, hi, sing, ns = _pair_window(pts[i], VX[e], Vc[e], VR[e], Vh[e], reach, cp, cs, dt, L,
+                                                np.int64(1), 0.0, tol, ns_base, ns_max, near)   # (lag_lo not literal)
                 eps = tol * Vh[e]
                 if sing < 0 and VX[e, 0, 0] - eps <= pts[i, 0] <= VX[e, 2, 0] + eps and \
                         VX[e, 0, 1] - eps <= pts[i, 1] <= VX[e, 2, 1] + eps:

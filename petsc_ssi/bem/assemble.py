@@ -184,7 +184,7 @@ def plane(flat, VX, ns, gq, gw, ns_max):
 
 
 @njit(cache=True)
-def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG, want_p=True):
+def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, mG, want_p):
     """The PLANE integrator of the kernel table: a regular pair of the plane z = 0 by
     ``integrate_plane`` into Pc[:9 mH nl] (and Uc; without ``want_p`` Uc alone) of ``bufs``, the element's
     geometry from ``plane`` at the base subdivisions, else computed into its scratch. Returns the kernel
@@ -207,7 +207,7 @@ def _plane_integrals(xc, v, X, ns, lo, hi, want_u, phys, quad, plane, bufs, mH, 
 
 
 @njit(cache=True)
-def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped, want_p=True):
+def _pair_integrals(xc, v, X, sing, ns, lo, hi, want_u, phys, quad, kern, bufs, dropped, want_p):
     """A pair's integrals of lags lo..hi in the patterns' layout (``_compact``): Pc[:9 m_H nl] and, with
     ``want_u``, Uc[:9 m_G nl] of ``bufs``, by the integrator of the kernel table (``kern``, as from
     ``kernels``): a regular pair by PLANE (``_plane_integrals``; with ``want_u`` and not ``want_p`` Uc

@@ -351,7 +351,7 @@ def _polar_ray(X, node, ray, rule, elastic, out, scr):
 
 
 @njit(cache=True)
-def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_ref=1.0):
+def singular_static(X, c, order_r, order_t, gr, gwr, gt, gwt, nu, mu, Us, Ps, h_ref):
     """Static Kelvin integrals over an element with xi at its node ``c``.
 
     Polar coordinates around the node in the parameter square, one triangle
@@ -503,7 +503,7 @@ def _plane_lags_u(Uf, S1, plo, phi, lo, pt_geo, s4, Nk):
 
 
 @njit(cache=True)
-def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u, want_p=True):
+def integrate_plane(xc, sub, pts, Ntab, ng2, lo, hi, phys, P, U, want_u, want_p):
     """``integrate_pair`` of a regular pair (``sing`` < 0) whose collocation point xc and element lie in
     the plane z = 0, the element given by ``plane_points`` (sub, pts, Ntab; ng2 Gauss points a
     subdivision), ``phys`` the material and the step (``packs.wave``). Accumulates lags lo..hi into
