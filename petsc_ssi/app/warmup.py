@@ -19,6 +19,12 @@ import time
 
 
 WARM_MARK = "warmup-done"
+# the warm-up's first run (-ssi_<key> <value>; its output in a scratch directory): a tiny BEM case on the block-sparse
+# lag store, time-blocked (the block-sparse kernels, bem/bsr.py, too); the same then on the toeplitz store
+# (jobscripts/compile_times.py times these two on an empty cache)
+RUN_OPTS = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
+            "load_p0": 1000, "dt": 0.005, "t_end": 0.02, "output_stride": 0, "warn_beta": 0, "output_overwrite": 1,
+            "lag_storage": "sparse", "history_block": 2}
 
 
 def main(argv=None):
@@ -80,10 +86,7 @@ def _runs():
     from .. import options
     from .kinds import run_bem
     with tempfile.TemporaryDirectory() as tmp:
-        opts = {"problem": "bem", "mesh_size": "4,4", "mesh_h": 1.0, "mesh_patch": "1,1", "load_group": "load",
-                "load_p0": 1000, "dt": 0.005, "t_end": 0.02, "output": os.path.join(tmp, "w.h5"),
-                "output_stride": 0, "warn_beta": 0, "output_overwrite": 1,
-                "lag_storage": "sparse", "history_block": 2}    # the block-sparse kernels (bem/bsr.py) too
+        opts = dict(RUN_OPTS, output=os.path.join(tmp, "w.h5"))
         db = PETSc.Options()
         for k, v in opts.items():
             db.setValue("ssi_" + k, str(v))
