@@ -37,7 +37,7 @@ def row(log):
     r["dofs"] = int(m.group(1)) if m else ""
     m = re.search(r"dt \S+ s, (\d+) steps", text)
     r["steps"] = int(m.group(1)) if m else ""
-    m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s\)", text)
+    m = re.search(r"\(([\d.e+-]+) GB with the kept states' transforms; kernels ([\d.e+-]+) s[:)]", text)
     if m:
         r["stored_GB"], r["kernels_s"] = float(m.group(1)), float(m.group(2))
         r["kernels_h_s"], r["kernels_g_s"] = r["kernels_s"], 0.0
@@ -48,6 +48,15 @@ def row(log):
             if gs:                              # kernels_s: both sides' build, as the estimate's kernels
                 r["kernels_g_s"] = float(gs.group(1))
                 r["kernels_s"] = round(r["kernels_s"] + r["kernels_g_s"], 3)
+        # the build's parts on rank 0 (logs since 2026-12-03: 'kernels T s: integrals a s, ...'), both sides summed,
+        # and the weights (the kernels' bytes written) per side: kernels_weights_h_s, kernels_weights_g_s
+        for part in ("integrals", "planes", "transforms", "weights"):
+            v = re.findall(rf"kernels [\d.e+-]+ s: .*?\b{part} ([\d.e+-]+) s", text)
+            if v:
+                r[f"kernels_{part}_s"] = round(sum(float(x) for x in v), 3)
+                if part == "weights":
+                    r["kernels_weights_h_s"] = float(v[0])
+                    r["kernels_weights_g_s"] = float(v[1]) if len(v) > 1 else 0.0
     else:
         m = re.search(r"stored (\S+) GB", text)
         r["stored_GB"] = float(m.group(1)) if m else ""

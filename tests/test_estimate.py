@@ -343,6 +343,15 @@ def test_the_toeplitz_tables_kernel_seconds_are_both_sides(tmp_path):
     assert (r["kernels_h_s"], r["kernels_g_s"]) == (3.01, 0.424)
     assert r["kernels_s"] == pytest.approx(3.434) and r["stored_GB"] == pytest.approx(0.803)
     assert (r["dofs"], r["steps"], r["store"]) == (4107, 159, "toeplitz")
+    # since 2026-12-03 the line gives each side's build by parts (rank 0's seconds): the same totals, the parts summed
+    log.write_text(log.read_text().replace("kernels 3.01 s)", "kernels 3.01 s: integrals 1 s, planes 0.5 s, "
+                                           "transforms 1.25 s, weights 0.125 s)")
+                   .replace("kernels 0.424 s,", "kernels 0.424 s: integrals 0.25 s, planes 0.0625 s, transforms "
+                            "0.0625 s, weights 0.03125 s,"))
+    r = row(str(log))
+    assert (r["kernels_h_s"], r["kernels_g_s"]) == (3.01, 0.424) and r["stored_GB"] == pytest.approx(0.803)
+    assert [r[f"kernels_{k}_s"] for k in ("integrals", "planes", "transforms", "weights")] == \
+        pytest.approx([1.25, 0.5625, 1.3125, 0.15625], abs=1e-3)
 
 
 def test_a_partial_benchmark_rerun_keeps_the_other_rows():

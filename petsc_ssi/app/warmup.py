@@ -149,10 +149,10 @@ def _single_kernels():
     for dt in (np.float64, np.float32):          # (the toeplitz store's per-step helpers; single kept states)
         put_state_grid(np.zeros((9, 3, 1, 1), complex), np.zeros((1, 1, 9, 2, FW), dt), np.zeros((1, 1, 18, 2, FW), dt), 0)
     unpack_grid(np.zeros((1, 1, 12, 2, FW)), 8, np.zeros((0, 0), complex), np.zeros((12, 1, 1), complex))
-    from ..bem.lanes import add_spectra           # (the toeplitz kernels' fill: real and complex spectra)
+    from ..bem.lanes import put_spectra           # (the toeplitz kernels' fill: real and complex spectra)
     idx, sel = np.zeros((1, 1), np.int64), np.zeros(1, np.int64)
     for kp, dt in ((1, np.float64), (2, np.complex128)):
-        add_spectra(np.zeros((1, 1, 1, kp, FW)), 0, np.zeros((1, 1, 1), dt), sel, idx, np.ones(1))
+        put_spectra(np.zeros((1, 1, 1, kp, FW)), 0, np.zeros((1, 1, 1), dt), sel, idx, np.ones(1))
     from ..bem.lanes import scatter_slots         # (a state onto the toeplitz store's grid: read-only or not)
     for xx in (np.ones((1, 3)), x.reshape(1, 3)):
         scatter_slots(xx, np.zeros((1, 9), np.int64), np.ones((1, 3)), np.zeros(1, np.int64), np.zeros(1, np.int64),

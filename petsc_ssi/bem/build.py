@@ -292,15 +292,15 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     tz_bytes = sum(t.bytes for t in march.toeplitz)
     mem = mem_g + tz_bytes
     gside = (f"; G lags as {march.toeplitz[1].D} kernels on the traction elements' {glat.in_n[0]} x "
-             f"{glat.in_n[1]} window (FFT grid {glat.Mx} x {glat.My}, kernels {march.toeplitz[1].t_build:.3g} s, "
+             f"{glat.in_n[1]} window (FFT grid {glat.Mx} x {glat.My}, {march.toeplitz[1].build_text()}, "
              f"{march.toeplitz[1].bytes / 1e9:.3g} GB)"
              if glat is not None else "")
     printf(f"[ssi] assembly {fmt_time(t_asm)}: lag store toeplitz on the {prob.lattice.describe()}: "
            f"{th.D} history kernels K'_d in Fourier space"
            + (f" and the {th.k} interpolating matrices' kernels (the far lags' states weighted per step, {th.R} "
               "steps kept)" if th.k else "")
-           + f" ({th.bytes / 1e9:.3g} GB with the kept states' transforms; kernels "
-           f"{th.t_build:.3g} s){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
+           + f" ({th.bytes / 1e9:.3g} GB with the kept states' transforms; "
+           f"{th.build_text()}){gside}, step matrix and G lags 1-2 {mem_g / 1e9:.3g} GB, "
            f"{ls.kernel_evaluations:.3g} kernel evaluations; kept transforms in "
            f"{cfg.get('toeplitz_precision', 'double')} precision (-ssi_toeplitz_precision)"
            + "".join(f"; {t.spec['what']} kernels real (point-symmetric offsets: half the products)"

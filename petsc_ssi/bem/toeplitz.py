@@ -57,7 +57,7 @@ from ..petsc import SSIError, printf, init
 from ..monitor import event
 from .assemble import _pair_window
 from .pfft import slab_counts
-from .lanes import (FW, n_groups, padded, add_spectra, history_lanes, interp_lanes, interp_flops,
+from .lanes import (FW, n_groups, padded, put_spectra, history_lanes, interp_lanes, interp_flops,
                     scatter_slots, put_state_grid, unpack_grid, CHUNK_GROUPS)
 
 # the nine node positions of an element relative to its centre, in half element sizes
@@ -586,6 +586,10 @@ class ToeplitzHistory:
         self.fft = SlabFFT(comm.tompi4py(), lat.Mx, lat.My, fft_ranks)
         self.f0, self.f1 = self.fft.f0, self.fft.f1
         self.upto = 0
+        # this rank's seconds of the build's parts (the log's breakdown, ``build_text``; the model's terms,
+        # ``estimate``): the element integrals, their scatter into the chunk's planes, the planes' sums over the
+        # ranks and their transforms (``_reduce_transform``), and the spectra written into the kernels' lanes
+        self.phases = dict.fromkeys(("integrals", "planes", "transforms", "weights"), 0.0)
 
     # ---------------------------------------------------------------- kernels
     def _integrate(self, lag_lo, c_lo, c_hi, toff, L, sel):
@@ -648,16 +652,23 @@ class ToeplitzHistory:
         t = self.offsets[:, 2]
         kx = np.mod(self.offsets[:, 3] + lat.in_lo[0], lat.Mx)      # (inputs placed from lattice index in_lo)
         ky = np.mod(self.offsets[:, 4] + lat.in_lo[1], lat.My)
+        ph = self.phases
         for c_lo in range(lag_lo, lag_hi + 1, chunk):
             c_hi = min(lag_hi, c_lo + chunk - 1)
+            t0 = time.perf_counter()
             idx, meta, offP, P = self._integrate(lag_lo, c_lo, c_hi, toff, L, sel)
+            t1 = time.perf_counter()
             mine[:] = -1
             mine[idx] = np.arange(len(idx))
             Kp = np.zeros((c_hi - c_lo + 1, 4, 5 if self.real else 9, m, lat.Mx, lat.My))
             _scatter_kernels(Kp, c_lo, mine[self.mirror_of], self.flip, meta, offP, P, t, kx, ky, lat.code0,
                              MIRROR_SLOTS, self.mirror_signs)
+            t2 = time.perf_counter()
             S = self._reduce_transform(Kp)
             Kp = None
+            ph["integrals"] += t1 - t0
+            ph["planes"] += t2 - t1
+            ph["transforms"] += time.perf_counter() - t2
             for i in range(c_hi - c_lo + 1):
                 yield c_lo + i, S[i]
             S = None
@@ -722,6 +733,7 @@ class ToeplitzHistory:
         self.rot_k = self._rotation(+1) if self.real else None
         self.dropped = self.kept = 0.0
         self.nev = 0
+        self.phases = dict.fromkeys(self.phases, 0.0)
         by_key = self._terms(march)
         D = max([d for (kind, _), v in by_key.items() if kind == "x" for d, _ in v] + [0])
         self.D = D
@@ -769,6 +781,12 @@ class ToeplitzHistory:
         self.bytes = mpi.allreduce(sum(a.nbytes for a in (self.K9, self.K18, self.A9, self.A18, self.V9, self.V18)))
         return self
 
+    def build_text(self):
+        """'kernels T s: integrals a s, planes b s, transforms c s, weights d s': the build's wall and this rank's
+        parts (``phases``; the rest, the set-up and the kernels' release, is the difference)."""
+        parts = ", ".join(f"{k} {v:.3g} s" for k, v in self.phases.items())
+        return f"kernels {self.t_build:.3g} s: {parts}"
+
     def _fill_kernels(self, by_key, plan, kernels=None):
         """Collective: K9, K18 (the exact lags' kernels, ``by_key``'s terms ("x", lag): [(d, c)], each lag's
         spectra weighted into the time distances d it serves) and A9, A18 (the interpolating matrices' anchors,
@@ -805,14 +823,16 @@ class ToeplitzHistory:
             for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
                 if ("x", lag) not in by_key:
                     continue
+                t0 = time.perf_counter()
                 if src is None:
                     src = np.empty((ring, 4 * 9 * S.shape[2], S.shape[-1]), np.float64 if self.real else np.complex128)
                 self._source(S, out=src[lag % ring])
                 for d in sorted(last.get(lag, ())):
                     sel = np.array([l_ % ring for l_, _ in into[d]], np.int64)
                     c = np.array([c for _, c in into[d]])
-                    add_spectra(self.K9, 9 * (D - d), src, sel, self._idx[0], c)
-                    add_spectra(self.K18, 18 * (D - d), src, sel, self._idx[1], c)
+                    put_spectra(self.K9, 9 * (D - d), src, sel, self._idx[0], c)
+                    put_spectra(self.K18, 18 * (D - d), src, sel, self._idx[1], c)
+                self.phases["weights"] += time.perf_counter() - t0
             src = None
         slot0, one = np.zeros(1, np.int64), np.ones(1)          # (an anchor's kernel: its one lag, weight 1)
         for i in range(plan_k):
@@ -820,9 +840,11 @@ class ToeplitzHistory:
                 continue
             lag, toff = plan.kernel_time(i)
             for _, S in self._spectra(lag, lag, toff, lag):
+                t0 = time.perf_counter()
                 src = self._source(S)[None]
-                add_spectra(self.A9, 9 * i, src, slot0, self._idx[0], one)
-                add_spectra(self.A18, 18 * i, src, slot0, self._idx[1], one)
+                put_spectra(self.A9, 9 * i, src, slot0, self._idx[0], one)
+                put_spectra(self.A18, 18 * i, src, slot0, self._idx[1], one)
+                self.phases["weights"] += time.perf_counter() - t0
 
     def _rotation(self, sign):
         """(4, frequencies) complex: exp(sign i psi_t(f)) per class t over this rank's slab,
@@ -841,7 +863,7 @@ class ToeplitzHistory:
 
     def _source(self, S, out=None):
         """One lag's spectra S (4 classes, 9 slots, m entries, slab) as the rows (class, slot, entry) x slab that
-        ``lanes.add_spectra`` adds into the kernels' lanes by ``_idx`` (``_kernel_blocks``' rows and columns):
+        ``lanes.put_spectra`` writes into the kernels' lanes by ``_idx`` (``_kernel_blocks``' rows and columns):
         complex, or on a point-symmetric grid real from the slots 0..4 only (S (4, 5, m, slab)): with
         h = exp(i psi_t) (``_rotation``) and the sign s of the point reflection (``point_sign``), the pair
         (a, 8 - a), a < 4, has h (K_a + s K_{8-a}) / 2 = Re(h K_a) and h (K_a - s K_{8-a}) / 2 = i Im(h K_a)

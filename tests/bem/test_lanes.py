@@ -249,13 +249,14 @@ def test_lag_file_layout_is_any_rank_counts():
 
 @pytest.mark.parametrize("real", [True, False])
 @pytest.mark.parametrize("m", [4, 5])
-def test_add_spectra_is_the_lanes_of_the_blocks(real, m):
-    """``add_spectra`` (the toeplitz build's kernels filled from the lags' spectra without copies) gives the bits of
-    the arrays it replaced: ``K[:, r0:r0 + n] += c * to_lanes(block)`` of ``toeplitz._kernel_blocks``' blocks, lag
-    after lag, for the H (m = 4) and G (m = 5) patterns, real and complex kernels, row blocks weighing one, two
-    and three slots of a ring (one twice), a row block added to twice (adds, not overwrites) and a slab that is not
-    whole lane groups (its padding lanes stay zero)."""
-    from petsc_ssi.bem.lanes import add_spectra, to_lanes, to_lanes_real, n_groups, FW
+def test_put_spectra_is_the_lanes_of_the_blocks(real, m):
+    """``put_spectra`` (the toeplitz build's kernels filled from the lags' spectra without copies) gives the bits of
+    the arrays it replaced: ``K[:, r0:r0 + n] = 0; K[:, r0:r0 + n] += c * to_lanes(block)`` of
+    ``toeplitz._kernel_blocks``' blocks, term after term, for the H (m = 4) and G (m = 5) patterns, real and complex
+    kernels, row blocks weighing one, two and three slots of a ring (one twice), a row block written twice (the
+    second write replaces the first: a put, not an add; the build writes each once), a slab that is not whole lane
+    groups (its padding lanes stay zero) and an empty slab (a rank without frequencies)."""
+    from petsc_ssi.bem.lanes import put_spectra, to_lanes, to_lanes_real, n_groups, FW
     from petsc_ssi.bem.toeplitz import _kernel_blocks
     rng = np.random.default_rng(5)
     slab, D = 3 * FW + 5, 4
@@ -269,9 +270,12 @@ def test_add_spectra_is_the_lanes_of_the_blocks(real, m):
         K = np.zeros((n_groups(slab), D * rows, B.shape[1], kp, FW))
         ref = K.copy()
         for d, sel, c in ((1, [2], [0.75]), (2, [0, 1], [-1.5, 0.3]), (3, [1, 2, 1], [1.0, -0.25, 2.0]), (1, [0], [2.0])):
-            add_spectra(K, rows * d, src, np.array(sel, np.int64), B, np.array(c))
+            put_spectra(K, rows * d, src, np.array(sel, np.int64), B, np.array(c))
+            ref[:, rows * d:rows * (d + 1)] = 0.0
             for t, ct in zip(sel, c):
                 blk = np.stack([src[t][B, f] for f in range(slab)])     # (slab, rows, columns): the block's values
                 ref[:, rows * d:rows * (d + 1)] += ct * lanes(blk)
         assert np.array_equal(K, ref)
-        assert not K[-1, :, :, :, slab % FW:].any() and not K[:, :rows].any()
+        assert K[:, rows:].any() and not K[-1, :, :, :, slab % FW:].any() and not K[:, :rows].any()
+        empty = np.zeros((0, D * rows, B.shape[1], kp, FW))
+        put_spectra(empty, rows, src[:, :, :0], np.zeros(1, np.int64), B, np.ones(1))     # (nothing to write)

@@ -225,7 +225,7 @@ def test_estimate_on_the_toeplitz_store(tmp_path):
     import re
     stored = float(re.search(r"\(([\d.e+-]+) GB with the kept states' transforms", out).group(1))
     g_stored = float(re.search(r"G lags as \d+ kernels on the traction elements' 2 x 2 window \(FFT grid 6 x 6, "
-                               r"kernels [\d.e+-]+ s, ([\d.e+-]+) GB\)", out).group(1))
+                               r"kernels [\d.e+-]+ s: [^)]*?, ([\d.e+-]+) GB\)", out).group(1))
 
     class Lat:
         Mx, My = 8, 8           # the 4 x 4 grid's FFT grid (2 n)
@@ -272,6 +272,7 @@ def test_fill_kernels_equals_the_lane_arrays_lag_by_lag(monkeypatch, real):
     th = object.__new__(tz.ToeplitzHistory)
     th.spec, th.real, th.sg, th.dropped, th.kept, th._idx = tz.SIDES["u"], real, -1, 0.0, 0.0, None
     th.rot_k = np.exp(1j * rng.uniform(0, 6.3, (4, slab)))
+    th.phases = dict.fromkeys(("integrals", "planes", "transforms", "weights"), 0.0)     # (``__init__``'s)
     by_key = {}
     for lag in range(1, L + 1):
         for d, c in ((lag - 1, -0.5), (lag, 1.25), (lag + 1, 0.375)) + (((lag, 0.5),) if lag == 4 else ()):
