@@ -10,8 +10,10 @@ runs (jobscripts/toeplitz_bench.sh), and print the model against each log.
 Each log's option table rebuilds its set-up in this process (no assembly: the lattice, the interpolation
 plan, the traction window), as `petsc-ssi estimate` does; ``toeplitz.estimate`` is then evaluated with one
 rate at a time to get each term's count, and the rates are fitted by non-negative least squares on
-relative errors: the kernels' build per side (t_pair_lag, seconds per H kernel offset and lag, against the
-H side's 'kernels ... s'; g_pair_factor, a G offset's seconds over an H offset's, against the G side's), the
+relative errors: the kernels' build per side (t_kernel_byte, seconds per byte of the kernels a rank writes,
+against both sides' 'weights' where the logs give the build's parts, else fitted with the next; t_pair_lag,
+seconds per H kernel offset and lag, against the rest of the H side's 'kernels ... s'; g_pair_factor, a G
+offset's seconds over an H offset's, against the rest of the G side's), the
 history sum (event SSI_BEM_History) against the products (1 / r_products), the
 per-step DOF term (t_step_dof), the per-step FFT-grid term (t_step_grid) and r_sums (the interpolated lags'
 weighted states anchor by anchor: multi-linear hats, the sites); r_sums_span (over the anchors' common span: Chebyshev)
@@ -58,15 +60,16 @@ def terms(opts, ranks):
     kw = dict(plan=plan, stabilized=cfg.scheme.startswith("stabili"), glat=glat,
               single=cfg.get("toeplitz_precision", "double") == "single")
     zero = {"r_products": big, "r_sums": big, "r_sums_span": big, "t_step_dof": 0.0, "t_step_grid": 0.0,
-            "t_step_elem": 0.0, "t_pair_lag": 0.0, "t_pair_int": 0.0}
+            "t_step_elem": 0.0, "t_pair_lag": 0.0, "t_kernel_byte": 0.0}
     one = lambda **r: estimate(*args, rates=dict(zero, **r), **kw)
     # the kernels' build per side: H's offsets and lags (glat=None) and G's, unweighted (g_pair_factor 1)
-    # (two terms: the planes' work, t_pair_lag, 5 of 9 slots with real kernels, and the integrals', t_pair_int)
+    # (two terms: the integrals and planes, t_pair_lag, 5 of 9 slots with real kernels, and the kernels' bytes a
+    # rank writes, t_kernel_byte)
     pairs_h = estimate(*args, rates=dict(zero, t_pair_lag=1.0), **dict(kw, glat=None))[1]
     pairs_g = one(t_pair_lag=1.0, g_pair_factor=1.0)[1] - pairs_h
-    int_h = estimate(*args, rates=dict(zero, t_pair_int=1.0), **dict(kw, glat=None))[1]
-    int_g = one(t_pair_int=1.0, g_pair_factor=1.0)[1] - int_h
-    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "int_h": int_h, "int_g": int_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
+    bytes_h = estimate(*args, rates=dict(zero, t_kernel_byte=1.0), **dict(kw, glat=None))[1]
+    bytes_g = one(t_kernel_byte=1.0)[1] - bytes_h
+    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "bytes_h": bytes_h, "bytes_g": bytes_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2],
             "sums": one(r_sums=RATES["r_sums"], r_sums_span=RATES["r_sums_span"])[2],
             # the weighted states anchor by anchor (multi-linear hats), flops a rank
@@ -114,7 +117,7 @@ def main(logs, check=False, products_rate=None):
     hist = np.array([r["history_s"] for _, r, _ in runs], float)
     if check:
         fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
-                                     "t_pair_int", "g_pair_factor", "r_sums")}
+                                     "t_kernel_byte", "g_pair_factor", "r_sums")}
     else:
         # the history less the weighted states over a common span (Chebyshev, at the committed r_sums_span, refitted
         # below from its own event); the anchor-by-anchor weighted states (multi-linear: the sites) fitted as r_sums
@@ -131,13 +134,30 @@ def main(logs, check=False, products_rate=None):
         fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
                "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
                "r_sums": 1.0 / inv_s if inv_s > 0 else RATES["r_sums"]}
-        fit["t_pair_lag"], fit["t_pair_int"] = (float(v) for v in _nnls(
-            np.array([[t["pairs_h"], t["int_h"]] for *_, t in runs]), kh))
-        # G's offsets against the G side's own seconds (the logs that print them): one factor on both terms
+        bh = np.array([t["bytes_h"] for *_, t in runs])
+        bg = np.array([t["bytes_g"] for *_, t in runs])
+        if all("kernels_weights_h_s" in r for _, r, _ in runs):
+            # the logs give the build's parts (since 2026-12-03): t_kernel_byte from the weights (the kernels
+            # written) of both sides, t_pair_lag from the rest of the H side's build
+            wh = np.array([r["kernels_weights_h_s"] for _, r, _ in runs])
+            wg = np.array([r["kernels_weights_g_s"] for _, r, _ in runs])
+            # (least squares on the seconds, not their ratios: the first write of fresh memory, which this term
+            # mostly is, costs more a byte the more the run needs (0.9-1.5 s/GB at 0.1-0.3 GB a rank, 3.6-4.6 s/GB at
+            # 0.9-3 GB on this VM, 2026-12-03), and the runs where the term matters are the large ones)
+            sel = bg > 0
+            x, y = np.r_[bh, bg[sel]], np.r_[wh, wg[sel]]
+            fit["t_kernel_byte"] = float(max(x @ y / (x @ x), 0.0))
+            fit["t_pair_lag"] = float(_nnls(np.array([[t["pairs_h"]] for *_, t in runs]), kh - wh)[0])
+        else:
+            fit["t_pair_lag"], fit["t_kernel_byte"] = (float(v) for v in _nnls(
+                np.array([[t["pairs_h"], t["bytes_h"]] for *_, t in runs]), kh))
+        # G's offsets against the G side's own seconds less its bytes' (the logs that print them)
         gsel = [i for i, (*_, t) in enumerate(runs) if t["pairs_g"] > 0 and kg[i] > 0]
-        gx = np.array([[fit["t_pair_lag"] * runs[i][2]["pairs_g"] + fit["t_pair_int"] * runs[i][2]["int_g"]]
+        gx = np.array([[fit["t_pair_lag"] * runs[i][2]["pairs_g"]] for i in gsel])
+        parts = all("kernels_weights_g_s" in r for _, r, _ in runs)
+        gy = np.array([kg[i] - runs[i][1]["kernels_weights_g_s"] if parts else max(kg[i] - fit["t_kernel_byte"] * bg[i], 1e-3)
                        for i in gsel])
-        fit["g_pair_factor"] = float(_nnls(gx, kg[gsel])[0]) if gsel and gx.any() else RATES["g_pair_factor"]
+        fit["g_pair_factor"] = float(_nnls(gx, gy)[0]) if gsel and gx.any() else RATES["g_pair_factor"]
     # r_sums_span from the logs whose far lags weigh states over a common span (Chebyshev): the span's flops
     # over the event SSI_BEM_HistInterp less its anchors' kernel products at r_products; the median of the logs
     spans = []
@@ -154,7 +174,7 @@ def main(logs, check=False, products_rate=None):
     print("|---|---|---|---|---|---|")
     for (path, r, t), k, h in zip(runs, kern, hist):
         mk = (fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
-              + fit["t_pair_int"] * (t["int_h"] + fit["g_pair_factor"] * t["int_g"]))
+              + fit["t_kernel_byte"] * (t["bytes_h"] + t["bytes_g"]))
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
               + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"])
         ms = 1e3 * t["solve"]

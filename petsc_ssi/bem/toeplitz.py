@@ -190,34 +190,38 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # cost model (``estimate``). The time rates r_products (the history's complex products per rank: the
 # block products' flops over this rate), the per-step work of every rank that is not split over the ranks
 # (t_step_dof a DOF, t_step_grid an FFT grid point, t_step_elem a virtual element: the state's gather, the
-# 27 + 12 transforms and their inputs element by element, images included; fitted while every rank made
-# every transform: since the transforms go over the ranks, ``pfft``, not refitted), t_pair_lag (seconds per H
-# kernel offset and lag of the kernels' integration) and g_pair_factor (a G offset's cost in H offsets: the
-# displacement kernel's integrals beside the traction kernel's) are fitted by `python
-# jobscripts/toeplitz_fit.py` (free; r_products and the per-step terms are nearly collinear on these logs, so
-# their split is loose, their sum is what the logs fix) to the 10 logs of `PARTS="paper grid site" SITE_SIZES="40
-# 60 80" SITE_EXACT="" OUT=<dir> bash jobscripts/quiet.sh bash jobscripts/toeplitz_bench.sh` (grids of 24-64 m,
-# the paper's quarter and whole models, the sites of 40-80 m with multi-linear far lags and single-precision
-# transforms) and of the building on the uniform 72 m grid (`OUT=<dir> RUNS=uniform-72-area-exact bash
-# jobscripts/quiet.sh bash jobscripts/building_uniform.sh`), 2 ranks, every other process paused, 2026-12-01
-# 23:26-23:30, code at 5543d9d (history blocks of 16 steps, the kernels filled a row block in one pass): kernels
-# from -23 % to +10 %, history from -12 % to +6 % of each log (the rates before, fitted 2026-11-30 at blocks of
-# 8, put these histories +28 % to +98 % over; t_step_grid, t_step_elem and t_pair_int fitted to 0: collinear with
-# t_step_dof and t_pair_lag). The fit holds for the machine's hour: the same runs took up to twice as long in
-# the slow spells of 2026-11-30 and 2026-12-01 (runs/building/README.md). The kernels' time is two terms an offset and lag: t_pair_lag its planes' scatter, transforms
-# and exchange (9 slots; 5 on a real side), t_pair_int its share of the integrals. The kernels are fitted per side (the log's H and G
-# seconds). r_sums, the real flops per second of the interpolated lags' weighted states anchor by anchor
-# (``interp_products``: the multi-linear weights, small products), fitted with the history's other terms
-# (the sites' logs; 4.69e9 before, from three sites on a shared machine, which left the sites' history +66 to
-# +80 % over the measured). r_sums_span prices Chebyshev's, every anchor over the common span of states (one larger product a
-# frequency, or two through the weights' rank, ``_low_rank``): the median over the logs that have it of the
-# span's flops, as ``interp_work`` counts them, over the event SSI_BEM_HistInterp less its anchors' modelled
-# kernel products (a model rate above dgemm's: the anchors' products are priced at r_products, slower than
-# they run). fill_bytes: the step matrix's LU factors (MUMPS) per DOF and
-# ln(DOF) (nested dissection of a surface grid: N log N entries; from one run, the 100 m site's two steps:
-# 4.46 GB peak over the ranks with 2.16 GB estimated before this term, 2.3 GB of factors)
-RATES = {"r_products": 1.45e10, "t_step_dof": 2.36e-7, "t_step_grid": 0.0, "t_step_elem": 0.0,
-         "t_pair_lag": 1.43e-6, "t_pair_int": 0.0, "r_sums": 8.5e10, "fill_bytes": 1620.0, "g_pair_factor": 1.17,
+# 27 + 12 transforms' inputs element by element, images included), the kernels' build (t_pair_lag: seconds per H
+# kernel offset and lag of its integrals, its planes' scatter, transforms and exchange, for 9 slots, 5 on a real
+# side; g_pair_factor: a G offset's cost in H offsets; t_kernel_byte: seconds per byte of a side's kernels a rank
+# writes, ``lanes.put_spectra``, which on this VM is mostly the first write of fresh memory, the host's pages)
+# are fitted by `python jobscripts/toeplitz_fit.py` (r_products and the per-step terms are nearly collinear, so
+# their split is loose, their sum is what the logs fix; t_kernel_byte to the logs' 'weights' seconds, t_pair_lag
+# and g_pair_factor to the rest of each side's build, the log's parts of 'kernels T s: integrals ...') to the 13
+# logs of `PARTS="paper grid site" SITE_SIZES="40 60 80" SITE_EXACT="" OUT=<dir> bash jobscripts/quiet.sh bash
+# jobscripts/toeplitz_bench.sh` (grids of 24-64 m, the paper's quarter and whole models, the sites of 40-80 m with
+# multi-linear far lags and single-precision transforms) and of `OUT=<dir> RUNS="uniform-36-smooth
+# uniform-72-area-exact uniform-72-smooth uniform-108-smooth" bash jobscripts/quiet.sh bash
+# jobscripts/building_uniform.sh` (the building on uniform grids of 36-108 m, every lag exact), 2 ranks, the
+# machine otherwise idle, 2026-12-03 14:10-14:18, code as committed with these rates (transforms over the ranks
+# through mpi4py-fft, ``pfft``; history blocks of 16 steps). Kernels from -3 % to +82 % of each log, history from
+# -18 % to +19 %. t_kernel_byte is fitted to the seconds, not their ratios: a byte's first write cost 0.9-1.5 s/GB
+# where a rank wrote 0.1-0.3 GB and 3.6-4.6 s/GB where it wrote 0.9-3 GB, so the large runs, where the term
+# matters, are within -5 % to +21 % (the building at 72 m -2 %, at 108 m -5 %) and the small ones over by 0.1-1.1 s
+# (the paper's quarter model +65 %, the building at 36 m +82 %). Before it (t_pair_lag alone, fitted 2026-12-01
+# before the transforms went over the ranks) the building's kernels at 72 m and 108 m were -41 % and -49 % of these
+# logs. The fit holds for the machine's hour: the same runs took up to twice as long in the slow spells of
+# 2026-11-30 and 2026-12-01 (runs/building/README.md). r_sums, the real flops per second of the interpolated lags'
+# weighted states anchor by anchor (``interp_products``: the multi-linear weights, small products), fitted with
+# the history's other terms (the sites' logs). r_sums_span prices Chebyshev's, every anchor over the common span
+# of states (one larger product a frequency, or two through the weights' rank, ``_low_rank``): the median over
+# the logs that have it of the span's flops, as ``interp_work`` counts them, over the event SSI_BEM_HistInterp
+# less its anchors' modelled kernel products (a model rate above dgemm's: the anchors' products are priced at
+# r_products, slower than they run; not refitted 2026-12-03: no log of the fit has a Chebyshev span).
+# fill_bytes: the step matrix's LU factors (MUMPS) per DOF and ln(DOF) (nested dissection of a surface grid:
+# N log N entries; from one run, the 100 m site's two steps: 4.46 GB peak over the ranks with 2.16 GB estimated
+# before this term, 2.3 GB of factors)
+RATES = {"r_products": 1.4e10, "t_step_dof": 3.58e-7, "t_step_grid": 0.0, "t_step_elem": 5.88e-7,
+         "t_pair_lag": 1.25e-6, "t_kernel_byte": 4.2e-9, "r_sums": 1e11, "fill_bytes": 1620.0, "g_pair_factor": 1.19,
          "r_sums_span": 4.82e10}
 # The step matrix's LU on a uniform grid (``step_lu``, ``step_lu_of``: the estimate's factor_s and solve_s and the runs'
 # loop predictions, BEM and coupled, where the dense
@@ -417,10 +421,10 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         build = max(build, ranks * copies * per_lag * max(1, min(D + k, int(chunk_bytes(kern / ranks) // per_lag))))
         nbytes += kern + vbytes * Fl * 27 * W
         pairs = g.n_offsets if hasattr(g, "n_offsets") else 4 * (2 * g.nx) * (2 * g.ny)
-        # (an offset and lag: its share of the integrals, a quarter at the mirror offsets, t_pair_int, and its
-        # planes' scatter, transforms and exchange, t_pair_lag for 9 slots: 5 of them with real kernels)
-        t_build += ((r["t_pair_lag"] * (5.0 if kp == 1.0 else 9.0) / 9.0 + r["t_pair_int"]) * pairs * (D + k) / ranks
-                    * (r["g_pair_factor"] if m == 180 else 1.0))
+        # (an offset and lag: its integrals, its planes' scatter, transforms and exchange, t_pair_lag for 9 slots: 5 of
+        # them with real kernels; and the kernels' bytes, each written once into fresh memory, t_kernel_byte)
+        t_build += (r["t_pair_lag"] * (5.0 if kp == 1.0 else 9.0) / 9.0 * pairs * (D + k) / ranks
+                    * (r["g_pair_factor"] if m == 180 else 1.0) + r["t_kernel_byte"] * kern / ranks)
         ramp += 4.0 * kp * m * Fl * (np.minimum(np.maximum(n - 1, 0), D) + k * isteps / max(n_steps, 1))
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
