@@ -6,7 +6,6 @@ roof's accelerations and twist (site-oblique.png in the run's directory).
 
     python runs/seismic/site_oblique_report.py out/seismic [NRANKS]
 """
-import csv
 import os
 import re
 import sys
@@ -17,6 +16,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "jobscripts"))
 from logview import parse  # noqa: E402
+sys.path.insert(0, HERE)
+from report import spectrum_peak  # noqa: E402  (runs/seismic/report.py: the spectrum's PSA peak)
 
 
 def estimate_row(path, ranks):
@@ -38,22 +39,14 @@ def _seconds(text):
     return s
 
 
-def spectrum_peak(path):
-    rows = [r for r in csv.reader(open(path)) if r and not r[0].startswith("#")]
-    head, data = rows[0], np.array(rows[1:], float)
-    k = head.index("PSA [m/s^2]")
-    i = int(np.argmax(data[:, k]))
-    return data[i, 0], data[i, k]
-
-
 def main(d, ranks=2):
     stem = os.path.join(d, f"site-oblique-n{ranks}")
     lv = parse(open(stem + ".log").read())
     ev = lv["events"]
     est_s, est_gb = estimate_row(stem + ".estimate", ranks)
     peak = (lv["peak_rss_bytes"] or np.nan) / 1e9
-    print(f"| ranks | wall [s] | BEM assembly (toeplitz kernels) [s] | interface matrices [s] | time loop [s] | "
-          f"history sum [s] | peak over the ranks [GB] | estimate: wall [s], GB |")
+    print("| ranks | wall [s] | BEM assembly (toeplitz kernels) [s] | interface matrices [s] | time loop [s] | "
+          "history sum [s] | peak over the ranks [GB] | estimate: wall [s], GB |")
     print("|---|---|---|---|---|---|---|---|")
     st = lv["stages"]
     print(f"| {ranks} | {lv['total_s']:.0f} | {st.get('SSI BEM assembly', np.nan):.1f} "
