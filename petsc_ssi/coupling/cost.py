@@ -27,9 +27,11 @@ assembles it). What the coupling adds is counted here, in three parts:
   memory       the interface matrices (``interface_bytes``) and the structure's measured growth
                times the ranks
 
-with n_I the interface nodes, N the soil nodes and N_Z those of Z's rows (N, or the region's). The constants r_cpl and c_cstep come from
-``estimate_constants.json`` ("coupled"), fitted to the coupled runs' logs by
-``jobscripts/long_record.py --fit``."""
+with n_I the interface nodes, N the soil nodes and N_Z those of Z's rows (N, or the region's). The constants r_cpl and c_cstep
+are ``FALLBACK``'s unless ``estimate_constants.json``'s constants carry them; none of its fits has (2026-12-03: no
+fit of them exists, and on the 28.8 m building of runs/seismic/site-oblique.opts, 1813 interface nodes, they put
+the coupled loop at 183 s against 115 s measured; runs/seismic/README.md). The structure's solve t_fs is timed on
+the estimate's own ranks (one, from the command line) and used at every rank count."""
 import statistics
 import time
 
