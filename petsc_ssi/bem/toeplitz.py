@@ -203,13 +203,13 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # uniform-72-area-exact uniform-72-smooth uniform-108-smooth" bash jobscripts/quiet.sh bash
 # jobscripts/building_uniform.sh` (the building on uniform grids of 36-108 m, every lag exact), 2 ranks, the
 # machine otherwise idle, 2026-12-03 14:10-14:18, code as committed with these rates (transforms over the ranks
-# through mpi4py-fft, ``pfft``; history blocks of 16 steps). Kernels from -3 % to +82 % of each log, history from
+# through mpi4py-fft, ``pfft``; history blocks of 16 steps). Kernels from -5 % to +81 % of each log, history from
 # -18 % to +19 %. t_kernel_byte is fitted to the seconds, not their ratios: a byte's first write cost 0.9-1.5 s/GB
 # where a rank wrote 0.1-0.3 GB and 3.6-4.6 s/GB where it wrote 0.9-3 GB, so the large runs, where the term
-# matters, are within -5 % to +21 % (the building at 72 m -2 %, at 108 m -5 %) and the small ones over by 0.1-1.1 s
-# (the paper's quarter model +65 %, the building at 36 m +82 %). Before it (t_pair_lag alone, fitted 2026-12-01
-# before the transforms went over the ranks) the building's kernels at 72 m and 108 m were -41 % and -49 % of these
-# logs. The fit holds for the machine's hour: the same runs took up to twice as long in the slow spells of
+# matters, are within -5 % to +21 % (the building at 72 m -3 %, at 108 m -5 %) and the small ones over by 0.1-1.1 s
+# (the paper's quarter model +65 %, the building at 36 m +81 %). Before it (t_pair_lag alone, fitted 2026-12-01
+# before the transforms went over the ranks) the building's kernels at 72 m and 108 m were -43 % and -45 % of these
+# logs. A run of 1000 steps (runs/seismic/site-oblique.opts, not in the fit) has its history sum 58 % over. The fit holds for the machine's hour: the same runs took up to twice as long in the slow spells of
 # 2026-11-30 and 2026-12-01 (runs/building/README.md). r_sums, the real flops per second of the interpolated lags'
 # weighted states anchor by anchor (``interp_products``: the multi-linear weights, small products), fitted with
 # the history's other terms (the sites' logs). r_sums_span prices Chebyshev's, every anchor over the common span
@@ -428,7 +428,7 @@ def estimate(lat, L, n_steps, ranks=1, block=BLOCK, n_dofs=0, g_bytes=0.0, rates
         ramp += 4.0 * kp * m * Fl * (np.minimum(np.maximum(n - 1, 0), D) + k * isteps / max(n_steps, 1))
         sums += 2.0 * 54 * Fl * iwork
         sums_span += 2.0 * 54 * Fl * ispan
-    # per step, on every rank (as fitted, before the transforms went over the ranks): the state's gather and the G
+    # per step, on every rank (fitted 2026-12-03 with the transforms over the ranks): the state's gather and the G
     # products (t_step_dof a DOF), the 27 + 12
     # transforms over the FFT grids of both sides (t_step_grid a grid point) and the transforms' inputs
     # element by element (t_step_elem a virtual element: a symmetric model's images count, so its step
@@ -824,7 +824,8 @@ class ToeplitzHistory:
                 last.setdefault(v[-1][0], []).append(d)
             ring = 1 + max(v[-1][0] - v[0][0] for v in into.values())
             src = None
-            for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):
+            assert all(1 <= d <= D for d in into), "toeplitz: a distance outside the kernels' rows"   # (put_spectra
+            for lag, S in self._spectra(1, max(exact), 0.0, max(exact)):                         # checks no bounds)
                 if ("x", lag) not in by_key:
                     continue
                 t0 = time.perf_counter()

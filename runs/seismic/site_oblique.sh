@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A 28.8 m x 21.6 m building on a 72 m x 72 m site under an oblique SV wave (runs/seismic/site-oblique.opts;
 # runs/seismic/README.md, "A large building on a large site, an oblique wave"): petsc-ssi estimate beside it, the
-# run with -log_view -memory_view, the roof's response spectra (x and y), and report.py's table of the run.
+# run with -log_view -memory_view, the roof's response spectra (x and y), and site_oblique_report.py's tables.
 #   bash runs/seismic/site_oblique.sh [NRANKS] [extra PETSc/-ssi_ options]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."

@@ -45,7 +45,8 @@ def main(d, ranks=2):
     ev = lv["events"]
     est_s, est_gb = estimate_row(stem + ".estimate", ranks)
     peak = (lv["peak_rss_bytes"] or np.nan) / 1e9
-    print("| ranks | wall [s] | BEM assembly (toeplitz kernels) [s] | interface matrices [s] | time loop [s] | "
+    print("| ranks | wall [s] | BEM assembly (of it: toeplitz kernels) [s] | of the assembly: interface matrices [s] | "
+          "time loop [s] | "
           "history sum [s] | peak over the ranks [GB] | estimate: wall [s], GB |")
     print("|---|---|---|---|---|---|---|---|")
     st = lv["stages"]
