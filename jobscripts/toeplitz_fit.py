@@ -69,7 +69,9 @@ def terms(opts, ranks):
     pairs_g = one(t_pair_lag=1.0, g_pair_factor=1.0)[1] - pairs_h
     bytes_h = estimate(*args, rates=dict(zero, t_kernel_byte=1.0), **dict(kw, glat=None))[1]
     bytes_g = one(t_kernel_byte=1.0)[1] - bytes_h
-    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "bytes_h": bytes_h, "bytes_g": bytes_g, "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
+    return {"pairs_h": pairs_h, "pairs_g": pairs_g, "bytes_h": bytes_h, "bytes_g": bytes_g,
+            "kept": one(t_kernel_byte=1.0)[2],      # (the kept states' transforms' first write, in the history's seconds)
+            "prod": one(r_products=1.0)[2], "dof": one(t_step_dof=1.0)[2],
             "grid": one(t_step_grid=1.0)[2], "elem": one(t_step_elem=1.0)[2],
             "sums": one(r_sums=RATES["r_sums"], r_sums_span=RATES["r_sums_span"])[2],
             # the weighted states anchor by anchor (multi-linear hats), flops a rank
@@ -119,21 +121,7 @@ def main(logs, check=False, products_rate=None):
         fit = {k: RATES[k] for k in ("r_products", "t_step_dof", "t_step_grid", "t_step_elem", "t_pair_lag",
                                      "t_kernel_byte", "g_pair_factor", "r_sums")}
     else:
-        # the history less the weighted states over a common span (Chebyshev, at the committed r_sums_span, refitted
-        # below from its own event); the anchor-by-anchor weighted states (multi-linear: the sites) fitted as r_sums
-        span_s = np.array([t["span"] for *_, t in runs]) / RATES["r_sums_span"]
-        S1 = np.array([[t["sums1"]] for *_, t in runs])
-        if products_rate:           # r_products held (the fit's products and per-step terms are nearly collinear
-            prod = np.array([t["prod"] for *_, t in runs]) / products_rate      # on few logs), the rest fitted
-            A = np.hstack([np.array([[t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
-            t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s - prod)
-            inv_r = 1.0 / products_rate
-        else:
-            A = np.hstack([np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
-            inv_r, t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s)
-        fit = {"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
-               "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
-               "r_sums": 1.0 / inv_s if inv_s > 0 else RATES["r_sums"]}
+        fit = {}
         bh = np.array([t["bytes_h"] for *_, t in runs])
         bg = np.array([t["bytes_g"] for *_, t in runs])
         if all("kernels_weights_h_s" in r for _, r, _ in runs):
@@ -158,6 +146,23 @@ def main(logs, check=False, products_rate=None):
         gy = np.array([kg[i] - runs[i][1]["kernels_weights_g_s"] if parts else max(kg[i] - fit["t_kernel_byte"] * bg[i], 1e-3)
                        for i in gsel])
         fit["g_pair_factor"] = float(_nnls(gx, gy)[0]) if gsel and gx.any() else RATES["g_pair_factor"]
+        # the history less the weighted states over a common span (Chebyshev, at the committed r_sums_span, refitted
+        # below from its own event) and the kept transforms' first write (at t_kernel_byte, fitted above); the
+        # anchor-by-anchor weighted states (multi-linear: the sites) fitted as r_sums
+        span_s = np.array([t["span"] for *_, t in runs]) / RATES["r_sums_span"] \
+            + fit["t_kernel_byte"] * np.array([t["kept"] for *_, t in runs])
+        S1 = np.array([[t["sums1"]] for *_, t in runs])
+        if products_rate:           # r_products held (the fit's products and per-step terms are nearly collinear
+            prod = np.array([t["prod"] for *_, t in runs]) / products_rate      # on few logs), the rest fitted
+            A = np.hstack([np.array([[t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
+            t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s - prod)
+            inv_r = 1.0 / products_rate
+        else:
+            A = np.hstack([np.array([[t["prod"], t["dof"], t["grid"], t["elem"]] for *_, t in runs]), S1])
+            inv_r, t_dof, t_grid, t_elem, inv_s = _nnls(A, hist - span_s)
+        fit.update({"r_products": 1.0 / inv_r if inv_r > 0 else float("inf"), "t_step_dof": float(t_dof),
+                    "t_step_grid": float(t_grid), "t_step_elem": float(t_elem),
+                    "r_sums": 1.0 / inv_s if inv_s > 0 else RATES["r_sums"]})
     # r_sums_span from the logs whose far lags weigh states over a common span (Chebyshev): the span's flops
     # over the event SSI_BEM_HistInterp less its anchors' kernel products at r_products; the median of the logs
     spans = []
@@ -176,7 +181,8 @@ def main(logs, check=False, products_rate=None):
         mk = (fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
               + fit["t_kernel_byte"] * (t["bytes_h"] + t["bytes_g"]))
         mh = (t["prod"] / fit["r_products"] + fit["t_step_dof"] * t["dof"] + fit["t_step_grid"] * t["grid"]
-              + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"])
+              + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"]
+              + fit["t_kernel_byte"] * t["kept"])
         ms = 1e3 * t["solve"]
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
               f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")
