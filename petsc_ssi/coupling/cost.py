@@ -28,10 +28,15 @@ assembles it). What the coupling adds is counted here, in three parts:
                times the ranks
 
 with n_I the interface nodes, N the soil nodes and N_Z those of Z's rows (N, or the region's). The constants r_cpl and c_cstep
-are ``FALLBACK``'s unless ``estimate_constants.json``'s constants carry them; none of its fits has (2026-12-03: no
-fit of them exists, and on the 28.8 m building of runs/seismic/site-oblique.opts, 1813 interface nodes, they put
-the coupled loop at 183 s against 115 s measured; runs/seismic/README.md). The structure's solve t_fs is timed on
-the estimate's own ranks (one, from the command line) and used at every rank count."""
+are ``FALLBACK``'s unless ``estimate_constants.json``'s constants carry them (none of its fits does): fitted by
+`python jobscripts/coupled_fit.py LOGS` to the coupling's seconds a step (SSI_FEM_Step + SSI_Contact, less the two
+solves with D at each run's timing) of five coupled runs on 2 ranks, 2026-12-03, the machine otherwise idle: the
+paper's building on its graded 36 m soil (`today-smooth`, 12:02) and on uniform grids of 36, 72 and 108 m
+(`uniform-*-smooth`, 14:10-14:18; jobscripts/building_uniform.sh), 475 interface nodes, and the 28.8 m building of
+runs/seismic/site_oblique.sh (1813 interface nodes, 14:44): -20 % to +18 % of each (the values before, 2e9 and 4 ms,
+never fitted: +36 % to +112 %). The structure's solve t_fs is timed on the estimate's own ranks (one, from the
+command line) and used at every rank count: the 28.8 m building's 22-32 ms on one rank against 19.2 ms in the run on
+two."""
 import statistics
 import time
 
@@ -43,7 +48,7 @@ from ..sysmem import process_rss
 # columns, 0.25 (jobscripts/building_estimate.sh); the building on the uniform 72 m grid, 1425 columns of a
 # 44 649-DOF step matrix, 0.15 (jobscripts/building_uniform.sh); 0.2 between them. Before, every column was
 # priced as a single solve (the uniform 72 m building's interface set-up: 155 s predicted, 21-27 s measured).
-FALLBACK = {"r_cpl": 2.0e9, "c_cstep": 4.0e-3, "n_fs": 2, "r_mms": 0.2}
+FALLBACK = {"r_cpl": 4.34e9, "c_cstep": 1.45e-3, "n_fs": 2, "r_mms": 0.2}
 
 
 class CoupledCounts:
