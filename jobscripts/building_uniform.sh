@@ -42,6 +42,8 @@
 #                  the interface columns and the step solves cheaper, the answer moved by about the dropping threshold
 #   estimate       (not by default) petsc-ssi estimate of uniform-36 and uniform-72 -> OUT/uniform-36.estimate,
 #                  OUT/uniform-72.estimate
+#   estimate-smooth (not by default) petsc-ssi estimate of uniform-72-smooth and uniform-108-smooth ->
+#                  OUT/uniform-72-smooth.estimate, OUT/uniform-108-smooth.estimate
 #   check          (not by default) uniform-36's first 6 steps, dense and toeplitz: the store's exactness on this
 #                  coupled case (every recorded series' largest difference over the largest value of its kind)
 # The far lags are interpolated as in today's run (Chebyshev from T_L = 0.27 s, k = 20: ssi-common.opts).
@@ -115,6 +117,11 @@ for r in $RUNS; do
     estimate) for size in 36,37.2 72,73.2; do
                 "$PY" -m petsc_ssi estimate "${B[@]}" "${U[@]}" -ssi_mesh_size $size $EXTRA -ssi_estimate_ranks "$RANKS" \
                   > "$OUT/uniform-${size%%,*}.estimate" 2>&1 || true
+              done ;;
+    # petsc-ssi estimate of uniform-72-smooth and uniform-108-smooth (the toeplitz fit's building runs; not runs)
+    estimate-smooth) for size in 72,73.2 108,109.2; do
+                "$PY" -m petsc_ssi estimate "${B[@]}" "${A[@]}" -ssi_mesh_size $size "${X[@]}" "${S[@]}" \
+                  -ssi_estimate_ranks "$RANKS" > "$OUT/uniform-${size%%,*}-smooth.estimate" 2>&1 || true
               done ;;
     *) echo "unknown run $r" >&2; exit 2 ;;
   esac

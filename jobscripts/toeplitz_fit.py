@@ -130,8 +130,9 @@ def main(logs, check=False, products_rate=None):
             wh = np.array([r["kernels_weights_h_s"] for _, r, _ in runs])
             wg = np.array([r["kernels_weights_g_s"] for _, r, _ in runs])
             # (least squares on the seconds, not their ratios: the first write of fresh memory, which this term
-            # mostly is, costs more a byte the more the run needs (0.9-1.5 s/GB at 0.1-0.3 GB a rank, 3.6-4.6 s/GB at
-            # 0.9-3 GB on this VM, 2026-12-03), and the runs where the term matters are the large ones)
+            # mostly is, costs more a byte the more the run needs: the H side's 0.89-1.53 s/GB where a rank wrote at
+            # most 0.3 GB, 2.1-4.6 s/GB at 0.4-3 GB, the table's column, 2026-12-03; and the runs where the term
+            # matters are the large ones)
             sel = bg > 0
             x, y = np.r_[bh, bg[sel]], np.r_[wh, wg[sel]]
             fit["t_kernel_byte"] = float(max(x @ y / (x @ x), 0.0))
@@ -175,8 +176,8 @@ def main(logs, check=False, products_rate=None):
         print(f"[toeplitz_fit] {name}: the weighted states over the common span at {rate / 1e9:.3g} GFlop/s a rank")
     fit["r_sums_span"] = RATES["r_sums_span"] if check or not spans else float(np.nanmedian([v for _, v in spans]))
     print("| log | ranks | dofs | kernels measured / model [s] | history measured / model [s] | a step solve measured / "
-          "model [ms] |")
-    print("|---|---|---|---|---|---|")
+          "model [ms] | weights a GB a rank written, H / G [s/GB] | the rest of the build an offset and lag, H / G [us] |")
+    print("|---|---|---|---|---|---|---|---|")
     for (path, r, t), k, h in zip(runs, kern, hist):
         mk = (fit["t_pair_lag"] * (t["pairs_h"] + fit["g_pair_factor"] * t["pairs_g"])
               + fit["t_kernel_byte"] * (t["bytes_h"] + t["bytes_g"]))
@@ -184,8 +185,17 @@ def main(logs, check=False, products_rate=None):
               + fit["t_step_elem"] * t["elem"] + t["sums1"] / fit["r_sums"] + t["span"] / fit["r_sums_span"]
               + fit["t_kernel_byte"] * t["kept"])
         ms = 1e3 * t["solve"]
+        # (the build's parts where the log gives them: the weights' seconds over the kernels' bytes a rank writes,
+        # and the rest of each side's build over its offsets and lags a rank, G's unweighted)
+        wpg = rest = "-"
+        if "kernels_weights_h_s" in r:
+            g = lambda a, b: f"{a / b:.3g}" if b > 0 else "-"
+            wpg = (f"{g(r['kernels_weights_h_s'], t['bytes_h'] / 1e9)} / "
+                   f"{g(r['kernels_weights_g_s'], t['bytes_g'] / 1e9)}")
+            rest = (f"{g(1e6 * (r['kernels_h_s'] - r['kernels_weights_h_s']), t['pairs_h'])} / "
+                    f"{g(1e6 * (r['kernels_g_s'] - r['kernels_weights_g_s']), t['pairs_g'])}")
         print(f"| {os.path.relpath(path, ROOT)} | {r['ranks']} | {r['dofs']} | {k:.3g} / {mk:.3g} ({100 * (mk / k - 1):+.0f} %) "
-              f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} |")
+              f"| {h:.3g} / {mh:.3g} ({100 * (mh / h - 1):+.0f} %) | {1e3 * r['solve_s']:.3g} / {ms:.3g} | {wpg} | {rest} |")
     print(("committed: " if check else "fitted: ") + ", ".join(f'"{k}": {v:.3g}' for k, v in fit.items()))
 
 

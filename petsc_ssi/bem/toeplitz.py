@@ -207,8 +207,8 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
 # steps, 14:44-14:48), 2 ranks, the machine otherwise idle, code as committed with these rates (transforms over
 # the ranks through mpi4py-fft, ``pfft``; history blocks of 16 steps). Kernels from -6 % to +79 % of each log,
 # history from -26 % (the building at 108 m) to +23 % (the 1000 steps). t_kernel_byte is fitted to the seconds,
-# not their ratios: a byte's first write cost 0.9-1.5 s/GB where a rank wrote 0.1-0.3 GB and 3.6-4.6 s/GB where it
-# wrote 0.9-3 GB, so the large runs, where the term matters, are within -6 % to +20 % (the building at 72 m -3 % and -4 %,
+# not their ratios: on the H side a byte's first write cost 0.89-1.53 s/GB where a rank wrote at most 0.3 GB and
+# 2.1-4.6 s/GB where it wrote 0.4-3 GB (0.91 s/GB in the 1000-step run: toeplitz_fit.py's column), so the large runs, where the term matters, are within -6 % to +20 % (the building at 72 m -3 % and -4 %,
 # at 108 m -6 %) and the small ones over by 0.1-1.1 s (the paper's quarter model +63 %, the building at 36 m
 # +79 %). Before it (t_pair_lag alone, fitted 2026-12-01 before the transforms went over the ranks) the
 # building's kernels at 72 m and 108 m were -43 % and -45 % of these logs. The fit holds for the machine's hour:

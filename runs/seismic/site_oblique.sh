@@ -13,6 +13,9 @@ OUT=${OUT:-out/seismic}
 mkdir -p "$OUT"
 O=(-options_file runs/seismic/site-oblique.opts -ssi_seismic_record "$REC" -ssi_output "$OUT/site-oblique.h5")
 "$PY" -m petsc_ssi estimate "${O[@]}" -ssi_estimate_ranks "$N" "$@" > "$OUT/site-oblique-n$N.estimate" 2>&1
+# what the dense lag store would need (its model counts the blocks: about a minute)
+"$PY" -m petsc_ssi estimate "${O[@]}" -ssi_lag_store dense -ssi_estimate_ranks "$N" "$@" \
+  > "$OUT/site-oblique-dense-n$N.estimate" 2>&1 || true
 mpirun --oversubscribe -n "$N" "$PY" -m petsc_ssi "${O[@]}" -ssi_output_overwrite -ssi_monitor \
   -log_view ":$OUT/site-oblique-n$N.log_view" -memory_view "$@" > "$OUT/site-oblique-n$N.log" 2>&1
 cat "$OUT/site-oblique-n$N.log_view" >> "$OUT/site-oblique-n$N.log"
