@@ -21,8 +21,11 @@ APT_PKGS := python3-petsc4py python3-petsc4py-real3.18 python3-mpi4py python3-h5
 PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obspy pyflakes mpi4py-fft
 # pytest workers of `make test` (pytest-xdist, whole test files to a worker): the suite is mostly
 # serial Python and short mpiruns, so 2 workers on a 2-core machine took it from 900-940 s to 545 s.
+# Its processes wait (mpirun's launch, file locks, I/O) a fifth of the time: on the 2-core machine of
+# 2026-12-03 (16:28-17:14, one after another, 1542 tests) 2 workers took 881 s, 3 took 790 s, 4 took 807 s
+# (`.venv/bin/python -m pytest -q -m "not slow" -n N --dist loadfile tests`), so 3.
 # The slow tier stays serial (its cases hold GBs each). TEST_JOBS=0: no workers, one process.
-TEST_JOBS ?= 2
+TEST_JOBS ?= 3
 XDIST = $(if $(filter 0,$(TEST_JOBS)),,-n $(TEST_JOBS) --dist loadfile)
 
 .PHONY: all deps demo test test-unit test-mpi test-slow test-all bench clean help-options

@@ -6,7 +6,7 @@ os.environ.setdefault("SLEPC_DIR", "/usr/lib/slepcdir/slepc3.18/x86_64-linux-gnu
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-# `make test` runs two pytest workers (pytest-xdist), so two mpiruns may share the 2 cores: their
+# `make test` runs three pytest workers (pytest-xdist), so mpiruns may share the 2 cores: their
 # ranks yield in MPI waits instead of spinning against each other (results do not depend on it)
 os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 # After a rank exits non-zero, OpenMPI's mpirun signals the job's processes and waits
