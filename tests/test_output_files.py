@@ -3,7 +3,7 @@
 its table (petsc_ssi/app/output_table.py) must equal the README's; every dataset carries a
 `unit` attribute (before: none did but the groups written as (array, unit) tuples); the timing
 conventions the table states hold in the files (soil receivers from t = dt, structure receivers
-from t = 0, no snapshot at t = 0, the last step missed when not a multiple of the stride, no
+from t = 0, a snapshot at t = 0 (at rest: zero fields), the last step missed when not a multiple of the stride, no
 acceleration field in the structure's XDMF)."""
 import os
 
@@ -39,7 +39,8 @@ def test_readme_output_table_is_a_real_runs(tmp_path):
             f.visititems(lambda k, o: missing.append(k) if isinstance(o, h5py.Dataset) and "unit" not in o.attrs
                          else None)
             assert not missing, (path, missing)
-            assert np.allclose(f["time"][:], dt * np.array([2, 4, 6, 8, 10]))    # no t = 0, step 11 missed
+            assert np.allclose(f["time"][:], dt * np.array([0, 2, 4, 6, 8, 10]))    # t = 0, step 11 missed
+            assert not np.any(f["displacement_000000"][:]) and np.any(f["displacement_000001"][:])    # at rest
     with h5py.File(soil) as f:
         assert np.allclose(f["receivers/t"][:], dt * np.arange(1, n + 1)) and f["receivers/u"].attrs["unit"] == "m"
         assert f["interface/p"].attrs["unit"] == "N/m^2" and f["interface/force_fe"].attrs["unit"] == "N"

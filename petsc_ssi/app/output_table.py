@@ -12,8 +12,8 @@ BEGIN, END = "<!-- BEGIN output-files -->", "<!-- END output-files -->"
 MEANING = {
     "coordinates": "node coordinates (the XDMF geometry)",
     "topology": "cells (node indices; XDMF topology; a Mixed list when element types mix)",
-    "time": "time of each snapshot (no snapshot at t = 0 in a soil or coupled run; the last step only if "
-            "a multiple of -ssi_output_stride)",
+    "time": "time of each snapshot (the first at t = 0, the state at rest; the last step only if a multiple "
+            "of -ssi_output_stride)",
     "displacement_NNNNNN": "snapshot k of the nodal displacement (total field with an earthquake)",
     "traction_NNNNNN": "snapshot k of the soil's nodal traction on the surface",
     "velocity_NNNNNN": "snapshot k of the structure's nodal velocity",

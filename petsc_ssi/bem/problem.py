@@ -57,7 +57,7 @@ class BEMTransient(TransientProblem):
     def start(self):
         self._advance("set up", "started")
         from ..io.recorder import Recorder
-        from .recorder import SoilRecorder
+        from .recorder import SoilRecorder, at_rest
         rd = self._open_restart()
         self.out = Output(self.cfg.output, self.comm, resume=rd.output_state("out") if rd else None, run_id=self.run_id)
         self.rec = Recorder(self.cfg, self.comm, "BEM time loop", self.grid,
@@ -67,6 +67,9 @@ class BEMTransient(TransientProblem):
         if self.cfg.guard:
             self.rec.add(DivergenceGuard(self.cfg, self.prob, self.march, self.rec.norms))
         self._ut = self.march.u_tmpl.duplicate()            # the total field (a seismic input's u_sc + u_ff)
+        if rd is None:                            # the fields of t = 0 (frame 0 of the XDMF)
+            self.rec.initial(self.time(0), write=self.grid.writes(0),
+                             soil=at_rest(self.prob, self.march, self.time(0), self._ut))
         self._resume()
 
     def checkpoint_state(self):

@@ -7,6 +7,15 @@ import numpy as np
 from ..monitor import event
 
 
+def at_rest(prob, march, t, out):
+    """Collective: the soil's (u, p) at rest at time t (t = 0): u the total field, the free field's
+    at t with a seismic input (``out`` holds it), p zero."""
+    u0, p0 = march.u_tmpl.duplicate(), march.p_tmpl.duplicate()
+    u0.zeroEntries()
+    p0.zeroEntries()
+    return prob.total_field(u0, t, out), p0
+
+
 class SoilRecorder:
     """Collective: the soil's fields and receiver series. ``out``: an Output (or None: receivers
     only); ``prob``: the BEM problem (bem/halfspace.py HalfSpace); ``march``: its Marcher."""
@@ -31,6 +40,12 @@ class SoilRecorder:
         if prob.regions.n_disp and getattr(prob, "motion", None) is not None:
             from .resultants import Resultants
             self.res = Resultants(comm, prob, march.p_tmpl)
+
+    def initial(self, t, step, write=False):
+        """The fields at t = 0 (the soil at rest, with a seismic input its free field), when the
+        time grid writes step 0: the XDMF's first frame. The receiver series start at step 1."""
+        if write and step.get("soil") is not None:
+            self.write(t, *step["soil"])
 
     def observe(self, n, t, step):
         if step.get("soil") is not None:

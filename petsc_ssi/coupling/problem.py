@@ -175,8 +175,11 @@ class SSITransient(TransientProblem):
         self.demands = self.rec.add(Demands(self.demand_spec, self.model, comm, "[ssi]"), out=self.sout)
         self._ut = self.march.u_tmpl.duplicate()
         self.integ.start(f0=self.load(0))
-        if rd is None:                            # the records of t = 0 (no fields: the soil has none at rest)
-            self.rec.initial(self.time(0), structure=(self.integ.u, self.integ.velocity(self.vel)))
+        if rd is None:                            # the records of t = 0 (and frame 0 of the XDMF files)
+            from ..bem.recorder import at_rest
+            self.rec.initial(self.time(0), write=self.grid.writes(0),
+                             soil=at_rest(self.prob, self.march, self.time(0), self._ut),
+                             structure=(self.integ.u, self.integ.velocity(self.vel)))
         self._resume()
         self.clock.start()
 

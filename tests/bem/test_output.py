@@ -19,7 +19,7 @@ def test_hdf5_xdmf_json_and_post_csv(tmp_path):
          "-ssi_output_stride", "2", "-ssi_output", str(out), "-ssi_plot",
          "-ssi_receivers", "2,0,0;3,1,0"])
     d = read_h5(out)
-    assert {"coordinates", "topology", "time", "displacement_000000", "displacement_000001",
+    assert {"coordinates", "topology", "time", "displacement_000000", "displacement_000001", "displacement_000002",
             "traction_000000", "receivers"} <= set(d["keys"])
     assert d["u"].shape == (4, 2, 3)
     np.testing.assert_allclose(d["t"], 7.5e-4 * np.arange(1, 5), rtol=1e-12)
@@ -28,12 +28,13 @@ def test_hdf5_xdmf_json_and_post_csv(tmp_path):
         ncoord = f["coordinates"].shape
         assert f["topology"].shape[1] == 9 and ncoord[1] == 3
         assert np.all(f["topology"][:] < ncoord[0])
-        np.testing.assert_allclose(f["time"][:], [1.5e-3, 3.0e-3])
+        np.testing.assert_allclose(f["time"][:], [0.0, 1.5e-3, 3.0e-3])     # t = 0 (at rest), steps 2 and 4
+        assert not np.any(f["displacement_000000"][:]) and not np.any(f["traction_000000"][:])
         # the applied traction appears in the traction field: -p0 in z under the load
-        assert np.isclose(f["traction_000000"][:, 2].min(), -1000.0)
+        assert np.isclose(f["traction_000001"][:, 2].min(), -1000.0)
     xmf = ET.parse(str(out).replace(".h5", ".xmf")).getroot()
     grids = xmf.findall(".//Grid[@GridType='Uniform']")
-    assert len(grids) == 2 and grids[0].find("Topology").get("TopologyType") == "Quadrilateral_9"
+    assert len(grids) == 3 and grids[0].find("Topology").get("TopologyType") == "Quadrilateral_9"
     rec = json.load(open(str(out).replace(".h5", ".json")))
     for key in ("petsc", "petsc4py", "mpi4py", "mpi", "ranks", "options", "git", "hdf5"):
         assert key in rec

@@ -403,10 +403,11 @@ def test_forces_in_a_coupled_run(tmp_path):
     with h5py.File(out.replace(".h5", "_structure.h5"), "r") as f:
         X = f["coordinates"][()]
         snaps = f["forces/snapshots"][()]
-        assert len(snaps) == len(f["time"]) == 2 and np.allclose(f["forces/time"][()], f["time"][()])
+        assert len(snaps) == len(f["time"]) == 3 and np.allclose(f["forces/time"][()], f["time"][()])   # t = 0, 4, 8 dt
         for part, p in props.items():
             F, env, nodes = f[f"forces/{part}"][()], f[f"forces/{part}_envelope"][()], f[f"forces/{part}_nodes"][()]
-            assert F.shape == (2, nodes.shape[0], 12 if part == "columns" else 8)
+            assert F.shape == (3, nodes.shape[0], 12 if part == "columns" else 8)
+            assert not np.any(F[0])                     # at rest at t = 0
             assert f[f"forces/{part}"].attrs["unit"].split(",")[3] == ("N m" if part == "columns" else "N m/m")
             peak = np.abs(F).max()
             assert peak > 0 and np.all(env >= np.abs(F).max(axis=0))
