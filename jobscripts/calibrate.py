@@ -48,7 +48,8 @@ def log_options(text):
         return None
     opts = {}
     for line in m.group(1).splitlines():
-        line = line.strip()
+        # from PETSc 3.19 each entry ends with where it came from: "-ssi_dt 0.005 # (source: command line)"
+        line = re.sub(r"\s*# \(source: [^)]*\)\s*$", "", line.strip())
         if not line.startswith("-ssi_"):
             continue
         key, _, val = line[1:].partition(" ")

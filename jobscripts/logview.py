@@ -12,7 +12,8 @@ import sys
 
 def parse(text):
     out = {"stages": {}, "events": {}, "total_s": None, "peak_rss_bytes": None, "ranks": None}
-    m = re.search(r"with (\d+) processors?", text)
+    # "with 2 processors" to PETSc 3.21, "with 2 processes" from 3.22 (commit 5c78b439518)
+    m = re.search(r"with (\d+) (?:processors?|processes|process)\b", text)
     if m:
         out["ranks"] = int(m.group(1))
     m = re.search(r"^Time \(sec\):\s+(\S+)\s+(\S+)?\s*(\S+)", text, re.M)

@@ -112,12 +112,12 @@ def init(argv=None):
     if not _INITIALISED:
         _pin_mmap_threshold()
         try:
-            import petsc4py  # noqa: F401
+            import petsc4py
         except ImportError:
             if not _find_debian_petsc4py():
                 raise SystemExit("petsc-ssi: error: petsc4py is not installed (run 'make deps', "
                                  "or set PETSC_DIR to a PETSc build with petsc4py)")
-        import petsc4py
+            import petsc4py
         petsc4py.init(sys.argv if argv is None else argv)
         _INITIALISED = True
     from petsc4py import PETSc

@@ -403,3 +403,24 @@ def test_times_below_a_second_and_the_verdict_s_nodes():
     line = _verdict(rows, 8e9)
     assert "from 1 rank(s); fastest predicted 0.020s on 4 rank(s) on 2 nodes (-ssi_estimate_ranks_per_node" in line, line
     assert "nodes" not in _verdict(rows[:1], 8e9)
+
+
+def test_the_log_parsers_read_newer_petscs_logs():
+    """jobscripts/logview.parse and calibrate.log_options on the text of PETSc 3.18 and of newer PETSc:
+    -log_view's header says 'with 2 processes' from 3.22 ('processors' before), and from 3.19 each entry of
+    the option table ends with its source ('# (source: command line)'); before, the rank count came out
+    None and the options' values carried the note (the fits then crashed or skipped every log)."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
+    from logview import parse
+    from calibrate import log_options
+    head = "/x/petsc_ssi on a  named h with {} {}, by root on Thu Dec  3 17:00:00 2026\n"
+    assert parse(head.format(2, "processors"))["ranks"] == 2        # 3.18-3.21
+    assert parse(head.format(4, "processes"))["ranks"] == 4         # 3.22 on
+    assert parse(head.format(1, "process"))["ranks"] == 1
+    old = "#PETSc Option Table entries:\n-log_view\n-ssi_dt 0.005\n-ssi_lag_store toeplitz\n" \
+          "#End of PETSc Option Table entries\n"
+    new = "#PETSc Option Table entries:\n-log_view # (source: command line)\n-ssi_dt 0.005 # (source: command line)\n" \
+          "-ssi_lag_store toeplitz # (source: file)\n#End of PETSc Option Table entries\n"
+    a, b = log_options(old), log_options(new)
+    assert a == b and a["dt"] == "0.005" and a["lag_store"] == "toeplitz", (a, b)

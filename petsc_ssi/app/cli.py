@@ -327,9 +327,11 @@ def _whole_line(text):
 
 
 def _petsc_message(exc):
-    """': <PETSc function>: <its messages>' of a petsc4py error (its ``_traceback_``: the call stack's
-    'F() at file:line' entries, then the message lines), '' without one."""
-    tb = [str(t).strip() for t in (getattr(exc, "_traceback_", None) or [])]
+    """': <PETSc function>: <its messages>' of a petsc4py error (its traceback entries: the call stack's
+    'F() at file:line' entries, then the message lines), '' without one. Newer petsc4py keeps them on the
+    error itself (``_traceback``); 3.18's keeps one class-wide list of the last error's (``_traceback_``)."""
+    own = getattr(exc, "_traceback", None)
+    tb = [str(t).strip() for t in (own if own is not None else getattr(exc, "_traceback_", None) or [])]
     calls = [t for t in tb if "() at " in t]
     msgs = [t for t in tb if t and "() at " not in t]
     if not msgs:

@@ -131,7 +131,7 @@ def measure(motions, target, damping):
         mx, my = motions[axes[0]], motions[axes[1]]
         if mx.t.size == my.t.size and np.array_equal(mx.t, my.t):
             r = rs.rotd(mx.t, mx.a.reshape(-1), my.a.reshape(-1), [T], [damping], percentiles=(100,))
-            return float(r[100].values["PSA"][0, 0]), f"RotD100 PSA (maximum direction of x and y)"
+            return float(r[100].values["PSA"][0, 0]), "RotD100 PSA (maximum direction of x and y)"
     vals = {a: one(motions[a]) for a in axes}
     a = max(vals, key=vals.get)
     return vals[a], q + (f" of {a} (the larger horizontal component)" if len(axes) > 1 else "")
