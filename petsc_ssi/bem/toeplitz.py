@@ -148,6 +148,10 @@ def detect(VX, nodes, what="-ssi_lag_store toeplitz", n_cells=None):
     area = 0.5 * np.sum(P[:, :, 0] * np.roll(P[:, :, 1], -1, axis=1) - np.roll(P[:, :, 0], -1, axis=1) * P[:, :, 1],
                         axis=1)
     bad |= np.sign(area) != np.sign(area[0])
+    if bad[0]:                  # (the others are measured against element 0: it must be one itself)
+        raise SSIError(f"{what}: element 0 (centre {c[0, 0]:.6g}, {c[0, 1]:.6g} m) is not a nine-node rectangle with "
+                       "its sides along x and y (straight sides, mid-side nodes): a grid of FFT lags needs cells "
+                       "along the axes (turn the mesh so they are), or use -ssi_lag_store dense")
     if np.any(bad):
         v = int(np.argmax(bad))
         raise SSIError(f"{what}: element {v} (centre {c[v, 0]:.6g}, {c[v, 1]:.6g} m) is not a "

@@ -80,7 +80,8 @@ register("fem_E", "real", 300e6, "N/m^2", "Young's modulus of the structure (pap
 register("fem_nu", "real", 0.2, "", "Poisson's ratio of the structure, in (-1, 0.5)", G, validator=_nu_range)
 register("fem_rho", "real", 2000.0, "kg/m^3", "density of the structure (lumped mass)", G, validator=positive)
 register("fem_cp", "real", 0.0, "m/s", "P-wave speed of the structure's single hex8 part, with -ssi_fem_cs and "
-         "-ssi_fem_rho instead of -ssi_fem_E and -ssi_fem_nu (a soil region filling an excavation); 0: unused", G,
+         "-ssi_fem_rho (required with them) instead of -ssi_fem_E and -ssi_fem_nu (a soil region filling an excavation); "
+         "0: unused", G,
          validator=nonnegative)
 register("fem_cs", "real", 0.0, "m/s", "S-wave speed of the structure's single hex8 part (with -ssi_fem_cp)", G,
          validator=nonnegative)

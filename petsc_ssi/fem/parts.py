@@ -184,6 +184,9 @@ def _legacy_props(cfg):
         given = [f"-ssi_fem_{p}" for p in ("E", "nu") if user("fem_" + p)]
         if given:
             raise SSIError(f"-ssi_fem_cp/-ssi_fem_cs give the structure's E and nu: drop {' and '.join(given)}")
+        if not user("fem_rho"):       # (the structure's default density would make another soil, silently)
+            raise SSIError("-ssi_fem_cp/-ssi_fem_cs: a soil region given by its wave speeds takes cp, cs and "
+                           "-ssi_fem_rho together (its density; the half-space's is -ssi_rho)")
         E, nu = elastic_from_wave_speeds(cp, cs, cfg.fem_rho, "-ssi_fem_cp/-ssi_fem_cs")
         return Props(E=E, nu=nu, rho=cfg.fem_rho)
     return Props(E=cfg.fem_E, nu=cfg.fem_nu, rho=cfg.fem_rho)

@@ -450,6 +450,14 @@ def test_detect_names_the_element():
         V[k] = X
         with pytest.raises(SSIError, match=f"element {k} "):
             detect(V, np.unique(V.reshape(-1, 3), axis=0))
+    # a grid turned by 0.5 rad: element 0 itself is no cell along the axes, and the message says so (before: "element
+    # 0 ... is not a 1.36 x 1.36 m nine-node rectangle like element 0", its bounding box, against itself)
+    c, s_ = np.cos(0.5), np.sin(0.5)
+    T = VX.copy()
+    T[..., 0], T[..., 1] = c * VX[..., 0] - s_ * VX[..., 1], s_ * VX[..., 0] + c * VX[..., 1]
+    with pytest.raises(SSIError, match=r"element 0 \(centre .*\) is not a nine-node rectangle with its sides along x "
+                                       r"and y .*turn the mesh so they are"):
+        detect(T, np.unique(T.reshape(-1, 3), axis=0))
     # a symmetric model whose mesh stops 0.2 m short of the plane x = 0: its mirror images (the elements after the
     # mesh's own 6) are off the mesh's grid; the message names the image that fixes the grid and says why
     M = np.array([elem(0.7 + i, 2 * j + 1.0) for i in range(3) for j in range(2)])
