@@ -19,11 +19,16 @@ os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 # takes the stale lock over with a warning, as after a kill. (Tests that time mpirun's own signal
 # forwarding set the timeout on their command line, which overrides this: test_checkpoint.py.)
 os.environ.setdefault("OMPI_MCA_odls_base_sigkill_timeout", "0")
-# A one-rank run started without mpirun (most of the suite's CLI tests) is an MPI singleton: OpenMPI 4 starts an
-# orted beside it unless the singleton is isolated (it then cannot MPI_Comm_spawn, which petsc-ssi never does):
-# on the 2-core machine of 2026-12-02 a refused one-rank run took about a tenth of a second less (a scratch
-# timing, not a benchmark). Ignored by mpirun's ranks and by other MPIs.
-os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+# A one-rank run started without mpirun (most of the suite's CLI tests, and the workers' in-process runs) is an MPI
+# singleton. Not isolated (OMPI_MCA_ess_singleton_isolated, set here from 2026-12-02 to 12-03, for about a tenth of
+# a second a refused run that a later timing did not confirm): isolated singletons all take the one session
+# directory /tmp/ompi.<host>.0/jf.0/1, where MPI-IO's shared file pointers keep a file named after the file opened
+# (p000000.h5_cid--1-0.sm for every output's first part), so concurrent workers' runs overwrite and remove each
+# other's; most likely why H5Fcreate once failed in MPI_File_open (MPI_ERR_OTHER) in an in-process run of a CI
+# run of 2026-12-03 with three workers. `python jobscripts/singleton_mpiio.py` (6 concurrent singletons, 300 HDF5
+# files each, of the same names): isolated, 0-48 "unable to open file for mmap" lines a process in 3.25 s; not
+# isolated, none, in 2.74 s.
+os.environ.pop("OMPI_MCA_ess_singleton_isolated", None)
 # The suite starts about a thousand petsc-ssi processes (mpirun ranks counted). Where the shell sets
 # PYTHONDONTWRITEBYTECODE (this machine and CI's do), each one compiled the ~90 modules it imports from
 # source again: 0.24 s of every start (cProfile of a 3-step run: 102 compile() calls, 2.0 s in all).
