@@ -3,11 +3,8 @@
 # both coupled runs (full model, 1000 steps of 5 ms), then compare.py (CSV, PNG, the README's table).
 #   [BUILDING=paper] bash runs/basement/run.sh [NRANKS] [extra PETSc/-ssi_ options, e.g. -ssi_t_end 1]
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/../.."
-PY=${PY:-.venv/bin/python}
+source "$(dirname "${BASH_SOURCE[0]}")/../run_env.sh"      # (the repository root, PY, REC)
 N=${1:-1}; shift || true
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1
-REC=$("$PY" -c "import obspy, os; print(os.path.join(os.path.dirname(obspy.__file__), 'io', 'nied', 'tests', 'data', 'test.knet'))")
 # BUILDING=paper: the paper's building (4 x 3 bays of 3.6 m, three storeys; 14.4 m x 10.8 m on a 24 m x 20.4 m
 # ground, the same 4.8 m margin) instead of the demo's, into out/basement-paper (about 12.6 GB on 2 ranks)
 OUT=out/basement

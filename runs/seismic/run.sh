@@ -4,11 +4,8 @@
 # glance (petsc-ssi post --glance: what the soil changes).
 #   bash runs/seismic/run.sh [NRANKS] [extra PETSc/-ssi_ options, e.g. -ssi_t_end 1]
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/../.."
-PY=${PY:-.venv/bin/python}
+source "$(dirname "${BASH_SOURCE[0]}")/../run_env.sh"      # (the repository root, PY, REC)
 N=${1:-2}; shift || true
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1
-REC=$("$PY" -c "import obspy, os; print(os.path.join(os.path.dirname(obspy.__file__), 'io', 'nied', 'tests', 'data', 'test.knet'))")
 mkdir -p out/seismic
 mpirun --oversubscribe -n "$N" "$PY" -m petsc_ssi -options_file runs/seismic/building.opts -ssi_seismic_record "$REC" \
   -ssi_output_overwrite -ssi_monitor -log_view :out/seismic/building-n$N.log_view -memory_view "$@" \

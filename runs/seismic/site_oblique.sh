@@ -4,11 +4,8 @@
 # run with -log_view -memory_view, the roof's response spectra (x and y), and site_oblique_report.py's tables.
 #   bash runs/seismic/site_oblique.sh [NRANKS] [extra PETSc/-ssi_ options]
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/../.."
-PY=${PY:-.venv/bin/python}
+source "$(dirname "${BASH_SOURCE[0]}")/../run_env.sh"      # (the repository root, PY, REC)
 N=${1:-2}; shift || true
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_NUM_THREADS=1
-REC=$("$PY" -c "import obspy, os; print(os.path.join(os.path.dirname(obspy.__file__), 'io', 'nied', 'tests', 'data', 'test.knet'))")
 OUT=${OUT:-out/seismic}
 mkdir -p "$OUT"
 O=(-options_file runs/seismic/site-oblique.opts -ssi_seismic_record "$REC" -ssi_output "$OUT/site-oblique.h5")
