@@ -57,8 +57,8 @@ def test_the_box_refuses_speeds_beside_E():
 
 def test_the_box_refuses_speeds_without_a_density():
     """-ssi_fem_cp/-ssi_fem_cs without -ssi_fem_rho: before, the region took the structure's default density
-    (2000 kg/m^3) silently, so a region meant as the half-space's own soil (rho 1800) scattered (its base shear
-    11 % off in an independent check of 2026-12-03)."""
+    (2000 kg/m^3) silently, so a region meant as the half-space's own soil (rho 1800) scattered (found by an
+    independent check of 2026-12-03)."""
     with pytest.raises(SSIError, match="takes cp, cs and -ssi_fem_rho together"):
         parse_parts(cfg(fem_cp=548.0, fem_cs=316.0), raw={})
 
