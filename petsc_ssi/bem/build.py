@@ -8,7 +8,8 @@ import numpy as np
 
 from ..petsc import init, printf
 from ..monitor import event, fmt_time
-from . import symmetry, lagmats
+from . import symmetry
+# (lagmats, numba's kernels, is imported where a lag matrix is built: bem/lagset.py)
 from .march import Marcher
 from .cost import history_block
 
@@ -16,6 +17,7 @@ from .cost import history_block
 def _block_of(cfg, comm, H, G, HI, GI):
     """history_block from this run's Mats (None: empty): per stored matrix the bytes of its H and
     of its G (read by the same panel products), dense or block-sparse, summed over the ranks."""
+    from . import lagmats
     from . import bsr
     Hs, Gs = list(H) + list(HI), list(G) + [None] * (len(H) - len(G)) + list(GI) + [None] * (len(HI) - len(GI))
     d = np.zeros((3, len(Hs)))              # dense bytes, block-sparse bytes, block-sparse values
@@ -67,6 +69,7 @@ def build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log=printf):
 
 
 def _build_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log):
+    from . import lagmats
     from .. import numba_cache_warm
     if not numba_cache_warm() and not os.environ.get("PETSC_SSI_WARMUP"):
         from .lagset import announce_compile
@@ -120,6 +123,7 @@ def _interpolating_lags(cfg, comm, prob, plan, ls, tcol_loc):
     """Collective: the lag matrices (HI, GI) at the interpolation plan's kernel times (none without
     interpolation; GI's None without traction columns, ``tcol_loc`` None); ``ls.kernel_evaluations``
     then counts the exact lags' and theirs."""
+    from . import lagmats
     N, nt = prob.mesh.n_nodes, prob.regions.n_t
     r0, r1 = ls.node_range
     single = int(cfg.lag_single_from)
@@ -139,6 +143,7 @@ def _interpolating_lags(cfg, comm, prob, plan, ls, tcol_loc):
 def _assembly_report(cfg, comm, plan, ls, N, mats, hinfo, t_asm):
     """Collective: the assembly's line (and the interpolating matrices' memory) and the run's info
     {t_asm, mem_exact, mem_interp, ndense, nbaij, nsingle, fill, mem}; ``mats``: (H, G, HI, GI)."""
+    from . import lagmats
     H, G, HI, GI = mats
     mem_exact = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in H + G))
     mem_interp = comm.tompi4py().allreduce(sum(lagmats.mat_bytes(A) for A in HI + GI))
@@ -165,6 +170,7 @@ def _assembly_report(cfg, comm, plan, ls, N, mats, hinfo, t_asm):
 
 def _load_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     """Collective: build_marcher with the matrices of -ssi_lags_load (checked in ``prepare``)."""
+    from . import lagmats
     from . import lagstore
     N = prob.mesh.n_nodes
     nt = prob.regions.n_t
@@ -210,6 +216,7 @@ def _traction_g(comm, prob, plan, ls, lag_hi, storage, fill, lag_lo=1, toff=0.0)
     threshold; the toeplitz store calls it): lags 1-2 reach only the soil nodes near the traction elements, where a dense Mat of every soil node's rows was read in full at each
     step (the uniform 72 m building, 484 traction nodes: 2 x 0.29 GB; block-sparse, its first 80 steps'
     MatMults 2.9 -> 1.4 s and the lags' panel products, 1.8 s, gone: jobscripts/README.md)."""
+    from . import lagmats
     nt = prob.regions.n_t
     tl = ls.restricted(np.any(ls.VT >= 0, axis=1))
     tcol_loc = _traction_cols_local(comm, nt)
@@ -237,6 +244,7 @@ def _toeplitz_loaded(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
 def _toeplitz_assembled(cfg, comm, prob, plan, ls, known_u, known_p, log, zero):
     """Collective: (march, H, G, kernel evaluations) of the toeplitz store's lags 1-2, assembled: the step
     matrix factorised, H's and (with tractions) G's lags 1-2 as Mats, the later lags None (kernels)."""
+    from . import lagmats
     N = prob.mesh.n_nodes
     r0, r1 = ls.node_range
     ls.assemble(monitor=cfg.monitor, lag_hi=2)
@@ -261,6 +269,7 @@ def _toeplitz_marcher(cfg, comm, prob, plan, ls, known_u, known_p, log, t0):
     kernels on the window of the traction elements (``toeplitz.traction_grid``). With -ssi_lags_load the step
     matrix, lags 1-2 and the kernels are read back from a file a toeplitz run saved (on any number of ranks)
     (``lagstore``), nothing assembled or integrated."""
+    from . import lagmats
     from .toeplitz import ToeplitzHistory, traction_grid, block_of
     k = plan.k if plan.active else 0
     zero = symmetry.zero_dofs(prob.mesh.nodes, prob.planes, prob.h)

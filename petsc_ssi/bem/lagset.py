@@ -16,9 +16,9 @@ from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes
 from .windows import bounding_spheres, estimate_blocks, plane_heights, candidates
 from . import symmetry
 from . import packs
-from .bsr import FULL, H4
-from .assemble import (assemble_rows, new_cache, index_len, new_work, enumerate_pairs, integrate_batch,
-                       cache_index, SING_TOL, KERNELS, PLANE, surface_kind, patterns, kernels)
+# The compiled kernels (.bsr, .assemble: numba, about 0.3 s to import) are imported where a LagSet uses them, so
+# that runs refused on their options, structure-only runs and the post tools start without numba
+# (tests/test_startup.py).
 
 
 class Material:
@@ -349,6 +349,8 @@ class LagSet:
     """The assembled H_l, G_l (l = 1..L) of one rank as triplets, then Mats."""
 
     def __init__(self, comm, mesh, mat, dt, L, regions, planes, opts):
+        from .bsr import FULL
+        from .assemble import KERNELS, PLANE, surface_kind, patterns
         self.comm = comm
         self.mesh, self.mat, self.dt, self.L = mesh, mat, dt, L
         self.regions, self.planes, self.opts = regions, planes, opts
@@ -482,11 +484,13 @@ class LagSet:
     def kernels(self, quad):
         """The kernels' pack of the assembly (``assemble.kernels``: the kernel table's choice for this
         surface and the block patterns as they stand, the plane geometry of ``quad``)."""
+        from .assemble import kernels
         return kernels(self.kind, self.pattern(), self.plane(quad.gq, quad.gw))
 
     def kernel_packs(self, lag_lo, lag_hi, toff):
         """(mesh, lags, phys, quad): the assembly kernels' packs of lags lag_lo..lag_hi at kernel times
         l dt + toff (``assemble.assemble_rows``)."""
+        from .assemble import SING_TOL
         mesh = (self.mesh.nodes, self.VX, self.VN, self.VS, self.VT, self.Vc, self.VR, self.Vh)
         phys = packs.wave(self.dt, self.mat.cp, self.mat.cs, self.mat.rho, self.mat.nu, toff)
         return mesh, (int(lag_lo), int(lag_hi)), phys, packs.quad_from(self.opts, float(self.Vh.min()), SING_TOL)
@@ -530,6 +534,7 @@ class LagSet:
         requesting rank (the pair a single rank would meet first, so -n p reproduces -n 1) and sends
         the blocks back (all-to-all-v of doubles); ``cand``: the rows' candidate elements (``candidates``,
         as the assembly's). Returns the cache arrays and the owned evaluations."""
+        from .assemble import cache_index, enumerate_pairs, index_len, integrate_batch
         cidx, ckeys, cmeta, cpP, cpU = cache
         if index_len(cidx):             # (the same on every rank: assemble() passes a new cache)
             raise RuntimeError("_share_cache fills an empty element cache only")
@@ -587,6 +592,8 @@ class LagSet:
         each rank its rows; sets and returns (H, G) Buckets (lags >= ``single_from`` > 0 kept in
         float32: -ssi_lag_single_from). ``quiet``: no -log_view event (``load_kernels``); ``keep_h`` False:
         G only, H's blocks not written (``build._traction_g``)."""
+        from .bsr import H4
+        from .assemble import assemble_rows, index_len, new_cache, new_work
         o = self.opts
         lag_hi = self.L if lag_hi is None else lag_hi
         rows = self.rows

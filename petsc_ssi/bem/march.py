@@ -27,8 +27,9 @@ import numpy as np
 from ..petsc import (init, set_default_options, soil_solver_defaults, printf, check_reproducible_solver,
                      mumps_failure, mumps_factor_info, solve_columns, SSIError)
 from ..monitor import event
-from . import bsr
 
+# (bsr, the block-sparse kernels, is imported where it is used: numba's import waits for a run that
+# multiplies; bem/lagset.py)
 BLOCK_MAX = 32          # the largest -ssi_history_block (the ring buffer's extra depth)
 
 
@@ -367,6 +368,7 @@ class Marcher:
         lag is a Mat whose columns are not read off (dense PETSc Mats, loaded AIJ) on any rank: multiply
         instead. Collective (the ranks agree on None: the fallback's products are collective); the
         coefficients are 1 and 4, so c H_1 e + H_2 e rounds as mult_step_H's VecAXPYs do."""
+        from . import bsr
         out = None
         for lag, c in self.coefficients():
             col = bsr.columns(self.H[lag - 1], dofs)
@@ -527,6 +529,7 @@ class Marcher:
     def _replicate(self, n0):
         """Collective: every rank's copies of the states m <= n0 the block reads (all-gathered once
         per state: the copies of earlier blocks stay valid, their states being final)."""
+        from . import bsr
         if getattr(self, "_rep", None) is None:
             self._rep, self._pctx, reads = {}, {}, {}
             for side, tmpl in (("u", self.u_tmpl), ("p", self.p_tmpl)):
@@ -629,6 +632,7 @@ class Marcher:
     def _panel_products(self, panel, R, upto):
         """Collective: R (w x local rows) += the panel products of ``panel`` {(key, side): [(row k
         of R, state m, coefficient)]}, states m <= ``upto`` (final) from every rank's copies."""
+        from . import bsr
         w = R.shape[0]
         self._replicate(upto)
         bufs = {}                                         # the panel per side and layout, made once
@@ -667,6 +671,7 @@ class Marcher:
     def _panel_kind(M):
         """'dense' (MATDENSE), 'bsr' (a python Mat of ``bsr``: block-sparse or a flat surface's dense
         pieces), matrices the block forms a panel product with, or None (step by step)."""
+        from . import bsr
         if "dense" in M.getType():
             return "dense"
         return "bsr" if bsr.context(M) is not None else None
@@ -695,6 +700,7 @@ class Marcher:
         """The block's row of step n and the terms it left to the step (in-block states, and
         matrices without a panel product). Dense and block-sparse matrices take them from every
         rank's copies of the states (one all-gather per new state, not one per product)."""
+        from . import bsr
         n0, rest, _ = self._blk
         todo = rest[n - n0 - 1]
         acc = self._R[n - n0 - 1].copy()
