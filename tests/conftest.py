@@ -37,6 +37,8 @@ os.environ.pop("OMPI_MCA_ess_singleton_isolated", None)
 os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 os.environ.setdefault("PYTHONPYCACHEPREFIX", os.path.join(os.path.expanduser("~"), ".cache", "petsc_ssi", "pycache"))
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# One mpirun at a time across the pytest workers (tests/bin/mpirun, first on PATH): see that file.
+os.environ["PATH"] = os.path.join(ROOT, "tests", "bin") + os.pathsep + os.environ.get("PATH", "")
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
 
