@@ -17,7 +17,7 @@ PETSc = init(sys.argv)
 from petsc_ssi import options
 import petsc_ssi.app.kinds  # noqa: F401  (every option declared)
 from petsc_ssi.bem.halfspace import HalfSpace
-from petsc_ssi.bem import lagset as model, lagmats
+from petsc_ssi.bem import lagset as model, lagmats, assemble as kern
 cfg = options.resolve(("common", "bem"))
 prob = HalfSpace(cfg, PETSc.COMM_WORLD, log=lambda m: None)
 ls = prob.lagset(prob.interp_plan())
@@ -36,8 +36,10 @@ def wrap(mod, name):
         if name == "_send_segments": T["received cache, GB"] = 8e-9 * sum(int(n.sum()) for n, _ in a[2])
         return r
     setattr(mod, name, g)
-for n in ("assemble_rows", "enumerate_pairs", "integrate_batch", "cache_index", "_send_segments"):
-    wrap(model, n)                          # the last four: the parts of _share_cache
+# (LagSet imports the kernels from bem/assemble.py where it calls them, so they are wrapped there)
+for n in ("assemble_rows", "enumerate_pairs", "integrate_batch", "cache_index"):
+    wrap(kern, n)                           # the last three, with _send_segments: the parts of _share_cache
+wrap(model, "_send_segments")
 wrap(model.LagSet, "_share_cache")
 _init = model.Buckets.__init__
 def init_prefault(self, *a, **k):
