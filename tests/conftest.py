@@ -37,8 +37,19 @@ os.environ.pop("OMPI_MCA_ess_singleton_isolated", None)
 os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 os.environ.setdefault("PYTHONPYCACHEPREFIX", os.path.join(os.path.expanduser("~"), ".cache", "petsc_ssi", "pycache"))
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# One mpirun at a time across the pytest workers (tests/bin/mpirun, first on PATH): see that file.
-os.environ["PATH"] = os.path.join(ROOT, "tests", "bin") + os.pathsep + os.environ.get("PATH", "")
+# One mpirun at a time across the pytest workers (tests/bin/mpirun, first on PATH, which runs the mpirun found
+# here: see that file), where there is an mpirun (without one, the tests that need it skip as before).
+_BIN = os.path.join(ROOT, "tests", "bin")
+if not os.environ.get("PETSC_SSI_REAL_MPIRUN"):
+    for _d in os.environ.get("PATH", "").split(os.pathsep):      # the first mpirun that is not a shim like ours
+        _m = os.path.join(_d or ".", "mpirun")
+        if os.path.isfile(_m) and os.access(_m, os.X_OK):
+            with open(_m, "rb") as _fh:
+                if b"PETSC_SSI_REAL_MPIRUN" not in _fh.read(4096):
+                    os.environ["PETSC_SSI_REAL_MPIRUN"] = os.path.abspath(_m)
+                    break
+if os.environ.get("PETSC_SSI_REAL_MPIRUN"):
+    os.environ["PATH"] = _BIN + os.pathsep + os.environ.get("PATH", "")
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
 
