@@ -25,7 +25,8 @@ PIP_PKGS := numba gmsh "matplotlib>=3.7" pytest pytest-timeout pytest-xdist obsp
 # 2026-12-03 (16:28-17:14, one after another, 1542 tests) 2 workers took 881 s, 3 took 790 s, 4 took 807 s
 # (`.venv/bin/python -m pytest -q -m "not slow" -n N --dist loadfile tests`), so 3.
 # The workers start one mpirun at a time (tests/bin/mpirun, first on the tests' PATH): two-rank runs sharing the
-# 2 cores with another's ranks spun in their waits (the fixed-base modes at -n 2: 33 s, 3.9 s alone). On
+# 2 cores with another's ranks spun in their waits (the fixed-base modes at -n 2: 33 s in
+# the suite without it, 3.9 s with it; the suites' junit times). On
 # 2026-12-03 (20:13-20:44, one after another) 3 workers took 584 s without it, 545 s with it (user+sys 1032 s,
 # 905 s); 4 workers with it 552 s.
 # The slow tier stays serial (its cases hold GBs each). TEST_JOBS=0: no workers, one process.

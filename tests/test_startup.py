@@ -1,6 +1,7 @@
 """What a petsc-ssi process imports before it does any work.
 
-numba takes about 0.3 s to import (of about 1 s for a one-rank run refused on its options). The compiled
+numba takes 0.24-0.26 s to import (a one-rank run refused on its options: 0.75 s with it, 0.56 s without;
+`python jobscripts/startup_times.py`, 2026-12-03). The compiled
 kernels (bem/bsr.py, assemble.py, lagmats.py, ...) are imported where a run first uses them, so a run refused
 on its options, a structure-only run (static, modes, -ssi_problem fem) and the post tools start without it.
 A top-level import of a kernel module in the modules every command imports would undo that: this fails then.

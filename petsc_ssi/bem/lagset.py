@@ -16,7 +16,7 @@ from .cost import (CACHE_MAX, row_work_bytes, chunk_rows, single_lags, lag_bytes
 from .windows import bounding_spheres, estimate_blocks, plane_heights, candidates
 from . import symmetry
 from . import packs
-# The compiled kernels (.bsr, .assemble: numba, about 0.3 s to import) are imported where a LagSet uses them, so
+# The compiled kernels (.bsr, .assemble: numba, 0.25 s to import) are imported where a LagSet uses them, so
 # that runs refused on their options, structure-only runs and the post tools start without numba
 # (tests/test_startup.py).
 
