@@ -22,6 +22,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests"))
 from helpers import kill_session  # noqa: E402  (SIGKILL to mpirun and every rank at once)
+from petsc_ssi.launch import child_env  # noqa: E402
 
 
 def writer(path):
@@ -84,7 +85,7 @@ def main():
         log = os.path.join(tmp, "writer.log")
         with open(log, "w") as fh:
             p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=fh, start_new_session=True, text=True,
-                                 env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+                                 env=child_env(OPENBLAS_NUM_THREADS="1"))
             first = p.stdout.readline()                # the first flush is done
             if first.startswith("flushed"):
                 time.sleep(rng.uniform(0.0, 1.0))

@@ -26,6 +26,8 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 from logview import write_csv, put_block  # noqa: E402
 
+from petsc_ssi.launch import child_env  # noqa: E402
+
 RANKS = (2, 4, 8, 16)
 
 
@@ -73,7 +75,8 @@ def counts(case):
 def main(cases):
     rows = []
     for case in cases:            # one process per case (PETSc reads its options file once)
-        out = subprocess.run([sys.executable, __file__, "--one", case], capture_output=True, text=True, check=True)
+        out = subprocess.run([sys.executable, __file__, "--one", case], capture_output=True, text=True, check=True,
+                             env=child_env())
         for line in out.stdout.splitlines():
             if line.startswith("{"):
                 rows.append(json.loads(line))

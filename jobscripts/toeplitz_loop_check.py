@@ -20,6 +20,8 @@ import time
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
 from logview import parse, write_csv, put_block  # noqa: E402
@@ -77,7 +79,7 @@ def main(out_dir, readme):
         t0 = time.perf_counter()
         loops, failed = [], None
         for k in range(REPEAT):
-            r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+            r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env())
             open(log.replace(".log", f"-{k}.log"), "w").write(r.stdout + r.stderr)
             if r.returncode:
                 failed = (r.stderr.strip().splitlines() or ['?'])[-1]

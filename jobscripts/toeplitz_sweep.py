@@ -23,6 +23,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [os.path.join(ROOT, "tests", "bem"), os.path.join(ROOT, "tests")]
 from test_history_block import fields, scales  # noqa: E402
+from petsc_ssi.launch import child_env  # noqa: E402
 
 PY = sys.executable
 MPI = ["mpirun", "--allow-run-as-root", "--oversubscribe"]
@@ -104,7 +105,7 @@ def run(args, n, path):
     cmd = (MPI + ["-n", str(n)] if n > 1 else []) + [PY, "-m", "petsc_ssi"] + args + [
         "-ssi_output", path, "-ssi_output_overwrite"]
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=900,
-                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+                       env=child_env(OPENBLAS_NUM_THREADS="1"))
     if p.returncode:
         raise RuntimeError(((p.stdout + p.stderr).strip().splitlines() or ["(no output)"])[-1])
 

@@ -14,6 +14,8 @@ import shutil
 import subprocess
 import sys
 
+from ..launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))      # the repository (this file: petsc_ssi/app/demo.py)
 
@@ -95,7 +97,7 @@ def building():
     cmd = _mpi([sys.executable, "-m", "petsc_ssi", "-options_file", opts, "-ssi_output", out, "-ssi_output_overwrite",
                 "-ssi_monitor", "-ssi_monitor_every", "40"])
     print("[demo] the reduced building on the half-space: " + " ".join(cmd), flush=True)
-    rc = subprocess.call(cmd, cwd=ROOT)
+    rc = subprocess.call(cmd, cwd=ROOT, env=child_env())
     if rc:
         return rc
     png1, png2, found = building_figures(out)
@@ -114,7 +116,7 @@ def lamb():
     if ncores >= 2 and shutil.which("mpirun"):
         cmd = ["mpirun", "--allow-run-as-root", "-n", "2"] + cmd
     print("[demo] " + " ".join(cmd), flush=True)
-    rc = subprocess.call(cmd, cwd=ROOT)
+    rc = subprocess.call(cmd, cwd=ROOT, env=child_env())
     if rc:
         return rc
     from ..verify import lamb_errors

@@ -17,6 +17,8 @@ import sys
 import tempfile
 import time
 
+from ..launch import child_env
+
 
 WARM_MARK = "warmup-done"
 # the warm-up's first run (-ssi_<key> <value>; its output in a scratch directory): a tiny BEM case on the block-sparse
@@ -54,7 +56,7 @@ def main(argv=None):
     helper = None
     if (os.cpu_count() or 1) > 1:
         helper = subprocess.Popen([sys.executable, "-m", "petsc_ssi.app.warmup", "--kernels"],
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=child_env())
     try:
         _runs()
     except BaseException:

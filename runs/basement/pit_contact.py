@@ -21,6 +21,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "runs", "seismic"))
 import input_motion  # noqa: E402
@@ -62,7 +64,7 @@ def series(path):
 def run(outdir, separation, preload, scale, record):
     out = os.path.join(outdir, f"pit_{separation}.h5")
     p = subprocess.run([sys.executable, "-m", "petsc_ssi", "run"] + args(record, out, separation, preload, scale),
-                       cwd=ROOT, capture_output=True, text=True)
+                       cwd=ROOT, capture_output=True, text=True, env=child_env())
     if p.returncode:
         raise SystemExit(p.stdout[-2000:] + p.stderr[-2000:])
     t, its, nopen, gaps = series(out)

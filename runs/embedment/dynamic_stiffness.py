@@ -34,6 +34,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 SOIL = dict(cp=548.0, cs=316.0, rho=2000.0)
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 # per mode: the footing's translation [m], its rotation [rad] (about the base's centre), the resultant's
@@ -59,7 +61,7 @@ def _run(opts, out):
     opts = dict(opts, problem="bem", scheme="plain", output=out, output_stride=0, output_overwrite=1, warn_beta=0,
                 disp_history="smoothstep", **SOIL)
     args = [a for k, v in opts.items() for a in ("-ssi_" + k, str(v))]
-    env = dict(os.environ, PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
+    env = child_env(PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
     p = subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, env=env, capture_output=True, text=True)
     if p.returncode:
         raise RuntimeError(f"petsc-ssi {' '.join(args)} failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}")

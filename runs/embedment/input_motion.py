@@ -32,6 +32,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 SOIL = dict(cp=548.0, cs=316.0, rho=2000.0)
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FREQS = (10.0, 25.0, 40.0, 55.0, 70.0, 85.0)
@@ -57,7 +59,7 @@ def run(D, h, L, dt, t_end, T, out):
                 seismic_ref="0,0", dt=dt, t_end=t_end, scheme="plain", output=out, output_stride=0,
                 output_overwrite=1, warn_beta=0, **SOIL)
     args = [a for k, v in opts.items() for a in ("-ssi_" + k, str(v))]
-    env = dict(os.environ, PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
+    env = child_env(PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
     p = subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, env=env, capture_output=True, text=True)
     os.remove(rec)
     if p.returncode:

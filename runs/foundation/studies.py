@@ -22,6 +22,8 @@ import sys
 import h5py
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 OUT = os.path.join(ROOT, "out", "foundation-studies")
 README = os.path.join(ROOT, "runs", "foundation", "README.md")
@@ -32,7 +34,7 @@ def run(opts, out, *extra):
     path = os.path.join(OUT, out)
     cmd = [PY, "-m", "petsc_ssi", "-options_file", f"runs/foundation/{opts}.opts", "-ssi_output", path, "-ssi_output_overwrite",
            "-ssi_output_stride", "0"] + list(extra)
-    subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True)
+    subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=child_env())
     return h5py.File(path, "r")["interface"]
 
 
@@ -80,7 +82,7 @@ def long():
     path = os.path.join(OUT, "long.h5")
     subprocess.run([PY, "-m", "petsc_ssi", "-options_file", "runs/foundation/sym-bonded.opts", "-ssi_t_end", "3",
                     "-ssi_output", path, "-ssi_output_overwrite", "-ssi_output_stride", "0", "-ssi_receivers", "0,0,0;1,0,0;2,0,0"],
-                   cwd=ROOT, check=True, capture_output=True)
+                   cwd=ROOT, check=True, capture_output=True, env=child_env())
     with h5py.File(path, "r") as f:
         t, u = f["receivers/t"][:], f["receivers/u"][:]
     nrm = np.linalg.norm(u.reshape(len(t), -1), axis=1)

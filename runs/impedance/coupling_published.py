@@ -36,6 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, ROOT)
 from petsc_ssi.analytic.disk_static import stiffness  # noqa: E402
+from petsc_ssi.launch import child_env  # noqa: E402
 
 OUT = os.path.join(ROOT, "out", "impedance", "coupling")
 NUS = (0.0, 0.25, 1.0 / 3.0, 0.4, 0.45, 0.49)
@@ -55,7 +56,7 @@ def bem_level(L, h, ranks):
         if ranks > 1:
             cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(ranks)] + cmd
         subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True,
-                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=ROOT))
+                       env=child_env(OPENBLAS_NUM_THREADS="1", PYTHONPATH=ROOT))
     K0 = {}
     with open(table) as fh:
         for r in csv.DictReader(fh):

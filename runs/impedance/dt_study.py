@@ -13,6 +13,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(ROOT, "out", "impedance")
@@ -29,7 +31,7 @@ def main():
                         "-ssi_mesh_patch", "1,1", "-ssi_disp_group", "load", "-ssi_dt", repr(dt), "-ssi_t_end", "0.1",
                         "-ssi_output_stride", "0", "-ssi_warn_beta", "0", "-ssi_impedance_modes", "vertical",
                         "-ssi_impedance_rise", "3.2e-3", "-ssi_output", stem + ".h5", "-ssi_output_overwrite"],
-                       cwd=ROOT, check=True, capture_output=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+                       cwd=ROOT, check=True, capture_output=True, env=child_env(OPENBLAS_NUM_THREADS="1"))
         r = list(csv.DictReader(open(stem + "-impedance.csv")))
         a, k, c = (np.array([float(x[q]) for x in r]) for q in ("a0", "k", "c"))
         for q in A0:

@@ -22,6 +22,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(ROOT, "out", "impedance")
@@ -42,7 +44,7 @@ def run(L):
            "-ssi_warn_beta", "0", "-ssi_impedance_modes", ",".join(MODES),
            "-ssi_output", stem + ".h5", "-ssi_output_overwrite"]
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True,
-                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1"))
+                       env=child_env(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1"))
     if p.returncode:
         sys.exit(f"{' '.join(cmd)} failed:\n{p.stdout[-3000:]}{p.stderr[-3000:]}")
     out = {}

@@ -30,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 from static_stiffness import MODES, OUT  # noqa: E402
+from petsc_ssi.launch import child_env  # noqa: E402
 
 CASES = [(0.5, 0.0), (0.5, 1.0), (0.25, 0.0), (0.25, 0.5), (0.25, 1.0)]     # (h [m], grade)
 L = 6.0
@@ -45,7 +46,7 @@ def run(mode, h, grade):
                "1,1", "-ssi_mesh_grade", f"{grade:g}", "-ssi_disp_group", "load", opt, val, "-ssi_symmetry", sym,
                "-ssi_dt", repr(dt), "-ssi_t_end", repr(max(0.1, 3.0 * L / 316.0)), "-ssi_output_stride", "0",
                "-ssi_warn_beta", "0", "-ssi_output", out, "-ssi_output_overwrite"]
-        subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+        subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=child_env(OPENBLAS_NUM_THREADS="1"))
     import h5py
     with h5py.File(out) as f:
         x = f["resultants"][what][:, comp] / amp

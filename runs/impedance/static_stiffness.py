@@ -26,6 +26,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(ROOT, "out", "impedance")
@@ -49,7 +51,7 @@ def run(mode, L, h):
            "-ssi_disp_group", "load", opt, val, "-ssi_symmetry", sym, "-ssi_dt", repr(dt),
            "-ssi_t_end", repr(max(0.1, 3.0 * L / 316.0)), "-ssi_output_stride", "0", "-ssi_warn_beta", "0",
            "-ssi_output", out, "-ssi_output_overwrite"]
-    subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, env=child_env(OPENBLAS_NUM_THREADS="1"))
     import h5py
     with h5py.File(out) as f:
         x = f["resultants"][what][:, comp] / amp

@@ -17,6 +17,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(ROOT, "out", "integrators")
@@ -29,7 +31,7 @@ def run(coupling, dt):
     cmd = [PY, "-m", "petsc_ssi", "-options_file", "runs/seismic/building.opts", "-ssi_seismic_record",
            os.path.join(OUT, "knet_hf.txt"), "-ssi_coupling", coupling, "-ssi_dt", repr(dt), "-ssi_t_end", str(T_END),
            "-ssi_output_stride", str(int(round(0.1 / dt))), "-ssi_output", stem + ".h5", "-ssi_output_overwrite"]
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env(OPENBLAS_NUM_THREADS="1"))
     text = p.stdout + p.stderr
     notes = [ln for ln in text.splitlines() if "static response" in ln]
     if p.returncode:

@@ -23,6 +23,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 OUT = os.path.join(ROOT, "out", "integrators")
@@ -56,7 +58,7 @@ def run(record, scheme, dt, stem):
     cmd = [PY, "-m", "petsc_ssi", "-options_file", "runs/seismic/fixed-base.opts", "-ssi_seismic_record", record,
            "-ssi_fem_integrator", scheme, "-ssi_dt", repr(dt), "-ssi_output_stride", str(int(round(0.1 / dt))),
            "-ssi_output", out, "-ssi_output_overwrite"]
-    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=child_env(OPENBLAS_NUM_THREADS="1"))
     if p.returncode:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     notes = [ln for ln in (p.stdout + p.stderr).splitlines() if "static response" in ln]

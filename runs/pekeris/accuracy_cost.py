@@ -27,6 +27,8 @@ sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
 sys.path.insert(0, ROOT)
 from logview import parse  # noqa: E402
 
+from petsc_ssi.launch import child_env  # noqa: E402
+
 R_FAR, CS = 5.0, 316.0
 
 
@@ -60,7 +62,7 @@ def run_one(name, opts, out):
                "-memory_view"] + args
         print("[sweep]", name, flush=True)
         with open(log, "w") as fh:
-            subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, check=True)
+            subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, check=True, env=child_env())
     lv = parse(open(log).read())
     from petsc_ssi.verify import lamb_errors
     errs = lamb_errors(h5)

@@ -38,6 +38,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
@@ -112,7 +114,7 @@ def run_level(h, half, out, ranks):
         if ranks > 1:
             cmd = ["mpirun", "--allow-run-as-root", "-n", str(ranks)] + cmd
         print("[convergence_smooth]", name, flush=True)
-        env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+        env = child_env(OPENBLAS_NUM_THREADS="1")
         with open(log, "w") as fh:
             subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, check=True, env=env)
     lv = parse(open(log).read())

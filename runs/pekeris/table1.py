@@ -47,6 +47,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "jobscripts"))
@@ -74,7 +76,7 @@ def run(name, extra, out, ranks):
                "-ssi_output_stride", "0", "-ssi_lag_storage", "sparse", "-log_view", "-memory_view"] + extra
         print("[table1]", " ".join(cmd), flush=True)
         with open(log, "w") as fh:
-            subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, check=True)
+            subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, cwd=ROOT, check=True, env=child_env())
     lv = parse(open(log).read())
     rec = json.load(open(h5[:-3] + ".json"))
     import h5py

@@ -18,6 +18,8 @@ import tempfile
 import h5py
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 SOILS = ((500.0, 6e-4), (200.0, 1.5e-3), (20.0, 0.0125))     # c_s and a dt with c_s dt / l <= 1.2
@@ -35,7 +37,8 @@ def pulse(path):
 
 
 def run(args):
-    subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, check=True, capture_output=True)
+    subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, check=True, capture_output=True,
+                   env=child_env())
 
 
 def top(path, key):

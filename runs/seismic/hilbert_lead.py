@@ -18,12 +18,15 @@ import tempfile
 import h5py
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
 
 def run(args):
-    p = subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, capture_output=True, text=True)
+    p = subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, capture_output=True, text=True,
+                       env=child_env())
     if p.returncode != 0:
         raise SystemExit(p.stdout + p.stderr)
     return p.stdout

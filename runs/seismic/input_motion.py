@@ -33,6 +33,8 @@ import tempfile
 import h5py
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 SOIL = ["-ssi_cp", "42", "-ssi_cs", "20", "-ssi_rho", "1800", "-ssi_mesh_size", "2,2", "-ssi_mesh_h", "0.5",
@@ -54,7 +56,7 @@ def pulse(path, T, cols=(1.0,), rest=False):
 def input_motion(tmp, name, args):
     out = os.path.join(tmp, name + ".h5")
     p = subprocess.run([sys.executable, "-m", "petsc_ssi", "input-motion"] + SOIL + args + ["-ssi_output", out],
-                       cwd=ROOT, capture_output=True, text=True)
+                       cwd=ROOT, capture_output=True, text=True, env=child_env())
     if p.returncode:
         raise SystemExit(p.stdout[-3000:] + p.stderr[-3000:])
     with h5py.File(out, "r") as f:

@@ -23,6 +23,8 @@ import tempfile
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "tests"))
@@ -33,7 +35,7 @@ def run(h, tmp):
     from pathlib import Path
     import test_excavation_coupled as T
     a = T.quarter(Path(tmp), f"q{h}.h5", h=h)
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    env = child_env(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     subprocess.run([sys.executable, "-m", "petsc_ssi"] + a[1:], cwd=ROOT, env=env, check=True,
                    stdout=subprocess.DEVNULL)
     return os.path.join(tmp, f"q{h}.h5")

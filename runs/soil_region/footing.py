@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CS, CP, RHO = 316.0, 548.0, 2000.0
 A, D, C, HF = 1.0, 1.0, 0.5, 0.5             # pit half-width, depth; footing half-width, height [m]
@@ -74,7 +76,7 @@ def run(case, h, outdir, nranks=1):
     cmd = [sys.executable, "-m", "petsc_ssi", "run"] + args(case, h, out, table)
     if nranks > 1:
         cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(nranks)] + cmd
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    env = child_env(OPENBLAS_NUM_THREADS="1")
     t0 = time.time()
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, env=env)
     if p.returncode:

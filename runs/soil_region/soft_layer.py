@@ -40,6 +40,8 @@ import time
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "runs", "seismic"))
@@ -88,9 +90,10 @@ def run(W, ranks, out, quarter=True, command="run", zeta=0.0):
     cmd = [sys.executable] + args
     if ranks > 1:
         cmd = ["mpirun", "--allow-run-as-root", "-n", str(ranks)] + cmd
-    # the run's output streamed, its last lines kept for the error: a failure under pytest-xdist (seen once in
-    # the slow tier, not reproduced alone) said only the exit status
-    p = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    # the run's output streamed, its last lines kept for the error. env=child_env(): started from a process that
+    # has initialised MPI (a pytest process after an in-process run), the inherited OMPI_MCA_ess=singleton made
+    # mpirun exit 1 without a line (the slow tier's flaky failure; petsc_ssi/launch.py)
+    p = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=child_env())
     tail = collections.deque(maxlen=60)
     for line in p.stdout:
         sys.stdout.write(line)

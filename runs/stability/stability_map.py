@@ -50,6 +50,7 @@ import os
 import subprocess
 import sys
 import time
+from petsc_ssi.launch import child_env
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -202,7 +203,7 @@ def append_row(path, row):
 
 def run_case(c, outdir, lock):
     cmd = [sys.executable, os.path.abspath(__file__), "--worker", json.dumps(c), "--out", outdir]
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    env = child_env(OPENBLAS_NUM_THREADS="1")
     t0 = time.time()
     fh = open(lock, "a") if lock else None
     try:

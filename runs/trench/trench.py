@@ -34,6 +34,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 SOIL = dict(cp=548.0, cs=316.0, rho=2000.0)
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -101,7 +103,7 @@ def run(lay, depth, out):
     burst(table, lay.f0, lay.cycles)
     opts = dict(lay.options(depth), output=out, load_table=table)
     args = [a for k, v in opts.items() for a in ("-ssi_" + k, str(v))]
-    env = dict(os.environ, PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
+    env = child_env(PYTHONPATH=ROOT, OPENBLAS_NUM_THREADS="1")
     p = subprocess.run([sys.executable, "-m", "petsc_ssi"] + args, cwd=ROOT, env=env, capture_output=True, text=True)
     os.remove(table)
     if p.returncode:

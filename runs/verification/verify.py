@@ -35,6 +35,8 @@ import sys
 
 import numpy as np
 
+from petsc_ssi.launch import child_env
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, ROOT)
@@ -141,7 +143,7 @@ def lamb(out_dir):
             for k, v in opts.items():
                 cmd += [f"-ssi_{k}", str(v)]
             subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL,
-                           env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+                           env=child_env(OPENBLAS_NUM_THREADS="1"))
         errs[h] = lamb_errors(h5)
     out = []
     for k, (r, _, _) in enumerate(errs[levels[0]]):
